@@ -1,0 +1,185 @@
+//! What drives the oscillator: the unbalanced rotor or a measured force.
+//!
+//! The rotor's force is `F0·ω²·sin φ` (the source study's form). Its angle φ(t) is either
+//! prescribed — constant ω, a linear sweep, a piecewise-linear ω(t) profile — or measured:
+//! samples of a record (wrapped or unwrapped), interpolated by cubic Hermite polynomials with ω
+//! from the derivative filter. Rigs driven by a shaker use a measured force `u` (N) instead.
+
+use crate::interpolate::{Hermite, Linear};
+
+/// How the rotor angle φ(t) is given.
+#[derive(Clone, Debug)]
+pub enum RotorAngle {
+    /// Constant speed: φ = φ0 + ω·t.
+    Constant {
+        /// ω, rad/s.
+        omega: f64,
+        /// φ at t = 0, rad.
+        phi0: f64,
+    },
+    /// Linear sweep: ω = w0 + α·(t − t0), φ = φ0 + w0·(t − t0) + α·(t − t0)²/2.
+    Sweep {
+        /// ω at t0, rad/s.
+        w0: f64,
+        /// Sweep rate, rad/s².
+        alpha: f64,
+        /// Start time, s.
+        t0: f64,
+        /// φ at t0, rad.
+        phi0: f64,
+    },
+    /// Piecewise-linear ω(t) through knots; ω is held outside them, φ is its exact integral.
+    Profile {
+        /// Knot times, s (increasing).
+        t: Vec<f64>,
+        /// ω at the knots, rad/s.
+        omega: Vec<f64>,
+        /// φ at the first knot, rad.
+        phi0: f64,
+    },
+    /// Measured φ samples, unwrapped, with ω from the derivative filter.
+    Measured(Hermite),
+}
+
+impl RotorAngle {
+    /// Constant ω from φ = 0 at t = 0.
+    pub fn constant(omega: f64) -> Self {
+        RotorAngle::Constant { omega, phi0: 0.0 }
+    }
+
+    /// A linear sweep ω = w0 + α·(t − t0) whose phase is that of a sweep begun from rest,
+    /// φ(t0) = w0²/(2α) (so ω = 0.047·t gives φ = 0.0235·t²).
+    pub fn sweep(w0: f64, alpha: f64, t0: f64) -> Self {
+        let phi0 = if alpha != 0.0 {
+            w0 * w0 / (2.0 * alpha)
+        } else {
+            0.0
+        };
+        RotorAngle::Sweep {
+            w0,
+            alpha,
+            t0,
+            phi0,
+        }
+    }
+
+    /// Measured samples: unwrapped angle `phi` and speed `omega` at times `t`.
+    pub fn measured(t: Vec<f64>, phi: Vec<f64>, omega: Vec<f64>) -> Self {
+        RotorAngle::Measured(Hermite::new(t, phi, omega))
+    }
+
+    /// φ (rad) and ω (rad/s) at time `t`.
+    pub fn at(&self, t: f64) -> (f64, f64) {
+        match self {
+            RotorAngle::Constant { omega, phi0 } => (phi0 + omega * t, *omega),
+            RotorAngle::Sweep {
+                w0,
+                alpha,
+                t0,
+                phi0,
+            } => {
+                let s = t - t0;
+                (phi0 + w0 * s + 0.5 * alpha * s * s, w0 + alpha * s)
+            }
+            RotorAngle::Profile { t: ts, omega, phi0 } => profile_at(ts, omega, *phi0, t),
+            RotorAngle::Measured(h) => h.at(t),
+        }
+    }
+}
+
+fn profile_at(ts: &[f64], omega: &[f64], phi0: f64, t: f64) -> (f64, f64) {
+    let n = ts.len();
+    if n == 0 {
+        return (phi0, 0.0);
+    }
+    if t <= ts[0] {
+        return (phi0 + omega[0] * (t - ts[0]), omega[0]);
+    }
+    let mut phi = phi0;
+    for i in 0..n - 1 {
+        let (ta, tb) = (ts[i], ts[i + 1]);
+        let slope = (omega[i + 1] - omega[i]) / (tb - ta);
+        if t < tb {
+            let s = t - ta;
+            return (
+                phi + omega[i] * s + 0.5 * slope * s * s,
+                omega[i] + slope * s,
+            );
+        }
+        phi += 0.5 * (omega[i] + omega[i + 1]) * (tb - ta);
+    }
+    (phi + omega[n - 1] * (t - ts[n - 1]), omega[n - 1])
+}
+
+/// The driving force of the oscillator.
+#[derive(Clone, Debug)]
+pub enum Excitation {
+    /// No drive: free vibration.
+    None,
+    /// The unbalanced rotor, `F0·ω²·sin φ`.
+    Rotor(RotorAngle),
+    /// A measured force `u(t)`, N, linearly interpolated.
+    Force(Linear),
+}
+
+impl Excitation {
+    /// The driving force at time `t`, N, for unbalance `f0` (kg·m).
+    #[inline]
+    pub fn force(&self, t: f64, f0: f64) -> f64 {
+        match self {
+            Excitation::None => 0.0,
+            Excitation::Rotor(angle) => {
+                let (phi, omega) = angle.at(t);
+                f0 * omega * omega * phi.sin()
+            }
+            Excitation::Force(u) => u.at(t),
+        }
+    }
+
+    /// Rotor speed ω at `t`, rad/s, if a rotor drives the oscillator.
+    pub fn omega(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::Rotor(angle) => Some(angle.at(t).1),
+            _ => None,
+        }
+    }
+
+    /// Rotor angle φ at `t`, rad, if a rotor drives the oscillator.
+    pub fn phi(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::Rotor(angle) => Some(angle.at(t).0),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn sweep_from_rest_matches_the_reference_phase() {
+        let a = RotorAngle::sweep(2.35, 0.047, 50.0);
+        for t in [50.0, 120.0, 200.0] {
+            let (phi, w) = a.at(t);
+            assert_relative_eq!(phi, 0.0235 * t * t, max_relative = 1e-12);
+            assert_relative_eq!(w, 0.047 * t, max_relative = 1e-12);
+        }
+    }
+
+    #[test]
+    fn profile_integrates_omega_exactly() {
+        let p = RotorAngle::Profile {
+            t: vec![0.0, 10.0, 20.0],
+            omega: vec![1.0, 3.0, 3.0],
+            phi0: 0.5,
+        };
+        let (phi, w) = p.at(5.0);
+        assert_relative_eq!(w, 2.0);
+        assert_relative_eq!(phi, 0.5 + 5.0 + 0.5 * 0.2 * 25.0);
+        let (phi, w) = p.at(25.0);
+        assert_relative_eq!(w, 3.0);
+        assert_relative_eq!(phi, 0.5 + 20.0 + 30.0 + 15.0);
+    }
+}

@@ -1,0 +1,158 @@
+//! Interpolation of sampled signals between their samples.
+//!
+//! Measured signals drive simulations between samples. Holding each sample constant acts as
+//! a half-sample delay (which a fitter would then "explain" with a spurious effect), so
+//! signals are interpolated: linearly ([`Linear`]) or, where the derivative is known, by
+//! cubic Hermite polynomials ([`Hermite`]). Outside the sampled span the end values are held.
+
+/// Locate `t` in increasing `ts`: the index `i` with `ts[i] ≤ t < ts[i+1]`, clamped.
+fn locate(ts: &[f64], uniform_step: Option<f64>, t: f64) -> usize {
+    let n = ts.len();
+    if n < 2 || t <= ts[0] {
+        return 0;
+    }
+    if t >= ts[n - 1] {
+        return n - 2;
+    }
+    if let Some(dt) = uniform_step {
+        let guess = (((t - ts[0]) / dt) as usize).min(n - 2);
+        // Floating point may put the guess one off.
+        if ts[guess] <= t && t < ts[guess + 1] {
+            return guess;
+        }
+    }
+    ts.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2)
+}
+
+fn uniform_step(ts: &[f64]) -> Option<f64> {
+    let n = ts.len();
+    if n < 2 {
+        return None;
+    }
+    let dt = (ts[n - 1] - ts[0]) / (n - 1) as f64;
+    let uniform = ts
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) - dt).abs() <= 1e-6 * dt);
+    uniform.then_some(dt)
+}
+
+/// Piecewise-linear interpolation of samples `(t_i, y_i)`.
+#[derive(Clone, Debug)]
+pub struct Linear {
+    t: Vec<f64>,
+    y: Vec<f64>,
+    step: Option<f64>,
+}
+
+impl Linear {
+    /// Interpolate `y` sampled at increasing times `t` (same length, at least one sample).
+    pub fn new(t: Vec<f64>, y: Vec<f64>) -> Self {
+        debug_assert_eq!(t.len(), y.len());
+        let step = uniform_step(&t);
+        Linear { t, y, step }
+    }
+
+    /// Value at time `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        match self.t.len() {
+            0 => 0.0,
+            1 => self.y[0],
+            _ => {
+                let i = locate(&self.t, self.step, t);
+                let (t0, t1) = (self.t[i], self.t[i + 1]);
+                let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+                self.y[i] + s * (self.y[i + 1] - self.y[i])
+            }
+        }
+    }
+
+    /// The sample times.
+    pub fn times(&self) -> &[f64] {
+        &self.t
+    }
+}
+
+/// Cubic Hermite interpolation of samples `(t_i, y_i)` with derivatives `dy_i`.
+#[derive(Clone, Debug)]
+pub struct Hermite {
+    t: Vec<f64>,
+    y: Vec<f64>,
+    dy: Vec<f64>,
+    step: Option<f64>,
+}
+
+impl Hermite {
+    /// Interpolate `y` with slopes `dy`, sampled at increasing times `t`.
+    pub fn new(t: Vec<f64>, y: Vec<f64>, dy: Vec<f64>) -> Self {
+        debug_assert!(t.len() == y.len() && t.len() == dy.len());
+        let step = uniform_step(&t);
+        Hermite { t, y, dy, step }
+    }
+
+    /// Value and derivative at time `t` (outside the span: linear continuation of the end).
+    pub fn at(&self, t: f64) -> (f64, f64) {
+        let n = self.t.len();
+        if n == 0 {
+            return (0.0, 0.0);
+        }
+        if n == 1 || t <= self.t[0] {
+            return (self.y[0] + self.dy[0] * (t - self.t[0]), self.dy[0]);
+        }
+        if t >= self.t[n - 1] {
+            return (
+                self.y[n - 1] + self.dy[n - 1] * (t - self.t[n - 1]),
+                self.dy[n - 1],
+            );
+        }
+        let i = locate(&self.t, self.step, t);
+        let h = self.t[i + 1] - self.t[i];
+        let s = (t - self.t[i]) / h;
+        let (y0, y1) = (self.y[i], self.y[i + 1]);
+        let (m0, m1) = (self.dy[i] * h, self.dy[i + 1] * h);
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let value = (2.0 * s3 - 3.0 * s2 + 1.0) * y0
+            + (s3 - 2.0 * s2 + s) * m0
+            + (-2.0 * s3 + 3.0 * s2) * y1
+            + (s3 - s2) * m1;
+        let slope = ((6.0 * s2 - 6.0 * s) * y0
+            + (3.0 * s2 - 4.0 * s + 1.0) * m0
+            + (-6.0 * s2 + 6.0 * s) * y1
+            + (3.0 * s2 - 2.0 * s) * m1)
+            / h;
+        (value, slope)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn linear_is_exact_on_lines_and_holds_ends() {
+        let t: Vec<f64> = (0..11).map(|i| i as f64 * 0.1).collect();
+        let y: Vec<f64> = t.iter().map(|t| 3.0 * t - 1.0).collect();
+        let l = Linear::new(t, y);
+        assert_relative_eq!(l.at(0.437), 3.0 * 0.437 - 1.0, max_relative = 1e-12);
+        assert_eq!(l.at(-5.0), -1.0);
+        assert_relative_eq!(l.at(5.0), 2.0, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn hermite_is_exact_on_cubics_nonuniform() {
+        let t = vec![0.0, 0.3, 0.35, 1.0, 2.2];
+        let f = |t: f64| t * t * t - 2.0 * t + 0.5;
+        let df = |t: f64| 3.0 * t * t - 2.0;
+        let h = Hermite::new(
+            t.clone(),
+            t.iter().map(|&t| f(t)).collect(),
+            t.iter().map(|&t| df(t)).collect(),
+        );
+        for q in [0.1, 0.33, 0.9, 1.7] {
+            let (v, d) = h.at(q);
+            assert_relative_eq!(v, f(q), max_relative = 1e-12);
+            assert_relative_eq!(d, df(q), max_relative = 1e-12);
+        }
+    }
+}
