@@ -43,6 +43,20 @@ impl System<f64, DVector<f64>> for Adapter<'_> {
     }
 }
 
+/// The common step of `t0, outputs…` if they are evenly spaced (relative 1e-9).
+fn uniform_step(t0: f64, outputs: &[f64]) -> Option<f64> {
+    let last = *outputs.last()?;
+    let dx = outputs[0] - t0;
+    let n = outputs.len() as f64;
+    let even = dx > 0.0
+        && ((last - t0) / n - dx).abs() <= 1e-9 * dx
+        && outputs
+            .iter()
+            .enumerate()
+            .all(|(i, &t)| (t - (t0 + (i as f64 + 1.0) * dx)).abs() <= 1e-9 * dx.max(t.abs()));
+    even.then_some(dx)
+}
+
 pub(super) fn integrate(
     sys: &dyn OdeSystem,
     t0: f64,
@@ -68,11 +82,19 @@ pub(super) fn integrate(
             calls: &calls,
         };
         let h_max = if s.h_max > 0.0 { s.h_max } else { t_end - t0 };
+        let outputs = &t_out[first_after..];
+        let step = uniform_step(t0, outputs);
+        // Uniform outputs use the solver's dense output directly; the run goes half a step
+        // past the end so the last sample is interpolated, never extrapolated.
+        let (x_end, dx, out_type) = match step {
+            Some(dx) => (t_end + 0.5 * dx, dx, OutputType::Dense),
+            None => (t_end, t_end - t0, OutputType::Continuous),
+        };
         let mut solver = Dopri5::from_param(
             adapter,
             t0,
-            t_end,
-            t_end - t0,
+            x_end,
+            dx,
             DVector::from_column_slice(y0),
             s.rtol,
             s.atol,
@@ -84,37 +106,47 @@ pub(super) fn integrate(
             0.0,
             s.max_steps,
             u32::MAX,
-            OutputType::Continuous,
+            out_type,
         );
         let mut model = ContinuousOutputModel::default();
-        let result = solver.integrate_with_continuous_output_model(&mut model);
-        drop(solver);
+        let result = if step.is_some() {
+            solver.integrate()
+        } else {
+            solver.integrate_with_continuous_output_model(&mut model)
+        };
         stats.rhs_calls = calls.get();
-        if let Some(e) = error.into_inner() {
+        if let Some(e) = error.borrow_mut().take() {
             return Err(e);
         }
-        let st = match result {
-            Ok(st) => st,
-            Err(IntegrationError::StepSizeUnderflow { x }) => {
-                return Err(SimError::StepSizeTooSmall { time: x })
-            }
-            Err(IntegrationError::MaxNumStepReached { x, n_step }) => {
-                return Err(SimError::TooManySteps {
-                    time: x,
-                    steps: u64::from(n_step),
-                })
-            }
-            Err(IntegrationError::StiffnessDetected { x }) => {
-                return Err(SimError::StepSizeTooSmall { time: x })
-            }
-        };
+        let st = result.map_err(|e| match e {
+            IntegrationError::StepSizeUnderflow { x } => SimError::StepSizeTooSmall { time: x },
+            IntegrationError::MaxNumStepReached { x, n_step } => SimError::TooManySteps {
+                time: x,
+                steps: u64::from(n_step),
+            },
+            IntegrationError::StiffnessDetected { x } => SimError::StepSizeTooSmall { time: x },
+        })?;
         stats.accepted = u64::from(st.accepted_steps);
         stats.rejected = u64::from(st.rejected_steps);
-        for &t in &t_out[first_after..] {
-            let y = model.evaluate(t).ok_or(SimError::BadSettings(format!(
-                "no solution at t = {t} s (integrated {t0} → {t_end})"
-            )))?;
-            states.extend_from_slice(y.as_slice());
+        if step.is_some() {
+            // Dense samples are t0, t0 + dx, …: outputs[k] is sample k + 1.
+            let ys = solver.y_out();
+            let ts = solver.x_out();
+            for (k, &t) in outputs.iter().enumerate() {
+                let i = k + 1;
+                let (ti, yi) = ts.get(i).zip(ys.get(i)).ok_or(SimError::BadSettings(format!(
+                    "no solution at t = {t} s (integrated {t0} → {t_end})"
+                )))?;
+                debug_assert!((ti - t).abs() < 1e-6);
+                states.extend_from_slice(yi.as_slice());
+            }
+        } else {
+            for &t in outputs {
+                let y = model.evaluate(t).ok_or(SimError::BadSettings(format!(
+                    "no solution at t = {t} s (integrated {t0} → {t_end})"
+                )))?;
+                states.extend_from_slice(y.as_slice());
+            }
         }
     }
     Ok(Solution {
@@ -123,4 +155,60 @@ pub(super) fn integrate(
         dim,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{integrate, Method, OdeSystem, Settings, SimError};
+
+    struct Oscillator;
+    impl OdeSystem for Oscillator {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+            dy[0] = y[1];
+            dy[1] = -y[0];
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn uniform_and_uneven_outputs_agree_with_the_exact_solution() {
+        let s = Settings::default().method(Method::Dopri5).rtol(1e-10).atol(1e-12);
+        let even: Vec<f64> = (0..=100).map(|i| i as f64 * 0.1).collect();
+        let uneven = [0.3, 0.35, 2.0, 9.99, 10.0];
+        for times in [&even[..], &even[1..], &uneven[..]] {
+            let sol = integrate(&Oscillator, 0.0, &[1.0, 0.0], times, &s).unwrap();
+            for (i, &t) in times.iter().enumerate() {
+                assert!((sol.y(i)[0] - t.cos()).abs() < 1e-8, "t {t}: {}", sol.y(i)[0]);
+                assert!((sol.y(i)[1] + t.sin()).abs() < 1e-8);
+            }
+        }
+    }
+
+    struct Failing;
+    impl OdeSystem for Failing {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, t: f64, _y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+            if t > 0.5 {
+                return Err(SimError::NonFinite {
+                    time: t,
+                    what: "test".into(),
+                });
+            }
+            dy[0] = 1.0;
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_failing_right_hand_side_stops_the_run_with_its_time() {
+        let s = Settings::default().method(Method::Dopri5);
+        let err = integrate(&Failing, 0.0, &[0.0], &[1.0, 2.0], &s).unwrap_err();
+        let t = err.time().unwrap();
+        assert!(t > 0.5 && t < 1.0, "{err}");
+    }
 }

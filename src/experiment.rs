@@ -1,0 +1,540 @@
+//! Experiment files: TOML parsed into raw serde structs, then validated into a trusted
+//! [`Experiment`].
+//!
+//! Unknown keys are errors (a misspelled `stifnes` must not fall back to a default); every
+//! error names the file, the line and the key path. Paths in the file are relative to it.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use stf_core::excitation::RotorAngle;
+use stf_core::integrate::{Method, Settings};
+use stf_core::system::OscillatorParams;
+use toml::Spanned;
+
+/// A parameter value: a number, or a table with value / min / max / fixed.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum RawParam {
+    /// Just the value.
+    Value(f64),
+    /// Value with bounds and a fixed/free switch.
+    Table(RawParamTable),
+}
+
+/// The table form of a parameter.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawParamTable {
+    /// Initial or fixed value.
+    pub value: Option<f64>,
+    /// Lower bound.
+    pub min: Option<f64>,
+    /// Upper bound.
+    pub max: Option<f64>,
+    /// Held at its value in fits.
+    pub fixed: Option<bool>,
+}
+
+/// One `[[models]]` (or `[[simulate.truth]]`) entry.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawModel {
+    /// A built-in model's name.
+    pub name: Option<String>,
+    /// A script model's path (relative to the experiment file).
+    pub script: Option<String>,
+    /// Further models added to this one (`name = "power_law", plus = ["added_mass"]`).
+    #[serde(default)]
+    pub plus: Vec<String>,
+    /// Parameter values and bounds; the rest take the model's defaults.
+    #[serde(default)]
+    pub params: BTreeMap<String, Spanned<RawParam>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+struct RawSystem {
+    preset: Option<String>,
+    m: Option<f64>,
+    k: Option<f64>,
+    c: Option<f64>,
+    #[serde(rename = "T")]
+    t_friction: Option<f64>,
+    delta_T: Option<f64>,
+    F0: Option<f64>,
+    eta: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Serialize, Clone)]
+#[serde(deny_unknown_fields)]
+struct RawSweep {
+    w0: f64,
+    alpha: f64,
+    t0: f64,
+    t1: f64,
+    phi0: Option<f64>,
+}
+
+#[derive(Debug, Deserialize, Serialize, Clone)]
+#[serde(deny_unknown_fields)]
+struct RawConstant {
+    omega: f64,
+    #[serde(default)]
+    t0: f64,
+    t1: f64,
+    #[serde(default)]
+    phi0: f64,
+}
+
+#[derive(Debug, Deserialize, Serialize, Clone)]
+#[serde(deny_unknown_fields)]
+struct RawProfile {
+    t: Vec<f64>,
+    omega: Vec<f64>,
+    #[serde(default)]
+    phi0: f64,
+}
+
+#[derive(Debug, Deserialize, Serialize, Clone)]
+#[serde(deny_unknown_fields)]
+struct RawFree {
+    t1: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSimulate {
+    sweep: Option<RawSweep>,
+    constant: Option<RawConstant>,
+    profile: Option<RawProfile>,
+    free: Option<RawFree>,
+    #[serde(default = "default_rate")]
+    rate: f64,
+    #[serde(default = "yes")]
+    noise: bool,
+    #[serde(default = "one")]
+    seed: u64,
+    #[serde(default)]
+    x0: f64,
+    #[serde(default)]
+    v0: f64,
+    #[serde(default)]
+    truth: Vec<Spanned<RawModel>>,
+}
+
+fn default_rate() -> f64 {
+    1000.0
+}
+fn yes() -> bool {
+    true
+}
+fn one() -> u64 {
+    1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawIntegrator {
+    method: Option<Method>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    h_max: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawData {
+    file: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDiscover {
+    base: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawExperiment {
+    data: Option<RawData>,
+    system: Option<Spanned<RawSystem>>,
+    integrator: Option<Spanned<RawIntegrator>>,
+    #[serde(default)]
+    models: Vec<Spanned<RawModel>>,
+    simulate: Option<Spanned<RawSimulate>>,
+    discover: Option<RawDiscover>,
+}
+
+/// A model as the experiment file gives it, with where it stands in the file.
+#[derive(Clone, Debug)]
+pub struct ModelEntry {
+    /// The raw entry.
+    pub raw: RawModel,
+    /// Line of the entry in the file (1-based).
+    pub line: usize,
+    /// Key path (`models[0]`, `simulate.truth[1]`).
+    pub key: String,
+    /// Line of each parameter given in `params`.
+    pub param_lines: BTreeMap<String, usize>,
+}
+
+/// How the rotor (or nothing) drives a simulation.
+#[derive(Clone, Debug)]
+pub enum Drive {
+    /// The rotor with a prescribed angle.
+    Rotor(RotorAngle),
+    /// No drive: free vibration from the initial state.
+    Free,
+}
+
+/// A validated `[simulate]` section.
+#[derive(Clone, Debug)]
+pub struct SimulateSpec {
+    /// The drive.
+    pub drive: Drive,
+    /// Start and end time, s.
+    pub t0: f64,
+    /// End time, s.
+    pub t1: f64,
+    /// Samples per second.
+    pub rate: f64,
+    /// Sensor noise on or off.
+    pub noise: bool,
+    /// Random seed.
+    pub seed: u64,
+    /// Initial displacement (m) and velocity (m/s).
+    pub x0: f64,
+    /// Initial velocity.
+    pub v0: f64,
+    /// The hidden models.
+    pub truth: Vec<ModelEntry>,
+    /// The section as written, for the sidecar.
+    pub as_json: serde_json::Value,
+}
+
+/// A validated experiment.
+#[derive(Clone, Debug)]
+pub struct Experiment {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// The folder paths are relative to.
+    pub dir: PathBuf,
+    /// The oscillator's parameters.
+    pub system: OscillatorParams,
+    /// Integrator settings.
+    pub integrator: Settings,
+    /// Models to fit or compare.
+    pub models: Vec<ModelEntry>,
+    /// `[simulate]`, if present.
+    pub simulate: Option<SimulateSpec>,
+    /// `[data] file`, resolved.
+    pub data_file: Option<PathBuf>,
+    /// `[discover] base`.
+    pub discover_base: Option<String>,
+}
+
+/// 1-based line of a byte offset.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+struct Ctx<'a> {
+    file: &'a Path,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn at(&self, span: Range<usize>, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+        anyhow::anyhow!(
+            "{}:{}: `{}`: {}",
+            self.file.display(),
+            line_of(self.text, span.start),
+            key,
+            msg
+        )
+    }
+}
+
+impl Experiment {
+    /// Read and validate an experiment file.
+    pub fn load(path: &Path) -> Result<Experiment> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read experiment file {}", path.display()))?;
+        Self::parse(path, &text)
+    }
+
+    /// Validate the text of an experiment file that lives at `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<Experiment> {
+        let raw: RawExperiment = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| line_of(text, s.start));
+            anyhow::anyhow!(
+                "{}:{}: {}",
+                path.display(),
+                line,
+                e.message().trim_end()
+            )
+        })?;
+        let cx = Ctx { file: path, text };
+        let dir = path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        let dir = if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir
+        };
+
+        let mut system = OscillatorParams::FORCED;
+        if let Some(s) = &raw.system {
+            let span = s.span();
+            let s = s.get_ref();
+            if let Some(name) = &s.preset {
+                system = OscillatorParams::preset(name).ok_or_else(|| {
+                    cx.at(
+                        span.clone(),
+                        "system.preset",
+                        format!("unknown preset `{name}`; known: forced, free"),
+                    )
+                })?;
+            }
+            let given = [
+                ("m", s.m),
+                ("k", s.k),
+                ("c", s.c),
+                ("T", s.t_friction),
+                ("delta_T", s.delta_T),
+                ("F0", s.F0),
+                ("eta", s.eta),
+            ];
+            for (name, value) in given {
+                if let Some(v) = value {
+                    let must_be_positive = matches!(name, "m" | "k" | "eta");
+                    if !v.is_finite() || v < 0.0 || (must_be_positive && v == 0.0) {
+                        return Err(cx.at(
+                            span.clone(),
+                            &format!("system.{name}"),
+                            format!("{v} is not a valid value"),
+                        ));
+                    }
+                    system.set(name, v);
+                }
+            }
+        }
+
+        let mut integrator = Settings::default();
+        if let Some(i) = &raw.integrator {
+            let span = i.span();
+            let i = i.get_ref();
+            if let Some(m) = i.method {
+                integrator.method = m;
+            }
+            for (name, value, slot) in [
+                ("rtol", i.rtol, &mut integrator.rtol),
+                ("atol", i.atol, &mut integrator.atol),
+                ("h_max", i.h_max, &mut integrator.h_max),
+            ] {
+                if let Some(v) = value {
+                    if !(v.is_finite() && v >= 0.0) || (name != "h_max" && v == 0.0) {
+                        return Err(cx.at(
+                            span.clone(),
+                            &format!("integrator.{name}"),
+                            format!("{v} must be positive"),
+                        ));
+                    }
+                    *slot = v;
+                }
+            }
+        }
+
+        let entries = |list: &[Spanned<RawModel>], prefix: &str| -> Result<Vec<ModelEntry>> {
+            list.iter()
+                .enumerate()
+                .map(|(i, m)| {
+                    let key = format!("{prefix}[{i}]");
+                    let r = m.get_ref();
+                    match (&r.name, &r.script) {
+                        (Some(_), Some(_)) => Err(cx.at(
+                            m.span(),
+                            &key,
+                            "give either `name` or `script`, not both",
+                        )),
+                        (None, None) => Err(cx.at(
+                            m.span(),
+                            &key,
+                            "a model needs `name` (a built-in) or `script` (a .rhai file)",
+                        )),
+                        _ => Ok(ModelEntry {
+                            raw: r.clone(),
+                            line: line_of(text, m.span().start),
+                            key,
+                            param_lines: r
+                                .params
+                                .iter()
+                                .map(|(k, v)| (k.clone(), line_of(text, v.span().start)))
+                                .collect(),
+                        }),
+                    }
+                })
+                .collect()
+        };
+        let models = entries(&raw.models, "models")?;
+
+        let simulate = match &raw.simulate {
+            None => None,
+            Some(s) => {
+                let span = s.span();
+                let s = s.get_ref();
+                let drives = [
+                    s.sweep.is_some(),
+                    s.constant.is_some(),
+                    s.profile.is_some(),
+                    s.free.is_some(),
+                ];
+                if drives.iter().filter(|d| **d).count() != 1 {
+                    return Err(cx.at(
+                        span,
+                        "simulate",
+                        "give exactly one of `sweep`, `constant`, `profile` or `free`",
+                    ));
+                }
+                let (drive, t0, t1, as_json) = if let Some(w) = &s.sweep {
+                    let mut angle = RotorAngle::sweep(w.w0, w.alpha, w.t0);
+                    if let (Some(p), RotorAngle::Sweep { phi0, .. }) = (w.phi0, &mut angle) {
+                        *phi0 = p;
+                    }
+                    (Drive::Rotor(angle), w.t0, w.t1, serde_json::json!({ "sweep": w }))
+                } else if let Some(c) = &s.constant {
+                    let angle = RotorAngle::Constant {
+                        omega: c.omega,
+                        phi0: c.phi0,
+                    };
+                    (Drive::Rotor(angle), c.t0, c.t1, serde_json::json!({ "constant": c }))
+                } else if let Some(p) = &s.profile {
+                    if p.t.len() != p.omega.len() || p.t.len() < 2 {
+                        return Err(cx.at(
+                            span,
+                            "simulate.profile",
+                            "`t` and `omega` need the same length, at least 2",
+                        ));
+                    }
+                    if p.t.windows(2).any(|w| !(w[1] > w[0])) {
+                        return Err(cx.at(span, "simulate.profile.t", "times must increase"));
+                    }
+                    let (t0, t1) = (p.t[0], p.t[p.t.len() - 1]);
+                    let angle = RotorAngle::Profile {
+                        t: p.t.clone(),
+                        omega: p.omega.clone(),
+                        phi0: p.phi0,
+                    };
+                    (Drive::Rotor(angle), t0, t1, serde_json::json!({ "profile": p }))
+                } else if let Some(f) = &s.free {
+                    (Drive::Free, 0.0, f.t1, serde_json::json!({ "free": f }))
+                } else {
+                    bail!("unreachable: no drive");
+                };
+                if !(t1 > t0) {
+                    return Err(cx.at(span, "simulate", format!("t1 = {t1} must exceed t0 = {t0}")));
+                }
+                if !(s.rate > 0.0 && s.rate.is_finite()) {
+                    return Err(cx.at(span, "simulate.rate", "must be a positive number"));
+                }
+                let mut as_json = as_json;
+                as_json["rate"] = s.rate.into();
+                as_json["noise"] = s.noise.into();
+                as_json["seed"] = s.seed.into();
+                as_json["x0"] = s.x0.into();
+                as_json["v0"] = s.v0.into();
+                Some(SimulateSpec {
+                    drive,
+                    t0,
+                    t1,
+                    rate: s.rate,
+                    noise: s.noise,
+                    seed: s.seed,
+                    x0: s.x0,
+                    v0: s.v0,
+                    truth: entries(&s.truth, "simulate.truth")?,
+                    as_json,
+                })
+            }
+        };
+
+        Ok(Experiment {
+            path: path.to_path_buf(),
+            data_file: raw.data.map(|d| dir.join(d.file)),
+            dir,
+            system,
+            integrator,
+            models,
+            simulate,
+            discover_base: raw.discover.map(|d| d.base),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn the_design_example_parses() {
+        let e = parse(
+            r#"
+[data]
+file = "record.csv"
+
+[system]
+m = 7.65
+
+[[models]]
+name = "power_law"
+params = { K = 2.0, n = { value = 1.2, min = 1.0, max = 4.0 } }
+
+[discover]
+base = "power_law"
+
+[simulate]
+sweep = { w0 = 2.35, alpha = 0.047, t0 = 50.0, t1 = 200.0 }
+rate = 1000.0
+noise = true
+seed = 1
+
+[[simulate.truth]]
+name = "power_law"
+params = { K = 4.0, n = 1.5 }
+"#,
+        )
+        .unwrap();
+        assert_eq!(e.models.len(), 1);
+        assert_eq!(e.models[0].line, 9);
+        assert_eq!(e.data_file.unwrap(), PathBuf::from("./record.csv"));
+        let s = e.simulate.unwrap();
+        assert_eq!((s.t0, s.t1), (50.0, 200.0));
+        assert_eq!(s.truth[0].key, "simulate.truth[0]");
+    }
+
+    #[test]
+    fn a_misspelled_key_is_an_error_with_file_and_line() {
+        let err = parse("[system]\nm = 7.65\nstifnes = 3.0\n").unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(msg.contains("exp.toml:3"), "{msg}");
+        assert!(msg.contains("stifnes"), "{msg}");
+    }
+
+    #[test]
+    fn two_drives_are_an_error() {
+        let err = parse("[simulate]\nsweep = { w0 = 1.0, alpha = 0.1, t0 = 0.0, t1 = 5.0 }\nconstant = { omega = 2.0, t1 = 3.0 }\n")
+            .unwrap_err();
+        assert!(format!("{err:#}").contains("exactly one"));
+    }
+}

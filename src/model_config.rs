@@ -1,0 +1,135 @@
+//! Force models as an experiment file names them: built-ins or scripts, summed, with their
+//! parameter values, bounds and fixed/free switches resolved once.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
+use stf_core::force_model::ForceModel;
+use stf_core::model_sum::ModelSum;
+
+use crate::experiment::{ModelEntry, RawParam};
+
+/// A parameter's setting for a fit: value, bounds and whether it is held fixed.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ParamSetting {
+    /// Name in the (summed) model.
+    pub name: String,
+    /// Initial or fixed value.
+    pub value: f64,
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+    /// Held at its value.
+    pub fixed: bool,
+}
+
+/// A model ready to plug into the oscillator.
+#[derive(Clone)]
+pub struct ConfiguredModel {
+    /// The model (a sum of the entry's parts).
+    pub model: Arc<dyn ForceModel>,
+    /// Parameter settings, in the model's order.
+    pub params: Vec<ParamSetting>,
+}
+
+impl ConfiguredModel {
+    /// The parameter values, in order.
+    pub fn values(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.value).collect()
+    }
+}
+
+/// Resolve a model name or script path (relative to `dir`) to a model.
+pub fn resolve(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
+    if spec.ends_with(".rhai") {
+        return Err(anyhow!(
+            "script models are not available in this build: `{}`",
+            dir.join(spec).display()
+        ));
+    }
+    stf_models::find(spec).ok_or_else(|| {
+        anyhow!(
+            "unknown model `{spec}`; known models: {}",
+            stf_models::names().join(", ")
+        )
+    })
+}
+
+/// Build one model from experiment entries: the parts of every entry are summed (one entry
+/// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
+/// are applied. `file` is the experiment file, `dir` its folder.
+pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<ConfiguredModel> {
+    let mut parts = Vec::new();
+    for entry in entries {
+        let at = |msg: String| anyhow!("{}:{}: `{}`: {}", file.display(), entry.line, entry.key, msg);
+        let raw = &entry.raw;
+        let first = raw
+            .name
+            .as_deref()
+            .or(raw.script.as_deref())
+            .ok_or_else(|| at("a model needs `name` or `script`".into()))?;
+        for spec in std::iter::once(first).chain(raw.plus.iter().map(String::as_str)) {
+            parts.push(resolve(spec, dir).map_err(|e| at(format!("{e:#}")))?);
+        }
+    }
+    let sum = ModelSum::new(parts).map_err(|e| {
+        let line = entries.first().map_or(0, |e| e.line);
+        anyhow!("{}:{}: {}", file.display(), line, e)
+    })?;
+    let mut params: Vec<ParamSetting> = sum
+        .params()
+        .iter()
+        .map(|s| ParamSetting {
+            name: s.name.clone(),
+            value: s.default,
+            min: s.min,
+            max: s.max,
+            fixed: false,
+        })
+        .collect();
+    for entry in entries {
+        for (name, value) in &entry.raw.params {
+            let line = entry.param_lines.get(name).copied().unwrap_or(entry.line);
+            let at = |msg: String| {
+                anyhow!(
+                    "{}:{}: `{}.params.{}`: {}",
+                    file.display(),
+                    line,
+                    entry.key,
+                    name,
+                    msg
+                )
+            };
+            let i = sum.param_index(name).ok_or_else(|| {
+                let known: Vec<&str> = sum.params().iter().map(|s| s.name.as_str()).collect();
+                at(format!(
+                    "`{}` has no parameter `{name}`; its parameters: {}",
+                    sum.name(),
+                    known.join(", ")
+                ))
+            })?;
+            let p = &mut params[i];
+            match value.get_ref() {
+                RawParam::Value(v) => p.value = *v,
+                RawParam::Table(t) => {
+                    p.value = t.value.unwrap_or(p.value);
+                    p.min = t.min.unwrap_or(p.min);
+                    p.max = t.max.unwrap_or(p.max);
+                    p.fixed = t.fixed.unwrap_or(p.fixed);
+                }
+            }
+            if !(p.value.is_finite() && p.min <= p.value && p.value <= p.max) {
+                return Err(at(format!(
+                    "{} lies outside its bounds [{}, {}]",
+                    p.value, p.min, p.max
+                )));
+            }
+        }
+    }
+    Ok(ConfiguredModel {
+        model: Arc::new(sum),
+        params,
+    })
+}
