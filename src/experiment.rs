@@ -229,12 +229,15 @@ pub struct Experiment {
     /// Integrator settings.
     pub integrator: Settings,
     /// Models to fit or compare.
+    #[allow(dead_code)] // read by fit, compare and discover
     pub models: Vec<ModelEntry>,
     /// `[simulate]`, if present.
     pub simulate: Option<SimulateSpec>,
     /// `[data] file`, resolved.
+    #[allow(dead_code)] // read by fit, compare and discover
     pub data_file: Option<PathBuf>,
     /// `[discover] base`.
+    #[allow(dead_code)] // read by fit, compare and discover
     pub discover_base: Option<String>,
 }
 
@@ -272,12 +275,7 @@ impl Experiment {
     pub fn parse(path: &Path, text: &str) -> Result<Experiment> {
         let raw: RawExperiment = toml::from_str(text).map_err(|e| {
             let line = e.span().map_or(0, |s| line_of(text, s.start));
-            anyhow::anyhow!(
-                "{}:{}: {}",
-                path.display(),
-                line,
-                e.message().trim_end()
-            )
+            anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message().trim_end())
         })?;
         let cx = Ctx { file: path, text };
         let dir = path
@@ -359,11 +357,9 @@ impl Experiment {
                     let key = format!("{prefix}[{i}]");
                     let r = m.get_ref();
                     match (&r.name, &r.script) {
-                        (Some(_), Some(_)) => Err(cx.at(
-                            m.span(),
-                            &key,
-                            "give either `name` or `script`, not both",
-                        )),
+                        (Some(_), Some(_)) => {
+                            Err(cx.at(m.span(), &key, "give either `name` or `script`, not both"))
+                        }
                         (None, None) => Err(cx.at(
                             m.span(),
                             &key,
@@ -408,13 +404,23 @@ impl Experiment {
                     if let (Some(p), RotorAngle::Sweep { phi0, .. }) = (w.phi0, &mut angle) {
                         *phi0 = p;
                     }
-                    (Drive::Rotor(angle), w.t0, w.t1, serde_json::json!({ "sweep": w }))
+                    (
+                        Drive::Rotor(angle),
+                        w.t0,
+                        w.t1,
+                        serde_json::json!({ "sweep": w }),
+                    )
                 } else if let Some(c) = &s.constant {
                     let angle = RotorAngle::Constant {
                         omega: c.omega,
                         phi0: c.phi0,
                     };
-                    (Drive::Rotor(angle), c.t0, c.t1, serde_json::json!({ "constant": c }))
+                    (
+                        Drive::Rotor(angle),
+                        c.t0,
+                        c.t1,
+                        serde_json::json!({ "constant": c }),
+                    )
                 } else if let Some(p) = &s.profile {
                     if p.t.len() != p.omega.len() || p.t.len() < 2 {
                         return Err(cx.at(
@@ -432,14 +438,23 @@ impl Experiment {
                         omega: p.omega.clone(),
                         phi0: p.phi0,
                     };
-                    (Drive::Rotor(angle), t0, t1, serde_json::json!({ "profile": p }))
+                    (
+                        Drive::Rotor(angle),
+                        t0,
+                        t1,
+                        serde_json::json!({ "profile": p }),
+                    )
                 } else if let Some(f) = &s.free {
                     (Drive::Free, 0.0, f.t1, serde_json::json!({ "free": f }))
                 } else {
                     bail!("unreachable: no drive");
                 };
                 if !(t1 > t0) {
-                    return Err(cx.at(span, "simulate", format!("t1 = {t1} must exceed t0 = {t0}")));
+                    return Err(cx.at(
+                        span,
+                        "simulate",
+                        format!("t1 = {t1} must exceed t0 = {t0}"),
+                    ));
                 }
                 if !(s.rate > 0.0 && s.rate.is_finite()) {
                     return Err(cx.at(span, "simulate.rate", "must be a positive number"));

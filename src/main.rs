@@ -5,6 +5,9 @@
 //! stf-lab simulate EXP.toml --out F.csv   write a synthetic record (section [simulate])
 //! ```
 
+// `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod cmd_models;
 mod cmd_simulate;
 mod experiment;

@@ -63,7 +63,15 @@ pub fn resolve(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
 pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
-        let at = |msg: String| anyhow!("{}:{}: `{}`: {}", file.display(), entry.line, entry.key, msg);
+        let at = |msg: String| {
+            anyhow!(
+                "{}:{}: `{}`: {}",
+                file.display(),
+                entry.line,
+                entry.key,
+                msg
+            )
+        };
         let raw = &entry.raw;
         let first = raw
             .name

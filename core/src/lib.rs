@@ -23,6 +23,8 @@
 //! ```
 
 #![deny(clippy::unwrap_used)]
+// `!(a > b)` is how this crate says "not greater, or NaN": the NaN case is meant.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
 pub mod derivative;

@@ -80,7 +80,7 @@ impl<'a> Simulation<'a> {
 
     /// Run from `t0` to `t1`, sampled at the rate (both ends included).
     pub fn run(&self, t0: f64, t1: f64) -> Result<Trajectory, SimError> {
-        if !(self.rate > 0.0 && self.rate.is_finite()) || !(t1 > t0) {
+        if !(self.rate > 0.0 && self.rate.is_finite() && t1 > t0) {
             return Err(SimError::BadSettings(format!(
                 "need a positive rate and t1 > t0 (rate {}, t0 {t0}, t1 {t1})",
                 self.rate

@@ -69,8 +69,12 @@ pub fn sample_record(run: &Trajectory, noise: &SensorNoise, seed: u64, rotor: bo
     let mut x = Vec::with_capacity(run.t.len());
     let mut f = Vec::with_capacity(run.t.len());
     for (&xi, &fi) in run.x.iter().zip(&run.f_stf) {
-        let ex = nx.filter(|_| noise.x_sigma > 0.0).map_or(0.0, |d| d.sample(&mut rng));
-        let ef = nf.filter(|_| noise.f_sigma > 0.0).map_or(0.0, |d| d.sample(&mut rng));
+        let ex = nx
+            .filter(|_| noise.x_sigma > 0.0)
+            .map_or(0.0, |d| d.sample(&mut rng));
+        let ef = nf
+            .filter(|_| noise.f_sigma > 0.0)
+            .map_or(0.0, |d| d.sample(&mut rng));
         x.push(quantize(xi + ex, noise.x_quantum));
         f.push(fi + ef);
     }
@@ -123,11 +127,20 @@ mod tests {
         assert_ne!(a.x, c.x);
         let f = a.f_stf.as_ref().unwrap();
         let n = f.len() as f64;
-        let sd = (f.iter().zip(&r.f_stf).map(|(m, t)| (m - t).powi(2)).sum::<f64>() / n).sqrt();
+        let sd = (f
+            .iter()
+            .zip(&r.f_stf)
+            .map(|(m, t)| (m - t).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
         assert!((sd - 0.02).abs() < 0.002, "force noise sd {sd}");
         for x in &a.x {
             let q = x / 1e-5;
-            assert!((q - q.round()).abs() < 1e-6, "x not on the 0.01 mm grid: {x}");
+            assert!(
+                (q - q.round()).abs() < 1e-6,
+                "x not on the 0.01 mm grid: {x}"
+            );
         }
         let step = std::f64::consts::TAU / 2048.0;
         for p in a.phi.as_ref().unwrap() {

@@ -37,7 +37,10 @@ pub const BUILTINS: &[BuiltinEntry] = &[BuiltinEntry {
 
 /// The built-in model called `name`, if there is one.
 pub fn find(name: &str) -> Option<Arc<dyn ForceModel>> {
-    BUILTINS.iter().find(|e| e.name == name).map(|e| (e.build)())
+    BUILTINS
+        .iter()
+        .find(|e| e.name == name)
+        .map(|e| (e.build)())
 }
 
 /// The names of all built-in models.

@@ -59,7 +59,12 @@ mod tests {
     #[test]
     fn force_is_proportional_to_velocity() {
         let m = Viscous::new();
-        let s = ModelState { t: 0.0, x: 0.1, v: -0.3, z: &[] };
+        let s = ModelState {
+            t: 0.0,
+            x: 0.1,
+            v: -0.3,
+            z: &[],
+        };
         assert_eq!(m.force(&[4.0], &s, &mut []).unwrap(), -1.2);
     }
 }

@@ -134,9 +134,12 @@ pub(super) fn integrate(
             let ts = solver.x_out();
             for (k, &t) in outputs.iter().enumerate() {
                 let i = k + 1;
-                let (ti, yi) = ts.get(i).zip(ys.get(i)).ok_or(SimError::BadSettings(format!(
-                    "no solution at t = {t} s (integrated {t0} → {t_end})"
-                )))?;
+                let (ti, yi) = ts
+                    .get(i)
+                    .zip(ys.get(i))
+                    .ok_or(SimError::BadSettings(format!(
+                        "no solution at t = {t} s (integrated {t0} → {t_end})"
+                    )))?;
                 debug_assert!((ti - t).abs() < 1e-6);
                 states.extend_from_slice(yi.as_slice());
             }
@@ -175,13 +178,20 @@ mod tests {
 
     #[test]
     fn uniform_and_uneven_outputs_agree_with_the_exact_solution() {
-        let s = Settings::default().method(Method::Dopri5).rtol(1e-10).atol(1e-12);
+        let s = Settings::default()
+            .method(Method::Dopri5)
+            .rtol(1e-10)
+            .atol(1e-12);
         let even: Vec<f64> = (0..=100).map(|i| i as f64 * 0.1).collect();
         let uneven = [0.3, 0.35, 2.0, 9.99, 10.0];
         for times in [&even[..], &even[1..], &uneven[..]] {
             let sol = integrate(&Oscillator, 0.0, &[1.0, 0.0], times, &s).unwrap();
             for (i, &t) in times.iter().enumerate() {
-                assert!((sol.y(i)[0] - t.cos()).abs() < 1e-8, "t {t}: {}", sol.y(i)[0]);
+                assert!(
+                    (sol.y(i)[0] - t.cos()).abs() < 1e-8,
+                    "t {t}: {}",
+                    sol.y(i)[0]
+                );
                 assert!((sol.y(i)[1] + t.sin()).abs() < 1e-8);
             }
         }
