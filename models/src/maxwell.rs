@@ -81,7 +81,7 @@ impl ForceModel for Maxwell {
     #[inline]
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
         let [c_m, tau] = take(self.name(), p)?;
-        if !(tau > 0.0) {
+        if tau.is_nan() || tau <= 0.0 {
             return Err(ModelError::new(
                 self.name(),
                 format!("relaxation time tau must be positive, got {tau}"),

@@ -66,7 +66,7 @@ impl Default for WallImpact {
 #[inline]
 pub fn hunt_crossley(k_w: f64, gap: f64, p: f64, c_r: f64, x: f64, v: f64) -> f64 {
     let delta = x.abs() - gap;
-    if !(delta > 0.0) {
+    if delta.is_nan() || delta <= 0.0 {
         return 0.0;
     }
     let side = x.signum();

@@ -99,7 +99,9 @@ fn max_force_below(run: &Trajectory, w_hi: f64) -> f64 {
 
 #[test]
 fn nil_force_at_constant_speed_before_resonance() {
-    let run = simulate(RotorAngle::constant(3.0), 30.0);
+    // The trolley sticks at this speed (F0·ω² = 0.42 N < T + ΔT = 0.64 N), which the explicit
+    // integrator crosses in ≈ 6e-5 s steps: 8 s (four rotor cycles) keep the test near 1 s.
+    let run = simulate(RotorAngle::constant(3.0), 8.0);
     let f_max = max_force_below(&run, 3.75);
     eprintln!("ω = 3.0: max |F_STF| = {f_max:.2e} N");
     assert!(f_max <= 0.2, "max |F_STF| = {f_max} N");
