@@ -4,6 +4,17 @@
 //! the one static table the registry reads. Models add: a [`stf_core::model_sum::ModelSum`] of
 //! built-ins is a model too.
 //!
+//! | name | law | parameters |
+//! |---|---|---|
+//! | `viscous` | c_s·v | `c_s` |
+//! | `power_law` | K·\|v\|ⁿ·sign v | `K`, `n` |
+//! | `added_mass` | m_a·ẍ | `m_a` |
+//! | `yield` | F_y·v/√(v² + v_s²) | `F_y`, `v_s` |
+//! | `wall_impact` | Hunt–Crossley contact past \|x\| = gap | `k_w`, `gap`, `p`, `c_r` |
+//! | `cubic_stiffness` | k3·x³ | `k3` |
+//! | `maxwell` | dF/dt = (c_m·v − F)/τ | `c_m`, `tau` |
+//! | `jamming_on_off` | K_j·\|v\|^n_j·sign v, gated on above v_c | `K_j`, `n_j`, `v_c`, `w` |
+//!
 //! ```
 //! use stf_models::find;
 //! let viscous = find("viscous").unwrap();

@@ -8,7 +8,7 @@
 //! dF/dt = (c_m·v − F)/τ
 //! ```
 //!
-//! F is the model's one internal state (z[0], starting at 0) and the force it returns. Slow
+//! F is the model's one internal state (`z[0]`, starting at 0) and the force it returns. Slow
 //! motion (ωτ ≪ 1) sees a dashpot c_m; fast motion (ωτ ≫ 1) sees a spring of stiffness c_m/τ.
 //! In steady sinusoidal motion v = V·sin ωt the force is
 //! `c_m·V/√(1 + (ωτ)²)·sin(ωt − atan ωτ)`. It dissipates on average over a cycle but not at
