@@ -27,11 +27,14 @@
 //!
 //! ## Steepness of the gate
 //! The gate is a tanh of width `w` rather than a hard switch so the right-hand side stays
-//! smooth for the integrator. The default w = 5 mm/s = v_c/10 makes G go from 1.8 % to 98 %
-//! between v_c − 2w and v_c + 2w (40 → 60 mm/s); at ω = 10 rad/s, X = 8 mm that takes
-//! ≈ 3 ms, impact-like on the 0.6 s rotor period, while the largest slope of the force,
-//! K_j·v_c²/(2w) = 25 N·s/m at the defaults, is a damping rate of ≈ 3 s⁻¹ on the 7.65 kg
-//! trolley: not stiff for an explicit integrator. At rest G = ½(1 − tanh(v_c/w)) ≈ 2·10⁻⁹,
+//! smooth for the integrator. The default w = 2 mm/s = v_c/25 makes G go from 1.8 % to 98 %
+//! between v_c − 2w and v_c + 2w (46 → 54 mm/s). At ω = 10 rad/s and X = 8 mm the blade's
+//! speed sweeps through that band in ≈ 12 ms, 2 % of the 0.63 s rotor period, so each pulse
+//! switches on and off abruptly on the scale of the cycle (the rise of the force to its peak
+//! then follows |v|^n_j). A steeper gate would not change the cycle's picture but would make
+//! fits in `v_c` rougher. The largest slope of the force, ≈ K_j·v_c²/(2w) = 62.5 N·s/m at the
+//! defaults, is a damping rate of ≈ 8 s⁻¹ on the 7.65 kg trolley, far from limiting an
+//! explicit integrator's step. At rest G = ½(1 − tanh(v_c/w)) ≈ 2·10⁻²²,
 //! so the force is zero for every practical purpose.
 //!
 //! | parameter | unit | default | bounds | meaning |
@@ -39,7 +42,7 @@
 //! | `K_j` | N·(s/m)^n_j | 100 | [0, 1e5] | jammed drag coefficient (1 N at 0.1 m/s with n_j = 2) |
 //! | `n_j` | — | 2 | [1, 4] | exponent of the jammed drag (2: momentum transfer to the front) |
 //! | `v_c` | m/s | 0.05 | [0, 1] | critical speed of jamming onset |
-//! | `w` | m/s | 0.005 | [1e-4, 0.1] | width of the onset gate |
+//! | `w` | m/s | 0.002 | [1e-4, 0.1] | width of the onset gate |
 
 use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::ParamSpec;
@@ -87,7 +90,7 @@ impl JammingOnOff {
                 ParamSpec::new(
                     "w",
                     "m/s",
-                    0.005,
+                    0.002,
                     1e-4,
                     0.1,
                     "width of the smooth jamming gate",
