@@ -4,6 +4,17 @@
 //! the one static table the registry reads. Models add: a [`stf_core::model_sum::ModelSum`] of
 //! built-ins is a model too.
 //!
+//! | name | law | parameters |
+//! |---|---|---|
+//! | `viscous` | c_s·v | `c_s` |
+//! | `power_law` | K·\|v\|ⁿ·sign v | `K`, `n` |
+//! | `added_mass` | m_a·ẍ | `m_a` |
+//! | `yield` | F_y·v/√(v² + v_s²) | `F_y`, `v_s` |
+//! | `wall_impact` | Hunt–Crossley contact past \|x\| = gap | `k_w`, `gap`, `p`, `c_r` |
+//! | `cubic_stiffness` | k3·x³ | `k3` |
+//! | `maxwell` | dF/dt = (c_m·v − F)/τ | `c_m`, `tau` |
+//! | `jamming_on_off` | K_j·\|v\|^n_j·sign v, gated on above v_c | `K_j`, `n_j`, `v_c`, `w` |
+//!
 //! ```
 //! use stf_models::find;
 //! let viscous = find("viscous").unwrap();
@@ -11,12 +22,21 @@
 //! ```
 
 #![deny(clippy::unwrap_used)]
+#![cfg_attr(test, allow(clippy::unwrap_used))]
 
 use std::sync::Arc;
 
 use stf_core::force_model::ForceModel;
 
+pub mod added_mass;
+pub mod cubic_stiffness;
+pub mod jamming_on_off;
+pub mod maxwell;
+pub mod power_law;
+mod values;
 pub mod viscous;
+pub mod wall_impact;
+pub mod yield_stress;
 
 /// An entry of the table of built-in models.
 pub struct BuiltinEntry {
@@ -28,12 +48,50 @@ pub struct BuiltinEntry {
     pub build: fn() -> Arc<dyn ForceModel>,
 }
 
-/// Every built-in model, in the order they are listed to users.
-pub const BUILTINS: &[BuiltinEntry] = &[BuiltinEntry {
-    name: "viscous",
-    summary: viscous::SUMMARY,
-    build: || Arc::new(viscous::Viscous::new()),
-}];
+/// Every built-in model, in the order they are listed to users. The names are those of the
+/// discovery vocabulary (DESIGN.md §5).
+pub const BUILTINS: &[BuiltinEntry] = &[
+    BuiltinEntry {
+        name: "viscous",
+        summary: viscous::SUMMARY,
+        build: || Arc::new(viscous::Viscous::new()),
+    },
+    BuiltinEntry {
+        name: "power_law",
+        summary: power_law::SUMMARY,
+        build: || Arc::new(power_law::PowerLaw::new()),
+    },
+    BuiltinEntry {
+        name: "added_mass",
+        summary: added_mass::SUMMARY,
+        build: || Arc::new(added_mass::AddedMass::new()),
+    },
+    BuiltinEntry {
+        name: "yield",
+        summary: yield_stress::SUMMARY,
+        build: || Arc::new(yield_stress::Yield::new()),
+    },
+    BuiltinEntry {
+        name: "wall_impact",
+        summary: wall_impact::SUMMARY,
+        build: || Arc::new(wall_impact::WallImpact::new()),
+    },
+    BuiltinEntry {
+        name: "cubic_stiffness",
+        summary: cubic_stiffness::SUMMARY,
+        build: || Arc::new(cubic_stiffness::CubicStiffness::new()),
+    },
+    BuiltinEntry {
+        name: "maxwell",
+        summary: maxwell::SUMMARY,
+        build: || Arc::new(maxwell::Maxwell::new()),
+    },
+    BuiltinEntry {
+        name: "jamming_on_off",
+        summary: jamming_on_off::SUMMARY,
+        build: || Arc::new(jamming_on_off::JammingOnOff::new()),
+    },
+];
 
 /// The built-in model called `name`, if there is one.
 pub fn find(name: &str) -> Option<Arc<dyn ForceModel>> {
@@ -46,4 +104,40 @@ pub fn find(name: &str) -> Option<Arc<dyn ForceModel>> {
 /// The names of all built-in models.
 pub fn names() -> Vec<&'static str> {
     BUILTINS.iter().map(|e| e.name).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_builds_a_model_of_its_own_name_with_sane_specs() {
+        let expected = [
+            "viscous",
+            "power_law",
+            "added_mass",
+            "yield",
+            "wall_impact",
+            "cubic_stiffness",
+            "maxwell",
+            "jamming_on_off",
+        ];
+        assert_eq!(names(), expected);
+        for e in BUILTINS {
+            let m = (e.build)();
+            assert_eq!(m.name(), e.name);
+            assert_eq!(m.summary(), e.summary);
+            assert!(!m.params().is_empty(), "{}", e.name);
+            for s in m.params() {
+                assert!(
+                    s.min <= s.default && s.default <= s.max,
+                    "{}.{}",
+                    e.name,
+                    s.name
+                );
+                assert!(!s.doc.is_empty(), "{}.{}", e.name, s.name);
+            }
+        }
+        assert!(find("no_such_model").is_none());
+    }
 }

@@ -1,7 +1,15 @@
 //! `viscous`: a Newtonian fluid, `F = c_s·v`.
+//!
+//! The baseline every thickening model is compared with.
+//!
+//! | parameter | unit | default | bounds | meaning |
+//! |---|---|---|---|---|
+//! | `c_s` | N·s/m | 2 | [0, 1e4] | damping coefficient of the fluid |
 
 use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::ParamSpec;
+
+use crate::values::take;
 
 /// One line for listings.
 pub const SUMMARY: &str = "Newtonian drag F = c_s·v";
@@ -48,7 +56,8 @@ impl ForceModel for Viscous {
     }
     #[inline]
     fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * s.v)
+        let [c_s] = take(self.name(), p)?;
+        Ok(c_s * s.v)
     }
 }
 

@@ -1,0 +1,86 @@
+//! `cubic_stiffness`: an elastic jammed network, `F = k3·x³`.
+//!
+//! A jammed suspension is a solid-like contact network that stores elastic energy; compressed
+//! between the blade and the walls it stiffens with strain, the lowest odd term of which is a
+//! Duffing-type cubic spring. It adds to the trolley's linear springs (k·x), bending the
+//! resonance curve towards higher frequencies (hardening) for k3 > 0. It is conservative (no
+//! dissipation) and odd in x: F(−x) = −F(x).
+//!
+//! | parameter | unit | default | bounds | meaning |
+//! |---|---|---|---|---|
+//! | `k3` | N/m³ | 1e5 | [0, 1e9] | cubic stiffness (0.1 N at 1 cm, 7.4 N at 42 mm) |
+
+use stf_core::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::params::ParamSpec;
+
+use crate::values::take;
+
+/// One line for listings.
+pub const SUMMARY: &str = "elastic jammed network F = k3·x³";
+
+/// Cubic (Duffing) stiffness; see the [module doc](self).
+pub struct CubicStiffness {
+    specs: Vec<ParamSpec>,
+}
+
+impl CubicStiffness {
+    /// The model with its parameter `k3`.
+    pub fn new() -> Self {
+        CubicStiffness {
+            specs: vec![ParamSpec::new(
+                "k3",
+                "N/m³",
+                1e5,
+                0.0,
+                1e9,
+                "cubic stiffness of the jammed network",
+            )],
+        }
+    }
+}
+
+impl Default for CubicStiffness {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ForceModel for CubicStiffness {
+    fn name(&self) -> &str {
+        "cubic_stiffness"
+    }
+    fn summary(&self) -> &str {
+        SUMMARY
+    }
+    fn params(&self) -> &[ParamSpec] {
+        &self.specs
+    }
+    #[inline]
+    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+        let [k3] = take(self.name(), p)?;
+        Ok(k3 * s.x * s.x * s.x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn force_is_k3_x_cubed_whatever_the_velocity() {
+        let m = CubicStiffness::new();
+        let s = ModelState {
+            t: 0.0,
+            x: -0.02,
+            v: 3.0,
+            z: &[],
+        };
+        // 2e5·(−0.02)³ = 2e5·(−8e-6) = −1.6 N.
+        assert_relative_eq!(
+            m.force(&[2e5], &s, &mut []).unwrap(),
+            -1.6,
+            max_relative = 1e-12
+        );
+    }
+}
