@@ -19,18 +19,24 @@ struct Layout {
 
 /// Read a record from CSV text.
 pub(super) fn read<R: std::io::Read>(
-    reader: R,
+    mut reader: R,
     source: &str,
     names: &ColumnNames,
 ) -> Result<Record, RecordError> {
+    // The whole text is kept so that rows can be reported as editor lines: the csv crate's
+    // own line count skips blank lines.
+    let mut data = Vec::new();
+    reader
+        .read_to_end(&mut data)
+        .map_err(|e| RecordError::new(source, format!("cannot read: {e}")))?;
     let mut rdr = ::csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
         .trim(::csv::Trim::All)
-        .from_reader(reader);
+        .from_reader(&data[..]);
     let header = rdr
         .headers()
-        .map_err(|e| csv_error(source, &e))?
+        .map_err(|e| csv_error(source, &data, &e))?
         .clone();
     if header.iter().all(str::is_empty) {
         return Err(RecordError::new(
@@ -49,17 +55,17 @@ pub(super) fn read<R: std::io::Read>(
         omega: layout.omega.map(|_| Vec::new()),
         u: layout.u.map(|_| Vec::new()),
     };
-    let mut lines: Vec<usize> = Vec::new();
+    let mut starts: Vec<u64> = Vec::new();
     let mut row = ::csv::StringRecord::new();
     loop {
         match rdr.read_record(&mut row) {
             Ok(false) => break,
             Ok(true) => {}
-            Err(e) => return Err(csv_error(source, &e)),
+            Err(e) => return Err(csv_error(source, &data, &e)),
         }
-        let line = row
-            .position()
-            .map_or(lines.last().map_or(2, |l| l + 1), |p| p.line() as usize);
+        let start = row.position().map_or(0, |p| p.byte());
+        // Counting lines is O(file): only done for an error.
+        let line = || line_of(&data, start);
         if row.len() < header.len() {
             return Err(RecordError::new(
                 source,
@@ -69,7 +75,7 @@ pub(super) fn read<R: std::io::Read>(
                     header.len()
                 ),
             )
-            .at_row(line)
+            .at_row(line())
             .in_column(header.get(row.len()).unwrap_or_default()));
         }
         if row.len() > header.len() {
@@ -81,9 +87,9 @@ pub(super) fn read<R: std::io::Read>(
                     header.len()
                 ),
             )
-            .at_row(line));
+            .at_row(line()));
         }
-        let cell = |index: usize, name: &str| number(source, line, name, row.get(index));
+        let cell = |index: usize, name: &str| number(source, &line, name, row.get(index));
         columns.t.push(cell(layout.t, &names.t)?);
         columns.x.push(cell(layout.x, &names.x)?);
         let optional = [
@@ -97,14 +103,34 @@ pub(super) fn read<R: std::io::Read>(
                 values.push(cell(index, name)?);
             }
         }
-        lines.push(line);
+        starts.push(start);
     }
-    if lines.is_empty() {
+    if starts.is_empty() {
         return Err(
             RecordError::new(source, "no data rows: the file holds only the header").at_row(2),
         );
     }
-    columns.into_record(source, names, &|i| lines.get(i).copied().unwrap_or(i + 2))
+    columns.into_record(source, names, &|i| {
+        starts.get(i).map_or(i + 2, |&b| line_of(&data, b))
+    })
+}
+
+/// The 1-based editor line of the record whose parse began at byte `start` (just after the
+/// previous record's terminator): newlines before it, plus any blank lines the parser
+/// skipped.
+fn line_of(data: &[u8], start: u64) -> usize {
+    let start = (start as usize).min(data.len());
+    let mut line = 1 + data[..start].iter().filter(|&&b| b == b'\n').count();
+    let mut rest = &data[start..];
+    loop {
+        match rest {
+            [b'\n', tail @ ..] | [b'\r', b'\n', tail @ ..] => {
+                line += 1;
+                rest = tail;
+            }
+            _ => return line,
+        }
+    }
 }
 
 /// Find the wanted columns in the header.
@@ -171,10 +197,15 @@ fn layout(
 }
 
 /// One numeric cell.
-fn number(source: &str, line: usize, name: &str, cell: Option<&str>) -> Result<f64, RecordError> {
+fn number(
+    source: &str,
+    line: &dyn Fn() -> usize,
+    name: &str,
+    cell: Option<&str>,
+) -> Result<f64, RecordError> {
     let at = |message: String| {
         RecordError::new(source, message)
-            .at_row(line)
+            .at_row(line())
             .in_column(name)
     };
     let text = cell.unwrap_or_default();
@@ -191,11 +222,11 @@ fn number(source: &str, line: usize, name: &str, cell: Option<&str>) -> Result<f
 }
 
 /// A CSV-level failure (I/O, invalid UTF-8), with the line where known.
-fn csv_error(source: &str, e: &::csv::Error) -> RecordError {
+fn csv_error(source: &str, data: &[u8], e: &::csv::Error) -> RecordError {
     let line = match e.kind() {
-        ::csv::ErrorKind::Utf8 { pos: Some(p), .. } => Some(p.line() as usize),
-        ::csv::ErrorKind::UnequalLengths { pos: Some(p), .. } => Some(p.line() as usize),
-        _ => None,
+        ::csv::ErrorKind::Utf8 { pos: Some(p), .. }
+        | ::csv::ErrorKind::UnequalLengths { pos: Some(p), .. } => Some(line_of(data, p.byte())),
+        _ => e.position().map(|p| line_of(data, p.byte())),
     };
     let message = match e.kind() {
         ::csv::ErrorKind::Io(io) => format!("cannot read: {io}"),
@@ -354,8 +385,18 @@ mod tests {
 
     #[test]
     fn error_missing_column() {
-        expect("t,phi\n0,0\n", Some(1), Some("x"), "missing column `x`; the header has: t, phi");
-        expect("T,x,phi\n0,0,0\n", Some(1), Some("t"), "differs only in case");
+        expect(
+            "t,phi\n0,0\n",
+            Some(1),
+            Some("x"),
+            "missing column `x`; the header has: t, phi",
+        );
+        expect(
+            "T,x,phi\n0,0,0\n",
+            Some(1),
+            Some("t"),
+            "differs only in case",
+        );
     }
 
     #[test]
@@ -370,24 +411,49 @@ mod tests {
 
     #[test]
     fn error_duplicate_column() {
-        expect("t,x,phi,x\n0,0,0,0\n", Some(1), Some("x"), "twice (columns 2 and 4)");
+        expect(
+            "t,x,phi,x\n0,0,0,0\n",
+            Some(1),
+            Some("x"),
+            "twice (columns 2 and 4)",
+        );
     }
 
     #[test]
     fn error_non_numeric_cell() {
-        expect("t,x,phi\n0,0,0\n0.1,0,0\n0.2,0,abc\n", Some(4), Some("phi"), "not a number: `abc`");
+        expect(
+            "t,x,phi\n0,0,0\n0.1,0,0\n0.2,0,abc\n",
+            Some(4),
+            Some("phi"),
+            "not a number: `abc`",
+        );
         expect("t,x,phi\n0,,0\n", Some(2), Some("x"), "empty cell");
     }
 
     #[test]
     fn error_nan_and_infinity() {
-        expect("t,x,phi\n0,0,0\n0.1,NaN,0\n", Some(3), Some("x"), "not a finite number: `NaN`");
-        expect("t,x,phi\n0,0,0\n0.1,0,0\n0.2,0,-inf\n", Some(4), Some("phi"), "not a finite");
+        expect(
+            "t,x,phi\n0,0,0\n0.1,NaN,0\n",
+            Some(3),
+            Some("x"),
+            "not a finite number: `NaN`",
+        );
+        expect(
+            "t,x,phi\n0,0,0\n0.1,0,0\n0.2,0,-inf\n",
+            Some(4),
+            Some("phi"),
+            "not a finite",
+        );
     }
 
     #[test]
     fn error_short_and_long_rows() {
-        expect("t,x,phi\n0,0,0\n0.1,0\n", Some(3), Some("phi"), "short row: 2 cell(s)");
+        expect(
+            "t,x,phi\n0,0,0\n0.1,0\n",
+            Some(3),
+            Some("phi"),
+            "short row: 2 cell(s)",
+        );
         expect("t,x,phi\n0,0,0,9\n", Some(2), None, "long row: 4 cells");
     }
 
@@ -399,13 +465,30 @@ mod tests {
             Some("t"),
             "not strictly increasing",
         );
-        expect("t,x,phi\n0,0,0\n-0.1,0,0\n", Some(3), Some("t"), "-0.1 s follows 0 s");
+        expect(
+            "t,x,phi\n0,0,0\n-0.1,0,0\n",
+            Some(3),
+            Some("t"),
+            "-0.1 s follows 0 s",
+        );
     }
 
     #[test]
     fn rows_are_editor_lines_even_after_blank_lines() {
         // Line 4 is blank; the bad value is on line 5.
-        expect("t,x,phi\n0,0,0\n1,0,0\n\n2,zz,0\n", Some(5), Some("x"), "`zz`");
+        expect(
+            "t,x,phi\n0,0,0\n1,0,0\n\n2,zz,0\n",
+            Some(5),
+            Some("x"),
+            "`zz`",
+        );
+        expect(
+            "t,x,phi\r\n0,0,0\r\n\r\n\r\n1,0,0\r\n0.5,0,0\r\n",
+            Some(6),
+            Some("t"),
+            "follows",
+        );
+        expect("t,x,phi\n\n0,0,0\n0,0,0\n", Some(4), Some("t"), "follows");
     }
 
     #[test]
@@ -425,7 +508,9 @@ mod tests {
     fn write_then_read_round_trips_exactly() {
         let mut rng = StdRng::seed_from_u64(3);
         let n = 500;
-        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3 + 1e-9 * rng.random::<f64>()).collect();
+        let t: Vec<f64> = (0..n)
+            .map(|i| i as f64 * 1e-3 + 1e-9 * rng.random::<f64>())
+            .collect();
         let rand_col = |rng: &mut StdRng| -> Vec<f64> {
             (0..n)
                 .map(|i| {
@@ -477,13 +562,51 @@ mod tests {
         let e = rec.write_csv(&path).unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(2), Some("x")));
         assert!(!path.exists());
-        let e = rec.write_csv(&dir.path().join("no_dir/x.csv"));
-        assert!(e.is_err());
+        let good = Record {
+            x: vec![0.0, 1.0],
+            ..rec
+        };
+        let missing_dir = dir.path().join("no_dir/x.csv");
+        let e = good.write_csv(&missing_dir).unwrap_err();
+        assert!(e.message.contains("cannot write"), "{e}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    /// Reading speed: `cargo test -p stf-core --release -- --ignored --nocapture csv_read_timing`
+    #[test]
+    #[ignore]
+    fn csv_read_timing_150k_rows() {
+        let mut text = String::from("t,phi,x,f_stf\n");
+        for i in 0..150_000 {
+            let t = i as f64 * 1e-3;
+            text += &format!(
+                "{t},{},{},{}\n",
+                0.0235 * t * t,
+                0.02 * t.sin(),
+                0.1 * t.cos()
+            );
+        }
+        let start = std::time::Instant::now();
+        let r = Record::read_csv_from(text.as_bytes(), "big.csv").unwrap();
+        println!(
+            "150 000 rows × 4 columns: {:.1} ms wall",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+        assert_eq!(r.len(), 150_000);
     }
 
     #[test]
     fn format_f64_is_shortest_and_exact() {
-        for v in [0.1, -0.0, 1e-300, 123456.789, 5e-324, f64::MAX, 1e15, 9.99e-5] {
+        for v in [
+            0.1,
+            -0.0,
+            1e-300,
+            123456.789,
+            5e-324,
+            f64::MAX,
+            1e15,
+            9.99e-5,
+        ] {
             let s = format_f64(v);
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
             assert!(s.len() < 26, "{s}");

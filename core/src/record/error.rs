@@ -51,7 +51,9 @@ fn row_part(row: Option<usize>) -> String {
 }
 
 fn column_part(column: Option<&str>) -> String {
-    column.map(|c| format!(", column `{c}`")).unwrap_or_default()
+    column
+        .map(|c| format!(", column `{c}`"))
+        .unwrap_or_default()
 }
 
 #[cfg(test)]
@@ -63,10 +65,18 @@ mod tests {
         let e = RecordError::new("a.csv", "not a number: `x`")
             .at_row(7)
             .in_column("phi");
-        assert_eq!(e.to_string(), "a.csv:row 7, column `phi`: not a number: `x`");
-        assert_eq!(RecordError::new("a.csv", "empty").to_string(), "a.csv: empty");
         assert_eq!(
-            RecordError::new("a.mat", "missing").in_column("t").to_string(),
+            e.to_string(),
+            "a.csv:row 7, column `phi`: not a number: `x`"
+        );
+        assert_eq!(
+            RecordError::new("a.csv", "empty").to_string(),
+            "a.csv: empty"
+        );
+        assert_eq!(
+            RecordError::new("a.mat", "missing")
+                .in_column("t")
+                .to_string(),
             "a.mat, column `t`: missing"
         );
     }

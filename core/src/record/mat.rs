@@ -14,8 +14,8 @@ const SAVE_HINT: &str = "save the signals as double vectors with `save(file, ...
 /// Read a record from a `.mat` file.
 pub(super) fn read(path: &Path, names: &ColumnNames) -> Result<Record, RecordError> {
     let source = path.display().to_string();
-    let bytes = std::fs::read(path)
-        .map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
     check_header(&source, &bytes)?;
     let file = matfile::MatFile::parse(&bytes[..]).map_err(|e| {
         RecordError::new(
@@ -334,6 +334,7 @@ pub(crate) mod tests {
             ]),
         );
         let e = Record::read_mat(&p).unwrap_err();
+        assert!(e.message.starts_with("cannot parse"), "{e}");
         assert!(e.message.contains("int32"), "{e}");
         assert!(e.message.contains("-v7"), "{e}");
     }
@@ -368,7 +369,11 @@ pub(crate) mod tests {
         let p = write(
             dir.path(),
             "bt.mat",
-            &mat_v5(&[col("t", &t, true), col("x", &X, true), col("phi", &PHI, true)]),
+            &mat_v5(&[
+                col("t", &t, true),
+                col("x", &X, true),
+                col("phi", &PHI, true),
+            ]),
         );
         let e = Record::read_mat(&p).unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(3), Some("t")), "{e}");
@@ -377,14 +382,22 @@ pub(crate) mod tests {
         let p = write(
             dir.path(),
             "bx.mat",
-            &mat_v5(&[col("t", &T, true), col("x", &x, true), col("phi", &PHI, true)]),
+            &mat_v5(&[
+                col("t", &T, true),
+                col("x", &x, true),
+                col("phi", &PHI, true),
+            ]),
         );
         let e = Record::read_mat(&p).unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(4), Some("x")), "{e}");
         let p = write(
             dir.path(),
             "len.mat",
-            &mat_v5(&[col("t", &T, true), col("x", &X[..3], true), col("phi", &PHI, true)]),
+            &mat_v5(&[
+                col("t", &T, true),
+                col("x", &X[..3], true),
+                col("phi", &PHI, true),
+            ]),
         );
         let e = Record::read_mat(&p).unwrap_err();
         assert_eq!(e.column.as_deref(), Some("x"), "{e}");
@@ -398,7 +411,10 @@ pub(crate) mod tests {
         v73[..19].copy_from_slice(b"MATLAB 7.3 MAT-file");
         v73[124..126].copy_from_slice(&0x0200u16.to_le_bytes());
         let e = Record::read_mat(&write(dir.path(), "h.mat", &v73)).unwrap_err();
-        assert!(e.message.contains("v7.3 (HDF5)") && e.message.contains("-v7"), "{e}");
+        assert!(
+            e.message.contains("v7.3 (HDF5)") && e.message.contains("-v7"),
+            "{e}"
+        );
         let mut v4 = vec![0u8; 200];
         v4[4] = 1;
         let e = Record::read_mat(&write(dir.path(), "v4.mat", &v4)).unwrap_err();

@@ -229,10 +229,7 @@ impl Record {
     }
 
     /// Read CSV text from `reader` with the default column names; `source` names it in errors.
-    pub fn read_csv_from<R: std::io::Read>(
-        reader: R,
-        source: &str,
-    ) -> Result<Record, RecordError> {
+    pub fn read_csv_from<R: std::io::Read>(reader: R, source: &str) -> Result<Record, RecordError> {
         ReadOptions::default().read_csv_from(reader, source)
     }
 
