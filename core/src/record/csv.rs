@@ -314,6 +314,7 @@ pub(super) fn write(record: &Record, path: &Path) -> Result<(), RecordError> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests may unwrap
 mod tests {
     use super::super::{ReadOptions, MEMORY_SOURCE};
     use super::*;

@@ -135,7 +135,8 @@ fn vector(
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+#[allow(clippy::unwrap_used)] // tests may unwrap
+mod tests {
     use super::*;
 
     /// MATLAB array classes used by the generator.
