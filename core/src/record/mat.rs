@@ -1,0 +1,426 @@
+//! Records as MATLAB `.mat` files (level 5: MATLAB's `-v6` and `-v7` formats).
+//!
+//! Each signal is a numeric vector variable (row or column) named like the CSV column.
+//! Double, single and integer classes are read and converted to `f64`. Limits of the
+//! `matfile` reader, turned into clear errors: v4 and v7.3 (HDF5) files cannot be read; an
+//! `int32` variable anywhere in the file makes the whole file unreadable; `char`, `struct` and
+//! `cell` variables are invisible. Rows in errors are the 1-based element of the vector.
+
+use super::{ColumnNames, Columns, Record, RecordError};
+use std::path::Path;
+
+const SAVE_HINT: &str = "save the signals as double vectors with `save(file, ..., '-v7')`";
+
+/// Read a record from a `.mat` file.
+pub(super) fn read(path: &Path, names: &ColumnNames) -> Result<Record, RecordError> {
+    let source = path.display().to_string();
+    let bytes =
+        std::fs::read(path).map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
+    check_header(&source, &bytes)?;
+    let file = matfile::MatFile::parse(&bytes[..]).map_err(|e| {
+        RecordError::new(
+            &source,
+            format!(
+                "cannot parse the .mat file ({e}); the reader handles numeric double, single \
+                 and (u)int8/16 arrays, and a single int32 variable makes the whole file \
+                 unreadable: {SAVE_HINT}"
+            ),
+        )
+    })?;
+    let get = |name: &str| vector(&source, &file, name);
+    let missing = |name: &str, extra: &str| {
+        let known: Vec<&str> = file.arrays().iter().map(|a| a.name()).collect();
+        RecordError::new(
+            &source,
+            format!(
+                "missing variable `{name}`{extra}; numeric variables in the file: {} \
+                 (char, struct and cell variables are not read: {SAVE_HINT})",
+                if known.is_empty() {
+                    "none".to_string()
+                } else {
+                    known.join(", ")
+                }
+            ),
+        )
+        .in_column(name)
+    };
+    let t = get(&names.t)?.ok_or_else(|| missing(&names.t, ""))?;
+    let x = get(&names.x)?.ok_or_else(|| missing(&names.x, ""))?;
+    let phi = get(&names.phi)?;
+    let u = get(&names.u)?;
+    if phi.is_none() && u.is_none() {
+        return Err(missing(
+            &names.phi,
+            &format!(" (or `{}` for a force-driven rig)", names.u),
+        ));
+    }
+    Columns {
+        t,
+        x,
+        phi,
+        f_stf: get(&names.f_stf)?,
+        omega: get(&names.omega)?,
+        u,
+    }
+    .into_record(&source, names, &|i| i + 1)
+}
+
+/// Recognise v4 and v7.3 files before the parser fails on them obscurely.
+fn check_header(source: &str, bytes: &[u8]) -> Result<(), RecordError> {
+    let not_v5 = |what: &str| {
+        RecordError::new(
+            source,
+            format!("{what}; only MATLAB level-5 files (-v6, -v7) are read: {SAVE_HINT}"),
+        )
+    };
+    if bytes.len() < 128 {
+        return Err(not_v5("too short to be a MATLAB .mat file"));
+    }
+    let text = String::from_utf8_lossy(&bytes[..116]);
+    let version = match &bytes[126..128] {
+        b"IM" => u16::from_le_bytes([bytes[124], bytes[125]]),
+        b"MI" => u16::from_be_bytes([bytes[124], bytes[125]]),
+        _ => 0,
+    };
+    if text.starts_with("MATLAB 7.3") || version == 0x0200 {
+        return Err(not_v5("a MATLAB v7.3 (HDF5) file"));
+    }
+    if bytes[..4].contains(&0) {
+        return Err(not_v5("looks like a MATLAB v4 file"));
+    }
+    if !text.starts_with("MATLAB") || version != 0x0100 {
+        return Err(not_v5("not a MATLAB .mat file (no level-5 header)"));
+    }
+    Ok(())
+}
+
+/// The variable `name` as a vector of f64, if present.
+fn vector(
+    source: &str,
+    file: &matfile::MatFile,
+    name: &str,
+) -> Result<Option<Vec<f64>>, RecordError> {
+    let Some(array) = file.find_by_name(name) else {
+        return Ok(None);
+    };
+    let err = |message: String| RecordError::new(source, message).in_column(name);
+    let size = array.size();
+    if size.iter().filter(|&&d| d > 1).count() > 1 {
+        let dims: Vec<String> = size.iter().map(usize::to_string).collect();
+        return Err(err(format!(
+            "is a {} array, not a vector: store one signal per variable",
+            dims.join("×")
+        )));
+    }
+    use matfile::NumericData as D;
+    fn widen<T: Copy + Into<f64>>(v: &[T]) -> Vec<f64> {
+        v.iter().map(|&x| x.into()).collect()
+    }
+    let (values, complex) = match array.data() {
+        D::Double { real, imag } => (real.clone(), imag.is_some()),
+        D::Single { real, imag } => (widen(real), imag.is_some()),
+        D::Int8 { real, imag } => (widen(real), imag.is_some()),
+        D::UInt8 { real, imag } => (widen(real), imag.is_some()),
+        D::Int16 { real, imag } => (widen(real), imag.is_some()),
+        D::UInt16 { real, imag } => (widen(real), imag.is_some()),
+        D::Int32 { real, imag } => (widen(real), imag.is_some()),
+        D::UInt32 { real, imag } => (widen(real), imag.is_some()),
+        D::Int64 { real, imag } => (real.iter().map(|&x| x as f64).collect(), imag.is_some()),
+        D::UInt64 { real, imag } => (real.iter().map(|&x| x as f64).collect(), imag.is_some()),
+    };
+    if complex {
+        return Err(err("is complex; a signal must be real".into()));
+    }
+    Ok(Some(values))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // tests may unwrap
+mod tests {
+    use super::*;
+
+    /// MATLAB array classes used by the generator.
+    #[derive(Clone, Copy)]
+    pub enum Class {
+        Double,
+        Int32,
+        Char,
+    }
+
+    /// One variable for [`mat_v5`].
+    pub struct Var<'a> {
+        pub name: &'a str,
+        pub dims: [i32; 2],
+        pub values: &'a [f64],
+        pub class: Class,
+    }
+
+    fn element(out: &mut Vec<u8>, data_type: u32, payload: &[u8]) {
+        if payload.len() <= 4 {
+            // Small data element format: type and size share the tag, data in 4 bytes.
+            out.extend_from_slice(&(data_type | ((payload.len() as u32) << 16)).to_le_bytes());
+            out.extend_from_slice(payload);
+            out.extend(std::iter::repeat_n(0u8, 4 - payload.len()));
+        } else {
+            out.extend_from_slice(&data_type.to_le_bytes());
+            out.extend_from_slice(&(payload.len() as u32).to_le_bytes());
+            out.extend_from_slice(payload);
+            out.extend(std::iter::repeat_n(0u8, (8 - payload.len() % 8) % 8));
+        }
+    }
+
+    /// A minimal little-endian level-5 MAT file: a 128-byte header, then one uncompressed
+    /// miMATRIX element per variable (array flags, dimensions, name, real part).
+    pub fn mat_v5(vars: &[Var]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut text = b"MATLAB 5.0 MAT-file, written by stf-core tests".to_vec();
+        text.resize(116, b' ');
+        out.extend_from_slice(&text);
+        out.extend_from_slice(&[0u8; 8]);
+        out.extend_from_slice(&0x0100u16.to_le_bytes());
+        out.extend_from_slice(b"IM");
+        for v in vars {
+            let mut body = Vec::new();
+            let class_code: u32 = match v.class {
+                Class::Double => 6,
+                Class::Int32 => 12,
+                Class::Char => 4,
+            };
+            let mut flags = class_code.to_le_bytes().to_vec();
+            flags.extend_from_slice(&0u32.to_le_bytes());
+            element(&mut body, 6, &flags); // miUINT32
+            let dims: Vec<u8> = v.dims.iter().flat_map(|d| d.to_le_bytes()).collect();
+            element(&mut body, 5, &dims); // miINT32
+            element(&mut body, 1, v.name.as_bytes()); // miINT8
+            match v.class {
+                Class::Double => {
+                    let data: Vec<u8> = v.values.iter().flat_map(|x| x.to_le_bytes()).collect();
+                    element(&mut body, 9, &data); // miDOUBLE
+                }
+                Class::Int32 => {
+                    let data: Vec<u8> = v
+                        .values
+                        .iter()
+                        .flat_map(|&x| (x as i32).to_le_bytes())
+                        .collect();
+                    element(&mut body, 5, &data); // miINT32
+                }
+                Class::Char => {
+                    let data: Vec<u8> = v
+                        .values
+                        .iter()
+                        .flat_map(|&x| (x as u16).to_le_bytes())
+                        .collect();
+                    element(&mut body, 4, &data); // miUINT16
+                }
+            }
+            element(&mut out, 14, &body); // miMATRIX
+        }
+        out
+    }
+
+    fn write(dir: &Path, name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+
+    fn col<'a>(name: &'a str, values: &'a [f64], column: bool) -> Var<'a> {
+        let n = values.len() as i32;
+        Var {
+            name,
+            dims: if column { [n, 1] } else { [1, n] },
+            values,
+            class: Class::Double,
+        }
+    }
+
+    const T: [f64; 4] = [0.0, 0.001, 0.002, 0.003];
+    const X: [f64; 4] = [1e-3, 1.5e-3, -2e-3, 0.1];
+    const PHI: [f64; 4] = [0.0, 0.01, 0.0201, 0.0303];
+    const F: [f64; 4] = [0.1, -0.2, 0.3, 1e-9];
+
+    #[test]
+    fn same_data_as_csv_and_mat_read_identically() {
+        let dir = tempfile::tempdir().unwrap();
+        let bytes = mat_v5(&[
+            col("t", &T, true),
+            col("x", &X, false),
+            col("phi", &PHI, true),
+            col("f_stf", &F, false),
+            col("other_signal", &F, true),
+        ]);
+        let mat = Record::read(&write(dir.path(), "r.mat", &bytes)).unwrap();
+        let mut csv = String::from("t,x,phi,f_stf\n");
+        for i in 0..4 {
+            csv += &format!("{},{},{},{}\n", T[i], X[i], PHI[i], F[i]);
+        }
+        let csv = Record::read(&write(dir.path(), "r.csv", csv.as_bytes())).unwrap();
+        assert_eq!(mat.t, csv.t);
+        assert_eq!(mat.x, csv.x);
+        assert_eq!(mat.phi, csv.phi);
+        assert_eq!(mat.f_stf, csv.f_stf);
+        assert_eq!(mat.omega, None);
+        assert!(mat.source.ends_with("r.mat"));
+    }
+
+    #[test]
+    fn committed_fixture_matches_its_csv_twin() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+        let mat = Record::read(&data.join("small_record.mat")).unwrap();
+        let csv = Record::read(&data.join("small_record.csv")).unwrap();
+        assert_eq!(mat.len(), csv.len());
+        assert_eq!((mat.t, mat.x, mat.phi), (csv.t, csv.x, csv.phi));
+    }
+
+    #[test]
+    fn missing_variable_names_it_and_lists_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "m.mat",
+            &mat_v5(&[col("t", &T, true), col("phi", &PHI, true)]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!(e.column.as_deref(), Some("x"));
+        assert!(e.message.contains("variables in the file: t, phi"), "{e}");
+        assert!(e.to_string().starts_with(&p.display().to_string()), "{e}");
+        let p = write(
+            dir.path(),
+            "n.mat",
+            &mat_v5(&[col("t", &T, true), col("x", &X, true)]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert!(e.message.contains("(or `u` for a force-driven rig)"), "{e}");
+    }
+
+    #[test]
+    fn char_variable_is_reported_as_missing_with_the_hint() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "c.mat",
+            &mat_v5(&[
+                col("t", &T, true),
+                Var {
+                    name: "x",
+                    dims: [1, 4],
+                    values: &[97.0, 98.0, 99.0, 100.0],
+                    class: Class::Char,
+                },
+                col("phi", &PHI, true),
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!(e.column.as_deref(), Some("x"));
+        assert!(e.message.contains("char, struct and cell"), "{e}");
+    }
+
+    #[test]
+    fn int32_variable_gives_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "i.mat",
+            &mat_v5(&[
+                col("t", &T, true),
+                col("x", &X, true),
+                col("phi", &PHI, true),
+                Var {
+                    name: "count",
+                    dims: [4, 1],
+                    values: &[1.0, 2.0, 3.0, 4.0],
+                    class: Class::Int32,
+                },
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert!(e.message.starts_with("cannot parse"), "{e}");
+        assert!(e.message.contains("int32"), "{e}");
+        assert!(e.message.contains("-v7"), "{e}");
+    }
+
+    #[test]
+    fn matrix_variable_is_rejected() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "mx.mat",
+            &mat_v5(&[
+                col("t", &T, true),
+                Var {
+                    name: "x",
+                    dims: [2, 2],
+                    values: &X,
+                    class: Class::Double,
+                },
+                col("phi", &PHI, true),
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!(e.column.as_deref(), Some("x"));
+        assert!(e.message.contains("2×2 array, not a vector"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_name_the_element_row() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut t = T;
+        t[2] = t[1];
+        let p = write(
+            dir.path(),
+            "bt.mat",
+            &mat_v5(&[
+                col("t", &t, true),
+                col("x", &X, true),
+                col("phi", &PHI, true),
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!((e.row, e.column.as_deref()), (Some(3), Some("t")), "{e}");
+        let mut x = X;
+        x[3] = f64::NAN;
+        let p = write(
+            dir.path(),
+            "bx.mat",
+            &mat_v5(&[
+                col("t", &T, true),
+                col("x", &x, true),
+                col("phi", &PHI, true),
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!((e.row, e.column.as_deref()), (Some(4), Some("x")), "{e}");
+        let p = write(
+            dir.path(),
+            "len.mat",
+            &mat_v5(&[
+                col("t", &T, true),
+                col("x", &X[..3], true),
+                col("phi", &PHI, true),
+            ]),
+        );
+        let e = Record::read_mat(&p).unwrap_err();
+        assert_eq!(e.column.as_deref(), Some("x"), "{e}");
+        assert!(e.message.contains("same length"), "{e}");
+    }
+
+    #[test]
+    fn v73_v4_and_garbage_files_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut v73 = mat_v5(&[col("t", &T, true)]);
+        v73[..19].copy_from_slice(b"MATLAB 7.3 MAT-file");
+        v73[124..126].copy_from_slice(&0x0200u16.to_le_bytes());
+        let e = Record::read_mat(&write(dir.path(), "h.mat", &v73)).unwrap_err();
+        assert!(
+            e.message.contains("v7.3 (HDF5)") && e.message.contains("-v7"),
+            "{e}"
+        );
+        let mut v4 = vec![0u8; 200];
+        v4[4] = 1;
+        let e = Record::read_mat(&write(dir.path(), "v4.mat", &v4)).unwrap_err();
+        assert!(e.message.contains("v4"), "{e}");
+        let e = Record::read_mat(&write(dir.path(), "s.mat", b"hello")).unwrap_err();
+        assert!(e.message.contains("too short"), "{e}");
+    }
+}
