@@ -531,7 +531,7 @@ params = { K = 4.0, n = 1.5 }
         )
         .unwrap();
         assert_eq!(e.models.len(), 1);
-        assert_eq!(e.models[0].line, 9);
+        assert_eq!(e.models[0].line, 8); // the `[[models]]` header
         assert_eq!(e.data_file.unwrap(), PathBuf::from("./record.csv"));
         let s = e.simulate.unwrap();
         assert_eq!((s.t0, s.t1), (50.0, 200.0));
