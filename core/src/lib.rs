@@ -32,6 +32,7 @@ pub mod excitation;
 pub mod force_model;
 pub mod integrate;
 pub mod interpolate;
+pub mod kinematics;
 pub mod model_sum;
 pub mod oscillator;
 pub mod params;
