@@ -121,7 +121,7 @@ impl Kinematics {
             (None, None) => None,
         };
         let motion = match &s.motion {
-            Some(f) => f.clone(),
+            Some(f) => *f,
             None => {
                 let f = dominant_frequency(omega.as_deref(), &record.x, dt);
                 let mean = record.x.iter().sum::<f64>() / record.x.len() as f64;
