@@ -181,3 +181,80 @@ impl DormandPrince {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y1' = y2, y2' = −y1 + cos(2t): exact y1 = (4/3)·cos t − (1/3)·cos 2t from (1, 0).
+    struct Forced;
+    impl OdeSystem for Forced {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+            dy[0] = y[1];
+            dy[1] = -y[0] + (2.0 * t).cos();
+            Ok(())
+        }
+    }
+
+    fn exact(t: f64) -> f64 {
+        4.0 / 3.0 * t.cos() - (2.0 * t).cos() / 3.0
+    }
+
+    fn fixed_steps(n: usize) -> (f64, f64) {
+        let mut dp = DormandPrince::new(2);
+        let (mut t, mut y, mut f0) = (0.0, vec![1.0, 0.0], vec![0.0; 2]);
+        Forced.rhs(t, &y, &mut f0).unwrap();
+        let h = 4.0 / n as f64;
+        let mut calls = 0;
+        let mut dense_err: f64 = 0.0;
+        let mut mid = [0.0; 2];
+        for _ in 0..n {
+            dp.trial(&Forced, t, &y, &f0, h, 1.0, 1.0, &mut calls)
+                .unwrap();
+            dp.accept(&y, h);
+            dp.dense(0.3, &mut mid);
+            dense_err = dense_err.max((mid[0] - exact(t + 0.3 * h)).abs());
+            y.copy_from_slice(&dp.y_new);
+            f0.copy_from_slice(dp.f_new());
+            t += h;
+        }
+        ((y[0] - exact(t)).abs(), dense_err)
+    }
+
+    #[test]
+    fn converges_with_order_five_and_dense_output_with_order_four() {
+        let (e1, d1) = fixed_steps(10);
+        let (e2, d2) = fixed_steps(20);
+        let (e3, d3) = fixed_steps(40);
+        let order = ((e1 / e2).log2() + (e2 / e3).log2()) / 2.0;
+        let dense_order = ((d1 / d2).log2() + (d2 / d3).log2()) / 2.0;
+        eprintln!("errors {e1:.2e} {e2:.2e} {e3:.2e} (order {order:.2}); dense {d1:.2e} {d2:.2e} {d3:.2e} (order {dense_order:.2})");
+        assert!((4.6..5.6).contains(&order), "order {order}");
+        assert!(dense_order > 3.7, "dense order {dense_order}");
+    }
+
+    #[test]
+    fn stiffness_indicator_reads_h_times_the_eigenvalue() {
+        // y' = −λ·y: k7 − k6 = −λ·(y1 − y6), so the indicator is exactly h·λ.
+        struct Decay;
+        impl OdeSystem for Decay {
+            fn dim(&self) -> usize {
+                1
+            }
+            fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+                dy[0] = -300.0 * y[0];
+                Ok(())
+            }
+        }
+        let mut dp = DormandPrince::new(1);
+        let mut calls = 0;
+        let trial = dp
+            .trial(&Decay, 0.0, &[1.0], &[-300.0], 0.01, 1e-6, 1e-6, &mut calls)
+            .unwrap();
+        assert!((trial.h_lambda - 3.0).abs() < 1e-9, "{}", trial.h_lambda);
+        assert_eq!(calls, 6);
+    }
+}

@@ -235,3 +235,81 @@ impl Rodas4 {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y' = −2t·y², y(0) = 1: y = 1/(1 + t²) (non-autonomous, so ∂f/∂t matters).
+    struct Riccati;
+    impl OdeSystem for Riccati {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+            dy[0] = -2.0 * t * y[0] * y[0];
+            Ok(())
+        }
+    }
+
+    /// Fixed steps over [0, 2]; returns the error at the end and the largest error of the
+    /// dense output at the midpoints.
+    fn fixed_steps(n: usize) -> (f64, f64) {
+        let exact = |t: f64| 1.0 / (1.0 + t * t);
+        let mut r = Rodas4::new(1);
+        let (mut t, mut y, mut f0) = (0.0, vec![1.0], vec![0.0]);
+        let h = 2.0 / n as f64;
+        let mut calls = 0;
+        let mut dense_err: f64 = 0.0;
+        let mut mid = [0.0];
+        for _ in 0..n {
+            Riccati.rhs(t, &y, &mut f0).unwrap();
+            r.linearise(&Riccati, t, &y, &f0, &mut calls).unwrap();
+            r.trial(&Riccati, t, &y, &f0, h, 1.0, 1.0, &mut calls)
+                .unwrap();
+            r.accept(&y);
+            r.dense(0.5, &mut mid);
+            dense_err = dense_err.max((mid[0] - exact(t + 0.5 * h)).abs());
+            y.copy_from_slice(&r.y_new);
+            t += h;
+        }
+        ((y[0] - exact(t)).abs(), dense_err)
+    }
+
+    #[test]
+    fn converges_with_order_four_and_dense_output_with_order_three() {
+        let (e1, d1) = fixed_steps(20);
+        let (e2, d2) = fixed_steps(40);
+        let (e3, d3) = fixed_steps(80);
+        let order = ((e1 / e2).log2() + (e2 / e3).log2()) / 2.0;
+        let dense_order = ((d1 / d2).log2() + (d2 / d3).log2()) / 2.0;
+        eprintln!("errors {e1:.2e} {e2:.2e} {e3:.2e} (order {order:.2}); dense {d1:.2e} {d2:.2e} {d3:.2e} (order {dense_order:.2})");
+        assert!((3.6..4.6).contains(&order), "order {order}");
+        assert!(dense_order > 2.7, "dense order {dense_order}");
+    }
+
+    #[test]
+    fn is_l_stable_on_a_very_stiff_linear_decay() {
+        // y' = −1e8·y with one step of h = 1: the exact factor is 0; A-stable but not
+        // L-stable methods would leave a factor near ±1.
+        struct Fast;
+        impl OdeSystem for Fast {
+            fn dim(&self) -> usize {
+                1
+            }
+            fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError> {
+                dy[0] = -1e8 * y[0];
+                Ok(())
+            }
+        }
+        let mut r = Rodas4::new(1);
+        let y = [1.0];
+        let mut f0 = [0.0];
+        Fast.rhs(0.0, &y, &mut f0).unwrap();
+        let mut calls = 0;
+        r.linearise(&Fast, 0.0, &y, &f0, &mut calls).unwrap();
+        r.trial(&Fast, 0.0, &y, &f0, 1.0, 1e-6, 1e-6, &mut calls)
+            .unwrap();
+        assert!(r.y_new[0].abs() < 1e-6, "{}", r.y_new[0]);
+    }
+}
