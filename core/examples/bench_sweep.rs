@@ -66,10 +66,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows = Vec::new();
     for method in [Method::Dopri5, Method::Auto, Method::Rodas4] {
         let settings = Settings::default().method(method);
-        let (t_int, sol) = best_of(repeats, || integrate(&osc, times[0], &y0, &times, &settings));
+        let (t_int, sol) = best_of(repeats, || {
+            integrate(&osc, times[0], &y0, &times, &settings)
+        });
         let sol = sol?;
         let (t_sim, run) = best_of(repeats, || {
-            Simulation::new(&osc).settings(settings.clone()).run_at(&times)
+            Simulation::new(&osc)
+                .settings(settings.clone())
+                .run_at(&times)
         });
         run?;
         println!(

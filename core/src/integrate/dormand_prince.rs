@@ -116,23 +116,23 @@ impl DormandPrince {
         sys.rhs(t + C5 * h, yt, k5)?;
         let ys = &mut self.ysti;
         for i in 0..n {
-            ys[i] = y[i]
-                + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+            ys[i] =
+                y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
         }
         let t_new = t + h;
         sys.rhs(t_new, ys, k6)?;
         let yn = &mut self.y_new;
         for i in 0..n {
-            yn[i] = y[i]
-                + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
+            yn[i] =
+                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
         }
         sys.rhs(t_new, yn, k7)?;
         *calls += 6;
         let mut sum = 0.0;
         let (mut num, mut den) = (0.0, 0.0);
         for i in 0..n {
-            let e = h
-                * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            let e =
+                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
             let sk = atol + rtol * y[i].abs().max(yn[i].abs());
             sum += (e / sk) * (e / sk);
             num += (k7[i] - k6[i]) * (k7[i] - k6[i]);
@@ -163,8 +163,8 @@ impl DormandPrince {
             c1[i] = ydiff;
             c2[i] = bspl;
             c3[i] = ydiff - h * k7[i] - bspl;
-            c4[i] = h
-                * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
+            c4[i] =
+                h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
         }
     }
 
@@ -176,13 +176,13 @@ impl DormandPrince {
         for (i, o) in out.iter_mut().enumerate() {
             *o = c[i]
                 + theta
-                    * (c[n + i]
-                        + s1 * (c[2 * n + i] + theta * (c[3 * n + i] + s1 * c[4 * n + i])));
+                    * (c[n + i] + s1 * (c[2 * n + i] + theta * (c[3 * n + i] + s1 * c[4 * n + i])));
         }
     }
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

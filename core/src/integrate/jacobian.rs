@@ -103,6 +103,7 @@ fn power_iteration(jac: &[f64], n: usize) -> f64 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

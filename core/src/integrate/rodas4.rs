@@ -172,8 +172,7 @@ impl Rodas4 {
         }
         sys.rhs(t + C4 * h, yt, ft)?;
         for i in 0..n {
-            k4[i] =
-                ft[i] + h * D4 * fx[i] + (C41 * k1[i] + C42 * k2[i] + C43 * k3[i]) * inv_h;
+            k4[i] = ft[i] + h * D4 * fx[i] + (C41 * k1[i] + C42 * k2[i] + C43 * k3[i]) * inv_h;
         }
         self.lu.solve(k4);
         // Stage 5, at t + h.
@@ -183,8 +182,7 @@ impl Rodas4 {
         let t_new = t + h;
         sys.rhs(t_new, yt, ft)?;
         for i in 0..n {
-            k5[i] = ft[i]
-                + (C51 * k1[i] + C52 * k2[i] + C53 * k3[i] + C54 * k4[i]) * inv_h;
+            k5[i] = ft[i] + (C51 * k1[i] + C52 * k2[i] + C53 * k3[i] + C54 * k4[i]) * inv_h;
         }
         self.lu.solve(k5);
         // Stage 6, at t + h; its argument plus k6 is the new state, k6 the error.
@@ -194,8 +192,7 @@ impl Rodas4 {
         sys.rhs(t_new, yt, ft)?;
         for i in 0..n {
             k6[i] = ft[i]
-                + (C61 * k1[i] + C62 * k2[i] + C63 * k3[i] + C64 * k4[i] + C65 * k5[i])
-                    * inv_h;
+                + (C61 * k1[i] + C62 * k2[i] + C63 * k3[i] + C64 * k4[i] + C65 * k5[i]) * inv_h;
         }
         self.lu.solve(k6);
         *calls += 5;
@@ -237,6 +234,7 @@ impl Rodas4 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

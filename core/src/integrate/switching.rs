@@ -28,6 +28,7 @@
 //! their code RODAS (method 1); Dormand–Prince: Solving ODEs I, §II.5 and their code DOPRI5.
 
 use super::dormand_prince::DormandPrince;
+use super::jacobian::spectral_radius;
 use super::rodas4::Rodas4;
 use super::{OdeSystem, Settings, SimError, Solution, Stats};
 
@@ -52,6 +53,11 @@ const STIFF_H_LAMBDA: f64 = 3.25;
 const STIFF_READINGS: u32 = 15;
 /// Calm readings that reset the stiff count.
 const CALM_READINGS: u32 = 6;
+/// Every this many accepted explicit steps the Jacobian is taken as a second indicator ...
+const JACOBIAN_CHECK_EVERY: u64 = 25;
+/// ... which reads stiff when `ρ·h` of the step just taken exceeds this; two such readings in a
+/// row hand over to Rodas4.
+const JACOBIAN_STIFF_RHO_H: f64 = 2.5;
 /// `ρ·h` below this lets the explicit method take over again.
 const EXPLICIT_RHO_H: f64 = 2.0;
 /// Rodas4 steps in a row that must satisfy it.
@@ -110,7 +116,11 @@ pub(super) fn run(
         return Ok(states);
     }
     let span = t_end - t0;
-    let h_max = if s.h_max > 0.0 { s.h_max.min(span) } else { span };
+    let h_max = if s.h_max > 0.0 {
+        s.h_max.min(span)
+    } else {
+        span
+    };
     let mut calls = 0u64;
 
     let mut t = t0;
@@ -139,6 +149,9 @@ pub(super) fn run(
     // Switching state.
     let (mut stiff_count, mut calm_count, mut explicit_count) = (0u32, 0u32, 0u32);
     let mut steps = 0u64;
+    let mut explicit_accepted = 0u64;
+    let mut jacobian_stiff = false;
+    let mut jac = vec![0.0; n * n];
 
     while t < t_end {
         if steps >= u64::from(s.max_steps) {
@@ -150,7 +163,8 @@ pub(super) fn run(
             h = t_end - t;
             last = true;
         }
-        if !(h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE)) {
+        let resolvable = h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
+        if !resolvable {
             work.stats.rhs_calls = calls;
             return Err(if non_finite_last {
                 SimError::NonFinite {
@@ -178,6 +192,7 @@ pub(super) fn run(
                     }
                     y.copy_from_slice(&dp.y_new);
                     f0.copy_from_slice(dp.f_new());
+                    let t_prev = t;
                     t = t_new;
                     work.stats.accepted += 1;
                     let fac = (fac11 / fac_old.powf(0.04) / 0.9).clamp(0.1, 5.0);
@@ -189,21 +204,32 @@ pub(super) fn run(
                     rejected_last = false;
                     h = h_new;
                     if policy == Policy::Switching {
+                        explicit_accepted += 1;
+                        let mut stiff_now = false;
+                        if explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
+                            calls += sys.jacobian(t, &y, &f0, &mut jac)?;
+                            let rho_h = spectral_radius(&jac, n) * (t - t_prev);
+                            stiff_now = jacobian_stiff && rho_h > JACOBIAN_STIFF_RHO_H;
+                            jacobian_stiff = rho_h > JACOBIAN_STIFF_RHO_H;
+                        }
                         if trial.h_lambda > STIFF_H_LAMBDA {
                             calm_count = 0;
                             stiff_count += 1;
-                            if stiff_count >= STIFF_READINGS {
-                                mode = Mode::Stiff;
-                                work.to_stiff += 1;
-                                stiff_count = 0;
-                                explicit_count = 0;
-                                gustafsson = None;
-                                linearised = false;
-                            }
                         } else {
                             calm_count += 1;
                             if calm_count >= CALM_READINGS {
                                 stiff_count = 0;
+                            }
+                        }
+                        if stiff_now || stiff_count >= STIFF_READINGS {
+                            {
+                                mode = Mode::Stiff;
+                                work.to_stiff += 1;
+                                stiff_count = 0;
+                                explicit_count = 0;
+                                jacobian_stiff = false;
+                                gustafsson = None;
+                                linearised = false;
                             }
                         }
                     }
