@@ -6,23 +6,34 @@
 //! h ≈ 4e-5 s by stability alone — 97 % of a sweep's 3.4 M right-hand-side calls. Once the
 //! trolley slides the problem is smooth and an explicit fifth-order method is the cheapest.
 //!
-//! How it switches: while explicit, Hairer's indicator `h·λ ≈ h·‖k7 − k6‖/‖y1 − y6‖` is
-//! watched after every accepted step; 15 readings above 3.25 (the stability boundary) without
-//! 6 calm ones in between hand over to Rodas4. While stiff, the spectral radius ρ of the
-//! Jacobian taken for each step is compared with the next step size: after 3 accepted steps with
-//! `ρ·h ≤ 2` the explicit method would be stable at that size and takes over again. Either way
-//! each step is error-controlled at the requested tolerances and sampled through its own dense
+//! How it switches: while explicit, two indicators are watched. Hairer's `h·λ ≈
+//! h·‖k7 − k6‖/‖y1 − y6‖` after every accepted step: 15 readings above 3.25 (the stability
+//! boundary) without 6 calm ones in between hand over to Rodas4. And every 25 accepted steps the
+//! Jacobian's spectral radius ρ: two readings in a row with `ρ·h > 2.5` do the same (Hairer's
+//! indicator alone can take thousands of steps when the stiff mode has died out). While stiff,
+//! ρ of the Jacobian taken for each step is compared with the next step size: after 3 accepted
+//! steps with `ρ·h ≤ 2` the explicit method would be stable at that size and takes over again
+//! (at 6 calls a step against Rodas4's 5 + dim + 2 it is then the cheaper one). Either way each
+//! step is error-controlled at the requested tolerances and sampled through its own dense
 //! output (4th order for Dormand–Prince, 3rd for Rodas4), never past the last step: switching
 //! changes the cost, not the accuracy contract. A step that cannot be made small enough ends the
 //! run with [`SimError::StepSizeTooSmall`] at its time; a non-finite state or Jacobian with
-//! [`SimError::NonFinite`].
+//! [`SimError::NonFinite`]; an error of the right-hand side is returned as it is.
+//!
+//! Known limit: like every Rosenbrock method without the Prothero–Robinson conditions, Rodas4
+//! loses order on stiff problems of the form `y' = λ·(y − g(t)) + g'(t)` at tight tolerances
+//! (the error stays controlled, but steps shrink faster than `tol^(1/4)`); the stuck trolley is
+//! of that form, yet its stuck phases take only ≈ 1 % of the sweep's work. Rodas4P/Rodas5P would
+//! lift it.
 //!
 //! Why no crate: measured on the 0.047 rad/s² sweep (see STACK.md), `differential-equations`
 //! 0.7 Radau5 took 12.8 ms and levels off near 1e-4 mm; diffsol's BDF 31 ms and pulls
 //! nalgebra 0.35 plus faer; russell_ode's Radau5 70 ms. None can hand a run between an explicit
-//! and a stiff method mid-way, which is what makes the sweep cheap (only ≈ 1 000 of its steps need
-//! the implicit method), so both methods are written here (≈ 500 lines with the tests) and
-//! checked against known solutions and a tight Dormand–Prince reference.
+//! and a stiff method mid-way, which is what makes the sweep cheap (the trolley sticks and
+//! slips ≈ 15 times, then slides), so both methods are written here (≈ 1 200 lines with their
+//! tests) and checked against known solutions, orders of convergence and tight Dormand–Prince
+//! references (`core/tests/stiff_methods.rs`); `cargo run --release -p stf-core --example
+//! bench_sweep` measures the sweep.
 //!
 //! Rodas4 coefficients: Hairer & Wanner, Solving Ordinary Differential Equations II, §IV.7 and
 //! their code RODAS (method 1); Dormand–Prince: Solving ODEs I, §II.5 and their code DOPRI5.
