@@ -20,8 +20,13 @@
 //! assert!((sol.y(1)[0] - (-1.0f64).exp()).abs() < 1e-9);
 //! ```
 
+mod dense_lu;
 mod dopri5;
+mod dormand_prince;
 mod error;
+mod jacobian;
+mod rodas4;
+mod switching;
 
 pub use error::SimError;
 
@@ -34,25 +39,40 @@ pub trait OdeSystem {
 
     /// Right-hand side; an error stops the integration and is returned as it is.
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimError>;
+
+    /// The Jacobian `∂f/∂y` at `(t, y)`, row-major (`jac[i·dim + j] = ∂f_i/∂y_j`), given
+    /// `fy = f(t, y)`; returns how many right-hand-side calls it made. Used by the stiff
+    /// methods; the default takes forward finite differences column by column (`dim` calls).
+    fn jacobian(&self, t: f64, y: &[f64], fy: &[f64], jac: &mut [f64]) -> Result<u64, SimError> {
+        let mut work = vec![0.0; y.len()];
+        jacobian::fd_jacobian(|t, y, dy| self.rhs(t, y, dy), t, y, fy, jac, &mut work)
+    }
 }
 
 /// Which integrator to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
-    /// Explicit Dormand–Prince 5(4) from `ode_solvers`, stiffness detection off.
+    /// Dormand–Prince 5(4) while the problem is not stiff, Rodas4 while it is, switched step
+    /// by step by stiffness detection (the default; cheap through dry-friction sticking).
     #[default]
+    Auto,
+    /// Explicit Dormand–Prince 5(4) from `ode_solvers`, stiffness detection off.
     Dopri5,
+    /// The L-stable Rosenbrock method Rodas4 for every step (for stiff models throughout).
+    Rodas4,
 }
 
 impl Method {
     /// All methods, for listings and error messages.
-    pub const ALL: [Method; 1] = [Method::Dopri5];
+    pub const ALL: [Method; 3] = [Method::Auto, Method::Dopri5, Method::Rodas4];
 
     /// The name used in experiment files.
     pub fn name(self) -> &'static str {
         match self {
+            Method::Auto => "auto",
             Method::Dopri5 => "dopri5",
+            Method::Rodas4 => "rodas4",
         }
     }
 }
@@ -194,6 +214,12 @@ pub fn integrate(
         _ => {}
     }
     match settings.method {
+        Method::Auto => {
+            switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::Switching)
+        }
         Method::Dopri5 => dopri5::integrate(sys, t0, y0, t_out, settings),
+        Method::Rodas4 => {
+            switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::StiffOnly)
+        }
     }
 }

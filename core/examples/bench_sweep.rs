@@ -1,0 +1,136 @@
+//! Benchmark: the 0.047 rad/s² sweep (ω = 0.047·t, t 50 → 200 s, 1 kHz, from rest, no STF)
+//! with plain Dormand–Prince and with the default method, against a tight reference.
+//!
+//! `cargo run --release -p stf-core --example bench_sweep [repeats]`
+//!
+//! Prints, for each method, the best wall time of `repeats` runs (default 5; 20× as many for the
+//! fast methods) of `integrate` alone (and its mean CPU time) and of a whole `Simulation::run` (which also evaluates the forces at every sample),
+//! the right-hand-side calls and steps, and the largest |Δx| against the reference (Dormand–
+//! Prince at rtol 1e-11, atol 1e-13) and between the two methods.
+
+use std::time::Instant;
+
+use stf_core::excitation::{Excitation, RotorAngle};
+use stf_core::integrate::{integrate, Method, Settings, Solution};
+use stf_core::oscillator::Oscillator;
+use stf_core::simulate::Simulation;
+use stf_core::system::OscillatorParams;
+
+/// CPU time of this process (user + system), s, from /proc (Linux; 0 elsewhere). On a
+/// machine shared with other jobs it is a steadier figure than wall time.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the parenthesised command name; utime and stime are the 12th and 13th.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// Best wall time of `repeats` runs, mean CPU time per run, and the last result.
+fn best_of<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, f64, T) {
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    let cpu0 = cpu_seconds();
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        let r = f();
+        best = best.min(start.elapsed().as_secs_f64());
+        last = Some(r);
+    }
+    let cpu = (cpu_seconds() - cpu0) / repeats.max(1) as f64;
+    match last {
+        Some(r) => (best, cpu, r),
+        None => unreachable!("at least one repeat"),
+    }
+}
+
+fn max_dx_mm(a: &Solution, b: &Solution) -> f64 {
+    (0..a.t.len())
+        .map(|i| (a.y(i)[0] - b.y(i)[0]).abs())
+        .fold(0.0, f64::max)
+        * 1e3
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let repeats: usize = match std::env::args().nth(1) {
+        Some(s) => s.parse()?,
+        None => 5,
+    };
+    let osc = Oscillator::new(
+        OscillatorParams::FORCED,
+        Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0)),
+    );
+    let times: Vec<f64> = (0..=150_000).map(|i| 50.0 + i as f64 * 1e-3).collect();
+    let y0 = osc.initial_state(0.0, 0.0);
+
+    let tight = Settings::default()
+        .method(Method::Dopri5)
+        .rtol(1e-11)
+        .atol(1e-13);
+    let (t_ref, _, reference) = best_of(1, || integrate(&osc, times[0], &y0, &times, &tight));
+    let reference = reference?;
+    println!(
+        "reference  dopri5 rtol 1e-11 atol 1e-13: {:8.2} ms, {:>9} RHS calls, {:>7} steps",
+        t_ref * 1e3,
+        reference.stats.rhs_calls,
+        reference.stats.accepted + reference.stats.rejected
+    );
+
+    let mut rows = Vec::new();
+    for method in [Method::Dopri5, Method::Auto, Method::Rodas4] {
+        let settings = Settings::default().method(method);
+        // Cheap methods get more repeats so that the CPU-time mean resolves the 10 ms tick.
+        let reps = if method == Method::Dopri5 {
+            repeats
+        } else {
+            20 * repeats
+        };
+        let (t_int, cpu_int, sol) =
+            best_of(reps, || integrate(&osc, times[0], &y0, &times, &settings));
+        let sol = sol?;
+        let (t_sim, _, run) = best_of(reps, || {
+            Simulation::new(&osc)
+                .settings(settings.clone())
+                .run_at(&times)
+        });
+        run?;
+        println!(
+            "{:<7} (rtol {:.0e}): integrate {:8.2} ms (CPU {:8.2} ms), Simulation::run {:8.2} ms, \
+             {:>9} RHS calls, {:>7} accepted, {:>6} rejected, max |Δx| vs reference {:.2e} mm",
+            method.name(),
+            settings.rtol,
+            t_int * 1e3,
+            cpu_int * 1e3,
+            t_sim * 1e3,
+            sol.stats.rhs_calls,
+            sol.stats.accepted,
+            sol.stats.rejected,
+            max_dx_mm(&sol, &reference)
+        );
+        rows.push((method, t_int, t_sim, sol));
+    }
+    let (_, d_int, d_sim, dopri) = &rows[0];
+    let (_, a_int, a_sim, auto) = &rows[1];
+    println!(
+        "default (auto) vs plain dopri5: integrate {:.2} ms vs {:.2} ms (×{:.1} faster), \
+         Simulation::run {:.2} ms vs {:.2} ms (×{:.1}), RHS calls {} vs {}, max |Δx| between them {:.2e} mm",
+        a_int * 1e3,
+        d_int * 1e3,
+        d_int / a_int,
+        a_sim * 1e3,
+        d_sim * 1e3,
+        d_sim / a_sim,
+        auto.stats.rhs_calls,
+        dopri.stats.rhs_calls,
+        max_dx_mm(auto, dopri)
+    );
+    Ok(())
+}

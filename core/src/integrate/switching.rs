@@ -1,0 +1,382 @@
+//! The default integrator: explicit Dormand–Prince 5(4) while the problem is not stiff,
+//! Rodas4 (L-stable Rosenbrock, order 4(3)) while it is, switched step by step; or Rodas4 alone.
+//!
+//! Why: with the paper's friction smoothing ε = 1e-6 m/s the oscillator is stiff while the
+//! trolley sticks (eigenvalue ≈ −(T + ΔT)/(m·ε) ≈ −8e4 s⁻¹), and an explicit method is held at
+//! h ≈ 4e-5 s by stability alone — 97 % of a sweep's 3.4 M right-hand-side calls. Once the
+//! trolley slides the problem is smooth and an explicit fifth-order method is the cheapest.
+//!
+//! How it switches: while explicit, two indicators are watched. Hairer's `h·λ ≈
+//! h·‖k7 − k6‖/‖y1 − y6‖` after every accepted step: 15 readings above 3.25 (the stability
+//! boundary) without 6 calm ones in between hand over to Rodas4. And every 25 accepted steps the
+//! Jacobian's spectral radius ρ: two readings in a row with `ρ·h > 2.5` do the same (Hairer's
+//! indicator alone can take thousands of steps when the stiff mode has died out). While stiff,
+//! ρ of the Jacobian taken for each step is compared with the next step size: after 3 accepted
+//! steps with `ρ·h ≤ 2` the explicit method would be stable at that size and takes over again
+//! (at 6 calls a step against Rodas4's 5 + dim + 2 it is then the cheaper one). Either way each
+//! step is error-controlled at the requested tolerances and sampled through its own dense
+//! output (4th order for Dormand–Prince, 3rd for Rodas4), never past the last step: switching
+//! changes the cost, not the accuracy contract. A step that cannot be made small enough ends the
+//! run with [`SimError::StepSizeTooSmall`] at its time; a non-finite state or Jacobian with
+//! [`SimError::NonFinite`]; an error of the right-hand side is returned as it is.
+//!
+//! Known limit: like every Rosenbrock method without the Prothero–Robinson conditions, Rodas4
+//! loses order on stiff problems of the form `y' = λ·(y − g(t)) + g'(t)` at tight tolerances
+//! (the error stays controlled, but steps shrink faster than `tol^(1/4)`); the stuck trolley is
+//! of that form, yet its stuck phases take only ≈ 1 % of the sweep's work. Rodas4P/Rodas5P would
+//! lift it.
+//!
+//! Why no crate: measured on the 0.047 rad/s² sweep (see STACK.md), `differential-equations`
+//! 0.7 Radau5 took 12.8 ms and levels off near 1e-4 mm; diffsol's BDF 31 ms and pulls
+//! nalgebra 0.35 plus faer; russell_ode's Radau5 70 ms. None can hand a run between an explicit
+//! and a stiff method mid-way, which is what makes the sweep cheap (the trolley sticks and
+//! slips ≈ 15 times, then slides), so both methods are written here (≈ 1 200 lines with their
+//! tests) and checked against known solutions, orders of convergence and tight Dormand–Prince
+//! references (`core/tests/stiff_methods.rs`); `cargo run --release -p stf-core --example
+//! bench_sweep` measures the sweep.
+//!
+//! Rodas4 coefficients: Hairer & Wanner, Solving Ordinary Differential Equations II, §IV.7 and
+//! their code RODAS (method 1); Dormand–Prince: Solving ODEs I, §II.5 and their code DOPRI5.
+
+use super::dormand_prince::DormandPrince;
+use super::jacobian::spectral_radius;
+use super::rodas4::Rodas4;
+use super::{OdeSystem, Settings, SimError, Solution, Stats};
+
+/// Which methods the driver may use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Policy {
+    /// Dormand–Prince while not stiff, Rodas4 while stiff.
+    Switching,
+    /// Rodas4 for every step.
+    StiffOnly,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    Explicit,
+    Stiff,
+}
+
+/// Readings of `h·λ` above this count as stiff (Dormand–Prince's real stability boundary).
+const STIFF_H_LAMBDA: f64 = 3.25;
+/// Stiff readings in a row (up to 5 calm ones may interleave) before switching to Rodas4.
+const STIFF_READINGS: u32 = 15;
+/// Calm readings that reset the stiff count.
+const CALM_READINGS: u32 = 6;
+/// Every this many accepted explicit steps the Jacobian is taken as a second indicator ...
+const JACOBIAN_CHECK_EVERY: u64 = 25;
+/// ... which reads stiff when `ρ·h` of the step just taken exceeds this; two such readings in a
+/// row hand over to Rodas4.
+const JACOBIAN_STIFF_RHO_H: f64 = 2.5;
+/// `ρ·h` below this lets the explicit method take over again.
+const EXPLICIT_RHO_H: f64 = 2.0;
+/// Rodas4 steps in a row that must satisfy it.
+const EXPLICIT_READINGS: u32 = 3;
+
+/// What the run has done so far (for tests and benchmarks).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Work {
+    pub stats: Stats,
+    /// Accepted Rodas4 steps.
+    pub stiff_steps: u64,
+    /// Hand-overs from the explicit to the stiff method.
+    pub to_stiff: u64,
+}
+
+/// Integrate with `policy`; the requests are checked by the caller.
+pub(super) fn integrate(
+    sys: &dyn OdeSystem,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    s: &Settings,
+    policy: Policy,
+) -> Result<Solution, SimError> {
+    let mut work = Work::default();
+    let states = run(sys, t0, y0, t_out, s, policy, &mut work)?;
+    Ok(Solution {
+        t: t_out.to_vec(),
+        states,
+        dim: y0.len(),
+        stats: work.stats,
+    })
+}
+
+/// The integration loop; returns the sampled states and counts its work in `work`.
+pub(super) fn run(
+    sys: &dyn OdeSystem,
+    t0: f64,
+    y0: &[f64],
+    t_out: &[f64],
+    s: &Settings,
+    policy: Policy,
+    work: &mut Work,
+) -> Result<Vec<f64>, SimError> {
+    let n = y0.len();
+    let mut states = Vec::with_capacity(t_out.len() * n);
+    let mut next_out = 0;
+    while next_out < t_out.len() && t_out[next_out] <= t0 {
+        states.extend_from_slice(y0);
+        next_out += 1;
+    }
+    let Some(&t_end) = t_out.last() else {
+        return Ok(states);
+    };
+    if next_out == t_out.len() {
+        return Ok(states);
+    }
+    let span = t_end - t0;
+    let h_max = if s.h_max > 0.0 {
+        s.h_max.min(span)
+    } else {
+        span
+    };
+    let mut calls = 0u64;
+
+    let mut t = t0;
+    let mut y = y0.to_vec();
+    let mut f0 = vec![0.0; n];
+    sys.rhs(t, &y, &mut f0)?;
+    calls += 1;
+    check_finite(&f0, t, "the right-hand side at the start")?;
+
+    let mut mode = match policy {
+        Policy::Switching => Mode::Explicit,
+        Policy::StiffOnly => Mode::Stiff,
+    };
+    let order = if mode == Mode::Explicit { 5.0 } else { 4.0 };
+    let mut h = initial_step(sys, t, &y, &f0, order, h_max, s, &mut calls)?;
+    let mut dp = DormandPrince::new(n);
+    let mut ro = Rodas4::new(n);
+    let mut linearised = false;
+    let mut out = vec![0.0; n];
+
+    // Controller state.
+    let mut rejected_last = false;
+    let mut fac_old = 1e-4_f64; // Dormand–Prince PI controller
+    let mut gustafsson: Option<(f64, f64)> = None; // Rodas4: (h, err) of the last accepted step
+    let mut non_finite_last = false;
+    // Switching state.
+    let (mut stiff_count, mut calm_count, mut explicit_count) = (0u32, 0u32, 0u32);
+    let mut steps = 0u64;
+    let mut explicit_accepted = 0u64;
+    let mut jacobian_stiff = false;
+    let mut jac = vec![0.0; n * n];
+
+    while t < t_end {
+        if steps >= u64::from(s.max_steps) {
+            work.stats.rhs_calls = calls;
+            return Err(SimError::TooManySteps { time: t, steps });
+        }
+        let mut last = false;
+        if t + 1.01 * h >= t_end {
+            h = t_end - t;
+            last = true;
+        }
+        let resolvable = h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
+        if !resolvable {
+            work.stats.rhs_calls = calls;
+            return Err(if non_finite_last {
+                SimError::NonFinite {
+                    time: t,
+                    what: "the solution at every step size tried".into(),
+                }
+            } else {
+                SimError::StepSizeTooSmall { time: t }
+            });
+        }
+        steps += 1;
+        let t_new = if last { t_end } else { t + h };
+        match mode {
+            Mode::Explicit => {
+                let trial = dp.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
+                let err = trial.err;
+                non_finite_last = !err.is_finite();
+                let fac11 = err.powf(0.17);
+                if err <= 1.0 {
+                    dp.accept(&y, h);
+                    while next_out < t_out.len() && t_out[next_out] <= t_new {
+                        dp.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), &mut out);
+                        states.extend_from_slice(&out);
+                        next_out += 1;
+                    }
+                    y.copy_from_slice(&dp.y_new);
+                    f0.copy_from_slice(dp.f_new());
+                    let t_prev = t;
+                    t = t_new;
+                    work.stats.accepted += 1;
+                    let fac = (fac11 / fac_old.powf(0.04) / 0.9).clamp(0.1, 5.0);
+                    fac_old = err.max(1e-4);
+                    let mut h_new = (h / fac).min(h_max);
+                    if rejected_last {
+                        h_new = h_new.min(h);
+                    }
+                    rejected_last = false;
+                    h = h_new;
+                    if policy == Policy::Switching {
+                        explicit_accepted += 1;
+                        let mut stiff_now = false;
+                        if explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
+                            calls += sys.jacobian(t, &y, &f0, &mut jac)?;
+                            let rho_h = spectral_radius(&jac, n) * (t - t_prev);
+                            stiff_now = jacobian_stiff && rho_h > JACOBIAN_STIFF_RHO_H;
+                            jacobian_stiff = rho_h > JACOBIAN_STIFF_RHO_H;
+                        }
+                        if trial.h_lambda > STIFF_H_LAMBDA {
+                            calm_count = 0;
+                            stiff_count += 1;
+                        } else {
+                            calm_count += 1;
+                            if calm_count >= CALM_READINGS {
+                                stiff_count = 0;
+                            }
+                        }
+                        if stiff_now || stiff_count >= STIFF_READINGS {
+                            {
+                                mode = Mode::Stiff;
+                                work.to_stiff += 1;
+                                stiff_count = 0;
+                                explicit_count = 0;
+                                jacobian_stiff = false;
+                                gustafsson = None;
+                                linearised = false;
+                            }
+                        }
+                    }
+                } else {
+                    work.stats.rejected += 1;
+                    rejected_last = true;
+                    h /= if err.is_finite() {
+                        (fac11 / 0.9).min(5.0)
+                    } else {
+                        5.0
+                    };
+                }
+            }
+            Mode::Stiff => {
+                if !linearised {
+                    ro.linearise(sys, t, &y, &f0, &mut calls)?;
+                    if !ro.jacobian_is_finite() {
+                        work.stats.rhs_calls = calls;
+                        return Err(SimError::NonFinite {
+                            time: t,
+                            what: "the Jacobian".into(),
+                        });
+                    }
+                    linearised = true;
+                }
+                let err = ro.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
+                non_finite_last = !err.is_finite();
+                let fac = if err.is_finite() {
+                    (err.powf(0.25) / 0.9).clamp(1.0 / 6.0, 5.0)
+                } else {
+                    5.0
+                };
+                if err <= 1.0 {
+                    let rho = ro.spectral_radius();
+                    ro.accept(&y);
+                    while next_out < t_out.len() && t_out[next_out] <= t_new {
+                        ro.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), &mut out);
+                        states.extend_from_slice(&out);
+                        next_out += 1;
+                    }
+                    y.copy_from_slice(&ro.y_new);
+                    t = t_new;
+                    sys.rhs(t, &y, &mut f0)?;
+                    calls += 1;
+                    check_finite(&f0, t, "the right-hand side")?;
+                    linearised = false;
+                    work.stats.accepted += 1;
+                    work.stiff_steps += 1;
+                    let mut fac = fac;
+                    if let Some((h_acc, err_acc)) = gustafsson {
+                        let fac_pred = (h_acc / h) * (err * err / err_acc).powf(0.25) / 0.9;
+                        fac = fac.max(fac_pred.clamp(1.0 / 6.0, 5.0));
+                    }
+                    gustafsson = Some((h, err.max(1e-2)));
+                    let mut h_new = (h / fac).min(h_max);
+                    if rejected_last {
+                        h_new = h_new.min(h);
+                    }
+                    rejected_last = false;
+                    h = h_new;
+                    if policy == Policy::Switching {
+                        if rho * h <= EXPLICIT_RHO_H {
+                            explicit_count += 1;
+                            if explicit_count >= EXPLICIT_READINGS {
+                                mode = Mode::Explicit;
+                                explicit_count = 0;
+                                stiff_count = 0;
+                                calm_count = 0;
+                                fac_old = 1e-4;
+                            }
+                        } else {
+                            explicit_count = 0;
+                        }
+                    }
+                } else {
+                    work.stats.rejected += 1;
+                    rejected_last = true;
+                    h /= fac;
+                }
+            }
+        }
+    }
+    work.stats.rhs_calls = calls;
+    Ok(states)
+}
+
+fn check_finite(v: &[f64], time: f64, what: &str) -> Result<(), SimError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(SimError::NonFinite {
+            time,
+            what: what.into(),
+        })
+    }
+}
+
+/// Hairer's initial step guess for a method of order `order`.
+#[allow(clippy::too_many_arguments)]
+fn initial_step(
+    sys: &dyn OdeSystem,
+    t: f64,
+    y: &[f64],
+    f0: &[f64],
+    order: f64,
+    h_max: f64,
+    s: &Settings,
+    calls: &mut u64,
+) -> Result<f64, SimError> {
+    let (mut dnf, mut dny) = (0.0, 0.0);
+    for (yi, fi) in y.iter().zip(f0) {
+        let sk = s.atol + s.rtol * yi.abs();
+        dnf += (fi / sk) * (fi / sk);
+        dny += (yi / sk) * (yi / sk);
+    }
+    let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
+        1e-6
+    } else {
+        (dny / dnf).sqrt() * 0.01
+    };
+    h = h.min(h_max);
+    let y1: Vec<f64> = y.iter().zip(f0).map(|(yi, fi)| yi + h * fi).collect();
+    let mut f1 = vec![0.0; y.len()];
+    sys.rhs(t + h, &y1, &mut f1)?;
+    *calls += 1;
+    let mut der2 = 0.0;
+    for ((yi, fi), f1i) in y.iter().zip(f0).zip(&f1) {
+        let sk = s.atol + s.rtol * yi.abs();
+        der2 += ((f1i - fi) / sk) * ((f1i - fi) / sk);
+    }
+    let der2 = der2.sqrt() / h;
+    let der12 = der2.abs().max(dnf.sqrt());
+    let h1 = if der12 <= 1e-15 || !der12.is_finite() {
+        (h * 1e-3).max(1e-6)
+    } else {
+        (0.01 / der12).powf(1.0 / order)
+    };
+    Ok((100.0 * h).min(h1).min(h_max))
+}
