@@ -82,7 +82,10 @@ mod tests {
     #[test]
     fn maxima_of_a_sine_are_its_crests() {
         let t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
-        let x: Vec<f64> = t.iter().map(|t| (std::f64::consts::TAU * t).sin()).collect();
+        let x: Vec<f64> = t
+            .iter()
+            .map(|t| (std::f64::consts::TAU * t).sin())
+            .collect();
         let w = vec![1.0; t.len()];
         let m = local_maxima(&t, &x, &w);
         assert_eq!(m.len(), 10);

@@ -184,7 +184,12 @@ mod tests {
         assert_eq!(sum.param_index("d.e"), Some(2));
         assert_eq!(sum.param_index("b.c"), Some(1));
         assert_eq!(sum.param_index("c"), None);
-        let s = ModelState { t: 0.0, x: 0.0, v: 2.0, z: &[] };
+        let s = ModelState {
+            t: 0.0,
+            x: 0.0,
+            v: 2.0,
+            z: &[],
+        };
         assert_eq!(sum.force(&[1.0, 2.0, 3.0], &s, &mut []).unwrap(), 12.0);
         assert_eq!(sum.name(), "a + b + d");
     }
