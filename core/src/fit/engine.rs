@@ -96,11 +96,19 @@ pub fn run(
                 (u, conv)
             }
             Solver::Auto => {
-                let tol = settings.simplex_tol.max(settings.presearch_tol);
-                let (u, it, conv) = nelder_mead(&obj, &u0, tol, settings)?;
-                iterations += it;
-                log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
-                lm(&u, &mut iterations, &mut log)
+                let (u, conv) = lm(&u0, &mut iterations, &mut log);
+                if conv.converged() {
+                    (u, conv)
+                } else {
+                    log.push(
+                        "levenberg_marquardt did not converge: Nelder–Mead, then again".into(),
+                    );
+                    let tol = settings.simplex_tol.max(settings.presearch_tol);
+                    let (u, it, conv) = nelder_mead(&obj, &u0, tol, settings)?;
+                    iterations += it;
+                    log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
+                    lm(&u, &mut iterations, &mut log)
+                }
             }
             Solver::LevenbergMarquardt => lm(&u0, &mut iterations, &mut log),
             Solver::ParticleSwarm => {

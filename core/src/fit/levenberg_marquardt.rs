@@ -9,6 +9,8 @@
 //! ```text
 //! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
 //! ```
+//!
+//! Steps are shortened to at most two scales of any parameter.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -25,6 +27,9 @@ pub struct Refined {
     /// How it ended.
     pub convergence: Convergence,
 }
+
+/// Longest step in internal coordinates (units of the parameters' scales).
+const MAX_STEP: f64 = 2.0;
 
 /// Largest damping before the refinement decides no step can lower the cost.
 const LAMBDA_MAX: f64 = 1e16;
@@ -85,7 +90,17 @@ pub fn refine(obj: &Objective, u0: &[f64], max_iters: u64, tol: f64, fd_step: f6
             for j in 0..p {
                 m[(j, j)] += lambda * a[(j, j)].max(floor);
             }
-            let step = m.cholesky().map(|c| c.solve(&(-&g)));
+            let step = m.cholesky().map(|c| {
+                let delta = c.solve(&(-&g));
+                // A step of at most MAX_STEP scales: a long one would run into the flat,
+                // saturated part of a bound transform and stall there.
+                let longest = delta.amax();
+                if longest > MAX_STEP {
+                    delta * (MAX_STEP / longest)
+                } else {
+                    delta
+                }
+            });
             let accepted = step.and_then(|delta| {
                 let cand: Vec<f64> = u.iter().zip(delta.iter()).map(|(a, b)| a + b).collect();
                 let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut trial)?;

@@ -9,8 +9,9 @@
 //!
 //! Parameters ([`FitParam`]) have start values, bounds (honoured by a change of variables,
 //! [`BoundTransform`], never by clipping) and a fixed/free switch. The default solver
-//! ([`Solver::Auto`]) runs Nelder–Mead (argmin) to find the basin, then a Levenberg–Marquardt
-//! refinement; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
+//! ([`Solver::Auto`]) runs a Levenberg–Marquardt refinement and falls back on Nelder–Mead
+//! (argmin) followed by another refinement if it does not converge; [`Solver::NelderMead`] is
+//! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
 //! with standard errors from a finite-difference Jacobian in the user's parameter space
 //! (`cov = s²·(JᵀJ)⁻¹`, `s² = RSS/(N − p)`), correlations, RMS, AIC and BIC, and says whether
 //! it converged ([`FitResult`]). A failure inside the fit (a simulation that diverges, a model

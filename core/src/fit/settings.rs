@@ -9,7 +9,10 @@ use super::error::FitError;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Solver {
-    /// Nelder–Mead to find the basin, then Levenberg–Marquardt to polish it.
+    /// Levenberg–Marquardt from the start; if it does not converge, Nelder–Mead (to
+    /// `presearch_tol`) then Levenberg–Marquardt again. (Nelder–Mead first was tried: on a
+    /// free vibration with dry friction its large first moves left the basin that
+    /// Levenberg–Marquardt, started 10 % off, finds directly.)
     #[default]
     Auto,
     /// Nelder–Mead alone (the source study's method), run to `simplex_tol`.
@@ -58,8 +61,8 @@ pub struct FitSettings {
     /// level (cosine), or when no step lowers the cost.
     pub tol: f64,
     /// Nelder–Mead stops when the standard deviation of ln(cost) over the simplex falls below
-    /// this (a relative spread of the costs). In [`Solver::Auto`] the simplex stage stops at
-    /// the larger of this and `presearch_tol`.
+    /// this (a relative spread of the costs). In [`Solver::Auto`]'s fallback the simplex stage
+    /// stops at the larger of this and `presearch_tol`.
     pub simplex_tol: f64,
     /// Simplex tolerance of the Nelder–Mead stage in [`Solver::Auto`].
     pub presearch_tol: f64,

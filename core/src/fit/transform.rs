@@ -13,7 +13,9 @@
 //! ```
 //!
 //! A start value on a bound is moved just inside it (by 1e-3 of the scale or of the width),
-//! since the interior maps never reach their bounds.
+//! since the interior maps never reach their bounds. The scale is capped at the distance to
+//! the nearest bound (and a quarter of the width): otherwise a unit step from a start near a
+//! bound would saturate the map, where its slope vanishes and an optimiser gets stuck.
 
 /// The four shapes of bound.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,6 +66,7 @@ impl BoundTransform {
             },
             (true, false) => {
                 let x0 = x0.max(min + 1e-3 * scale);
+                let scale = scale.min(x0 - min);
                 BoundTransform {
                     min,
                     max,
@@ -74,6 +77,7 @@ impl BoundTransform {
             }
             (false, true) => {
                 let x0 = x0.min(max - 1e-3 * scale);
+                let scale = scale.min(max - x0);
                 BoundTransform {
                     min,
                     max,
@@ -86,7 +90,7 @@ impl BoundTransform {
                 let width = max - min;
                 let nudge = 1e-3 * width;
                 let x0 = x0.clamp(min + nudge, max - nudge);
-                let scale = scale.min(0.25 * width);
+                let scale = scale.min(0.25 * width).min(x0 - min).min(max - x0);
                 let s0 = (x0 - min) / width;
                 let w0 = (s0 / (1.0 - s0)).ln();
                 let c = scale / (width * s0 * (1.0 - s0));
