@@ -79,7 +79,11 @@ impl ForceData<'_> {
                 )));
             }
         }
-        if let Some(i) = self.t.windows(2).position(|w| !(w[1] > w[0])) {
+        if let Some(i) = self
+            .t
+            .windows(2)
+            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
             return Err(FitError::BadData(format!(
                 "time must increase strictly (t[{i}] = {}, t[{}] = {})",
                 self.t[i],

@@ -78,7 +78,7 @@ impl FitParam {
 
     /// Check bounds and start value.
     pub fn validate(&self) -> Result<(), FitError> {
-        if !(self.min < self.max) {
+        if self.min.partial_cmp(&self.max) != Some(std::cmp::Ordering::Less) {
             return Err(FitError::BadBounds {
                 name: self.name.clone(),
                 min: self.min,

@@ -159,7 +159,11 @@ impl TrajectoryFit {
         if let Some(i) = data.x.iter().position(|v| !v.is_finite()) {
             return Err(FitError::BadData(format!("x[{i}] is not finite")));
         }
-        if let Some(i) = data.t.windows(2).position(|w| !(w[1] > w[0])) {
+        if let Some(i) = data
+            .t
+            .windows(2)
+            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
             return Err(FitError::BadData(format!(
                 "time must increase strictly (at sample {i})"
             )));

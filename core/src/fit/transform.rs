@@ -128,13 +128,13 @@ impl BoundTransform {
         let u = match self.shape {
             Shape::Free => (x - self.x0) / self.scale,
             Shape::Lower { d } => {
-                if !(x > self.min) {
+                if x.partial_cmp(&self.min) != Some(std::cmp::Ordering::Greater) {
                     return None;
                 }
                 d / self.scale * ((x - self.min) / d).ln()
             }
             Shape::Upper { d } => {
-                if !(x < self.max) {
+                if x.partial_cmp(&self.max) != Some(std::cmp::Ordering::Less) {
                     return None;
                 }
                 -d / self.scale * ((self.max - x) / d).ln()
@@ -166,6 +166,7 @@ impl BoundTransform {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
