@@ -29,6 +29,7 @@
 pub mod analysis;
 pub mod derivative;
 pub mod excitation;
+pub mod fit;
 pub mod force_model;
 pub mod integrate;
 pub mod interpolate;

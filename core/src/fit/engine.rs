@@ -1,0 +1,295 @@
+//! The driver shared by every kind of fit: validated parameters in, [`FitResult`] out.
+//!
+//! It runs the stages of the chosen [`Solver`] on an [`Objective`], then computes the residuals
+//! and a forward-difference Jacobian at the best point in the user's parameter space (so the
+//! standard errors are those of the values reported, whatever the transforms), and the
+//! statistics of the result.
+
+use std::time::Instant;
+
+use argmin::core::{Executor, State, TerminationReason};
+use argmin::solver::neldermead::NelderMead;
+use argmin::solver::particleswarm::ParticleSwarm;
+use nalgebra::DMatrix;
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+
+use super::covariance;
+use super::error::FitError;
+use super::jacobian::forward_difference;
+use super::levenberg_marquardt;
+use super::objective::{LnCost, Objective, Residuals};
+use super::param::FitParam;
+use super::result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
+use super::settings::{FitSettings, Solver};
+
+/// Fit the free members of `params` (all of them, in order) of `problem`, whose
+/// [`Residuals::residuals`] receives the user values of the free parameters only.
+/// `trajectory`: report S(μ) in mm² (the residuals are displacements in m).
+pub fn run(
+    problem: &dyn Residuals,
+    params: &[FitParam],
+    settings: &FitSettings,
+    observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    trajectory: bool,
+) -> Result<FitResult, FitError> {
+    let clock = Instant::now();
+    settings.validate()?;
+    for (i, p) in params.iter().enumerate() {
+        p.validate()?;
+        if params[..i].iter().any(|q| q.name == p.name) {
+            return Err(FitError::DuplicateParam(p.name.clone()));
+        }
+    }
+    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
+    let n = problem.len();
+    if n <= free.len() {
+        return Err(FitError::BadData(format!(
+            "{n} samples cannot determine {} free parameters",
+            free.len()
+        )));
+    }
+    let obj = Objective::new(
+        problem,
+        free.iter().map(|p| p.transform()).collect(),
+        observer,
+    );
+    let p = obj.dim();
+    let u0 = vec![0.0; p];
+    if obj.cost(&u0).is_none() {
+        return Err(FitError::StartFails(
+            obj.last_failure().unwrap_or_else(|| "unknown".into()),
+        ));
+    }
+    let mut log = Vec::new();
+    let mut iterations = 0;
+    let (u, convergence) = if p == 0 {
+        log.push("no free parameters: evaluated only".to_string());
+        (
+            u0,
+            Convergence::Converged {
+                reason: "nothing to fit".into(),
+            },
+        )
+    } else {
+        let lm = |start: &[f64], iterations: &mut u64, log: &mut Vec<String>| {
+            obj.set_stage(Stage::LevenbergMarquardt);
+            let out = levenberg_marquardt::refine(
+                &obj,
+                start,
+                settings.max_iters,
+                settings.tol,
+                settings.fd_step,
+            );
+            *iterations += out.iterations;
+            log.push(format!(
+                "levenberg_marquardt: {} iterations, {:?}",
+                out.iterations, out.convergence
+            ));
+            (out.u, out.convergence)
+        };
+        match settings.solver {
+            Solver::NelderMead => {
+                let (u, it, conv) = nelder_mead(&obj, &u0, settings.simplex_tol, settings)?;
+                iterations += it;
+                log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
+                (u, conv)
+            }
+            Solver::Auto => {
+                let (u, conv) = lm(&u0, &mut iterations, &mut log);
+                if conv.converged() {
+                    (u, conv)
+                } else {
+                    log.push(
+                        "levenberg_marquardt did not converge: Nelder–Mead, then again".into(),
+                    );
+                    let tol = settings.simplex_tol.max(settings.presearch_tol);
+                    let (u, it, conv) = nelder_mead(&obj, &u0, tol, settings)?;
+                    iterations += it;
+                    log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
+                    lm(&u, &mut iterations, &mut log)
+                }
+            }
+            Solver::LevenbergMarquardt => lm(&u0, &mut iterations, &mut log),
+            Solver::ParticleSwarm => {
+                let (u, it) = particle_swarm(&obj, &u0, settings)?;
+                iterations += it;
+                log.push(format!("particle_swarm: {it} iterations"));
+                lm(&u, &mut iterations, &mut log)
+            }
+        }
+    };
+    finish(
+        &obj,
+        params,
+        &u,
+        settings,
+        convergence,
+        iterations,
+        log,
+        trajectory,
+        clock,
+    )
+}
+
+fn nelder_mead(
+    obj: &Objective,
+    u0: &[f64],
+    tol: f64,
+    settings: &FitSettings,
+) -> Result<(Vec<f64>, u64, Convergence), FitError> {
+    obj.set_stage(Stage::NelderMead);
+    let p = u0.len();
+    let mut simplex = vec![u0.to_vec()];
+    for j in 0..p {
+        let mut v = u0.to_vec();
+        v[j] += settings.simplex_step;
+        simplex.push(v);
+    }
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(tol)
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let res = Executor::new(LnCost(obj), solver)
+        .configure(|s| s.max_iters(settings.max_iters))
+        .timer(false)
+        .run()
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let state = res.state();
+    let u = state
+        .get_best_param()
+        .cloned()
+        .unwrap_or_else(|| u0.to_vec());
+    let conv = match state.get_termination_reason() {
+        Some(TerminationReason::SolverConverged) => Convergence::Converged {
+            reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
+        },
+        Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
+        other => Convergence::Failed {
+            reason: format!("Nelder–Mead stopped: {other:?}"),
+        },
+    };
+    Ok((u, state.get_iter(), conv))
+}
+
+fn particle_swarm(
+    obj: &Objective,
+    u0: &[f64],
+    settings: &FitSettings,
+) -> Result<(Vec<f64>, u64), FitError> {
+    obj.set_stage(Stage::ParticleSwarm);
+    let (lo, hi): (Vec<f64>, Vec<f64>) = obj.transforms().iter().map(|t| t.search_box()).unzip();
+    let solver = ParticleSwarm::new((lo, hi), settings.particles)
+        .with_rng_generator(StdRng::seed_from_u64(settings.seed));
+    let res = Executor::new(LnCost(obj), solver)
+        .configure(|s| s.max_iters(settings.max_iters))
+        .timer(false)
+        .run()
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let state = res.state();
+    let iters = state.get_iter();
+    // Keep the start if the swarm found nothing better.
+    let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
+    let u = match state.get_best_param() {
+        Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
+        _ => u0.to_vec(),
+    };
+    Ok((u, iters))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    obj: &Objective,
+    params: &[FitParam],
+    u: &[f64],
+    settings: &FitSettings,
+    mut convergence: Convergence,
+    iterations: u64,
+    mut log: Vec<String>,
+    trajectory: bool,
+    clock: Instant,
+) -> Result<FitResult, FitError> {
+    obj.set_stage(Stage::Errors);
+    let n = obj.len();
+    let x = obj.to_user(u);
+    let mut r0 = vec![0.0; n];
+    let Some(rss) = obj.residuals_user(&x, &mut r0) else {
+        return Err(FitError::Solver(format!(
+            "the best point cannot be re-evaluated: {}",
+            obj.last_failure().unwrap_or_default()
+        )));
+    };
+    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
+    let p = free.len();
+    let (std_errors, correlation) = if p > 0 {
+        let mut jac = DMatrix::<f64>::zeros(n, p);
+        let steps: Vec<f64> = free
+            .iter()
+            .map(|q| settings.fd_step * q.effective_scale())
+            .collect();
+        forward_difference(
+            &x,
+            &r0,
+            &steps,
+            &|j, v| !(v > free[j].min && v < free[j].max),
+            &mut |point, out| obj.residuals_user(point, out).is_some(),
+            &mut jac,
+        );
+        let cov = covariance::from_jacobian(&jac, rss);
+        (cov.std_errors, cov.correlation)
+    } else {
+        (vec![], vec![])
+    };
+    let mut fitted = Vec::with_capacity(params.len());
+    let mut k = 0;
+    for q in params {
+        if q.fixed {
+            fitted.push(FittedParam {
+                name: q.name.clone(),
+                value: q.value,
+                std_error: 0.0,
+                fixed: true,
+            });
+        } else {
+            fitted.push(FittedParam {
+                name: q.name.clone(),
+                value: x[k],
+                std_error: std_errors[k],
+                fixed: false,
+            });
+            k += 1;
+        }
+    }
+    let nf = n as f64;
+    let mean = rss / nf;
+    let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
+    if obj.failures() > 0 {
+        log.push(format!(
+            "{} evaluations failed and were scored as penalties; last: {}",
+            obj.failures(),
+            obj.last_failure().unwrap_or_default()
+        ));
+    }
+    if !x.iter().all(|v| v.is_finite()) {
+        convergence = Convergence::Failed {
+            reason: "a parameter is not finite".into(),
+        };
+    }
+    Ok(FitResult {
+        params: fitted,
+        correlation,
+        n_points: n,
+        n_free: p,
+        rss,
+        rms: mean.sqrt(),
+        s_mm2: trajectory.then_some(mean * 1e6),
+        aic: ln_term + 2.0 * p as f64,
+        bic: ln_term + p as f64 * nf.ln(),
+        evaluations: obj.evaluations(),
+        failures: obj.failures(),
+        last_failure: obj.last_failure(),
+        iterations,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+        convergence,
+        log,
+    })
+}

@@ -1,0 +1,288 @@
+//! Force-level calibration: an STF model's force against a measured F_STF.
+//!
+//! Residual of sample i: `F_meas,i − (m_a·a_i + f(t_i, x_i, v_i, z_i) + f_off)`, with the
+//! kinematics (x, v, a) given — typically from the derivative filter. A model with internal
+//! state is integrated along the measured kinematics with one classical Runge–Kutta (RK4)
+//! step per sample interval, x and v interpolated linearly between the samples (the midpoint
+//! stages use their means); z starts from the model's own initial state at the first sample.
+//! Memoryless models cost one call per sample, models with state four. Nothing is allocated
+//! per sample; an evaluation allocates only the model's few state variables.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use stf_core::fit::{ForceData, ForceFit};
+//! use stf_core::force_model::{ForceModel, ModelError, ModelState};
+//! use stf_core::params::ParamSpec;
+//! struct Lin(Vec<ParamSpec>);
+//! impl ForceModel for Lin {
+//!     fn name(&self) -> &str { "lin" }
+//!     fn params(&self) -> &[ParamSpec] { &self.0 }
+//!     fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+//!         Ok(p[0] * s.v)
+//!     }
+//! }
+//! let model = Arc::new(Lin(vec![ParamSpec::new("c", "N·s/m", 1.0, 0.0, 100.0, "")]));
+//! let t: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
+//! let v: Vec<f64> = t.iter().map(|t| (5.0 * t).cos()).collect();
+//! let f: Vec<f64> = v.iter().map(|v| 3.0 * v).collect();
+//! let zeros = vec![0.0; t.len()];
+//! let data = ForceData { t: &t, x: &zeros, v: &v, a: &zeros, f: &f };
+//! let result = ForceFit::new(model).fit(&data, None).unwrap();
+//! assert!((result.value("c").unwrap() - 3.0).abs() < 1e-6);
+//! ```
+
+use std::sync::Arc;
+
+use super::engine;
+use super::error::FitError;
+use super::objective::Residuals;
+use super::param::FitParam;
+use super::result::{FitProgress, FitResult};
+use super::settings::FitSettings;
+use crate::force_model::{ForceModel, ModelState};
+
+/// Measured kinematics and force, sample by sample (SI units, equal lengths).
+#[derive(Clone, Copy, Debug)]
+pub struct ForceData<'a> {
+    /// Time, s (strictly increasing).
+    pub t: &'a [f64],
+    /// Displacement, m.
+    pub x: &'a [f64],
+    /// Velocity, m/s.
+    pub v: &'a [f64],
+    /// Acceleration, m/s².
+    pub a: &'a [f64],
+    /// Measured STF force, N.
+    pub f: &'a [f64],
+}
+
+impl ForceData<'_> {
+    fn validate(&self) -> Result<(), FitError> {
+        let n = self.t.len();
+        let lens = [self.x.len(), self.v.len(), self.a.len(), self.f.len()];
+        if lens.iter().any(|&l| l != n) {
+            return Err(FitError::BadData(format!(
+                "t, x, v, a, f must have equal lengths (got {n}, {lens:?})"
+            )));
+        }
+        for (name, col) in [
+            ("t", self.t),
+            ("x", self.x),
+            ("v", self.v),
+            ("a", self.a),
+            ("f", self.f),
+        ] {
+            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+                return Err(FitError::BadData(format!(
+                    "{name}[{i}] = {} is not finite",
+                    col[i]
+                )));
+            }
+        }
+        if let Some(i) = self
+            .t
+            .windows(2)
+            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
+            return Err(FitError::BadData(format!(
+                "time must increase strictly (t[{i}] = {}, t[{}] = {})",
+                self.t[i],
+                i + 1,
+                self.t[i + 1]
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A force-level calibration of one STF model (a [`crate::model_sum::ModelSum`] is one model).
+#[derive(Clone)]
+pub struct ForceFit {
+    model: Arc<dyn ForceModel>,
+    params: Vec<FitParam>,
+    unknown: Vec<String>,
+    offset: Option<FitParam>,
+    settings: FitSettings,
+}
+
+/// Name of the constant force offset parameter, N.
+pub const FORCE_OFFSET: &str = "f_off";
+
+impl ForceFit {
+    /// Fit every parameter of `model` from its defaults within its bounds; no offset.
+    pub fn new(model: Arc<dyn ForceModel>) -> Self {
+        let params = model.params().iter().map(FitParam::from_spec).collect();
+        ForceFit {
+            model,
+            params,
+            unknown: Vec::new(),
+            offset: None,
+            settings: FitSettings::default(),
+        }
+    }
+
+    /// Start value, bounds or fixing of one of the model's parameters (by its name).
+    pub fn param(mut self, p: FitParam) -> Self {
+        match self.params.iter_mut().find(|q| q.name == p.name) {
+            Some(slot) => *slot = p,
+            None => self.unknown.push(p.name),
+        }
+        self
+    }
+
+    /// Add a constant force offset `f_off` (N) to the model's force; fit it unless `fixed`.
+    /// Its name is replaced by [`FORCE_OFFSET`].
+    pub fn offset(mut self, p: FitParam) -> Self {
+        let mut p = p;
+        p.name = FORCE_OFFSET.to_string();
+        if p.scale.is_none() && p.value == 0.0 {
+            p.scale = Some(0.1);
+        }
+        self.offset = Some(p);
+        self
+    }
+
+    /// Settings of the optimiser.
+    pub fn settings(mut self, settings: FitSettings) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    /// The parameters as they stand (model's, then the offset).
+    pub fn params(&self) -> Vec<FitParam> {
+        let mut all = self.params.clone();
+        all.extend(self.offset.clone());
+        all
+    }
+
+    /// Run the fit; `observer` is called after every evaluation.
+    pub fn fit(
+        &self,
+        data: &ForceData,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
+        if let Some(name) = self.unknown.first() {
+            return Err(FitError::UnknownParam {
+                name: name.clone(),
+                known: self
+                    .model
+                    .params()
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        data.validate()?;
+        let all = self.params();
+        let problem = ForceResiduals {
+            model: self.model.as_ref(),
+            data: *data,
+            all: &all,
+        };
+        engine::run(&problem, &all, &self.settings, observer, false)
+    }
+}
+
+/// The residuals of a force-level fit.
+struct ForceResiduals<'a> {
+    model: &'a dyn ForceModel,
+    data: ForceData<'a>,
+    /// Model parameters, then the offset if any.
+    all: &'a [FitParam],
+}
+
+impl Residuals for ForceResiduals<'_> {
+    fn len(&self) -> usize {
+        self.data.t.len()
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        let n_model = self.model.params().len();
+        // Full parameter vector: fixed values, free values in order.
+        let mut full = Vec::with_capacity(self.all.len());
+        let mut free = x.iter();
+        for q in self.all {
+            full.push(if q.fixed {
+                q.value
+            } else {
+                *free.next().ok_or("too few free values")?
+            });
+        }
+        let p = &full[..n_model];
+        let offset = full.get(n_model).copied().unwrap_or(0.0);
+        let d = &self.data;
+        let m = self.model;
+        let nz = m.n_internal();
+        let err = |e: crate::force_model::ModelError| e.to_string();
+        if nz == 0 {
+            for i in 0..d.t.len() {
+                let s = ModelState {
+                    t: d.t[i],
+                    x: d.x[i],
+                    v: d.v[i],
+                    z: &[],
+                };
+                let ma = m.added_mass(p, &s).map_err(err)?;
+                let f = m.force(p, &s, &mut []).map_err(err)?;
+                sink(i, d.f[i] - (ma * d.a[i] + f + offset));
+            }
+            return Ok(());
+        }
+        // z, stage rates k1..k4, stage state.
+        let mut buf = vec![0.0; 6 * nz];
+        let (z, rest) = buf.split_at_mut(nz);
+        let (k1, rest) = rest.split_at_mut(nz);
+        let (k2, rest) = rest.split_at_mut(nz);
+        let (k3, rest) = rest.split_at_mut(nz);
+        let (k4, zs) = rest.split_at_mut(nz);
+        m.initial_internal(p, z);
+        let last = d.t.len() - 1;
+        for i in 0..=last {
+            let s = ModelState {
+                t: d.t[i],
+                x: d.x[i],
+                v: d.v[i],
+                z,
+            };
+            let ma = m.added_mass(p, &s).map_err(err)?;
+            let f = m.force(p, &s, k1).map_err(err)?;
+            sink(i, d.f[i] - (ma * d.a[i] + f + offset));
+            if i == last {
+                break;
+            }
+            let h = d.t[i + 1] - d.t[i];
+            let (tm, xm, vm) = (
+                0.5 * (d.t[i] + d.t[i + 1]),
+                0.5 * (d.x[i] + d.x[i + 1]),
+                0.5 * (d.v[i] + d.v[i + 1]),
+            );
+            for j in 0..nz {
+                zs[j] = z[j] + 0.5 * h * k1[j];
+            }
+            m.force(p, &midpoint(tm, xm, vm, zs), k2).map_err(err)?;
+            for j in 0..nz {
+                zs[j] = z[j] + 0.5 * h * k2[j];
+            }
+            m.force(p, &midpoint(tm, xm, vm, zs), k3).map_err(err)?;
+            for j in 0..nz {
+                zs[j] = z[j] + h * k3[j];
+            }
+            let se = ModelState {
+                t: d.t[i + 1],
+                x: d.x[i + 1],
+                v: d.v[i + 1],
+                z: zs,
+            };
+            m.force(p, &se, k4).map_err(err)?;
+            for j in 0..nz {
+                z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+            }
+        }
+        Ok(())
+    }
+}
+
+fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
+    ModelState { t, x, v, z }
+}

@@ -1,0 +1,151 @@
+//! A damped Gauss–Newton (Levenberg–Marquardt) refinement, written with nalgebra.
+//!
+//! Why not argmin's `GaussNewton`: it takes undamped steps, which diverge from a start that is
+//! not already close (and our bound transforms flatten the residuals near a bound), it has no
+//! way to treat a failed evaluation as "step rejected", and its finite-difference Jacobian
+//! would be ours anyway. This is Nielsen's update of the damping λ with Marquardt's diagonal
+//! scaling, in the transforms' internal coordinates:
+//!
+//! ```text
+//! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
+//! ```
+//!
+//! Steps are shortened to at most two scales of any parameter.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::jacobian::forward_difference;
+use super::objective::Objective;
+use super::result::Convergence;
+
+/// What the refinement did.
+pub struct Refined {
+    /// Best internal coordinates.
+    pub u: Vec<f64>,
+    /// Iterations (Jacobians computed).
+    pub iterations: u64,
+    /// How it ended.
+    pub convergence: Convergence,
+}
+
+/// Longest step in internal coordinates (units of the parameters' scales).
+const MAX_STEP: f64 = 2.0;
+
+/// Largest damping before the refinement decides no step can lower the cost.
+const LAMBDA_MAX: f64 = 1e16;
+
+/// Refine `u0` by Levenberg–Marquardt; stops after `max_iters` Jacobians.
+pub fn refine(obj: &Objective, u0: &[f64], max_iters: u64, tol: f64, fd_step: f64) -> Refined {
+    let n = obj.len();
+    let p = obj.dim();
+    let mut u = u0.to_vec();
+    let mut r = vec![0.0; n];
+    let mut trial = vec![0.0; n];
+    let Some(mut rss) = obj.residuals_user(&obj.to_user(&u), &mut r) else {
+        return Refined {
+            u,
+            iterations: 0,
+            convergence: Convergence::Failed {
+                reason: "the start of the refinement cannot be evaluated".into(),
+            },
+        };
+    };
+    let mut jac = DMatrix::<f64>::zeros(n, p);
+    let steps = vec![fd_step; p];
+    let mut lambda = 1e-3;
+    let mut nu = 2.0;
+    for iter in 1..=max_iters {
+        forward_difference(
+            &u,
+            &r,
+            &steps,
+            &|_, _| false,
+            &mut |point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
+            &mut jac,
+        );
+        jac.iter_mut()
+            .filter(|v| !v.is_finite())
+            .for_each(|v| *v = 0.0);
+        let jt = jac.transpose();
+        let a = &jt * &jac;
+        let g = &jt * DVector::from_column_slice(&r);
+        let rnorm = rss.sqrt();
+        let cosine = (0..p)
+            .filter(|&j| a[(j, j)] > 0.0)
+            .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
+            .fold(0.0_f64, f64::max);
+        if rnorm == 0.0 || cosine < tol.sqrt() * 1e-2 {
+            return Refined {
+                u,
+                iterations: iter,
+                convergence: Convergence::Converged {
+                    reason: format!("residuals orthogonal to the Jacobian (cosine {cosine:.1e})"),
+                },
+            };
+        }
+        let dmax = (0..p).map(|j| a[(j, j)]).fold(0.0_f64, f64::max);
+        let floor = (1e-12 * dmax).max(f64::MIN_POSITIVE);
+        loop {
+            let mut m = a.clone();
+            for j in 0..p {
+                m[(j, j)] += lambda * a[(j, j)].max(floor);
+            }
+            let step = m.cholesky().map(|c| {
+                let delta = c.solve(&(-&g));
+                // A step of at most MAX_STEP scales: a long one would run into the flat,
+                // saturated part of a bound transform and stall there.
+                let longest = delta.amax();
+                if longest > MAX_STEP {
+                    delta * (MAX_STEP / longest)
+                } else {
+                    delta
+                }
+            });
+            let accepted = step.and_then(|delta| {
+                let cand: Vec<f64> = u.iter().zip(delta.iter()).map(|(a, b)| a + b).collect();
+                let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut trial)?;
+                let predicted = -2.0 * g.dot(&delta) - delta.dot(&(&a * &delta));
+                let rho = (rss - new_rss) / predicted;
+                (new_rss < rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
+            });
+            match accepted {
+                Some((cand, new_rss, rho, step_size)) => {
+                    let drop = (rss - new_rss) / rss;
+                    u = cand;
+                    rss = new_rss;
+                    std::mem::swap(&mut r, &mut trial);
+                    lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                    nu = 2.0;
+                    if drop < tol || step_size < 1e-12 {
+                        return Refined {
+                            u,
+                            iterations: iter,
+                            convergence: Convergence::Converged {
+                                reason: format!("relative cost change {drop:.1e} < {tol:.1e}"),
+                            },
+                        };
+                    }
+                    break;
+                }
+                None => {
+                    lambda *= nu;
+                    nu *= 2.0;
+                    if lambda > LAMBDA_MAX {
+                        return Refined {
+                            u,
+                            iterations: iter,
+                            convergence: Convergence::Converged {
+                                reason: "no step lowers the cost any further".into(),
+                            },
+                        };
+                    }
+                }
+            }
+        }
+    }
+    Refined {
+        u,
+        iterations: max_iters,
+        convergence: Convergence::MaxIterations,
+    }
+}

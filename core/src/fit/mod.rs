@@ -1,0 +1,53 @@
+//! Calibration: fitting STF models and the oscillator itself to measurements.
+//!
+//! Two kinds of fit share one engine:
+//!
+//! - [`ForceFit`]: force level — an STF model's force `m_a·a + f(t, x, v, z) + f_off` against a
+//!   measured F_STF, along measured kinematics ([`ForceData`]).
+//! - [`TrajectoryFit`]: trajectory level, as in the source study — simulate the oscillator
+//!   (with or without an STF model) and minimise `S(μ) = mean((x_exp − x_sim − x_off)²)`.
+//!
+//! Parameters ([`FitParam`]) have start values, bounds (honoured by a change of variables,
+//! [`BoundTransform`], never by clipping) and a fixed/free switch. The default solver
+//! ([`Solver::Auto`]) runs a Levenberg–Marquardt refinement and falls back on Nelder–Mead
+//! (argmin) followed by another refinement if it does not converge; [`Solver::NelderMead`] is
+//! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
+//! with standard errors from a finite-difference Jacobian in the user's parameter space
+//! (`cov = s²·(JᵀJ)⁻¹`, `s² = RSS/(N − p)`), correlations, RMS, AIC and BIC, and says whether
+//! it converged ([`FitResult`]). A failure inside the fit (a simulation that diverges, a model
+//! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
+//! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
+
+mod covariance;
+mod engine;
+mod error;
+mod force;
+mod jacobian;
+mod levenberg_marquardt;
+mod objective;
+mod param;
+mod result;
+mod settings;
+mod trajectory;
+mod transform;
+
+pub use error::FitError;
+pub use force::{ForceData, ForceFit, FORCE_OFFSET};
+pub use objective::Residuals;
+pub use param::FitParam;
+pub use result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
+pub use settings::{FitSettings, Solver};
+pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};
+pub use transform::BoundTransform;
+
+/// Fit any least-squares problem: `params` lists every parameter (free and fixed, in order);
+/// `problem` receives the user values of the free ones. For problems that are neither
+/// [`ForceFit`] nor [`TrajectoryFit`].
+pub fn fit_residuals(
+    problem: &dyn Residuals,
+    params: &[FitParam],
+    settings: &FitSettings,
+    observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+) -> Result<FitResult, FitError> {
+    engine::run(problem, params, settings, observer, false)
+}

@@ -1,0 +1,183 @@
+//! The objective every optimiser sees: residuals of free parameters, with failures turned into
+//! penalties, evaluations counted and progress reported.
+//!
+//! A fit problem implements [`Residuals`]: given the user values of the free parameters it
+//! streams its residuals to a sink (no residual vector is allocated for a plain cost). The
+//! [`Objective`] maps internal coordinates through the bound transforms, scores the mean
+//! squared residual, and counts every evaluation and every failure.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+use argmin::core::{CostFunction, Error as ArgminError};
+
+use super::result::{FitProgress, Stage};
+use super::transform::BoundTransform;
+
+/// A least-squares problem: residuals as a function of the free parameters' user values.
+pub trait Residuals: Sync {
+    /// Number of residuals.
+    fn len(&self) -> usize;
+
+    /// Whether there are no residuals.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Stream the residuals at free values `x` to `sink(i, r_i)`, in any order, each once;
+    /// an error (a failed simulation, a model error) as text.
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String>;
+}
+
+/// ln of the cost that stands for a failed evaluation in the optimisers (cost 1e300).
+pub const PENALTY_LN_COST: f64 = 690.775_527_898_213_7;
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// The objective of a fit in internal coordinates.
+pub struct Objective<'a> {
+    problem: &'a dyn Residuals,
+    transforms: Vec<BoundTransform>,
+    observer: Option<&'a (dyn Fn(FitProgress) + Sync)>,
+    evaluations: AtomicU64,
+    failures: AtomicU64,
+    last_failure: Mutex<Option<String>>,
+    best: Mutex<f64>,
+    stage: Mutex<Stage>,
+}
+
+impl<'a> Objective<'a> {
+    /// The objective of `problem` with one transform per free parameter.
+    pub fn new(
+        problem: &'a dyn Residuals,
+        transforms: Vec<BoundTransform>,
+        observer: Option<&'a (dyn Fn(FitProgress) + Sync)>,
+    ) -> Self {
+        Objective {
+            problem,
+            transforms,
+            observer,
+            evaluations: AtomicU64::new(0),
+            failures: AtomicU64::new(0),
+            last_failure: Mutex::new(None),
+            best: Mutex::new(f64::INFINITY),
+            stage: Mutex::new(Stage::NelderMead),
+        }
+    }
+
+    /// Number of free parameters.
+    pub fn dim(&self) -> usize {
+        self.transforms.len()
+    }
+
+    /// Number of residuals.
+    pub fn len(&self) -> usize {
+        self.problem.len()
+    }
+
+    /// The transforms of the free parameters.
+    pub fn transforms(&self) -> &[BoundTransform] {
+        &self.transforms
+    }
+
+    /// Report progress as this stage from now on.
+    pub fn set_stage(&self, stage: Stage) {
+        *lock(&self.stage) = stage;
+    }
+
+    /// Evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.load(Ordering::Relaxed)
+    }
+
+    /// Failed evaluations so far.
+    pub fn failures(&self) -> u64 {
+        self.failures.load(Ordering::Relaxed)
+    }
+
+    /// The last failure's message.
+    pub fn last_failure(&self) -> Option<String> {
+        lock(&self.last_failure).clone()
+    }
+
+    /// User values of the free parameters at internal coordinates `u`.
+    pub fn to_user(&self, u: &[f64]) -> Vec<f64> {
+        self.transforms
+            .iter()
+            .zip(u)
+            .map(|(t, &u)| t.to_user(u))
+            .collect()
+    }
+
+    /// Evaluate at user values `x`, streaming residuals to `sink`; `None` on failure (counted
+    /// and remembered). Returns the residual sum of squares.
+    pub fn eval_user(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Option<f64> {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let mut rss = 0.0;
+        let outcome = self.problem.residuals(x, &mut |i, r| {
+            rss += r * r;
+            sink(i, r);
+        });
+        let failure = match outcome {
+            Err(e) => Some(e),
+            Ok(()) if !rss.is_finite() => Some("a residual is not finite".to_string()),
+            Ok(()) => None,
+        };
+        if let Some(reason) = failure {
+            self.failures.fetch_add(1, Ordering::Relaxed);
+            *lock(&self.last_failure) = Some(reason);
+            return None;
+        }
+        let mean = rss / self.len().max(1) as f64;
+        let best = {
+            let mut b = lock(&self.best);
+            if mean < *b {
+                *b = mean;
+            }
+            *b
+        };
+        if let Some(observer) = self.observer {
+            observer(FitProgress {
+                stage: *lock(&self.stage),
+                evaluations: self.evaluations(),
+                best_cost: best,
+            });
+        }
+        Some(rss)
+    }
+
+    /// Residuals at user values `x` written to `out`; the residual sum of squares.
+    pub fn residuals_user(&self, x: &[f64], out: &mut [f64]) -> Option<f64> {
+        self.eval_user(x, &mut |i, r| {
+            if let Some(slot) = out.get_mut(i) {
+                *slot = r;
+            }
+        })
+    }
+
+    /// Mean squared residual at internal coordinates `u`; `None` on failure.
+    pub fn cost(&self, u: &[f64]) -> Option<f64> {
+        let x = self.to_user(u);
+        self.eval_user(&x, &mut |_, _| {})
+            .map(|rss| rss / self.len().max(1) as f64)
+    }
+}
+
+/// The objective as argmin sees it: ln of the mean squared residual, so that Nelder–Mead's
+/// tolerance on the spread of the simplex's costs is relative; a failure scores
+/// [`PENALTY_LN_COST`].
+pub struct LnCost<'o, 'a>(pub &'o Objective<'a>);
+
+impl CostFunction for LnCost<'_, '_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, u: &Self::Param) -> Result<f64, ArgminError> {
+        Ok(match self.0.cost(u) {
+            Some(c) => c.max(1e-300).ln().min(PENALTY_LN_COST),
+            None => PENALTY_LN_COST,
+        })
+    }
+}

@@ -1,0 +1,123 @@
+//! What a fit reports: values with standard errors and correlations, goodness of fit,
+//! information criteria, the work done, and whether it converged.
+
+use serde::Serialize;
+
+/// How a fit ended.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Convergence {
+    /// The last stage met its stopping rule.
+    Converged {
+        /// Which rule.
+        reason: String,
+    },
+    /// The last stage ran out of iterations: the values may not be the optimum.
+    MaxIterations,
+    /// The optimiser failed.
+    Failed {
+        /// Why.
+        reason: String,
+    },
+}
+
+impl Convergence {
+    /// Whether the fit converged.
+    pub fn converged(&self) -> bool {
+        matches!(self, Convergence::Converged { .. })
+    }
+}
+
+/// A stage of a fit, for progress reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// Particle swarm.
+    ParticleSwarm,
+    /// Nelder–Mead.
+    NelderMead,
+    /// Levenberg–Marquardt.
+    LevenbergMarquardt,
+    /// The final Jacobian for the standard errors.
+    Errors,
+}
+
+/// Progress of a running fit, passed to the observer after every evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitProgress {
+    /// The stage running.
+    pub stage: Stage,
+    /// Evaluations of the model so far (simulations, for trajectory fits).
+    pub evaluations: u64,
+    /// Lowest cost so far: mean squared residual (N² or m²).
+    pub best_cost: f64,
+}
+
+/// A fitted parameter.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FittedParam {
+    /// Name.
+    pub name: String,
+    /// Best value.
+    pub value: f64,
+    /// Standard error (infinite or NaN if the data do not determine the parameter; 0 if
+    /// fixed).
+    pub std_error: f64,
+    /// Held fixed.
+    pub fixed: bool,
+}
+
+/// The outcome of a fit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FitResult {
+    /// All parameters of the fit, free and fixed, in the order given.
+    pub params: Vec<FittedParam>,
+    /// Correlations of the free parameters, in their order in `params`.
+    pub correlation: Vec<Vec<f64>>,
+    /// Number of residuals (samples).
+    pub n_points: usize,
+    /// Number of free parameters.
+    pub n_free: usize,
+    /// Residual sum of squares (N² or m²).
+    pub rss: f64,
+    /// RMS residual (N, or m for trajectory fits).
+    pub rms: f64,
+    /// S(μ) = mean((x_exp − x_sim)²) in mm² (trajectory fits only).
+    pub s_mm2: Option<f64>,
+    /// Akaike information criterion, N·ln(RSS/N) + 2p.
+    pub aic: f64,
+    /// Bayesian information criterion, N·ln(RSS/N) + p·ln N.
+    pub bic: f64,
+    /// Evaluations of the model (simulations, for trajectory fits), all stages.
+    pub evaluations: u64,
+    /// Evaluations that failed (a simulation error, a model error, a non-finite residual)
+    /// and were scored as a penalty.
+    pub failures: u64,
+    /// The last such failure, if any.
+    pub last_failure: Option<String>,
+    /// Iterations of all stages.
+    pub iterations: u64,
+    /// Wall time, s.
+    pub wall_seconds: f64,
+    /// How the fit ended.
+    pub convergence: Convergence,
+    /// One line per stage: what ran and how it ended.
+    pub log: Vec<String>,
+}
+
+impl FitResult {
+    /// The fitted parameter called `name`.
+    pub fn param(&self, name: &str) -> Option<&FittedParam> {
+        self.params.iter().find(|p| p.name == name)
+    }
+
+    /// The best value of `name`.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.param(name).map(|p| p.value)
+    }
+
+    /// The standard error of `name`.
+    pub fn std_error(&self, name: &str) -> Option<f64> {
+        self.param(name).map(|p| p.std_error)
+    }
+}

@@ -1,0 +1,162 @@
+//! Which optimiser a fit uses and when it stops.
+
+use serde::{Deserialize, Serialize};
+
+use super::error::FitError;
+
+/// The optimiser, or chain of optimisers, of a fit. Every chain ends with standard errors
+/// from a finite-difference Jacobian at the best point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Solver {
+    /// Levenberg–Marquardt from the start; if it does not converge, Nelder–Mead (to
+    /// `presearch_tol`) then Levenberg–Marquardt again. (Nelder–Mead first was tried: on a
+    /// free vibration with dry friction its large first moves left the basin that
+    /// Levenberg–Marquardt, started 10 % off, finds directly.)
+    #[default]
+    Auto,
+    /// Nelder–Mead alone (the source study's method), run to `simplex_tol`.
+    NelderMead,
+    /// Levenberg–Marquardt alone, from the start values.
+    LevenbergMarquardt,
+    /// Particle swarm over the whole bounded box (a global search), then Levenberg–Marquardt.
+    ParticleSwarm,
+}
+
+impl Solver {
+    /// All solvers, for listings and error messages.
+    pub const ALL: [Solver; 4] = [
+        Solver::Auto,
+        Solver::NelderMead,
+        Solver::LevenbergMarquardt,
+        Solver::ParticleSwarm,
+    ];
+
+    /// The name used in experiment files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Auto => "auto",
+            Solver::NelderMead => "nelder_mead",
+            Solver::LevenbergMarquardt => "levenberg_marquardt",
+            Solver::ParticleSwarm => "particle_swarm",
+        }
+    }
+}
+
+/// Settings of a fit, with named setters.
+///
+/// ```
+/// use stf_core::fit::{FitSettings, Solver};
+/// let s = FitSettings::default().solver(Solver::NelderMead).max_iters(200).seed(7);
+/// assert_eq!(s.max_iters, 200);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitSettings {
+    /// The optimiser.
+    pub solver: Solver,
+    /// Most iterations of each stage.
+    pub max_iters: u64,
+    /// Levenberg–Marquardt stops when an accepted step lowers the cost by less than this
+    /// fraction, or when the residuals are orthogonal to the Jacobian's columns to this
+    /// level (cosine), or when no step lowers the cost.
+    pub tol: f64,
+    /// Nelder–Mead stops when the standard deviation of ln(cost) over the simplex falls below
+    /// this (a relative spread of the costs). In [`Solver::Auto`]'s fallback the simplex stage
+    /// stops at the larger of this and `presearch_tol`.
+    pub simplex_tol: f64,
+    /// Simplex tolerance of the Nelder–Mead stage in [`Solver::Auto`].
+    pub presearch_tol: f64,
+    /// Initial simplex edge, in units of each parameter's scale.
+    pub simplex_step: f64,
+    /// Finite-difference step of Jacobians, in units of each parameter's scale.
+    pub fd_step: f64,
+    /// Particles of the swarm.
+    pub particles: usize,
+    /// Seed of every random choice (the swarm).
+    pub seed: u64,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        FitSettings {
+            solver: Solver::Auto,
+            max_iters: 1000,
+            tol: 1e-9,
+            simplex_tol: 1e-8,
+            presearch_tol: 1e-3,
+            simplex_step: 0.1,
+            fd_step: 1e-5,
+            particles: 40,
+            seed: 1,
+        }
+    }
+}
+
+impl FitSettings {
+    /// The optimiser.
+    pub fn solver(mut self, solver: Solver) -> Self {
+        self.solver = solver;
+        self
+    }
+    /// Most iterations of each stage.
+    pub fn max_iters(mut self, n: u64) -> Self {
+        self.max_iters = n;
+        self
+    }
+    /// Relative cost tolerance of Levenberg–Marquardt.
+    pub fn tol(mut self, tol: f64) -> Self {
+        self.tol = tol;
+        self
+    }
+    /// Nelder–Mead's tolerance on the spread of ln(cost).
+    pub fn simplex_tol(mut self, tol: f64) -> Self {
+        self.simplex_tol = tol;
+        self
+    }
+    /// Tolerance of the Nelder–Mead stage in [`Solver::Auto`].
+    pub fn presearch_tol(mut self, tol: f64) -> Self {
+        self.presearch_tol = tol;
+        self
+    }
+    /// Initial simplex edge, in scales.
+    pub fn simplex_step(mut self, step: f64) -> Self {
+        self.simplex_step = step;
+        self
+    }
+    /// Finite-difference step, in scales.
+    pub fn fd_step(mut self, step: f64) -> Self {
+        self.fd_step = step;
+        self
+    }
+    /// Particles of the swarm.
+    pub fn particles(mut self, n: usize) -> Self {
+        self.particles = n;
+        self
+    }
+    /// Random seed.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Check the settings.
+    pub fn validate(&self) -> Result<(), FitError> {
+        let pos = |v: f64| v > 0.0 && v.is_finite();
+        let ok = self.max_iters > 0
+            && pos(self.tol)
+            && pos(self.simplex_tol)
+            && pos(self.presearch_tol)
+            && pos(self.simplex_step)
+            && pos(self.fd_step)
+            && self.fd_step < 0.5
+            && self.particles >= 2;
+        if ok {
+            Ok(())
+        } else {
+            Err(FitError::BadSettings(format!(
+                "need max_iters > 0, positive finite tolerances and steps, fd_step < 0.5, \
+                 particles ≥ 2 (got {self:?})"
+            )))
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! Trajectory-level identification, as in the source study: simulate the oscillator (with or
+//! without an STF model) and minimise `S(μ) = mean((x_exp − x_sim − x_off)²)`, reported in mm².
+//!
+//! Free parameters are named: the oscillator's (`m`, `k`, `c`, `T`, `delta_T`, `F0`, `eta`),
+//! the STF model's (as its specs name them), and the displacement offset `x_off` (m). Each
+//! evaluation is one simulation from the first sample's time, from `(x0, v0)`: by default
+//! `x0 = x_exp[0] − x_off` and `v0 = 0`. A simulation that fails scores a penalty.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use stf_core::excitation::Excitation;
+//! use stf_core::fit::{FitParam, TrajectoryData, TrajectoryFit};
+//! use stf_core::{oscillator::Oscillator, simulate::Simulation, system::OscillatorParams};
+//! let truth = OscillatorParams { t_friction: 0.0, ..OscillatorParams::FREE };
+//! let osc = Oscillator::new(truth, Excitation::None);
+//! let run = Simulation::new(&osc).rate(50.0).initial(0.03, 0.0).run(0.0, 2.0).unwrap();
+//! let fit = TrajectoryFit::new(truth, Arc::new(Excitation::None))
+//!     .free(FitParam::new("k", 250.0).bounds(100.0, 400.0));
+//! let result = fit.fit(&TrajectoryData { t: &run.t, x: &run.x }, None).unwrap();
+//! assert!((result.value("k").unwrap() / truth.k - 1.0).abs() < 1e-4);
+//! ```
+
+use std::sync::Arc;
+
+use super::engine;
+use super::error::FitError;
+use super::objective::Residuals;
+use super::param::FitParam;
+use super::result::{FitProgress, FitResult};
+use super::settings::FitSettings;
+use crate::excitation::Excitation;
+use crate::force_model::ForceModel;
+use crate::integrate::{integrate, Settings};
+use crate::oscillator::Oscillator;
+use crate::system::OscillatorParams;
+
+/// A measured displacement record (SI units, equal lengths, time strictly increasing).
+#[derive(Clone, Copy, Debug)]
+pub struct TrajectoryData<'a> {
+    /// Time, s.
+    pub t: &'a [f64],
+    /// Displacement, m.
+    pub x: &'a [f64],
+}
+
+/// Name of the constant displacement offset parameter, m.
+pub const DISPLACEMENT_OFFSET: &str = "x_off";
+
+/// A trajectory-level fit of the oscillator and, optionally, an STF model.
+#[derive(Clone)]
+pub struct TrajectoryFit {
+    system: OscillatorParams,
+    excitation: Arc<Excitation>,
+    model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
+    free: Vec<FitParam>,
+    initial: Option<(f64, f64)>,
+    sim: Settings,
+    settings: FitSettings,
+}
+
+/// Where a named parameter lives.
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Oscillator(&'static str),
+    Model(usize),
+    Offset,
+}
+
+impl TrajectoryFit {
+    /// Fit nothing yet: the oscillator `system` driven by `excitation`, no STF model.
+    pub fn new(system: OscillatorParams, excitation: Arc<Excitation>) -> Self {
+        TrajectoryFit {
+            system,
+            excitation,
+            model: None,
+            free: Vec::new(),
+            initial: None,
+            sim: Settings::default(),
+            settings: FitSettings::default(),
+        }
+    }
+
+    /// Add an STF model with its parameter values (in the order of its specs); those not
+    /// named in [`TrajectoryFit::free`] stay at these values.
+    pub fn model(mut self, model: Arc<dyn ForceModel>, values: Vec<f64>) -> Self {
+        self.model = Some((model, values));
+        self
+    }
+
+    /// A parameter to fit (or to hold, if `fixed`): an oscillator parameter, a model
+    /// parameter, or `x_off` (the displacement offset, m, default scale 1 mm).
+    pub fn free(mut self, p: FitParam) -> Self {
+        let mut p = p;
+        if p.name == DISPLACEMENT_OFFSET && p.scale.is_none() && p.value == 0.0 {
+            p.scale = Some(1e-3);
+        }
+        self.free.push(p);
+        self
+    }
+
+    /// Initial displacement (m) and velocity (m/s) of every simulation.
+    pub fn initial(mut self, x0: f64, v0: f64) -> Self {
+        self.initial = Some((x0, v0));
+        self
+    }
+
+    /// Integrator settings of the simulations.
+    pub fn sim_settings(mut self, sim: Settings) -> Self {
+        self.sim = sim;
+        self
+    }
+
+    /// Settings of the optimiser.
+    pub fn settings(mut self, settings: FitSettings) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    fn resolve(&self, name: &str) -> Result<Slot, FitError> {
+        if name == DISPLACEMENT_OFFSET {
+            return Ok(Slot::Offset);
+        }
+        let osc = OscillatorParams::NAMES.iter().find(|n| **n == name);
+        let model = self
+            .model
+            .as_ref()
+            .and_then(|(m, _)| m.params().iter().position(|s| s.name == name));
+        match (osc, model) {
+            (Some(_), Some(_)) => Err(FitError::AmbiguousParam(name.to_string())),
+            (Some(n), None) => Ok(Slot::Oscillator(n)),
+            (None, Some(i)) => Ok(Slot::Model(i)),
+            (None, None) => {
+                let mut known: Vec<&str> = OscillatorParams::NAMES.to_vec();
+                if let Some((m, _)) = &self.model {
+                    known.extend(m.params().iter().map(|s| s.name.as_str()));
+                }
+                known.push(DISPLACEMENT_OFFSET);
+                Err(FitError::UnknownParam {
+                    name: name.to_string(),
+                    known: known.join(", "),
+                })
+            }
+        }
+    }
+
+    /// Run the fit; `observer` is called after every simulation.
+    pub fn fit(
+        &self,
+        data: &TrajectoryData,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
+        let n = data.t.len();
+        if data.x.len() != n || n < 2 {
+            return Err(FitError::BadData(format!(
+                "t and x must have equal lengths ≥ 2 (got {n} and {})",
+                data.x.len()
+            )));
+        }
+        if let Some(i) = data.x.iter().position(|v| !v.is_finite()) {
+            return Err(FitError::BadData(format!("x[{i}] is not finite")));
+        }
+        if let Some(i) = data
+            .t
+            .windows(2)
+            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
+            return Err(FitError::BadData(format!(
+                "time must increase strictly (at sample {i})"
+            )));
+        }
+        if let Some((m, values)) = &self.model {
+            if values.len() != m.params().len() {
+                return Err(FitError::BadData(format!(
+                    "model `{}` expects {} values, got {}",
+                    m.name(),
+                    m.params().len(),
+                    values.len()
+                )));
+            }
+        }
+        let slots = self
+            .free
+            .iter()
+            .map(|p| self.resolve(&p.name))
+            .collect::<Result<Vec<_>, _>>()?;
+        let problem = TrajectoryResiduals {
+            fit: self,
+            data: *data,
+            slots,
+        };
+        engine::run(&problem, &self.free, &self.settings, observer, true)
+    }
+}
+
+struct TrajectoryResiduals<'a> {
+    fit: &'a TrajectoryFit,
+    data: TrajectoryData<'a>,
+    slots: Vec<Slot>,
+}
+
+impl Residuals for TrajectoryResiduals<'_> {
+    fn len(&self) -> usize {
+        self.data.t.len()
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        let fit = self.fit;
+        let mut system = fit.system;
+        let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
+        let mut offset = 0.0;
+        let mut free = x.iter();
+        for (p, slot) in fit.free.iter().zip(&self.slots) {
+            let value = if p.fixed {
+                p.value
+            } else {
+                *free.next().ok_or("too few free values")?
+            };
+            match *slot {
+                Slot::Oscillator(name) => {
+                    system.set(name, value);
+                }
+                Slot::Model(i) => {
+                    if let Some(slot) = model_values.as_mut().and_then(|v| v.get_mut(i)) {
+                        *slot = value;
+                    }
+                }
+                Slot::Offset => offset = value,
+            }
+        }
+        let mut osc = Oscillator::with_shared_excitation(system, fit.excitation.clone());
+        if let (Some((m, _)), Some(values)) = (&fit.model, model_values) {
+            osc = osc
+                .with_model(m.clone(), values)
+                .map_err(|e| e.to_string())?;
+        }
+        let d = &self.data;
+        let (x0, v0) = fit.initial.unwrap_or((d.x[0] - offset, 0.0));
+        let y0 = osc.initial_state(x0, v0);
+        let sol = integrate(&osc, d.t[0], &y0, d.t, &fit.sim).map_err(|e| e.to_string())?;
+        for (i, &xe) in d.x.iter().enumerate() {
+            sink(i, xe - sol.states[i * sol.dim] - offset);
+        }
+        Ok(())
+    }
+}
