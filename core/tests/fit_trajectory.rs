@@ -37,7 +37,6 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 #[test]
-#[ignore = "≈ 6 s in release with Dopri5 (64 simulations of the stiff stuck phase); un-ignore once the stiff-capable integrator lands"]
 fn free_vibration_recovers_k_c_t_from_ten_percent_off() {
     let truth = OscillatorParams::FREE;
     let osc = Oscillator::new(truth, Excitation::None);
