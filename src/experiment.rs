@@ -10,8 +10,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
+use stf_core::derivative::{Boundary, PolyFilter};
 use stf_core::excitation::RotorAngle;
+use stf_core::fit::{FitSettings, Solver};
 use stf_core::integrate::{Method, Settings};
+use stf_core::kinematics::KinematicsSettings;
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
@@ -150,6 +153,48 @@ struct RawIntegrator {
 #[serde(deny_unknown_fields)]
 struct RawData {
     file: String,
+    /// Time window to use, s.
+    window: Option<[f64; 2]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFit {
+    level: Option<String>,
+    solver: Option<String>,
+    max_iters: Option<u64>,
+    seed: Option<u64>,
+    #[serde(default)]
+    system: Vec<String>,
+    #[serde(default)]
+    offset: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFilterSpec {
+    order: usize,
+    window: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFilter {
+    motion: Option<RawFilterSpec>,
+    omega: Option<RawFilterSpec>,
+    boundary: Option<String>,
+    #[serde(default)]
+    paper: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStage {
+    data: String,
+    preset: Option<String>,
+    free: Vec<String>,
+    #[serde(default)]
+    set: BTreeMap<String, f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -168,6 +213,47 @@ struct RawExperiment {
     models: Vec<Spanned<RawModel>>,
     simulate: Option<Spanned<RawSimulate>>,
     discover: Option<RawDiscover>,
+    fit: Option<Spanned<RawFit>>,
+    filter: Option<Spanned<RawFilter>>,
+    #[serde(default)]
+    identify: Vec<Spanned<RawStage>>,
+}
+
+/// Whether models are fitted to the measured force or to the measured motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FitLevel {
+    /// Against `f_stf`, along the record's kinematics.
+    Force,
+    /// Against `x`, by simulating the oscillator driven as in the record.
+    Trajectory,
+}
+
+/// A validated `[fit]` section.
+#[derive(Clone, Debug)]
+pub struct FitSpec {
+    /// Force or trajectory level; `None`: force when the record has `f_stf`.
+    pub level: Option<FitLevel>,
+    /// Optimiser settings.
+    pub settings: FitSettings,
+    /// Oscillator parameters fitted along with a model (trajectory level).
+    pub system_free: Vec<String>,
+    /// Fit a constant offset (force: `f_off`, trajectory: `x_off`).
+    pub offset: bool,
+}
+
+/// One stage of an oscillator identification (`[[identify]]`).
+#[derive(Clone, Debug)]
+pub struct StageSpec {
+    /// The record, resolved.
+    pub data: PathBuf,
+    /// Start values replaced by a preset before this stage.
+    pub preset: Option<OscillatorParams>,
+    /// Oscillator parameters fitted in this stage.
+    pub free: Vec<String>,
+    /// Values set (and held) before this stage.
+    pub set: Vec<(String, f64)>,
+    /// Line in the file.
+    pub line: usize,
 }
 
 /// A model as the experiment file gives it, with where it stands in the file.
@@ -236,6 +322,14 @@ pub struct Experiment {
     /// `[data] file`, resolved.
     #[allow(dead_code)] // read by fit, compare and discover
     pub data_file: Option<PathBuf>,
+    /// Time window of the data, s.
+    pub data_window: Option<(f64, f64)>,
+    /// `[fit]`.
+    pub fit: FitSpec,
+    /// `[filter]`.
+    pub kinematics: KinematicsSettings,
+    /// `[[identify]]` stages.
+    pub identify: Vec<StageSpec>,
     /// `[discover] base`.
     #[allow(dead_code)] // read by fit, compare and discover
     pub discover_base: Option<String>,
@@ -480,8 +574,147 @@ impl Experiment {
             }
         };
 
+        let mut fit = FitSpec {
+            level: None,
+            settings: FitSettings::default(),
+            system_free: Vec::new(),
+            offset: false,
+        };
+        if let Some(f) = &raw.fit {
+            let span = f.span();
+            let f = f.get_ref();
+            fit.level = match f.level.as_deref() {
+                None => None,
+                Some("force") => Some(FitLevel::Force),
+                Some("trajectory") => Some(FitLevel::Trajectory),
+                Some(other) => {
+                    return Err(cx.at(
+                        span,
+                        "fit.level",
+                        format!("unknown level `{other}`; known: force, trajectory"),
+                    ))
+                }
+            };
+            if let Some(name) = &f.solver {
+                fit.settings.solver = Solver::ALL
+                    .into_iter()
+                    .find(|s| s.name() == name)
+                    .ok_or_else(|| {
+                        let known: Vec<&str> = Solver::ALL.iter().map(|s| s.name()).collect();
+                        cx.at(
+                            span.clone(),
+                            "fit.solver",
+                            format!("unknown solver `{name}`; known: {}", known.join(", ")),
+                        )
+                    })?;
+            }
+            if let Some(n) = f.max_iters {
+                fit.settings.max_iters = n;
+            }
+            if let Some(seed) = f.seed {
+                fit.settings.seed = seed;
+            }
+            for name in &f.system {
+                if OscillatorParams::get(&OscillatorParams::FORCED, name).is_none() {
+                    return Err(cx.at(
+                        span.clone(),
+                        "fit.system",
+                        format!(
+                            "`{name}` is not an oscillator parameter; known: {}",
+                            OscillatorParams::NAMES.join(", ")
+                        ),
+                    ));
+                }
+            }
+            fit.system_free = f.system.clone();
+            fit.offset = f.offset;
+        }
+
+        let mut kinematics = KinematicsSettings::default();
+        if let Some(f) = &raw.filter {
+            let span = f.span();
+            let f = f.get_ref();
+            if f.paper {
+                kinematics = KinematicsSettings::paper();
+            }
+            if let Some(b) = &f.boundary {
+                kinematics.boundary = match b.as_str() {
+                    "shifted" => Boundary::Shifted,
+                    "zero" => Boundary::Zero,
+                    other => {
+                        return Err(cx.at(
+                            span,
+                            "filter.boundary",
+                            format!("unknown boundary `{other}`; known: shifted, zero"),
+                        ))
+                    }
+                };
+            }
+            let boundary = kinematics.boundary;
+            let make = |key: &str, spec: &RawFilterSpec| {
+                PolyFilter::new(spec.order, spec.window)
+                    .map(|f| f.boundary(boundary))
+                    .map_err(|e| cx.at(span.clone(), key, e))
+            };
+            if let Some(m) = &f.motion {
+                kinematics.motion = Some(make("filter.motion", m)?);
+            } else if let Some(m) = kinematics.motion.as_mut() {
+                *m = m.boundary(boundary);
+            }
+            if let Some(o) = &f.omega {
+                kinematics.omega = make("filter.omega", o)?;
+            } else {
+                kinematics.omega = kinematics.omega.boundary(boundary);
+            }
+        }
+
+        let mut identify = Vec::new();
+        for (i, st) in raw.identify.iter().enumerate() {
+            let span = st.span();
+            let key = format!("identify[{i}]");
+            let r = st.get_ref();
+            let preset = match &r.preset {
+                None => None,
+                Some(name) => Some(OscillatorParams::preset(name).ok_or_else(|| {
+                    cx.at(
+                        span.clone(),
+                        &format!("{key}.preset"),
+                        format!("unknown preset `{name}`; known: forced, free"),
+                    )
+                })?),
+            };
+            for name in r.free.iter().chain(r.set.keys()) {
+                if OscillatorParams::FORCED.get(name).is_none() {
+                    return Err(cx.at(
+                        span.clone(),
+                        &key,
+                        format!(
+                            "`{name}` is not an oscillator parameter; known: {}",
+                            OscillatorParams::NAMES.join(", ")
+                        ),
+                    ));
+                }
+            }
+            identify.push(StageSpec {
+                data: dir.join(&r.data),
+                preset,
+                free: r.free.clone(),
+                set: r.set.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+                line: line_of(text, span.start),
+            });
+        }
+
+        let data_window = raw
+            .data
+            .as_ref()
+            .and_then(|d| d.window)
+            .map(|[a, b]| (a, b));
         Ok(Experiment {
             path: path.to_path_buf(),
+            data_window,
+            fit,
+            kinematics,
+            identify,
             data_file: raw.data.map(|d| dir.join(d.file)),
             dir,
             system,

@@ -3,16 +3,20 @@
 //! ```text
 //! stf-lab models                          list models with their parameters
 //! stf-lab simulate EXP.toml --out F.csv   write a synthetic record (section [simulate])
+//! stf-lab fit EXP.toml --out DIR          calibrate every model of the experiment
 //! ```
 
 // `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod cmd_fit;
 mod cmd_models;
 mod cmd_simulate;
 mod experiment;
+mod fitting;
 mod model_config;
 mod output;
+mod progress;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -42,6 +46,20 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Calibrate every model of the experiment against its record.
+    Fit {
+        /// The experiment file.
+        experiment: PathBuf,
+        /// Folder for fit.json and fitted.csv.
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace results in an existing folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress display.
+        #[arg(long)]
+        quiet: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -53,6 +71,12 @@ fn main() -> ExitCode {
             out,
             force,
         } => cmd_simulate::run(&experiment, &out, force),
+        Command::Fit {
+            experiment,
+            out,
+            force,
+            quiet,
+        } => cmd_fit::run(&experiment, &out, force, quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

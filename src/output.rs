@@ -42,6 +42,44 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     result.with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Make `dir` ready for a command's outputs: create it, or, if it exists and holds files,
+/// refuse unless `force` (then its files are replaced one by one, atomically).
+pub fn prepare_dir(dir: &Path, force: bool) -> Result<()> {
+    if dir.exists() {
+        let occupied = std::fs::read_dir(dir)
+            .with_context(|| format!("cannot read folder {}", dir.display()))?
+            .next()
+            .is_some();
+        if occupied && !force {
+            bail!(
+                "{} already exists and is not empty; pass --force to replace its results",
+                dir.display()
+            );
+        }
+        return Ok(());
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
+}
+
+/// Serialize `value` as pretty JSON into `path`, atomically.
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    write_atomic(path, text.as_bytes())
+}
+
+/// Write columns of numbers as CSV (header `names`) into `path`, atomically.
+pub fn write_columns(path: &Path, names: &[&str], columns: &[&[f64]]) -> Result<()> {
+    let n = columns.iter().map(|c| c.len()).min().unwrap_or(0);
+    let mut text = names.join(",");
+    text.push('\n');
+    for i in 0..n {
+        let row: Vec<String> = columns.iter().map(|c| format!("{}", c[i])).collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    write_atomic(path, text.as_bytes())
+}
+
 /// Create the parent folder of `path` if it is missing.
 pub fn ensure_parent(path: &Path) -> Result<()> {
     if let Some(parent) = path.parent() {

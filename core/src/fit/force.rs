@@ -184,6 +184,36 @@ impl ForceFit {
     }
 }
 
+impl ForceFit {
+    /// The modelled force (with the offset, if any) at every sample for the full parameter
+    /// vector `values` (the model's parameters, then the offset), along the kinematics.
+    pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        data.validate()?;
+        let mut all = self.params();
+        if values.len() != all.len() {
+            return Err(FitError::BadData(format!(
+                "{} values given for {} parameters",
+                values.len(),
+                all.len()
+            )));
+        }
+        for (p, &v) in all.iter_mut().zip(values) {
+            p.value = v;
+            p.fixed = true;
+        }
+        let problem = ForceResiduals {
+            model: self.model.as_ref(),
+            data: *data,
+            all: &all,
+        };
+        let mut out = data.f.to_vec();
+        problem
+            .residuals(&[], &mut |i, r| out[i] -= r)
+            .map_err(FitError::BadData)?;
+        Ok(out)
+    }
+}
+
 /// The residuals of a force-level fit.
 struct ForceResiduals<'a> {
     model: &'a dyn ForceModel,

@@ -1,0 +1,213 @@
+//! `stf-lab fit EXP.toml --out DIR`: calibrate every model of the experiment, or run the
+//! oscillator identification stages of `[[identify]]`.
+//!
+//! Writes `DIR/fit.json` (for each model: `name`, `params`, `rms`, standard errors, AIC/BIC,
+//! convergence …) and `DIR/fitted.csv` (the measured signal and each model's fit).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use anyhow::{Context, Result};
+use serde_json::json;
+use stf_core::fit::{FitParam, TrajectoryData, TrajectoryFit};
+use stf_core::kinematics::Kinematics;
+use stf_core::record::Record;
+
+use crate::experiment::{Experiment, FitLevel};
+use crate::fitting::{finite_or_null, fit_all, load_data};
+use crate::output::{prepare_dir, write_columns, write_json};
+use crate::progress::{fit_message, Progress};
+
+/// Run `stf-lab fit`.
+pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
+    let exp = Experiment::load(exp_path)?;
+    let progress = Progress::new(quiet);
+    if !exp.identify.is_empty() {
+        prepare_dir(out, force)?;
+        return identify(&exp, out, &progress);
+    }
+    let data = load_data(&exp)?;
+    prepare_dir(out, force)?;
+    let fits = fit_all(&exp, &data, &progress)?;
+
+    let level = data.level;
+    let doc = json!({
+        "experiment": exp.path.display().to_string(),
+        "record": data.record.source,
+        "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
+        "samples": data.record.len(),
+        "motion_filter": { "order": data.kinematics.motion_filter.order(), "window": data.kinematics.motion_filter.window() },
+        "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
+    });
+    write_json(&out.join("fit.json"), &doc)?;
+
+    let measured_name = match level {
+        FitLevel::Force => "f_stf",
+        FitLevel::Trajectory => "x",
+    };
+    let names: Vec<String> = std::iter::once("t".to_string())
+        .chain(std::iter::once(measured_name.to_string()))
+        .chain(
+            fits.iter()
+                .map(|f| format!("{measured_name}_{}", f.name().replace(' ', ""))),
+        )
+        .collect();
+    let mut columns: Vec<&[f64]> = vec![&data.record.t, data.target()];
+    columns.extend(fits.iter().map(|f| f.fitted.as_slice()));
+    let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
+
+    let unit = match level {
+        FitLevel::Force => "N",
+        FitLevel::Trajectory => "mm",
+    };
+    let scale = if level == FitLevel::Force { 1.0 } else { 1e3 };
+    println!(
+        "fitted {} model(s) at {} level on {} samples of {}",
+        fits.len(),
+        if level == FitLevel::Force {
+            "force"
+        } else {
+            "trajectory"
+        },
+        data.record.len(),
+        data.record.source
+    );
+    for f in &fits {
+        let params: Vec<String> = f
+            .result
+            .params
+            .iter()
+            .filter(|p| !p.fixed)
+            .map(|p| format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error))
+            .collect();
+        println!(
+            "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
+            f.name(),
+            f.result.rms * scale,
+            f.result.aic,
+            params.join(", "),
+            if f.result.convergence.converged() {
+                ""
+            } else {
+                "  (did not converge)"
+            }
+        );
+    }
+    println!(
+        "wrote {}/fit.json and {}/fitted.csv",
+        out.display(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// The source study's identification: each stage fits the oscillator's parameters against a
+/// record's displacement, starting from the previous stage's values.
+fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
+    let mut system = exp.system;
+    let mut stages = Vec::new();
+    for (i, stage) in exp.identify.iter().enumerate() {
+        if let Some(preset) = stage.preset {
+            // A preset replaces only the parameters not found by earlier stages.
+            let found: Vec<String> = exp.identify[..i]
+                .iter()
+                .flat_map(|s| s.free.clone())
+                .collect();
+            for name in stf_core::system::OscillatorParams::NAMES {
+                if !found.iter().any(|f| f == name) {
+                    system.set(name, preset.get(name).unwrap_or(0.0));
+                }
+            }
+        }
+        for (name, value) in &stage.set {
+            system.set(name, *value);
+        }
+        let record = Record::read(&stage.data)?;
+        let k = Kinematics::from_record(&record, &exp.kinematics)
+            .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
+        let mut fit = TrajectoryFit::new(system, Arc::new(k.excitation()))
+            .sim_settings(exp.integrator.clone())
+            .settings(exp.fit.settings.clone())
+            .initial(k.x[0], k.v[0]);
+        for name in &stage.free {
+            let v = system.get(name).unwrap_or(0.0);
+            let (min, max) = if v > 0.0 {
+                (v / 5.0, v * 5.0)
+            } else {
+                (0.0, 10.0)
+            };
+            fit = fit.free(FitParam::new(name.clone(), v).bounds(min, max));
+        }
+        let bar = progress.job(&format!("stage {}", i + 1));
+        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));
+        let result = fit
+            .fit(
+                &TrajectoryData {
+                    t: &record.t,
+                    x: &record.x,
+                },
+                Some(&observer),
+            )
+            .with_context(|| {
+                format!(
+                    "{}:{}: identification stage {} failed",
+                    exp.path.display(),
+                    stage.line,
+                    i + 1
+                )
+            })?;
+        bar.finish_and_clear();
+        for name in &stage.free {
+            if let Some(v) = result.value(name) {
+                system.set(name, v);
+            }
+        }
+        println!(
+            "stage {} ({}): S(μ) = {:.4} mm², {}{}",
+            i + 1,
+            stage.data.display(),
+            result.s_mm2.unwrap_or(f64::NAN),
+            result
+                .params
+                .iter()
+                .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if result.convergence.converged() {
+                ""
+            } else {
+                " (did not converge)"
+            }
+        );
+        stages.push(json!({
+            "record": stage.data.display().to_string(),
+            "free": stage.free,
+            "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
+            "std_errors": result.params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "s_mm2": result.s_mm2,
+            "rms": result.rms,
+            "aic": finite_or_null(result.aic),
+            "bic": finite_or_null(result.bic),
+            "evaluations": result.evaluations,
+            "wall_seconds": result.wall_seconds,
+            "converged": result.convergence.converged(),
+            "convergence": result.convergence,
+        }));
+    }
+    let doc = json!({
+        "experiment": exp.path.display().to_string(),
+        "level": "trajectory",
+        "stages": stages,
+        "system": system,
+        "models": [{
+            "name": "none",
+            "params": serde_json::to_value(system)?,
+            "rms": stages.last().and_then(|s| s["rms"].as_f64()),
+        }],
+    });
+    write_json(&out.join("fit.json"), &doc)?;
+    println!("identified system: {}", serde_json::to_string(&system)?);
+    println!("wrote {}/fit.json", out.display());
+    Ok(())
+}

@@ -1,0 +1,322 @@
+//! Fitting the models of an experiment to its record: the shared step of `fit`, `compare`
+//! and `discover`.
+//!
+//! The record is read, cut to the experiment's time window, and its kinematics derived
+//! once. Each model is then fitted on its own thread (rayon), deterministically, at force level
+//! (against `f_stf`, along the kinematics) or trajectory level (against `x`, simulating the
+//! oscillator driven as in the record).
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, bail, Context, Result};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::kinematics::Kinematics;
+use stf_core::oscillator::Oscillator;
+use stf_core::record::Record;
+use stf_core::simulate::Simulation;
+use stf_core::system::OscillatorParams;
+
+use crate::experiment::{Experiment, FitLevel};
+use crate::model_config::{configure, ConfiguredModel};
+use crate::progress::{fit_message, Progress};
+
+/// A record with its kinematics, ready to fit.
+pub struct FitData {
+    /// The record, cut to the time window.
+    pub record: Record,
+    /// Its kinematics.
+    pub kinematics: Kinematics,
+    /// The level fits run at.
+    pub level: FitLevel,
+}
+
+impl FitData {
+    /// The measured signal fits aim at: `f_stf` (force level) or `x` (trajectory level).
+    pub fn target(&self) -> &[f64] {
+        match self.level {
+            FitLevel::Force => self.record.f_stf.as_deref().unwrap_or(&[]),
+            FitLevel::Trajectory => &self.record.x,
+        }
+    }
+
+    /// The force-level data (f_stf must be present).
+    pub fn force_data(&self) -> ForceData<'_> {
+        ForceData {
+            t: &self.kinematics.t,
+            x: &self.kinematics.x,
+            v: &self.kinematics.v,
+            a: &self.kinematics.a,
+            f: self.record.f_stf.as_deref().unwrap_or(&[]),
+        }
+    }
+}
+
+/// Read the experiment's record and derive its kinematics.
+pub fn load_data(exp: &Experiment) -> Result<FitData> {
+    let Some(file) = &exp.data_file else {
+        bail!("{}: has no [data] file to fit", exp.path.display());
+    };
+    let mut record = Record::read(file)?;
+    if let Some((t0, t1)) = exp.data_window {
+        record = record.slice_time(t0, t1);
+        if record.len() < 10 {
+            bail!(
+                "{}: `data.window` [{t0}, {t1}] keeps {} samples of {}",
+                exp.path.display(),
+                record.len(),
+                file.display()
+            );
+        }
+    }
+    let kinematics = Kinematics::from_record(&record, &exp.kinematics)
+        .with_context(|| format!("cannot derive the kinematics of {}", file.display()))?;
+    let level = match exp.fit.level {
+        Some(l) => l,
+        None if record.f_stf.is_some() && !exp.models.is_empty() => FitLevel::Force,
+        None => FitLevel::Trajectory,
+    };
+    if level == FitLevel::Force && record.f_stf.is_none() {
+        bail!(
+            "{}: a force-level fit needs an `f_stf` column, which {} lacks",
+            exp.path.display(),
+            file.display()
+        );
+    }
+    Ok(FitData {
+        record,
+        kinematics,
+        level,
+    })
+}
+
+/// One fitted model.
+pub struct ModelFit {
+    /// The model as configured (start values and bounds).
+    pub configured: Option<ConfiguredModel>,
+    /// The fit.
+    pub result: FitResult,
+    /// The model's prediction of the target signal with the fitted parameters.
+    pub fitted: Vec<f64>,
+    /// The oscillator's parameters after the fit (trajectory level; else as given).
+    pub system: OscillatorParams,
+}
+
+impl ModelFit {
+    /// The model's name (`none` for the bare oscillator).
+    pub fn name(&self) -> String {
+        self.configured
+            .as_ref()
+            .map_or_else(|| "none".to_string(), |c| c.model.name().to_string())
+    }
+
+    /// The fitted values of the model's parameters, in its order.
+    pub fn model_values(&self) -> Vec<f64> {
+        self.configured.as_ref().map_or_else(Vec::new, |c| {
+            c.params
+                .iter()
+                .map(|p| self.result.value(&p.name).unwrap_or(p.value))
+                .collect()
+        })
+    }
+
+    /// The fit as the JSON of DESIGN.md §6 (`name`, `params`, `rms`) and more.
+    pub fn to_json(&self, level: FitLevel) -> Value {
+        let params: serde_json::Map<String, Value> = self
+            .result
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), json!(p.value)))
+            .collect();
+        let errors: serde_json::Map<String, Value> = self
+            .result
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), finite_or_null(p.std_error)))
+            .collect();
+        let fixed: Vec<&str> = self
+            .result
+            .params
+            .iter()
+            .filter(|p| p.fixed)
+            .map(|p| p.name.as_str())
+            .collect();
+        json!({
+            "name": self.name(),
+            "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
+            "params": params,
+            "std_errors": errors,
+            "fixed": fixed,
+            "rms": self.result.rms,
+            "rms_unit": match level { FitLevel::Force => "N", FitLevel::Trajectory => "m" },
+            "s_mm2": self.result.s_mm2,
+            "aic": finite_or_null(self.result.aic),
+            "bic": finite_or_null(self.result.bic),
+            "n_points": self.result.n_points,
+            "n_free": self.result.n_free,
+            "evaluations": self.result.evaluations,
+            "failures": self.result.failures,
+            "converged": self.result.convergence.converged(),
+            "convergence": self.result.convergence,
+            "system": (level == FitLevel::Trajectory).then_some(self.system),
+            "correlation": self.result.correlation.iter().map(|row| row.iter().map(|&c| finite_or_null(c)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// JSON has no NaN or infinity: those become null.
+pub fn finite_or_null(v: f64) -> Value {
+    if v.is_finite() {
+        json!(v)
+    } else {
+        Value::Null
+    }
+}
+
+fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
+    c.params
+        .iter()
+        .map(|p| {
+            FitParam::new(p.name.clone(), p.value)
+                .bounds(p.min, p.max)
+                .fixed(p.fixed)
+        })
+        .collect()
+}
+
+/// Bounds for an oscillator parameter freed in a trajectory fit: a factor 5 around its
+/// start (from 0 when it starts at 0).
+fn system_param(name: &str, value: f64) -> FitParam {
+    let (min, max) = if value > 0.0 {
+        (value / 5.0, value * 5.0)
+    } else {
+        (0.0, 10.0)
+    };
+    FitParam::new(name, value).bounds(min, max)
+}
+
+/// Fit one configured model (or, with `None`, the bare oscillator) to `data`.
+pub fn fit_model(
+    exp: &Experiment,
+    data: &FitData,
+    configured: Option<&ConfiguredModel>,
+    progress: &indicatif::ProgressBar,
+) -> Result<ModelFit> {
+    let observer = |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p));
+    let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
+    match data.level {
+        FitLevel::Force => {
+            let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
+            let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+            for p in fit_params(c) {
+                fit = fit.param(p);
+            }
+            if exp.fit.offset {
+                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
+            }
+            let fd = data.force_data();
+            let result = fit
+                .fit(&fd, Some(&observer))
+                .with_context(|| format!("fitting `{label}`"))?;
+            let values: Vec<f64> = fit
+                .params()
+                .iter()
+                .map(|p| result.value(&p.name).unwrap_or(p.value))
+                .collect();
+            let fitted = fit.predict(&fd, &values)?;
+            Ok(ModelFit {
+                configured: Some(c.clone()),
+                result,
+                fitted,
+                system: exp.system,
+            })
+        }
+        FitLevel::Trajectory => {
+            let k = &data.kinematics;
+            let excitation = Arc::new(k.excitation());
+            let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
+                .sim_settings(exp.integrator.clone())
+                .settings(exp.fit.settings.clone())
+                .initial(k.x[0], k.v[0]);
+            if let Some(c) = configured {
+                fit = fit.model(c.model.clone(), c.values());
+                for p in fit_params(c).into_iter().filter(|p| !p.fixed) {
+                    fit = fit.free(p);
+                }
+            }
+            for name in &exp.fit.system_free {
+                let value = exp.system.get(name).unwrap_or(0.0);
+                fit = fit.free(system_param(name, value));
+            }
+            if exp.fit.offset {
+                fit = fit.free(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05));
+            }
+            let td = TrajectoryData {
+                t: &data.record.t,
+                x: &data.record.x,
+            };
+            let result = fit
+                .fit(&td, Some(&observer))
+                .with_context(|| format!("fitting `{label}`"))?;
+            let mut system = exp.system;
+            for name in &exp.fit.system_free {
+                if let Some(v) = result.value(name) {
+                    system.set(name, v);
+                }
+            }
+            let mf = ModelFit {
+                configured: configured.cloned(),
+                result,
+                fitted: Vec::new(),
+                system,
+            };
+            let x_off = mf.result.value("x_off").unwrap_or(0.0);
+            let mut osc = Oscillator::with_shared_excitation(system, excitation);
+            if let Some(c) = configured {
+                osc = osc.with_model(c.model.clone(), mf.model_values())?;
+            }
+            let run = Simulation::new(&osc)
+                .settings(exp.integrator.clone())
+                .initial(k.x[0] - x_off, k.v[0])
+                .run_at(&data.record.t)
+                .with_context(|| format!("simulating the fitted `{label}`"))?;
+            let fitted = run.x.iter().map(|x| x + x_off).collect();
+            Ok(ModelFit { fitted, ..mf })
+        }
+    }
+}
+
+/// Configure and fit every model of the experiment, in parallel.
+pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<Vec<ModelFit>> {
+    let configured: Vec<Option<ConfiguredModel>> = if exp.models.is_empty() {
+        if data.level == FitLevel::Force {
+            bail!("{}: no [[models]] to fit", exp.path.display());
+        }
+        if exp.fit.system_free.is_empty() {
+            bail!(
+                "{}: nothing to fit: no [[models]] and no `fit.system` parameters",
+                exp.path.display()
+            );
+        }
+        vec![None]
+    } else {
+        exp.models
+            .iter()
+            .map(|m| configure(std::slice::from_ref(m), &exp.path, &exp.dir).map(Some))
+            .collect::<Result<_>>()?
+    };
+    let bars: Vec<_> = configured
+        .iter()
+        .map(|c| progress.job(c.as_ref().map_or("oscillator", |c| c.model.name())))
+        .collect();
+    configured
+        .par_iter()
+        .zip(bars.par_iter())
+        .map(|(c, bar)| {
+            let r = fit_model(exp, data, c.as_ref(), bar);
+            bar.finish_and_clear();
+            r
+        })
+        .collect()
+}
