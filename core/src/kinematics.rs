@@ -233,13 +233,22 @@ fn dominant_frequency(omega: Option<&[f64]>, x: &[f64], dt: f64) -> f64 {
         .map(|w| w.iter().fold(0.0_f64, |m, w| m.max(w.abs())) / std::f64::consts::TAU)
         .filter(|f| *f > 0.0);
     from_rotor.unwrap_or_else(|| {
+        // Half a period between successive crossings of the mean, over the span where the
+        // signal crosses (a decaying or stopping motion does not dilute the estimate).
         let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
-        let crossings = x
+        let crossings: Vec<usize> = x
             .windows(2)
-            .filter(|w| (w[0] - mean) * (w[1] - mean) < 0.0)
-            .count();
-        let span = dt * x.len() as f64;
-        (crossings as f64 / (2.0 * span)).max(0.5)
+            .enumerate()
+            .filter(|(_, w)| (w[0] - mean) * (w[1] - mean) < 0.0)
+            .map(|(i, _)| i)
+            .collect();
+        match (crossings.first(), crossings.last()) {
+            (Some(&a), Some(&b)) if b > a => {
+                let span = (b - a) as f64 * dt;
+                ((crossings.len() - 1) as f64 / (2.0 * span)).max(0.1)
+            }
+            _ => 0.5,
+        }
     })
 }
 
