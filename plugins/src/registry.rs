@@ -120,6 +120,7 @@ pub fn check_script(path: &Path) -> Result<Vec<ParamSpec>, ScriptError> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

@@ -284,7 +284,7 @@ impl ScriptModel {
                 .collect();
             let map = Dynamic::from_map(map).into_shared();
             if cache.len() >= PARAM_CACHE_SIZE {
-                cache.swap_remove(0);
+                let _ = cache.remove(0);
             }
             cache.push((self.id, p.to_vec(), map.clone()));
             map
@@ -446,6 +446,7 @@ fn describe(err: EvalAltResult, fname: &str) -> CallError {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

@@ -113,6 +113,7 @@ pub(crate) fn param_docs(source: &str, params_line: Option<usize>) -> HashMap<St
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
