@@ -1,1 +1,21 @@
+//! stf-plugins: force models written as rhai scripts, and the registry that maps a model name
+//! or a script path to a [`stf_core::force_model::ForceModel`].
+//!
+//! ```
+//! use stf_plugins::registry::Registry;
+//! let registry = Registry::new();
+//! let viscous = registry.resolve("viscous", std::path::Path::new(".")).unwrap();
+//! assert_eq!(viscous.name(), "viscous");
+//! assert!(registry.resolve("nonesuch", std::path::Path::new(".")).is_err());
+//! ```
 
+#![deny(clippy::unwrap_used)]
+
+pub mod error;
+pub mod registry;
+pub mod sandbox;
+pub mod script_model;
+mod script_params;
+
+pub use error::{ScriptError, ScriptLocation};
+pub use script_model::ScriptModel;

@@ -1,0 +1,79 @@
+//! Errors of loading and checking script models; each names the script and, where known, the
+//! line.
+
+use std::fmt;
+
+use thiserror::Error;
+
+/// Where in a script something went wrong: its path and, when known, the line (1-based).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ScriptLocation {
+    /// The script's path as given (or the name given to [`crate::ScriptModel::from_source`]).
+    pub path: String,
+    /// Line, 1-based, when known.
+    pub line: Option<usize>,
+}
+
+impl fmt::Display for ScriptLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{line}", self.path),
+            None => write!(f, "{}", self.path),
+        }
+    }
+}
+
+/// A script could not be loaded as a force model.
+#[derive(Debug, Error)]
+pub enum ScriptError {
+    /// The file could not be read.
+    #[error("{path}: cannot read the script: {source}")]
+    Read {
+        /// The script's path.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// rhai could not parse the script (syntax, undefined variable, disabled `import`, …).
+    #[error("{at}: syntax error: {message}")]
+    Syntax {
+        /// Where.
+        at: ScriptLocation,
+        /// rhai's message.
+        message: String,
+    },
+    /// A required function is missing, or a function has the wrong number of arguments.
+    #[error("{at}: {message}")]
+    Contract {
+        /// Where (the function's line when it exists).
+        at: ScriptLocation,
+        /// What is wrong.
+        message: String,
+    },
+    /// The map returned by `params()` is ill-formed.
+    #[error("{at}: bad params(): {message}")]
+    Params {
+        /// Where (the line of `fn params`).
+        at: ScriptLocation,
+        /// What is wrong.
+        message: String,
+    },
+    /// A script function failed when the host called it at load time.
+    #[error("{at}: {message}")]
+    Runtime {
+        /// Where.
+        at: ScriptLocation,
+        /// What went wrong.
+        message: String,
+    },
+    /// A name is neither a built-in model nor a script path.
+    #[error(
+        "unknown model `{name}`; built-in models: {known}; or give a script path ending in .rhai"
+    )]
+    UnknownModel {
+        /// The name asked for.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
+}

@@ -1,0 +1,147 @@
+//! The model registry: built-in models by name, script models by path.
+//!
+//! A spec ending in `.rhai` is a script path (relative paths are taken from a base directory,
+//! usually the experiment file's); anything else is looked up in [`stf_models::BUILTINS`].
+//! An unknown name is an error listing the known ones.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use stf_core::force_model::ForceModel;
+use stf_core::params::ParamSpec;
+
+use crate::error::ScriptError;
+use crate::script_model::ScriptModel;
+
+/// One model a user can pick.
+#[derive(Clone, Debug)]
+pub struct ModelEntry {
+    /// The name to write in an experiment file (a built-in's name or a script's path).
+    pub name: String,
+    /// One line saying what the model is.
+    pub summary: String,
+    /// The parameters.
+    pub params: Vec<ParamSpec>,
+    /// Whether the model is a script.
+    pub is_script: bool,
+}
+
+/// Built-in models plus scripts from an optional directory.
+#[derive(Clone, Debug, Default)]
+pub struct Registry {
+    script_dir: Option<PathBuf>,
+}
+
+impl Registry {
+    /// The built-in models only (scripts are still resolved by path).
+    pub fn new() -> Self {
+        Registry { script_dir: None }
+    }
+
+    /// The built-ins plus the `*.rhai` scripts of `dir` in listings.
+    pub fn with_script_dir(dir: impl Into<PathBuf>) -> Self {
+        Registry {
+            script_dir: Some(dir.into()),
+        }
+    }
+
+    /// The model named by `spec`: a built-in's name, or a path ending in `.rhai` (relative to
+    /// `base_dir` unless absolute).
+    pub fn resolve(&self, spec: &str, base_dir: &Path) -> Result<Arc<dyn ForceModel>, ScriptError> {
+        let spec = spec.trim();
+        if spec.ends_with(".rhai") {
+            let path = Path::new(spec);
+            let path = if path.is_absolute() {
+                path.to_path_buf()
+            } else {
+                base_dir.join(path)
+            };
+            return Ok(Arc::new(ScriptModel::load(path)?));
+        }
+        stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
+            name: spec.to_string(),
+            known: stf_models::names().join(", "),
+        })
+    }
+
+    /// Every built-in model, then every script of the script directory (sorted by file name).
+    /// A script that fails to load is listed with its error as summary and no parameters.
+    pub fn list(&self) -> Vec<ModelEntry> {
+        let mut entries: Vec<ModelEntry> = stf_models::BUILTINS
+            .iter()
+            .map(|b| ModelEntry {
+                name: b.name.to_string(),
+                summary: b.summary.to_string(),
+                params: (b.build)().params().to_vec(),
+                is_script: false,
+            })
+            .collect();
+        for path in self.scripts() {
+            let name = path.display().to_string();
+            entries.push(match ScriptModel::load(&path) {
+                Ok(m) => ModelEntry {
+                    name,
+                    summary: m.summary().to_string(),
+                    params: m.params().to_vec(),
+                    is_script: true,
+                },
+                Err(e) => ModelEntry {
+                    name,
+                    summary: format!("(does not load: {e})"),
+                    params: Vec::new(),
+                    is_script: true,
+                },
+            });
+        }
+        entries
+    }
+
+    /// The `*.rhai` files of the script directory, sorted.
+    pub fn scripts(&self) -> Vec<PathBuf> {
+        let Some(dir) = &self.script_dir else {
+            return Vec::new();
+        };
+        let Ok(read) = std::fs::read_dir(dir) else {
+            return Vec::new();
+        };
+        let mut paths: Vec<PathBuf> = read
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+            .collect();
+        paths.sort();
+        paths
+    }
+}
+
+/// Load and check the script at `path` (for `stf-lab models --check`): its parameters, or
+/// the error naming the script and line.
+pub fn check_script(path: &Path) -> Result<Vec<ParamSpec>, ScriptError> {
+    ScriptModel::load(path).map(|m| m.params().to_vec())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_names_list_the_known_ones() {
+        let err = Registry::new()
+            .resolve("powr_law", Path::new("."))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(err.contains("powr_law"), "{err}");
+        for name in stf_models::names() {
+            assert!(err.contains(name), "{err}");
+        }
+    }
+
+    #[test]
+    fn builtins_are_listed_first() {
+        let list = Registry::new().list();
+        assert_eq!(list.len(), stf_models::BUILTINS.len());
+        assert_eq!(list[0].name, stf_models::BUILTINS[0].name);
+        assert!(!list[0].is_script);
+    }
+}

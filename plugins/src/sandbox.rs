@@ -1,0 +1,87 @@
+//! The sandboxed rhai engine every script model runs in, and the per-thread bytecode VM.
+//!
+//! One engine, built once, serves all scripts: rhai's standard packages (arithmetic, math,
+//! strings, arrays, maps: no file, network or process access exist in rhai), `import` and
+//! `eval` disabled with a module resolver that resolves nothing, `print`/`debug` discarded,
+//! strict variables (an undefined name is a compile error), and limits on call depth, string,
+//! array and map sizes. Each call to a script function gets a budget of
+//! [`MAX_OPERATIONS`] operations, so a script that loops forever is stopped with an error.
+//!
+//! Calls run on rhai's `grain` bytecode VM. A VM is reused per thread (it keeps its function
+//! resolution cache), so no lock is taken on the hot path and models stay `Send + Sync`.
+
+use std::cell::{Cell, RefCell};
+use std::sync::OnceLock;
+
+use rhai::grain::Vm;
+use rhai::module_resolvers::DummyModuleResolver;
+use rhai::{Dynamic, Engine};
+
+/// Operations one call of a script function may perform before it is stopped.
+pub const MAX_OPERATIONS: u64 = 1_000_000;
+/// Deepest nesting of script function calls.
+pub const MAX_CALL_LEVELS: usize = 32;
+/// Longest string a script may build, in bytes.
+pub const MAX_STRING_SIZE: usize = 10_000;
+/// Largest array a script may build.
+pub const MAX_ARRAY_SIZE: usize = 10_000;
+/// Largest object map a script may build.
+pub const MAX_MAP_SIZE: usize = 1_000;
+
+/// The token of the error raised when a call exceeds its operation budget.
+pub(crate) const BUDGET_TOKEN: &str = "operation budget exceeded";
+
+thread_local! {
+    /// Operation count of this thread's VM when the current call started.
+    static OPS_BASE: Cell<u64> = const { Cell::new(0) };
+    /// Last operation count this thread's VM reported.
+    static OPS_LAST: Cell<u64> = const { Cell::new(0) };
+    /// This thread's VM, reused from call to call.
+    static VM: RefCell<Option<Vm<'static>>> = const { RefCell::new(None) };
+}
+
+/// The shared sandboxed engine.
+pub fn engine() -> &'static Engine {
+    static ENGINE: OnceLock<Engine> = OnceLock::new();
+    ENGINE.get_or_init(build_engine)
+}
+
+fn build_engine() -> Engine {
+    let mut engine = Engine::new();
+    engine
+        .set_module_resolver(DummyModuleResolver::new())
+        .disable_symbol("import")
+        .disable_symbol("eval")
+        .set_strict_variables(true)
+        .set_max_call_levels(MAX_CALL_LEVELS)
+        .set_max_string_size(MAX_STRING_SIZE)
+        .set_max_array_size(MAX_ARRAY_SIZE)
+        .set_max_map_size(MAX_MAP_SIZE)
+        .set_max_modules(0)
+        // The VM is reused, so rhai's own counter never resets; the budget is per call here.
+        .set_max_operations(0)
+        .on_progress(|count| {
+            OPS_LAST.with(|last| last.set(count));
+            let used = count.saturating_sub(OPS_BASE.with(Cell::get));
+            (used > MAX_OPERATIONS).then(|| Dynamic::from(BUDGET_TOKEN))
+        })
+        .on_print(|_| {})
+        .on_debug(|_, _, _| {});
+    engine
+}
+
+/// Run `f` with this thread's VM and a fresh operation budget.
+///
+/// Returns `None` if the VM is already in use on this thread (a script model called from
+/// inside a script call, which the host never does).
+pub(crate) fn with_vm<R>(f: impl FnOnce(&mut Vm<'static>) -> R) -> Option<R> {
+    VM.with(|cell| {
+        let mut slot = cell.try_borrow_mut().ok()?;
+        let vm = slot.get_or_insert_with(|| {
+            OPS_LAST.with(|last| last.set(0));
+            Vm::new(engine())
+        });
+        OPS_BASE.with(|base| base.set(OPS_LAST.with(Cell::get)));
+        Some(f(vm))
+    })
+}

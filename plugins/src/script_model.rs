@@ -1,0 +1,480 @@
+//! A force model written as a rhai script.
+//!
+//! The script contract (see `models/scripts/` for documented examples):
+//!
+//! ```rhai
+//! //! Power-law thickening with a structure variable λ that builds up with speed.
+//! /// name => [default, min, max, unit]
+//! fn params() { #{ K: [5.0, 0.0, 1e3, "N (s/m)^n"], n: [1.6, 1.0, 4.0, ""], tau: [0.05, 1e-4, 10.0, "s"] } }
+//! fn n_internal() { 1 }
+//! /// Force of the fluid on the blade, N.
+//! fn force(p, t, x, v, z) { p.K * (1.0 + z[0]) * v.abs() ** p.n * v.sign() }
+//! /// dλ/dt
+//! fn rates(p, t, x, v, z) { [(v.abs() - z[0]) / p.tau] }
+//! ```
+//!
+//! - required: `params()` returning `#{ name: [default, min, max, unit(, doc)] }` and
+//!   `force(p, t, x, v, z)` returning the force in N;
+//! - optional: `n_internal()` (number of internal states, default 0), `rates(p, t, x, v, z)`
+//!   returning an array of `n_internal` rates (required when `n_internal() > 0`),
+//!   `added_mass(p, t, x, v, z)` in kg, `initial(p)` returning the initial internal state;
+//! - `p` is an object map of the parameter values (`p.K`), `z` an array of the internal state;
+//! - parameter order is the map's key order, which rhai sorts by key (`K`, `n`, `tau`);
+//! - the first `//!` line is the model's summary; top-level statements are never run.
+//!
+//! The script is compiled once, checked at load (functions and arities, the params map, one
+//! call of each function at the defaults) and then run on rhai's bytecode VM in the sandbox of
+//! [`crate::sandbox`]. Errors name the script's path and line.
+//!
+//! ```
+//! use stf_plugins::ScriptModel;
+//! use stf_core::force_model::{ForceModel, ModelState};
+//! let m = ScriptModel::from_source("lin", "fn params() { #{ c: [2.0, 0.0, 10.0, \"N s/m\"] } }\n\
+//!                                          fn force(p, t, x, v, z) { p.c * v }").unwrap();
+//! let s = ModelState { t: 0.0, x: 0.0, v: 0.5, z: &[] };
+//! assert_eq!(m.force(&[2.0], &s, &mut []).unwrap(), 1.0);
+//! ```
+
+use std::cell::RefCell;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rhai::grain::{Compiler, SharedProgram};
+use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
+use stf_core::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::params::{defaults, ParamSpec};
+
+use crate::error::{ScriptError, ScriptLocation};
+use crate::sandbox::{self, BUDGET_TOKEN, MAX_CALL_LEVELS, MAX_OPERATIONS};
+use crate::script_params::{param_docs, parse_params, to_f64};
+
+/// Most internal states a script may declare.
+pub const MAX_INTERNAL: usize = 64;
+
+/// Functions a script may define: name, arity, required.
+const CONTRACT: &[(&str, usize, &str, bool)] = &[
+    ("params", 0, "params()", true),
+    ("force", 5, "force(p, t, x, v, z)", true),
+    ("n_internal", 0, "n_internal()", false),
+    ("rates", 5, "rates(p, t, x, v, z)", false),
+    ("added_mass", 5, "added_mass(p, t, x, v, z)", false),
+    ("initial", 1, "initial(p)", false),
+];
+
+/// Parameter maps built for recent parameter vectors, per thread: `(model id, values, map)`.
+/// In a simulation the values never change, so the map is built once and shared.
+const PARAM_CACHE_SIZE: usize = 8;
+thread_local! {
+    static PARAM_MAPS: RefCell<Vec<(u64, Vec<f64>, Dynamic)>> = const { RefCell::new(Vec::new()) };
+}
+
+/// A force model defined by a rhai script.
+pub struct ScriptModel {
+    id: u64,
+    name: String,
+    path: String,
+    summary: String,
+    specs: Vec<ParamSpec>,
+    n_internal: usize,
+    has_rates: bool,
+    has_added_mass: bool,
+    has_initial: bool,
+    program: SharedProgram,
+}
+
+/// A failure of a script call: line (if rhai knows it) and message.
+struct CallError {
+    line: Option<usize>,
+    message: String,
+}
+
+impl std::fmt::Debug for ScriptModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ScriptModel")
+            .field("path", &self.path)
+            .field("params", &self.specs)
+            .field("n_internal", &self.n_internal)
+            .finish()
+    }
+}
+
+impl ScriptModel {
+    /// Load, compile and check the script at `path`; the model's name is the file stem.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, ScriptError> {
+        let path = path.as_ref();
+        let shown = path.display().to_string();
+        let source = std::fs::read_to_string(path).map_err(|source| ScriptError::Read {
+            path: shown.clone(),
+            source,
+        })?;
+        let name = path
+            .file_stem()
+            .map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
+        Self::compile(name, shown, &source)
+    }
+
+    /// Compile and check a script given as text; `name` is used as its name and path.
+    pub fn from_source(name: &str, source: &str) -> Result<Self, ScriptError> {
+        Self::compile(name.to_string(), name.to_string(), source)
+    }
+
+    /// The script's path (or the name given to [`ScriptModel::from_source`]).
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    fn compile(name: String, path: String, source: &str) -> Result<Self, ScriptError> {
+        let at = |line: Option<usize>| ScriptLocation {
+            path: path.clone(),
+            line,
+        };
+        let mut ast = sandbox::engine()
+            .compile(source)
+            .map_err(|e| ScriptError::Syntax {
+                at: at(e.1.line()),
+                message: e.0.to_string(),
+            })?;
+        ast.set_source(path.as_str());
+
+        let defined: Vec<(String, usize)> = ast
+            .iter_functions()
+            .map(|f| (f.name.to_string(), f.params.len()))
+            .collect();
+        for &(fname, arity, signature, required) in CONTRACT {
+            let arities: Vec<usize> = defined
+                .iter()
+                .filter(|(n, _)| n == fname)
+                .map(|(_, a)| *a)
+                .collect();
+            if arities.contains(&arity) {
+                continue;
+            }
+            if let Some(&wrong) = arities.first() {
+                return Err(ScriptError::Contract {
+                    at: at(fn_line(source, fname)),
+                    message: format!(
+                        "fn {fname} takes {wrong} argument(s); it must be fn {signature}"
+                    ),
+                });
+            }
+            if required {
+                return Err(ScriptError::Contract {
+                    at: at(None),
+                    message: format!("the script must define fn {signature}"),
+                });
+            }
+        }
+        let has =
+            |fname: &str, arity: usize| defined.iter().any(|(n, a)| n == fname && *a == arity);
+
+        let mut model = ScriptModel {
+            id: next_id(),
+            name,
+            summary: summary_of(source),
+            specs: Vec::new(),
+            n_internal: 0,
+            has_rates: has("rates", 5),
+            has_added_mass: has("added_mass", 5),
+            has_initial: has("initial", 1),
+            program: Compiler::new().compile(&ast).into_shared(),
+            path: path.clone(),
+        };
+        let runtime = |e: CallError| ScriptError::Runtime {
+            at: at(e.line),
+            message: e.message,
+        };
+
+        let params_line = fn_line(source, "params");
+        let value = model.call("params", ()).map_err(runtime)?;
+        model.specs = parse_params(value, &param_docs(source, params_line)).map_err(|message| {
+            ScriptError::Params {
+                at: at(params_line),
+                message,
+            }
+        })?;
+
+        if has("n_internal", 0) {
+            let line = fn_line(source, "n_internal");
+            let value = model.call("n_internal", ()).map_err(runtime)?;
+            model.n_internal = value
+                .as_int()
+                .ok()
+                .and_then(|n| usize::try_from(n).ok())
+                .filter(|&n| n <= MAX_INTERNAL)
+                .ok_or_else(|| ScriptError::Contract {
+                    at: at(line),
+                    message: format!(
+                        "n_internal() must return an integer from 0 to {MAX_INTERNAL}, not {value}"
+                    ),
+                })?;
+        }
+        if model.n_internal > 0 && !model.has_rates {
+            return Err(ScriptError::Contract {
+                at: at(fn_line(source, "n_internal")),
+                message: format!(
+                    "n_internal() is {}, so the script must define fn rates(p, t, x, v, z)",
+                    model.n_internal
+                ),
+            });
+        }
+        model
+            .check_at_defaults()
+            .map_err(|e| ScriptError::Runtime {
+                at: at(e.line),
+                message: e.message,
+            })?;
+        Ok(model)
+    }
+
+    /// Call every function once at the defaults, from rest, so errors show at load time.
+    fn check_at_defaults(&self) -> Result<(), CallError> {
+        let p = defaults(&self.specs);
+        let mut z = vec![0.0; self.n_internal];
+        if self.has_initial {
+            self.initial_state(&p, &mut z)?;
+        }
+        let s = ModelState {
+            t: 0.0,
+            x: 0.0,
+            v: 0.0,
+            z: &z,
+        };
+        let mut dz = vec![0.0; self.n_internal];
+        self.eval_force(&p, &s, &mut dz)?;
+        if self.has_added_mass {
+            self.eval_number("added_mass", &p, &s)?;
+        }
+        Ok(())
+    }
+
+    /// Call script function `fname` on this thread's VM.
+    fn call(&self, fname: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, CallError> {
+        let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
+        sandbox::with_vm(|vm| {
+            vm.call_fn_with_options::<Dynamic>(
+                options,
+                &mut Scope::new(),
+                &self.program,
+                fname,
+                args,
+            )
+        })
+        .ok_or_else(|| CallError {
+            line: None,
+            message: format!("fn {fname} called re-entrantly on one thread"),
+        })?
+        .map_err(|e| describe(*e, fname))
+    }
+
+    /// The parameter map for `p`, cached per thread.
+    fn param_map(&self, p: &[f64]) -> Dynamic {
+        PARAM_MAPS.with(|cell| {
+            let mut cache = cell.borrow_mut();
+            if let Some((_, _, map)) = cache
+                .iter()
+                .find(|(id, values, _)| *id == self.id && values == p)
+            {
+                return map.clone();
+            }
+            let map: rhai::Map = self
+                .specs
+                .iter()
+                .zip(p)
+                .map(|(spec, &v)| (spec.name.as_str().into(), Dynamic::from_float(v)))
+                .collect();
+            let map = Dynamic::from_map(map).into_shared();
+            if cache.len() >= PARAM_CACHE_SIZE {
+                let _ = cache.remove(0);
+            }
+            cache.push((self.id, p.to_vec(), map.clone()));
+            map
+        })
+    }
+
+    fn args(&self, p: &[f64], s: &ModelState) -> (Dynamic, f64, f64, f64, rhai::Array) {
+        let z: rhai::Array = s.z.iter().map(|&v| Dynamic::from_float(v)).collect();
+        (self.param_map(p), s.t, s.x, s.v, z)
+    }
+
+    fn eval_number(&self, fname: &str, p: &[f64], s: &ModelState) -> Result<f64, CallError> {
+        let value = self.call(fname, self.args(p, s))?;
+        to_f64(&value).ok_or_else(|| CallError {
+            line: None,
+            message: format!(
+                "fn {fname} returned {} ({value}), not a number",
+                value.type_name()
+            ),
+        })
+    }
+
+    fn eval_force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, CallError> {
+        let f = self.eval_number("force", p, s)?;
+        if self.n_internal > 0 {
+            let value = self.call("rates", self.args(p, s))?;
+            self.write_array("rates", value, dz)?;
+        }
+        Ok(f)
+    }
+
+    fn initial_state(&self, p: &[f64], z0: &mut [f64]) -> Result<(), CallError> {
+        let value = self.call("initial", (self.param_map(p),))?;
+        self.write_array("initial", value, z0)
+    }
+
+    /// Write an array of numbers returned by `fname` into `out` (lengths must match).
+    fn write_array(&self, fname: &str, value: Dynamic, out: &mut [f64]) -> Result<(), CallError> {
+        let n = out.len();
+        let bad = |what: String| CallError {
+            line: None,
+            message: format!("fn {fname} must return an array of {n} numbers; {what}"),
+        };
+        let type_name = value.type_name();
+        let Some(items) = value.try_cast::<rhai::Array>() else {
+            return Err(bad(format!("it returned {type_name}")));
+        };
+        if items.len() != out.len() {
+            return Err(bad(format!("it returned {} elements", items.len())));
+        }
+        for (i, (slot, item)) in out.iter_mut().zip(&items).enumerate() {
+            *slot =
+                to_f64(item).ok_or_else(|| bad(format!("element {i} is {}", item.type_name())))?;
+        }
+        Ok(())
+    }
+
+    fn model_error(&self, e: CallError) -> ModelError {
+        let message = match e.line {
+            Some(line) => format!("line {line}: {}", e.message),
+            None => e.message,
+        };
+        ModelError::new(self.path.clone(), message)
+    }
+}
+
+impl ForceModel for ScriptModel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn summary(&self) -> &str {
+        &self.summary
+    }
+    fn params(&self) -> &[ParamSpec] {
+        &self.specs
+    }
+    fn n_internal(&self) -> usize {
+        self.n_internal
+    }
+    /// The script's `initial(p)`, or zeros. The trait gives no way to fail here, so an error
+    /// (already ruled out at the defaults when the script was loaded) yields NaN, which the
+    /// simulation reports as a non-finite state.
+    fn initial_internal(&self, p: &[f64], z0: &mut [f64]) {
+        if !self.has_initial {
+            z0.fill(0.0);
+        } else if self.initial_state(p, z0).is_err() {
+            z0.fill(f64::NAN);
+        }
+    }
+    fn added_mass(&self, p: &[f64], s: &ModelState) -> Result<f64, ModelError> {
+        if !self.has_added_mass {
+            return Ok(0.0);
+        }
+        self.eval_number("added_mass", p, s)
+            .map_err(|e| self.model_error(e))
+    }
+    fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+        self.eval_force(p, s, dz).map_err(|e| self.model_error(e))
+    }
+}
+
+fn next_id() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+/// The first `//!` line of a script.
+fn summary_of(source: &str) -> String {
+    source
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("//!"))
+        .map(|s| s.trim().to_string())
+        .unwrap_or_default()
+}
+
+/// The line (1-based) where `fn name(` is defined.
+fn fn_line(source: &str, name: &str) -> Option<usize> {
+    source
+        .lines()
+        .position(|l| {
+            l.trim_start()
+                .strip_prefix("fn ")
+                .and_then(|rest| rest.trim_start().strip_prefix(name))
+                .is_some_and(|rest| rest.trim_start().starts_with('('))
+        })
+        .map(|i| i + 1)
+}
+
+/// A runtime error as line + message, from the innermost function call that failed.
+fn describe(err: EvalAltResult, fname: &str) -> CallError {
+    let mut err = err;
+    let mut line = err.position().line();
+    let mut callee = fname.to_string();
+    while let EvalAltResult::ErrorInFunctionCall(name, _, inner, pos) = err {
+        line = pos.line().or(line);
+        callee = name;
+        err = *inner;
+    }
+    line = err.position().line().or(line);
+    let message = match &err {
+        EvalAltResult::ErrorTerminated(token, _)
+            if token.clone().into_string().is_ok_and(|t| t == BUDGET_TOKEN) =>
+        {
+            format!("stopped after {MAX_OPERATIONS} operations in one call (an endless loop?)")
+        }
+        EvalAltResult::ErrorStackOverflow(_) => {
+            format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")
+        }
+        _ => {
+            let mut e = err;
+            let _ = e.take_position();
+            e.to_string()
+        }
+    };
+    CallError {
+        line,
+        message: format!("{message} (in fn {callee})"),
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fn_lines_and_summary_are_found() {
+        let src = "//! A model.\n\nfn params() { #{} }\n  fn  force (p, t, x, v, z) { 0.0 }";
+        assert_eq!(fn_line(src, "params"), Some(3));
+        assert_eq!(fn_line(src, "force"), Some(4));
+        assert_eq!(fn_line(src, "rates"), None);
+        assert_eq!(summary_of(src), "A model.");
+    }
+
+    #[test]
+    fn parameters_reach_the_script_by_name() {
+        let m = ScriptModel::from_source(
+            "m",
+            "fn params() { #{ b: [1.0, 0.0, 9.0, \"\"], a: [2.0, 0.0, 9.0, \"\"] } }\n\
+             fn force(p, t, x, v, z) { p.a * 10.0 + p.b }",
+        )
+        .unwrap();
+        let s = ModelState {
+            t: 0.0,
+            x: 0.0,
+            v: 0.0,
+            z: &[],
+        };
+        assert_eq!(m.force(&[3.0, 4.0], &s, &mut []).unwrap(), 34.0);
+        // A new parameter vector is seen (no stale cache).
+        assert_eq!(m.force(&[5.0, 6.0], &s, &mut []).unwrap(), 56.0);
+    }
+}
