@@ -9,8 +9,8 @@
 //!    [`Classification::no_stf`] is set and every cycle is labelled
 //!    [`Regime::PreResonance`] ("force negligible") — no regime is invented from noise.
 //! 3. Otherwise a cycle is [`Regime::Resonance`] when its force is not negligible, is on for at
-//!    least `resonance_duty` (0.7) of the cycle (strong damping: force on most of the cycle)
-//!    and its amplitude is at least `resonance_amplitude` (0.3) of the record's largest.
+//!    least `resonance_duty` (0.5) of the cycle (strong damping: force on most of the cycle)
+//!    and its amplitude is at least `resonance_amplitude` (0.6) of the record's largest.
 //! 4. Any other cycle is [`Regime::PreResonance`] if its ω lies below that of the record's
 //!    largest-amplitude cycle (the resonance peak), [`Regime::PostResonance`] if not: before
 //!    the resonance the force is negligible or merely starting, after it the amplitude is small
