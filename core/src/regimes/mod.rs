@@ -7,10 +7,10 @@
 //! 1. [`cycles`] cuts the record into rotor cycles (φ crossing multiples of 2π), or into
 //!    cycles of x (upward zero crossings) when there is no rotor;
 //! 2. [`noise`] estimates the force's noise floor from the record (users may override it);
-//! 3. [`features`] computes per-cycle features: ω, displacement amplitude, peak and RMS force,
+//! 3. [`features`](mod@features) computes per-cycle features: ω, displacement amplitude, peak and RMS force,
 //!    duty (fraction of the cycle the force is on), ∮F dx and the alignment of |F| with
 //!    |x|, |v|, |a|;
-//! 4. [`classify`] labels each cycle [`Regime::PreResonance`], [`Regime::Resonance`] or
+//! 4. [`classify`](mod@classify) labels each cycle [`Regime::PreResonance`], [`Regime::Resonance`] or
 //!    [`Regime::PostResonance`] with the thresholds of [`RegimeThresholds`], smooths the labels
 //!    along the sweep and finds the [`boundaries`] in rad/s with an uncertainty;
 //! 5. [`metrics`] compares a model's force on the same kinematics with the measured force,
