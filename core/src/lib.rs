@@ -39,6 +39,7 @@ pub mod oscillator;
 pub mod params;
 pub mod record;
 pub mod recover;
+pub mod regimes;
 pub mod resistance;
 pub mod simulate;
 pub mod synthetic;

@@ -1,0 +1,259 @@
+//! Labelling each cycle pre-resonance, resonance or post-resonance.
+//!
+//! The rules, with the thresholds of [`RegimeThresholds`] (DESIGN.md §1 describes the regimes
+//! these defaults reproduce):
+//!
+//! 1. The noise σ of the force is `noise_sigma` if given, else [`noise_floor`] of the record.
+//! 2. A cycle's force is *negligible* if its peak |F| ≤ max(`negligible_force` (0.2 N),
+//!    `negligible_k`·σ). If every cycle's force is negligible the record has no STF effect:
+//!    [`Classification::no_stf`] is set and every cycle is labelled
+//!    [`Regime::PreResonance`] ("force negligible") — no regime is invented from noise.
+//! 3. Otherwise a cycle is [`Regime::Resonance`] when its force is not negligible, is on for at
+//!    least `resonance_duty` (0.5) of the cycle (strong damping: force on most of the cycle)
+//!    and its amplitude is at least `resonance_amplitude` (0.6) of the record's largest.
+//! 4. Any other cycle is [`Regime::PreResonance`] if its ω lies below that of the record's
+//!    largest-amplitude cycle (the resonance peak), [`Regime::PostResonance`] if not: before
+//!    the resonance the force is negligible or merely starting, after it the amplitude is small
+//!    and the force on–off (duty well below 1, zero between spikes) or gone. The comparison
+//!    with ω of the peak makes the rule hold for up- and down-sweeps alike.
+//! 5. The labels are smoothed by a median filter over `smoothing_cycles` (5) cycles, ordered
+//!    Pre < Resonance < Post (the order along a sweep), so single noisy cycles do not flip; the
+//!    window shrinks symmetrically at the ends.
+//! 6. [`find_boundaries`] places the changes of the smoothed labels in ω, with an uncertainty.
+
+use serde::{Deserialize, Serialize};
+
+use super::boundaries::{find_boundaries, Boundaries};
+use super::cycles::Cycle;
+use super::error::RegimeError;
+use super::features::{features, CycleFeatures, Signals};
+use super::noise::noise_floor;
+use super::thresholds::RegimeThresholds;
+
+/// The three behaviours of the STF along a sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Regime {
+    /// Below resonance: force negligible (or only starting).
+    PreResonance,
+    /// Through resonance: large amplitude, force on most of the cycle, strong damping.
+    Resonance,
+    /// Above resonance: small amplitude, on–off force (or none).
+    PostResonance,
+}
+
+impl Regime {
+    /// The three regimes in sweep order.
+    pub const ALL: [Regime; 3] = [
+        Regime::PreResonance,
+        Regime::Resonance,
+        Regime::PostResonance,
+    ];
+
+    /// The name used in results (`pre_resonance`, `resonance`, `post_resonance`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Regime::PreResonance => "pre_resonance",
+            Regime::Resonance => "resonance",
+            Regime::PostResonance => "post_resonance",
+        }
+    }
+
+    fn rank(self) -> u8 {
+        self as u8
+    }
+
+    fn from_rank(r: u8) -> Regime {
+        match r {
+            0 => Regime::PreResonance,
+            1 => Regime::Resonance,
+            _ => Regime::PostResonance,
+        }
+    }
+}
+
+/// A record's cycles, their features and labels.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Classification {
+    /// σ of the force noise used, N (given or estimated).
+    pub noise_sigma: f64,
+    /// The on-threshold used for the duty, N.
+    pub on_threshold: f64,
+    /// Peak force at or below which a cycle's force counted as negligible, N.
+    pub negligible_level: f64,
+    /// Whether every cycle's force is negligible (no STF effect in the record).
+    pub no_stf: bool,
+    /// ω of the largest-amplitude cycle (the resonance peak), rad/s; NaN without cycles.
+    pub peak_omega: f64,
+    /// The cycles.
+    pub cycles: Vec<Cycle>,
+    /// Their features.
+    pub features: Vec<CycleFeatures>,
+    /// Labels before smoothing.
+    pub raw_labels: Vec<Regime>,
+    /// Smoothed labels.
+    pub labels: Vec<Regime>,
+    /// Where the smoothed labels change, rad/s.
+    pub boundaries: Boundaries,
+}
+
+impl Classification {
+    /// Number of cycles labelled `regime`.
+    pub fn count(&self, regime: Regime) -> usize {
+        self.labels.iter().filter(|&&r| r == regime).count()
+    }
+}
+
+/// Raw labels of cycles with `features` (rules 2–4 of the [module doc](self)), given the
+/// negligible-force level (N). Returns the labels, whether the record has no STF effect and ω
+/// of the largest-amplitude cycle.
+pub fn label_cycles(
+    features: &[CycleFeatures],
+    th: &RegimeThresholds,
+    negligible_level: f64,
+) -> (Vec<Regime>, bool, f64) {
+    let peak = features
+        .iter()
+        .max_by(|a, b| a.amplitude.total_cmp(&b.amplitude));
+    let (a_max, peak_omega) = peak.map_or((0.0, f64::NAN), |p| (p.amplitude, p.omega));
+    let significant = |f: &CycleFeatures| f.f_peak > negligible_level;
+    let no_stf = !features.iter().any(significant);
+    let labels = features
+        .iter()
+        .map(|f| {
+            if no_stf {
+                Regime::PreResonance
+            } else if significant(f)
+                && f.duty >= th.resonance_duty
+                && f.amplitude >= th.resonance_amplitude * a_max
+            {
+                Regime::Resonance
+            } else if f.omega < peak_omega {
+                Regime::PreResonance
+            } else {
+                Regime::PostResonance
+            }
+        })
+        .collect();
+    (labels, no_stf, peak_omega)
+}
+
+/// Median filter of `labels` (ordered Pre < Resonance < Post) over `window` cycles (odd); the
+/// window shrinks symmetrically at the ends.
+pub fn median_filter(labels: &[Regime], window: usize) -> Vec<Regime> {
+    let n = labels.len();
+    let h = window / 2;
+    (0..n)
+        .map(|i| {
+            let hi = h.min(i).min(n - 1 - i);
+            let mut w: Vec<u8> = labels[i - hi..=i + hi].iter().map(|r| r.rank()).collect();
+            w.sort_unstable();
+            Regime::from_rank(w[w.len() / 2])
+        })
+        .collect()
+}
+
+/// Classify the cycles of a record (see the [module doc](self) for the rules).
+pub fn classify(
+    sig: &Signals,
+    cycles: Vec<Cycle>,
+    th: &RegimeThresholds,
+) -> Result<Classification, RegimeError> {
+    th.validate()?;
+    sig.check()?;
+    let noise_sigma = match th.noise_sigma {
+        Some(s) => s,
+        None => noise_floor(sig.f)?,
+    };
+    let features = features(sig, &cycles, th, noise_sigma)?;
+    let negligible_level = th.negligible_level(noise_sigma);
+    let (raw_labels, no_stf, peak_omega) = label_cycles(&features, th, negligible_level);
+    let labels = median_filter(&raw_labels, th.smoothing_cycles);
+    let omega: Vec<f64> = features.iter().map(|f| f.omega).collect();
+    let boundaries = find_boundaries(&omega, &raw_labels, &labels, th.smoothing_cycles);
+    Ok(Classification {
+        noise_sigma,
+        on_threshold: th.on_threshold(noise_sigma),
+        negligible_level,
+        no_stf,
+        peak_omega,
+        cycles,
+        features,
+        raw_labels,
+        labels,
+        boundaries,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use Regime::{PostResonance as Post, PreResonance as Pre, Resonance as Res};
+
+    fn feat(omega: f64, amplitude: f64, f_peak: f64, duty: f64) -> CycleFeatures {
+        CycleFeatures {
+            t_mid: omega,
+            omega,
+            amplitude,
+            f_peak,
+            f_rms: f_peak / 2.0,
+            duty,
+            energy: 0.0,
+            energy_ratio: 0.0,
+            corr_x: 0.0,
+            corr_v: 0.0,
+            corr_a: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_rules_label_a_hand_made_sweep() {
+        let th = RegimeThresholds::default();
+        let f = [
+            feat(3.0, 0.0001, 0.05, 0.0), // stuck, no force
+            feat(4.0, 0.005, 0.5, 0.3),   // starting, on–off below the peak
+            feat(5.0, 0.02, 3.0, 0.9),    // resonance
+            feat(6.0, 0.03, 5.0, 0.95),   // the peak
+            feat(8.0, 0.02, 3.0, 0.8),    // resonance
+            feat(10.0, 0.008, 1.0, 0.4),  // on–off after the peak
+            feat(12.0, 0.004, 0.1, 0.0),  // negligible after the peak
+            feat(13.0, 0.02, 3.0, 0.5),   // big but on–off
+        ];
+        let (l, no_stf, peak) = label_cycles(&f, &th, 0.2);
+        assert!(!no_stf);
+        assert_eq!(peak, 6.0);
+        assert_eq!(l, vec![Pre, Pre, Res, Res, Res, Post, Post, Post]);
+    }
+
+    #[test]
+    fn noise_alone_invents_no_regime() {
+        let th = RegimeThresholds::default();
+        let f: Vec<_> = (0..30)
+            .map(|i| {
+                feat(
+                    3.0 + 0.3 * i as f64,
+                    0.001 + 0.03 * (i == 12) as u8 as f64,
+                    0.15,
+                    0.9,
+                )
+            })
+            .collect();
+        let (l, no_stf, _) = label_cycles(&f, &th, 0.2);
+        assert!(no_stf);
+        assert!(l.iter().all(|&r| r == Pre));
+    }
+
+    #[test]
+    fn the_median_filter_removes_single_flips_and_keeps_changes() {
+        let l = [
+            Pre, Pre, Res, Pre, Pre, Res, Res, Post, Res, Res, Post, Post, Post,
+        ];
+        let m = median_filter(&l, 3);
+        assert_eq!(
+            m,
+            vec![Pre, Pre, Pre, Pre, Pre, Res, Res, Res, Res, Res, Post, Post, Post]
+        );
+        assert_eq!(median_filter(&l, 1), l.to_vec());
+        assert!(median_filter(&[], 5).is_empty());
+    }
+}

@@ -1,0 +1,55 @@
+//! Regimes of a sweep and metrics that compare force models regime by regime.
+//!
+//! The source study's STF behaves in three ways along a frequency sweep (DESIGN.md §1):
+//! negligible force before resonance, a strong damper through resonance, an on–off impact
+//! force after it. This module makes that measurable on any record, measured or simulated:
+//!
+//! 1. [`cycles`] cuts the record into rotor cycles (φ crossing multiples of 2π), or into
+//!    cycles of x (upward zero crossings) when there is no rotor;
+//! 2. [`noise`] estimates the force's noise floor from the record (users may override it);
+//! 3. [`features`](mod@features) computes per-cycle features: ω, displacement amplitude, peak and RMS force,
+//!    duty (fraction of the cycle the force is on), ∮F dx and the alignment of |F| with
+//!    |x|, |v|, |a|;
+//! 4. [`classify`](mod@classify) labels each cycle [`Regime::PreResonance`], [`Regime::Resonance`] or
+//!    [`Regime::PostResonance`] with the thresholds of [`RegimeThresholds`], smooths the labels
+//!    along the sweep and finds the [`boundaries`] in rad/s with an uncertainty;
+//! 5. [`metrics`] compares a model's force on the same kinematics with the measured force,
+//!    per measured regime, and [`ranking`] names the best model per regime and overall.
+//!
+//! Everything works on plain slices; nothing here fits or simulates.
+//!
+//! ```
+//! use stf_core::regimes::{classify, cycles_from_phase, Regime, RegimeThresholds, Signals};
+//! // 20 s at ω = 6 rad/s, 200 Hz, x = 10 mm·sin φ, a viscous force 20·v.
+//! let t: Vec<f64> = (0..4000).map(|i| i as f64 / 200.0).collect();
+//! let phi: Vec<f64> = t.iter().map(|t| 6.0 * t).collect();
+//! let x: Vec<f64> = phi.iter().map(|p| 0.01 * p.sin()).collect();
+//! let v: Vec<f64> = phi.iter().map(|p| 0.06 * p.cos()).collect();
+//! let a: Vec<f64> = phi.iter().map(|p| -0.36 * p.sin()).collect();
+//! let f: Vec<f64> = v.iter().map(|v| 20.0 * v).collect();
+//! let sig = Signals { t: &t, x: &x, v: &v, a: &a, f: &f };
+//! let cycles = cycles_from_phase(&t, &phi).unwrap();
+//! let c = classify(&sig, cycles, &RegimeThresholds::default()).unwrap();
+//! assert!(!c.no_stf);
+//! assert!(c.labels.iter().all(|&r| r == Regime::Resonance)); // force on all the cycle
+//! ```
+
+pub mod boundaries;
+pub mod classify;
+pub mod cycles;
+pub mod error;
+pub mod features;
+pub mod metrics;
+pub mod noise;
+pub mod ranking;
+pub mod thresholds;
+
+pub use boundaries::{find_boundaries, Boundaries, Boundary};
+pub use classify::{classify, label_cycles, median_filter, Classification, Regime};
+pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, Cycle};
+pub use error::RegimeError;
+pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
+pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};
+pub use noise::noise_floor;
+pub use ranking::{rank_models, Ranking, Score};
+pub use thresholds::RegimeThresholds;
