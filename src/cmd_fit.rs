@@ -47,10 +47,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     };
     let names: Vec<String> = std::iter::once("t".to_string())
         .chain(std::iter::once(measured_name.to_string()))
-        .chain(
-            fits.iter()
-                .map(|f| format!("{measured_name}_{}", f.name().replace(' ', ""))),
-        )
+        .chain(fits.iter().map(|f| format!("{measured_name}_{}", f.label)))
         .collect();
     let mut columns: Vec<&[f64]> = vec![&data.record.t, data.target()];
     columns.extend(fits.iter().map(|f| f.fitted.as_slice()));
@@ -83,7 +80,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             .collect();
         println!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
-            f.name(),
+            f.label,
             f.result.rms * scale,
             f.result.aic,
             params.join(", "),

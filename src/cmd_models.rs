@@ -1,18 +1,46 @@
-//! `stf-lab models`: list the models with their parameters.
+//! `stf-lab models`: list the models (built-ins and the scripts of `models/scripts`) with
+//! their parameters; `--check SCRIPT` validates one script.
+
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
+use stf_core::params::ParamSpec;
+use stf_plugins::registry::{check_script, Registry};
 
-/// Print every built-in model with its parameters and one line of doc.
-pub fn list() -> Result<()> {
-    for entry in stf_models::BUILTINS {
-        let model = (entry.build)();
-        println!("{}  —  {}", entry.name, entry.summary);
-        for p in model.params() {
-            println!(
-                "    {:<10} {:>10} [{}, {}] {:<12} {}",
-                p.name, p.default, p.min, p.max, p.unit, p.doc
-            );
-        }
+fn print_params(params: &[ParamSpec]) {
+    for p in params {
+        println!(
+            "    {:<10} {:>10} [{}, {}] {:<14} {}",
+            p.name, p.default, p.min, p.max, p.unit, p.doc
+        );
     }
+}
+
+/// Print every model with its parameters and one line of doc; scripts are looked for in
+/// `script_dir` (default `models/scripts` when it exists).
+pub fn list(script_dir: Option<&Path>) -> Result<()> {
+    let default_dir = PathBuf::from("models/scripts");
+    let dir = script_dir.or_else(|| default_dir.is_dir().then_some(default_dir.as_path()));
+    let registry = match dir {
+        Some(d) => Registry::with_script_dir(d),
+        None => Registry::new(),
+    };
+    for entry in registry.list() {
+        println!(
+            "{}{}  —  {}",
+            entry.name,
+            if entry.is_script { " (script)" } else { "" },
+            entry.summary
+        );
+        print_params(&entry.params);
+    }
+    Ok(())
+}
+
+/// Validate a script and print its parameters, or fail with the script's error.
+pub fn check(path: &Path) -> Result<()> {
+    let params = check_script(path)?;
+    println!("{}: ok, {} parameter(s)", path.display(), params.len());
+    print_params(&params);
     Ok(())
 }

@@ -101,6 +101,8 @@ pub struct ModelFit {
     pub fitted: Vec<f64>,
     /// The oscillator's parameters after the fit (trajectory level; else as given).
     pub system: OscillatorParams,
+    /// A label unique within the experiment (the name, numbered if it repeats).
+    pub label: String,
 }
 
 impl ModelFit {
@@ -144,6 +146,7 @@ impl ModelFit {
             .collect();
         json!({
             "name": self.name(),
+            "label": self.label,
             "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
             "params": params,
             "std_errors": errors,
@@ -230,6 +233,7 @@ pub fn fit_model(
                 result,
                 fitted,
                 system: exp.system,
+                label,
             })
         }
         FitLevel::Trajectory => {
@@ -270,6 +274,7 @@ pub fn fit_model(
                 result,
                 fitted: Vec::new(),
                 system,
+                label: label.clone(),
             };
             let x_off = mf.result.value("x_off").unwrap_or(0.0);
             let mut osc = Oscillator::with_shared_excitation(system, excitation);
@@ -310,7 +315,7 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .iter()
         .map(|c| progress.job(c.as_ref().map_or("oscillator", |c| c.model.name())))
         .collect();
-    configured
+    let mut fits: Vec<ModelFit> = configured
         .par_iter()
         .zip(bars.par_iter())
         .map(|(c, bar)| {
@@ -318,5 +323,15 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             bar.finish_and_clear();
             r
         })
-        .collect()
+        .collect::<Result<_>>()?;
+    let names: Vec<String> = fits.iter().map(|f| f.label.replace(' ', "")).collect();
+    for (i, f) in fits.iter_mut().enumerate() {
+        let same = names[..i].iter().filter(|n| **n == names[i]).count();
+        f.label = if same > 0 {
+            format!("{}#{}", names[i], same + 1)
+        } else {
+            names[i].clone()
+        };
+    }
+    Ok(fits)
 }

@@ -34,7 +34,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// List the force models (built-in and scripts) with their parameters.
-    Models,
+    Models {
+        /// Validate this script and print its parameters instead.
+        #[arg(long, value_name = "SCRIPT")]
+        check: Option<PathBuf>,
+        /// Folder of script models to list (default: models/scripts when present).
+        #[arg(long, value_name = "DIR")]
+        scripts: Option<PathBuf>,
+    },
     /// Write a synthetic record from the experiment's [simulate] section.
     Simulate {
         /// The experiment file.
@@ -65,7 +72,10 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Models => cmd_models::list(),
+        Command::Models { check, scripts } => match check {
+            Some(path) => cmd_models::check(&path),
+            None => cmd_models::list(scripts.as_deref()),
+        },
         Command::Simulate {
             experiment,
             out,

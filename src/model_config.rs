@@ -41,20 +41,9 @@ impl ConfiguredModel {
     }
 }
 
-/// Resolve a model name or script path (relative to `dir`) to a model.
+/// Resolve a model name or script path (relative to `dir`) to a model, through the registry.
 pub fn resolve(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
-    if spec.ends_with(".rhai") {
-        return Err(anyhow!(
-            "script models are not available in this build: `{}`",
-            dir.join(spec).display()
-        ));
-    }
-    stf_models::find(spec).ok_or_else(|| {
-        anyhow!(
-            "unknown model `{spec}`; known models: {}",
-            stf_models::names().join(", ")
-        )
-    })
+    Ok(stf_plugins::registry::Registry::new().resolve(spec, dir)?)
 }
 
 /// Build one model from experiment entries: the parts of every entry are summed (one entry

@@ -1,0 +1,88 @@
+//! End-to-end tests of `stf-lab fit` on the bundled examples.
+
+use std::path::Path;
+use std::process::Command;
+
+fn stf_lab() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_stf-lab"))
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn power_law_example_recovers_the_truth_natively_and_as_a_script() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("fit");
+    let run = stf_lab()
+        .args(["fit", "--quiet", "--out"])
+        .arg(&dir)
+        .arg(root().join("experiments/power_law_fit.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let fit: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("fit.json")).unwrap()).unwrap();
+    let models = fit["models"].as_array().unwrap();
+    assert_eq!(models.len(), 4);
+    let power = &models[1];
+    assert_eq!(power["name"], "power_law");
+    let k = power["params"]["K"].as_f64().unwrap();
+    let n = power["params"]["n"].as_f64().unwrap();
+    assert!((k / 4.0 - 1.0).abs() < 0.02, "K = {k}");
+    assert!((n / 1.5 - 1.0).abs() < 0.02, "n = {n}");
+    assert!(power["rms"].as_f64().unwrap() < 0.021);
+    // The viscous model fits worse than the truth.
+    assert!(models[0]["rms"].as_f64().unwrap() > power["rms"].as_f64().unwrap());
+    // The script twin recovers the same values.
+    let script = &models[3];
+    let ks = script["params"]["K"].as_f64().unwrap();
+    assert!((ks / k - 1.0).abs() < 1e-6, "script K = {ks}, native {k}");
+    // The CSV has the measured force and one column per model.
+    let csv = std::fs::read_to_string(dir.join("fitted.csv")).unwrap();
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("t,f_stf,f_stf_viscous"));
+
+    // A second run into the same folder refuses without --force.
+    let again = stf_lab()
+        .args(["fit", "--quiet", "--out"])
+        .arg(&dir)
+        .arg(root().join("experiments/power_law_fit.toml"))
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+}
+
+#[test]
+fn paper_identification_finds_k_and_f0() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("id");
+    let run = stf_lab()
+        .args(["fit", "--quiet", "--out"])
+        .arg(&dir)
+        .arg(root().join("experiments/paper_identification.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let fit: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("fit.json")).unwrap()).unwrap();
+    let system = &fit["system"];
+    let k = system["k"].as_f64().unwrap();
+    let f0 = system["F0"].as_f64().unwrap();
+    assert!((k / 269.9346 - 1.0).abs() < 0.005, "k = {k}");
+    assert!((f0 / 0.0462 - 1.0).abs() < 0.005, "F0 = {f0}");
+    assert_eq!(fit["stages"].as_array().unwrap().len(), 2);
+}
