@@ -15,6 +15,7 @@ use stf_core::excitation::RotorAngle;
 use stf_core::fit::{FitSettings, Solver};
 use stf_core::integrate::{Method, Settings};
 use stf_core::kinematics::KinematicsSettings;
+use stf_core::regimes::RegimeThresholds;
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
@@ -217,6 +218,7 @@ struct RawExperiment {
     filter: Option<Spanned<RawFilter>>,
     #[serde(default)]
     identify: Vec<Spanned<RawStage>>,
+    regimes: Option<Spanned<toml::Value>>,
 }
 
 /// Whether models are fitted to the measured force or to the measured motion.
@@ -330,6 +332,8 @@ pub struct Experiment {
     pub kinematics: KinematicsSettings,
     /// `[[identify]]` stages.
     pub identify: Vec<StageSpec>,
+    /// `[regimes]` thresholds (defaults where not given).
+    pub regimes: RegimeThresholds,
     /// `[discover] base`.
     #[allow(dead_code)] // read by fit, compare and discover
     pub discover_base: Option<String>,
@@ -704,6 +708,19 @@ impl Experiment {
             });
         }
 
+        let regimes = match &raw.regimes {
+            None => RegimeThresholds::default(),
+            Some(v) => {
+                let th: RegimeThresholds = v
+                    .get_ref()
+                    .clone()
+                    .try_into()
+                    .map_err(|e: toml::de::Error| cx.at(v.span(), "regimes", e.message()))?;
+                th.validate().map_err(|e| cx.at(v.span(), "regimes", e))?;
+                th
+            }
+        };
+
         let data_window = raw
             .data
             .as_ref()
@@ -715,6 +732,7 @@ impl Experiment {
             fit,
             kinematics,
             identify,
+            regimes,
             data_file: raw.data.map(|d| dir.join(d.file)),
             dir,
             system,

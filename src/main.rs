@@ -4,11 +4,13 @@
 //! stf-lab models                          list models with their parameters
 //! stf-lab simulate EXP.toml --out F.csv   write a synthetic record (section [simulate])
 //! stf-lab fit EXP.toml --out DIR          calibrate every model of the experiment
+//! stf-lab compare EXP.toml --out DIR      fit, then compare models on the regime metrics
 //! ```
 
 // `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod cmd_compare;
 mod cmd_fit;
 mod cmd_models;
 mod cmd_simulate;
@@ -53,6 +55,20 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Fit every model, then compare them regime by regime.
+    Compare {
+        /// The experiment file.
+        experiment: PathBuf,
+        /// Folder for compare.json, compare.md, compare.csv and the fit results.
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace results in an existing folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress display.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Calibrate every model of the experiment against its record.
     Fit {
         /// The experiment file.
@@ -87,6 +103,12 @@ fn main() -> ExitCode {
             force,
             quiet,
         } => cmd_fit::run(&experiment, &out, force, quiet),
+        Command::Compare {
+            experiment,
+            out,
+            force,
+            quiet,
+        } => cmd_compare::run(&experiment, &out, force, quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

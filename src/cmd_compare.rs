@@ -1,0 +1,281 @@
+//! `stf-lab compare EXP.toml --out DIR`: fit every model, then compare them regime by regime.
+//!
+//! The measured record is cut into rotor cycles and each cycle labelled pre-resonance,
+//! resonance or post-resonance (`stf_core::regimes`). Each fitted model's force, on the same
+//! kinematics, is scored per regime (force RMS error, energy per cycle, on–off duty, peak
+//! force, label agreement, boundary error), and the oscillator with the model plugged in is
+//! simulated against the record for the resonance peak. Writes `compare.json`, `compare.md`
+//! and `compare.csv` (models × regimes).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use serde_json::{json, Value};
+use stf_core::analysis::peak;
+use stf_core::oscillator::Oscillator;
+use stf_core::regimes::{
+    classify, compare, cycles_from_phase, cycles_from_x, phase_from_omega, rank_models,
+    Classification, Comparison, Regime, Signals,
+};
+use stf_core::simulate::Simulation;
+
+use crate::experiment::{Experiment, FitLevel};
+use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
+use crate::output::{prepare_dir, write_atomic, write_json};
+use crate::progress::Progress;
+
+/// The measured record's regimes.
+pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {
+    let k = &data.kinematics;
+    let f = data
+        .record
+        .f_stf
+        .as_deref()
+        .context("comparing models needs the record's `f_stf` column")?;
+    let sig = Signals {
+        t: &k.t,
+        x: &k.x,
+        v: &k.v,
+        a: &k.a,
+        f,
+    };
+    let cycles = match (&k.phi, &k.omega) {
+        (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
+        (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
+        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
+    };
+    Ok(classify(&sig, cycles, &exp.regimes)?)
+}
+
+fn signals<'a>(data: &'a FitData) -> Signals<'a> {
+    let k = &data.kinematics;
+    Signals {
+        t: &k.t,
+        x: &k.x,
+        v: &k.v,
+        a: &k.a,
+        f: data.record.f_stf.as_deref().unwrap_or(&[]),
+    }
+}
+
+/// Resonance peak of the oscillator with the fitted model, driven as in the record.
+fn simulated_peak(exp: &Experiment, data: &FitData, fit: &ModelFit) -> Result<(f64, f64)> {
+    let k = &data.kinematics;
+    let mut osc = Oscillator::new(fit.system, k.excitation());
+    if let Some(c) = &fit.configured {
+        osc = osc.with_model(c.model.clone(), fit.model_values())?;
+    }
+    let run = Simulation::new(&osc)
+        .settings(exp.integrator.clone())
+        .initial(k.x[0], k.v[0])
+        .run_at(&k.t)?;
+    let p = peak(&run.t, &run.x, k.omega.as_deref()).context("empty simulation")?;
+    Ok((p.amplitude, p.omega))
+}
+
+fn regime_json(c: &Comparison) -> Value {
+    let mut m = serde_json::Map::new();
+    for r in Regime::ALL {
+        m.insert(
+            r.name().into(),
+            serde_json::to_value(c.per_regime.get(r)).unwrap_or(Value::Null),
+        );
+    }
+    Value::Object(m)
+}
+
+/// Run `stf-lab compare`.
+pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
+    let exp = Experiment::load(exp_path)?;
+    let data = load_data(&exp)?;
+    if data.level != FitLevel::Force {
+        bail!(
+            "{}: compare scores models on the measured STF force; the record needs `f_stf`",
+            exp_path.display()
+        );
+    }
+    prepare_dir(out, force)?;
+    let measured = measured_regimes(&exp, &data)?;
+    let fits = fit_all(&exp, &data, &Progress::new(quiet))?;
+    let sig = signals(&data);
+    let comparisons: Vec<Comparison> = fits
+        .iter()
+        .map(|f| compare(&measured, &sig, &f.fitted, &exp.regimes))
+        .collect::<std::result::Result<_, _>>()?;
+    let measured_peak = peak(
+        &data.record.t,
+        &data.record.x,
+        data.kinematics.omega.as_deref(),
+    )
+    .context("empty record")?;
+    let peaks: Vec<Option<(f64, f64)>> = fits
+        .iter()
+        .map(|f| simulated_peak(&exp, &data, f).ok())
+        .collect();
+    let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
+    let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
+    let ranking = rank_models(&pairs);
+
+    let count = |r: Regime| measured.labels.iter().filter(|l| **l == r).count();
+    let models: Vec<Value> = fits
+        .iter()
+        .zip(&comparisons)
+        .zip(&peaks)
+        .map(|((f, c), p)| {
+            json!({
+                "name": f.name(),
+                "label": f.label,
+                "fit": f.to_json(data.level),
+                "regimes": regime_json(c),
+                "overall": c.overall,
+                "boundary_errors": c.boundary_errors,
+                "model_boundaries": c.model_boundaries,
+                "resonance": p.map(|(x, w)| json!({
+                    "peak_x_m": x,
+                    "peak_omega_rad_s": finite_or_null(w),
+                    "peak_x_error_m": x - measured_peak.amplitude,
+                    "peak_omega_error_rad_s": finite_or_null(w - measured_peak.omega),
+                })),
+            })
+        })
+        .collect();
+    let best: serde_json::Map<String, Value> = Regime::ALL
+        .iter()
+        .map(|&r| (r.name().to_string(), json!(ranking.best_in(r))))
+        .chain(std::iter::once((
+            "overall".to_string(),
+            json!(ranking.best_overall()),
+        )))
+        .collect();
+    let doc = json!({
+        "experiment": exp.path.display().to_string(),
+        "record": data.record.source,
+        "measured": {
+            "noise_sigma": measured.noise_sigma,
+            "on_threshold": measured.on_threshold,
+            "no_stf": measured.no_stf,
+            "cycles": measured.labels.len(),
+            "cycles_per_regime": Regime::ALL.iter().map(|&r| (r.name().to_string(), json!(count(r)))).collect::<serde_json::Map<_, _>>(),
+            "boundaries": measured.boundaries,
+            "resonance": { "peak_x_m": measured_peak.amplitude, "peak_omega_rad_s": finite_or_null(measured_peak.omega) },
+        },
+        "thresholds": exp.regimes,
+        "models": models,
+        "ranking": ranking,
+        "best": best,
+    });
+    write_json(&out.join("compare.json"), &doc)?;
+
+    // models × regimes: relative force RMS error and duty error.
+    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement\n");
+    let mut md = String::new();
+    let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
+    let _ = writeln!(
+        md,
+        "Record `{}`: {} cycles; noise floor σ = {:.4} N{}.\n",
+        data.record.source,
+        measured.labels.len(),
+        measured.noise_sigma,
+        if measured.no_stf {
+            "; the STF force is negligible everywhere (no regimes)"
+        } else {
+            ""
+        }
+    );
+    if let Some(b) = measured.boundaries.pre_resonance {
+        let _ = writeln!(
+            md,
+            "- pre-resonance → resonance at ω = {:.2} ± {:.2} rad/s",
+            b.omega, b.uncertainty
+        );
+    }
+    if let Some(b) = measured.boundaries.resonance_post {
+        let _ = writeln!(
+            md,
+            "- resonance → post-resonance at ω = {:.2} ± {:.2} rad/s",
+            b.omega, b.uncertainty
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nRelative force RMS error (duty error) per regime; lower is better.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| model | pre-resonance | resonance | post-resonance | overall | peak x (mm) at ω |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    for ((f, c), p) in fits.iter().zip(&comparisons).zip(&peaks) {
+        let mut row = format!("| {} ", f.label);
+        for r in Regime::ALL {
+            match c.per_regime.get(r) {
+                Some(m) => {
+                    let _ = write!(row, "| {:.3} ({:.2}) ", m.relative_rms_error, m.duty_error);
+                    let _ = writeln!(
+                        csv,
+                        "{},{},{},{},{},{},{},{},{}",
+                        f.label,
+                        r.name(),
+                        m.cycles,
+                        m.force_rms_error,
+                        m.relative_rms_error,
+                        m.energy_error,
+                        m.duty_error,
+                        m.peak_force_error,
+                        m.label_agreement
+                    );
+                }
+                None => row.push_str("| — "),
+            }
+        }
+        let o = &c.overall;
+        let _ = write!(row, "| {:.3} ({:.2}) ", o.relative_rms_error, o.duty_error);
+        match p {
+            Some((x, w)) => {
+                let _ = write!(row, "| {:.2} at {:.2} |", x * 1e3, w);
+            }
+            None => row.push_str("| simulation failed |"),
+        }
+        let _ = writeln!(md, "{row}");
+    }
+    let _ = writeln!(
+        md,
+        "| *measured* | | | | | {:.2} at {:.2} |\n",
+        measured_peak.amplitude * 1e3,
+        measured_peak.omega
+    );
+    for r in Regime::ALL {
+        if let Some(b) = ranking.best_in(r) {
+            let _ = writeln!(md, "- best in {}: **{b}**", r.name().replace('_', "-"));
+        }
+    }
+    if let Some(b) = ranking.best_overall() {
+        let _ = writeln!(md, "- best overall: **{b}**");
+    }
+    // Say what each model misses: a duty error above 0.2 in a regime is an on–off miss.
+    for (f, c) in fits.iter().zip(&comparisons) {
+        for r in Regime::ALL {
+            if let Some(m) = c.per_regime.get(r) {
+                if m.duty_error > 0.2 {
+                    let _ = writeln!(
+                        md,
+                        "- {} misses the on–off behaviour in {}: duty {:.2} against the measured {:.2}",
+                        f.label,
+                        r.name().replace('_', "-"),
+                        m.model_duty,
+                        m.measured_duty
+                    );
+                }
+            }
+        }
+    }
+    write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
+    write_atomic(&out.join("compare.md"), md.as_bytes())?;
+    print!("{md}");
+    println!(
+        "wrote {}/compare.json, compare.md and compare.csv",
+        out.display()
+    );
+    Ok(())
+}
