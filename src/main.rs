@@ -14,8 +14,8 @@ mod experiment;
 mod model_config;
 mod output;
 // Figures and reports; no command calls them yet (fit, compare and discover will): drop the
-// allow then.
-#[allow(dead_code)]
+// allow then (unused_imports: its re-exports are unused until then too).
+#[allow(dead_code, unused_imports)]
 mod report;
 
 use std::path::PathBuf;

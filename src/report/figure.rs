@@ -30,19 +30,19 @@ pub const SIZE_TALL: (u32, u32) = (1000, 1000);
 
 /// Title text style.
 pub fn title_style() -> TextStyle<'static> {
-    (FAMILY, 26).into_text_style(&())
+    TextStyle::from((FAMILY, 26).into_font())
 }
 /// Axis description (quantity and unit) style.
 pub fn axis_desc_style() -> TextStyle<'static> {
-    (FAMILY, 19).into_text_style(&())
+    TextStyle::from((FAMILY, 19).into_font())
 }
 /// Tick label style.
 pub fn tick_style() -> TextStyle<'static> {
-    (FAMILY, 15).into_text_style(&())
+    TextStyle::from((FAMILY, 15).into_font())
 }
 /// Legend text style.
 pub fn legend_style() -> TextStyle<'static> {
-    (FAMILY, 16).into_text_style(&())
+    TextStyle::from((FAMILY, 16).into_font())
 }
 
 /// A legend sample: a short thick line in `colour`.

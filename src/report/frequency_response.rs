@@ -148,3 +148,55 @@ pub fn frequency_response(
         &columns,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column};
+
+    /// A resonance curve x(ω) = 1 mm / |1 − (ω/ωn)²|, capped, sampled at `n` maxima.
+    fn resonance(label: &str, wn: f64, damping: f64, n: usize) -> FrfCurve {
+        let omega: Vec<f64> = (0..n).map(|i| 10.0 + 60.0 * i as f64 / n as f64).collect();
+        let x_peak = omega
+            .iter()
+            .map(|w| {
+                let r = w / wn;
+                1e-3 / ((1.0 - r * r).powi(2) + (2.0 * damping * r).powi(2)).sqrt()
+            })
+            .collect();
+        FrfCurve {
+            label: label.into(),
+            omega,
+            x_peak,
+        }
+    }
+
+    #[test]
+    fn renders_two_curves_with_trends_and_writes_them() {
+        let mut without = resonance("without STF", 40.0, 0.05, 300);
+        without.x_peak[100] *= 3.0; // an outlier the trend must ignore
+        let with = resonance("with STF", 42.0, 0.2, 250);
+        let dir = tempfile::tempdir().unwrap();
+        let smoothing = Smoothing::default();
+        let files =
+            frequency_response(dir.path(), "frf", &[without.clone(), with], &smoothing).unwrap();
+        let cols = assert_rendered(&files, SIZE);
+        assert_eq!(cols.len(), 6);
+        assert_eq!(column(&cols, "without STF: ω, rad/s"), &without.omega[..]);
+        assert_eq!(
+            column(&cols, "without STF: local maximum of x, m"),
+            &without.x_peak[..]
+        );
+        let trend = column(&cols, "without STF: smoothed trend, m");
+        assert_eq!(trend, &smooth_trend(&without.x_peak, &smoothing)[..]);
+        assert!(trend[100] < 1.5 * without.x_peak[99], "outlier leaked into the trend");
+        assert_eq!(column(&cols, "with STF: ω, rad/s").len(), 250);
+    }
+
+    #[test]
+    fn no_curve_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = frequency_response(dir.path(), "f", &[], &Smoothing::default()).unwrap_err();
+        assert!(matches!(err, ReportError::NoData { .. }), "{err}");
+    }
+}

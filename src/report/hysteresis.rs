@@ -152,3 +152,40 @@ pub fn hysteresis(
     ];
     render(out_dir, name, SIZE, &plot, &columns)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_loops_against_x_v_and_a_with_the_plotted_data() {
+        let s = damped_sine(4_000, 3.0);
+        let dir = tempfile::tempdir().unwrap();
+        for (name, label, y) in [
+            ("loop_x", "displacement x, m", &s.x),
+            ("loop_v", "velocity v, m/s", &s.v),
+            ("loop_a", "acceleration a, m/s²", &s.a),
+        ] {
+            let files = hysteresis(dir.path(), name, (label, y), &s.f, &s.t).unwrap();
+            let cols = assert_rendered(&files, SIZE);
+            // Short record: nothing decimated, the CSV is the data.
+            assert_eq!(column(&cols, "t, s"), &s.t[..]);
+            assert_eq!(column(&cols, label), &y[..]);
+            assert_eq!(column(&cols, F_LABEL), &s.f[..]);
+            // The colour bar is drawn: the SVG has its axis label and many colour steps.
+            let svg = std::fs::read_to_string(&files.svg).unwrap();
+            assert!(svg.contains(T_LABEL));
+            assert!(svg.matches("<rect").count() >= COLOUR_STEPS);
+        }
+    }
+
+    #[test]
+    fn all_nan_input_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let nan = [f64::NAN; 5];
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let err = hysteresis(dir.path(), "h", ("x, m", &nan), &t, &t).unwrap_err();
+        assert!(matches!(err, ReportError::NoData { .. }), "{err}");
+    }
+}

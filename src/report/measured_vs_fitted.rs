@@ -124,3 +124,30 @@ pub fn measured_vs_fitted(
     );
     render(out_dir, name, SIZE, &plot, &columns)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_measured_and_two_models() {
+        let s = damped_sine(3_000, 3.0);
+        let linear: Vec<f64> = s.v.iter().map(|v| 25.0 * v).collect();
+        let quadratic: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files = measured_vs_fitted(
+            dir.path(),
+            "fit",
+            &s.t,
+            &s.f,
+            &[("linear", &linear), ("power law", &quadratic)],
+        )
+        .unwrap();
+        let cols = assert_rendered(&files, SIZE);
+        assert_eq!(column(&cols, "measured F_STF, N"), &s.f[..]);
+        assert_eq!(column(&cols, "power law: fitted F_STF, N"), &quadratic[..]);
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(svg.contains("power law") && svg.contains("measured"), "legend");
+    }
+}

@@ -2,8 +2,10 @@
 //! replaced by the mean of their neighbours, then a centred moving average is taken.
 //!
 //! A point is an outlier when it departs from the median of its five-point neighbourhood by
-//! more than `outlier_k` robust standard deviations (1.4826 × the median absolute departure of
-//! the whole series). It is replaced by the mean of its nearest non-outlier neighbours.
+//! more than `outlier_k` times a scale: the robust standard deviation of those departures
+//! (1.4826 × their median absolute value) or, when larger, the median step between successive
+//! points (so a clean, noise-free curve has no outliers but its spikes). It is replaced by the
+//! mean of its nearest non-outlier neighbours.
 
 /// Settings of [`smooth_trend`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,7 +53,8 @@ pub fn outliers(y: &[f64], outlier_k: f64) -> Vec<bool> {
         })
         .collect();
     let mut abs: Vec<f64> = departure.iter().map(|d| d.abs()).collect();
-    let scale = 1.4826 * median(&mut abs);
+    let mut steps: Vec<f64> = y.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+    let scale = (1.4826 * median(&mut abs)).max(median(&mut steps));
     // A floor so that an exactly flat series with one spike still flags the spike only.
     let floor = 1e-12 * y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let limit = outlier_k * scale.max(floor);

@@ -195,3 +195,58 @@ pub fn time_history(
     ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::figure::SIZE_TALL;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_a_long_damped_sine_decimated_with_its_extrema() {
+        let s = damped_sine(60_000, 10.0);
+        let dir = tempfile::tempdir().unwrap();
+        let motion = Motion {
+            t: &s.t,
+            x: &s.x,
+            v: &s.v,
+            a: &s.a,
+        };
+        let files = time_history(dir.path(), "history", &motion, &s.f).unwrap();
+        let cols = assert_rendered(&files, SIZE_TALL);
+        let t = column(&cols, "t, s");
+        let x = column(&cols, "x, m");
+        let f = column(&cols, "F_STF, N");
+        assert!(t.len() < s.t.len() && t.len() <= MAX_POINTS_PER_LINE + 100);
+        // Every plotted row is a sample of the record (the grid is uniform: index = t / dt).
+        let dt = s.t[1] - s.t[0];
+        for (k, tk) in t.iter().enumerate() {
+            let i = (tk / dt).round() as usize;
+            assert_eq!(s.t[i], *tk);
+            assert_eq!(s.x[i], x[k]);
+            assert_eq!(s.f[i], f[k]);
+        }
+        let max = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
+        assert_eq!(max(x), max(&s.x));
+        assert_eq!(max(f), max(&s.f));
+        // Two force peaks and two troughs per period of 0.5 s over 10 s, less the damped tail
+        // lost in the noise: many extrema, alternating, and no more than the true count.
+        let kinds = column(&cols, "F_STF extremum kind (1 max, -1 min)");
+        assert!(kinds.len() > 20 && kinds.len() <= 40, "{} extrema", kinds.len());
+        assert!(kinds.windows(2).all(|w| w[0] == -w[1]));
+    }
+
+    #[test]
+    fn mismatched_lengths_are_an_error() {
+        let s = damped_sine(100, 1.0);
+        let motion = Motion {
+            t: &s.t,
+            x: &s.x[..50],
+            v: &s.v,
+            a: &s.a,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let err = time_history(dir.path(), "h", &motion, &s.f).unwrap_err();
+        assert!(matches!(err, ReportError::LengthMismatch { .. }), "{err}");
+    }
+}
