@@ -17,6 +17,8 @@ use super::ReportError;
 
 /// How many colour steps the line and the colour bar use.
 const COLOUR_STEPS: usize = 256;
+/// Width of the colour bar's strip (bar 28 px, then ticks and the axis label), pixels.
+const COLOUR_BAR_WIDTH: u32 = 150;
 const F_LABEL: &str = "F_STF, N";
 const T_LABEL: &str = "time t, s";
 
@@ -61,7 +63,7 @@ impl Draw for HysteresisPlot {
             )
             .map_err(msg)?;
         let (width, _) = root.dim_in_pixel();
-        let (main, bar) = root.split_horizontally(width.saturating_sub(130));
+        let (main, bar) = root.split_horizontally(width.saturating_sub(COLOUR_BAR_WIDTH));
 
         let mut chart = ChartBuilder::on(&main)
             .margin(10)
@@ -86,11 +88,14 @@ impl Draw for HysteresisPlot {
             )
             .map_err(msg)?;
 
+        // The colour bar: a narrow strip with the time axis on its right, aligned with the
+        // plotting area of the main chart (same top margin and bottom label area).
         let mut colour_bar = ChartBuilder::on(&bar)
             .margin(10)
-            .margin_right(40)
+            .margin_left(15)
             .x_label_area_size(50)
-            .y_label_area_size(70)
+            .y_label_area_size(0)
+            .right_y_label_area_size(COLOUR_BAR_WIDTH - 15 - 10 - 28)
             .build_cartesian_2d(0.0..1.0, t_range.clone())
             .map_err(msg)?;
         colour_bar
