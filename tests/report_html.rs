@@ -87,9 +87,14 @@ fn build_report(dir: &Path) -> PathBuf {
     };
     let figures = dir.join("figures");
     let history = report::time_history(&figures, "time_history", &motion, &s.f).unwrap();
-    let loop_v =
-        report::hysteresis(&figures, "hysteresis_v", ("velocity v, m/s", &s.v), &s.f, &s.t)
-            .unwrap();
+    let loop_v = report::hysteresis(
+        &figures,
+        "hysteresis_v",
+        ("velocity v, m/s", &s.v),
+        &s.f,
+        &s.t,
+    )
+    .unwrap();
 
     let mut r = Report::new("Power-law fit of a synthetic record");
     r.intro.push(
@@ -162,10 +167,7 @@ fn report_html_renders_every_figure_in_headless_chromium() {
         .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
     assert!(!check.contains("error:"), "page errors:\n{check}");
     assert!(check.contains("figures 2"), "layout check:\n{check}");
-    let figures: Vec<&str> = check
-        .lines()
-        .filter(|l| l.starts_with("figure "))
-        .collect();
+    let figures: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
     assert_eq!(figures.len(), 2, "{check}");
     for line in figures {
         // "figure 0 img 1000x1000 natural 1000x1000"

@@ -122,9 +122,7 @@ mod tests {
         let keep = decimate_union(&[&a, &b], 4_000);
         assert!(keep.len() <= 4_000);
         assert!(keep.contains(&4242));
-        let argmax_a = (0..a.len())
-            .max_by(|&i, &j| a[i].total_cmp(&a[j]))
-            .unwrap();
+        let argmax_a = (0..a.len()).max_by(|&i, &j| a[i].total_cmp(&a[j])).unwrap();
         assert!(keep.contains(&argmax_a));
     }
 

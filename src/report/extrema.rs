@@ -24,7 +24,7 @@ pub struct Extremum {
 /// samples are skipped). A non-positive or non-finite `delta` finds nothing.
 pub fn extrema(y: &[f64], delta: f64) -> Vec<Extremum> {
     let mut out = Vec::new();
-    if !(delta > 0.0) || !delta.is_finite() {
+    if !delta.is_finite() || delta <= 0.0 {
         return out;
     }
     let (mut mx, mut mx_i) = (f64::NEG_INFINITY, 0);
@@ -78,7 +78,7 @@ pub fn noise_delta(y: &[f64]) -> f64 {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(hi > lo) {
+    if hi <= lo {
         return 0.0;
     }
     let mut d2: Vec<f64> = finite
@@ -86,7 +86,9 @@ pub fn noise_delta(y: &[f64]) -> f64 {
         .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
         .collect();
     d2.sort_unstable_by(f64::total_cmp);
-    let sigma = d2.get(d2.len() / 2).map_or(0.0, |m| 1.4826 * m / 6f64.sqrt());
+    let sigma = d2
+        .get(d2.len() / 2)
+        .map_or(0.0, |m| 1.4826 * m / 6f64.sqrt());
     (0.05 * (hi - lo)).max(4.0 * sigma)
 }
 

@@ -16,8 +16,8 @@ static REGISTERED: OnceLock<bool> = OnceLock::new();
 
 /// Register the embedded font (once per process); every figure calls this before drawing.
 pub fn ensure_registered() -> Result<(), ReportError> {
-    let ok = *REGISTERED
-        .get_or_init(|| register_font(FAMILY, FontStyle::Normal, DEJAVU_SANS).is_ok());
+    let ok =
+        *REGISTERED.get_or_init(|| register_font(FAMILY, FontStyle::Normal, DEJAVU_SANS).is_ok());
     if ok {
         Ok(())
     } else {

@@ -43,9 +43,14 @@ struct FrequencyResponsePlot {
 impl Draw for FrequencyResponsePlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let no_data = || "frequency response: no finite value".to_string();
-        let w_range = padded_range(self.curves.iter().flat_map(|c| &c.omega)).ok_or_else(no_data)?;
-        let x_range = padded_range(self.curves.iter().flat_map(|c| c.x_peak.iter().chain(&c.trend)))
-            .ok_or_else(no_data)?;
+        let w_range =
+            padded_range(self.curves.iter().flat_map(|c| &c.omega)).ok_or_else(no_data)?;
+        let x_range = padded_range(
+            self.curves
+                .iter()
+                .flat_map(|c| c.x_peak.iter().chain(&c.trend)),
+        )
+        .ok_or_else(no_data)?;
         let root = root
             .titled("Frequency response: local maxima of x", title_style())
             .map_err(msg)?;
@@ -135,7 +140,10 @@ pub fn frequency_response(
         .flat_map(|c| {
             [
                 Column::new(format!("{}: ω, rad/s", c.label), c.omega.clone()),
-                Column::new(format!("{}: local maximum of x, m", c.label), c.x_peak.clone()),
+                Column::new(
+                    format!("{}: local maximum of x, m", c.label),
+                    c.x_peak.clone(),
+                ),
                 Column::new(format!("{}: smoothed trend, m", c.label), c.trend.clone()),
             ]
         })
@@ -189,7 +197,10 @@ mod tests {
         );
         let trend = column(&cols, "without STF: smoothed trend, m");
         assert_eq!(trend, &smooth_trend(&without.x_peak, &smoothing)[..]);
-        assert!(trend[100] < 1.5 * without.x_peak[99], "outlier leaked into the trend");
+        assert!(
+            trend[100] < 1.5 * without.x_peak[99],
+            "outlier leaked into the trend"
+        );
         assert_eq!(column(&cols, "with STF: ω, rad/s").len(), 250);
     }
 

@@ -79,7 +79,10 @@ fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
 
 fn looks_numeric(cell: &str) -> bool {
     let t = cell.trim();
-    !t.is_empty() && t.split_whitespace().next().is_some_and(|w| w.parse::<f64>().is_ok())
+    !t.is_empty()
+        && t.split_whitespace()
+            .next()
+            .is_some_and(|w| w.parse::<f64>().is_ok())
 }
 
 fn table_html(out: &mut String, table: &Table) {
@@ -103,7 +106,11 @@ fn table_html(out: &mut String, table: &Table) {
         out.push_str("<tr>");
         for i in 0..width {
             let cell = row.get(i).map(String::as_str).unwrap_or("");
-            let class = if looks_numeric(cell) { " class=\"num\"" } else { "" };
+            let class = if looks_numeric(cell) {
+                " class=\"num\""
+            } else {
+                ""
+            };
             let _ = write!(out, "<td{class}>{}</td>", escape(cell));
         }
         out.push_str("</tr>\n");

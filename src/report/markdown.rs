@@ -39,9 +39,8 @@ fn table_md(out: &mut String, table: &Table) {
 
 /// `target` relative to folder `base` (both made absolute first), with `/` separators.
 pub fn relative_link(target: &Path, base: &Path) -> String {
-    let absolute = |p: &Path| -> PathBuf {
-        std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
-    };
+    let absolute =
+        |p: &Path| -> PathBuf { std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()) };
     let (t, b) = (absolute(target), absolute(base));
     let tc: Vec<Component> = t.components().collect();
     let bc: Vec<Component> = b.components().collect();
@@ -137,7 +136,10 @@ mod tests {
         write_markdown(&report, &path).unwrap();
         let md = std::fs::read_to_string(&path).unwrap();
         assert!(md.starts_with("# Fit\n\nIntro.\n\n## Parameters\n"), "{md}");
-        assert!(md.contains("| name | value, N |\n| --- | --- |\n| a\\|b | 1 |"), "{md}");
+        assert!(
+            md.contains("| name | value, N |\n| --- | --- |\n| a\\|b | 1 |"),
+            "{md}"
+        );
         assert!(md.contains("![Figure 1: A loop.](fig/h.png)"), "{md}");
         assert!(md.contains("[fig/h.csv](fig/h.csv)"), "{md}");
     }

@@ -16,7 +16,8 @@ use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
 use super::ReportError;
 
-const MEASURED_GREY: RGBColor = RGBColor(90, 90, 90);
+/// The measured force is a wide light-grey band under the fitted lines, so both stay visible.
+const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
 
 struct MeasuredVsFittedPlot {
     t: Vec<f64>,
@@ -56,11 +57,13 @@ impl Draw for MeasuredVsFittedPlot {
         chart
             .draw_series(LineSeries::new(
                 finite_points(&self.t, &self.measured),
-                MEASURED_GREY.stroke_width(3),
+                MEASURED_GREY.stroke_width(6),
             ))
             .map_err(msg)?
             .label("measured")
-            .legend(legend_line(MEASURED_GREY));
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
+            });
         for (i, (label, f)) in self.fitted.iter().enumerate() {
             let colour = series_colour(i);
             chart
@@ -148,6 +151,9 @@ mod tests {
         assert_eq!(column(&cols, "measured F_STF, N"), &s.f[..]);
         assert_eq!(column(&cols, "power law: fitted F_STF, N"), &quadratic[..]);
         let svg = std::fs::read_to_string(&files.svg).unwrap();
-        assert!(svg.contains("power law") && svg.contains("measured"), "legend");
+        assert!(
+            svg.contains("power law") && svg.contains("measured"),
+            "legend"
+        );
     }
 }

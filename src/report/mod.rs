@@ -40,9 +40,9 @@ mod measured_vs_fitted;
 mod plot_range;
 mod series_csv;
 mod smoothing;
-mod time_history;
 #[cfg(test)]
 pub(crate) mod test_signals;
+mod time_history;
 
 pub use decimate::{decimate_indices, decimate_union, MAX_POINTS_PER_LINE};
 pub use document::{FigureRef, Report, Section, Table};

@@ -116,7 +116,10 @@ mod tests {
         ];
         write_csv(&path, &columns).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.starts_with("\"t, s\",\"say \"\"F\"\", N\"\n"), "{text}");
+        assert!(
+            text.starts_with("\"t, s\",\"say \"\"F\"\", N\"\n"),
+            "{text}"
+        );
         assert_eq!(read_csv_columns(&path).unwrap(), columns);
     }
 }

@@ -151,7 +151,9 @@ mod tests {
         for (a, b) in moving_average(&line, 7).iter().zip(&line) {
             assert_relative_eq!(*a, *b, epsilon = 1e-12);
         }
-        let zigzag: Vec<f64> = (0..40).map(|i| if i % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let zigzag: Vec<f64> = (0..40)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
         let s = moving_average(&zigzag, 9);
         assert!(s[10..30].iter().all(|v| v.abs() < 0.2));
     }

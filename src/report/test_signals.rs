@@ -18,11 +18,16 @@ pub fn damped_sine(n: usize, duration: f64) -> Signals {
     let amp = 5e-3;
     let mut state = 7u64;
     let mut noise = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 33) as f64 / (1u64 << 31) as f64) - 0.5
     };
     let t: Vec<f64> = (0..n).map(|i| duration * i as f64 / n as f64).collect();
-    let x: Vec<f64> = t.iter().map(|t| amp * (-z * t).exp() * (w * t).sin()).collect();
+    let x: Vec<f64> = t
+        .iter()
+        .map(|t| amp * (-z * t).exp() * (w * t).sin())
+        .collect();
     let v: Vec<f64> = t
         .iter()
         .map(|t| amp * (-z * t).exp() * (w * (w * t).cos() - z * (w * t).sin()))
@@ -48,7 +53,10 @@ pub fn assert_rendered(
 ) -> Vec<super::series_csv::Column> {
     let svg = std::fs::read_to_string(&files.svg).unwrap();
     assert!(svg.len() > 1000, "SVG too small: {} bytes", svg.len());
-    assert!(svg.contains("<svg") && svg.contains("<text"), "SVG has no text");
+    assert!(
+        svg.contains("<svg") && svg.contains("<text"),
+        "SVG has no text"
+    );
     let png = std::fs::read(&files.png).unwrap();
     assert!(png.len() > 1000, "PNG too small: {} bytes", png.len());
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");

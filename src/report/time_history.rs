@@ -56,7 +56,7 @@ impl TimeHistoryPlot {
             .margin(8)
             .x_label_area_size(if index == 2 { 48 } else { 28 })
             .y_label_area_size(90)
-            .right_y_label_area_size(90)
+            .right_y_label_area_size(80)
             .build_cartesian_2d(t_range.clone(), y_range)
             .map_err(msg)?
             .set_secondary_coord(t_range, f_range);
@@ -232,7 +232,11 @@ mod tests {
         // Two force peaks and two troughs per period of 0.5 s over 10 s, less the damped tail
         // lost in the noise: many extrema, alternating, and no more than the true count.
         let kinds = column(&cols, "F_STF extremum kind (1 max, -1 min)");
-        assert!(kinds.len() > 20 && kinds.len() <= 40, "{} extrema", kinds.len());
+        assert!(
+            kinds.len() > 20 && kinds.len() <= 40,
+            "{} extrema",
+            kinds.len()
+        );
         assert!(kinds.windows(2).all(|w| w[0] == -w[1]));
     }
 
