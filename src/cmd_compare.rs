@@ -12,7 +12,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use serde_json::{json, Value};
-use stf_core::analysis::peak;
+use stf_core::analysis::{local_maxima, peak};
 use stf_core::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare, cycles_from_phase, cycles_from_x, phase_from_omega, rank_models,
@@ -24,6 +24,8 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
 use crate::output::{prepare_dir, write_atomic, write_json};
 use crate::progress::Progress;
+use crate::report::{FrfCurve, Section, Table};
+use crate::reporting::{frequency_section, record_sections, write_report};
 
 /// The measured record's regimes.
 pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {
@@ -59,19 +61,45 @@ fn signals<'a>(data: &'a FitData) -> Signals<'a> {
     }
 }
 
-/// Resonance peak of the oscillator with the fitted model, driven as in the record.
-fn simulated_peak(exp: &Experiment, data: &FitData, fit: &ModelFit) -> Result<(f64, f64)> {
+/// The oscillator with the fitted model (or none), driven as in the record: its local maxima
+/// of x against ω and its resonance peak (|x|, ω).
+fn simulated_response(
+    exp: &Experiment,
+    data: &FitData,
+    fit: Option<&ModelFit>,
+) -> Result<(FrfCurve, (f64, f64))> {
     let k = &data.kinematics;
-    let mut osc = Oscillator::new(fit.system, k.excitation());
-    if let Some(c) = &fit.configured {
-        osc = osc.with_model(c.model.clone(), fit.model_values())?;
+    let system = fit.map_or(exp.system, |f| f.system);
+    let mut osc = Oscillator::new(system, k.excitation());
+    if let Some(f) = fit {
+        if let Some(c) = &f.configured {
+            osc = osc.with_model(c.model.clone(), f.model_values())?;
+        }
     }
     let run = Simulation::new(&osc)
         .settings(exp.integrator.clone())
         .initial(k.x[0], k.v[0])
         .run_at(&k.t)?;
     let p = peak(&run.t, &run.x, k.omega.as_deref()).context("empty simulation")?;
-    Ok((p.amplitude, p.omega))
+    Ok((
+        frf(
+            fit.map_or("without STF", |f| f.label.as_str()),
+            &run.t,
+            &run.x,
+            k.omega.as_deref(),
+        ),
+        (p.amplitude, p.omega),
+    ))
+}
+
+fn frf(label: &str, t: &[f64], x: &[f64], omega: Option<&[f64]>) -> FrfCurve {
+    let zeros = vec![0.0; t.len()];
+    let maxima = local_maxima(t, x, omega.unwrap_or(&zeros));
+    FrfCurve {
+        label: label.to_string(),
+        omega: maxima.iter().map(|m| m.omega).collect(),
+        x_peak: maxima.iter().map(|m| m.x).collect(),
+    }
 }
 
 fn regime_json(c: &Comparison) -> Value {
@@ -109,10 +137,12 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         data.kinematics.omega.as_deref(),
     )
     .context("empty record")?;
-    let peaks: Vec<Option<(f64, f64)>> = fits
+    let responses: Vec<Option<(FrfCurve, (f64, f64))>> = fits
         .iter()
-        .map(|f| simulated_peak(&exp, &data, f).ok())
+        .map(|f| simulated_response(&exp, &data, Some(f)).ok())
         .collect();
+    let peaks: Vec<Option<(f64, f64)>> =
+        responses.iter().map(|r| r.as_ref().map(|r| r.1)).collect();
     let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
     let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
     let ranking = rank_models(&pairs);
@@ -272,9 +302,69 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
     write_atomic(&out.join("compare.md"), md.as_bytes())?;
+    // The report: regimes table, frequency response, the record and the fits.
+    let mut curves = vec![frf(
+        "measured",
+        &data.record.t,
+        &data.record.x,
+        data.kinematics.omega.as_deref(),
+    )];
+    if let Ok((c, _)) = simulated_response(&exp, &data, None) {
+        curves.push(c);
+    }
+    curves.extend(responses.into_iter().flatten().map(|r| r.0));
+    let mut regimes = Section::new("Models regime by regime");
+    regimes.paragraphs = md
+        .lines()
+        .filter(|l| l.starts_with("- "))
+        .map(|l| l.trim_start_matches("- ").replace("**", ""))
+        .collect();
+    let mut table = Table {
+        caption:
+            "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
+                .into(),
+        columns: [
+            "model",
+            "pre-resonance",
+            "resonance",
+            "post-resonance",
+            "overall",
+        ]
+        .iter()
+        .map(|c| c.to_string())
+        .collect(),
+        rows: Vec::new(),
+    };
+    for (f, c) in fits.iter().zip(&comparisons) {
+        let mut row = vec![f.label.clone()];
+        for r in Regime::ALL {
+            row.push(c.per_regime.get(r).map_or("—".to_string(), |m| {
+                format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
+            }));
+        }
+        row.push(format!(
+            "{:.3} ({:.2})",
+            c.overall.relative_rms_error, c.overall.duty_error
+        ));
+        table.rows.push(row);
+    }
+    regimes.tables.push(table);
+    let mut sections = vec![regimes, frequency_section(&curves, out)?];
+    sections.extend(record_sections(&data, &fits, out)?);
+    write_report(
+        &format!("Comparison: {}", exp.path.display()),
+        vec![format!(
+            "{} cycles of {}; noise floor σ = {:.4} N.",
+            measured.labels.len(),
+            data.record.source,
+            measured.noise_sigma
+        )],
+        sections,
+        out,
+    )?;
     print!("{md}");
     println!(
-        "wrote {}/compare.json, compare.md and compare.csv",
+        "wrote {}/compare.json, compare.md, compare.csv, report.html, report.md and figures/",
         out.display()
     );
     Ok(())

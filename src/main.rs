@@ -19,6 +19,11 @@ mod fitting;
 mod model_config;
 mod output;
 mod progress;
+// The figure library exports more than the commands use yet (decimation, extrema, CSV
+// readers are used by its tests and the browser test).
+#[allow(dead_code, unused_imports)]
+mod report;
+mod reporting;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -1,0 +1,90 @@
+//! Atomic file writes: the content goes to a temporary file beside the target (same folder,
+//! same extension, so format-sniffing writers such as the PNG encoder still work), which is then
+//! renamed over the target. A crash never leaves a half-written file under the final name.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::ReportError;
+
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// A fresh temporary path beside `path` that keeps its extension: `.name.<pid>-<n>.tmp.ext`.
+pub fn temporary_sibling(path: &Path) -> PathBuf {
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "output".into());
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    path.with_file_name(format!(".{stem}.{}-{n}.tmp{ext}", std::process::id()))
+}
+
+/// Write `bytes` to `path` atomically.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+    let tmp = temporary_sibling(path);
+    let result = (|| -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|source| {
+        let _ = std::fs::remove_file(&tmp);
+        ReportError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Move a finished temporary file into place.
+pub fn commit(tmp: &Path, path: &Path) -> Result<(), ReportError> {
+    std::fs::rename(tmp, path).map_err(|source| {
+        let _ = std::fs::remove_file(tmp);
+        ReportError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+/// Create `dir` (and its parents) if missing.
+pub fn ensure_dir(dir: &Path) -> Result<(), ReportError> {
+    if dir.as_os_str().is_empty() {
+        return Ok(());
+    }
+    std::fs::create_dir_all(dir).map_err(|source| ReportError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn replaces_content_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.csv");
+        write_atomic(&p, b"one").unwrap();
+        write_atomic(&p, b"two").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"two");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn temporary_sibling_keeps_folder_and_extension() {
+        let p = Path::new("/some/dir/fig.png");
+        let a = temporary_sibling(p);
+        let b = temporary_sibling(p);
+        assert_eq!(a.parent(), p.parent());
+        assert_eq!(a.extension().unwrap(), "png");
+        assert_ne!(a, b);
+    }
+}

@@ -1,0 +1,79 @@
+//! The content of a report, independent of its format: a title, an introduction, and sections
+//! of paragraphs, tables and figures. [`write_html`](super::write_html) and
+//! [`write_markdown`](super::write_markdown) render it.
+
+use super::FigureFiles;
+
+/// A report: what was done, the numbers, the figures.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Report {
+    /// Page title.
+    pub title: String,
+    /// Paragraphs before the first section (plain text).
+    pub intro: Vec<String>,
+    /// The sections, in order.
+    pub sections: Vec<Section>,
+}
+
+impl Report {
+    /// An empty report with a title.
+    pub fn new(title: impl Into<String>) -> Self {
+        Self {
+            title: title.into(),
+            ..Self::default()
+        }
+    }
+}
+
+/// A section: heading, then paragraphs, tables and figures in that order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Section {
+    /// Heading.
+    pub heading: String,
+    /// Paragraphs (plain text).
+    pub paragraphs: Vec<String>,
+    /// Tables.
+    pub tables: Vec<Table>,
+    /// Figures.
+    pub figures: Vec<FigureRef>,
+}
+
+impl Section {
+    /// An empty section with a heading.
+    pub fn new(heading: impl Into<String>) -> Self {
+        Self {
+            heading: heading.into(),
+            ..Self::default()
+        }
+    }
+}
+
+/// A table of text cells (format numbers before: the report does not).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Table {
+    /// Caption above the table (may be empty).
+    pub caption: String,
+    /// Column headers, with units.
+    pub columns: Vec<String>,
+    /// Rows; a short row is padded with empty cells.
+    pub rows: Vec<Vec<String>>,
+}
+
+/// A figure in a report: its files and a caption saying what it shows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FigureRef {
+    /// The files written by a figure function.
+    pub files: FigureFiles,
+    /// What the figure shows, for a reader who never ran the tool.
+    pub caption: String,
+}
+
+impl FigureRef {
+    /// A figure with a caption.
+    pub fn new(files: FigureFiles, caption: impl Into<String>) -> Self {
+        Self {
+            files,
+            caption: caption.into(),
+        }
+    }
+}

@@ -1,0 +1,52 @@
+//! The errors of figure and report writing: bad input data, a file that cannot be written, a
+//! plot that cannot be drawn.
+
+use std::path::PathBuf;
+
+/// Why a figure or a report could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// Series that must be paired have different lengths.
+    #[error("{what}: lengths differ ({left} and {right} samples)")]
+    LengthMismatch {
+        /// Which series.
+        what: String,
+        /// Length of the first.
+        left: usize,
+        /// Length of the second.
+        right: usize,
+    },
+    /// A series has no finite value to plot.
+    #[error("{what}: no finite value to plot")]
+    NoData {
+        /// Which series.
+        what: String,
+    },
+    /// A file or folder could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A file could not be read (a figure to inline in a report).
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The plotting library failed to draw a figure.
+    #[error("cannot draw {}: {message}", path.display())]
+    Plot {
+        /// The figure file.
+        path: PathBuf,
+        /// The plotting library's message.
+        message: String,
+    },
+    /// The embedded font could not be registered.
+    #[error("the embedded font cannot be loaded")]
+    Font,
+}

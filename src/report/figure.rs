@@ -1,0 +1,131 @@
+//! Rendering a figure to its three files: the same drawing code runs on the SVG and the PNG
+//! backend, and the CSV holds the columns the drawing used. Also the text styles shared by all
+//! figures, so they look alike.
+
+use std::path::{Path, PathBuf};
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::atomic::{commit, ensure_dir, temporary_sibling, write_atomic};
+use super::font::{ensure_registered, FAMILY};
+use super::series_csv::{write_csv, Column};
+use super::ReportError;
+
+/// The files of one figure.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FigureFiles {
+    /// Vector image.
+    pub svg: PathBuf,
+    /// Raster image (what reports inline).
+    pub png: PathBuf,
+    /// Every plotted series, one column per quantity, headed with its unit.
+    pub csv: PathBuf,
+}
+
+/// Width × height of a one-panel figure, pixels.
+pub const SIZE: (u32, u32) = (1000, 600);
+/// Width × height of a figure with three stacked panels, pixels.
+pub const SIZE_TALL: (u32, u32) = (1000, 1000);
+
+/// Title text style.
+pub fn title_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 26).into_font())
+}
+/// Axis description (quantity and unit) style.
+pub fn axis_desc_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 19).into_font())
+}
+/// Tick label style.
+pub fn tick_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 15).into_font())
+}
+/// Legend text style.
+pub fn legend_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 16).into_font())
+}
+
+/// A legend sample: a short thick line in `colour`.
+pub fn legend_line(colour: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+}
+
+/// Turn any plotting error into its message.
+pub fn msg<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// A figure that can draw itself on any plotters backend.
+pub trait Draw {
+    /// Draw on `root` (already filled white).
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+fn draw_on<DB: DrawingBackend>(backend: DB, plot: &impl Draw) -> Result<(), String> {
+    let root = backend.into_drawing_area();
+    root.fill(&WHITE).map_err(msg)?;
+    plot.draw(&root)?;
+    root.present().map_err(msg)
+}
+
+/// Write `out_dir/name.{svg,png,csv}`: the SVG and PNG drawn by `plot` at `size`, the CSV
+/// from `columns`. Each file is written atomically.
+pub fn render(
+    out_dir: &Path,
+    name: &str,
+    size: (u32, u32),
+    plot: &impl Draw,
+    columns: &[Column],
+) -> Result<FigureFiles, ReportError> {
+    ensure_registered()?;
+    ensure_dir(out_dir)?;
+    let files = FigureFiles {
+        svg: out_dir.join(format!("{name}.svg")),
+        png: out_dir.join(format!("{name}.png")),
+        csv: out_dir.join(format!("{name}.csv")),
+    };
+
+    let mut svg = String::new();
+    draw_on(SVGBackend::with_string(&mut svg, size), plot).map_err(|message| {
+        ReportError::Plot {
+            path: files.svg.clone(),
+            message,
+        }
+    })?;
+    write_atomic(&files.svg, svg.as_bytes())?;
+
+    let tmp = temporary_sibling(&files.png);
+    if let Err(message) = draw_on(BitMapBackend::new(&tmp, size), plot) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(ReportError::Plot {
+            path: files.png.clone(),
+            message,
+        });
+    }
+    commit(&tmp, &files.png)?;
+
+    write_csv(&files.csv, columns)?;
+    Ok(files)
+}
+
+/// Check that two series have the same length.
+pub fn same_length(what: &str, a: &[f64], b: &[f64]) -> Result<(), ReportError> {
+    if a.len() == b.len() {
+        Ok(())
+    } else {
+        Err(ReportError::LengthMismatch {
+            what: what.to_string(),
+            left: a.len(),
+            right: b.len(),
+        })
+    }
+}
+
+/// The finite (x, y) pairs of two series, for drawing.
+pub fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    x.iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .collect()
+}

@@ -1,0 +1,246 @@
+//! `report.html`: one self-contained page — CSS inline, figures inlined as PNG `data:` URIs,
+//! no script or font from the network — that a reader who never ran the tool can open
+//! anywhere. A tiny inline script writes each figure's laid-out size (and any page error) into
+//! a hidden `<pre id="layout-check">`, which lets a headless browser test check the page.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::atomic::write_atomic;
+use super::base64;
+use super::document::{FigureRef, Report, Table};
+use super::ReportError;
+
+const STYLE: &str = r#"
+body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; color: #222;
+       max-width: 1060px; margin: 2em auto; padding: 0 1.2em; line-height: 1.5; }
+h1 { font-size: 1.9em; border-bottom: 2px solid #0072b2; padding-bottom: .2em; }
+h2 { font-size: 1.4em; margin-top: 2em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; margin: 1em 0; font-size: .95em; }
+caption { text-align: left; font-weight: bold; padding-bottom: .3em; }
+th, td { border: 1px solid #bbb; padding: .3em .7em; }
+th { background: #eef3f8; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+tbody tr:nth-child(even) { background: #f8f8f8; }
+figure { margin: 1.5em 0; }
+figure img { display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }
+figcaption { margin-top: .4em; font-size: .95em; }
+figcaption .files { color: #666; font-size: .9em; }
+footer { margin-top: 3em; color: #777; font-size: .85em; border-top: 1px solid #ddd; }
+"#;
+
+const LAYOUT_CHECK: &str = r#"
+(function () {
+  var lines = [];
+  function show() {
+    var pre = document.getElementById("layout-check");
+    if (pre) { pre.textContent = lines.join("\n"); }
+  }
+  window.addEventListener("error", function (e) { lines.push("error: " + e.message); show(); });
+  window.addEventListener("load", function () {
+    var figures = document.querySelectorAll("figure img, figure svg");
+    figures.forEach(function (el, i) {
+      var r = el.getBoundingClientRect();
+      lines.push("figure " + i + " " + el.tagName.toLowerCase() + " " + Math.round(r.width) +
+        "x" + Math.round(r.height) + " natural " + (el.naturalWidth || 0) + "x" +
+        (el.naturalHeight || 0));
+    });
+    lines.push("figures " + figures.length);
+    show();
+  });
+})();
+"#;
+
+/// Escape text for HTML content and attribute values.
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// Width and height from a PNG's header, if it is one.
+fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    if bytes.len() < 24 || &bytes[..8] != b"\x89PNG\r\n\x1a\n" {
+        return None;
+    }
+    let w = u32::from_be_bytes(bytes[16..20].try_into().ok()?);
+    let h = u32::from_be_bytes(bytes[20..24].try_into().ok()?);
+    Some((w, h))
+}
+
+fn looks_numeric(cell: &str) -> bool {
+    let t = cell.trim();
+    !t.is_empty()
+        && t.split_whitespace()
+            .next()
+            .is_some_and(|w| w.parse::<f64>().is_ok())
+}
+
+fn table_html(out: &mut String, table: &Table) {
+    out.push_str("<table>\n");
+    if !table.caption.is_empty() {
+        let _ = writeln!(out, "<caption>{}</caption>", escape(&table.caption));
+    }
+    out.push_str("<thead><tr>");
+    for c in &table.columns {
+        let _ = write!(out, "<th>{}</th>", escape(c));
+    }
+    out.push_str("</tr></thead>\n<tbody>\n");
+    let width = table
+        .rows
+        .iter()
+        .map(Vec::len)
+        .chain([table.columns.len()])
+        .max()
+        .unwrap_or(0);
+    for row in &table.rows {
+        out.push_str("<tr>");
+        for i in 0..width {
+            let cell = row.get(i).map(String::as_str).unwrap_or("");
+            let class = if looks_numeric(cell) {
+                " class=\"num\""
+            } else {
+                ""
+            };
+            let _ = write!(out, "<td{class}>{}</td>", escape(cell));
+        }
+        out.push_str("</tr>\n");
+    }
+    out.push_str("</tbody>\n</table>\n");
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<(), ReportError> {
+    let png = std::fs::read(&figure.files.png).map_err(|source| ReportError::Read {
+        path: figure.files.png.clone(),
+        source,
+    })?;
+    let size = png_size(&png)
+        .map(|(w, h)| format!(" width=\"{w}\" height=\"{h}\""))
+        .unwrap_or_default();
+    let _ = writeln!(
+        out,
+        "<figure id=\"figure-{number}\">\n<img src=\"data:image/png;base64,{}\" alt=\"{}\"{size}>",
+        base64::encode(&png),
+        escape(&figure.caption)
+    );
+    let _ = writeln!(
+        out,
+        "<figcaption><b>Figure {number}.</b> {} <span class=\"files\">Files beside this page: \
+         {} (vector), {} (the plotted data).</span></figcaption>\n</figure>",
+        escape(&figure.caption),
+        escape(&file_name(&figure.files.svg)),
+        escape(&file_name(&figure.files.csv)),
+    );
+    Ok(())
+}
+
+/// The HTML text of `report`, with every figure's PNG read and inlined.
+pub fn to_html(report: &Report) -> Result<String, ReportError> {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>{}</title>\n<style>{STYLE}</style>\n<script>{LAYOUT_CHECK}</script>\n</head>\n<body>",
+        escape(&report.title)
+    );
+    let _ = writeln!(out, "<h1>{}</h1>", escape(&report.title));
+    for p in &report.intro {
+        let _ = writeln!(out, "<p>{}</p>", escape(p));
+    }
+    let mut number = 0;
+    for section in &report.sections {
+        let _ = writeln!(out, "<section>\n<h2>{}</h2>", escape(&section.heading));
+        for p in &section.paragraphs {
+            let _ = writeln!(out, "<p>{}</p>", escape(p));
+        }
+        for table in &section.tables {
+            table_html(&mut out, table);
+        }
+        for figure in &section.figures {
+            number += 1;
+            figure_html(&mut out, number, figure)?;
+        }
+        out.push_str("</section>\n");
+    }
+    let _ = writeln!(
+        out,
+        "<footer>Written by stf-lab {}. Figures are inlined; their SVG and CSV files sit \
+         beside this page.</footer>\n<pre id=\"layout-check\" hidden></pre>\n</body>\n</html>",
+        env!("CARGO_PKG_VERSION")
+    );
+    Ok(out)
+}
+
+/// Write `report` as one self-contained HTML page at `path` (atomically).
+pub fn write_html(report: &Report, path: &Path) -> Result<(), ReportError> {
+    let html = to_html(report)?;
+    if let Some(dir) = path.parent() {
+        super::atomic::ensure_dir(dir)?;
+    }
+    write_atomic(path, html.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::Section;
+
+    #[test]
+    fn escapes_markup_and_right_aligns_numbers() {
+        let mut report = Report::new("A <b> & \"c\"");
+        let mut s = Section::new("Fit");
+        s.tables.push(Table {
+            caption: "Parameters".into(),
+            columns: vec!["name".into(), "value".into()],
+            rows: vec![vec!["K".into(), "1.5e3 N".into()], vec!["<n>".into()]],
+        });
+        report.sections.push(s);
+        let html = to_html(&report).unwrap();
+        assert!(html.contains("<h1>A &lt;b&gt; &amp; &quot;c&quot;</h1>"));
+        assert!(html.contains("<td class=\"num\">1.5e3 N</td>"));
+        assert!(html.contains("<td>&lt;n&gt;</td><td></td>"));
+        assert!(!html.contains("http"), "no network reference");
+    }
+
+    #[test]
+    fn a_missing_figure_file_is_an_error_naming_it() {
+        let mut report = Report::new("r");
+        let mut s = Section::new("s");
+        s.figures.push(FigureRef::new(
+            crate::report::FigureFiles {
+                svg: "nowhere/f.svg".into(),
+                png: "nowhere/f.png".into(),
+                csv: "nowhere/f.csv".into(),
+            },
+            "c",
+        ));
+        report.sections.push(s);
+        let err = to_html(&report).unwrap_err().to_string();
+        assert!(err.contains("nowhere/f.png"), "{err}");
+    }
+
+    #[test]
+    fn reads_png_size_from_header() {
+        let mut header = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+        header.extend(1000u32.to_be_bytes());
+        header.extend(600u32.to_be_bytes());
+        assert_eq!(png_size(&header), Some((1000, 600)));
+        assert_eq!(png_size(b"GIF89a"), None);
+    }
+}

@@ -1,0 +1,196 @@
+//! Hysteresis loops: the STF force against displacement, velocity or acceleration, the line
+//! coloured by time (viridis) with a colour bar, so the reader sees how the loop drifts.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::viridis;
+use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::figure::{
+    axis_desc_style, msg, render, same_length, tick_style, title_style, Draw, FigureFiles, SIZE,
+};
+use super::plot_range::{exact_range, padded_range};
+use super::series_csv::Column;
+use super::ReportError;
+
+/// How many colour steps the line and the colour bar use.
+const COLOUR_STEPS: usize = 256;
+/// Width of the colour bar's strip (bar 28 px, then ticks and the axis label), pixels.
+const COLOUR_BAR_WIDTH: u32 = 150;
+const F_LABEL: &str = "F_STF, N";
+const T_LABEL: &str = "time t, s";
+
+struct HysteresisPlot {
+    label: String,
+    t: Vec<f64>,
+    x: Vec<f64>,
+    f: Vec<f64>,
+}
+
+impl HysteresisPlot {
+    /// The loop cut into runs of consecutive samples, each with the colour of its mid time.
+    fn coloured_runs(&self, t0: f64, t1: f64) -> Vec<(Vec<(f64, f64)>, RGBColor)> {
+        let n = self.t.len();
+        let run = n.div_ceil(COLOUR_STEPS).max(1);
+        let span = if t1 > t0 { t1 - t0 } else { 1.0 };
+        (0..n)
+            .step_by(run)
+            .map(|start| {
+                let end = (start + run + 1).min(n); // overlap one sample: no gaps
+                let points = (start..end)
+                    .filter(|&i| self.x[i].is_finite() && self.f[i].is_finite())
+                    .map(|i| (self.x[i], self.f[i]))
+                    .collect();
+                let mid = self.t[(start + end - 1) / 2];
+                (points, viridis((mid - t0) / span))
+            })
+            .collect()
+    }
+}
+
+impl Draw for HysteresisPlot {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let no_data = |what: &str| format!("{what}: no finite value");
+        let x_range = padded_range(&self.x).ok_or_else(|| no_data(&self.label))?;
+        let f_range = padded_range(&self.f).ok_or_else(|| no_data(F_LABEL))?;
+        let t_range = exact_range(&self.t).ok_or_else(|| no_data(T_LABEL))?;
+        let root = root
+            .titled(
+                &format!("Hysteresis: F_STF against {}, coloured by time", self.label),
+                title_style(),
+            )
+            .map_err(msg)?;
+        let (width, _) = root.dim_in_pixel();
+        let (main, bar) = root.split_horizontally(width.saturating_sub(COLOUR_BAR_WIDTH));
+
+        let mut chart = ChartBuilder::on(&main)
+            .margin(10)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x_range, f_range)
+            .map_err(msg)?;
+        chart
+            .configure_mesh()
+            .x_desc(self.label.as_str())
+            .y_desc(F_LABEL)
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(msg)?;
+        let runs = self.coloured_runs(t_range.start, t_range.end);
+        chart
+            .draw_series(
+                runs.into_iter()
+                    .map(|(points, colour)| PathElement::new(points, colour.stroke_width(2))),
+            )
+            .map_err(msg)?;
+
+        // The colour bar: a narrow strip with the time axis on its right, aligned with the
+        // plotting area of the main chart (same top margin and bottom label area).
+        let mut colour_bar = ChartBuilder::on(&bar)
+            .margin(10)
+            .margin_left(15)
+            .x_label_area_size(50)
+            .y_label_area_size(0)
+            .right_y_label_area_size(COLOUR_BAR_WIDTH - 15 - 10 - 28)
+            .build_cartesian_2d(0.0..1.0, t_range.clone())
+            .map_err(msg)?;
+        colour_bar
+            .configure_mesh()
+            .disable_x_mesh()
+            .disable_y_mesh()
+            .disable_x_axis()
+            .y_desc(T_LABEL)
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .draw()
+            .map_err(msg)?;
+        let (t0, t1) = (t_range.start, t_range.end);
+        let step = (t1 - t0) / COLOUR_STEPS as f64;
+        colour_bar
+            .draw_series((0..COLOUR_STEPS).map(|k| {
+                let lo = t0 + step * k as f64;
+                Rectangle::new(
+                    [(0.0, lo), (1.0, lo + step)],
+                    viridis((k as f64 + 0.5) / COLOUR_STEPS as f64).filled(),
+                )
+            }))
+            .map_err(msg)?;
+        Ok(())
+    }
+}
+
+/// Draw F_STF against one motion quantity (`against` = its label with unit, e.g.
+/// `("x, m", &x)`), the loop coloured by time `t` with a colour bar, to
+/// `out_dir/name.{svg,png,csv}`. The CSV holds t, the quantity and F_STF as plotted.
+pub fn hysteresis(
+    out_dir: &Path,
+    name: &str,
+    against: (&str, &[f64]),
+    f_stf: &[f64],
+    t: &[f64],
+) -> Result<FigureFiles, ReportError> {
+    let (label, x) = against;
+    same_length(&format!("hysteresis: {label} and F_STF"), x, f_stf)?;
+    same_length("hysteresis: t and F_STF", t, f_stf)?;
+    for (what, s) in [("t", t), (label, x), ("F_STF", f_stf)] {
+        if !s.iter().any(|v| v.is_finite()) {
+            return Err(ReportError::NoData {
+                what: format!("hysteresis: {what}"),
+            });
+        }
+    }
+    let keep = decimate_union(&[x, f_stf], MAX_POINTS_PER_LINE);
+    let plot = HysteresisPlot {
+        label: label.to_string(),
+        t: pick(t, &keep),
+        x: pick(x, &keep),
+        f: pick(f_stf, &keep),
+    };
+    let columns = vec![
+        Column::new("t, s", plot.t.clone()),
+        Column::new(label, plot.x.clone()),
+        Column::new(F_LABEL, plot.f.clone()),
+    ];
+    render(out_dir, name, SIZE, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_loops_against_x_v_and_a_with_the_plotted_data() {
+        let s = damped_sine(4_000, 3.0);
+        let dir = tempfile::tempdir().unwrap();
+        for (name, label, y) in [
+            ("loop_x", "displacement x, m", &s.x),
+            ("loop_v", "velocity v, m/s", &s.v),
+            ("loop_a", "acceleration a, m/s²", &s.a),
+        ] {
+            let files = hysteresis(dir.path(), name, (label, y), &s.f, &s.t).unwrap();
+            let cols = assert_rendered(&files, SIZE);
+            // Short record: nothing decimated, the CSV is the data.
+            assert_eq!(column(&cols, "t, s"), &s.t[..]);
+            assert_eq!(column(&cols, label), &y[..]);
+            assert_eq!(column(&cols, F_LABEL), &s.f[..]);
+            // The colour bar is drawn: the SVG has its axis label and many colour steps.
+            let svg = std::fs::read_to_string(&files.svg).unwrap();
+            assert!(svg.contains(T_LABEL));
+            assert!(svg.matches("<rect").count() >= COLOUR_STEPS);
+        }
+    }
+
+    #[test]
+    fn all_nan_input_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let nan = [f64::NAN; 5];
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let err = hysteresis(dir.path(), "h", ("x, m", &nan), &t, &t).unwrap_err();
+        assert!(matches!(err, ReportError::NoData { .. }), "{err}");
+    }
+}

@@ -1,0 +1,146 @@
+//! `report.md`: the same report for a terminal or a lab notebook — headings, pipe tables, and
+//! figures linked by their path relative to the Markdown file.
+
+use std::fmt::Write as _;
+use std::path::{Component, Path, PathBuf};
+
+use super::atomic::{ensure_dir, write_atomic};
+use super::document::{Report, Table};
+use super::ReportError;
+
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+}
+
+fn table_md(out: &mut String, table: &Table) {
+    if !table.caption.is_empty() {
+        let _ = writeln!(out, "**{}**\n", table.caption);
+    }
+    let width = table
+        .rows
+        .iter()
+        .map(Vec::len)
+        .chain([table.columns.len()])
+        .max()
+        .unwrap_or(0);
+    let header: Vec<String> = (0..width)
+        .map(|i| cell(table.columns.get(i).map(String::as_str).unwrap_or("")))
+        .collect();
+    let _ = writeln!(out, "| {} |", header.join(" | "));
+    let _ = writeln!(out, "|{}", " --- |".repeat(width));
+    for row in &table.rows {
+        let cells: Vec<String> = (0..width)
+            .map(|i| cell(row.get(i).map(String::as_str).unwrap_or("")))
+            .collect();
+        let _ = writeln!(out, "| {} |", cells.join(" | "));
+    }
+    out.push('\n');
+}
+
+/// `target` relative to folder `base` (both made absolute first), with `/` separators.
+pub fn relative_link(target: &Path, base: &Path) -> String {
+    let absolute =
+        |p: &Path| -> PathBuf { std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()) };
+    let (t, b) = (absolute(target), absolute(base));
+    let tc: Vec<Component> = t.components().collect();
+    let bc: Vec<Component> = b.components().collect();
+    let common = tc.iter().zip(&bc).take_while(|(a, b)| a == b).count();
+    let mut parts: Vec<String> = vec!["..".to_string(); bc.len() - common];
+    parts.extend(
+        tc[common..]
+            .iter()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+    );
+    parts.join("/")
+}
+
+/// The Markdown text of `report`, figure links relative to folder `base`.
+pub fn to_markdown(report: &Report, base: &Path) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "# {}\n", report.title);
+    for p in &report.intro {
+        let _ = writeln!(out, "{p}\n");
+    }
+    let mut number = 0;
+    for section in &report.sections {
+        let _ = writeln!(out, "## {}\n", section.heading);
+        for p in &section.paragraphs {
+            let _ = writeln!(out, "{p}\n");
+        }
+        for table in &section.tables {
+            table_md(&mut out, table);
+        }
+        for figure in &section.figures {
+            number += 1;
+            let _ = writeln!(
+                out,
+                "![Figure {number}: {}]({})\n\n*Figure {number}.* {} (vector: [{}]({}), data: [{}]({}))\n",
+                cell(&figure.caption),
+                relative_link(&figure.files.png, base),
+                figure.caption,
+                relative_link(&figure.files.svg, base),
+                relative_link(&figure.files.svg, base),
+                relative_link(&figure.files.csv, base),
+                relative_link(&figure.files.csv, base),
+            );
+        }
+    }
+    out
+}
+
+/// Write `report` as Markdown at `path` (atomically), figures linked relative to it.
+pub fn write_markdown(report: &Report, path: &Path) -> Result<(), ReportError> {
+    let dir = path.parent().unwrap_or(Path::new(""));
+    ensure_dir(dir)?;
+    write_atomic(path, to_markdown(report, dir).as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::{FigureFiles, FigureRef, Section};
+
+    #[test]
+    fn links_are_relative_to_the_markdown_file() {
+        assert_eq!(
+            relative_link(Path::new("/out/figures/a.png"), Path::new("/out")),
+            "figures/a.png"
+        );
+        assert_eq!(
+            relative_link(Path::new("/data/a.png"), Path::new("/out/run")),
+            "../../data/a.png"
+        );
+    }
+
+    #[test]
+    fn writes_headings_tables_and_figure_links() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut report = Report::new("Fit");
+        report.intro.push("Intro.".into());
+        let mut s = Section::new("Parameters");
+        s.tables.push(Table {
+            caption: String::new(),
+            columns: vec!["name".into(), "value, N".into()],
+            rows: vec![vec!["a|b".into(), "1".into()]],
+        });
+        s.figures.push(FigureRef::new(
+            FigureFiles {
+                svg: dir.path().join("fig/h.svg"),
+                png: dir.path().join("fig/h.png"),
+                csv: dir.path().join("fig/h.csv"),
+            },
+            "A loop.",
+        ));
+        report.sections.push(s);
+        let path = dir.path().join("report.md");
+        write_markdown(&report, &path).unwrap();
+        let md = std::fs::read_to_string(&path).unwrap();
+        assert!(md.starts_with("# Fit\n\nIntro.\n\n## Parameters\n"), "{md}");
+        assert!(
+            md.contains("| name | value, N |\n| --- | --- |\n| a\\|b | 1 |"),
+            "{md}"
+        );
+        assert!(md.contains("![Figure 1: A loop.](fig/h.png)"), "{md}");
+        assert!(md.contains("[fig/h.csv](fig/h.csv)"), "{md}");
+    }
+}

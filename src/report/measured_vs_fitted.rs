@@ -1,0 +1,159 @@
+//! Measured against fitted force: the STF force recovered from a record and each model's
+//! fitted force over time, on one axis, so the reader sees where a model misses.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::series_colour;
+use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::figure::{
+    axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
+    tick_style, title_style, Draw, FigureFiles, SIZE,
+};
+use super::plot_range::{exact_range, padded_range};
+use super::series_csv::Column;
+use super::ReportError;
+
+/// The measured force is a wide light-grey band under the fitted lines, so both stay visible.
+const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
+
+struct MeasuredVsFittedPlot {
+    t: Vec<f64>,
+    measured: Vec<f64>,
+    fitted: Vec<(String, Vec<f64>)>,
+}
+
+impl Draw for MeasuredVsFittedPlot {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let no_data = || "measured vs fitted: no finite value".to_string();
+        let t_range = exact_range(&self.t).ok_or_else(no_data)?;
+        let f_range = padded_range(
+            self.measured
+                .iter()
+                .chain(self.fitted.iter().flat_map(|(_, f)| f)),
+        )
+        .ok_or_else(no_data)?;
+        let root = root
+            .titled("STF force: measured and fitted", title_style())
+            .map_err(msg)?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .margin_right(30)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(t_range, f_range)
+            .map_err(msg)?;
+        chart
+            .configure_mesh()
+            .x_desc("time t, s")
+            .y_desc("F_STF, N")
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(msg)?;
+        chart
+            .draw_series(LineSeries::new(
+                finite_points(&self.t, &self.measured),
+                MEASURED_GREY.stroke_width(6),
+            ))
+            .map_err(msg)?
+            .label("measured")
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
+            });
+        for (i, (label, f)) in self.fitted.iter().enumerate() {
+            let colour = series_colour(i);
+            chart
+                .draw_series(LineSeries::new(
+                    finite_points(&self.t, f),
+                    colour.stroke_width(2),
+                ))
+                .map_err(msg)?
+                .label(label.as_str())
+                .legend(legend_line(colour));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(legend_style())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(msg)
+    }
+}
+
+/// Draw the measured STF force and each model's fitted force (`(model label, force)`, N) over
+/// time `t` (s) to `out_dir/name.{svg,png,csv}`. The CSV holds t, the measured force and one
+/// column per model, as plotted.
+pub fn measured_vs_fitted(
+    out_dir: &Path,
+    name: &str,
+    t: &[f64],
+    measured: &[f64],
+    fitted: &[(&str, &[f64])],
+) -> Result<FigureFiles, ReportError> {
+    same_length("measured vs fitted: t and measured", t, measured)?;
+    for (label, f) in fitted {
+        same_length(&format!("measured vs fitted: t and {label}"), t, f)?;
+    }
+    if !measured.iter().any(|v| v.is_finite()) {
+        return Err(ReportError::NoData {
+            what: "measured vs fitted: measured force".into(),
+        });
+    }
+    let mut all: Vec<&[f64]> = vec![measured];
+    all.extend(fitted.iter().map(|(_, f)| *f));
+    let keep = decimate_union(&all, MAX_POINTS_PER_LINE);
+    let plot = MeasuredVsFittedPlot {
+        t: pick(t, &keep),
+        measured: pick(measured, &keep),
+        fitted: fitted
+            .iter()
+            .map(|(label, f)| (label.to_string(), pick(f, &keep)))
+            .collect(),
+    };
+    let mut columns = vec![
+        Column::new("t, s", plot.t.clone()),
+        Column::new("measured F_STF, N", plot.measured.clone()),
+    ];
+    columns.extend(
+        plot.fitted
+            .iter()
+            .map(|(label, f)| Column::new(format!("{label}: fitted F_STF, N"), f.clone())),
+    );
+    render(out_dir, name, SIZE, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_measured_and_two_models() {
+        let s = damped_sine(3_000, 3.0);
+        let linear: Vec<f64> = s.v.iter().map(|v| 25.0 * v).collect();
+        let quadratic: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files = measured_vs_fitted(
+            dir.path(),
+            "fit",
+            &s.t,
+            &s.f,
+            &[("linear", &linear), ("power law", &quadratic)],
+        )
+        .unwrap();
+        let cols = assert_rendered(&files, SIZE);
+        assert_eq!(column(&cols, "measured F_STF, N"), &s.f[..]);
+        assert_eq!(column(&cols, "power law: fitted F_STF, N"), &quadratic[..]);
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(
+            svg.contains("power law") && svg.contains("measured"),
+            "legend"
+        );
+    }
+}

@@ -1,0 +1,59 @@
+//! Figures and self-contained reports: the plots the source study uses (time histories,
+//! hysteresis loops coloured by time, the frequency response with its smoothed trend, measured
+//! against fitted force), each written as SVG, PNG and a CSV of every plotted series, and a
+//! report gathering tables and figures into one self-contained `report.html` and a `report.md`.
+//!
+//! The API takes plain data (slices of `f64`, labels), so it knows nothing of fitting.
+//! Fonts are embedded in the binary ([`font`]), so rendering needs no system library. Every
+//! file is written atomically (a temporary file beside the target, then a rename).
+//!
+//! ```no_run
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use std::path::Path;
+//! let t: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
+//! let x: Vec<f64> = t.iter().map(|t| (20.0 * t).sin() * 1e-3).collect();
+//! let f: Vec<f64> = t.iter().map(|t| (20.0 * t).cos()).collect();
+//! let files = report::hysteresis(Path::new("out"), "loop_x", ("x, m", &x), &f, &t)?;
+//! let mut report = report::Report::new("Power-law fit");
+//! report.intro.push("What was fitted and how well.".into());
+//! let mut section = report::Section::new("Hysteresis");
+//! section.figures.push(report::FigureRef::new(files, "F_STF against x, coloured by time."));
+//! report.sections.push(section);
+//! report::write_html(&report, Path::new("out/report.html"))?;
+//! # Ok(()) }
+//! ```
+
+mod atomic;
+mod base64;
+mod colour;
+mod decimate;
+mod document;
+mod error;
+mod extrema;
+mod figure;
+mod font;
+mod frequency_response;
+mod html;
+mod hysteresis;
+mod markdown;
+mod measured_vs_fitted;
+mod plot_range;
+mod series_csv;
+mod smoothing;
+#[cfg(test)]
+pub(crate) mod test_signals;
+mod time_history;
+
+pub use decimate::{decimate_indices, decimate_union, MAX_POINTS_PER_LINE};
+pub use document::{FigureRef, Report, Section, Table};
+pub use error::ReportError;
+pub use extrema::{extrema, Extremum, ExtremumKind};
+pub use figure::FigureFiles;
+pub use frequency_response::{frequency_response, FrfCurve};
+pub use html::write_html;
+pub use hysteresis::hysteresis;
+pub use markdown::write_markdown;
+pub use measured_vs_fitted::measured_vs_fitted;
+pub use series_csv::{read_csv_columns, Column};
+pub use smoothing::{smooth_trend, Smoothing};
+pub use time_history::{time_history, Motion};

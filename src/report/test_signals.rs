@@ -1,0 +1,83 @@
+//! Synthetic signals for the figure tests: a damped oscillation and a force that depends on
+//! its velocity, with a little deterministic noise.
+
+/// A synthetic record (SI units).
+pub struct Signals {
+    pub t: Vec<f64>,
+    pub x: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    pub f: Vec<f64>,
+}
+
+/// `n` samples over `duration` seconds of x = 5 mm · e^(−0.3 t) sin(2π·2 t), with v and a
+/// exact, and F = 20 v + 400 v|v| + noise (N).
+pub fn damped_sine(n: usize, duration: f64) -> Signals {
+    let w = 2.0 * std::f64::consts::PI * 2.0;
+    let z = 0.3;
+    let amp = 5e-3;
+    let mut state = 7u64;
+    let mut noise = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 33) as f64 / (1u64 << 31) as f64) - 0.5
+    };
+    let t: Vec<f64> = (0..n).map(|i| duration * i as f64 / n as f64).collect();
+    let x: Vec<f64> = t
+        .iter()
+        .map(|t| amp * (-z * t).exp() * (w * t).sin())
+        .collect();
+    let v: Vec<f64> = t
+        .iter()
+        .map(|t| amp * (-z * t).exp() * (w * (w * t).cos() - z * (w * t).sin()))
+        .collect();
+    let a: Vec<f64> = t
+        .iter()
+        .map(|t| {
+            amp * (-z * t).exp() * ((z * z - w * w) * (w * t).sin() - 2.0 * z * w * (w * t).cos())
+        })
+        .collect();
+    let f: Vec<f64> = v
+        .iter()
+        .map(|v| 20.0 * v + 400.0 * v * v.abs() + 0.005 * noise())
+        .collect();
+    Signals { t, x, v, a, f }
+}
+
+/// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works) and the
+/// PNG has the expected size; returns the CSV's columns.
+pub fn assert_rendered(
+    files: &super::FigureFiles,
+    size: (u32, u32),
+) -> Vec<super::series_csv::Column> {
+    let svg = std::fs::read_to_string(&files.svg).unwrap();
+    assert!(svg.len() > 1000, "SVG too small: {} bytes", svg.len());
+    assert!(
+        svg.contains("<svg") && svg.contains("<text"),
+        "SVG has no text"
+    );
+    let png = std::fs::read(&files.png).unwrap();
+    assert!(png.len() > 1000, "PNG too small: {} bytes", png.len());
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert_eq!((w, h), size);
+    let dir = files.png.parent().unwrap();
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    super::read_csv_columns(&files.csv).unwrap()
+}
+
+/// The column named `name`.
+pub fn column<'a>(columns: &'a [super::series_csv::Column], name: &str) -> &'a [f64] {
+    &columns
+        .iter()
+        .find(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no column {name:?}"))
+        .values
+}

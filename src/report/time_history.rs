@@ -1,0 +1,256 @@
+//! Time histories: displacement, velocity and acceleration, each in its own panel against the
+//! STF force on a second axis, with the force's extrema (those standing above the noise)
+//! marked, as in the source study.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::series_colour;
+use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::extrema::{extrema, noise_delta, ExtremumKind};
+use super::figure::{
+    axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
+    tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
+};
+use super::plot_range::{exact_range, padded_range};
+use super::series_csv::Column;
+use super::ReportError;
+
+/// The motion of the trolley over time (SI units: s, m, m/s, m/s²), all of one length.
+#[derive(Clone, Copy, Debug)]
+pub struct Motion<'a> {
+    /// Time, s.
+    pub t: &'a [f64],
+    /// Displacement, m.
+    pub x: &'a [f64],
+    /// Velocity, m/s.
+    pub v: &'a [f64],
+    /// Acceleration, m/s².
+    pub a: &'a [f64],
+}
+
+const F_LABEL: &str = "F_STF, N";
+const T_LABEL: &str = "time t, s";
+
+struct TimeHistoryPlot {
+    t: Vec<f64>,
+    panels: [(&'static str, Vec<f64>); 3],
+    f: Vec<f64>,
+    marks: Vec<(f64, f64, ExtremumKind)>,
+}
+
+impl TimeHistoryPlot {
+    fn panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        index: usize,
+    ) -> Result<(), String> {
+        let (label, y) = &self.panels[index];
+        let no_data = || format!("{label}: no finite value");
+        let t_range = exact_range(&self.t).ok_or_else(no_data)?;
+        let y_range = padded_range(y).ok_or_else(no_data)?;
+        let f_range = padded_range(&self.f).ok_or_else(|| "F_STF: no finite value".to_string())?;
+        let mut chart = ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(if index == 2 { 48 } else { 28 })
+            .y_label_area_size(90)
+            .right_y_label_area_size(80)
+            .build_cartesian_2d(t_range.clone(), y_range)
+            .map_err(msg)?
+            .set_secondary_coord(t_range, f_range);
+        let mut mesh = chart.configure_mesh();
+        mesh.y_desc(*label)
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .light_line_style(WHITE.mix(0.0));
+        if index == 2 {
+            mesh.x_desc(T_LABEL);
+        }
+        mesh.draw().map_err(msg)?;
+        chart
+            .configure_secondary_axes()
+            .y_desc(F_LABEL)
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .draw()
+            .map_err(msg)?;
+
+        let c_motion = series_colour(0);
+        let c_force = series_colour(1);
+        chart
+            .draw_series(LineSeries::new(
+                finite_points(&self.t, y),
+                c_motion.stroke_width(2),
+            ))
+            .map_err(msg)?
+            .label(*label)
+            .legend(legend_line(c_motion));
+        chart
+            .draw_secondary_series(LineSeries::new(
+                finite_points(&self.t, &self.f),
+                c_force.stroke_width(1),
+            ))
+            .map_err(msg)?
+            .label(F_LABEL)
+            .legend(legend_line(c_force));
+        chart
+            .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
+                let style = match kind {
+                    ExtremumKind::Max => BLACK.filled(),
+                    ExtremumKind::Min => BLACK.stroke_width(2),
+                };
+                Circle::new((t, f), 4, style)
+            }))
+            .map_err(msg)?
+            .label("F_STF maxima (●) and minima (○)")
+            .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(legend_style())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(msg)
+    }
+}
+
+impl Draw for TimeHistoryPlot {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let root = root
+            .titled("Motion against the STF force", title_style())
+            .map_err(msg)?;
+        for (i, area) in root.split_evenly((3, 1)).iter().enumerate() {
+            self.panel(area, i)?;
+        }
+        Ok(())
+    }
+}
+
+/// Draw x, v and a against F_STF over time (three panels, F_STF on the right axis, its
+/// extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
+/// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
+pub fn time_history(
+    out_dir: &Path,
+    name: &str,
+    motion: &Motion,
+    f_stf: &[f64],
+) -> Result<FigureFiles, ReportError> {
+    let Motion { t, x, v, a } = *motion;
+    same_length("time history: t and x", t, x)?;
+    same_length("time history: t and v", t, v)?;
+    same_length("time history: t and a", t, a)?;
+    same_length("time history: t and F_STF", t, f_stf)?;
+    for (what, s) in [("t", t), ("x", x), ("F_STF", f_stf)] {
+        if !s.iter().any(|v| v.is_finite()) {
+            return Err(ReportError::NoData {
+                what: format!("time history: {what}"),
+            });
+        }
+    }
+
+    let marks_full = extrema(f_stf, noise_delta(f_stf));
+    let mut keep = decimate_union(&[x, v, a, f_stf], MAX_POINTS_PER_LINE);
+    keep.extend(marks_full.iter().map(|e| e.index));
+    keep.sort_unstable();
+    keep.dedup();
+
+    let plot = TimeHistoryPlot {
+        t: pick(t, &keep),
+        panels: [
+            ("displacement x, m", pick(x, &keep)),
+            ("velocity v, m/s", pick(v, &keep)),
+            ("acceleration a, m/s²", pick(a, &keep)),
+        ],
+        f: pick(f_stf, &keep),
+        marks: marks_full
+            .iter()
+            .map(|e| (t[e.index], f_stf[e.index], e.kind))
+            .collect(),
+    };
+    let kind_code = |k: ExtremumKind| match k {
+        ExtremumKind::Max => 1.0,
+        ExtremumKind::Min => -1.0,
+    };
+    let columns = vec![
+        Column::new("t, s", plot.t.clone()),
+        Column::new("x, m", plot.panels[0].1.clone()),
+        Column::new("v, m/s", plot.panels[1].1.clone()),
+        Column::new("a, m/s²", plot.panels[2].1.clone()),
+        Column::new(F_LABEL, plot.f.clone()),
+        Column::new(
+            "F_STF extremum t, s",
+            plot.marks.iter().map(|m| m.0).collect(),
+        ),
+        Column::new(
+            "F_STF extremum, N",
+            plot.marks.iter().map(|m| m.1).collect(),
+        ),
+        Column::new(
+            "F_STF extremum kind (1 max, -1 min)",
+            plot.marks.iter().map(|m| kind_code(m.2)).collect(),
+        ),
+    ];
+    render(out_dir, name, SIZE_TALL, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::figure::SIZE_TALL;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn renders_a_long_damped_sine_decimated_with_its_extrema() {
+        let s = damped_sine(60_000, 10.0);
+        let dir = tempfile::tempdir().unwrap();
+        let motion = Motion {
+            t: &s.t,
+            x: &s.x,
+            v: &s.v,
+            a: &s.a,
+        };
+        let files = time_history(dir.path(), "history", &motion, &s.f).unwrap();
+        let cols = assert_rendered(&files, SIZE_TALL);
+        let t = column(&cols, "t, s");
+        let x = column(&cols, "x, m");
+        let f = column(&cols, "F_STF, N");
+        assert!(t.len() < s.t.len() && t.len() <= MAX_POINTS_PER_LINE + 100);
+        // Every plotted row is a sample of the record (the grid is uniform: index = t / dt).
+        let dt = s.t[1] - s.t[0];
+        for (k, tk) in t.iter().enumerate() {
+            let i = (tk / dt).round() as usize;
+            assert_eq!(s.t[i], *tk);
+            assert_eq!(s.x[i], x[k]);
+            assert_eq!(s.f[i], f[k]);
+        }
+        let max = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
+        assert_eq!(max(x), max(&s.x));
+        assert_eq!(max(f), max(&s.f));
+        // Two force peaks and two troughs per period of 0.5 s over 10 s, less the damped tail
+        // lost in the noise: many extrema, alternating, and no more than the true count.
+        let kinds = column(&cols, "F_STF extremum kind (1 max, -1 min)");
+        assert!(
+            kinds.len() > 20 && kinds.len() <= 40,
+            "{} extrema",
+            kinds.len()
+        );
+        assert!(kinds.windows(2).all(|w| w[0] == -w[1]));
+    }
+
+    #[test]
+    fn mismatched_lengths_are_an_error() {
+        let s = damped_sine(100, 1.0);
+        let motion = Motion {
+            t: &s.t,
+            x: &s.x[..50],
+            v: &s.v,
+            a: &s.a,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let err = time_history(dir.path(), "h", &motion, &s.f).unwrap_err();
+        assert!(matches!(err, ReportError::LengthMismatch { .. }), "{err}");
+    }
+}

@@ -1,0 +1,196 @@
+//! `report.html` in a real browser: a small report with two figures and a table is written,
+//! then opened in headless Chromium, which must load it with no script error and lay out every
+//! figure with a non-zero size. Chromium comes from Debian's `chromium` package (`.ci/run`
+//! installs it); when it is missing the test fails, unless `STF_SKIP_BROWSER=1` is set.
+//!
+//! Set `STF_REPORT_TEST_OUT=DIR` to keep the report, its figures and the browser's screenshot
+//! in DIR for a look.
+
+// The report module lives in the binary crate; the test compiles it in directly.
+#[path = "../src/report/mod.rs"]
+#[allow(dead_code, unused_imports)]
+mod report;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use report::test_signals::damped_sine;
+use report::{FigureRef, Motion, Report, Section, Table};
+
+fn find_chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .flat_map(|dir| ["chromium", "chromium-browser"].map(|name| dir.join(name)))
+        .find(|p| p.is_file())
+}
+
+/// Run Chromium headless on `page` with the extra `args`; returns stdout. Output goes to files
+/// (a large DOM would fill a pipe nobody reads yet). A safety limit of two minutes ends a
+/// browser that hangs (the test then fails).
+fn run_chromium(chromium: &Path, page: &Path, args: &[String]) -> String {
+    let profile = tempfile::tempdir().unwrap();
+    let stdout_path = profile.path().join("stdout.txt");
+    let stderr_path = profile.path().join("stderr.txt");
+    let mut child = Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--hide-scrollbars",
+            "--window-size=1200,2000",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!(
+            "--user-data-dir={}",
+            profile.path().join("profile").display()
+        ))
+        .args(args)
+        .arg(format!("file://{}", page.display()))
+        .stdin(Stdio::null())
+        .stdout(std::fs::File::create(&stdout_path).unwrap())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
+        .spawn()
+        .expect("cannot start chromium");
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("chromium did not finish within 2 minutes");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    assert!(
+        status.success(),
+        "chromium failed ({status}): {}",
+        std::fs::read_to_string(&stderr_path).unwrap_or_default()
+    );
+    std::fs::read_to_string(&stdout_path).unwrap()
+}
+
+fn build_report(dir: &Path) -> PathBuf {
+    let s = damped_sine(5_000, 5.0);
+    let motion = Motion {
+        t: &s.t,
+        x: &s.x,
+        v: &s.v,
+        a: &s.a,
+    };
+    let figures = dir.join("figures");
+    let history = report::time_history(&figures, "time_history", &motion, &s.f).unwrap();
+    let loop_v = report::hysteresis(
+        &figures,
+        "hysteresis_v",
+        ("velocity v, m/s", &s.v),
+        &s.f,
+        &s.t,
+    )
+    .unwrap();
+
+    let mut r = Report::new("Power-law fit of a synthetic record");
+    r.intro.push(
+        "A damped oscillation of the trolley (5 mm, 2 Hz) with an STF force that grows with \
+         the square of the velocity. This page is self-contained: it needs no network."
+            .into(),
+    );
+    let mut fit = Section::new("Fitted parameters");
+    fit.paragraphs
+        .push("Values with their standard errors, from the fitted force.".into());
+    fit.tables.push(Table {
+        caption: "Power law F = K·|v|^n·sign(v)".into(),
+        columns: vec!["parameter".into(), "value".into(), "unit".into()],
+        rows: vec![
+            vec!["K".into(), "402.1 ± 3.5".into(), "N (s/m)^n".into()],
+            vec!["n".into(), "1.98 ± 0.02".into(), "".into()],
+        ],
+    });
+    r.sections.push(fit);
+    let mut figs = Section::new("Figures");
+    figs.figures.push(FigureRef::new(
+        history,
+        "Displacement, velocity and acceleration (left axes) against the STF force (right \
+         axes); black dots mark the force's maxima, circles its minima.",
+    ));
+    figs.figures.push(FigureRef::new(
+        loop_v,
+        "The STF force against velocity; the colour shows time, from dark (start) to yellow \
+         (end).",
+    ));
+    r.sections.push(figs);
+
+    let page = dir.join("report.html");
+    report::write_html(&r, &page).unwrap();
+    report::write_markdown(&r, &dir.join("report.md")).unwrap();
+    page
+}
+
+#[test]
+fn report_html_renders_every_figure_in_headless_chromium() {
+    let kept = std::env::var_os("STF_REPORT_TEST_OUT").map(PathBuf::from);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = kept.clone().unwrap_or_else(|| tmp.path().to_path_buf());
+    std::fs::create_dir_all(&dir).unwrap();
+    let dir = dir.canonicalize().unwrap();
+    let page = build_report(&dir);
+
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert_eq!(html.matches("<img src=\"data:image/png;base64,").count(), 2);
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("](figures/time_history.png)"), "{md}");
+
+    let Some(chromium) = find_chromium() else {
+        if std::env::var("STF_SKIP_BROWSER").as_deref() == Ok("1") {
+            eprintln!("chromium not found; browser check skipped (STF_SKIP_BROWSER=1)");
+            return;
+        }
+        panic!(
+            "chromium not found on PATH: install Debian's package \
+             (apt-get install -y chromium), or set STF_SKIP_BROWSER=1 to skip this check"
+        );
+    };
+
+    let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
+    let check = dom
+        .split("<pre id=\"layout-check\" hidden=\"\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
+    assert!(!check.contains("error:"), "page errors:\n{check}");
+    assert!(check.contains("figures 2"), "layout check:\n{check}");
+    let figures: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
+    assert_eq!(figures.len(), 2, "{check}");
+    for line in figures {
+        // "figure 0 img 1000x1000 natural 1000x1000"
+        let sizes: Vec<(u32, u32)> = line
+            .split_whitespace()
+            .filter(|w| w.contains('x') && w.chars().next().is_some_and(|c| c.is_ascii_digit()))
+            .map(|w| {
+                let (a, b) = w.split_once('x').unwrap();
+                (a.parse().unwrap(), b.parse().unwrap())
+            })
+            .collect();
+        assert_eq!(sizes.len(), 2, "{line}");
+        for (w, h) in sizes {
+            assert!(w > 0 && h > 0, "a figure has zero size: {line}");
+        }
+    }
+
+    let shot = dir.join("screenshot.png");
+    run_chromium(
+        &chromium,
+        &page,
+        &[format!("--screenshot={}", shot.display())],
+    );
+    let png = std::fs::read(&shot).unwrap();
+    assert!(png.len() > 10_000, "screenshot is {} bytes", png.len());
+}
