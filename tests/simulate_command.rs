@@ -103,3 +103,50 @@ fn models_lists_the_builtins_with_parameters() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("viscous") && text.contains("c_s"), "{text}");
 }
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn the_readme_example_prints_the_reference_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("paper_sweep.csv");
+    let run = stf_lab()
+        .arg("simulate")
+        .arg(root().join("experiments/paper_sweep.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(text.contains("peak |x| = 41.69 mm at ω = 6.22 rad/s"), "{text}");
+    assert!(text.contains("breakaway (|x| first above 0.1 mm) at ω = 3.79 rad/s"), "{text}");
+}
+
+#[test]
+fn bundled_records_regenerate_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    for (exp, record) in [
+        ("experiments/power_law_fit.toml", "experiments/records/power_law_sweep.csv"),
+        ("experiments/jamming_compare.toml", "experiments/records/jamming_sweep.csv"),
+        ("experiments/records/free_vibration.toml", "experiments/records/free_vibration.csv"),
+        ("experiments/records/forced_sweep.toml", "experiments/records/forced_sweep.csv"),
+    ] {
+        let out = dir.path().join("again.csv");
+        let run = stf_lab()
+            .arg("simulate")
+            .arg(root().join(exp))
+            .arg("--out")
+            .arg(&out)
+            .arg("--force")
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{exp}: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(
+            std::fs::read(&out).unwrap() == std::fs::read(root().join(record)).unwrap(),
+            "{record} is not what {exp} makes"
+        );
+    }
+}
