@@ -207,7 +207,7 @@ struct RawDiscover {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawExperiment {
-    data: Option<RawData>,
+    data: Option<Spanned<RawData>>,
     system: Option<Spanned<RawSystem>>,
     integrator: Option<Spanned<RawIntegrator>>,
     #[serde(default)]
@@ -724,8 +724,27 @@ impl Experiment {
         let data_window = raw
             .data
             .as_ref()
-            .and_then(|d| d.window)
+            .and_then(|d| d.get_ref().window)
             .map(|[a, b]| (a, b));
+        let data_file = match &raw.data {
+            None => None,
+            Some(d) => {
+                let file = dir.join(&d.get_ref().file);
+                if !file.is_file() {
+                    return Err(cx.at(
+                        d.span(),
+                        "data.file",
+                        format!("no such record: {}", file.display()),
+                    ));
+                }
+                if let Some((a, b)) = data_window {
+                    if !(b > a) {
+                        return Err(cx.at(d.span(), "data.window", format!("[{a}, {b}] is empty")));
+                    }
+                }
+                Some(file)
+            }
+        };
         Ok(Experiment {
             path: path.to_path_buf(),
             data_window,
@@ -733,7 +752,7 @@ impl Experiment {
             kinematics,
             identify,
             regimes,
-            data_file: raw.data.map(|d| dir.join(d.file)),
+            data_file,
             dir,
             system,
             integrator,
@@ -754,7 +773,10 @@ mod tests {
 
     #[test]
     fn the_design_example_parses() {
-        let e = parse(
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("record.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        let e = Experiment::parse(
+            &dir.path().join("exp.toml"),
             r#"
 [data]
 file = "record.csv"
@@ -783,7 +805,7 @@ params = { K = 4.0, n = 1.5 }
         .unwrap();
         assert_eq!(e.models.len(), 1);
         assert_eq!(e.models[0].line, 8); // the `[[models]]` header
-        assert_eq!(e.data_file.unwrap(), PathBuf::from("./record.csv"));
+        assert_eq!(e.data_file.unwrap(), dir.path().join("record.csv"));
         let s = e.simulate.unwrap();
         assert_eq!((s.t0, s.t1), (50.0, 200.0));
         assert_eq!(s.truth[0].key, "simulate.truth[0]");
@@ -795,6 +817,44 @@ params = { K = 4.0, n = 1.5 }
         let msg = format!("{err:#}");
         assert!(msg.contains("exp.toml:3"), "{msg}");
         assert!(msg.contains("stifnes"), "{msg}");
+    }
+
+    #[test]
+    fn a_missing_record_names_the_file_line_and_key() {
+        let err = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("exp.toml:2") && msg.contains("data.file"),
+            "{msg}"
+        );
+        assert!(msg.contains("nowhere.csv"), "{msg}");
+    }
+
+    #[test]
+    fn an_unknown_solver_or_preset_names_the_key_and_the_known_ones() {
+        let msg = format!("{:#}", parse("\n[fit]\nsolver = \"newton\"\n").unwrap_err());
+        assert!(
+            msg.contains("exp.toml:2") && msg.contains("fit.solver"),
+            "{msg}"
+        );
+        assert!(msg.contains("nelder_mead"), "{msg}");
+        let msg = format!("{:#}", parse("[system]\npreset = \"forcd\"\n").unwrap_err());
+        assert!(
+            msg.contains("exp.toml:1") && msg.contains("system.preset"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn a_misspelled_key_inside_a_model_names_its_line() {
+        let msg = format!(
+            "{:#}",
+            parse("[[models]]\nname = \"viscous\"\nparmas = { c_s = 1.0 }\n").unwrap_err()
+        );
+        assert!(
+            msg.contains("exp.toml:3") && msg.contains("parmas"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -130,3 +130,69 @@ pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<Conf
         params,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::Experiment;
+
+    fn models_of(text: &str) -> Result<ConfiguredModel> {
+        let exp = Experiment::parse(Path::new("exp.toml"), text)?;
+        configure(&exp.models, &exp.path, &exp.dir)
+    }
+
+    #[test]
+    fn a_misspelled_model_lists_the_known_ones_with_file_line_and_key() {
+        let err = models_of("\n[[models]]\nname = \"powr_law\"\n")
+            .err()
+            .unwrap();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("exp.toml:2") && msg.contains("models[0]"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("powr_law") && msg.contains("power_law"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn a_misspelled_parameter_lists_the_model_s_parameters() {
+        let err = models_of("[[models]]\nname = \"power_law\"\nparams = { k = 2.0 }\n")
+            .err()
+            .unwrap();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("exp.toml:3") && msg.contains("models[0].params.k"),
+            "{msg}"
+        );
+        assert!(msg.contains("K, n"), "{msg}");
+    }
+
+    #[test]
+    fn a_bound_that_excludes_its_value_is_an_error() {
+        let err = models_of(
+            "[[models]]\nname = \"power_law\"\nparams = { n = { value = 0.5, min = 1.0 } }\n",
+        )
+        .err()
+        .unwrap();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("exp.toml:3") && msg.contains("models[0].params.n"),
+            "{msg}"
+        );
+        assert!(msg.contains("outside its bounds"), "{msg}");
+    }
+
+    #[test]
+    fn sums_and_prefixed_names_resolve() {
+        let m = models_of(
+            "[[models]]\nname = \"power_law\"\nplus = [\"added_mass\"]\nparams = { K = 3.0, \"added_mass.m_a\" = 1.0 }\n",
+        )
+        .unwrap();
+        assert_eq!(m.model.name(), "power_law + added_mass");
+        assert_eq!(m.values()[0], 3.0);
+        assert_eq!(m.values()[2], 1.0);
+    }
+}

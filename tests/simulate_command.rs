@@ -119,20 +119,42 @@ fn the_readme_example_prints_the_reference_figures() {
         .arg(&out)
         .output()
         .unwrap();
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let text = String::from_utf8_lossy(&run.stdout);
-    assert!(text.contains("peak |x| = 41.69 mm at ω = 6.22 rad/s"), "{text}");
-    assert!(text.contains("breakaway (|x| first above 0.1 mm) at ω = 3.79 rad/s"), "{text}");
+    assert!(
+        text.contains("peak |x| = 41.69 mm at ω = 6.22 rad/s"),
+        "{text}"
+    );
+    assert!(
+        text.contains("breakaway (|x| first above 0.1 mm) at ω = 3.79 rad/s"),
+        "{text}"
+    );
 }
 
 #[test]
 fn bundled_records_regenerate_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     for (exp, record) in [
-        ("experiments/power_law_fit.toml", "experiments/records/power_law_sweep.csv"),
-        ("experiments/jamming_compare.toml", "experiments/records/jamming_sweep.csv"),
-        ("experiments/records/free_vibration.toml", "experiments/records/free_vibration.csv"),
-        ("experiments/records/forced_sweep.toml", "experiments/records/forced_sweep.csv"),
+        (
+            "experiments/power_law_fit.toml",
+            "experiments/records/power_law_sweep.csv",
+        ),
+        (
+            "experiments/jamming_compare.toml",
+            "experiments/records/jamming_sweep.csv",
+        ),
+        (
+            "experiments/records/free_vibration.toml",
+            "experiments/records/free_vibration.csv",
+        ),
+        (
+            "experiments/records/forced_sweep.toml",
+            "experiments/records/forced_sweep.csv",
+        ),
     ] {
         let out = dir.path().join("again.csv");
         let run = stf_lab()
@@ -143,7 +165,11 @@ fn bundled_records_regenerate_byte_for_byte() {
             .arg("--force")
             .output()
             .unwrap();
-        assert!(run.status.success(), "{exp}: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(
+            run.status.success(),
+            "{exp}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         assert!(
             std::fs::read(&out).unwrap() == std::fs::read(root().join(record)).unwrap(),
             "{record} is not what {exp} makes"
