@@ -156,6 +156,50 @@ struct RawData {
     file: String,
     /// Time window to use, s.
     window: Option<[f64; 2]>,
+    /// Column (CSV) or variable (.mat) names, where they differ from the contract's.
+    #[serde(default)]
+    columns: BTreeMap<String, String>,
+    /// Units of the columns, where they are not SI (`x = "mm"`, `phi = "deg"`, `t = "ms"`).
+    #[serde(default)]
+    units: BTreeMap<String, String>,
+    /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
+    calibration: Option<RawCalibration>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCalibration {
+    a: f64,
+    b: f64,
+}
+
+/// How to read the experiment's record: names, units and the force calibration.
+#[derive(Clone, Debug, Default)]
+pub struct DataSpec {
+    /// Column names by signal (`t`, `x`, `phi`, `f_stf`, `omega`, `u`).
+    pub columns: BTreeMap<String, String>,
+    /// Scale to SI by signal (e.g. `x` in mm: 1e-3).
+    pub scale: BTreeMap<String, f64>,
+    /// F = a·signal + b applied to `f_stf`.
+    pub calibration: Option<(f64, f64)>,
+}
+
+const SIGNALS: [&str; 6] = ["t", "x", "phi", "f_stf", "omega", "u"];
+
+/// The factor that brings `unit` of `signal` to SI, if known.
+fn unit_scale(signal: &str, unit: &str) -> Option<f64> {
+    match (signal, unit) {
+        ("t", "s") | ("x", "m") | ("phi", "rad") | ("omega", "rad/s") => Some(1.0),
+        ("f_stf" | "u", "N") => Some(1.0),
+        ("t", "ms") => Some(1e-3),
+        ("x", "mm") => Some(1e-3),
+        ("x", "um" | "µm") => Some(1e-6),
+        ("phi", "deg") => Some(std::f64::consts::PI / 180.0),
+        ("omega", "rpm") => Some(std::f64::consts::TAU / 60.0),
+        ("omega", "Hz") => Some(std::f64::consts::TAU),
+        ("f_stf" | "u", "mN") => Some(1e-3),
+        _ => None,
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -202,6 +246,22 @@ struct RawStage {
 #[serde(deny_unknown_fields)]
 struct RawDiscover {
     base: String,
+    candidates: Option<Vec<String>>,
+    max_effects: Option<usize>,
+    holdout_every: Option<usize>,
+}
+
+/// A validated `[discover]` section.
+#[derive(Clone, Debug)]
+pub struct DiscoverSpec {
+    /// The base model: a name, a script path, or `a + b`.
+    pub base: String,
+    /// Candidate effects (default: the vocabulary of DESIGN.md §5).
+    pub candidates: Option<Vec<String>>,
+    /// At most this many effects are added.
+    pub max_effects: Option<usize>,
+    /// Every k-th cycle is held out for scoring.
+    pub holdout_every: Option<usize>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -317,15 +377,15 @@ pub struct Experiment {
     /// Integrator settings.
     pub integrator: Settings,
     /// Models to fit or compare.
-    #[allow(dead_code)] // read by fit, compare and discover
     pub models: Vec<ModelEntry>,
     /// `[simulate]`, if present.
     pub simulate: Option<SimulateSpec>,
     /// `[data] file`, resolved.
-    #[allow(dead_code)] // read by fit, compare and discover
     pub data_file: Option<PathBuf>,
     /// Time window of the data, s.
     pub data_window: Option<(f64, f64)>,
+    /// Column names, units and calibration of the record.
+    pub data_spec: DataSpec,
     /// `[fit]`.
     pub fit: FitSpec,
     /// `[filter]`.
@@ -335,8 +395,7 @@ pub struct Experiment {
     /// `[regimes]` thresholds (defaults where not given).
     pub regimes: RegimeThresholds,
     /// `[discover] base`.
-    #[allow(dead_code)] // read by fit, compare and discover
-    pub discover_base: Option<String>,
+    pub discover: Option<DiscoverSpec>,
 }
 
 /// 1-based line of a byte offset.
@@ -726,6 +785,32 @@ impl Experiment {
             .as_ref()
             .and_then(|d| d.get_ref().window)
             .map(|[a, b]| (a, b));
+        let mut data_spec = DataSpec::default();
+        if let Some(d) = &raw.data {
+            let span = d.span();
+            let r = d.get_ref();
+            for (signal, name) in &r.columns {
+                if !SIGNALS.contains(&signal.as_str()) {
+                    return Err(cx.at(
+                        span.clone(),
+                        &format!("data.columns.{signal}"),
+                        format!("unknown signal; known: {}", SIGNALS.join(", ")),
+                    ));
+                }
+                data_spec.columns.insert(signal.clone(), name.clone());
+            }
+            for (signal, unit) in &r.units {
+                let scale = unit_scale(signal, unit).ok_or_else(|| {
+                    cx.at(
+                        span.clone(),
+                        &format!("data.units.{signal}"),
+                        format!("unknown unit `{unit}` for `{signal}`"),
+                    )
+                })?;
+                data_spec.scale.insert(signal.clone(), scale);
+            }
+            data_spec.calibration = r.calibration.as_ref().map(|c| (c.a, c.b));
+        }
         let data_file = match &raw.data {
             None => None,
             Some(d) => {
@@ -748,6 +833,7 @@ impl Experiment {
         Ok(Experiment {
             path: path.to_path_buf(),
             data_window,
+            data_spec,
             fit,
             kinematics,
             identify,
@@ -758,7 +844,12 @@ impl Experiment {
             integrator,
             models,
             simulate,
-            discover_base: raw.discover.map(|d| d.base),
+            discover: raw.discover.map(|d| DiscoverSpec {
+                base: d.base,
+                candidates: d.candidates,
+                max_effects: d.max_effects,
+                holdout_every: d.holdout_every,
+            }),
         })
     }
 }

@@ -14,7 +14,7 @@ use serde_json::{json, Value};
 use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
-use stf_core::record::Record;
+use stf_core::record::{ColumnNames, ReadOptions, Record};
 use stf_core::simulate::Simulation;
 use stf_core::system::OscillatorParams;
 
@@ -53,12 +53,45 @@ impl FitData {
     }
 }
 
+/// Read a record as the experiment's `[data]` says: column names, units, calibration.
+pub fn read_record(exp: &Experiment, file: &std::path::Path) -> Result<Record> {
+    let spec = &exp.data_spec;
+    let mut names = ColumnNames::default();
+    for (signal, name) in &spec.columns {
+        let slot = match signal.as_str() {
+            "t" => &mut names.t,
+            "x" => &mut names.x,
+            "phi" => &mut names.phi,
+            "f_stf" => &mut names.f_stf,
+            "omega" => &mut names.omega,
+            _ => &mut names.u,
+        };
+        *slot = name.clone();
+    }
+    let mut record = ReadOptions::default().columns(names).read(file)?;
+    let scale = |v: &mut Vec<f64>, k: f64| v.iter_mut().for_each(|x| *x *= k);
+    for (signal, &k) in &spec.scale {
+        match signal.as_str() {
+            "t" => scale(&mut record.t, k),
+            "x" => scale(&mut record.x, k),
+            "phi" => record.phi.iter_mut().for_each(|v| scale(v, k)),
+            "f_stf" => record.f_stf.iter_mut().for_each(|v| scale(v, k)),
+            "omega" => record.omega.iter_mut().for_each(|v| scale(v, k)),
+            _ => record.u.iter_mut().for_each(|v| scale(v, k)),
+        }
+    }
+    if let (Some((a, b)), Some(f)) = (spec.calibration, record.f_stf.as_mut()) {
+        f.iter_mut().for_each(|v| *v = a * *v + b);
+    }
+    Ok(record)
+}
+
 /// Read the experiment's record and derive its kinematics.
 pub fn load_data(exp: &Experiment) -> Result<FitData> {
     let Some(file) = &exp.data_file else {
         bail!("{}: has no [data] file to fit", exp.path.display());
     };
-    let mut record = Record::read(file)?;
+    let mut record = read_record(exp, file)?;
     if let Some((t0, t1)) = exp.data_window {
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
@@ -334,4 +367,52 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         };
     }
     Ok(fits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_units_and_calibration_are_applied() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("rig.csv"),
+            "time_ms,angle_deg,disp_mm,gauge_V\n0,0,1.5,2.0\n10,90,2.5,-1.0\n",
+        )
+        .unwrap();
+        let exp = Experiment::parse(
+            &dir.path().join("exp.toml"),
+            r#"
+[data]
+file = "rig.csv"
+columns = { t = "time_ms", phi = "angle_deg", x = "disp_mm", f_stf = "gauge_V" }
+units = { t = "ms", phi = "deg", x = "mm" }
+calibration = { a = 0.2942906, b = 0.0044168 }
+"#,
+        )
+        .unwrap();
+        let r = read_record(&exp, exp.data_file.as_ref().unwrap()).unwrap();
+        assert_eq!(r.t, [0.0, 0.01]);
+        assert!((r.phi.as_ref().unwrap()[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert!((r.x[0] - 1.5e-3).abs() < 1e-15);
+        let f = r.f_stf.as_ref().unwrap();
+        assert!((f[0] - (0.2942906 * 2.0 + 0.0044168)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_unknown_unit_names_the_key() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        let err = Experiment::parse(
+            &dir.path().join("exp.toml"),
+            "[data]\nfile = \"r.csv\"\nunits = { x = \"furlong\" }\n",
+        )
+        .unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(
+            msg.contains("exp.toml:1") && msg.contains("data.units.x"),
+            "{msg}"
+        );
+    }
 }
