@@ -198,7 +198,6 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             "aic": finite_or_null(result.aic),
             "bic": finite_or_null(result.bic),
             "evaluations": result.evaluations,
-            "wall_seconds": result.wall_seconds,
             "converged": result.convergence.converged(),
             "convergence": result.convergence,
         }));

@@ -86,3 +86,24 @@ fn paper_identification_finds_k_and_f0() {
     assert!((f0 / 0.0462 - 1.0).abs() < 0.005, "F0 = {f0}");
     assert_eq!(fit["stages"].as_array().unwrap().len(), 2);
 }
+
+#[test]
+fn the_same_experiment_gives_byte_identical_results() {
+    let out = tempfile::tempdir().unwrap();
+    let mut outputs = Vec::new();
+    for name in ["a", "b"] {
+        let dir = out.path().join(name);
+        let run = stf_lab()
+            .args(["fit", "--quiet", "--out"])
+            .arg(&dir)
+            .arg(root().join("experiments/power_law_fit.toml"))
+            .output()
+            .unwrap();
+        assert!(run.status.success());
+        outputs.push((
+            std::fs::read(dir.join("fit.json")).unwrap(),
+            std::fs::read(dir.join("fitted.csv")).unwrap(),
+        ));
+    }
+    assert!(outputs[0] == outputs[1], "two runs differ");
+}
