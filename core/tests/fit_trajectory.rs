@@ -162,3 +162,44 @@ fn names_are_resolved_or_refused() {
     assert!(matches!(err, FitError::UnknownParam { ref name, .. } if name == "stifness"));
     assert!(err.to_string().contains("delta_T"));
 }
+
+#[test]
+fn forced_sweep_identification_from_ten_percent_off_reaches_the_noise() {
+    use stf_core::excitation::RotorAngle;
+    let truth = OscillatorParams::FORCED;
+    let excitation = Arc::new(Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0)));
+    let osc = Oscillator::with_shared_excitation(truth, excitation.clone());
+    let run = Simulation::new(&osc).rate(200.0).run(50.0, 200.0).unwrap();
+    let mut rng = StdRng::seed_from_u64(3);
+    let noise = Normal::new(0.0, 1e-4).unwrap();
+    let x: Vec<f64> = run.x.iter().map(|x| x + noise.sample(&mut rng)).collect();
+    let data = TrajectoryData { t: &run.t, x: &x };
+    let s_truth = TrajectoryFit::new(truth, excitation.clone())
+        .fit(&data, None)
+        .unwrap()
+        .s_mm2
+        .unwrap();
+    let mut fit = TrajectoryFit::new(truth, excitation);
+    for (name, factor) in [
+        ("k", 1.1),
+        ("c", 0.9),
+        ("T", 1.1),
+        ("delta_T", 0.9),
+        ("F0", 1.1),
+    ] {
+        let v = truth.get(name).unwrap() * factor;
+        fit = fit.free(FitParam::new(name, v).bounds(0.0, 3.0 * v));
+    }
+    let r = fit.fit(&data, None).unwrap();
+    let s = r.s_mm2.unwrap();
+    eprintln!(
+        "S = {s:.5} mm² vs {s_truth:.5} at the truth; k {:.4}, F0 {:.6}; {} simulations",
+        r.value("k").unwrap(),
+        r.value("F0").unwrap(),
+        r.evaluations
+    );
+    assert!(s <= 1.05 * s_truth, "S = {s}, at the truth {s_truth}");
+    assert!(rel(r.value("k").unwrap(), truth.k) < 0.005);
+    assert!(rel(r.value("F0").unwrap(), truth.f0) < 0.005);
+    assert!(r.convergence.converged(), "{:?}", r.convergence);
+}
