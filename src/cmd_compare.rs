@@ -24,7 +24,7 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
 use crate::output::{prepare_dir, write_atomic, write_json};
 use crate::progress::Progress;
-use crate::report::{FrfCurve, Section, Table};
+use crate::report::{regime_errors, FigureRef, FrfCurve, Section, Table};
 use crate::reporting::{frequency_section, record_sections, write_report};
 
 /// The measured record's regimes.
@@ -349,7 +349,35 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         table.rows.push(row);
     }
     regimes.tables.push(table);
-    let mut sections = vec![regimes, frequency_section(&curves, out)?];
+    let bars: Vec<(&str, Vec<f64>)> = fits
+        .iter()
+        .zip(&comparisons)
+        .map(|(f, c)| {
+            let mut v: Vec<f64> = Regime::ALL
+                .iter()
+                .map(|&r| {
+                    c.per_regime
+                        .get(r)
+                        .map_or(f64::NAN, |m| m.relative_rms_error)
+                })
+                .collect();
+            v.push(c.overall.relative_rms_error);
+            (f.label.as_str(), v)
+        })
+        .collect();
+    let fig = regime_errors(
+        &out.join("figures"),
+        "regime_errors",
+        &["pre-resonance", "resonance", "post-resonance", "overall"],
+        &bars,
+        "relative force RMS error",
+    )?;
+    regimes.figures.push(FigureRef::new(
+        fig,
+        "Relative force RMS error of each model in each regime of the record (lower is better).",
+    ));
+    let frequency = frequency_section(&curves, out)?;
+    let mut sections = vec![regimes, frequency];
     sections.extend(record_sections(&data, &fits, out)?);
     write_report(
         &format!("Comparison: {}", exp.path.display()),

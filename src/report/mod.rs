@@ -38,6 +38,7 @@ mod hysteresis;
 mod markdown;
 mod measured_vs_fitted;
 mod plot_range;
+mod regime_errors;
 mod series_csv;
 mod smoothing;
 #[cfg(test)]
@@ -54,6 +55,7 @@ pub use html::write_html;
 pub use hysteresis::hysteresis;
 pub use markdown::write_markdown;
 pub use measured_vs_fitted::measured_vs_fitted;
+pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};
 pub use time_history::{time_history, Motion};

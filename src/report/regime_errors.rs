@@ -1,0 +1,153 @@
+//! The per-regime errors of several models as grouped bars: one group per regime
+//! (pre-resonance, resonance, post-resonance, overall), one bar per model.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::series_colour;
+use super::figure::{
+    axis_desc_style, legend_style, msg, render, tick_style, title_style, Draw, FigureFiles, SIZE,
+};
+use super::series_csv::Column;
+use super::ReportError;
+
+struct RegimeErrorPlot {
+    groups: Vec<String>,
+    models: Vec<(String, Vec<f64>)>,
+    y_label: String,
+}
+
+impl Draw for RegimeErrorPlot {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let top = self
+            .models
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .filter(|v| v.is_finite())
+            .fold(0.0_f64, f64::max)
+            .max(1e-9)
+            * 1.15;
+        let n_groups = self.groups.len();
+        let root = root
+            .titled("Errors of each model, regime by regime", title_style())
+            .map_err(msg)?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .margin_right(30)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(0.0..n_groups as f64, 0.0..top)
+            .map_err(msg)?;
+        let groups = self.groups.clone();
+        chart
+            .configure_mesh()
+            .x_labels(n_groups * 2 + 1)
+            .x_label_formatter(&|x| {
+                let i = x.floor() as usize;
+                if (x - i as f64 - 0.5).abs() < 0.26 {
+                    groups.get(i).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .disable_x_mesh()
+            .y_desc(self.y_label.as_str())
+            .x_desc("regime")
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .draw()
+            .map_err(msg)?;
+        let n_models = self.models.len().max(1) as f64;
+        let width = 0.8 / n_models;
+        for (m, (label, values)) in self.models.iter().enumerate() {
+            let colour = series_colour(m);
+            let bars = values
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_finite())
+                .map(|(g, &v)| {
+                    let x0 = g as f64 + 0.1 + m as f64 * width;
+                    Rectangle::new([(x0, 0.0), (x0 + width * 0.9, v)], colour.filled())
+                });
+            chart
+                .draw_series(bars)
+                .map_err(msg)?
+                .label(label.as_str())
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(legend_style())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(msg)
+    }
+}
+
+/// Draw `models` (label, one value per group; NaN: no bar) over `groups` as grouped bars
+/// with the y axis `y_label` to `out_dir/name.{svg,png,csv}`.
+pub fn regime_errors(
+    out_dir: &Path,
+    name: &str,
+    groups: &[&str],
+    models: &[(&str, Vec<f64>)],
+    y_label: &str,
+) -> Result<FigureFiles, ReportError> {
+    if models.is_empty() || groups.is_empty() {
+        return Err(ReportError::NoData {
+            what: "regime errors: no model or no regime".into(),
+        });
+    }
+    let plot = RegimeErrorPlot {
+        groups: groups.iter().map(|g| g.to_string()).collect(),
+        models: models
+            .iter()
+            .map(|(l, v)| (l.to_string(), v.clone()))
+            .collect(),
+        y_label: y_label.to_string(),
+    };
+    let columns: Vec<Column> = std::iter::once(Column::new(
+        "regime (0 pre-resonance, 1 resonance, 2 post-resonance, 3 overall)",
+        (0..groups.len()).map(|g| g as f64).collect(),
+    ))
+    .chain(
+        models
+            .iter()
+            .map(|(l, v)| Column::new(format!("{l}: {y_label}"), v.clone())),
+    )
+    .collect();
+    render(out_dir, name, SIZE, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_grouped_bars_and_their_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = regime_errors(
+            dir.path(),
+            "errors",
+            &["pre", "res", "post", "overall"],
+            &[
+                ("a", vec![0.5, 0.2, f64::NAN, 0.3]),
+                ("b", vec![0.1, 0.1, 0.1, 0.1]),
+            ],
+            "relative force RMS error",
+        )
+        .unwrap();
+        assert!(std::fs::metadata(&files.png).unwrap().len() > 1000);
+        assert!(std::fs::read_to_string(&files.svg)
+            .unwrap()
+            .contains("relative force RMS error"));
+        let csv = std::fs::read_to_string(&files.csv).unwrap();
+        assert!(csv.lines().count() == 5, "{csv}");
+    }
+}
