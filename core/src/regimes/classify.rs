@@ -217,7 +217,7 @@ mod tests {
             feat(8.0, 0.02, 3.0, 0.8),    // resonance
             feat(10.0, 0.008, 1.0, 0.4),  // on–off after the peak
             feat(12.0, 0.004, 0.1, 0.0),  // negligible after the peak
-            feat(13.0, 0.02, 3.0, 0.5),   // big but on–off
+            feat(13.0, 0.02, 3.0, 0.4),   // big but on–off (duty below resonance_duty)
         ];
         let (l, no_stf, peak) = label_cycles(&f, &th, 0.2);
         assert!(!no_stf);
