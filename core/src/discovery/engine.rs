@@ -29,6 +29,8 @@ struct Stage {
 struct Trial {
     stage: Stage,
     train: FitResult,
+    /// Residuals at the held-out samples.
+    holdout: Vec<f64>,
     holdout_mse: f64,
 }
 
@@ -99,6 +101,7 @@ impl Stage {
         Ok(Trial {
             stage,
             train,
+            holdout: split.holdout.iter().map(|&i| r[i]).collect(),
             holdout_mse: h * h,
         })
     }
@@ -216,10 +219,11 @@ pub fn discover_force(
 
     // 3–4. Add effects while the held-out evidence demands one.
     let mut current = start.trial(data, &split, settings)?;
-    let base_excess = (current.holdout_mse - floor * floor).max(f64::MIN_POSITIVE);
+    // The base's held-out gap in mean square; at least what a gain of 3σ/√N_h in RMS is.
+    let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
+    let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
-    let margin = acceptance::margin(settings, floor, split.holdout.len());
     for _ in 0..settings.max_effects {
         let current_h = current.holdout_mse.sqrt();
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
@@ -253,13 +257,16 @@ pub fn discover_force(
                         delta_aic: trial.train.aic - current.train.aic,
                         delta_bic: trial.train.bic - current.train.bic,
                         holdout_gain: current_h - h,
+                        gain_z: acceptance::paired_z(&current.holdout, &trial.holdout),
                         explained_fraction: (current.holdout_mse - trial.holdout_mse)
                             / base_excess,
                         params: own,
                         significant: false,
                         failure,
+                        evaluations: trial.train.evaluations,
+                        wall_seconds: trial.train.wall_seconds,
                     };
-                    score.significant = acceptance::is_significant(&score, margin, settings);
+                    score.significant = acceptance::is_significant(&score, settings);
                     (score, Some(trial))
                 }
                 Err(e) => (
@@ -272,10 +279,13 @@ pub fn discover_force(
                         delta_aic: f64::NAN,
                         delta_bic: f64::NAN,
                         holdout_gain: f64::NAN,
+                        gain_z: f64::NAN,
                         explained_fraction: f64::NAN,
                         params: Vec::new(),
                         significant: false,
                         failure: Some(e.to_string()),
+                        evaluations: 0,
+                        wall_seconds: 0.0,
                     },
                     None,
                 ),
@@ -286,11 +296,14 @@ pub fn discover_force(
         }
         scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
         let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
-        let choice = acceptance::choose(&scores, margin);
+        let holdout: Vec<&[f64]> = scored
+            .iter()
+            .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
+            .collect();
+        let choice = acceptance::choose(&scores, &holdout, settings);
         let mut step = Step {
             current: current.stage.name(),
             current_holdout_rms: current_h,
-            margin,
             candidates: scores,
             accepted: None,
             tie_with: Vec::new(),
@@ -298,10 +311,9 @@ pub fn discover_force(
         };
         let Some((winner, ties)) = choice else {
             step.verdict = format!(
-                "no candidate lowers the held-out RMS ({current_h:.4} N) by more than \
-                 {margin:.4} N with a BIC drop above {}: nothing is missing that the data \
-                 demand",
-                settings.min_bic_drop
+                "no candidate lowers the held-out RMS ({current_h:.4} N) with a paired z above \
+                 {} and a BIC drop above {}: nothing is missing that the data demand",
+                settings.min_gain_sigma, settings.min_bic_drop
             );
             notes.push(step.verdict.clone());
             steps.push(step);
@@ -315,18 +327,19 @@ pub fn discover_force(
             .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
             .collect();
         step.verdict = format!(
-            "add `{}`: held-out RMS {current_h:.4} → {:.4} N (margin {margin:.4} N), ΔBIC \
+            "add `{}`: held-out RMS {current_h:.4} → {:.4} N (paired z {:.1}), ΔBIC \
              {:.1}, explains {:.0} % of the base's held-out gap; {}",
             w.name,
             w.holdout_rms,
+            w.gain_z,
             w.delta_bic,
             100.0 * w.explained_fraction,
             params.join(", ")
         );
         if !tie_names.is_empty() {
             step.verdict.push_str(&format!(
-                "; `{}` explain the data equally well (within the margin), `{}` is chosen for \
-                 its lower BIC",
+                "; `{}` explain the data equally well (the best is not better by the held-out \
+                 test), `{}` is chosen for its lower BIC",
                 tie_names.join("`, `"),
                 w.name
             ));

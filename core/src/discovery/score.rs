@@ -23,6 +23,8 @@ pub struct CandidateScore {
     pub delta_bic: f64,
     /// Fall of the held-out RMS from the current model's, N.
     pub holdout_gain: f64,
+    /// Paired z of the held-out gain (see [`super::acceptance`]).
+    pub gain_z: f64,
     /// Share of the base model's held-out gap (mean square above the noise floor) that this
     /// candidate removes at this step: (MSE_current − MSE_candidate) / (MSE_base − σ²).
     pub explained_fraction: f64,
@@ -32,6 +34,10 @@ pub struct CandidateScore {
     pub significant: bool,
     /// Why the fit failed, if it did (the candidate then scores nothing).
     pub failure: Option<String>,
+    /// Evaluations of the model in the fit.
+    pub evaluations: u64,
+    /// Wall time of the fit, s.
+    pub wall_seconds: f64,
 }
 
 /// One round: every candidate tried on the current model, and what was done.
@@ -41,8 +47,6 @@ pub struct Step {
     pub current: String,
     /// The current model's held-out RMS, N.
     pub current_holdout_rms: f64,
-    /// The margin a held-out gain had to exceed, N.
-    pub margin: f64,
     /// Every candidate's score, best held-out RMS first.
     pub candidates: Vec<CandidateScore>,
     /// The effect added at this step, if any.

@@ -20,9 +20,9 @@ pub struct DiscoverySettings {
     /// Every k-th whole cycle is held out of the fits and used to score them (default 4,
     /// ≥ 2).
     pub holdout_every: usize,
-    /// The held-out RMS must drop by more than `min_gain_sigma · σ / √N_holdout` (σ: the
-    /// noise floor) for a candidate to count; candidates within that margin of the winner
-    /// are ties (default 3).
+    /// The paired z of a candidate's held-out gain must exceed this for it to count;
+    /// candidates the winner does not beat by this z are ties (default 3; see
+    /// [`super::acceptance`]).
     pub min_gain_sigma: f64,
     /// The BIC (on the training samples) must fall by more than this (default 10: "very
     /// strong" evidence on Kass and Raftery's scale).
@@ -61,7 +61,7 @@ impl DiscoverySettings {
         self.holdout_every = k;
         self
     }
-    /// Margin of the held-out test, in σ/√N_holdout.
+    /// Least paired z of a held-out gain.
     pub fn min_gain_sigma(mut self, z: f64) -> Self {
         self.min_gain_sigma = z;
         self
