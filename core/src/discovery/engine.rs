@@ -55,7 +55,7 @@ impl Stage {
         let model = self.model()?;
         let mut fit = ForceFit::new(model.clone()).settings(settings.fit.clone());
         for (spec, &v) in model.params().iter().zip(&self.values) {
-            fit = fit.param(FitParam::from_spec(spec).value(v.clamp(spec.min, spec.max)));
+            fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
         }
         if settings.fit_offset {
             let start = self.values.get(model.params().len()).copied().unwrap_or(0.0);
@@ -401,4 +401,17 @@ pub fn discover_force(
         final_fit: final_result,
         notes,
     })
+}
+
+/// `v` clamped into `[min, max]` and, when both bounds are finite, kept 1 % of the width
+/// below the upper one: a refit that starts on an upper bound (an exponent fitted to its
+/// largest value) starts where the bound's change of variables is flat and cannot leave it.
+/// Lower bounds are left alone: 0 is a common, meaningful value there.
+fn inside(v: f64, min: f64, max: f64) -> f64 {
+    let v = v.clamp(min, max);
+    if min.is_finite() && max.is_finite() {
+        v.min(max - 0.01 * (max - min))
+    } else {
+        v
+    }
 }

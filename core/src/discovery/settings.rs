@@ -27,7 +27,8 @@ pub struct DiscoverySettings {
     /// The BIC (on the training samples) must fall by more than this (default 10: "very
     /// strong" evidence on Kass and Raftery's scale).
     pub min_bic_drop: f64,
-    /// Settings of every fit.
+    /// Settings of every fit (default: [`FitSettings::default`] with at most 200 iterations
+    /// per stage, to bound the time of a candidate whose fit wanders).
     pub fit: FitSettings,
     /// σ of the force noise, N; `None`: estimated from the measured force
     /// ([`crate::regimes::noise_floor`]).
@@ -43,7 +44,7 @@ impl Default for DiscoverySettings {
             holdout_every: 4,
             min_gain_sigma: 3.0,
             min_bic_drop: 10.0,
-            fit: FitSettings::default(),
+            fit: FitSettings::default().max_iters(200),
             noise_sigma: None,
             fit_offset: false,
         }

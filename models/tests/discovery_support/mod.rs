@@ -146,8 +146,8 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
         eprintln!("   step on `{}`: {}", s.current, s.verdict);
         for c in &s.candidates {
             eprintln!(
-                "      {:<16} holdout {:.4} gain {:+.4} z {:6.1} ΔBIC {:+9.1} expl {:5.2} sig {} {} evals {} {:.2}s",
-                c.name,
+                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} ΔBIC {:+9.1} expl {:5.2} sig {} {} evals {} {:.2}s {:?}",
+                c.name, c.train_rms,
                 c.holdout_rms,
                 c.holdout_gain, c.gain_z,
                 c.delta_bic,
@@ -155,7 +155,7 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
                 c.significant,
                 c.failure.as_deref().unwrap_or(""),
                 c.evaluations,
-                c.wall_seconds
+                c.wall_seconds, c.params.iter().map(|p| format!("{}={:.3e}", p.name, p.value)).collect::<Vec<_>>()
             );
         }
     }
