@@ -28,6 +28,7 @@
 
 pub mod analysis;
 pub mod derivative;
+pub mod discovery;
 pub mod excitation;
 pub mod fit;
 pub mod force_model;

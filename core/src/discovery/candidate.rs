@@ -1,0 +1,36 @@
+//! A candidate effect: a named force model that discovery may add to the current model.
+
+use std::sync::Arc;
+
+use crate::force_model::ForceModel;
+
+/// An effect the discovery may add, by name (e.g. a name of DESIGN.md §5, or a script's).
+///
+/// The model's parameters start at their defaults when the candidate is tried; its name in
+/// the sum is the model's own [`ForceModel::name`], `name` is what reports call the effect.
+#[derive(Clone)]
+pub struct Candidate {
+    /// The effect's name in reports.
+    pub name: String,
+    /// The model of the effect.
+    pub model: Arc<dyn ForceModel>,
+}
+
+impl Candidate {
+    /// A candidate called `name` whose force is `model`'s.
+    pub fn new(name: impl Into<String>, model: Arc<dyn ForceModel>) -> Self {
+        Candidate {
+            name: name.into(),
+            model,
+        }
+    }
+}
+
+impl std::fmt::Debug for Candidate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Candidate")
+            .field("name", &self.name)
+            .field("model", &self.model.name())
+            .finish()
+    }
+}

@@ -1,0 +1,90 @@
+//! Splitting a record into training and held-out samples by whole cycles.
+//!
+//! Every k-th whole cycle (the k-th, 2k-th, … counting from 1) is held out; all other
+//! samples, including the partial cycles at both ends, train. Whole cycles keep the held-out
+//! samples independent of the training ones at the scale of the motion: a model cannot score
+//! well on them by interpolating between neighbouring samples.
+
+use super::error::DiscoveryError;
+use crate::regimes::Cycle;
+
+/// Sample indices that train the fits and those held out to score them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HoldoutSplit {
+    /// Training samples, increasing.
+    pub train: Vec<usize>,
+    /// Held-out samples, increasing.
+    pub holdout: Vec<usize>,
+    /// Number of held-out cycles.
+    pub holdout_cycles: usize,
+}
+
+impl HoldoutSplit {
+    /// Hold out every `every`-th of `cycles` in a record of `n` samples.
+    pub fn new(n: usize, cycles: &[Cycle], every: usize) -> Result<Self, DiscoveryError> {
+        if every < 2 {
+            return Err(DiscoveryError::BadSettings(format!(
+                "holdout_every must be ≥ 2 (got {every})"
+            )));
+        }
+        let mut held = vec![false; n];
+        let mut holdout_cycles = 0;
+        for (i, c) in cycles.iter().enumerate() {
+            if c.end > n || c.start >= c.end {
+                return Err(DiscoveryError::BadData(format!(
+                    "cycle {i} spans samples {}..{} of a record of {n}",
+                    c.start, c.end
+                )));
+            }
+            if (i + 1) % every == 0 {
+                held[c.start..c.end].fill(true);
+                holdout_cycles += 1;
+            }
+        }
+        if holdout_cycles == 0 {
+            return Err(DiscoveryError::BadData(format!(
+                "{} whole cycles hold out none at one in {every}: the record is too short",
+                cycles.len()
+            )));
+        }
+        let (holdout, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| held[i]);
+        Ok(HoldoutSplit {
+            train,
+            holdout,
+            holdout_cycles,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cycle(start: usize, end: usize) -> Cycle {
+        Cycle {
+            start,
+            end,
+            t_mid: 0.0,
+            omega: 1.0,
+        }
+    }
+
+    #[test]
+    fn every_kth_whole_cycle_is_held_out() {
+        let cycles: Vec<Cycle> = (0..8).map(|i| cycle(5 + 10 * i, 15 + 10 * i)).collect();
+        let s = HoldoutSplit::new(100, &cycles, 4).unwrap();
+        assert_eq!(s.holdout_cycles, 2);
+        let expected: Vec<usize> = (35..45).chain(75..85).collect();
+        assert_eq!(s.holdout, expected);
+        assert_eq!(s.train.len() + s.holdout.len(), 100);
+        assert!(s.train.contains(&0) && s.train.contains(&99));
+    }
+
+    #[test]
+    fn too_few_cycles_or_bad_cycles_are_errors() {
+        let cycles = [cycle(0, 10), cycle(10, 20)];
+        assert!(HoldoutSplit::new(30, &cycles, 4).is_err());
+        assert!(HoldoutSplit::new(15, &cycles, 2).is_err());
+        assert!(HoldoutSplit::new(30, &cycles, 1).is_err());
+    }
+}

@@ -1,0 +1,40 @@
+//! Discovery: find where a model and the measurement disagree, name the missing effect, add
+//! it, and show the gap shrink.
+//!
+//! At force level (records with a measured F_STF and kinematics, [`ForceData`]),
+//! [`discover_force`] runs the workflow:
+//!
+//! 1. fit the base model on the whole record;
+//! 2. locate its residual against the noise floor ([`gap`]: by regime, ω band, |x|, |v|, |a|
+//!    and direction of motion, in words);
+//! 3. add each [`Candidate`] not yet in the model to it ([`crate::model_sum::ModelSum`]),
+//!    refit the sum from the current values (the new parameters from their defaults) on the
+//!    training cycles and score it on the held-out ones ([`holdout`]) and by AIC/BIC; accept
+//!    the best only if the data demand it ([`acceptance`]), naming ties;
+//! 4. repeat until nothing is significant or `max_effects` are added;
+//! 5. refit the final model on the whole record: gap (RMS residual) before and after.
+//!
+//! Core knows no model library: the caller passes the base and the candidates (built-ins of
+//! DESIGN.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
+//!
+//! [`ForceData`]: crate::fit::ForceData
+
+pub mod acceptance;
+pub mod candidate;
+pub mod engine;
+pub mod error;
+pub mod gap;
+pub mod holdout;
+pub mod report;
+pub mod score;
+pub mod settings;
+mod subset_fit;
+
+pub use candidate::Candidate;
+pub use engine::discover_force;
+pub use error::DiscoveryError;
+pub use gap::{locate_gap, GapBreakdown, GapGroup, GapLocation};
+pub use holdout::HoldoutSplit;
+pub use report::Discovery;
+pub use score::{CandidateScore, Step};
+pub use settings::DiscoverySettings;

@@ -1,0 +1,114 @@
+//! Settings of a discovery run, with named setters and the documented acceptance thresholds.
+
+use serde::{Deserialize, Serialize};
+
+use super::error::DiscoveryError;
+use crate::fit::FitSettings;
+
+/// How discovery fits, holds out data and decides that an effect is significant.
+///
+/// ```
+/// use stf_core::discovery::DiscoverySettings;
+/// let s = DiscoverySettings::default().max_effects(2).holdout_every(5);
+/// assert!(s.validate().is_ok());
+/// assert!(DiscoverySettings::default().holdout_every(1).validate().is_err());
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiscoverySettings {
+    /// Most effects added (default 3).
+    pub max_effects: usize,
+    /// Every k-th whole cycle is held out of the fits and used to score them (default 4,
+    /// ≥ 2).
+    pub holdout_every: usize,
+    /// The paired z of a candidate's held-out gain must exceed this for it to count;
+    /// candidates the winner does not beat by this z are ties (default 3; see
+    /// [`super::acceptance`]).
+    pub min_gain_sigma: f64,
+    /// The BIC (on the training samples) must fall by more than this (default 10: "very
+    /// strong" evidence on Kass and Raftery's scale).
+    pub min_bic_drop: f64,
+    /// Settings of every fit (default: [`FitSettings::default`] with at most 200 iterations
+    /// per stage, to bound the time of a candidate whose fit wanders).
+    pub fit: FitSettings,
+    /// σ of the force noise, N; `None`: estimated from the measured force
+    /// ([`crate::regimes::noise_floor`]).
+    pub noise_sigma: Option<f64>,
+    /// Fit a constant force offset `f_off` with every model (default false).
+    pub fit_offset: bool,
+}
+
+impl Default for DiscoverySettings {
+    fn default() -> Self {
+        DiscoverySettings {
+            max_effects: 3,
+            holdout_every: 4,
+            min_gain_sigma: 3.0,
+            min_bic_drop: 10.0,
+            fit: FitSettings::default().max_iters(200),
+            noise_sigma: None,
+            fit_offset: false,
+        }
+    }
+}
+
+impl DiscoverySettings {
+    /// Most effects added.
+    pub fn max_effects(mut self, n: usize) -> Self {
+        self.max_effects = n;
+        self
+    }
+    /// Hold out every k-th whole cycle.
+    pub fn holdout_every(mut self, k: usize) -> Self {
+        self.holdout_every = k;
+        self
+    }
+    /// Least paired z of a held-out gain.
+    pub fn min_gain_sigma(mut self, z: f64) -> Self {
+        self.min_gain_sigma = z;
+        self
+    }
+    /// Least fall of the BIC.
+    pub fn min_bic_drop(mut self, d: f64) -> Self {
+        self.min_bic_drop = d;
+        self
+    }
+    /// Settings of every fit.
+    pub fn fit(mut self, fit: FitSettings) -> Self {
+        self.fit = fit;
+        self
+    }
+    /// σ of the force noise, N (instead of the estimate).
+    pub fn noise_sigma(mut self, sigma: Option<f64>) -> Self {
+        self.noise_sigma = sigma;
+        self
+    }
+    /// Fit a constant force offset with every model.
+    pub fn fit_offset(mut self, on: bool) -> Self {
+        self.fit_offset = on;
+        self
+    }
+
+    /// Check the settings.
+    pub fn validate(&self) -> Result<(), DiscoveryError> {
+        self.fit
+            .validate()
+            .map_err(|e| DiscoveryError::BadSettings(e.to_string()))?;
+        let sigma_ok = match self.noise_sigma {
+            Some(s) => s > 0.0 && s.is_finite(),
+            None => true,
+        };
+        if self.holdout_every < 2
+            || !(self.min_gain_sigma >= 0.0 && self.min_gain_sigma.is_finite())
+            || !(self.min_bic_drop >= 0.0 && self.min_bic_drop.is_finite())
+            || !sigma_ok
+        {
+            return Err(DiscoveryError::BadSettings(format!(
+                "need holdout_every ≥ 2, finite min_gain_sigma ≥ 0 and min_bic_drop ≥ 0, \
+                 a positive finite noise_sigma (got holdout_every {}, min_gain_sigma {}, \
+                 min_bic_drop {}, noise_sigma {:?})",
+                self.holdout_every, self.min_gain_sigma, self.min_bic_drop, self.noise_sigma
+            )));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,171 @@
+//! Shared by the discovery tests: synthetic sweep records whose truth is a sum of built-ins,
+//! and the candidate vocabulary of DESIGN.md §5.
+//!
+//! A record: the forced reference oscillator driven by a rotor sweep ω = 4 → 10 rad/s at
+//! 0.1 rad/s² (60 s, through resonance at 5.9 rad/s), simulated with the truth model,
+//! sampled at 200 Hz through the rig's sensors ([`SensorNoise::RIG`]: x noise 0.05 mm,
+//! quantized to 0.01 mm, force noise 0.02 N, 2048-count encoder). v and a come from the
+//! derivative filter ([`Kinematics::from_record`]) unless `exact_kinematics` is set.
+
+#![allow(dead_code)]
+
+use std::sync::Arc;
+
+use stf_core::discovery::{discover_force, Candidate, Discovery, DiscoverySettings};
+use stf_core::excitation::{Excitation, RotorAngle};
+use stf_core::fit::ForceData;
+use stf_core::force_model::ForceModel;
+use stf_core::kinematics::{Kinematics, KinematicsSettings};
+use stf_core::model_sum::ModelSum;
+use stf_core::oscillator::Oscillator;
+use stf_core::regimes::cycles_from_phase;
+use stf_core::simulate::Simulation;
+use stf_core::synthetic::{sample_record, SensorNoise};
+use stf_core::system::OscillatorParams;
+use stf_models::{find, BUILTINS};
+
+/// A part of a truth model: a built-in's name and its parameter values.
+pub type Part<'a> = (&'a str, &'a [f64]);
+
+/// A synthetic record ready for discovery.
+pub struct Case {
+    pub t: Vec<f64>,
+    pub x: Vec<f64>,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+    pub f: Vec<f64>,
+    pub phi: Vec<f64>,
+    /// The true STF force of each part of the truth, N (noise-free).
+    pub part_forces: Vec<Vec<f64>>,
+}
+
+impl Case {
+    pub fn data(&self) -> ForceData<'_> {
+        ForceData {
+            t: &self.t,
+            x: &self.x,
+            v: &self.v,
+            a: &self.a,
+            f: &self.f,
+        }
+    }
+
+    /// RMS of the true force of part `i`, N.
+    pub fn part_rms(&self, i: usize) -> f64 {
+        let f = &self.part_forces[i];
+        (f.iter().map(|v| v * v).sum::<f64>() / f.len() as f64).sqrt()
+    }
+}
+
+fn build(parts: &[Part]) -> (Arc<dyn ForceModel>, Vec<f64>) {
+    let models: Vec<Arc<dyn ForceModel>> = parts.iter().map(|(n, _)| find(n).unwrap()).collect();
+    let values: Vec<f64> = parts.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+    let model: Arc<dyn ForceModel> = Arc::new(ModelSum::new(models).unwrap());
+    (model, values)
+}
+
+/// Simulate `truth` over the sweep and sample it with the rig's noise (`seed`).
+pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
+    let (model, values) = build(truth);
+    let osc = Oscillator::new(
+        OscillatorParams::FORCED,
+        Excitation::Rotor(RotorAngle::sweep(4.0, 0.1, 0.0)),
+    )
+    .with_model(model, values)
+    .unwrap();
+    let run = Simulation::new(&osc).rate(200.0).run(0.0, 60.0).unwrap();
+    let rec = sample_record(&run, &SensorNoise::RIG, seed, true);
+    // The force of each part alone along the true motion (a part with internal state gets
+    // its share of the simulated state).
+    let mut part_forces = Vec::new();
+    let mut z_off = 0;
+    for (name, vals) in truth {
+        let m = find(name).unwrap();
+        let nz = m.n_internal();
+        let f: Vec<f64> = (0..run.t.len())
+            .map(|i| {
+                let z: Vec<f64> = (z_off..z_off + nz).map(|j| run.z[j][i]).collect();
+                let s = stf_core::force_model::ModelState {
+                    t: run.t[i],
+                    x: run.x[i],
+                    v: run.v[i],
+                    z: &z,
+                };
+                let mut dz = vec![0.0; nz];
+                m.added_mass(vals, &s).unwrap() * run.a[i] + m.force(vals, &s, &mut dz).unwrap()
+            })
+            .collect();
+        z_off += nz;
+        part_forces.push(f);
+    }
+    let (v, a) = if exact_kinematics {
+        (run.v.clone(), run.a.clone())
+    } else {
+        let k = Kinematics::from_record(&rec, &KinematicsSettings::default()).unwrap();
+        (k.v, k.a)
+    };
+    Case {
+        t: rec.t.clone(),
+        x: rec.x.clone(),
+        v,
+        a,
+        f: rec.f_stf.clone().unwrap(),
+        phi: rec.phi.clone().unwrap(),
+        part_forces,
+    }
+}
+
+/// Every built-in as a candidate, by its own name.
+pub fn vocabulary() -> Vec<Candidate> {
+    BUILTINS
+        .iter()
+        .map(|e| Candidate::new(e.name, (e.build)()))
+        .collect()
+}
+
+/// Run discovery from the built-in `base` with the whole vocabulary.
+pub fn discover(case: &Case, base: &str, settings: &DiscoverySettings) -> Discovery {
+    let cycles = cycles_from_phase(&case.t, &case.phi).unwrap();
+    discover_force(
+        find(base).unwrap(),
+        &vocabulary(),
+        &case.data(),
+        &cycles,
+        settings,
+    )
+    .unwrap()
+}
+
+/// Print what a run found, for the test log.
+pub fn print(label: &str, case: &Case, d: &Discovery) {
+    eprintln!("== {label}");
+    for i in 0..case.part_forces.len() {
+        eprintln!("   truth part {i}: RMS {:.4} N", case.part_rms(i));
+    }
+    for s in &d.steps {
+        eprintln!("   step on `{}`: {}", s.current, s.verdict);
+        for c in &s.candidates {
+            eprintln!(
+                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} ΔBIC {:+9.1} expl {:5.2} sig {} {} evals {} {:.2}s {:?}",
+                c.name, c.train_rms,
+                c.holdout_rms,
+                c.holdout_gain, c.gain_z,
+                c.delta_bic,
+                c.explained_fraction,
+                c.significant,
+                c.failure.as_deref().unwrap_or(""),
+                c.evaluations,
+                c.wall_seconds, c.params.iter().map(|p| format!("{}={:.3e}", p.name, p.value)).collect::<Vec<_>>()
+            );
+        }
+    }
+    eprintln!(
+        "   effects {:?}; gap {:.4} → {:.4} N, floor {:.4} N ({:.2}×); {}",
+        d.effects,
+        d.gap_before,
+        d.gap_after,
+        d.noise_floor,
+        d.gap_after / d.noise_floor,
+        d.where_before.summary
+    );
+}
