@@ -382,6 +382,8 @@ pub struct Experiment {
     pub simulate: Option<SimulateSpec>,
     /// `[data] file`, resolved.
     pub data_file: Option<PathBuf>,
+    /// Line of `[data]` in the file.
+    pub data_line: usize,
     /// Time window of the data, s.
     pub data_window: Option<(f64, f64)>,
     /// Column names, units and calibration of the record.
@@ -811,17 +813,12 @@ impl Experiment {
             }
             data_spec.calibration = r.calibration.as_ref().map(|c| (c.a, c.b));
         }
+        let mut data_line = 0;
         let data_file = match &raw.data {
             None => None,
             Some(d) => {
                 let file = dir.join(&d.get_ref().file);
-                if !file.is_file() {
-                    return Err(cx.at(
-                        d.span(),
-                        "data.file",
-                        format!("no such record: {}", file.display()),
-                    ));
-                }
+                data_line = line_of(text, d.span().start);
                 if let Some((a, b)) = data_window {
                     if !(b > a) {
                         return Err(cx.at(d.span(), "data.window", format!("[{a}, {b}] is empty")));
@@ -839,6 +836,7 @@ impl Experiment {
             identify,
             regimes,
             data_file,
+            data_line,
             dir,
             system,
             integrator,
@@ -912,7 +910,8 @@ params = { K = 4.0, n = 1.5 }
 
     #[test]
     fn a_missing_record_names_the_file_line_and_key() {
-        let err = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap_err();
+        let exp = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap();
+        let err = crate::fitting::load_data(&exp).err().unwrap();
         let msg = format!("{err:#}");
         assert!(
             msg.contains("exp.toml:2") && msg.contains("data.file"),

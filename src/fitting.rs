@@ -91,6 +91,14 @@ pub fn load_data(exp: &Experiment) -> Result<FitData> {
     let Some(file) = &exp.data_file else {
         bail!("{}: has no [data] file to fit", exp.path.display());
     };
+    if !file.is_file() {
+        bail!(
+            "{}:{}: `data.file`: no such record: {}",
+            exp.path.display(),
+            exp.data_line,
+            file.display()
+        );
+    }
     let mut record = read_record(exp, file)?;
     if let Some((t0, t1)) = exp.data_window {
         record = record.slice_time(t0, t1);
@@ -107,7 +115,9 @@ pub fn load_data(exp: &Experiment) -> Result<FitData> {
         .with_context(|| format!("cannot derive the kinematics of {}", file.display()))?;
     let level = match exp.fit.level {
         Some(l) => l,
-        None if record.f_stf.is_some() && !exp.models.is_empty() => FitLevel::Force,
+        None if record.f_stf.is_some() && (!exp.models.is_empty() || exp.discover.is_some()) => {
+            FitLevel::Force
+        }
         None => FitLevel::Trajectory,
     };
     if level == FitLevel::Force && record.f_stf.is_none() {

@@ -5,12 +5,14 @@
 //! stf-lab simulate EXP.toml --out F.csv   write a synthetic record (section [simulate])
 //! stf-lab fit EXP.toml --out DIR          calibrate every model of the experiment
 //! stf-lab compare EXP.toml --out DIR      fit, then compare models on the regime metrics
+//! stf-lab discover EXP.toml --out DIR     find, name and add the missing effect
 //! ```
 
 // `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod cmd_compare;
+mod cmd_discover;
 mod cmd_fit;
 mod cmd_models;
 mod cmd_simulate;
@@ -74,6 +76,20 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Find, name and add the effect the base model misses; show the gap shrink.
+    Discover {
+        /// The experiment file (with a [discover] section).
+        experiment: PathBuf,
+        /// Folder for discovery.json, the report and figures.
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace results in an existing folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress messages.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Calibrate every model of the experiment against its record.
     Fit {
         /// The experiment file.
@@ -114,6 +130,12 @@ fn main() -> ExitCode {
             force,
             quiet,
         } => cmd_compare::run(&experiment, &out, force, quiet),
+        Command::Discover {
+            experiment,
+            out,
+            force,
+            quiet,
+        } => cmd_discover::run(&experiment, &out, force, quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,241 @@
+//! `stf-lab discover EXP.toml --out DIR`: find where the base model and the measurement
+//! disagree, name the missing effect, add it, repeat, and show the gap shrink.
+//!
+//! Candidates are the effects of DESIGN.md §5 (the built-ins `viscous`, `power_law`,
+//! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`) not
+//! already in the base, plus any scripts `[discover] candidates` lists. Writes
+//! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
+//! scores, and the final model as an experiment entry), a report and figures.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
+use stf_core::force_model::ForceModel;
+use stf_core::model_sum::ModelSum;
+use stf_core::regimes::{cycles_from_phase, cycles_from_x, phase_from_omega};
+
+use crate::experiment::{Experiment, FitLevel};
+use crate::fitting::{finite_or_null, load_data};
+use crate::model_config::resolve;
+use crate::output::{prepare_dir, write_json};
+use crate::report::{measured_vs_fitted, FigureRef, Section, Table};
+use crate::reporting::{record_sections, write_report};
+
+/// The effects of DESIGN.md §5, the default candidates.
+pub const EFFECTS: [&str; 8] = [
+    "viscous",
+    "power_law",
+    "added_mass",
+    "yield",
+    "wall_impact",
+    "cubic_stiffness",
+    "maxwell",
+    "jamming_on_off",
+];
+
+/// A model from `a + b + …` (names or script paths).
+fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
+    let parts = spec
+        .split('+')
+        .map(|s| resolve(s.trim(), dir))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Arc::new(ModelSum::new(parts)?))
+}
+
+/// Run `stf-lab discover`.
+pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
+    let exp = Experiment::load(exp_path)?;
+    let Some(spec) = &exp.discover else {
+        bail!("{}: has no [discover] section (base = \"…\")", exp_path.display());
+    };
+    let data = load_data(&exp)?;
+    if data.level != FitLevel::Force {
+        bail!(
+            "{}: discovery works on the measured STF force; the record needs `f_stf`",
+            exp_path.display()
+        );
+    }
+    prepare_dir(out, force)?;
+    let base = model_from(&spec.base, &exp.dir)
+        .with_context(|| format!("{}: `discover.base`", exp_path.display()))?;
+    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
+    let mut candidates = Vec::new();
+    let names: Vec<String> = match &spec.candidates {
+        Some(list) => list.clone(),
+        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
+    };
+    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
+        let model = resolve(name, &exp.dir)
+            .with_context(|| format!("{}: `discover.candidates`", exp_path.display()))?;
+        candidates.push(Candidate::new(model.name().to_string(), model));
+    }
+    let k = &data.kinematics;
+    let cycles = match (&k.phi, &k.omega) {
+        (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
+        (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
+        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
+    };
+    let mut settings = DiscoverySettings::default().fit(exp.fit.settings.clone());
+    if let Some(n) = spec.max_effects {
+        settings = settings.max_effects(n);
+    }
+    if let Some(n) = spec.holdout_every {
+        settings = settings.holdout_every(n);
+    }
+    let started = Instant::now();
+    if !quiet {
+        eprintln!(
+            "discovering from `{}` over {} candidates on {} cycles…",
+            spec.base,
+            candidates.len(),
+            cycles.len()
+        );
+    }
+    let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings)?;
+    let wall = started.elapsed().as_secs_f64();
+
+    // The final model as an experiment entry that `fit` and `compare` accept as it is.
+    let parts: Vec<&str> = found.final_model_name.split(" + ").collect();
+    let params: serde_json::Map<String, serde_json::Value> = found
+        .final_params
+        .iter()
+        .map(|p| (p.name.clone(), json!(p.value)))
+        .collect();
+    let mut toml_entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
+    if parts.len() > 1 {
+        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
+        toml_entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
+    }
+    let values: Vec<String> = found
+        .final_params
+        .iter()
+        .filter(|p| p.name != "f_off")
+        .map(|p| format!("\"{}\" = {}", p.name, p.value))
+        .collect();
+    toml_entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
+
+    let doc = json!({
+        "experiment": exp.path.display().to_string(),
+        "record": data.record.source,
+        "base": spec.base,
+        "effects": found.effects,
+        "gap_before": found.gap_before,
+        "gap_after": found.gap_after,
+        "noise_floor": found.noise_floor,
+        "gap_unit": "N",
+        "holdout_cycles": found.holdout_cycles,
+        "where_before": found.where_before,
+        "where_after": found.where_after,
+        "steps": found.steps,
+        "final_model": {
+            "name": found.final_model_name,
+            "params": params,
+            "std_errors": found.final_params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "experiment_entry": toml_entry,
+        },
+        "notes": found.notes,
+    });
+    write_json(&out.join("discovery.json"), &doc)?;
+
+    // Report.
+    let dir = out.join("figures");
+    std::fs::create_dir_all(&dir)?;
+    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
+    let before: Vec<f64> = f.iter().zip(&found.residual_before).map(|(m, r)| m - r).collect();
+    let after: Vec<f64> = f.iter().zip(&found.residual_after).map(|(m, r)| m - r).collect();
+    let mut s = Section::new("Discovery");
+    s.paragraphs.push(format!(
+        "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
+        spec.base, found.gap_before, found.noise_floor, found.where_before.summary
+    ));
+    for step in &found.steps {
+        s.paragraphs.push(step.verdict.clone());
+    }
+    s.paragraphs.push(format!(
+        "Final `{}`: gap {:.4} N. {}",
+        found.final_model_name, found.gap_after, found.where_after.summary
+    ));
+    s.paragraphs.extend(found.notes.iter().cloned());
+    for (i, step) in found.steps.iter().enumerate() {
+        s.tables.push(Table {
+            caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
+            columns: ["candidate", "held-out RMS, N", "ΔBIC", "gain (σ)", "explains", "significant"]
+                .iter()
+                .map(|c| c.to_string())
+                .collect(),
+            rows: step
+                .candidates
+                .iter()
+                .map(|c| {
+                    vec![
+                        c.name.clone(),
+                        format!("{:.5}", c.holdout_rms),
+                        format!("{:.1}", c.delta_bic),
+                        format!("{:.1}", c.gain_z),
+                        format!("{:.0} %", 100.0 * c.explained_fraction),
+                        if c.significant { "yes".into() } else { "no".into() },
+                    ]
+                })
+                .collect(),
+        });
+    }
+    let fig = measured_vs_fitted(
+        &dir,
+        "discovery_force",
+        &data.record.t,
+        f,
+        &[("base", &before), ("final", &after)],
+    )?;
+    s.figures.push(FigureRef::new(fig, "Measured STF force against the base and the final model."));
+    let fig = measured_vs_fitted(
+        &dir,
+        "discovery_residual",
+        &data.record.t,
+        &found.residual_before,
+        &[("residual after", &found.residual_after)],
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "Residual (measured − model) of the base (grey band) and of the final model.",
+    ));
+    let mut sections = vec![s];
+    sections.extend(record_sections(&data, &[], out)?);
+    write_report(
+        &format!("Discovery: {}", exp.path.display()),
+        vec![format!(
+            "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
+            if found.effects.is_empty() { "none".to_string() } else { found.effects.join(", ") },
+            found.gap_before,
+            found.gap_after,
+            found.noise_floor
+        )],
+        sections,
+        out,
+    )?;
+
+    println!("base `{}`: gap {:.4} N; {}", spec.base, found.gap_before, found.where_before.summary);
+    for step in &found.steps {
+        println!("  {}", step.verdict);
+    }
+    println!(
+        "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
+        if found.effects.is_empty() { "none".to_string() } else { found.effects.join(", ") },
+        found.gap_before,
+        found.gap_after,
+        found.noise_floor,
+        wall
+    );
+    for note in &found.notes {
+        println!("  note: {note}");
+    }
+    println!("final model, as an experiment entry:\n{toml_entry}");
+    println!(
+        "wrote {0}/discovery.json, {0}/report.html, {0}/report.md and {0}/figures/",
+        out.display()
+    );
+    Ok(())
+}
