@@ -62,8 +62,7 @@ pub fn choose(
     let tied: Vec<usize> = (0..scores.len())
         .filter(|&i| {
             scores[i].significant
-                && (i == best
-                    || paired_z(holdout[i], holdout[best]) <= settings.min_gain_sigma)
+                && (i == best || paired_z(holdout[i], holdout[best]) <= settings.min_gain_sigma)
         })
         .collect();
     let &winner = tied
@@ -76,7 +75,13 @@ pub fn choose(
 mod tests {
     use super::*;
 
-    fn score(name: &str, holdout_rms: f64, gain_z: f64, bic: f64, delta_bic: f64) -> CandidateScore {
+    fn score(
+        name: &str,
+        holdout_rms: f64,
+        gain_z: f64,
+        bic: f64,
+        delta_bic: f64,
+    ) -> CandidateScore {
         CandidateScore {
             name: name.into(),
             holdout_rms,

@@ -58,7 +58,11 @@ impl Stage {
             fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
         }
         if settings.fit_offset {
-            let start = self.values.get(model.params().len()).copied().unwrap_or(0.0);
+            let start = self
+                .values
+                .get(model.params().len())
+                .copied()
+                .unwrap_or(0.0);
             fit = fit.offset(FitParam::new(FORCE_OFFSET, start));
         }
         Ok(fit)
@@ -206,12 +210,11 @@ pub fn discover_force(
         parts: vec![base.clone()],
     };
     let (base_full, base_fit, base_result) = start.fit(data, &all, settings)?;
-    let residual_before = residuals(&base_fit, data, &base_full.values).map_err(|source| {
-        DiscoveryError::Fit {
+    let residual_before =
+        residuals(&base_fit, data, &base_full.values).map_err(|source| DiscoveryError::Fit {
             model: base_name.clone(),
             source,
-        }
-    })?;
+        })?;
     let gap_before = rms(&residual_before);
     // 2. Where the gap lives.
     let where_before = locate_gap(&residual_before, data, cycles, floor);
@@ -229,7 +232,11 @@ pub fn discover_force(
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
             let name_taken = in_base.iter().any(|b| b == c.model.name())
-                || current.stage.parts.iter().any(|p| p.name() == c.model.name())
+                || current
+                    .stage
+                    .parts
+                    .iter()
+                    .any(|p| p.name() == c.model.name())
                 || effects.contains(&c.name);
             if name_taken {
                 continue;
@@ -258,8 +265,7 @@ pub fn discover_force(
                         delta_bic: trial.train.bic - current.train.bic,
                         holdout_gain: current_h - h,
                         gain_z: acceptance::paired_z(&current.holdout, &trial.holdout),
-                        explained_fraction: (current.holdout_mse - trial.holdout_mse)
-                            / base_excess,
+                        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
                         params: own,
                         significant: false,
                         failure,
@@ -319,7 +325,10 @@ pub fn discover_force(
             steps.push(step);
             break;
         };
-        let tie_names: Vec<String> = ties.iter().map(|&i| step.candidates[i].name.clone()).collect();
+        let tie_names: Vec<String> = ties
+            .iter()
+            .map(|&i| step.candidates[i].name.clone())
+            .collect();
         let w = &step.candidates[winner];
         let params: Vec<String> = w
             .params
@@ -364,15 +373,24 @@ pub fn discover_force(
     let (final_stage, final_fit, final_result) = if effects.is_empty() {
         (base_full, base_fit, base_result)
     } else {
-        current.stage.fit(data, &all, settings)?
+        // From the training fit's values, which are near the optimum: Levenberg–Marquardt
+        // alone, which never leaves the start for a worse point (the fallback of the default
+        // solver was seen to wander off and end far worse).
+        let lm = DiscoverySettings {
+            fit: settings
+                .fit
+                .clone()
+                .solver(crate::fit::Solver::LevenbergMarquardt),
+            ..settings.clone()
+        };
+        current.stage.fit(data, &all, &lm)?
     };
     let final_model = final_stage.model()?;
-    let residual_after = residuals(&final_fit, data, &final_stage.values).map_err(|source| {
-        DiscoveryError::Fit {
+    let residual_after =
+        residuals(&final_fit, data, &final_stage.values).map_err(|source| DiscoveryError::Fit {
             model: final_stage.name(),
             source,
-        }
-    })?;
+        })?;
     let gap_after = rms(&residual_after);
     let where_after = locate_gap(&residual_after, data, cycles, floor);
     notes.push(format!(

@@ -226,7 +226,10 @@ mod tests {
         let v: Vec<f64> = phase.iter().map(|p| p.cos()).collect();
         let a = x.iter().map(|x| -x).collect::<Vec<_>>();
         let f = vec![0.0; n];
-        let r: Vec<f64> = v.iter().map(|v| if v.abs() > 0.9 { 1.0 } else { 0.01 }).collect();
+        let r: Vec<f64> = v
+            .iter()
+            .map(|v| if v.abs() > 0.9 { 1.0 } else { 0.01 })
+            .collect();
         let cycles: Vec<Cycle> = (0..39)
             .map(|k| Cycle {
                 start: 100 * k,

@@ -97,11 +97,13 @@ impl DiscoverySettings {
             Some(s) => s > 0.0 && s.is_finite(),
             None => true,
         };
-        if self.holdout_every < 2
-            || !(self.min_gain_sigma >= 0.0 && self.min_gain_sigma.is_finite())
-            || !(self.min_bic_drop >= 0.0 && self.min_bic_drop.is_finite())
-            || !sigma_ok
-        {
+        let ok = self.holdout_every >= 2
+            && self.min_gain_sigma >= 0.0
+            && self.min_gain_sigma.is_finite()
+            && self.min_bic_drop >= 0.0
+            && self.min_bic_drop.is_finite()
+            && sigma_ok;
+        if !ok {
             return Err(DiscoveryError::BadSettings(format!(
                 "need holdout_every ≥ 2, finite min_gain_sigma ≥ 0 and min_bic_drop ≥ 0, \
                  a positive finite noise_sigma (got holdout_every {}, min_gain_sigma {}, \
