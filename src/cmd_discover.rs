@@ -50,7 +50,10 @@ fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let exp = Experiment::load(exp_path)?;
     let Some(spec) = &exp.discover else {
-        bail!("{}: has no [discover] section (base = \"…\")", exp_path.display());
+        bail!(
+            "{}: has no [discover] section (base = \"…\")",
+            exp_path.display()
+        );
     };
     let data = load_data(&exp)?;
     if data.level != FitLevel::Force {
@@ -145,8 +148,16 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir)?;
     let f = data.record.f_stf.as_deref().unwrap_or(&[]);
-    let before: Vec<f64> = f.iter().zip(&found.residual_before).map(|(m, r)| m - r).collect();
-    let after: Vec<f64> = f.iter().zip(&found.residual_after).map(|(m, r)| m - r).collect();
+    let before: Vec<f64> = f
+        .iter()
+        .zip(&found.residual_before)
+        .map(|(m, r)| m - r)
+        .collect();
+    let after: Vec<f64> = f
+        .iter()
+        .zip(&found.residual_after)
+        .map(|(m, r)| m - r)
+        .collect();
     let mut s = Section::new("Discovery");
     s.paragraphs.push(format!(
         "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
@@ -163,10 +174,17 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     for (i, step) in found.steps.iter().enumerate() {
         s.tables.push(Table {
             caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
-            columns: ["candidate", "held-out RMS, N", "ΔBIC", "gain (σ)", "explains", "significant"]
-                .iter()
-                .map(|c| c.to_string())
-                .collect(),
+            columns: [
+                "candidate",
+                "held-out RMS, N",
+                "ΔBIC",
+                "gain (σ)",
+                "explains",
+                "significant",
+            ]
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
             rows: step
                 .candidates
                 .iter()
@@ -177,7 +195,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                         format!("{:.1}", c.delta_bic),
                         format!("{:.1}", c.gain_z),
                         format!("{:.0} %", 100.0 * c.explained_fraction),
-                        if c.significant { "yes".into() } else { "no".into() },
+                        if c.significant {
+                            "yes".into()
+                        } else {
+                            "no".into()
+                        },
                     ]
                 })
                 .collect(),
@@ -190,7 +212,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         f,
         &[("base", &before), ("final", &after)],
     )?;
-    s.figures.push(FigureRef::new(fig, "Measured STF force against the base and the final model."));
+    s.figures.push(FigureRef::new(
+        fig,
+        "Measured STF force against the base and the final model.",
+    ));
     let fig = measured_vs_fitted(
         &dir,
         "discovery_residual",
@@ -208,7 +233,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         &format!("Discovery: {}", exp.path.display()),
         vec![format!(
             "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-            if found.effects.is_empty() { "none".to_string() } else { found.effects.join(", ") },
+            if found.effects.is_empty() {
+                "none".to_string()
+            } else {
+                found.effects.join(", ")
+            },
             found.gap_before,
             found.gap_after,
             found.noise_floor
@@ -217,13 +246,20 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         out,
     )?;
 
-    println!("base `{}`: gap {:.4} N; {}", spec.base, found.gap_before, found.where_before.summary);
+    println!(
+        "base `{}`: gap {:.4} N; {}",
+        spec.base, found.gap_before, found.where_before.summary
+    );
     for step in &found.steps {
         println!("  {}", step.verdict);
     }
     println!(
         "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
-        if found.effects.is_empty() { "none".to_string() } else { found.effects.join(", ") },
+        if found.effects.is_empty() {
+            "none".to_string()
+        } else {
+            found.effects.join(", ")
+        },
         found.gap_before,
         found.gap_after,
         found.noise_floor,

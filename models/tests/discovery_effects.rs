@@ -68,8 +68,6 @@ fn names_yield() {
 }
 
 #[test]
-#[ignore = "fails: wall_impact is named (held-out z 9.1, ΔBIC −9621) but the final whole-record \
-            refit ends at gap 165.6 N (before 0.0346 N, floor 0.0208 N): bug in the final refit"]
 fn names_wall_impact() {
     check(
         "wall_impact",
@@ -82,8 +80,6 @@ fn names_wall_impact() {
 }
 
 #[test]
-#[ignore = "fails: cubic_stiffness is named (held-out RMS 0.0582 → 0.0200 N) but the final \
-            whole-record refit ends at gap 0.0494 N (floor 0.0208 N): bug in the final refit"]
 fn names_cubic_stiffness() {
     check(
         "cubic_stiffness",
