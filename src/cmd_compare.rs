@@ -15,8 +15,7 @@ use serde_json::{json, Value};
 use stf_core::analysis::{local_maxima, peak};
 use stf_core::oscillator::Oscillator;
 use stf_core::regimes::{
-    classify, compare, cycles_from_phase, cycles_from_x, phase_from_omega, rank_models,
-    Classification, Comparison, Regime, Signals,
+    classify, compare, rank_models, Classification, Comparison, Regime, Signals,
 };
 use stf_core::simulate::Simulation;
 
@@ -42,11 +41,7 @@ pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classificati
         a: &k.a,
         f,
     };
-    let cycles = match (&k.phi, &k.omega) {
-        (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
-        (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
-        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
-    };
+    let cycles = crate::fitting::cycles_of(data)?;
     Ok(classify(&sig, cycles, &exp.regimes)?)
 }
 

@@ -16,7 +16,6 @@ use serde_json::json;
 use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
-use stf_core::regimes::{cycles_from_phase, cycles_from_x, phase_from_omega};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, load_data};
@@ -76,12 +75,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             .with_context(|| format!("{}: `discover.candidates`", exp_path.display()))?;
         candidates.push(Candidate::new(model.name().to_string(), model));
     }
-    let k = &data.kinematics;
-    let cycles = match (&k.phi, &k.omega) {
-        (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
-        (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
-        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
-    };
+    let cycles = crate::fitting::cycles_of(&data)?;
     let mut settings = DiscoverySettings::default().fit(exp.fit.settings.clone());
     if let Some(n) = spec.max_effects {
         settings = settings.max_effects(n);

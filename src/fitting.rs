@@ -134,6 +134,17 @@ pub fn load_data(exp: &Experiment) -> Result<FitData> {
     })
 }
 
+/// The record's rotor cycles (from φ, or ω integrated, or upward crossings of x).
+pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
+    use stf_core::regimes::{cycles_from_phase, cycles_from_x, phase_from_omega};
+    let k = &data.kinematics;
+    Ok(match (&k.phi, &k.omega) {
+        (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
+        (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
+        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
+    })
+}
+
 /// One fitted model.
 pub struct ModelFit {
     /// The model as configured (start values and bounds).
