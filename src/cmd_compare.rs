@@ -297,94 +297,96 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
     write_atomic(&out.join("compare.md"), md.as_bytes())?;
-    // The report: regimes table, frequency response, the record and the fits.
-    let mut curves = vec![frf(
-        "measured",
-        &data.record.t,
-        &data.record.x,
-        data.kinematics.omega.as_deref(),
-    )];
-    if let Ok((c, _)) = simulated_response(&exp, &data, None) {
-        curves.push(c);
-    }
-    curves.extend(responses.into_iter().flatten().map(|r| r.0));
-    let mut regimes = Section::new("Models regime by regime");
-    regimes.paragraphs = md
-        .lines()
-        .filter(|l| l.starts_with("- "))
-        .map(|l| l.trim_start_matches("- ").replace("**", ""))
-        .collect();
-    let mut table = Table {
-        caption:
-            "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
-                .into(),
-        columns: [
-            "model",
-            "pre-resonance",
-            "resonance",
-            "post-resonance",
-            "overall",
-        ]
-        .iter()
-        .map(|c| c.to_string())
-        .collect(),
-        rows: Vec::new(),
-    };
-    for (f, c) in fits.iter().zip(&comparisons) {
-        let mut row = vec![f.label.clone()];
-        for r in Regime::ALL {
-            row.push(c.per_regime.get(r).map_or("—".to_string(), |m| {
-                format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
-            }));
+    if exp.output.report {
+        // The report: regimes table, frequency response, the record and the fits.
+        let mut curves = vec![frf(
+            "measured",
+            &data.record.t,
+            &data.record.x,
+            data.kinematics.omega.as_deref(),
+        )];
+        if let Ok((c, _)) = simulated_response(&exp, &data, None) {
+            curves.push(c);
         }
-        row.push(format!(
-            "{:.3} ({:.2})",
-            c.overall.relative_rms_error, c.overall.duty_error
+        curves.extend(responses.into_iter().flatten().map(|r| r.0));
+        let mut regimes = Section::new("Models regime by regime");
+        regimes.paragraphs = md
+            .lines()
+            .filter(|l| l.starts_with("- "))
+            .map(|l| l.trim_start_matches("- ").replace("**", ""))
+            .collect();
+        let mut table = Table {
+            caption:
+                "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
+                    .into(),
+            columns: [
+                "model",
+                "pre-resonance",
+                "resonance",
+                "post-resonance",
+                "overall",
+            ]
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+            rows: Vec::new(),
+        };
+        for (f, c) in fits.iter().zip(&comparisons) {
+            let mut row = vec![f.label.clone()];
+            for r in Regime::ALL {
+                row.push(c.per_regime.get(r).map_or("—".to_string(), |m| {
+                    format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
+                }));
+            }
+            row.push(format!(
+                "{:.3} ({:.2})",
+                c.overall.relative_rms_error, c.overall.duty_error
+            ));
+            table.rows.push(row);
+        }
+        regimes.tables.push(table);
+        let bars: Vec<(&str, Vec<f64>)> = fits
+            .iter()
+            .zip(&comparisons)
+            .map(|(f, c)| {
+                let mut v: Vec<f64> = Regime::ALL
+                    .iter()
+                    .map(|&r| {
+                        c.per_regime
+                            .get(r)
+                            .map_or(f64::NAN, |m| m.relative_rms_error)
+                    })
+                    .collect();
+                v.push(c.overall.relative_rms_error);
+                (f.label.as_str(), v)
+            })
+            .collect();
+        let fig = regime_errors(
+            &out.join("figures"),
+            "regime_errors",
+            &["pre-resonance", "resonance", "post-resonance", "overall"],
+            &bars,
+            "relative force RMS error",
+        )?;
+        regimes.figures.push(FigureRef::new(
+            fig,
+            "Relative force RMS error of each model in each regime of the record (lower is better).",
         ));
-        table.rows.push(row);
+        let frequency = frequency_section(&curves, out)?;
+        let mut sections = vec![regimes, frequency];
+        sections.extend(record_sections(&data, &fits, out)?);
+        write_report(
+            &format!("Comparison: {}", exp.path.display()),
+            vec![format!(
+                "{} cycles of {}; noise floor σ = {:.4} N.",
+                measured.labels.len(),
+                data.record.source,
+                measured.noise_sigma
+            )],
+            sections,
+            out,
+        )?;
     }
-    regimes.tables.push(table);
-    let bars: Vec<(&str, Vec<f64>)> = fits
-        .iter()
-        .zip(&comparisons)
-        .map(|(f, c)| {
-            let mut v: Vec<f64> = Regime::ALL
-                .iter()
-                .map(|&r| {
-                    c.per_regime
-                        .get(r)
-                        .map_or(f64::NAN, |m| m.relative_rms_error)
-                })
-                .collect();
-            v.push(c.overall.relative_rms_error);
-            (f.label.as_str(), v)
-        })
-        .collect();
-    let fig = regime_errors(
-        &out.join("figures"),
-        "regime_errors",
-        &["pre-resonance", "resonance", "post-resonance", "overall"],
-        &bars,
-        "relative force RMS error",
-    )?;
-    regimes.figures.push(FigureRef::new(
-        fig,
-        "Relative force RMS error of each model in each regime of the record (lower is better).",
-    ));
-    let frequency = frequency_section(&curves, out)?;
-    let mut sections = vec![regimes, frequency];
-    sections.extend(record_sections(&data, &fits, out)?);
-    write_report(
-        &format!("Comparison: {}", exp.path.display()),
-        vec![format!(
-            "{} cycles of {}; noise floor σ = {:.4} N.",
-            measured.labels.len(),
-            data.record.source,
-            measured.noise_sigma
-        )],
-        sections,
-        out,
-    )?;
     print!("{md}");
     println!(
         "wrote {}/compare.json, compare.md, compare.csv, report.html, report.md and figures/",

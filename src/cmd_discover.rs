@@ -138,107 +138,109 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     });
     write_json(&out.join("discovery.json"), &doc)?;
 
-    // Report.
-    let dir = out.join("figures");
-    std::fs::create_dir_all(&dir)?;
-    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
-    let before: Vec<f64> = f
-        .iter()
-        .zip(&found.residual_before)
-        .map(|(m, r)| m - r)
-        .collect();
-    let after: Vec<f64> = f
-        .iter()
-        .zip(&found.residual_after)
-        .map(|(m, r)| m - r)
-        .collect();
-    let mut s = Section::new("Discovery");
-    s.paragraphs.push(format!(
-        "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
-        spec.base, found.gap_before, found.noise_floor, found.where_before.summary
-    ));
-    for step in &found.steps {
-        s.paragraphs.push(step.verdict.clone());
-    }
-    s.paragraphs.push(format!(
-        "Final `{}`: gap {:.4} N. {}",
-        found.final_model_name, found.gap_after, found.where_after.summary
-    ));
-    s.paragraphs.extend(found.notes.iter().cloned());
-    for (i, step) in found.steps.iter().enumerate() {
-        s.tables.push(Table {
-            caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
-            columns: [
-                "candidate",
-                "held-out RMS, N",
-                "ΔBIC",
-                "gain (σ)",
-                "explains",
-                "significant",
-            ]
+    if exp.output.report {
+        // Report.
+        let dir = out.join("figures");
+        std::fs::create_dir_all(&dir)?;
+        let f = data.record.f_stf.as_deref().unwrap_or(&[]);
+        let before: Vec<f64> = f
             .iter()
-            .map(|c| c.to_string())
-            .collect(),
-            rows: step
-                .candidates
+            .zip(&found.residual_before)
+            .map(|(m, r)| m - r)
+            .collect();
+        let after: Vec<f64> = f
+            .iter()
+            .zip(&found.residual_after)
+            .map(|(m, r)| m - r)
+            .collect();
+        let mut s = Section::new("Discovery");
+        s.paragraphs.push(format!(
+            "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
+            spec.base, found.gap_before, found.noise_floor, found.where_before.summary
+        ));
+        for step in &found.steps {
+            s.paragraphs.push(step.verdict.clone());
+        }
+        s.paragraphs.push(format!(
+            "Final `{}`: gap {:.4} N. {}",
+            found.final_model_name, found.gap_after, found.where_after.summary
+        ));
+        s.paragraphs.extend(found.notes.iter().cloned());
+        for (i, step) in found.steps.iter().enumerate() {
+            s.tables.push(Table {
+                caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
+                columns: [
+                    "candidate",
+                    "held-out RMS, N",
+                    "ΔBIC",
+                    "gain (σ)",
+                    "explains",
+                    "significant",
+                ]
                 .iter()
-                .map(|c| {
-                    vec![
-                        c.name.clone(),
-                        format!("{:.5}", c.holdout_rms),
-                        format!("{:.1}", c.delta_bic),
-                        format!("{:.1}", c.gain_z),
-                        format!("{:.0} %", 100.0 * c.explained_fraction),
-                        if c.significant {
-                            "yes".into()
-                        } else {
-                            "no".into()
-                        },
-                    ]
-                })
+                .map(|c| c.to_string())
                 .collect(),
-        });
+                rows: step
+                    .candidates
+                    .iter()
+                    .map(|c| {
+                        vec![
+                            c.name.clone(),
+                            format!("{:.5}", c.holdout_rms),
+                            format!("{:.1}", c.delta_bic),
+                            format!("{:.1}", c.gain_z),
+                            format!("{:.0} %", 100.0 * c.explained_fraction),
+                            if c.significant {
+                                "yes".into()
+                            } else {
+                                "no".into()
+                            },
+                        ]
+                    })
+                    .collect(),
+            });
+        }
+        let fig = measured_vs_fitted(
+            &dir,
+            "discovery_force",
+            &data.record.t,
+            f,
+            &[("base", &before), ("final", &after)],
+        )?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "Measured STF force against the base and the final model.",
+        ));
+        let fig = measured_vs_fitted(
+            &dir,
+            "discovery_residual",
+            &data.record.t,
+            &found.residual_before,
+            &[("residual after", &found.residual_after)],
+        )?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "Residual (measured − model) of the base (grey band) and of the final model.",
+        ));
+        let mut sections = vec![s];
+        sections.extend(record_sections(&data, &[], out)?);
+        write_report(
+            &format!("Discovery: {}", exp.path.display()),
+            vec![format!(
+                "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
+                if found.effects.is_empty() {
+                    "none".to_string()
+                } else {
+                    found.effects.join(", ")
+                },
+                found.gap_before,
+                found.gap_after,
+                found.noise_floor
+            )],
+            sections,
+            out,
+        )?;
     }
-    let fig = measured_vs_fitted(
-        &dir,
-        "discovery_force",
-        &data.record.t,
-        f,
-        &[("base", &before), ("final", &after)],
-    )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Measured STF force against the base and the final model.",
-    ));
-    let fig = measured_vs_fitted(
-        &dir,
-        "discovery_residual",
-        &data.record.t,
-        &found.residual_before,
-        &[("residual after", &found.residual_after)],
-    )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Residual (measured − model) of the base (grey band) and of the final model.",
-    ));
-    let mut sections = vec![s];
-    sections.extend(record_sections(&data, &[], out)?);
-    write_report(
-        &format!("Discovery: {}", exp.path.display()),
-        vec![format!(
-            "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-            if found.effects.is_empty() {
-                "none".to_string()
-            } else {
-                found.effects.join(", ")
-            },
-            found.gap_before,
-            found.gap_after,
-            found.noise_floor
-        )],
-        sections,
-        out,
-    )?;
 
     println!(
         "base `{}`: gap {:.4} N; {}",

@@ -91,18 +91,20 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             }
         );
     }
-    let sections = crate::reporting::record_sections(&data, &fits, out)?;
-    crate::reporting::write_report(
-        &format!("Fit: {}", exp.path.display()),
-        vec![format!(
-            "stf-lab fitted {} model(s) of {} to {}.",
-            fits.len(),
-            exp.path.display(),
-            data.record.source
-        )],
-        sections,
-        out,
-    )?;
+    if exp.output.report {
+        let sections = crate::reporting::record_sections(&data, &fits, out)?;
+        crate::reporting::write_report(
+            &format!("Fit: {}", exp.path.display()),
+            vec![format!(
+                "stf-lab fitted {} model(s) of {} to {}.",
+                fits.len(),
+                exp.path.display(),
+                data.record.source
+            )],
+            sections,
+            out,
+        )?;
+    }
     println!(
         "wrote {0}/fit.json, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
         out.display()

@@ -279,6 +279,20 @@ struct RawExperiment {
     #[serde(default)]
     identify: Vec<Spanned<RawStage>>,
     regimes: Option<Spanned<toml::Value>>,
+    output: Option<RawOutput>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    report: Option<bool>,
+}
+
+/// What the commands write besides their JSON.
+#[derive(Clone, Debug)]
+pub struct OutputSpec {
+    /// Figures (SVG, PNG, CSV), report.html and report.md.
+    pub report: bool,
 }
 
 /// Whether models are fitted to the measured force or to the measured motion.
@@ -394,6 +408,8 @@ pub struct Experiment {
     pub kinematics: KinematicsSettings,
     /// `[[identify]]` stages.
     pub identify: Vec<StageSpec>,
+    /// `[output]`.
+    pub output: OutputSpec,
     /// `[regimes]` thresholds (defaults where not given).
     pub regimes: RegimeThresholds,
     /// `[discover] base`.
@@ -835,6 +851,9 @@ impl Experiment {
             kinematics,
             identify,
             regimes,
+            output: OutputSpec {
+                report: raw.output.as_ref().and_then(|o| o.report).unwrap_or(true),
+            },
             data_file,
             data_line,
             dir,

@@ -107,3 +107,32 @@ fn the_same_experiment_gives_byte_identical_results() {
     }
     assert!(outputs[0] == outputs[1], "two runs differ");
 }
+
+#[test]
+fn output_report_false_writes_only_the_results() {
+    let out = tempfile::tempdir().unwrap();
+    let record = root().join("experiments/records/power_law_sweep.csv");
+    let exp = out.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "[data]\nfile = {:?}\n\n[output]\nreport = false\n\n[[models]]\nname = \"viscous\"\n",
+            record.display().to_string()
+        ),
+    )
+    .unwrap();
+    let dir = out.path().join("fit");
+    let run = stf_lab()
+        .args(["fit", "--quiet", "--out"])
+        .arg(&dir)
+        .arg(&exp)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(dir.join("fit.json").exists() && dir.join("fitted.csv").exists());
+    assert!(!dir.join("report.html").exists() && !dir.join("figures").exists());
+}
