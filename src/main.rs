@@ -62,6 +62,20 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Calibrate every model of the experiment against its record.
+    Fit {
+        /// The experiment file.
+        experiment: PathBuf,
+        /// Folder for fit.json and fitted.csv.
+        #[arg(long)]
+        out: PathBuf,
+        /// Replace results in an existing folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress display.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Fit every model, then compare them regime by regime.
     Compare {
         /// The experiment file.
@@ -87,20 +101,6 @@ enum Command {
         #[arg(long)]
         force: bool,
         /// No progress messages.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// Calibrate every model of the experiment against its record.
-    Fit {
-        /// The experiment file.
-        experiment: PathBuf,
-        /// Folder for fit.json and fitted.csv.
-        #[arg(long)]
-        out: PathBuf,
-        /// Replace results in an existing folder.
-        #[arg(long)]
-        force: bool,
-        /// No progress display.
         #[arg(long)]
         quiet: bool,
     },
