@@ -12,7 +12,11 @@ fn main() {
     for _ in 0..3 {
         let t = std::time::Instant::now();
         match Simulation::new(&osc).rate(1000.0).run(50.0, 200.0) {
-            Ok(run) => println!("{} RHS calls, {:.2} ms", run.stats.rhs_calls, t.elapsed().as_secs_f64() * 1e3),
+            Ok(run) => println!(
+                "{} RHS calls, {:.2} ms",
+                run.stats.rhs_calls,
+                t.elapsed().as_secs_f64() * 1e3
+            ),
             Err(e) => eprintln!("{e}"),
         }
     }
