@@ -972,4 +972,58 @@ params = { K = 4.0, n = 1.5 }
             .unwrap_err();
         assert!(format!("{err:#}").contains("exactly one"));
     }
+
+    const VALID: &str = r#"
+[system]
+preset = "forced"
+k = 270.0
+
+[integrator]
+method = "auto"
+
+[fit]
+solver = "auto"
+system = ["k"]
+
+[filter]
+motion = { order = 3, window = 101 }
+
+[[models]]
+name = "power_law"
+plus = ["added_mass"]
+params = { K = 2.0, n = { value = 1.2, min = 1.0, max = 4.0 } }
+
+[simulate]
+sweep = { w0 = 2.35, alpha = 0.047, t0 = 50.0, t1 = 200.0 }
+
+[[simulate.truth]]
+name = "viscous"
+
+[regimes]
+on_k = 3.0
+"#;
+
+    proptest::proptest! {
+        /// Any text is an experiment or an error, never a panic. Long run (documented in the
+        /// README): `PROPTEST_CASES=1000000 cargo test --release --bin stf-lab never_panics`.
+        #[test]
+        fn the_parser_never_panics_on_any_text(text in "\\PC{0,400}") {
+            let _ = parse(&text);
+        }
+
+        /// Nor on a valid file with bytes replaced, cut or repeated.
+        #[test]
+        fn the_parser_never_panics_on_a_mutated_experiment(
+            edits in proptest::collection::vec((0usize..600, proptest::char::any()), 1..6),
+            cut in 0usize..700,
+        ) {
+            let mut chars: Vec<char> = VALID.chars().collect();
+            for (at, c) in edits {
+                let i = at % chars.len();
+                chars[i] = c;
+            }
+            let text: String = chars.into_iter().take(cut.max(1)).collect();
+            let _ = parse(&text);
+        }
+    }
 }

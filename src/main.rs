@@ -10,6 +10,7 @@
 
 // `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![deny(clippy::unwrap_used)]
 
 mod cmd_compare;
 mod cmd_discover;

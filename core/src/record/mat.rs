@@ -16,8 +16,18 @@ pub(super) fn read(path: &Path, names: &ColumnNames) -> Result<Record, RecordErr
     let source = path.display().to_string();
     let bytes =
         std::fs::read(path).map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
-    check_header(&source, &bytes)?;
-    let file = matfile::MatFile::parse(&bytes[..]).map_err(|e| {
+    read_bytes(&bytes, &source, names)
+}
+
+/// Read a record from the bytes of a `.mat` file; `source` names it in errors.
+pub(super) fn read_bytes(
+    bytes: &[u8],
+    source: &str,
+    names: &ColumnNames,
+) -> Result<Record, RecordError> {
+    let source = source.to_string();
+    check_header(&source, bytes)?;
+    let file = matfile::MatFile::parse(bytes).map_err(|e| {
         RecordError::new(
             &source,
             format!(

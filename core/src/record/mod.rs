@@ -138,6 +138,11 @@ impl ReadOptions {
     pub fn read_mat(&self, path: &Path) -> Result<Record, RecordError> {
         mat::read(path, &self.columns)
     }
+
+    /// Read the bytes of a MATLAB `.mat` file; `source` names it in errors.
+    pub fn read_mat_bytes(&self, bytes: &[u8], source: &str) -> Result<Record, RecordError> {
+        mat::read_bytes(bytes, source, &self.columns)
+    }
 }
 
 /// The signals of a record while it is being assembled, before validation.
