@@ -168,6 +168,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
                 )
             })?;
         bar.finish_and_clear();
+        crate::interrupt::finished_step(format!("identification stage {}", i + 1));
         for name in &stage.free {
             if let Some(v) = result.value(name) {
                 system.set(name, v);

@@ -375,6 +375,10 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .map(|(c, bar)| {
             let r = fit_model(exp, data, c.as_ref(), bar);
             bar.finish_and_clear();
+            if r.is_ok() {
+                let name = c.as_ref().map_or("the oscillator", |c| c.model.name());
+                crate::interrupt::finished_step(format!("the fit of `{name}`"));
+            }
             r
         })
         .collect::<Result<_>>()?;

@@ -19,6 +19,7 @@ mod cmd_models;
 mod cmd_simulate;
 mod experiment;
 mod fitting;
+mod interrupt;
 mod model_config;
 mod output;
 mod progress;
@@ -109,6 +110,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    interrupt::install();
     let result = match cli.command {
         Command::Models { check, scripts } => match check {
             Some(path) => cmd_models::check(&path),
