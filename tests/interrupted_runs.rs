@@ -55,7 +55,7 @@ fn a_killed_fit_leaves_whole_results() {
 fn ctrl_c_says_what_had_finished_and_writes_nothing() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("id");
-    let mut child = fit(&dir, "experiments/paper_identification.toml")
+    let child = fit(&dir, "experiments/paper_identification.toml")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
