@@ -1,25 +1,19 @@
 //! End-to-end test of `stf-lab compare` on the bundled on–off jamming example.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
+
+use common::{read_json, root, run_ok};
 
 #[test]
 fn the_truth_ranks_first_and_viscous_misses_the_on_off_force() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("cmp");
-    let run = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-        .args(["compare", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/jamming_compare.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let _ = run_ok(
+        "compare",
+        &root().join("experiments/jamming_compare.toml"),
+        &dir,
     );
-    let doc: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("compare.json")).unwrap()).unwrap();
+    let doc = read_json(&dir.join("compare.json"));
     assert_eq!(doc["best"]["overall"], "jamming_on_off");
     assert_eq!(doc["best"]["post_resonance"], "jamming_on_off");
     assert_eq!(doc["measured"]["no_stf"], false);

@@ -1,25 +1,15 @@
 //! End-to-end test of `stf-lab discover` on the bundled example.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
+
+use common::{read_json, root, run_ok};
 
 #[test]
 fn discovery_names_the_hidden_cubic_spring_and_the_gap_shrinks_to_the_noise() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("disc");
-    let run = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-        .args(["discover", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/discovery.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let doc: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("discovery.json")).unwrap()).unwrap();
+    let _ = run_ok("discover", &root().join("experiments/discovery.toml"), &dir);
+    let doc = read_json(&dir.join("discovery.json"));
     assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
     let before = doc["gap_before"].as_f64().unwrap();
     let after = doc["gap_after"].as_f64().unwrap();
@@ -33,8 +23,7 @@ fn discovery_names_the_hidden_cubic_spring_and_the_gap_shrinks_to_the_noise() {
     assert!(entry.contains("plus = [\"cubic_stiffness\"]"), "{entry}");
     assert!(dir.join("report.html").exists());
 
-    let record =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/records/discovery_sweep.csv");
+    let record = root().join("experiments/records/discovery_sweep.csv");
     let exp = out.path().join("refit.toml");
     std::fs::write(
         &exp,
@@ -44,15 +33,5 @@ fn discovery_names_the_hidden_cubic_spring_and_the_gap_shrinks_to_the_noise() {
         ),
     )
     .unwrap();
-    let fit = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-        .args(["fit", "--quiet", "--out"])
-        .arg(out.path().join("refit"))
-        .arg(&exp)
-        .output()
-        .unwrap();
-    assert!(
-        fit.status.success(),
-        "{}",
-        String::from_utf8_lossy(&fit.stderr)
-    );
+    let _ = run_ok("fit", &exp, &out.path().join("refit"));
 }

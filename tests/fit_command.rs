@@ -1,33 +1,15 @@
 //! End-to-end tests of `stf-lab fit` on the bundled examples.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn stf_lab() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-}
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use common::{read_json, root, run, run_ok};
 
 #[test]
 fn power_law_example_recovers_the_truth_natively_and_as_a_script() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("fit");
-    let run = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(root().join("experiments/power_law_fit.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let fit: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("fit.json")).unwrap()).unwrap();
+    let _ = run_ok("fit", &root().join("experiments/power_law_fit.toml"), &dir);
+    let fit: serde_json::Value = read_json(&dir.join("fit.json"));
     let models = fit["models"].as_array().unwrap();
     assert_eq!(models.len(), 4);
     let power = &models[1];
@@ -52,12 +34,7 @@ fn power_law_example_recovers_the_truth_natively_and_as_a_script() {
         .starts_with("t,f_stf,f_stf_viscous"));
 
     // A second run into the same folder refuses without --force.
-    let again = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(root().join("experiments/power_law_fit.toml"))
-        .output()
-        .unwrap();
+    let again = run("fit", &root().join("experiments/power_law_fit.toml"), &dir);
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
 }
@@ -66,19 +43,12 @@ fn power_law_example_recovers_the_truth_natively_and_as_a_script() {
 fn paper_identification_finds_k_and_f0() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("id");
-    let run = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(root().join("experiments/paper_identification.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let _ = run_ok(
+        "fit",
+        &root().join("experiments/paper_identification.toml"),
+        &dir,
     );
-    let fit: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("fit.json")).unwrap()).unwrap();
+    let fit: serde_json::Value = read_json(&dir.join("fit.json"));
     let system = &fit["system"];
     let k = system["k"].as_f64().unwrap();
     let f0 = system["F0"].as_f64().unwrap();
@@ -93,13 +63,7 @@ fn the_same_experiment_gives_byte_identical_results() {
     let mut outputs = Vec::new();
     for name in ["a", "b"] {
         let dir = out.path().join(name);
-        let run = stf_lab()
-            .args(["fit", "--quiet", "--out"])
-            .arg(&dir)
-            .arg(root().join("experiments/power_law_fit.toml"))
-            .output()
-            .unwrap();
-        assert!(run.status.success());
+        let _ = run_ok("fit", &root().join("experiments/power_law_fit.toml"), &dir);
         outputs.push((
             std::fs::read(dir.join("fit.json")).unwrap(),
             std::fs::read(dir.join("fitted.csv")).unwrap(),
@@ -122,17 +86,7 @@ fn output_report_false_writes_only_the_results() {
     )
     .unwrap();
     let dir = out.path().join("fit");
-    let run = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(&dir)
-        .arg(&exp)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let _ = run_ok("fit", &exp, &dir);
     assert!(dir.join("fit.json").exists() && dir.join("fitted.csv").exists());
     assert!(!dir.join("report.html").exists() && !dir.join("figures").exists());
 }
