@@ -1,17 +1,15 @@
 //! A hostile or broken script inside a fit or a simulation is stopped, and the command reports
 //! the error with the script's name instead of a result.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-fn stf_lab() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-}
+use std::path::Path;
+
+use common::{root, run, stf_lab};
 
 fn experiment(dir: &Path, script: &str, body: &str) -> std::path::PathBuf {
     std::fs::write(dir.join("hostile.rhai"), script).unwrap();
-    let record =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/records/power_law_sweep.csv");
+    let record = root().join("experiments/records/power_law_sweep.csv");
     let exp = dir.join("exp.toml");
     std::fs::write(
         &exp,
@@ -37,12 +35,7 @@ fn a_script_that_loops_forever_once_the_blade_moves_stops_the_fit_with_its_name(
         &script,
         "[[models]]\nscript = \"hostile.rhai\"\n",
     );
-    let out = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(dir.path().join("out"))
-        .arg(&exp)
-        .output()
-        .unwrap();
+    let out = run("fit", &exp, &dir.path().join("out"));
     assert!(!out.status.success());
     let msg = String::from_utf8_lossy(&out.stderr);
     assert!(msg.contains("hostile.rhai"), "{msg}");
@@ -87,12 +80,7 @@ fn a_script_that_reads_a_file_is_refused_at_load() {
         &script,
         "[[models]]\nscript = \"hostile.rhai\"\n",
     );
-    let out = stf_lab()
-        .args(["fit", "--quiet", "--out"])
-        .arg(dir.path().join("out"))
-        .arg(&exp)
-        .output()
-        .unwrap();
+    let out = run("fit", &exp, &dir.path().join("out"));
     assert!(!out.status.success());
     let msg = String::from_utf8_lossy(&out.stderr);
     assert!(msg.contains("hostile.rhai"), "{msg}");
