@@ -9,12 +9,12 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use stf_core::fit::{FitParam, TrajectoryData, TrajectoryFit};
+use stf_core::fit::{TrajectoryData, TrajectoryFit};
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, fit_all, load_data};
+use crate::fitting::{finite_or_null, fit_all, load_data, system_param};
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
 
@@ -141,13 +141,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             .settings(exp.fit.settings.clone())
             .initial(k.x[0], k.v[0]);
         for name in &stage.free {
-            let v = system.get(name).unwrap_or(0.0);
-            let (min, max) = if v > 0.0 {
-                (v / 5.0, v * 5.0)
-            } else {
-                (0.0, 10.0)
-            };
-            fit = fit.free(FitParam::new(name.clone(), v).bounds(min, max));
+            fit = fit.free(system_param(name, system.get(name).unwrap_or(0.0)));
         }
         let bar = progress.job(&format!("stage {}", i + 1));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));

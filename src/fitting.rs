@@ -244,7 +244,7 @@ fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
 
 /// Bounds for an oscillator parameter freed in a trajectory fit: a factor 5 around its
 /// start (from 0 when it starts at 0).
-fn system_param(name: &str, value: f64) -> FitParam {
+pub fn system_param(name: &str, value: f64) -> FitParam {
     let (min, max) = if value > 0.0 {
         (value / 5.0, value * 5.0)
     } else {

@@ -2,8 +2,7 @@
 //! renamed into place, so a crash never leaves a half-written file under the final name; an
 //! existing output is replaced only when the user says `--force`.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 
@@ -18,28 +17,11 @@ pub fn check_overwrite(path: &Path, force: bool) -> Result<()> {
     Ok(())
 }
 
-/// A temporary path beside `path`, unique to this process.
-pub fn temporary_beside(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".into());
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
-}
-
-/// Write `bytes` to `path` atomically (temporary file + rename).
+/// Write `bytes` to `path` atomically (temporary file beside it, then a rename): the one
+/// implementation, shared with the figures in [`crate::report`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = temporary_beside(path);
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("cannot write {}", path.display()))
+    crate::report::write_file_atomic(path, bytes)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Make `dir` ready for a command's outputs: create it, or, if it exists and holds files,

@@ -45,6 +45,7 @@ mod smoothing;
 pub(crate) mod test_signals;
 mod time_history;
 
+pub use atomic::write_atomic as write_file_atomic;
 pub use decimate::{decimate_indices, decimate_union, MAX_POINTS_PER_LINE};
 pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;
