@@ -136,6 +136,20 @@ impl Excitation {
         }
     }
 
+    /// The driving force at `t` (N, for unbalance `f0`) together with the rotor angle and speed
+    /// `(φ, ω)` if a rotor drives the oscillator: one evaluation of the angle for all three
+    /// (the same values as [`Excitation::force`], [`Excitation::phi`], [`Excitation::omega`]).
+    #[inline]
+    pub fn force_and_angle(&self, t: f64, f0: f64) -> (f64, Option<(f64, f64)>) {
+        match self {
+            Excitation::Rotor(angle) => {
+                let (phi, omega) = angle.at(t);
+                (f0 * omega * omega * phi.sin(), Some((phi, omega)))
+            }
+            _ => (self.force(t, f0), None),
+        }
+    }
+
     /// Rotor speed ω at `t`, rad/s, if a rotor drives the oscillator.
     pub fn omega(&self, t: f64) -> Option<f64> {
         match self {
@@ -166,6 +180,18 @@ mod tests {
             assert_relative_eq!(phi, 0.0235 * t * t, max_relative = 1e-12);
             assert_relative_eq!(w, 0.047 * t, max_relative = 1e-12);
         }
+    }
+
+    #[test]
+    fn force_and_angle_agrees_with_the_separate_evaluations() {
+        let rotor = Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0));
+        for t in [50.0, 77.7, 199.9] {
+            let (drive, angle) = rotor.force_and_angle(t, 0.0462);
+            assert_eq!(drive, rotor.force(t, 0.0462));
+            assert_eq!(angle, Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap())));
+        }
+        let free = Excitation::None;
+        assert_eq!(free.force_and_angle(3.0, 0.0462), (0.0, None));
     }
 
     #[test]

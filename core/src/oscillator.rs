@@ -110,9 +110,22 @@ impl Oscillator {
     /// The forces at `(t, y)`; writes the rates of the internal states to `dz`.
     #[inline]
     pub fn forces(&self, t: f64, y: &[f64], dz: &mut [f64]) -> Result<Forces, SimError> {
+        let drive = self.excitation.force(t, self.params.f0);
+        self.forces_with_drive(t, y, drive, dz)
+    }
+
+    /// [`Oscillator::forces`] with the driving force at `t` already known (e.g. from
+    /// [`Excitation::force_and_angle`]), so that it is not evaluated twice.
+    #[inline]
+    pub fn forces_with_drive(
+        &self,
+        t: f64,
+        y: &[f64],
+        drive: f64,
+        dz: &mut [f64],
+    ) -> Result<Forces, SimError> {
         let (x, v) = (y[0], y[1]);
         let p = &self.params;
-        let drive = self.excitation.force(t, p.f0);
         let f_r = bearing_resistance(p, v);
         let (m_a, f) = match &self.model {
             None => (0.0, 0.0),

@@ -112,10 +112,18 @@ impl<'a> Simulation<'a> {
             z: vec![Vec::with_capacity(n); nz],
             stats: sol.stats,
         };
+        let rotor = self.osc.excitation.omega(t0).is_some();
+        let (mut phi, mut omega) = if rotor {
+            (Vec::with_capacity(n), Vec::with_capacity(n))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let mut dz = vec![0.0; nz];
+        // One pass: the rotor angle is evaluated once per sample for the drive, φ and ω.
         for (i, &t) in times.iter().enumerate() {
             let y = sol.y(i);
-            let f = self.osc.forces(t, y, &mut dz)?;
+            let (drive, angle) = self.osc.excitation.force_and_angle(t, self.osc.params.f0);
+            let f = self.osc.forces_with_drive(t, y, drive, &mut dz)?;
             out.x.push(y[0]);
             out.v.push(y[1]);
             out.a.push(f.a);
@@ -124,17 +132,12 @@ impl<'a> Simulation<'a> {
             for (j, zj) in out.z.iter_mut().enumerate() {
                 zj.push(y[2 + j]);
             }
+            if let (true, Some((p, w))) = (rotor, angle) {
+                phi.push(p);
+                omega.push(w);
+            }
         }
-        if self.osc.excitation.omega(t0).is_some() {
-            let (phi, omega): (Vec<f64>, Vec<f64>) = times
-                .iter()
-                .map(|&t| {
-                    (
-                        self.osc.excitation.phi(t).unwrap_or(0.0),
-                        self.osc.excitation.omega(t).unwrap_or(0.0),
-                    )
-                })
-                .unzip();
+        if rotor {
             out.phi = Some(phi);
             out.omega = Some(omega);
         }

@@ -172,11 +172,13 @@ impl DormandPrince {
     pub(super) fn dense(&self, theta: f64, out: &mut [f64]) {
         let n = out.len();
         let s1 = 1.0 - theta;
-        let c = &self.cont;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = c[i]
-                + theta
-                    * (c[n + i] + s1 * (c[2 * n + i] + theta * (c[3 * n + i] + s1 * c[4 * n + i])));
+        let (c0, rest) = self.cont.split_at(n);
+        let (c1, rest) = rest.split_at(n);
+        let (c2, rest) = rest.split_at(n);
+        let (c3, c4) = rest.split_at(n);
+        let rows = c0.iter().zip(c1).zip(c2).zip(c3).zip(c4);
+        for (o, ((((c0, c1), c2), c3), c4)) in out.iter_mut().zip(rows) {
+            *o = c0 + theta * (c1 + s1 * (c2 + theta * (c3 + s1 * c4)));
         }
     }
 }

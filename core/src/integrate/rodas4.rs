@@ -226,9 +226,12 @@ impl Rodas4 {
     pub(super) fn dense(&self, theta: f64, out: &mut [f64]) {
         let n = self.n;
         let s1 = 1.0 - theta;
-        let c = &self.cont;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = c[i] * s1 + theta * (c[n + i] + s1 * (c[2 * n + i] + theta * c[3 * n + i]));
+        let (c0, rest) = self.cont.split_at(n);
+        let (c1, rest) = rest.split_at(n);
+        let (c2, c3) = rest.split_at(n);
+        let rows = c0.iter().zip(c1).zip(c2).zip(c3);
+        for (o, (((c0, c1), c2), c3)) in out.iter_mut().zip(rows) {
+            *o = c0 * s1 + theta * (c1 + s1 * (c2 + theta * c3));
         }
     }
 }

@@ -114,10 +114,11 @@ pub(super) fn run(
     work: &mut Work,
 ) -> Result<Vec<f64>, SimError> {
     let n = y0.len();
-    let mut states = Vec::with_capacity(t_out.len() * n);
+    // Every sample is written once, in place (the run ends with an error otherwise).
+    let mut states = vec![0.0; t_out.len() * n];
     let mut next_out = 0;
     while next_out < t_out.len() && t_out[next_out] <= t0 {
-        states.extend_from_slice(y0);
+        states[next_out * n..(next_out + 1) * n].copy_from_slice(y0);
         next_out += 1;
     }
     let Some(&t_end) = t_out.last() else {
@@ -150,7 +151,6 @@ pub(super) fn run(
     let mut dp = DormandPrince::new(n);
     let mut ro = Rodas4::new(n);
     let mut linearised = false;
-    let mut out = vec![0.0; n];
 
     // Controller state.
     let mut rejected_last = false;
@@ -197,8 +197,8 @@ pub(super) fn run(
                 if err <= 1.0 {
                     dp.accept(&y, h);
                     while next_out < t_out.len() && t_out[next_out] <= t_new {
-                        dp.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), &mut out);
-                        states.extend_from_slice(&out);
+                        let row = &mut states[next_out * n..(next_out + 1) * n];
+                        dp.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), row);
                         next_out += 1;
                     }
                     y.copy_from_slice(&dp.y_new);
@@ -277,8 +277,8 @@ pub(super) fn run(
                     let rho = ro.spectral_radius();
                     ro.accept(&y);
                     while next_out < t_out.len() && t_out[next_out] <= t_new {
-                        ro.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), &mut out);
-                        states.extend_from_slice(&out);
+                        let row = &mut states[next_out * n..(next_out + 1) * n];
+                        ro.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), row);
                         next_out += 1;
                     }
                     y.copy_from_slice(&ro.y_new);
