@@ -69,6 +69,7 @@ impl RotorAngle {
     }
 
     /// φ (rad) and ω (rad/s) at time `t`.
+    #[inline]
     pub fn at(&self, t: f64) -> (f64, f64) {
         match self {
             RotorAngle::Constant { omega, phi0 } => (phi0 + omega * t, *omega),

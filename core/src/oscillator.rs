@@ -116,7 +116,7 @@ impl Oscillator {
 
     /// [`Oscillator::forces`] with the driving force at `t` already known (e.g. from
     /// [`Excitation::force_and_angle`]), so that it is not evaluated twice.
-    #[inline]
+    #[inline(always)]
     pub fn forces_with_drive(
         &self,
         t: f64,

@@ -262,6 +262,16 @@ fn stiff_wall_and_steep_gate_with_an_internal_state() {
         eprintln!("{m:?}: max |Δx| {dx:.2e} m, |Δz| {dz:.2e}, {:?}", sol.stats);
         assert!(dx < 1e-6, "{m:?}: max |Δx| {dx:e}");
         assert!(dz <= 2.0 * dz_explicit, "{m:?}: max |Δz| {dz:e}");
+        // The default tolerances (what an experiment file gets without [integrator]) keep x
+        // within a micrometre of the reference too.
+        let default = Settings::default().method(m);
+        let sol = integrate(&WallAndGate, 0.0, &y0, &t_out, &default).unwrap();
+        let dx = max_diff(&sol, &reference, 0);
+        eprintln!(
+            "{m:?} at rtol {:e}: max |Δx| {dx:.2e} m, {:?}",
+            default.rtol, sol.stats
+        );
+        assert!(dx < 1e-6, "{m:?} at the default tolerances: max |Δx| {dx:e}");
     }
 }
 

@@ -96,7 +96,7 @@ impl Default for Settings {
     fn default() -> Self {
         Settings {
             method: Method::default(),
-            rtol: 1e-8,
+            rtol: 1e-7,
             atol: 1e-10,
             h_max: 0.0,
             max_steps: 50_000_000,
