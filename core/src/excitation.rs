@@ -189,7 +189,10 @@ mod tests {
         for t in [50.0, 77.7, 199.9] {
             let (drive, angle) = rotor.force_and_angle(t, 0.0462);
             assert_eq!(drive, rotor.force(t, 0.0462));
-            assert_eq!(angle, Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap())));
+            assert_eq!(
+                angle,
+                Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap()))
+            );
         }
         let free = Excitation::None;
         assert_eq!(free.force_and_angle(3.0, 0.0462), (0.0, None));

@@ -99,48 +99,99 @@ impl<'a> Simulation<'a> {
         let y0 = self.osc.initial_state(self.x0, self.v0);
         let sol = integrate(self.osc, t0, &y0, times, &self.settings)?;
         let n = times.len();
-        let nz = self.osc.n_internal();
-        let mut out = Trajectory {
-            t: times.to_vec(),
-            x: Vec::with_capacity(n),
-            v: Vec::with_capacity(n),
-            a: Vec::with_capacity(n),
-            f_stf: Vec::with_capacity(n),
-            drive: Vec::with_capacity(n),
-            phi: None,
-            omega: None,
-            z: vec![Vec::with_capacity(n); nz],
-            stats: sol.stats,
-        };
+        let dim = sol.dim;
+        let column =
+            |j: usize| -> Vec<f64> { sol.states.chunks_exact(dim).map(|y| y[j]).collect() };
         let rotor = self.osc.excitation.omega(t0).is_some();
+        let f0 = self.osc.params.f0;
+        // The rotor angle is evaluated once per sample, for the drive, φ and ω.
+        let mut drive = vec![0.0; n];
         let (mut phi, mut omega) = if rotor {
-            (Vec::with_capacity(n), Vec::with_capacity(n))
+            (vec![0.0; n], vec![0.0; n])
         } else {
             (Vec::new(), Vec::new())
         };
-        let mut dz = vec![0.0; nz];
-        // One pass: the rotor angle is evaluated once per sample for the drive, φ and ω.
-        for (i, &t) in times.iter().enumerate() {
-            let y = sol.y(i);
-            let (drive, angle) = self.osc.excitation.force_and_angle(t, self.osc.params.f0);
-            let f = self.osc.forces_with_drive(t, y, drive, &mut dz)?;
-            out.x.push(y[0]);
-            out.v.push(y[1]);
-            out.a.push(f.a);
-            out.f_stf.push(f.f_stf);
-            out.drive.push(f.drive);
-            for (j, zj) in out.z.iter_mut().enumerate() {
-                zj.push(y[2 + j]);
-            }
-            if let (true, Some((p, w))) = (rotor, angle) {
-                phi.push(p);
-                omega.push(w);
-            }
-        }
         if rotor {
-            out.phi = Some(phi);
-            out.omega = Some(omega);
+            let rows = drive.iter_mut().zip(phi.iter_mut()).zip(omega.iter_mut());
+            for (((d, p), w), &t) in rows.zip(times) {
+                let (force, angle) = self.osc.excitation.force_and_angle(t, f0);
+                *d = force;
+                (*p, *w) = angle.unwrap_or((0.0, 0.0));
+            }
+        } else {
+            for (d, &t) in drive.iter_mut().zip(times) {
+                *d = self.osc.excitation.force(t, f0);
+            }
         }
+        let (mut a, mut f_stf) = (vec![0.0; n], vec![0.0; n]);
+        let mut dz = vec![0.0; self.osc.n_internal()];
+        let rows = sol.states.chunks_exact(dim).zip(times).zip(&drive);
+        for ((ai, fi), ((y, &t), &d)) in a.iter_mut().zip(f_stf.iter_mut()).zip(rows) {
+            let f = self.osc.forces_with_drive(t, y, d, &mut dz)?;
+            *ai = f.a;
+            *fi = f.f_stf;
+        }
+        let out = Trajectory {
+            t: times.to_vec(),
+            x: column(0),
+            v: column(1),
+            a,
+            f_stf,
+            drive,
+            phi: rotor.then_some(phi),
+            omega: rotor.then_some(omega),
+            z: (2..dim).map(column).collect(),
+            stats: sol.stats,
+        };
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::excitation::{Excitation, RotorAngle};
+    use crate::system::OscillatorParams;
+
+    #[test]
+    fn force_columns_are_the_forces_at_the_sampled_states() {
+        let osc = Oscillator::new(
+            OscillatorParams::FORCED,
+            Excitation::Rotor(RotorAngle::sweep(5.0, 0.047, 0.0)),
+        );
+        let run = Simulation::new(&osc)
+            .rate(200.0)
+            .initial(0.01, 0.0)
+            .run(0.0, 3.0)
+            .unwrap();
+        let (phi, omega) = (run.phi.as_ref().unwrap(), run.omega.as_ref().unwrap());
+        assert_eq!(run.t.len(), 601);
+        assert!(run.z.is_empty());
+        for i in 0..run.t.len() {
+            let f = osc
+                .forces(run.t[i], &[run.x[i], run.v[i]], &mut [])
+                .unwrap();
+            assert_eq!(
+                (run.a[i], run.f_stf[i], run.drive[i]),
+                (f.a, f.f_stf, f.drive)
+            );
+            assert_eq!(phi[i], osc.excitation.phi(run.t[i]).unwrap());
+            assert_eq!(omega[i], osc.excitation.omega(run.t[i]).unwrap());
+        }
+        let free = Oscillator::new(OscillatorParams::FREE, Excitation::None);
+        let run = Simulation::new(&free)
+            .rate(100.0)
+            .initial(0.02, 0.0)
+            .run(0.0, 1.0)
+            .unwrap();
+        assert!(run.phi.is_none() && run.omega.is_none());
+        assert!(run.drive.iter().all(|&d| d == 0.0));
+        for i in 0..run.t.len() {
+            let f = free
+                .forces(run.t[i], &[run.x[i], run.v[i]], &mut [])
+                .unwrap();
+            assert_eq!(run.a[i], f.a);
+        }
     }
 }

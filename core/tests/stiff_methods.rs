@@ -271,7 +271,10 @@ fn stiff_wall_and_steep_gate_with_an_internal_state() {
             "{m:?} at rtol {:e}: max |Δx| {dx:.2e} m, {:?}",
             default.rtol, sol.stats
         );
-        assert!(dx < 1e-6, "{m:?} at the default tolerances: max |Δx| {dx:e}");
+        assert!(
+            dx < 1e-6,
+            "{m:?} at the default tolerances: max |Δx| {dx:e}"
+        );
     }
 }
 
