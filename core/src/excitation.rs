@@ -82,8 +82,18 @@ impl RotorAngle {
                 let s = t - t0;
                 (phi0 + w0 * s + 0.5 * alpha * s * s, w0 + alpha * s)
             }
+            _ => self.tabulated_at(t),
+        }
+    }
+
+    /// [`RotorAngle::at`] for the tabulated kinds (kept out of line so that the analytic ones
+    /// inline into the right-hand side).
+    #[inline(never)]
+    fn tabulated_at(&self, t: f64) -> (f64, f64) {
+        match self {
             RotorAngle::Profile { t: ts, omega, phi0 } => profile_at(ts, omega, *phi0, t),
             RotorAngle::Measured(h) => h.at(t),
+            RotorAngle::Constant { .. } | RotorAngle::Sweep { .. } => self.at(t),
         }
     }
 }

@@ -95,9 +95,13 @@ impl DormandPrince {
         calls: &mut u64,
     ) -> Result<Trial, SimError> {
         let n = y.len();
+        // Slices of one known length, so that the loops below carry no bounds checks.
+        let f0 = &f0[..n];
         let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        let (k1, k2, k3, k4) = (&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]);
+        let (k5, k6, k7) = (&mut k5[..n], &mut k6[..n], &mut k7[..n]);
         k1.copy_from_slice(f0);
-        let yt = &mut self.ytmp;
+        let yt = &mut self.ytmp[..n];
         for i in 0..n {
             yt[i] = y[i] + h * A21 * k1[i];
         }
@@ -114,14 +118,14 @@ impl DormandPrince {
             yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
         }
         sys.rhs(t + C5 * h, yt, k5)?;
-        let ys = &mut self.ysti;
+        let ys = &mut self.ysti[..n];
         for i in 0..n {
             ys[i] =
                 y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
         }
         let t_new = t + h;
         sys.rhs(t_new, ys, k6)?;
-        let yn = &mut self.y_new;
+        let yn = &mut self.y_new[..n];
         for i in 0..n {
             yn[i] =
                 y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
@@ -152,12 +156,14 @@ impl DormandPrince {
     pub(super) fn accept(&mut self, y: &[f64], h: f64) {
         let n = y.len();
         let [k1, _, k3, k4, k5, k6, k7] = &self.k;
+        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
+        let y_new = &self.y_new[..n];
         let (c0, rest) = self.cont.split_at_mut(n);
         let (c1, rest) = rest.split_at_mut(n);
         let (c2, rest) = rest.split_at_mut(n);
         let (c3, c4) = rest.split_at_mut(n);
         for i in 0..n {
-            let ydiff = self.y_new[i] - y[i];
+            let ydiff = y_new[i] - y[i];
             let bspl = h * k1[i] - ydiff;
             c0[i] = y[i];
             c1[i] = ydiff;
