@@ -46,6 +46,7 @@ use stf_core::params::{defaults, ParamSpec};
 
 use crate::error::{ScriptError, ScriptLocation};
 use crate::sandbox::{self, BUDGET_TOKEN, MAX_CALL_LEVELS, MAX_OPERATIONS};
+use crate::script_compiled::{self, CompiledFn};
 use crate::script_params::{param_docs, parse_params, to_f64};
 
 /// Most internal states a script may declare.
@@ -80,6 +81,15 @@ pub struct ScriptModel {
     has_added_mass: bool,
     has_initial: bool,
     program: SharedProgram,
+    /// The compiled fast path, when the script is inside its subset.
+    compiled: Option<Compiled>,
+}
+
+/// The hot functions translated to closures ([`crate::script_compiled`]).
+struct Compiled {
+    force: CompiledFn,
+    rates: Option<CompiledFn>,
+    added_mass: Option<CompiledFn>,
 }
 
 /// A failure of a script call: line (if rhai knows it) and message.
@@ -94,6 +104,7 @@ impl std::fmt::Debug for ScriptModel {
             .field("path", &self.path)
             .field("params", &self.specs)
             .field("n_internal", &self.n_internal)
+            .field("compiled", &self.is_compiled())
             .finish()
     }
 }
@@ -121,6 +132,18 @@ impl ScriptModel {
     /// The script's path (or the name given to [`ScriptModel::from_source`]).
     pub fn path(&self) -> &str {
         &self.path
+    }
+
+    /// Whether calls take the compiled fast path (`false`: every call runs on rhai's VM).
+    pub fn is_compiled(&self) -> bool {
+        self.compiled.is_some()
+    }
+
+    /// The same model with the compiled fast path dropped, so every call runs on rhai's VM
+    /// (for comparisons and benchmarks).
+    pub fn vm_only(mut self) -> Self {
+        self.compiled = None;
+        self
     }
 
     fn compile(name: String, path: String, source: &str) -> Result<Self, ScriptError> {
@@ -178,6 +201,7 @@ impl ScriptModel {
             has_initial: has("initial", 1),
             program: Compiler::new().compile(&ast).into_shared(),
             path: path.clone(),
+            compiled: None,
         };
         let runtime = |e: CallError| ScriptError::Runtime {
             at: at(e.line),
@@ -217,6 +241,7 @@ impl ScriptModel {
                 ),
             });
         }
+        model.compiled = model.translate(&ast);
         model
             .check_at_defaults()
             .map_err(|e| ScriptError::Runtime {
@@ -224,6 +249,27 @@ impl ScriptModel {
                 message: e.message,
             })?;
         Ok(model)
+    }
+
+    /// Translate the hot functions to closures; `None` if any is outside the subset.
+    fn translate(&self, ast: &rhai::AST) -> Option<Compiled> {
+        let names: Vec<String> = self.specs.iter().map(|s| s.name.clone()).collect();
+        let force = script_compiled::translate(ast, "force", &names, false)?;
+        let rates = if self.n_internal > 0 {
+            Some(script_compiled::translate(ast, "rates", &names, true)?)
+        } else {
+            None
+        };
+        let added_mass = if self.has_added_mass {
+            Some(script_compiled::translate(ast, "added_mass", &names, false)?)
+        } else {
+            None
+        };
+        Some(Compiled {
+            force,
+            rates,
+            added_mass,
+        })
     }
 
     /// Call every function once at the defaults, from rest, so errors show at load time.
@@ -297,6 +343,14 @@ impl ScriptModel {
     }
 
     fn eval_number(&self, fname: &str, p: &[f64], s: &ModelState) -> Result<f64, CallError> {
+        let compiled = match (&self.compiled, fname) {
+            (Some(c), "force") => Some(&c.force),
+            (Some(c), "added_mass") => c.added_mass.as_ref(),
+            _ => None,
+        };
+        if let Some(f) = compiled.and_then(|c| c.number(p, s.t, s.x, s.v, s.z)) {
+            return Ok(f);
+        }
         let value = self.call(fname, self.args(p, s))?;
         to_f64(&value).ok_or_else(|| CallError {
             line: None,
@@ -310,6 +364,10 @@ impl ScriptModel {
     fn eval_force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, CallError> {
         let f = self.eval_number("force", p, s)?;
         if self.n_internal > 0 {
+            let rates = self.compiled.as_ref().and_then(|c| c.rates.as_ref());
+            if rates.is_some_and(|r| r.array(p, s.t, s.x, s.v, s.z, dz).is_some()) {
+                return Ok(f);
+            }
             let value = self.call("rates", self.args(p, s))?;
             self.write_array("rates", value, dz)?;
         }
