@@ -77,12 +77,12 @@ fn per_call(model: &dyn ForceModel, p: &[f64], n: usize) -> Duration {
 fn main() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts/power_law.rhai");
     let loaded = ScriptModel::load(&path).expect("script loads");
-    assert!(loaded.is_compiled(), "power_law.rhai takes the compiled path");
-    let vm: Arc<dyn ForceModel> = Arc::new(
-        ScriptModel::load(&path)
-            .expect("script loads")
-            .vm_only(),
+    assert!(
+        loaded.is_compiled(),
+        "power_law.rhai takes the compiled path"
     );
+    let vm: Arc<dyn ForceModel> =
+        Arc::new(ScriptModel::load(&path).expect("script loads").vm_only());
     let compiled: Arc<dyn ForceModel> = Arc::new(loaded);
     let native: Arc<dyn ForceModel> = Arc::new(NativePowerLaw(compiled.params().to_vec()));
     let p = [5.0, 1.6];

@@ -323,6 +323,28 @@ impl Translator<'_> {
             Expr::FloatConstant(x, _) => Some(constant(Val::Float(**x))),
             Expr::BoolConstant(b, _) => Some(constant(Val::Bool(*b))),
             Expr::Unit(_) => Some(constant(Val::Unit)),
+            Expr::DynamicConstant(d, _) if d.is_array() => {
+                if !(tail && self.arrays) {
+                    return None;
+                }
+                // A literal array the optimizer folded: numbers only, else decline.
+                let items = d.clone().into_array().ok()?;
+                let values = items
+                    .iter()
+                    .map(|item| {
+                        item.as_float()
+                            .ok()
+                            .or_else(|| item.as_int().ok().map(|i| i as f64))
+                    })
+                    .collect::<Option<Vec<f64>>>()?;
+                Some(Box::new(move |f| {
+                    if values.len() != f.out.len() {
+                        return Err(Flow::Bail);
+                    }
+                    f.out.copy_from_slice(&values);
+                    Ok(Val::Written)
+                }))
+            }
             Expr::DynamicConstant(d, _) => {
                 let v = if let Ok(i) = d.as_int() {
                     Val::Int(i)
@@ -345,11 +367,8 @@ impl Translator<'_> {
                 }
             }
             Expr::Dot(bin, flags, _) | Expr::Index(bin, flags, _) => {
-                if !flags.is_empty() {
-                    return None;
-                }
                 let is_dot = matches!(expr, Expr::Dot(..));
-                self.chain(&bin.lhs, is_dot, &bin.rhs)
+                self.chain(&bin.lhs, is_dot, *flags, &bin.rhs)
             }
             Expr::FnCall(call, _) => self.call(call, None),
             Expr::Stmt(block) => self.block(block, tail),
@@ -395,13 +414,10 @@ impl Translator<'_> {
     }
 
     /// A chain `base.step…` or `base[step]…`: rhai nests the rest of the chain in the step.
-    fn chain(&mut self, base: &Expr, is_dot: bool, rest: &Expr) -> Option<Node> {
-        let (step, next) = match rest {
-            Expr::Dot(bin, flags, _) if flags.is_empty() => (&bin.lhs, Some((true, &bin.rhs))),
-            Expr::Index(bin, flags, _) if flags.is_empty() => (&bin.lhs, Some((false, &bin.rhs))),
-            Expr::Dot(..) | Expr::Index(..) => return None,
-            step => (step, None),
-        };
+    /// `flags` are those of the node holding `rest`: `BREAK` ends the chain there, `NEGATED`
+    /// (`?.`, `?[`) declines.
+    fn chain(&mut self, base: &Expr, is_dot: bool, flags: ASTFlags, rest: &Expr) -> Option<Node> {
+        let (step, next) = split_chain(flags, rest)?;
         let binding = match base {
             Expr::Variable(var, _, _) if var.2.is_empty() => self.lookup(&var.1),
             _ => None,
@@ -409,11 +425,7 @@ impl Translator<'_> {
         let head: Node = match (binding, is_dot, step) {
             (Some(Binding::Params), true, Expr::Property(prop, _)) => {
                 let index = self.params.iter().position(|n| *n == prop.2.as_str())?;
-                Box::new(move |f| {
-                    f.p.get(index)
-                        .map(|&x| Val::Float(x))
-                        .ok_or(Flow::Bail)
-                })
+                Box::new(move |f| f.p.get(index).map(|&x| Val::Float(x)).ok_or(Flow::Bail))
             }
             (Some(Binding::State), false, Expr::IntegerConstant(i, _)) => {
                 let i = *i;
@@ -436,28 +448,27 @@ impl Translator<'_> {
         };
         match next {
             None => Some(head),
-            Some((next_is_dot, next_rest)) => self.chain_on(head, next_is_dot, next_rest),
+            Some((next_is_dot, next_flags, next_rest)) => {
+                self.chain_on(head, next_is_dot, next_flags, next_rest)
+            }
         }
     }
 
     /// The rest of a chain applied to an already translated value (only method calls).
-    fn chain_on(&mut self, head: Node, is_dot: bool, rest: &Expr) -> Option<Node> {
+    fn chain_on(&mut self, head: Node, is_dot: bool, flags: ASTFlags, rest: &Expr) -> Option<Node> {
         if !is_dot {
             return None;
         }
-        let (step, next) = match rest {
-            Expr::Dot(bin, flags, _) if flags.is_empty() => (&bin.lhs, Some((true, &bin.rhs))),
-            Expr::Index(bin, flags, _) if flags.is_empty() => (&bin.lhs, Some((false, &bin.rhs))),
-            Expr::Dot(..) | Expr::Index(..) => return None,
-            step => (step, None),
-        };
+        let (step, next) = split_chain(flags, rest)?;
         let Expr::MethodCall(call, _) = step else {
             return None;
         };
         let node = self.call(call, Some(head))?;
         match next {
             None => Some(node),
-            Some((next_is_dot, next_rest)) => self.chain_on(node, next_is_dot, next_rest),
+            Some((next_is_dot, next_flags, next_rest)) => {
+                self.chain_on(node, next_is_dot, next_flags, next_rest)
+            }
         }
     }
 
@@ -478,6 +489,24 @@ impl Translator<'_> {
         }
         function(call.name.as_str(), args)
     }
+}
+
+/// The first step of a chain and the rest, if any: `(is_dot, flags, rest)`.
+type ChainRest<'e> = Option<(bool, ASTFlags, &'e Expr)>;
+
+/// Split the `rest` of a chain held by a node with `flags`; `None` for `?.`/`?[`.
+fn split_chain(flags: ASTFlags, rest: &Expr) -> Option<(&Expr, ChainRest<'_>)> {
+    if flags.contains(ASTFlags::NEGATED) {
+        return None;
+    }
+    if flags.contains(ASTFlags::BREAK) {
+        return Some((rest, None));
+    }
+    Some(match rest {
+        Expr::Dot(bin, f, _) => (&bin.lhs, Some((true, *f, &bin.rhs))),
+        Expr::Index(bin, f, _) => (&bin.lhs, Some((false, *f, &bin.rhs))),
+        step => (step, None),
+    })
 }
 
 /// Binary operators rhai evaluates with its built-in fast path.

@@ -261,7 +261,12 @@ impl ScriptModel {
             None
         };
         let added_mass = if self.has_added_mass {
-            Some(script_compiled::translate(ast, "added_mass", &names, false)?)
+            Some(script_compiled::translate(
+                ast,
+                "added_mass",
+                &names,
+                false,
+            )?)
         } else {
             None
         };
@@ -318,7 +323,7 @@ impl ScriptModel {
             let mut cache = cell.borrow_mut();
             if let Some((_, _, map)) = cache
                 .iter()
-                .find(|(id, values, _)| *id == self.id && values == p)
+                .find(|(id, values, _)| *id == self.id && same_bits(values, p))
             {
                 return map.clone();
             }
@@ -442,6 +447,11 @@ impl ForceModel for ScriptModel {
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
         self.eval_force(p, s, dz).map_err(|e| self.model_error(e))
     }
+}
+
+/// Equal bit for bit (so -0.0 and 0.0 get separate parameter maps).
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 fn next_id() -> u64 {
