@@ -730,6 +730,8 @@ fn unary_fn(name: &str) -> Option<UnaryFn> {
             Val::Int(i) => i.checked_abs().map(Val::Int),
             _ => None,
         },
+        // rhai: 0 for ±0.0, an error for NaN, else signum as an integer.
+        #[allow(clippy::redundant_guards)]
         "sign" => |v| match v {
             Val::Float(x) if x == 0.0 => Some(Val::Int(0)),
             Val::Float(x) if x.is_nan() => None,
