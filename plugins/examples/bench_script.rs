@@ -1,5 +1,6 @@
 //! Native vs script power law on the paper's sweep (ω = 0.047·t, t 50→200 s, from rest,
-//! 1 kHz output), plus the per-call cost of the script.
+//! 1 kHz output): the native twin, the script on its compiled fast path, and the same script
+//! forced onto rhai's VM, with ratios and per-call costs.
 //!
 //! `cargo run --release -p stf-plugins --example bench_script`
 
@@ -75,73 +76,50 @@ fn per_call(model: &dyn ForceModel, p: &[f64], n: usize) -> Duration {
 
 fn main() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts/power_law.rhai");
-    let script: Arc<dyn ForceModel> = Arc::new(ScriptModel::load(&path).expect("script loads"));
-    let native: Arc<dyn ForceModel> = Arc::new(NativePowerLaw(script.params().to_vec()));
+    let loaded = ScriptModel::load(&path).expect("script loads");
+    assert!(
+        loaded.is_compiled(),
+        "power_law.rhai takes the compiled path"
+    );
+    let vm: Arc<dyn ForceModel> =
+        Arc::new(ScriptModel::load(&path).expect("script loads").vm_only());
+    let compiled: Arc<dyn ForceModel> = Arc::new(loaded);
+    let native: Arc<dyn ForceModel> = Arc::new(NativePowerLaw(compiled.params().to_vec()));
     let p = [5.0, 1.6];
     let reps = 3;
 
-    // The same law with a branch instead of abs/sign: fewer rhai operations, same bits.
-    let branchy: Arc<dyn ForceModel> = Arc::new(
-        ScriptModel::from_source(
-            "power_law_branch",
-            "fn params() { #{ K: [5.0, 0.0, 1e3, \"\"], n: [1.6, 0.1, 4.0, \"\"] } }\n\
-             fn force(p, t, x, v, z) { if v < 0.0 { -(p.K * (-v) ** p.n) } else { p.K * v ** p.n } }",
-        )
-        .expect("script loads"),
-    );
     // Interleaved, best of `reps`, so the machine's load hits all alike.
-    let (mut run_n, mut t_n) = best(&native, &p, 1);
-    let (mut run_s, mut t_s) = best(&script, &p, 1);
-    let (_, mut t_b) = best(&branchy, &p, 1);
-    for _ in 1..reps {
-        let (r, t) = best(&native, &p, 1);
-        if t < t_n {
-            (run_n, t_n) = (r, t);
+    let models = [("native", &native), ("compiled", &compiled), ("VM", &vm)];
+    let mut runs: Vec<Option<(Trajectory, Duration)>> = vec![None, None, None];
+    for _ in 0..reps {
+        for (slot, (_, model)) in runs.iter_mut().zip(&models) {
+            let (run, dt) = best(model, &p, 1);
+            if slot.as_ref().is_none_or(|(_, b)| dt < *b) {
+                *slot = Some((run, dt));
+            }
         }
-        let (r, t) = best(&script, &p, 1);
-        if t < t_s {
-            (run_s, t_s) = (r, t);
-        }
-        t_b = t_b.min(best(&branchy, &p, 1).1);
     }
-    let calls = run_s.stats.rhs_calls;
-    let dx = run_n
-        .x
-        .iter()
-        .zip(&run_s.x)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let runs: Vec<(Trajectory, Duration)> = runs.into_iter().map(|r| r.expect("ran")).collect();
+    let (run_n, t_n) = &runs[0];
     println!("sweep t 50→200 s, ω = 0.047·t, 1 kHz out, power_law K = 5, n = 1.6 (best of {reps})");
-    println!(
-        "  native: {:>9.1} ms  {} RHS calls",
-        t_n.as_secs_f64() * 1e3,
-        run_n.stats.rhs_calls
-    );
-    println!(
-        "  script: {:>9.1} ms  {} RHS calls",
-        t_s.as_secs_f64() * 1e3,
-        calls
-    );
-    println!(
-        "  ratio script/native: {:.2}×   max |Δx| = {dx:.2e} m",
-        t_s.as_secs_f64() / t_n.as_secs_f64()
-    );
-    println!(
-        "  script with a branch instead of abs/sign: {:.1} ms, ratio {:.2}×",
-        t_b.as_secs_f64() * 1e3,
-        t_b.as_secs_f64() / t_n.as_secs_f64()
-    );
-    println!(
-        "  per RHS call: native {:.1} ns, script {:.1} ns (whole sweep / RHS calls)",
-        t_n.as_secs_f64() * 1e9 / run_n.stats.rhs_calls as f64,
-        t_s.as_secs_f64() * 1e9 / calls as f64
-    );
     let n = 1_000_000;
     let c_n = per_call(native.as_ref(), &p, n);
-    let c_s = per_call(script.as_ref(), &p, n);
-    println!(
-        "  one force() call: native {:.1} ns, script {:.1} ns ({:.0}×)",
-        c_n.as_secs_f64() * 1e9,
-        c_s.as_secs_f64() * 1e9,
-        c_s.as_secs_f64() / c_n.as_secs_f64()
-    );
+    for ((name, model), (run, t)) in models.iter().zip(&runs) {
+        let dx = run_n
+            .x
+            .iter()
+            .zip(&run.x)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let c = per_call(model.as_ref(), &p, n);
+        println!(
+            "  {name:>8}: {:>8.1} ms  {:>6} RHS calls  {:>6.2}× native  max |Δx| = {dx:.1e} m  \
+             sweep/RHS {:>6.1} ns  one force() {:>6.1} ns ({:.1}× native)",
+            t.as_secs_f64() * 1e3,
+            run.stats.rhs_calls,
+            t.as_secs_f64() / t_n.as_secs_f64(),
+            t.as_secs_f64() * 1e9 / run.stats.rhs_calls as f64,
+            c.as_secs_f64() * 1e9,
+            c.as_secs_f64() / c_n.as_secs_f64(),
+        );
+    }
 }

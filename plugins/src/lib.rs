@@ -14,6 +14,7 @@
 pub mod error;
 pub mod registry;
 pub mod sandbox;
+mod script_compiled;
 pub mod script_model;
 mod script_params;
 
