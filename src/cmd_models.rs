@@ -4,8 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
+use stf_core::force_model::ForceModel;
 use stf_core::params::ParamSpec;
-use stf_plugins::registry::{check_script, Registry};
+use stf_plugins::registry::Registry;
+use stf_plugins::ScriptModel;
 
 fn print_params(params: &[ParamSpec]) {
     for p in params {
@@ -39,8 +41,18 @@ pub fn list(script_dir: Option<&Path>) -> Result<()> {
 
 /// Validate a script and print its parameters, or fail with the script's error.
 pub fn check(path: &Path) -> Result<()> {
-    let params = check_script(path)?;
-    println!("{}: ok, {} parameter(s)", path.display(), params.len());
-    print_params(&params);
+    let model = ScriptModel::load(path)?;
+    let params = model.params();
+    let path_taken = if model.is_compiled() {
+        "compiled to native closures (fast path)"
+    } else {
+        "runs on the rhai VM (uses constructs outside the compiled subset)"
+    };
+    println!(
+        "{}: ok, {} parameter(s); {path_taken}",
+        path.display(),
+        params.len()
+    );
+    print_params(params);
     Ok(())
 }
