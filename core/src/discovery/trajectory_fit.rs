@@ -65,7 +65,9 @@ impl Rig<'_> {
         let osc = Oscillator::with_shared_excitation(system, self.excitation.clone())
             .with_model(model.clone(), values[n_osc..n_osc + n_model].to_vec())
             .map_err(|e| e.to_string())?;
-        let (x0, v0) = self.initial.unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
+        let (x0, v0) = self
+            .initial
+            .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
         let sim = Simulation::new(&osc)
             .settings(self.sim.clone())
             .initial(x0 - offset, v0)
