@@ -300,7 +300,11 @@ fn refitted(exp: &Experiment, data: &FitData) -> Vec<String> {
     }
     let k = &data.kinematics;
     let rotor = k.phi.is_some() || k.omega.is_some();
-    let names: &[&str] = if rotor { &["k", "c", "T"] } else { &["m", "k", "c"] };
+    let names: &[&str] = if rotor {
+        &["k", "c", "T"]
+    } else {
+        &["m", "k", "c"]
+    };
     names.iter().map(|s| s.to_string()).collect()
 }
 
@@ -363,11 +367,11 @@ fn run_trajectory(
         .collect();
     toml_entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
     let system_entry: String = std::iter::once("[system]\n".to_string())
-        .chain(names.iter().filter_map(|n| {
-            tf.system_after
-                .get(n)
-                .map(|v| format!("{n} = {v}\n"))
-        }))
+        .chain(
+            names
+                .iter()
+                .filter_map(|n| tf.system_after.get(n).map(|v| format!("{n} = {v}\n"))),
+        )
         .collect();
     let doc = json!({
         "experiment": exp.path.display().to_string(),

@@ -878,7 +878,7 @@ impl Experiment {
                                 at..at,
                                 "discover.level",
                                 format!("unknown level `{other}`; known: force, trajectory"),
-                            ))
+                            ));
                         }
                     },
                     base: d.base,
