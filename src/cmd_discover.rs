@@ -5,7 +5,9 @@
 //! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`) not
 //! already in the base, plus any scripts `[discover] candidates` lists. Writes
 //! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
-//! scores, and the final model as an experiment entry), a report and figures.
+//! scores, and the final model as an experiment entry), a report and figures. A record
+//! without `f_stf` (or `[discover] level = "trajectory"`) is discovered at trajectory level
+//! (`run_trajectory`).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -13,12 +15,15 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
-use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
+use stf_core::discovery::{
+    discover_force, discover_trajectory, Candidate, DiscoverySettings, TrajectorySetup,
+};
+use stf_core::fit::TrajectoryData;
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, load_data};
+use crate::fitting::{finite_or_null, load_data, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
 use crate::report::{measured_vs_fitted, FigureRef, Section, Table};
@@ -54,12 +59,15 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             exp_path.display()
         );
     };
-    let data = load_data(&exp)?;
-    if data.level != FitLevel::Force {
-        bail!(
-            "{}: discovery works on the measured STF force; the record needs `f_stf`",
-            exp_path.display()
-        );
+    let mut data = load_data(&exp)?;
+    if let Some(level) = spec.level {
+        if level == FitLevel::Force && data.record.f_stf.is_none() {
+            bail!(
+                "{}: `discover.level = \"force\"` needs an `f_stf` column in the record",
+                exp_path.display()
+            );
+        }
+        data.level = level;
     }
     prepare_dir(out, force)?;
     let base = model_from(&spec.base, &exp.dir)
@@ -90,6 +98,18 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             spec.base,
             candidates.len(),
             cycles.len()
+        );
+    }
+    if data.level == FitLevel::Trajectory {
+        return run_trajectory(
+            &exp,
+            &data,
+            base,
+            &candidates,
+            &cycles,
+            &settings,
+            out,
+            quiet,
         );
     }
     let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings)?;
@@ -269,5 +289,175 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "wrote {0}/discovery.json, {0}/report.html, {0}/report.md and {0}/figures/",
         out.display()
     );
+    Ok(())
+}
+
+/// The oscillator parameters refitted with every model at trajectory level: `[fit] system`,
+/// or `m`, `k`, `c` for a rig driven by a measured force `u`, `k`, `c`, `T` for the rotor.
+fn refitted(exp: &Experiment, data: &FitData) -> Vec<String> {
+    if !exp.fit.system_free.is_empty() {
+        return exp.fit.system_free.clone();
+    }
+    let k = &data.kinematics;
+    let rotor = k.phi.is_some() || k.omega.is_some();
+    let names: &[&str] = if rotor {
+        &["k", "c", "T"]
+    } else {
+        &["m", "k", "c"]
+    };
+    names.iter().map(|s| s.to_string()).collect()
+}
+
+/// `discover` at trajectory level: the simulated oscillator against the measured x.
+#[allow(clippy::too_many_arguments)]
+fn run_trajectory(
+    exp: &Experiment,
+    data: &FitData,
+    base: Arc<dyn ForceModel>,
+    candidates: &[Candidate],
+    cycles: &[stf_core::regimes::Cycle],
+    settings: &DiscoverySettings,
+    out: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let Some(spec) = &exp.discover else {
+        bail!("{}: has no [discover] section", exp.path.display());
+    };
+    let k = &data.kinematics;
+    let names = refitted(exp, data);
+    let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
+        .sim_settings(exp.integrator.clone())
+        .initial(k.x[0], k.v[0]);
+    for name in &names {
+        setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
+    }
+    let settings = settings.clone().fit_offset(exp.fit.offset);
+    let started = Instant::now();
+    if !quiet {
+        eprintln!(
+            "discovering from `{}` at trajectory level (refitting {}) over {} candidates on {} \
+             cycles…",
+            spec.base,
+            names.join(", "),
+            candidates.len(),
+            cycles.len()
+        );
+    }
+    let td = TrajectoryData {
+        t: &data.record.t,
+        x: &data.record.x,
+    };
+    let tf = discover_trajectory(base, candidates, &td, cycles, &setup, &settings)?;
+    let wall = started.elapsed().as_secs_f64();
+    let found = &tf.discovery;
+    let model_params: Vec<&stf_core::fit::FittedParam> = found
+        .final_params
+        .iter()
+        .filter(|p| !names.contains(&p.name) && p.name != "x_off")
+        .collect();
+    let parts: Vec<&str> = found.final_model_name.split(" + ").collect();
+    let mut toml_entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
+    if parts.len() > 1 {
+        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
+        toml_entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
+    }
+    let values: Vec<String> = model_params
+        .iter()
+        .map(|p| format!("\"{}\" = {}", p.name, p.value))
+        .collect();
+    toml_entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
+    let system_entry: String = std::iter::once("[system]\n".to_string())
+        .chain(
+            names
+                .iter()
+                .filter_map(|n| tf.system_after.get(n).map(|v| format!("{n} = {v}\n"))),
+        )
+        .collect();
+    let doc = json!({
+        "experiment": exp.path.display().to_string(),
+        "record": data.record.source,
+        "level": "trajectory",
+        "base": spec.base,
+        "effects": found.effects,
+        "gap_before": found.gap_before,
+        "gap_after": found.gap_after,
+        "noise_floor": found.noise_floor,
+        "gap_unit": "m",
+        "s_before_mm2": tf.s_before_mm2,
+        "s_after_mm2": tf.s_after_mm2,
+        "holdout_cycles": found.holdout_cycles,
+        "where_before": found.where_before,
+        "where_after": found.where_after,
+        "steps": found.steps,
+        "refitted": names,
+        "system_before": tf.system_before,
+        "system": tf.system_after,
+        "final_model": {
+            "name": found.final_model_name,
+            "params": model_params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
+            "std_errors": found.final_params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "system": names.iter().filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), json!(v)))).collect::<serde_json::Map<_, _>>(),
+            "experiment_entry": toml_entry,
+            "system_entry": system_entry,
+        },
+        "wall_seconds": wall,
+        "notes": found.notes,
+    });
+    write_json(&out.join("discovery.json"), &doc)?;
+    if exp.output.report {
+        let dir = out.join("figures");
+        std::fs::create_dir_all(&dir)?;
+        let mut s = Section::new("Discovery (trajectory level)");
+        s.paragraphs.extend(found.notes.iter().cloned());
+        let fig = measured_vs_fitted(
+            &dir,
+            "discovery_x",
+            &data.record.t,
+            &data.record.x,
+            &[("base", &tf.x_before), ("final", &tf.x_after)],
+        )?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "Measured displacement against the simulated base and final model.",
+        ));
+        let mut sections = vec![s];
+        sections.extend(record_sections(data, &[], out)?);
+        write_report(
+            &format!("Discovery: {}", exp.path.display()),
+            vec![format!(
+                "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor \
+                 {:.4} mm).",
+                if found.effects.is_empty() {
+                    "none".to_string()
+                } else {
+                    found.effects.join(", ")
+                },
+                tf.s_before_mm2,
+                tf.s_after_mm2,
+                found.gap_before * 1e3,
+                found.gap_after * 1e3,
+                found.noise_floor * 1e3
+            )],
+            sections,
+            out,
+        )?;
+    }
+    for step in &found.steps {
+        println!("  {}", step.verdict);
+    }
+    println!(
+        "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
+        if found.effects.is_empty() {
+            "none".to_string()
+        } else {
+            found.effects.join(", ")
+        },
+        tf.s_before_mm2,
+        tf.s_after_mm2,
+        found.noise_floor * 1e3,
+        wall
+    );
+    println!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
+    println!("wrote {}/discovery.json", out.display());
     Ok(())
 }

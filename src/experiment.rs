@@ -249,6 +249,7 @@ struct RawDiscover {
     candidates: Option<Vec<String>>,
     max_effects: Option<usize>,
     holdout_every: Option<usize>,
+    level: Option<String>,
 }
 
 /// A validated `[discover]` section.
@@ -262,6 +263,9 @@ pub struct DiscoverSpec {
     pub max_effects: Option<usize>,
     /// Every k-th cycle is held out for scoring.
     pub holdout_every: Option<usize>,
+    /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
+    /// `f_stf`.
+    pub level: Option<FitLevel>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -861,12 +865,28 @@ impl Experiment {
             integrator,
             models,
             simulate,
-            discover: raw.discover.map(|d| DiscoverSpec {
-                base: d.base,
-                candidates: d.candidates,
-                max_effects: d.max_effects,
-                holdout_every: d.holdout_every,
-            }),
+            discover: match raw.discover {
+                None => None,
+                Some(d) => Some(DiscoverSpec {
+                    level: match d.level.as_deref() {
+                        None => None,
+                        Some("force") => Some(FitLevel::Force),
+                        Some("trajectory") => Some(FitLevel::Trajectory),
+                        Some(other) => {
+                            let at = text.find("[discover]").unwrap_or(0);
+                            return Err(cx.at(
+                                at..at,
+                                "discover.level",
+                                format!("unknown level `{other}`; known: force, trajectory"),
+                            ));
+                        }
+                    },
+                    base: d.base,
+                    candidates: d.candidates,
+                    max_effects: d.max_effects,
+                    holdout_every: d.holdout_every,
+                }),
+            },
         })
     }
 }

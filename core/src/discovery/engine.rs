@@ -451,7 +451,7 @@ pub fn discover_force(
 /// below the upper one: a refit that starts on an upper bound (an exponent fitted to its
 /// largest value) starts where the bound's change of variables is flat and cannot leave it.
 /// Lower bounds are left alone: 0 is a common, meaningful value there.
-fn inside(v: f64, min: f64, max: f64) -> f64 {
+pub(super) fn inside(v: f64, min: f64, max: f64) -> f64 {
     let v = v.clamp(min, max);
     if min.is_finite() && max.is_finite() {
         v.min(max - 0.01 * (max - min))

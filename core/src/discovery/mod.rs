@@ -14,6 +14,10 @@
 //! 4. repeat until nothing is significant or `max_effects` are added;
 //! 5. refit the final model on the whole record: gap (RMS residual) before and after.
 //!
+//! At trajectory level (records with a measured displacement only), [`discover_trajectory`]
+//! runs the same workflow on the simulated oscillator against the measured x, refitting the
+//! oscillator's own parameters with every model ([`trajectory`]).
+//!
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
 //! DESIGN.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
 //!
@@ -29,6 +33,9 @@ pub mod report;
 pub mod score;
 pub mod settings;
 mod subset_fit;
+pub mod trajectory;
+mod trajectory_fit;
+mod trajectory_gap;
 
 pub use candidate::Candidate;
 pub use engine::discover_force;
@@ -38,3 +45,4 @@ pub use holdout::HoldoutSplit;
 pub use report::Discovery;
 pub use score::{CandidateScore, Step};
 pub use settings::DiscoverySettings;
+pub use trajectory::{discover_trajectory, TrajectoryDiscovery, TrajectorySetup};

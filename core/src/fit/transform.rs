@@ -89,7 +89,13 @@ impl BoundTransform {
             (true, true) => {
                 let width = max - min;
                 let nudge = 1e-3 * width;
-                let x0 = x0.clamp(min + nudge, max - nudge);
+                // Only a start on (or outside) a bound is nudged: a nudge of 1e-3 of a wide box
+                // (1e6 for [0, 1e9]) would move a start inside it far away.
+                let x0 = if x0 > min && x0 < max {
+                    x0
+                } else {
+                    x0.clamp(min + nudge, max - nudge)
+                };
                 let scale = scale.min(0.25 * width).min(x0 - min).min(max - x0);
                 let s0 = (x0 - min) / width;
                 let w0 = (s0 / (1.0 - s0)).ln();

@@ -1,0 +1,150 @@
+//! A trajectory-level fit scored on a subset of the samples: the oscillator (some of its
+//! parameters free) with an STF model, simulated through the whole record, its displacement
+//! compared with the measured one at the chosen samples only.
+//!
+//! The simulation always runs through the whole record, so the held-out cycles are driven by
+//! the same history as in reality, and the residuals of any samples can be read off one run.
+//! Parameters are, in order: the oscillator's free ones (by [`OscillatorParams`] name), every
+//! parameter of the model (in its order), then the displacement offset `x_off` if fitted.
+
+use std::sync::Arc;
+
+use crate::excitation::Excitation;
+use crate::fit::{fit_residuals, FitError, FitParam, FitResult, FitSettings, Residuals};
+use crate::force_model::ForceModel;
+use crate::integrate::Settings;
+use crate::oscillator::Oscillator;
+use crate::simulate::{Simulation, Trajectory};
+use crate::system::OscillatorParams;
+
+/// The oscillator side of a trajectory-level fit: everything but the STF model.
+#[derive(Clone)]
+pub(super) struct Rig<'a> {
+    pub system: OscillatorParams,
+    pub excitation: Arc<Excitation>,
+    /// Names of the oscillator parameters that are fitted (the first parameters).
+    pub oscillator: Vec<&'a str>,
+    pub initial: Option<(f64, f64)>,
+    pub sim: Settings,
+    pub fit_offset: bool,
+    pub t: &'a [f64],
+    pub x: &'a [f64],
+}
+
+/// One evaluation: the model's simulated motion and the displacement residual.
+pub(super) struct Run {
+    pub sim: Trajectory,
+    /// Measured − simulated x (with the offset) at every sample, m.
+    pub residual: Vec<f64>,
+}
+
+impl Rig<'_> {
+    /// Simulate `model` on the rig with the full parameter vector `values` (oscillator's,
+    /// model's, offset).
+    pub fn run(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Run, String> {
+        let n_osc = self.oscillator.len();
+        let n_model = model.params().len();
+        if values.len() != n_osc + n_model + usize::from(self.fit_offset) {
+            return Err(format!(
+                "expected {} parameter values, got {}",
+                n_osc + n_model + usize::from(self.fit_offset),
+                values.len()
+            ));
+        }
+        let mut system = self.system;
+        for (name, &v) in self.oscillator.iter().zip(values) {
+            if !system.set(name, v) {
+                return Err(format!("`{name}` is not an oscillator parameter"));
+            }
+        }
+        let offset = if self.fit_offset {
+            values[n_osc + n_model]
+        } else {
+            0.0
+        };
+        let osc = Oscillator::with_shared_excitation(system, self.excitation.clone())
+            .with_model(model.clone(), values[n_osc..n_osc + n_model].to_vec())
+            .map_err(|e| e.to_string())?;
+        let (x0, v0) = self
+            .initial
+            .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
+        let sim = Simulation::new(&osc)
+            .settings(self.sim.clone())
+            .initial(x0 - offset, v0)
+            .run_at(self.t)
+            .map_err(|e| e.to_string())?;
+        if sim.x.len() != self.x.len() {
+            return Err("the simulation returned too few samples".into());
+        }
+        let residual: Vec<f64> = self
+            .x
+            .iter()
+            .zip(&sim.x)
+            .map(|(m, s)| m - s - offset)
+            .collect();
+        if let Some(i) = residual.iter().position(|r| !r.is_finite()) {
+            return Err(format!("non-finite displacement at sample {i}"));
+        }
+        Ok(Run { sim, residual })
+    }
+
+    /// The oscillator's parameters with the fitted values of `values` set.
+    pub fn system_of(&self, values: &[f64]) -> OscillatorParams {
+        let mut system = self.system;
+        for (name, &v) in self.oscillator.iter().zip(values) {
+            system.set(name, v);
+        }
+        system
+    }
+}
+
+/// The residuals of the rig with `model` at the samples `subset`.
+struct SubsetProblem<'a> {
+    rig: &'a Rig<'a>,
+    model: &'a Arc<dyn ForceModel>,
+    params: &'a [FitParam],
+    subset: &'a [usize],
+}
+
+impl Residuals for SubsetProblem<'_> {
+    fn len(&self) -> usize {
+        self.subset.len()
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        let mut free = x.iter();
+        let mut full = Vec::with_capacity(self.params.len());
+        for p in self.params {
+            full.push(if p.fixed {
+                p.value
+            } else {
+                *free.next().ok_or("too few free values")?
+            });
+        }
+        let run = self.rig.run(self.model, &full)?;
+        for (k, &i) in self.subset.iter().enumerate() {
+            sink(k, run.residual[i]);
+        }
+        Ok(())
+    }
+}
+
+/// Fit `params` (all of them, in the rig's order) of `model` on the rig at the samples
+/// `subset`; statistics are those of the subset, and `s_mm2` is set.
+pub(super) fn fit_on(
+    rig: &Rig,
+    model: &Arc<dyn ForceModel>,
+    params: &[FitParam],
+    subset: &[usize],
+    settings: &FitSettings,
+) -> Result<FitResult, FitError> {
+    let problem = SubsetProblem {
+        rig,
+        model,
+        params,
+        subset,
+    };
+    let mut result = fit_residuals(&problem, params, settings, None)?;
+    result.s_mm2 = Some(result.rms * result.rms * 1e6);
+    Ok(result)
+}
