@@ -41,8 +41,7 @@ mod plot_range;
 mod regime_errors;
 mod series_csv;
 mod smoothing;
-#[cfg(test)]
-pub(crate) mod test_signals;
+pub mod test_signals;
 mod time_history;
 
 pub use atomic::write_atomic as write_file_atomic;
