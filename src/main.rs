@@ -8,31 +8,13 @@
 //! stf-lab discover EXP.toml --out DIR     find, name and add the missing effect
 //! ```
 
-// `!(a > b)` is how this program says "not greater, or NaN": the NaN case is meant.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![deny(clippy::unwrap_used)]
-
-mod cmd_compare;
-mod cmd_discover;
-mod cmd_fit;
-mod cmd_models;
-mod cmd_simulate;
-mod experiment;
-mod fitting;
-mod interrupt;
-mod model_config;
-mod output;
-mod progress;
-// The figure library exports more than the commands use yet (decimation, extrema, CSV
-// readers are used by its tests and the browser test).
-#[allow(dead_code, unused_imports)]
-mod report;
-mod reporting;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use stf_lab::{cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt};
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.
 #[derive(Parser)]

@@ -39,8 +39,8 @@ fn write_record(path: &std::path::Path, k3: f64) {
     let rec = sample_record(&run, &SensorNoise::RIG, 7, false);
     let u = rec.u.unwrap();
     let mut csv = String::from("t,x,u\n");
-    for i in 0..rec.t.len() {
-        csv.push_str(&format!("{},{},{}\n", rec.t[i], rec.x[i], u[i]));
+    for ((t, x), u) in rec.t.iter().zip(&rec.x).zip(&u) {
+        csv.push_str(&format!("{t},{x},{u}\n"));
     }
     std::fs::write(path, csv).unwrap();
 }

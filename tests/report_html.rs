@@ -6,17 +6,13 @@
 //! Set `STF_REPORT_TEST_OUT=DIR` to keep the report, its figures and the browser's screenshot
 //! in DIR for a look.
 
-// The report module lives in the binary crate; the test compiles it in directly.
-#[path = "../src/report/mod.rs"]
-#[allow(dead_code, unused_imports)]
-mod report;
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use report::test_signals::damped_sine;
-use report::{FigureRef, Motion, Report, Section, Table};
+use stf_lab::report;
+use stf_lab::report::test_signals::damped_sine;
+use stf_lab::report::{FigureRef, Motion, Report, Section, Table};
 
 fn find_chromium() -> Option<PathBuf> {
     let path = std::env::var_os("PATH")?;

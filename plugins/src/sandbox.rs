@@ -5,13 +5,16 @@
 //! `eval` disabled with a module resolver that resolves nothing, `print`/`debug` discarded,
 //! strict variables (an undefined name is a compile error), and limits on call depth, string,
 //! array and map sizes. Each call to a script function gets a budget of
-//! [`MAX_OPERATIONS`] operations, so a script that loops forever is stopped with an error.
+//! [`MAX_OPERATIONS`] operations and [`MAX_CALL_SECONDS`] of wall-clock time (checked every
+//! [`DEADLINE_CHECK_EVERY`] operations), so a script that loops forever, or one whose every
+//! operation is slow (large strings and arrays under the size limits), is stopped with an error.
 //!
 //! Calls run on rhai's `grain` bytecode VM. A VM is reused per thread (it keeps its function
 //! resolution cache), so no lock is taken on the hot path and models stay `Send + Sync`.
 
 use std::cell::{Cell, RefCell};
 use std::sync::OnceLock;
+use std::time::{Duration, Instant};
 
 use rhai::grain::Vm;
 use rhai::module_resolvers::DummyModuleResolver;
@@ -19,6 +22,13 @@ use rhai::{Dynamic, Engine};
 
 /// Operations one call of a script function may perform before it is stopped.
 pub const MAX_OPERATIONS: u64 = 1_000_000;
+/// Wall-clock seconds one call of a script function may take before it is stopped.
+pub const MAX_CALL_SECONDS: f64 = 1.0;
+/// Operations between two looks at the clock. One look (≈ 20 ns) costs about as much as a
+/// simple operation, so this adds ≈ 1 % to a call; one operation on data at the size limits
+/// (`contains` or `sort` on a 10 000-element array) takes up to a few milliseconds, so the
+/// call stops well within a second past its deadline.
+pub const DEADLINE_CHECK_EVERY: u64 = 16;
 /// Deepest nesting of script function calls.
 pub const MAX_CALL_LEVELS: usize = 32;
 /// Longest string a script may build, in bytes.
@@ -30,12 +40,18 @@ pub const MAX_MAP_SIZE: usize = 1_000;
 
 /// The token of the error raised when a call exceeds its operation budget.
 pub(crate) const BUDGET_TOKEN: &str = "operation budget exceeded";
+/// The token of the error raised when a call exceeds its wall-clock deadline.
+pub(crate) const DEADLINE_TOKEN: &str = "call deadline exceeded";
 
 thread_local! {
     /// Operation count of this thread's VM when the current call started.
     static OPS_BASE: Cell<u64> = const { Cell::new(0) };
     /// Last operation count this thread's VM reported.
     static OPS_LAST: Cell<u64> = const { Cell::new(0) };
+    /// Operation count at which the current call looks at the clock next.
+    static NEXT_CLOCK_CHECK: Cell<u64> = const { Cell::new(0) };
+    /// When the current call must be finished.
+    static DEADLINE: Cell<Option<Instant>> = const { Cell::new(None) };
     /// This thread's VM, reused from call to call.
     static VM: RefCell<Option<Vm<'static>>> = const { RefCell::new(None) };
 }
@@ -63,14 +79,29 @@ fn build_engine() -> Engine {
         .on_progress(|count| {
             OPS_LAST.with(|last| last.set(count));
             let used = count.saturating_sub(OPS_BASE.with(Cell::get));
-            (used > MAX_OPERATIONS).then(|| Dynamic::from(BUDGET_TOKEN))
+            if used > MAX_OPERATIONS {
+                return Some(Dynamic::from(BUDGET_TOKEN));
+            }
+            past_deadline(count).then(|| Dynamic::from(DEADLINE_TOKEN))
         })
         .on_print(|_| {})
         .on_debug(|_, _, _| {});
     engine
 }
 
-/// Run `f` with this thread's VM and a fresh operation budget.
+/// Whether the current call is past its deadline; looks at the clock only once every
+/// [`DEADLINE_CHECK_EVERY`] operations (`count` is the VM's operation counter).
+fn past_deadline(count: u64) -> bool {
+    if count < NEXT_CLOCK_CHECK.with(Cell::get) {
+        return false;
+    }
+    NEXT_CLOCK_CHECK.with(|next| next.set(count.saturating_add(DEADLINE_CHECK_EVERY)));
+    DEADLINE
+        .with(Cell::get)
+        .is_some_and(|deadline| Instant::now() > deadline)
+}
+
+/// Run `f` with this thread's VM, a fresh operation budget and a fresh deadline.
 ///
 /// Returns `None` if the VM is already in use on this thread (a script model called from
 /// inside a script call, which the host never does).
@@ -81,7 +112,11 @@ pub(crate) fn with_vm<R>(f: impl FnOnce(&mut Vm<'static>) -> R) -> Option<R> {
             OPS_LAST.with(|last| last.set(0));
             Vm::new(engine())
         });
-        OPS_BASE.with(|base| base.set(OPS_LAST.with(Cell::get)));
+        let base = OPS_LAST.with(Cell::get);
+        OPS_BASE.with(|b| b.set(base));
+        NEXT_CLOCK_CHECK.with(|next| next.set(base.saturating_add(DEADLINE_CHECK_EVERY)));
+        let deadline = Instant::now().checked_add(Duration::from_secs_f64(MAX_CALL_SECONDS));
+        DEADLINE.with(|d| d.set(deadline));
         Some(f(vm))
     })
 }

@@ -59,7 +59,9 @@ use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::{defaults, ParamSpec};
 
 use crate::error::{ScriptError, ScriptLocation};
-use crate::sandbox::{self, BUDGET_TOKEN, MAX_CALL_LEVELS, MAX_OPERATIONS};
+use crate::sandbox::{
+    self, BUDGET_TOKEN, DEADLINE_TOKEN, MAX_CALL_LEVELS, MAX_CALL_SECONDS, MAX_OPERATIONS,
+};
 use crate::script_compiled::{self, CompiledFn};
 use crate::script_params::{param_docs, parse_params, to_f64};
 
@@ -95,6 +97,9 @@ pub struct ScriptModel {
     has_added_mass: bool,
     has_initial: bool,
     program: SharedProgram,
+    /// Line of each contract function the script defines: where an error is reported when
+    /// rhai's bytecode VM gives no position (stopped calls, data too large, deep recursion).
+    fn_lines: Vec<(&'static str, usize)>,
     /// The compiled fast path, when the script is inside its subset.
     compiled: Option<Compiled>,
 }
@@ -215,6 +220,10 @@ impl ScriptModel {
             has_initial: has("initial", 1),
             program: Compiler::new().compile(&ast).into_shared(),
             path: path.clone(),
+            fn_lines: CONTRACT
+                .iter()
+                .filter_map(|(fname, ..)| Some((*fname, fn_line(source, fname)?)))
+                .collect(),
             compiled: None,
         };
         let runtime = |e: CallError| ScriptError::Runtime {
@@ -329,6 +338,14 @@ impl ScriptModel {
             message: format!("fn {fname} called re-entrantly on one thread"),
         })?
         .map_err(|e| describe(*e, fname))
+        .map_err(|e| CallError {
+            line: e.line.or_else(|| {
+                self.fn_lines
+                    .iter()
+                    .find_map(|(name, line)| (*name == fname).then_some(*line))
+            }),
+            message: e.message,
+        })
     }
 
     /// The parameter map for `p`, cached per thread.
@@ -511,6 +528,16 @@ fn describe(err: EvalAltResult, fname: &str) -> CallError {
             if token.clone().into_string().is_ok_and(|t| t == BUDGET_TOKEN) =>
         {
             format!("stopped after {MAX_OPERATIONS} operations in one call (an endless loop?)")
+        }
+        EvalAltResult::ErrorTerminated(token, _)
+            if token
+                .clone()
+                .into_string()
+                .is_ok_and(|t| t == DEADLINE_TOKEN) =>
+        {
+            format!(
+                "stopped after {MAX_CALL_SECONDS} s in one call (an endless loop, or too slow?)"
+            )
         }
         EvalAltResult::ErrorStackOverflow(_) => {
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")

@@ -201,6 +201,42 @@ fn sandbox_has_no_file_access() {
 }
 
 #[test]
+fn sandbox_cannot_write_files_or_spawn_processes() {
+    let src = format!(
+        "{PARAMS}fn force(p, t, x, v, z) {{\n  write_file(\"/tmp/owned\", \"x\");\n  0.0\n}}"
+    );
+    assert_names(
+        &load_err("writes.rhai", &src),
+        "writes.rhai",
+        Some(3),
+        "write_file",
+    );
+    let src =
+        format!("{PARAMS}fn force(p, t, x, v, z) {{\n  0.0\n}}\nfn rates(p, t, x, v, z) {{\n  system(\"rm -rf /\")\n}}\nfn n_internal() {{ 1 }}");
+    assert_names(
+        &load_err("spawns.rhai", &src),
+        "spawns.rhai",
+        Some(6),
+        "system",
+    );
+}
+
+#[test]
+fn sandbox_stops_a_call_past_its_deadline_even_under_the_operation_budget() {
+    // Each `contains` on a 10 000-element array is one operation of ~10 µs or more: the
+    // operation budget alone would let this run for many seconds.
+    let src = format!(
+        "{PARAMS}fn force(p, t, x, v, z) {{\n  let a = [];\n  a.pad(10000, 1.0);\n  loop {{ a.contains(2.0); }}\n}}"
+    );
+    assert_names(
+        &load_err("slow.rhai", &src),
+        "slow.rhai",
+        Some(2),
+        &format!("stopped after {} s", stf_plugins::sandbox::MAX_CALL_SECONDS),
+    );
+}
+
+#[test]
 fn sandbox_refuses_import_and_eval() {
     let src = format!("import \"os\" as os;\n{PARAMS}fn force(p, t, x, v, z) {{ 0.0 }}");
     assert_names(
@@ -219,7 +255,7 @@ fn sandbox_stops_endless_loops() {
     assert_names(
         &load_err("loops.rhai", &src),
         "loops.rhai",
-        None,
+        Some(2),
         "operations",
     );
     // Also when the loop only starts during a simulation.
@@ -229,6 +265,7 @@ fn sandbox_stops_endless_loops() {
         .unwrap_err()
         .to_string();
     assert_names(&err, "loops_late.rhai", None, "operations");
+    assert!(err.contains("line 2"), "{err}");
 }
 
 #[test]
@@ -239,7 +276,7 @@ fn sandbox_stops_endless_recursion() {
     assert_names(
         &load_err("recurses.rhai", &src),
         "recurses.rhai",
-        None,
+        Some(3),
         "nested calls",
     );
 }
@@ -252,7 +289,7 @@ fn sandbox_limits_data_sizes() {
     assert_names(
         &load_err("big_array.rhai", &src),
         "big_array.rhai",
-        None,
+        Some(2),
         "too large",
     );
     let src =
@@ -260,7 +297,15 @@ fn sandbox_limits_data_sizes() {
     assert_names(
         &load_err("big_string.rhai", &src),
         "big_string.rhai",
-        None,
+        Some(2),
+        "too large",
+    );
+    let src =
+        format!("{PARAMS}fn force(p, t, x, v, z) {{\n  let a = [];\n  loop {{ a.push(1.0); }}\n}}");
+    assert_names(
+        &load_err("growing_array.rhai", &src),
+        "growing_array.rhai",
+        Some(2),
         "too large",
     );
     // Object maps: rhai 1.27's grain VM does not check the map size limit on `m[k] = v` (the

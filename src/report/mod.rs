@@ -10,6 +10,7 @@
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use std::path::Path;
+//! use stf_lab::report;
 //! let t: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
 //! let x: Vec<f64> = t.iter().map(|t| (20.0 * t).sin() * 1e-3).collect();
 //! let f: Vec<f64> = t.iter().map(|t| (20.0 * t).cos()).collect();
@@ -41,8 +42,7 @@ mod plot_range;
 mod regime_errors;
 mod series_csv;
 mod smoothing;
-#[cfg(test)]
-pub(crate) mod test_signals;
+pub mod test_signals;
 mod time_history;
 
 pub use atomic::write_atomic as write_file_atomic;

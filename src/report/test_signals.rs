@@ -1,12 +1,18 @@
-//! Synthetic signals for the figure tests: a damped oscillation and a force that depends on
-//! its velocity, with a little deterministic noise.
+//! Synthetic signals for the figure tests (unit tests here, `tests/report_html.rs`): a damped
+//! oscillation and a force that depends on its velocity, with a little deterministic noise.
+//! The checks on a rendered figure exist only in unit tests.
 
 /// A synthetic record (SI units).
 pub struct Signals {
+    /// Time, s.
     pub t: Vec<f64>,
+    /// Displacement, m.
     pub x: Vec<f64>,
+    /// Velocity, m/s.
     pub v: Vec<f64>,
+    /// Acceleration, m/s².
     pub a: Vec<f64>,
+    /// Force, N.
     pub f: Vec<f64>,
 }
 
@@ -47,6 +53,7 @@ pub fn damped_sine(n: usize, duration: f64) -> Signals {
 
 /// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works) and the
 /// PNG has the expected size; returns the CSV's columns.
+#[cfg(test)]
 pub fn assert_rendered(
     files: &super::FigureFiles,
     size: (u32, u32),
@@ -74,6 +81,7 @@ pub fn assert_rendered(
 }
 
 /// The column named `name`.
+#[cfg(test)]
 pub fn column<'a>(columns: &'a [super::series_csv::Column], name: &str) -> &'a [f64] {
     &columns
         .iter()

@@ -1,0 +1,23 @@
+//! `stf_lab`: the library behind the `stf-lab` program of the shear-thickening fluid lab. It
+//! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
+//! compare, discover, models), and writes results, figures and reports ([`output`],
+//! [`report`], [`reporting`]). The binary (`src/main.rs`) only parses the command line and
+//! calls one `cmd_*::run`; integration tests and fuzz targets use the same functions.
+
+// `!(a > b)` is how this crate says "not greater, or NaN": the NaN case is meant.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![deny(clippy::unwrap_used)]
+
+pub mod cmd_compare;
+pub mod cmd_discover;
+pub mod cmd_fit;
+pub mod cmd_models;
+pub mod cmd_simulate;
+pub mod experiment;
+pub mod fitting;
+pub mod interrupt;
+pub mod model_config;
+pub mod output;
+pub mod progress;
+pub mod report;
+pub mod reporting;
