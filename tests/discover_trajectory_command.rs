@@ -60,7 +60,6 @@ fn experiment(dir: &std::path::Path, k3: f64) -> std::path::PathBuf {
 }
 
 #[test]
-#[ignore = "open: from the CLI the cubic case ends at S 2.04 → 1.73 mm² (core test: → 0.0026)"]
 fn trajectory_discovery_names_cubic_stiffness_from_x_and_u_and_fit_accepts_the_result() {
     let tmp = tempfile::tempdir().unwrap();
     let exp = experiment(tmp.path(), 1e4);
