@@ -194,9 +194,12 @@ fn linear_start(
     let (Ok(f1), Ok(f2)) = (fit.predict(data, &defaults), fit.predict(data, &doubled)) else {
         return defaults;
     };
+    // Against the largest force: `predict` returns measured − residual, whose rounding is
+    // relative to the measured force, not to a force near zero.
+    let largest = subset.iter().map(|&i| f2[i].abs()).fold(0.0, f64::max);
     let proportional = subset
         .iter()
-        .all(|&i| (f2[i] - 2.0 * f1[i]).abs() <= 1e-9 * (f2[i].abs() + f64::MIN_POSITIVE));
+        .all(|&i| (f2[i] - 2.0 * f1[i]).abs() <= 1e-9 * largest);
     let (rf, ff) = subset.iter().fold((0.0, 0.0), |(rf, ff), &i| {
         (rf + r[i] * f1[i], ff + f1[i] * f1[i])
     });
@@ -510,7 +513,8 @@ pub fn discover_force(
             fit: settings
                 .fit
                 .clone()
-                .solver(crate::fit::Solver::LevenbergMarquardt),
+                .solver(crate::fit::Solver::LevenbergMarquardt)
+                .tol(settings.fit.tol.min(1e-9)),
             ..settings.clone()
         };
         current.stage.fit(data, &all, &lm)?
