@@ -605,6 +605,7 @@ fn reconsider(
     let n_base = current.stage.parts.len().saturating_sub(effects.len());
     // (score, trial, effect index, candidate index, a tie rather than a win)
     let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
+    #[allow(clippy::needless_range_loop)] // `j` also names the part and the effect replaced
     for j in 0..effects.len().saturating_sub(1) {
         let part = n_base + j;
         let Some(old) = current.stage.parts.get(part).cloned() else {
