@@ -128,6 +128,29 @@ impl Stage {
         Stage { parts, values }
     }
 
+    /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
+    /// restarted from its default, or `None` when none does. A parameter pinned on a bound by
+    /// the fit of a model that lacked an effect (n = 1 for a power law absorbing a yield
+    /// force) hardly leaves it when the effect is added: the bound map is flat there.
+    fn released(&self) -> Option<Stage> {
+        let specs: Vec<crate::params::ParamSpec> =
+            self.parts.iter().flat_map(|p| p.params().to_vec()).collect();
+        let mut values = self.values.clone();
+        let mut any = false;
+        for (spec, v) in specs.iter().zip(values.iter_mut()) {
+            let tol = 1e-9 * (spec.max - spec.min).abs();
+            let pinned = (*v - spec.min).abs() <= tol || (*v - spec.max).abs() <= tol;
+            if pinned && *v != spec.default {
+                *v = spec.default;
+                any = true;
+            }
+        }
+        any.then(|| Stage {
+            parts: self.parts.clone(),
+            values,
+        })
+    }
+
     /// This stage without its part `index` (its parameters dropped).
     fn without(&self, index: usize) -> Stage {
         let sizes: Vec<usize> = self.parts.iter().map(|p| p.params().len()).collect();
@@ -170,29 +193,35 @@ impl Stage {
     }
 }
 
-/// Start values of `model`'s parameters for adding it to a model whose residual is `r`: the
-/// defaults, except a first parameter the force is proportional to (checked numerically:
-/// doubling it doubles the force along the record), which starts from the linear least
-/// squares of `r` on the force at the defaults over `subset` — or at 1e-3 of its default when
-/// that slope is not positive (the effect is then absent, or of the other sign). A start far
-/// from the answer (k3 = 1e5 for an effect of 1e4, or of none) cost Levenberg–Marquardt
-/// dozens of iterations creeping along a log-like bound map.
-fn linear_start(
+/// The start values of `model`'s parameters for adding it to a model whose residual over
+/// `subset` is `r`, and the starts of a multi-start: the first is the defaults; then, when the
+/// force is proportional to the first parameter (checked numerically: doubling it doubles the
+/// force along the record), the best `extra` points of a coarse grid over the other
+/// parameters ([`start_grid`]) by variable projection — with those fixed, the first parameter
+/// is the linear least squares of `r` on the force, and the point is scored by the residual
+/// sum of squares left. Each start's first parameter is that least-squares value (or 1e-3 of
+/// its default when the slope is not positive: the effect is then absent, or of the other
+/// sign). A start far from the answer (k3 = 1e5 for an effect of 1e4) cost
+/// Levenberg–Marquardt dozens of iterations creeping along a log-like bound map, and a start
+/// at the defaults alone left `power_law + yield` in a poorer local minimum (F_y 0.052 N for
+/// 0.08 N).
+fn candidate_starts(
     model: &Arc<dyn ForceModel>,
     data: &ForceData,
     subset: &[usize],
     r: &[f64],
-) -> Vec<f64> {
+    extra: usize,
+) -> Vec<Vec<f64>> {
     let specs = model.params();
     let defaults: Vec<f64> = specs.iter().map(|s| s.default).collect();
     let Some(first) = specs.first() else {
-        return defaults;
+        return vec![defaults];
     };
     let fit = ForceFit::new(model.clone());
     let mut doubled = defaults.clone();
     doubled[0] *= 2.0;
     let (Ok(f1), Ok(f2)) = (fit.predict(data, &defaults), fit.predict(data, &doubled)) else {
-        return defaults;
+        return vec![defaults];
     };
     // Against the largest force: `predict` returns measured − residual, whose rounding is
     // relative to the measured force, not to a force near zero.
@@ -200,23 +229,160 @@ fn linear_start(
     let proportional = subset
         .iter()
         .all(|&i| (f2[i] - 2.0 * f1[i]).abs() <= 1e-9 * largest);
-    let (rf, ff) = subset.iter().fold((0.0, 0.0), |(rf, ff), &i| {
-        (rf + r[i] * f1[i], ff + f1[i] * f1[i])
-    });
-    if !proportional || !(ff > 0.0) || first.default == 0.0 {
-        return defaults;
+    if !proportional || first.default == 0.0 {
+        return vec![defaults];
     }
-    let slope = rf / ff;
-    let v = if slope > 0.0 && slope.is_finite() {
-        slope * first.default
-    } else {
-        1e-3 * first.default
+    // The start from `values` (first parameter at its default) whose force is `f`, and the
+    // residual sum of squares it leaves; `None` when the force is zero on the subset.
+    let project = |values: &[f64], f: &[f64]| -> Option<(Vec<f64>, f64)> {
+        let (rf, ff) = subset.iter().fold((0.0, 0.0), |(rf, ff), &i| {
+            (rf + r[i] * f[i], ff + f[i] * f[i])
+        });
+        if !(ff > 0.0 && ff.is_finite() && rf.is_finite()) {
+            return None;
+        }
+        let slope = rf / ff;
+        let (v, drop) = if slope > 0.0 {
+            (slope * first.default, rf * rf / ff)
+        } else {
+            (1e-3 * first.default, 0.0)
+        };
+        let mut start = values.to_vec();
+        if v > first.min && v < first.max {
+            start[0] = v;
+        }
+        Some((start, -drop))
     };
-    let mut start = defaults;
-    if v > first.min && v < first.max {
-        start[0] = v;
+    let Some((at_defaults, _)) = project(&defaults, &f1) else {
+        return vec![defaults];
+    };
+    let mut starts = vec![at_defaults];
+    if extra == 0 || specs.len() < 2 {
+        return starts;
     }
-    start
+    let mut scored: Vec<(Vec<f64>, f64)> = start_grid(&specs[1..])
+        .into_iter()
+        .filter_map(|point| {
+            let mut values = defaults.clone();
+            values[1..].copy_from_slice(&point);
+            let f = fit.predict(data, &values).ok()?;
+            project(&values, &f)
+        })
+        .collect();
+    scored.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for (start, _) in scored {
+        if starts.len() > extra {
+            break;
+        }
+        if starts.iter().all(|s| s[1..] != start[1..]) {
+            starts.push(start);
+        }
+    }
+    starts
+}
+
+/// Points per parameter of the start grid, and the most points in all.
+const GRID_POINTS: usize = 4;
+const GRID_MAX: usize = 256;
+
+/// A coarse grid over the parameters `specs`: for each, its default and [`GRID_POINTS`]
+/// points spread evenly across its bounds — in the logarithm when the range is positive and
+/// spans more than a decade (a lower bound of 0 counts as 1e-4 of the upper), linearly
+/// otherwise — at the middles of equal sub-ranges, so no point lies on a bound. With many
+/// parameters the points per parameter are fewer, to keep the grid within [`GRID_MAX`].
+fn start_grid(specs: &[crate::params::ParamSpec]) -> Vec<Vec<f64>> {
+    let mut per = GRID_POINTS;
+    while per > 1 && (per + 1).pow(specs.len() as u32) > GRID_MAX {
+        per -= 1;
+    }
+    let axes: Vec<Vec<f64>> = specs
+        .iter()
+        .map(|s| {
+            let lo = if s.min > 0.0 { s.min } else { 1e-4 * s.max };
+            let log = lo > 0.0 && s.max > 10.0 * lo;
+            let mut axis = vec![s.default];
+            for k in 0..per {
+                let u = (k as f64 + 0.5) / per as f64;
+                let v = if log {
+                    (lo.ln() + u * (s.max.ln() - lo.ln())).exp()
+                } else {
+                    s.min + u * (s.max - s.min)
+                };
+                if v.is_finite() && v != s.default {
+                    axis.push(v);
+                }
+            }
+            axis
+        })
+        .collect();
+    let mut grid: Vec<Vec<f64>> = vec![Vec::new()];
+    for axis in &axes {
+        grid = grid
+            .into_iter()
+            .flat_map(|point| {
+                axis.iter().map(move |&v| {
+                    let mut p = point.clone();
+                    p.push(v);
+                    p
+                })
+            })
+            .collect();
+    }
+    grid
+}
+
+/// The trial with the lowest training RMS (a converged fit before a failed one) among those
+/// run from the stages `stage(start)` for each of the candidate's `starts`, and from the
+/// first of them [`Stage::released`] when a parameter of it sits on a bound: the multi-start
+/// of a candidate. Its evaluations and wall time are those of all the runs; the first run's
+/// error if every run fails.
+fn best_trial(
+    starts: &[Vec<f64>],
+    stage: impl Fn(&[f64]) -> Stage,
+    data: &ForceData,
+    split: &HoldoutSplit,
+    settings: &DiscoverySettings,
+) -> Result<Trial, DiscoveryError> {
+    let mut stages: Vec<Stage> = starts.iter().map(|s| stage(s)).collect();
+    if let Some(released) = stages.first().and_then(Stage::released) {
+        stages.push(released);
+    }
+    let mut best: Option<Trial> = None;
+    let mut first_error = None;
+    let (mut evaluations, mut wall) = (0, 0.0);
+    for stage in &stages {
+        match stage.trial(data, split, settings) {
+            Ok(trial) => {
+                evaluations += trial.train.evaluations;
+                wall += trial.train.wall_seconds;
+                let failed = |t: &Trial| {
+                    matches!(t.train.convergence, crate::fit::Convergence::Failed { .. })
+                };
+                let better = match &best {
+                    None => true,
+                    Some(b) => {
+                        (failed(b) && !failed(&trial))
+                            || (failed(b) == failed(&trial) && trial.train.rms < b.train.rms)
+                    }
+                };
+                if better {
+                    best = Some(trial);
+                }
+            }
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_error) {
+        (Some(mut t), _) => {
+            t.train.evaluations = evaluations;
+            t.train.wall_seconds = wall;
+            Ok(t)
+        }
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(DiscoveryError::BadSettings("no start to fit from".into())),
+    }
 }
 
 /// How `trial` (a model with the candidate `name`, whose own parameters are its `n_own`
@@ -404,10 +570,18 @@ pub fn discover_force(
             if name_taken {
                 continue;
             }
-            let start = linear_start(&c.model, data, &split.train, &current_residual);
-            let stage = current.stage.with_values(&c.model, &start, settings);
+            let starts = candidate_starts(
+                &c.model,
+                data,
+                &split.train,
+                &current_residual,
+                settings.extra_starts,
+            );
             let n_own = c.model.params().len();
-            scored.push(match stage.trial(data, &split, settings) {
+            let best = best_trial(&starts, |start| {
+                current.stage.with_values(&c.model, start, settings)
+            }, data, &split, settings);
+            scored.push(match best {
                 Ok(trial) => (
                     score_trial(&c.name, n_own, &trial, &current, base_excess, settings),
                     Some(trial),
@@ -624,12 +798,27 @@ fn reconsider(
                 continue;
             }
             let label = format!("{} for {}", c.name, effects[j]);
-            let start = linear_start(&c.model, data, &split.train, &rest_residual);
-            let stage = rest.inserting(part, &c.model, &start);
-            match stage.trial(data, split, settings) {
+            let starts = candidate_starts(
+                &c.model,
+                data,
+                &split.train,
+                &rest_residual,
+                settings.extra_starts,
+            );
+            let best = best_trial(
+                &starts,
+                |start| rest.inserting(part, &c.model, start),
+                data,
+                split,
+                settings,
+            );
+            match best {
                 Ok(trial) => {
                     // Its own parameters are not last here: take them by position.
-                    let from: usize = stage.parts[..part].iter().map(|p| p.params().len()).sum();
+                    let from: usize = rest.parts[..part.min(rest.parts.len())]
+                        .iter()
+                        .map(|p| p.params().len())
+                        .sum();
                     let n_own = c.model.params().len();
                     let mut score = score_trial(&label, 0, &trial, current, base_excess, settings);
                     score.params = trial

@@ -14,6 +14,7 @@ use crate::fit::FitSettings;
 /// assert!(DiscoverySettings::default().holdout_every(1).validate().is_err());
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct DiscoverySettings {
     /// Most effects added (default 3).
     pub max_effects: usize,
@@ -39,6 +40,10 @@ pub struct DiscoverySettings {
     pub noise_sigma: Option<f64>,
     /// Fit a constant force offset `f_off` with every model (default false).
     pub fit_offset: bool,
+    /// Starts of a candidate's trial besides its defaults: the best points of a coarse grid
+    /// over its nonlinear parameters, scored by variable projection on the current residual;
+    /// the trial with the lowest training RMS is kept (default 2; 0: the defaults only).
+    pub extra_starts: usize,
 }
 
 impl Default for DiscoverySettings {
@@ -51,6 +56,7 @@ impl Default for DiscoverySettings {
             fit: FitSettings::default().max_iters(200).tol(1e-7),
             noise_sigma: None,
             fit_offset: false,
+            extra_starts: 2,
         }
     }
 }
@@ -89,6 +95,12 @@ impl DiscoverySettings {
     /// Fit a constant force offset with every model.
     pub fn fit_offset(mut self, on: bool) -> Self {
         self.fit_offset = on;
+        self
+    }
+
+    /// Starts of a candidate's trial besides its defaults.
+    pub fn extra_starts(mut self, n: usize) -> Self {
+        self.extra_starts = n;
         self
     }
 
