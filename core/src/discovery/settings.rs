@@ -42,7 +42,7 @@ pub struct DiscoverySettings {
     pub fit_offset: bool,
     /// Starts of a candidate's trial besides its defaults: the best points of a coarse grid
     /// over its nonlinear parameters, scored by variable projection on the current residual;
-    /// the trial with the lowest training RMS is kept (default 2; 0: the defaults only).
+    /// the trial with the lowest training RMS is kept (default 1; 0: the defaults only).
     pub extra_starts: usize,
 }
 
@@ -56,7 +56,7 @@ impl Default for DiscoverySettings {
             fit: FitSettings::default().max_iters(200).tol(1e-7),
             noise_sigma: None,
             fit_offset: false,
-            extra_starts: 2,
+            extra_starts: 1,
         }
     }
 }
