@@ -133,8 +133,11 @@ impl Stage {
     /// the fit of a model that lacked an effect (n = 1 for a power law absorbing a yield
     /// force) hardly leaves it when the effect is added: the bound map is flat there.
     fn released(&self) -> Option<Stage> {
-        let specs: Vec<crate::params::ParamSpec> =
-            self.parts.iter().flat_map(|p| p.params().to_vec()).collect();
+        let specs: Vec<crate::params::ParamSpec> = self
+            .parts
+            .iter()
+            .flat_map(|p| p.params().to_vec())
+            .collect();
         let mut values = self.values.clone();
         let mut any = false;
         for (spec, v) in specs.iter().zip(values.iter_mut()) {
@@ -578,9 +581,13 @@ pub fn discover_force(
                 settings.extra_starts,
             );
             let n_own = c.model.params().len();
-            let best = best_trial(&starts, |start| {
-                current.stage.with_values(&c.model, start, settings)
-            }, data, &split, settings);
+            let best = best_trial(
+                &starts,
+                |start| current.stage.with_values(&c.model, start, settings),
+                data,
+                &split,
+                settings,
+            );
             scored.push(match best {
                 Ok(trial) => (
                     score_trial(&c.name, n_own, &trial, &current, base_excess, settings),
@@ -640,7 +647,7 @@ pub fn discover_force(
         if !tie_names.is_empty() {
             step.verdict.push_str(&format!(
                 "; `{}` explain the data equally well (the best is not better by the held-out \
-                 test), `{}` is chosen for its lower BIC",
+                 test), `{}` is chosen as the simplest (fewest parameters, then lowest BIC)",
                 tie_names.join("`, `"),
                 w.name
             ));
