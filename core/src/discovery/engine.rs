@@ -460,8 +460,11 @@ fn failed_score(name: &str, error: &DiscoveryError) -> CandidateScore {
 /// `data` holds the measured kinematics and F_STF; `cycles` cut it into whole cycles (e.g.
 /// [`crate::regimes::cycles_from_phase`]), every `settings.holdout_every`-th of which is held
 /// out to score the fits. The acceptance rule is that of [`super::acceptance`]. A candidate
-/// whose model is already a part of the base (by name) is not tried. A candidate whose fit
-/// fails is scored as failed, not an error; a base that cannot be fitted is an error.
+/// whose model is already a part of the base (by name) is not tried. Each candidate's trial
+/// is a small multi-start (its defaults, `settings.extra_starts` points of a grid over its
+/// nonlinear parameters, and the current model's parameters pinned on a bound released), of
+/// which the best training fit is scored. A candidate whose fit fails is scored as failed,
+/// not an error; a base that cannot be fitted is an error.
 ///
 /// ```
 /// use std::sync::Arc;
@@ -915,4 +918,100 @@ fn reconsider(
 /// the stall it worked around was the transform moving interior starts, now fixed.)
 fn inside(v: f64, min: f64, max: f64) -> f64 {
     v.clamp(min, max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::force_model::{ModelError, ModelState};
+    use crate::params::ParamSpec;
+
+    /// F = a·tanh(v/s): proportional to `a`, nonlinear in `s`.
+    struct Smooth(Vec<ParamSpec>);
+    impl ForceModel for Smooth {
+        fn name(&self) -> &str {
+            "smooth"
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.0
+        }
+        fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+            Ok(p[0] * (s.v / p[1]).tanh())
+        }
+    }
+
+    fn smooth() -> Arc<dyn ForceModel> {
+        Arc::new(Smooth(vec![
+            ParamSpec::new("a", "N", 1.0, 0.0, 100.0, ""),
+            ParamSpec::new("s", "m/s", 1e-3, 1e-6, 1.0, ""),
+        ]))
+    }
+
+    #[test]
+    fn the_grid_holds_each_default_and_no_bound() {
+        // The grid is over the parameters after the first (the scale).
+        let specs = smooth().params()[1..].to_vec();
+        let grid = start_grid(&specs);
+        assert_eq!(grid.len(), GRID_POINTS + 1);
+        assert!(grid.iter().any(|p| p[..] == [1e-3]));
+        for p in &grid {
+            for (v, s) in p.iter().zip(&specs) {
+                assert!(*v > s.min && *v < s.max, "{v} on a bound of {}", s.name);
+            }
+        }
+        // The positive range of `s` spans six decades: spread in the logarithm.
+        let s: Vec<f64> = grid.iter().map(|p| p[0]).filter(|&v| v != 1e-3).collect();
+        let ratios: Vec<f64> = s.windows(2).map(|w| w[1] / w[0]).collect();
+        assert!(
+            ratios.iter().all(|r| (r / ratios[0] - 1.0).abs() < 1e-9),
+            "{s:?}"
+        );
+        // Many parameters: fewer points each, within the cap.
+        let many = vec![specs[0].clone(); 6];
+        let g = start_grid(&many);
+        assert!(g.len() <= GRID_MAX && g.len() > 1, "{}", g.len());
+    }
+
+    #[test]
+    fn a_grid_start_lands_near_a_smoothing_speed_far_from_its_default() {
+        // The residual to explain: 0.5·tanh(v/0.02), v a slow sweep of speeds.
+        let n = 2000;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 0.01).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.1 * (0.7 * t).sin()).collect();
+        let x = vec![0.0; n];
+        let a = vec![0.0; n];
+        let r: Vec<f64> = v.iter().map(|v| 0.5 * (v / 0.02).tanh()).collect();
+        let data = ForceData {
+            t: &t,
+            x: &x,
+            v: &v,
+            a: &a,
+            f: &r,
+        };
+        let all: Vec<usize> = (0..n).collect();
+        let starts = candidate_starts(&smooth(), &data, &all, &r, 1);
+        assert_eq!(starts.len(), 2, "{starts:?}");
+        // The first: the default s, its scale the least squares there.
+        assert_eq!(starts[0][1], 1e-3);
+        assert!(starts[0][0] > 0.0 && starts[0][0] < 1.0, "{starts:?}");
+        // The second: within one grid step (10^1.5) of the true s, and a scale near 0.5.
+        let s = starts[1][1];
+        assert!(s > 0.02 / 31.7 && s < 0.02 * 31.7, "{s}");
+        assert!((starts[1][0] - 0.5).abs() < 0.25, "{starts:?}");
+        // No extra start asked: the defaults only.
+        assert_eq!(candidate_starts(&smooth(), &data, &all, &r, 0).len(), 1);
+    }
+
+    #[test]
+    fn only_parameters_pinned_on_a_bound_are_released() {
+        let stage = |values: Vec<f64>| Stage {
+            parts: vec![smooth()],
+            values,
+        };
+        assert!(stage(vec![3.0, 0.05]).released().is_none());
+        let r = stage(vec![3.0, 1.0]).released().unwrap();
+        assert_eq!(r.values, [3.0, 1e-3]);
+        let r = stage(vec![0.0, 1e-6]).released().unwrap();
+        assert_eq!(r.values, [1.0, 1e-3]);
+    }
 }
