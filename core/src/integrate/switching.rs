@@ -38,6 +38,7 @@
 //! Rodas4 coefficients: Hairer & Wanner, Solving Ordinary Differential Equations II, §IV.7 and
 //! their code RODAS (method 1); Dormand–Prince: Solving ODEs I, §II.5 and their code DOPRI5.
 
+use super::approach::Approach;
 use super::dormand_prince::DormandPrince;
 use super::jacobian::spectral_radius;
 use super::rodas4::Rodas4;
@@ -57,6 +58,13 @@ enum Mode {
     Explicit,
     Stiff,
 }
+
+/// Safety factor of the step-size controllers.
+const SAFETY: f64 = 0.9;
+/// Dormand–Prince steps grow at most this much ...
+const EXPLICIT_GROWTH: f64 = 5.0;
+/// ... and shrink at most this much (0.2: a fifth) from one trial to the next.
+const EXPLICIT_SHRINK: f64 = 0.2;
 
 /// Readings of `h·λ` above this count as stiff (Dormand–Prince's real stability boundary).
 const STIFF_H_LAMBDA: f64 = 3.25;
@@ -154,7 +162,6 @@ pub(super) fn run(
 
     // Controller state.
     let mut rejected_last = false;
-    let mut fac_old = 1e-4_f64; // Dormand–Prince PI controller
     let mut gustafsson: Option<(f64, f64)> = None; // Rodas4: (h, err) of the last accepted step
     let mut non_finite_last = false;
     // Switching state.
@@ -163,6 +170,10 @@ pub(super) fn run(
     let mut explicit_accepted = 0u64;
     let mut jacobian_stiff = false;
     let mut jac = vec![0.0; n * n];
+    let mut approach = sys
+        .switching_component()
+        .filter(|&j| j < n)
+        .map(Approach::new);
 
     while t < t_end {
         if steps >= u64::from(s.max_steps) {
@@ -193,7 +204,7 @@ pub(super) fn run(
                 let trial = dp.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
                 let err = trial.err;
                 non_finite_last = !err.is_finite();
-                let fac11 = err.powf(0.17);
+                let err_root = err.powf(0.2);
                 if err <= 1.0 {
                     dp.accept(&y, h);
                     while next_out < t_out.len() && t_out[next_out] <= t_new {
@@ -201,18 +212,25 @@ pub(super) fn run(
                         dp.dense(((t_out[next_out] - t) / h).clamp(0.0, 1.0), row);
                         next_out += 1;
                     }
+                    let f_old = approach.map_or(0.0, |ap| f0[ap.component()]);
+                    if let Some(ap) = approach.as_mut() {
+                        ap.accepted(&y, &dp.y_new, h);
+                    }
                     y.copy_from_slice(&dp.y_new);
                     f0.copy_from_slice(dp.f_new());
                     let t_prev = t;
                     t = t_new;
                     work.stats.accepted += 1;
-                    let fac = (fac11 / fac_old.powf(0.04) / 0.9).clamp(0.1, 5.0);
-                    fac_old = err.max(1e-4);
+                    let fac =
+                        (err_root / SAFETY).clamp(1.0 / EXPLICIT_GROWTH, 1.0 / EXPLICIT_SHRINK);
                     let mut h_new = (h / fac).min(h_max);
                     if rejected_last {
                         h_new = h_new.min(h);
                     }
                     rejected_last = false;
+                    if let Some(ap) = &approach {
+                        h_new = ap.cap(h_new, &y, &f0, f_old, h);
+                    }
                     h = h_new;
                     if policy == Policy::Switching {
                         explicit_accepted += 1;
@@ -248,9 +266,9 @@ pub(super) fn run(
                     work.stats.rejected += 1;
                     rejected_last = true;
                     h /= if err.is_finite() {
-                        (fac11 / 0.9).min(5.0)
+                        (err_root / SAFETY).min(1.0 / EXPLICIT_SHRINK)
                     } else {
-                        5.0
+                        1.0 / EXPLICIT_SHRINK
                     };
                 }
             }
@@ -309,7 +327,6 @@ pub(super) fn run(
                                 explicit_count = 0;
                                 stiff_count = 0;
                                 calm_count = 0;
-                                fac_old = 1e-4;
                             }
                         } else {
                             explicit_count = 0;
