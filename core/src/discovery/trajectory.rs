@@ -11,7 +11,10 @@
 //! 3. add each candidate, refit everything on the training samples — the simulation runs
 //!    through the whole record, so the held-out cycles (every `holdout_every`-th whole cycle)
 //!    are predicted by a model that never saw them — and score the x residual there with the
-//!    paired test and the BIC on the training samples ([`super::acceptance`]);
+//!    paired test and the BIC on the training samples ([`super::acceptance`]). The paired
+//!    test pairs whole held-out cycles (their mean squared residual), not samples: a
+//!    simulated x residual is correlated over a cycle, so per-sample pairs would count one
+//!    cycle's misfit hundreds of times and overstate the evidence;
 //! 4. repeat until nothing is significant or `max_effects` are added;
 //! 5. refit the final model and the oscillator on the whole record: gap before and after.
 //!
@@ -131,8 +134,58 @@ struct Stage {
 struct Trial {
     stage: Stage,
     train: FitResult,
+    /// RMS residual of each held-out cycle ([`cycle_rms`]): the units of the paired test.
     holdout: Vec<f64>,
     holdout_mse: f64,
+}
+
+/// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
+/// scale: `dᵢ = 2·ln(reference_i / new_i)` (the log-ratio of cycle i's mean squared residual),
+/// `z = mean(d) / (sd(d)/√N)`. A cycle is the unit: residuals within one are correlated. The
+/// log makes cycles of small and large amplitude count alike: an effect that grows with
+/// amplitude (a cubic spring) removes most of each cycle's misfit, a different share of
+/// different sizes, and a difference of squares would vary so much across cycles that a few
+/// held-out cycles could never show it. +∞ for a consistent gain without spread, 0 with fewer
+/// than two cycles or no difference.
+fn cycle_gain_z(reference: &[f64], new: &[f64]) -> f64 {
+    let d: Vec<f64> = reference
+        .iter()
+        .zip(new)
+        .map(|(a, b)| 2.0 * (a.max(f64::MIN_POSITIVE) / b.max(f64::MIN_POSITIVE)).ln())
+        .collect();
+    let n = d.len();
+    if n < 2 || d.iter().any(|v| !v.is_finite()) {
+        return 0.0;
+    }
+    let mean = d.iter().sum::<f64>() / n as f64;
+    let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
+    let se = (var / n as f64).sqrt();
+    if se > 0.0 {
+        mean / se
+    } else if mean > 0.0 {
+        f64::INFINITY
+    } else {
+        0.0
+    }
+}
+
+/// The RMS of `r` over each held-out cycle: `holdout` holds whole cycles of increasing
+/// samples, never two neighbouring cycles (one in `holdout_every` ≥ 2 is held out), so each
+/// run of consecutive indices is one cycle.
+fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
+    let mut out = Vec::new();
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (k, &i) in holdout.iter().enumerate() {
+        let value = r.get(i).copied().unwrap_or(f64::NAN);
+        sum += value * value;
+        count += 1;
+        let ends = holdout.get(k + 1).is_none_or(|&next| next != i + 1);
+        if ends {
+            out.push((sum / count as f64).sqrt());
+            (sum, count) = (0.0, 0);
+        }
+    }
+    out
 }
 
 impl Stage {
@@ -217,7 +270,7 @@ impl Stage {
         Ok(Trial {
             stage,
             train,
-            holdout: split.holdout.iter().map(|&i| r[i]).collect(),
+            holdout: cycle_rms(&r, &split.holdout),
             holdout_mse: h * h,
         })
     }
@@ -320,7 +373,7 @@ fn score_of(
         delta_aic: trial.train.aic - current.train.aic,
         delta_bic: trial.train.bic - current.train.bic,
         holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: acceptance::paired_z(&current.holdout, &trial.holdout),
+        gain_z: cycle_gain_z(&current.holdout, &trial.holdout),
         explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
         params: own,
         significant: false,
@@ -560,7 +613,22 @@ pub fn discover_trajectory(
         let Some(trial) = scored.swap_remove(pos).1 else {
             break;
         };
-        current = trial;
+        // The accepted model, polished from its trial fit at the final fit's tolerance: the
+        // next step's candidates must beat the model at its best on the training cycles, not
+        // a screening fit stopped early (whose leftover misfit a later candidate's extra
+        // parameters would otherwise "explain").
+        let polish = DiscoverySettings {
+            fit: settings
+                .fit
+                .clone()
+                .solver(Solver::LevenbergMarquardt)
+                .tol(settings.fit.tol.min(1e-9)),
+            ..settings.clone()
+        };
+        current = match trial.stage.trial(&rig, setup, &split, &polish) {
+            Ok(polished) if polished.train.rms <= trial.train.rms => polished,
+            _ => trial,
+        };
     }
 
     // 5. The final model and the oscillator on the whole record: the gap after.
@@ -647,6 +715,28 @@ mod tests {
     use crate::regimes::cycles_from_x;
     use crate::simulate::Simulation;
     use crate::synthetic::{sample_record, SensorNoise};
+
+    #[test]
+    fn the_cycle_gain_counts_ratios_not_differences() {
+        // Cycles of very different size, each halved: a perfectly consistent gain.
+        assert_eq!(
+            cycle_gain_z(&[1.0, 10.0, 0.1], &[0.5, 5.0, 0.05]),
+            f64::INFINITY
+        );
+        // Better on some, worse on others: no evidence.
+        let z = cycle_gain_z(&[1.0, 1.0, 1.0, 1.0], &[0.9, 1.1, 0.95, 1.05]);
+        assert!(z.abs() < 1.0, "{z}");
+        assert_eq!(cycle_gain_z(&[1.0], &[0.1]), 0.0);
+    }
+
+    #[test]
+    fn held_out_cycles_are_the_runs_of_consecutive_samples() {
+        let r = [3.0, 1.0, 1.0, 9.0, 9.0, 2.0, 2.0, 2.0, 4.0];
+        let rms = cycle_rms(&r, &[1, 2, 5, 6, 7]);
+        assert_eq!(rms, vec![1.0, 2.0]);
+        assert_eq!(cycle_rms(&r, &[0, 8]), vec![3.0, 4.0]);
+        assert!(cycle_rms(&r, &[]).is_empty());
+    }
 
     /// A one-parameter force `p·g(x, v)`.
     struct Term(&'static str, Vec<ParamSpec>, fn(&ModelState) -> f64);
