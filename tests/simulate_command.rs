@@ -155,6 +155,10 @@ fn bundled_records_regenerate_byte_for_byte() {
             "experiments/records/forced_sweep.toml",
             "experiments/records/forced_sweep.csv",
         ),
+        (
+            "experiments/trajectory_discovery.toml",
+            "experiments/records/trajectory_discovery.csv",
+        ),
     ] {
         let out = dir.path().join("again.csv");
         let run = stf_lab()
