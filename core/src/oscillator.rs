@@ -11,8 +11,9 @@ use std::sync::Arc;
 
 use crate::excitation::Excitation;
 use crate::force_model::{ForceModel, ModelError, ModelState};
+use crate::integrate::fd_jacobian;
 use crate::integrate::{OdeSystem, SimError};
-use crate::resistance::bearing_resistance;
+use crate::resistance::{bearing_resistance, bearing_resistance_slope};
 use crate::system::OscillatorParams;
 
 /// The forces acting at one instant.
@@ -174,5 +175,27 @@ impl OdeSystem for Oscillator {
         head[0] = y[1];
         head[1] = f.a;
         Ok(())
+    }
+
+    /// Analytic without an STF model (`∂ẍ/∂x = −k/m`, `∂ẍ/∂v = −F_R'(v)/m`, no right-hand-side
+    /// call); with one, forward differences (the model's derivatives are not known).
+    fn jacobian(&self, t: f64, y: &[f64], fy: &[f64], jac: &mut [f64]) -> Result<u64, SimError> {
+        if self.model.is_some() || y.len() != 2 || jac.len() != 4 {
+            let mut work = vec![0.0; y.len()];
+            return fd_jacobian(|t, y, dy| self.rhs(t, y, dy), t, y, fy, jac, &mut work);
+        }
+        let p = &self.params;
+        jac.copy_from_slice(&[
+            0.0,
+            1.0,
+            -p.k / p.m,
+            -bearing_resistance_slope(p, y[1]) / p.m,
+        ]);
+        Ok(0)
+    }
+
+    /// The velocity: dry friction flips with its sign.
+    fn switching_component(&self) -> Option<usize> {
+        Some(1)
     }
 }

@@ -129,19 +129,9 @@ impl Residuals for SubsetProblem<'_> {
     }
 }
 
-/// The finite-difference step of a trajectory fit, in units of the parameters' scales: at
-/// least `√rtol` of the rig's integrator. The simulated x carries the integrator's relative
-/// error, which jumps as the adaptive steps change with the parameters; a forward difference
-/// over a step `h` divides that noise by `h`, and its total error is smallest near
-/// `h ≈ √noise`. With the default `fd_step` (1e-5) and `rtol` 1e-7 the Jacobian is noise and
-/// Levenberg–Marquardt stops far from the optimum (a hidden cubic stiffness is then missed).
-pub(super) fn fd_step_for(rig: &Rig, settings: &FitSettings) -> f64 {
-    settings.fd_step.max(rig.sim.rtol.sqrt())
-}
-
 /// Fit `params` (all of them, in the rig's order) of `model` on the rig at the samples
 /// `subset`; statistics are those of the subset, and `s_mm2` is set. The finite-difference
-/// step is [`fd_step_for`].
+/// step follows the rig's integrator ([`FitSettings::for_simulation`]).
 pub(super) fn fit_on(
     rig: &Rig,
     model: &Arc<dyn ForceModel>,
@@ -155,7 +145,7 @@ pub(super) fn fit_on(
         params,
         subset,
     };
-    let settings = settings.clone().fd_step(fd_step_for(rig, settings));
+    let settings = settings.clone().for_simulation(rig.sim.rtol);
     let mut result = fit_residuals(&problem, params, &settings, None)?;
     result.s_mm2 = Some(result.rms * result.rms * 1e6);
     Ok(result)

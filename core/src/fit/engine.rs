@@ -66,7 +66,7 @@ pub fn run(
     let (u, convergence) = if p == 0 {
         log.push("no free parameters: evaluated only".to_string());
         (
-            u0,
+            u0.clone(),
             Convergence::Converged {
                 reason: "nothing to fit".into(),
             },
@@ -100,11 +100,16 @@ pub fn run(
                 if conv.converged() {
                     (u, conv)
                 } else {
+                    // From where Levenberg–Marquardt got to, not from the start: restarting
+                    // from the start threw its progress away, and a simplex from there was
+                    // seen to end far worse.
                     log.push(
-                        "levenberg_marquardt did not converge: Nelder–Mead, then again".into(),
+                        "levenberg_marquardt did not converge: Nelder–Mead from its best \
+                         point, then again"
+                            .into(),
                     );
                     let tol = settings.simplex_tol.max(settings.presearch_tol);
-                    let (u, it, conv) = nelder_mead(&obj, &u0, tol, settings)?;
+                    let (u, it, conv) = nelder_mead(&obj, &u, tol, settings)?;
                     iterations += it;
                     log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
                     lm(&u, &mut iterations, &mut log)
@@ -117,6 +122,25 @@ pub fn run(
                 log.push(format!("particle_swarm: {it} iterations"));
                 lm(&u, &mut iterations, &mut log)
             }
+        }
+    };
+    // A fit never ends worse than its start: whatever the chain did, the start is kept if
+    // it is better.
+    let start_cost = obj.cost(&u0).unwrap_or(f64::INFINITY);
+    let (u, convergence) = match obj.cost(&u) {
+        Some(c) if c <= start_cost => (u, convergence),
+        end => {
+            log.push(format!(
+                "the solvers ended worse than the start (mean square {} > {start_cost:e}): \
+                 the start is kept",
+                end.map_or("failed".to_string(), |c| format!("{c:e}"))
+            ));
+            (
+                u0,
+                Convergence::Failed {
+                    reason: "no solver improved on the start".into(),
+                },
+            )
         }
     };
     finish(
@@ -292,4 +316,68 @@ fn finish(
         convergence,
         log,
     })
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// r_i = y_i − k·x_i.
+    struct Line {
+        x: Vec<f64>,
+        y: Vec<f64>,
+    }
+
+    impl Residuals for Line {
+        fn len(&self) -> usize {
+            self.x.len()
+        }
+        fn residuals(&self, k: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+            for (i, (x, y)) in self.x.iter().zip(&self.y).enumerate() {
+                sink(i, y - k[0] * x);
+            }
+            Ok(())
+        }
+    }
+
+    fn rss_at(line: &Line, k: f64) -> f64 {
+        line.x
+            .iter()
+            .zip(&line.y)
+            .map(|(x, y)| (y - k * x).powi(2))
+            .sum()
+    }
+
+    /// A stiffness of 554 with wide bounds [0, 1e9] (those of `wall_impact.k_w`), started at
+    /// its least-squares value: no solver, however few its iterations, may end worse. (The
+    /// bound transform used to move this start to 1e6, "1e-3 of the width inside", and a
+    /// short refit then ended 1e5 times worse than it started.)
+    #[test]
+    fn a_fit_started_at_the_optimum_never_ends_worse() {
+        let x: Vec<f64> = (0..200).map(|i| (i as f64 * 0.1).sin() * 0.01).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, x)| 554.0 * x + 1e-3 * ((i * 7919 % 13) as f64 - 6.0))
+            .collect();
+        let line = Line { x, y };
+        let best = line.x.iter().zip(&line.y).map(|(x, y)| x * y).sum::<f64>()
+            / line.x.iter().map(|x| x * x).sum::<f64>();
+        let start_rss = rss_at(&line, best);
+        for solver in Solver::ALL {
+            for iters in [1, 2, 200] {
+                let params = [FitParam::new("k", best).bounds(0.0, 1e9)];
+                let settings = FitSettings::default().solver(solver).max_iters(iters);
+                let fit = run(&line, &params, &settings, None, false).unwrap();
+                assert!(
+                    fit.rss <= start_rss * (1.0 + 1e-12),
+                    "{solver:?}, {iters} iterations: rss {} > start {start_rss}, k = {}",
+                    fit.rss,
+                    fit.params[0].value
+                );
+                assert!((fit.params[0].value / best - 1.0).abs() < 1e-6);
+            }
+        }
+    }
 }

@@ -93,6 +93,25 @@ impl Default for FitSettings {
 }
 
 impl FitSettings {
+    /// These settings for a fit whose residuals come from a simulation integrated to
+    /// relative tolerance `rtol`: the finite-difference step is at least `√rtol`.
+    ///
+    /// The simulated x carries the integrator's relative error, which jumps as the adaptive
+    /// steps change with the parameters; a forward difference over a step `h` divides that
+    /// noise by `h`, and its total error is smallest near `h ≈ √noise`. With `fd_step` 1e-5
+    /// and `rtol` 1e-7 the Jacobian would be mostly noise and Levenberg–Marquardt would stop
+    /// far from the optimum.
+    ///
+    /// ```
+    /// use stf_core::fit::FitSettings;
+    /// assert_eq!(FitSettings::default().for_simulation(1e-6).fd_step, 1e-3);
+    /// assert_eq!(FitSettings::default().for_simulation(1e-12).fd_step, 1e-5);
+    /// ```
+    pub fn for_simulation(mut self, rtol: f64) -> Self {
+        self.fd_step = self.fd_step.max(rtol.sqrt());
+        self
+    }
+
     /// The optimiser.
     pub fn solver(mut self, solver: Solver) -> Self {
         self.solver = solver;

@@ -188,7 +188,8 @@ impl TrajectoryFit {
             data: *data,
             slots,
         };
-        engine::run(&problem, &self.free, &self.settings, observer, true)
+        let settings = self.settings.clone().for_simulation(self.sim.rtol);
+        engine::run(&problem, &self.free, &settings, observer, true)
     }
 }
 

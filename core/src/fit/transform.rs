@@ -13,7 +13,8 @@
 //! ```
 //!
 //! A start value on a bound is moved just inside it (by 1e-3 of the scale or of the width),
-//! since the interior maps never reach their bounds. The scale is capped at the distance to
+//! since the interior maps never reach their bounds; a start inside stays where it is, however
+//! close to a bound (within 1e-12 of the width, for rounding). The scale is capped at the distance to
 //! the nearest bound (and a quarter of the width): otherwise a unit step from a start near a
 //! bound would saturate the map, where its slope vanishes and an optimiser gets stuck.
 
@@ -38,6 +39,9 @@ pub struct BoundTransform {
 
 /// Largest |w| of the logistic map explored by a global search (σ ∈ [1.2e-4, 1 − 1.2e-4]).
 const LOGIT_SPAN: f64 = 9.0;
+/// Closest an interior start may lie to a bound of two, as a fraction of the width (a start
+/// closer than this is moved to it; one on the bound moves by 1e-3 of the width).
+const EDGE: f64 = 1e-12;
 /// Half-width of the global search box, in units of the scale, for maps without two bounds.
 const FREE_SPAN: f64 = 5.0;
 
@@ -88,12 +92,16 @@ impl BoundTransform {
             }
             (true, true) => {
                 let width = max - min;
-                let nudge = 1e-3 * width;
-                // Only a start on (or outside) a bound is nudged: a nudge of 1e-3 of a wide box
-                // (1e6 for [0, 1e9]) would move a start inside it far away.
-                let x0 = if x0 > min && x0 < max {
+                // Only a start on (or numerically at) a bound moves: an interior start stays
+                // where it is however close to a bound (moving k = 554 in [0, 1e9] to the
+                // "inside" 1e6 made a fit from the optimum start far from it).
+                let s = (x0 - min) / width;
+                let x0 = if (EDGE..=1.0 - EDGE).contains(&s) {
                     x0
+                } else if s > 0.0 && s < 1.0 {
+                    x0.clamp(min + EDGE * width, max - EDGE * width)
                 } else {
+                    let nudge = 1e-3 * width;
                     x0.clamp(min + nudge, max - nudge)
                 };
                 let scale = scale.min(0.25 * width).min(x0 - min).min(max - x0);
@@ -234,6 +242,30 @@ mod tests {
             let h = 1e-6;
             let slope = (tr.to_user(h) - tr.to_user(-h)) / (2.0 * h);
             assert!((slope - 0.5).abs() < 1e-6, "{min} {max}: slope {slope}");
+        }
+    }
+
+    #[test]
+    fn an_interior_start_stays_put_however_wide_the_bounds() {
+        // A stiffness fitted to 554 in [0, 1e9]: the start of a refit must be 554, not the
+        // 1e6 that "1e-3 of the width inside" would make it.
+        for (x0, min, max) in [
+            (554.0, 0.0, 1e9),
+            (2.7e-9, 0.0, 10.0),
+            (3.0 - 1e-6, 1.0, 3.0),
+        ] {
+            let tr = BoundTransform::new(x0, min, max, x0);
+            assert_eq!(tr.start(), x0);
+            assert!(
+                (tr.to_user(0.0) - x0).abs() <= 1e-12 * x0,
+                "{x0}: {}",
+                tr.to_user(0.0)
+            );
+            // And the map still moves it by about one scale per unit step.
+            let h = 1e-6;
+            let slope = (tr.to_user(h) - tr.to_user(-h)) / (2.0 * h);
+            let scale = x0.min(0.25 * (max - min)).min(max - x0);
+            assert!((slope / scale - 1.0).abs() < 1e-3, "{x0}: slope {slope}");
         }
     }
 

@@ -76,9 +76,11 @@ impl DormandPrince {
         }
     }
 
-    /// `f(t + h, y_new)` of the last trial step (first stage of the next one).
-    pub(super) fn f_new(&self) -> &[f64] {
-        &self.k[6]
+    /// Move the last trial step's new state and its derivative `f(t + h, y_new)` (the first
+    /// stage of the next step) into `y` and `f`, by swapping buffers (after [`Self::accept`]).
+    pub(super) fn advance(&mut self, y: &mut Vec<f64>, f: &mut Vec<f64>) {
+        std::mem::swap(y, &mut self.y_new);
+        std::mem::swap(f, &mut self.k[6]);
     }
 
     /// Try a step of size `h` from `(t, y)` with `f0 = f(t, y)`; counts calls in `calls`.
@@ -96,11 +98,11 @@ impl DormandPrince {
     ) -> Result<Trial, SimError> {
         let n = y.len();
         // Slices of one known length, so that the loops below carry no bounds checks.
-        let f0 = &f0[..n];
-        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        let (k1, k2, k3, k4) = (&mut k1[..n], &mut k2[..n], &mut k3[..n], &mut k4[..n]);
+        // The first stage is f0 itself (no copy).
+        let k1 = &f0[..n];
+        let [_, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        let (k2, k3, k4) = (&mut k2[..n], &mut k3[..n], &mut k4[..n]);
         let (k5, k6, k7) = (&mut k5[..n], &mut k6[..n], &mut k7[..n]);
-        k1.copy_from_slice(f0);
         let yt = &mut self.ytmp[..n];
         for i in 0..n {
             yt[i] = y[i] + h * A21 * k1[i];
@@ -152,11 +154,12 @@ impl DormandPrince {
         Ok(Trial { err, h_lambda })
     }
 
-    /// Keep the dense output of the last trial step (call when accepting it).
-    pub(super) fn accept(&mut self, y: &[f64], h: f64) {
+    /// Keep the dense output of the last trial step from `(y, f0)` (call when accepting it).
+    pub(super) fn accept(&mut self, y: &[f64], f0: &[f64], h: f64) {
         let n = y.len();
-        let [k1, _, k3, k4, k5, k6, k7] = &self.k;
-        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
+        let k1 = &f0[..n];
+        let [_, _, k3, k4, k5, k6, k7] = &self.k;
+        let (k3, k4, k5, k6, k7) = (&k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
         let y_new = &self.y_new[..n];
         let (c0, rest) = self.cont.split_at_mut(n);
         let (c1, rest) = rest.split_at_mut(n);
@@ -175,16 +178,17 @@ impl DormandPrince {
     }
 
     /// The state at fraction `theta ∈ [0, 1]` of the last accepted step.
+    #[inline(always)]
     pub(super) fn dense(&self, theta: f64, out: &mut [f64]) {
         let n = out.len();
         let s1 = 1.0 - theta;
-        let (c0, rest) = self.cont.split_at(n);
-        let (c1, rest) = rest.split_at(n);
-        let (c2, rest) = rest.split_at(n);
-        let (c3, c4) = rest.split_at(n);
-        let rows = c0.iter().zip(c1).zip(c2).zip(c3).zip(c4);
-        for (o, ((((c0, c1), c2), c3), c4)) in out.iter_mut().zip(rows) {
-            *o = c0 + theta * (c1 + s1 * (c2 + theta * (c3 + s1 * c4)));
+        // Rows of one known length and an index loop: no bounds checks, no iterator set-up
+        // (this runs once per output sample).
+        let c = &self.cont;
+        let (c0, c1, c2) = (&c[..n], &c[n..2 * n], &c[2 * n..3 * n]);
+        let (c3, c4) = (&c[3 * n..4 * n], &c[4 * n..5 * n]);
+        for i in 0..n {
+            out[i] = c0[i] + theta * (c1[i] + s1 * (c2[i] + theta * (c3[i] + s1 * c4[i])));
         }
     }
 }
@@ -222,11 +226,10 @@ mod tests {
         for _ in 0..n {
             dp.trial(&Forced, t, &y, &f0, h, 1.0, 1.0, &mut calls)
                 .unwrap();
-            dp.accept(&y, h);
+            dp.accept(&y, &f0, h);
             dp.dense(0.3, &mut mid);
             dense_err = dense_err.max((mid[0] - exact(t + 0.3 * h)).abs());
-            y.copy_from_slice(&dp.y_new);
-            f0.copy_from_slice(dp.f_new());
+            dp.advance(&mut y, &mut f0);
             t += h;
         }
         ((y[0] - exact(t)).abs(), dense_err)

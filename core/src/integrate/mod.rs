@@ -20,6 +20,7 @@
 //! assert!((sol.y(1)[0] - (-1.0f64).exp()).abs() < 1e-9);
 //! ```
 
+mod approach;
 mod dense_lu;
 mod dopri5;
 mod dormand_prince;
@@ -29,6 +30,7 @@ mod rodas4;
 mod switching;
 
 pub use error::SimError;
+pub(crate) use jacobian::fd_jacobian;
 
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +48,14 @@ pub trait OdeSystem {
     fn jacobian(&self, t: f64, y: &[f64], fy: &[f64], jac: &mut [f64]) -> Result<u64, SimError> {
         let mut work = vec![0.0; y.len()];
         jacobian::fd_jacobian(|t, y, dy| self.rhs(t, y, dy), t, y, fy, jac, &mut work)
+    }
+
+    /// A state component across whose zero the right-hand side changes abruptly (a smoothed
+    /// sign function, as dry friction in the velocity), if any. The explicit method then
+    /// approaches a predicted zero of it in shrinking steps instead of stepping over it and
+    /// being rejected; this changes the cost, never the error control. Default: none.
+    fn switching_component(&self) -> Option<usize> {
+        None
     }
 }
 

@@ -207,6 +207,12 @@ impl Rodas4 {
         Ok(if err.is_finite() { err } else { f64::INFINITY })
     }
 
+    /// Move the last trial step's new state into `y` by swapping buffers (after
+    /// [`Self::accept`]).
+    pub(super) fn advance(&mut self, y: &mut Vec<f64>) {
+        std::mem::swap(y, &mut self.y_new);
+    }
+
     /// Keep the dense output of the last trial step (call when accepting it).
     pub(super) fn accept(&mut self, y: &[f64]) {
         let n = self.n;
@@ -223,15 +229,14 @@ impl Rodas4 {
     }
 
     /// The state at fraction `theta ∈ [0, 1]` of the last accepted step.
+    #[inline(always)]
     pub(super) fn dense(&self, theta: f64, out: &mut [f64]) {
-        let n = self.n;
+        let n = out.len();
         let s1 = 1.0 - theta;
-        let (c0, rest) = self.cont.split_at(n);
-        let (c1, rest) = rest.split_at(n);
-        let (c2, c3) = rest.split_at(n);
-        let rows = c0.iter().zip(c1).zip(c2).zip(c3);
-        for (o, (((c0, c1), c2), c3)) in out.iter_mut().zip(rows) {
-            *o = c0 * s1 + theta * (c1 + s1 * (c2 + theta * c3));
+        let c = &self.cont;
+        let (c0, c1, c2, c3) = (&c[..n], &c[n..2 * n], &c[2 * n..3 * n], &c[3 * n..4 * n]);
+        for i in 0..n {
+            out[i] = c0[i] * s1 + theta * (c1[i] + s1 * (c2[i] + theta * c3[i]));
         }
     }
 }
