@@ -110,6 +110,17 @@ struct RawFree {
     t1: f64,
 }
 
+#[derive(Debug, Deserialize, Serialize, Clone)]
+#[serde(deny_unknown_fields)]
+struct RawChirp {
+    f0: f64,
+    f1: f64,
+    amplitude: f64,
+    #[serde(default)]
+    t0: f64,
+    t1: f64,
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawSimulate {
@@ -117,6 +128,7 @@ struct RawSimulate {
     constant: Option<RawConstant>,
     profile: Option<RawProfile>,
     free: Option<RawFree>,
+    chirp: Option<Spanned<RawChirp>>,
     #[serde(default = "default_rate")]
     rate: f64,
     #[serde(default = "yes")]
@@ -356,6 +368,33 @@ pub enum Drive {
     Rotor(RotorAngle),
     /// No drive: free vibration from the initial state.
     Free,
+    /// A measured-style force `u(t)` (a shaker), recorded in the `u` column.
+    Force(Chirp),
+}
+
+/// A linear chirp force `u = A·sin(2π·(f0·s + (f1 − f0)·s²/(2·(t1 − t0))))`, `s = t − t0`:
+/// the frequency sweeps linearly from `f0` at `t0` to `f1` at `t1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Chirp {
+    /// Frequency at `t0`, Hz.
+    pub f0: f64,
+    /// Frequency at `t1`, Hz.
+    pub f1: f64,
+    /// Force amplitude A, N.
+    pub amplitude: f64,
+    /// Start time, s.
+    pub t0: f64,
+    /// End time, s.
+    pub t1: f64,
+}
+
+impl Chirp {
+    /// The force at time `t`, N.
+    pub fn at(&self, t: f64) -> f64 {
+        let s = t - self.t0;
+        let rate = (self.f1 - self.f0) / (self.t1 - self.t0);
+        self.amplitude * (std::f64::consts::TAU * (self.f0 * s + 0.5 * rate * s * s)).sin()
+    }
 }
 
 /// A validated `[simulate]` section.
@@ -570,12 +609,13 @@ impl Experiment {
                     s.constant.is_some(),
                     s.profile.is_some(),
                     s.free.is_some(),
+                    s.chirp.is_some(),
                 ];
                 if drives.iter().filter(|d| **d).count() != 1 {
                     return Err(cx.at(
                         span,
                         "simulate",
-                        "give exactly one of `sweep`, `constant`, `profile` or `free`",
+                        "give exactly one of `sweep`, `constant`, `profile`, `free` or `chirp`",
                     ));
                 }
                 let (drive, t0, t1, as_json) = if let Some(w) = &s.sweep {
@@ -625,6 +665,38 @@ impl Experiment {
                     )
                 } else if let Some(f) = &s.free {
                     (Drive::Free, 0.0, f.t1, serde_json::json!({ "free": f }))
+                } else if let Some(c) = &s.chirp {
+                    let (at, c) = (c.span(), c.get_ref());
+                    for (name, v) in [("f0", c.f0), ("f1", c.f1), ("t0", c.t0), ("t1", c.t1)] {
+                        let is_frequency = name.starts_with('f');
+                        if !v.is_finite() || (is_frequency && v < 0.0) {
+                            return Err(cx.at(
+                                at.clone(),
+                                &format!("simulate.chirp.{name}"),
+                                format!("{v} is not a valid value"),
+                            ));
+                        }
+                    }
+                    if !(c.amplitude.is_finite() && c.amplitude > 0.0) {
+                        return Err(cx.at(
+                            at,
+                            "simulate.chirp.amplitude",
+                            format!("{} must be a positive force, N", c.amplitude),
+                        ));
+                    }
+                    let chirp = Chirp {
+                        f0: c.f0,
+                        f1: c.f1,
+                        amplitude: c.amplitude,
+                        t0: c.t0,
+                        t1: c.t1,
+                    };
+                    (
+                        Drive::Force(chirp),
+                        c.t0,
+                        c.t1,
+                        serde_json::json!({ "chirp": c }),
+                    )
                 } else {
                     bail!("unreachable: no drive");
                 };
@@ -991,6 +1063,58 @@ params = { K = 4.0, n = 1.5 }
         let err = parse("[simulate]\nsweep = { w0 = 1.0, alpha = 0.1, t0 = 0.0, t1 = 5.0 }\nconstant = { omega = 2.0, t1 = 3.0 }\n")
             .unwrap_err();
         assert!(format!("{err:#}").contains("exactly one"));
+    }
+
+    #[test]
+    fn a_chirp_drive_parses_and_a_bad_value_names_file_line_and_key() {
+        let e = parse(
+            "[simulate]\nrate = 200.0\nchirp = { f0 = 0.5, f1 = 1.5, amplitude = 2.0, t1 = 20.0 }\n",
+        )
+        .unwrap();
+        let s = e.simulate.unwrap();
+        assert_eq!((s.t0, s.t1), (0.0, 20.0));
+        let Drive::Force(chirp) = s.drive else {
+            panic!("not a force drive: {:?}", s.drive)
+        };
+        // The frequency sweeps 0.5 → 1.5 Hz: the phase is 2π·(0.5·t + 0.025·t²).
+        let t = 7.3;
+        let expected = 2.0 * (std::f64::consts::TAU * (0.5 * t + 0.025 * t * t)).sin();
+        assert!((chirp.at(t) - expected).abs() < 1e-12);
+        assert_eq!(s.as_json["chirp"]["amplitude"], 2.0);
+
+        for (bad, key) in [
+            ("f0 = -0.5, f1 = 1.5, amplitude = 2.0", "simulate.chirp.f0"),
+            ("f0 = 0.5, f1 = nan, amplitude = 2.0", "simulate.chirp.f1"),
+            (
+                "f0 = 0.5, f1 = 1.5, amplitude = 0.0",
+                "simulate.chirp.amplitude",
+            ),
+            (
+                "f0 = 0.5, f1 = 1.5, amplitude = inf",
+                "simulate.chirp.amplitude",
+            ),
+        ] {
+            let text = format!("[simulate]\nrate = 200.0\n\nchirp = {{ {bad}, t1 = 20.0 }}\n");
+            let msg = format!("{:#}", parse(&text).unwrap_err());
+            assert!(msg.contains("exp.toml:4") && msg.contains(key), "{msg}");
+        }
+        let msg = format!(
+            "{:#}",
+            parse(
+                "[simulate]\nchirp = { f0 = 0.5, f1 = 1.5, amplitude = 2.0, t0 = 5.0, t1 = 5.0 }\n"
+            )
+            .unwrap_err()
+        );
+        assert!(msg.contains("t1 = 5 must exceed t0 = 5"), "{msg}");
+        let msg = format!(
+            "{:#}",
+            parse("[simulate]\nchirp = { f0 = 0.5, f1 = 1.5, amplitud = 2.0, t1 = 5.0 }\n")
+                .unwrap_err()
+        );
+        assert!(
+            msg.contains("exp.toml:2") && msg.contains("amplitud"),
+            "{msg}"
+        );
     }
 
     const VALID: &str = r#"

@@ -1,62 +1,88 @@
-//! End-to-end test of `stf-lab discover` at trajectory level: a record with x and the
-//! measured drive force `u` only (no `f_stf`), whose truth hides a cubic stiffness.
+//! End-to-end tests of `stf-lab discover` at trajectory level: `stf-lab simulate` writes a
+//! shaker rig's record (x and the measured drive force `u`, a chirp), whose truth may hide a
+//! cubic stiffness; `discover` works from x and u only, and `fit` accepts what it names.
 
 mod common;
 
-use std::sync::Arc;
+use std::path::{Path, PathBuf};
 
-use common::{read_json, run_ok};
-use stf_core::excitation::Excitation;
-use stf_core::interpolate::Linear;
-use stf_core::model_sum::ModelSum;
-use stf_core::oscillator::Oscillator;
-use stf_core::simulate::Simulation;
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
+use common::{read_json, root, run_ok, stf_lab};
 
-/// A 20 s chirp 0.5 → 1.5 Hz of 2 N through resonance at 200 Hz, STF = 1·v + k3·x³, rig
-/// sensors; written as `t,x,u`.
-fn write_record(path: &std::path::Path, k3: f64) {
-    let system = OscillatorParams {
-        t_friction: 0.0,
-        delta_t: 0.0,
-        ..OscillatorParams::FORCED
-    };
-    let t: Vec<f64> = (0..4001).map(|i| i as f64 / 200.0).collect();
-    let u: Vec<f64> = t
-        .iter()
-        .map(|&t| 2.0 * (std::f64::consts::TAU * (0.5 * t + 0.025 * t * t)).sin())
-        .collect();
-    let truth = ModelSum::new(vec![
-        stf_models::find("viscous").unwrap(),
-        stf_models::find("cubic_stiffness").unwrap(),
-    ])
-    .unwrap();
-    let osc = Oscillator::new(system, Excitation::Force(Linear::new(t.clone(), u)))
-        .with_model(Arc::new(truth), vec![1.0, k3])
+/// `stf-lab simulate EXP --out OUT`, asserting success.
+fn simulate(exp: &Path, out: &Path) {
+    let run = stf_lab()
+        .arg("simulate")
+        .arg(exp)
+        .arg("--out")
+        .arg(out)
+        .output()
         .unwrap();
-    let run = Simulation::new(&osc).run_at(&t).unwrap();
-    let rec = sample_record(&run, &SensorNoise::RIG, 7, false);
-    let u = rec.u.unwrap();
-    let mut csv = String::from("t,x,u\n");
-    for ((t, x), u) in rec.t.iter().zip(&rec.x).zip(&u) {
-        csv.push_str(&format!("{t},{x},{u}\n"));
-    }
-    std::fs::write(path, csv).unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }
 
-fn experiment(dir: &std::path::Path, k3: f64) -> std::path::PathBuf {
-    write_record(&dir.join("record.csv"), k3);
-    // The oscillator 2 % off the truth; m, k, c refitted (the default for a u-driven rig).
+/// A 20 s chirp 0.5 → 1.5 Hz of 2 N through resonance at 200 Hz on the frictionless forced
+/// trolley, STF = 1·v + k3·x³, rig sensors; simulated by the program into `record.csv`.
+fn write_record(dir: &Path, k3: f64) {
+    let truth = if k3 > 0.0 {
+        format!("name = \"viscous\"\nplus = [\"cubic_stiffness\"]\nparams = {{ c_s = 1.0, k3 = {k3:e} }}\n")
+    } else {
+        "name = \"viscous\"\nparams = { c_s = 1.0 }\n".to_string()
+    };
+    let exp = dir.join("sim.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n[simulate]\n\
+             chirp = {{ f0 = 0.5, f1 = 1.5, amplitude = 2.0, t1 = 20.0 }}\nrate = 200.0\n\
+             seed = 7\n\n[[simulate.truth]]\n{truth}"
+        ),
+    )
+    .unwrap();
+    simulate(&exp, &dir.join("record.csv"));
+}
+
+/// The discovery experiment on `record.csv`: the oscillator 2 % off the truth; m, k, c refitted
+/// (the default for a u-driven rig); trajectory level, as the record has an `f_stf` column too.
+fn experiment(dir: &Path, k3: f64) -> PathBuf {
+    write_record(dir, k3);
     let exp = dir.join("exp.toml");
     std::fs::write(
         &exp,
         "[data]\nfile = \"record.csv\"\n\n[system]\nm = 7.803\nk = 275.333\nc = 3.7576\n\
          T = 0.0\ndelta_T = 0.0\n\n[discover]\nbase = \"viscous\"\n\
-         candidates = [\"cubic_stiffness\", \"power_law\"]\n\n[output]\nreport = false\n",
+         candidates = [\"cubic_stiffness\", \"power_law\"]\nlevel = \"trajectory\"\n\n\
+         [output]\nreport = false\n",
     )
     .unwrap();
     exp
+}
+
+#[test]
+fn the_program_simulates_a_chirp_rig_and_its_columns_are_t_x_f_stf_u() {
+    let tmp = tempfile::tempdir().unwrap();
+    write_record(tmp.path(), 1e4);
+    let text = std::fs::read_to_string(tmp.path().join("record.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,x,f_stf,u"));
+    // u is the chirp at the sample times, written exact.
+    for line in lines.take(4001).step_by(397) {
+        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        let t = cells[0];
+        let chirp = 2.0 * (std::f64::consts::TAU * (0.5 * t + 0.025 * t * t)).sin();
+        assert!(
+            (cells[3] - chirp).abs() < 1e-12,
+            "t = {t}: u = {}",
+            cells[3]
+        );
+    }
+    assert_eq!(text.lines().count(), 4002);
+    let sidecar = read_json(&tmp.path().join("record.json"));
+    assert_eq!(sidecar["simulate"]["chirp"]["f1"], 1.5);
+    assert!(sidecar["summary"]["motion_stops_t_s"].is_null());
 }
 
 #[test]
@@ -74,8 +100,14 @@ fn trajectory_discovery_names_cubic_stiffness_from_x_and_u_and_fit_accepts_the_r
         doc["s_before_mm2"].as_f64().unwrap(),
         doc["s_after_mm2"].as_f64().unwrap(),
     );
-    eprintln!("S {before} → {after} mm²");
+    // S of a model that leaves only the sensor noise: the noise floor squared.
+    let floor_mm2 = (doc["noise_floor"].as_f64().unwrap() * 1e3).powi(2);
+    eprintln!("S {before} → {after} mm², noise floor's S {floor_mm2} mm²");
     assert!(after < 0.1 * before, "S {before} → {after} mm²");
+    assert!(
+        after < 2.0 * floor_mm2,
+        "S after {after} mm², noise floor's S {floor_mm2} mm²"
+    );
     assert!(doc["gap_after"].as_f64().unwrap() < doc["gap_before"].as_f64().unwrap());
     let k = doc["system"]["k"].as_f64().unwrap();
     assert!((k / 269.9346 - 1.0).abs() < 0.01, "k = {k}");
@@ -102,4 +134,20 @@ fn trajectory_discovery_names_nothing_without_the_cubic_term() {
     run_ok("discover", &exp, &out);
     let doc = read_json(&out.join("discovery.json"));
     assert_eq!(doc["effects"], serde_json::json!([]), "{:#}", doc["steps"]);
+}
+
+#[test]
+fn the_bundled_example_names_the_cubic_spring() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("disc");
+    run_ok(
+        "discover",
+        &root().join("experiments/trajectory_discovery.toml"),
+        &out,
+    );
+    let doc = read_json(&out.join("discovery.json"));
+    assert_eq!(doc["level"], "trajectory");
+    assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
+    let k3 = doc["final_model"]["params"]["k3"].as_f64().unwrap();
+    assert!((k3 / 1e4 - 1.0).abs() < 0.05, "k3 = {k3}");
 }
