@@ -27,13 +27,23 @@ use super::settings::DiscoverySettings;
 /// `reference² − new²` over its standard error. +∞ for a consistent gain without spread,
 /// 0 for no samples or no difference.
 pub fn paired_z(reference: &[f64], new: &[f64]) -> f64 {
-    let n = reference.len().min(new.len());
+    let d: Vec<f64> = reference
+        .iter()
+        .zip(new)
+        .map(|(a, b)| a * a - b * b)
+        .collect();
+    mean_z(&d)
+}
+
+/// The z of the mean of paired differences `d`: mean over its standard error. +∞ for a
+/// consistent gain without spread, 0 for fewer than two pairs or no difference.
+pub fn mean_z(d: &[f64]) -> f64 {
+    let n = d.len();
     if n < 2 {
         return 0.0;
     }
-    let d = reference.iter().zip(new).map(|(a, b)| a * a - b * b);
-    let mean = d.clone().sum::<f64>() / n as f64;
-    let var = d.map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
+    let mean = d.iter().sum::<f64>() / n as f64;
+    let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
     let se = (var / n as f64).sqrt();
     if se > 0.0 {
         mean / se

@@ -5,7 +5,9 @@
 //! chosen samples enter the least squares. With every sample chosen this is an ordinary
 //! [`ForceFit`].
 
-use crate::fit::{fit_residuals, FitParam, FitResult, FitSettings, ForceData, ForceFit, Residuals};
+use crate::fit::{
+    fit_residuals, full_values, FitParam, FitResult, FitSettings, ForceData, ForceFit, Residuals,
+};
 
 /// The residuals of `fit` (all its parameters in `params`) at the samples `subset`.
 struct SubsetResiduals<'a> {
@@ -21,15 +23,7 @@ impl Residuals for SubsetResiduals<'_> {
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
-        let mut free = x.iter();
-        let mut full = Vec::with_capacity(self.params.len());
-        for p in self.params {
-            full.push(if p.fixed {
-                p.value
-            } else {
-                *free.next().ok_or("too few free values")?
-            });
-        }
+        let full = full_values(self.params, x)?;
         let predicted = self
             .fit
             .predict(&self.data, &full)

@@ -153,20 +153,10 @@ fn cycle_gain_z(reference: &[f64], new: &[f64]) -> f64 {
         .zip(new)
         .map(|(a, b)| 2.0 * (a.max(f64::MIN_POSITIVE) / b.max(f64::MIN_POSITIVE)).ln())
         .collect();
-    let n = d.len();
-    if n < 2 || d.iter().any(|v| !v.is_finite()) {
+    if d.iter().any(|v| !v.is_finite()) {
         return 0.0;
     }
-    let mean = d.iter().sum::<f64>() / n as f64;
-    let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
-    let se = (var / n as f64).sqrt();
-    if se > 0.0 {
-        mean / se
-    } else if mean > 0.0 {
-        f64::INFINITY
-    } else {
-        0.0
-    }
+    acceptance::mean_z(&d)
 }
 
 /// The RMS of `r` over each held-out cycle: `holdout` holds whole cycles of increasing

@@ -10,7 +10,9 @@
 use std::sync::Arc;
 
 use crate::excitation::Excitation;
-use crate::fit::{fit_residuals, FitError, FitParam, FitResult, FitSettings, Residuals};
+use crate::fit::{
+    fit_residuals, full_values, FitError, FitParam, FitResult, FitSettings, Residuals,
+};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
 use crate::oscillator::Oscillator;
@@ -112,15 +114,7 @@ impl Residuals for SubsetProblem<'_> {
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
-        let mut free = x.iter();
-        let mut full = Vec::with_capacity(self.params.len());
-        for p in self.params {
-            full.push(if p.fixed {
-                p.value
-            } else {
-                *free.next().ok_or("too few free values")?
-            });
-        }
+        let full = full_values(self.params, x)?;
         let run = self.rig.run(self.model, &full)?;
         for (k, &i) in self.subset.iter().enumerate() {
             sink(k, run.residual[i]);

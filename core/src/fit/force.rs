@@ -36,7 +36,7 @@ use std::sync::Arc;
 use super::engine;
 use super::error::FitError;
 use super::objective::Residuals;
-use super::param::FitParam;
+use super::param::{full_values, FitParam};
 use super::result::{FitProgress, FitResult};
 use super::settings::FitSettings;
 use crate::force_model::{ForceModel, ModelState};
@@ -229,16 +229,7 @@ impl Residuals for ForceResiduals<'_> {
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
         let n_model = self.model.params().len();
-        // Full parameter vector: fixed values, free values in order.
-        let mut full = Vec::with_capacity(self.all.len());
-        let mut free = x.iter();
-        for q in self.all {
-            full.push(if q.fixed {
-                q.value
-            } else {
-                *free.next().ok_or("too few free values")?
-            });
-        }
+        let full = full_values(self.all, x)?;
         let p = &full[..n_model];
         let offset = full.get(n_model).copied().unwrap_or(0.0);
         let d = &self.data;

@@ -34,7 +34,7 @@ mod transform;
 pub use error::FitError;
 pub use force::{ForceData, ForceFit, FORCE_OFFSET};
 pub use objective::Residuals;
-pub use param::FitParam;
+pub use param::{full_values, FitParam};
 pub use result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
 pub use settings::{FitSettings, Solver};
 pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};

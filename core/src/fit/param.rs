@@ -33,6 +33,31 @@ pub struct FitParam {
     pub scale: Option<f64>,
 }
 
+/// The value of every parameter of `params`, in order: a fixed one's own value, a free one's
+/// from `free` (the free values in order); an error if `free` is too short.
+///
+/// ```
+/// use stf_core::fit::{full_values, FitParam};
+/// let params = [FitParam::new("a", 1.0).fixed(true), FitParam::new("b", 2.0)];
+/// assert_eq!(full_values(&params, &[5.0]).unwrap(), vec![1.0, 5.0]);
+/// assert!(full_values(&params, &[]).is_err());
+/// ```
+pub fn full_values(params: &[FitParam], free: &[f64]) -> Result<Vec<f64>, String> {
+    let mut free = free.iter();
+    params
+        .iter()
+        .map(|p| {
+            if p.fixed {
+                Ok(p.value)
+            } else {
+                free.next()
+                    .copied()
+                    .ok_or_else(|| "too few free values".to_string())
+            }
+        })
+        .collect()
+}
+
 impl FitParam {
     /// A free, unbounded parameter starting at `value`.
     pub fn new(name: impl Into<String>, value: f64) -> Self {
