@@ -26,7 +26,9 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, load_data, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
-use crate::report::{measured_vs_fitted, FigureRef, Section, Table};
+use crate::report::{
+    measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
+};
 use crate::reporting::{record_sections, write_report};
 
 /// The effects of DESIGN.md §5, the default candidates.
@@ -409,12 +411,14 @@ fn run_trajectory(
         std::fs::create_dir_all(&dir)?;
         let mut s = Section::new("Discovery (trajectory level)");
         s.paragraphs.extend(found.notes.iter().cloned());
-        let fig = measured_vs_fitted(
+        let mm = |x: &[f64]| x.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
+        let fig = measured_vs_model(
             &dir,
             "discovery_x",
+            DISPLACEMENT_MM,
             &data.record.t,
-            &data.record.x,
-            &[("base", &tf.x_before), ("final", &tf.x_after)],
+            &mm(&data.record.x),
+            &[("base", &mm(&tf.x_before)), ("final", &mm(&tf.x_after))],
         )?;
         s.figures.push(FigureRef::new(
             fig,

@@ -1,5 +1,6 @@
-//! Measured against fitted force: the STF force recovered from a record and each model's
-//! fitted force over time, on one axis, so the reader sees where a model misses.
+//! Measured against modelled signal over time, on one axis, so the reader sees where a model
+//! misses: the STF force of a record and each model's fitted force, or (trajectory level) the
+//! measured displacement and the oscillator simulated with each model.
 
 use std::path::Path;
 
@@ -19,7 +20,34 @@ use super::ReportError;
 /// The measured force is a wide light-grey band under the fitted lines, so both stay visible.
 const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
 
+/// What a measured-vs-modelled figure shows: its title, the quantity with its unit (axis and
+/// CSV columns) and what the model curves are.
+#[derive(Clone, Copy, Debug)]
+pub struct Quantity {
+    /// Figure title.
+    pub title: &'static str,
+    /// The quantity and its unit, e.g. `F_STF, N`.
+    pub label: &'static str,
+    /// What a model curve is: `fitted` or `simulated`.
+    pub model_word: &'static str,
+}
+
+/// The STF force against each model's fitted force.
+pub const STF_FORCE: Quantity = Quantity {
+    title: "STF force: measured and fitted",
+    label: "F_STF, N",
+    model_word: "fitted",
+};
+
+/// The displacement against the oscillator simulated with each model (values in mm).
+pub const DISPLACEMENT_MM: Quantity = Quantity {
+    title: "Displacement: measured and simulated",
+    label: "x, mm",
+    model_word: "simulated",
+};
+
 struct MeasuredVsFittedPlot {
+    quantity: Quantity,
     t: Vec<f64>,
     measured: Vec<f64>,
     fitted: Vec<(String, Vec<f64>)>,
@@ -36,7 +64,7 @@ impl Draw for MeasuredVsFittedPlot {
         )
         .ok_or_else(no_data)?;
         let root = root
-            .titled("STF force: measured and fitted", title_style())
+            .titled(self.quantity.title, title_style())
             .map_err(msg)?;
         let mut chart = ChartBuilder::on(&root)
             .margin(10)
@@ -48,7 +76,7 @@ impl Draw for MeasuredVsFittedPlot {
         chart
             .configure_mesh()
             .x_desc("time t, s")
-            .y_desc("F_STF, N")
+            .y_desc(self.quantity.label)
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0))
@@ -96,19 +124,34 @@ pub fn measured_vs_fitted(
     measured: &[f64],
     fitted: &[(&str, &[f64])],
 ) -> Result<FigureFiles, ReportError> {
+    measured_vs_model(out_dir, name, STF_FORCE, t, measured, fitted)
+}
+
+/// Draw the measured `quantity` and each model's (`(model label, values)`) over time `t` (s)
+/// to `out_dir/name.{svg,png,csv}`. The CSV holds t, the measured values and one column per
+/// model, as plotted.
+pub fn measured_vs_model(
+    out_dir: &Path,
+    name: &str,
+    quantity: Quantity,
+    t: &[f64],
+    measured: &[f64],
+    fitted: &[(&str, &[f64])],
+) -> Result<FigureFiles, ReportError> {
     same_length("measured vs fitted: t and measured", t, measured)?;
     for (label, f) in fitted {
         same_length(&format!("measured vs fitted: t and {label}"), t, f)?;
     }
     if !measured.iter().any(|v| v.is_finite()) {
         return Err(ReportError::NoData {
-            what: "measured vs fitted: measured force".into(),
+            what: format!("measured vs fitted: measured {}", quantity.label),
         });
     }
     let mut all: Vec<&[f64]> = vec![measured];
     all.extend(fitted.iter().map(|(_, f)| *f));
     let keep = decimate_union(&all, MAX_POINTS_PER_LINE);
     let plot = MeasuredVsFittedPlot {
+        quantity,
         t: pick(t, &keep),
         measured: pick(measured, &keep),
         fitted: fitted
@@ -118,13 +161,17 @@ pub fn measured_vs_fitted(
     };
     let mut columns = vec![
         Column::new("t, s", plot.t.clone()),
-        Column::new("measured F_STF, N", plot.measured.clone()),
+        Column::new(
+            format!("measured {}", quantity.label),
+            plot.measured.clone(),
+        ),
     ];
-    columns.extend(
-        plot.fitted
-            .iter()
-            .map(|(label, f)| Column::new(format!("{label}: fitted F_STF, N"), f.clone())),
-    );
+    columns.extend(plot.fitted.iter().map(|(label, f)| {
+        Column::new(
+            format!("{label}: {} {}", quantity.model_word, quantity.label),
+            f.clone(),
+        )
+    }));
     render(out_dir, name, SIZE, &plot, &columns)
 }
 
@@ -155,5 +202,26 @@ mod tests {
             svg.contains("power law") && svg.contains("measured"),
             "legend"
         );
+    }
+
+    #[test]
+    fn a_displacement_figure_says_displacement_not_force() {
+        let s = damped_sine(1_000, 2.0);
+        let x_mm: Vec<f64> = s.x.iter().map(|x| x * 1e3).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files = measured_vs_model(
+            dir.path(),
+            "x",
+            DISPLACEMENT_MM,
+            &s.t,
+            &x_mm,
+            &[("base", &x_mm)],
+        )
+        .unwrap();
+        let cols = assert_rendered(&files, SIZE);
+        assert_eq!(column(&cols, "measured x, mm"), &x_mm[..]);
+        assert_eq!(column(&cols, "base: simulated x, mm"), &x_mm[..]);
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(svg.contains("Displacement") && !svg.contains("STF force"));
     }
 }

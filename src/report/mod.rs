@@ -55,7 +55,9 @@ pub use frequency_response::{frequency_response, FrfCurve};
 pub use html::write_html;
 pub use hysteresis::hysteresis;
 pub use markdown::write_markdown;
-pub use measured_vs_fitted::measured_vs_fitted;
+pub use measured_vs_fitted::{
+    measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, STF_FORCE,
+};
 pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};
