@@ -8,7 +8,7 @@
 //! assert_eq!(run.x.len(), 51);
 //! ```
 
-use crate::integrate::{integrate, Method, Settings, SimError, Stats};
+use crate::integrate::{integrate_states, Method, Settings, SimError, Stats};
 use crate::oscillator::Oscillator;
 
 /// Samples of a simulated run.
@@ -88,20 +88,24 @@ impl<'a> Simulation<'a> {
         }
         let n = ((t1 - t0) * self.rate).round() as usize + 1;
         let times: Vec<f64> = (0..n).map(|i| t0 + i as f64 / self.rate).collect();
-        self.run_at(&times)
+        self.sample(times)
     }
 
     /// Run from `times[0]` and sample at `times` (strictly increasing).
     pub fn run_at(&self, times: &[f64]) -> Result<Trajectory, SimError> {
+        self.sample(times.to_vec())
+    }
+
+    /// [`Simulation::run_at`], keeping `times` as the trajectory's time column (no copy).
+    fn sample(&self, times: Vec<f64>) -> Result<Trajectory, SimError> {
         let Some(&t0) = times.first() else {
             return Ok(Trajectory::default());
         };
         let y0 = self.osc.initial_state(self.x0, self.v0);
-        let sol = integrate(self.osc, t0, &y0, times, &self.settings)?;
+        let (states, stats) = integrate_states(self.osc, t0, &y0, &times, &self.settings)?;
         let n = times.len();
-        let dim = sol.dim;
-        let column =
-            |j: usize| -> Vec<f64> { sol.states.chunks_exact(dim).map(|y| y[j]).collect() };
+        let dim = y0.len();
+        let column = |j: usize| -> Vec<f64> { states.chunks_exact(dim).map(|y| y[j]).collect() };
         let rotor = self.osc.excitation.omega(t0).is_some();
         let f0 = self.osc.params.f0;
         // The rotor angle is evaluated once per sample, for the drive, φ and ω.
@@ -113,26 +117,26 @@ impl<'a> Simulation<'a> {
         };
         if rotor {
             let rows = drive.iter_mut().zip(phi.iter_mut()).zip(omega.iter_mut());
-            for (((d, p), w), &t) in rows.zip(times) {
+            for (((d, p), w), &t) in rows.zip(&times) {
                 let (force, angle) = self.osc.excitation.force_and_angle(t, f0);
                 *d = force;
                 (*p, *w) = angle.unwrap_or((0.0, 0.0));
             }
         } else {
-            for (d, &t) in drive.iter_mut().zip(times) {
+            for (d, &t) in drive.iter_mut().zip(&times) {
                 *d = self.osc.excitation.force(t, f0);
             }
         }
         let (mut a, mut f_stf) = (vec![0.0; n], vec![0.0; n]);
         let mut dz = vec![0.0; self.osc.n_internal()];
-        let rows = sol.states.chunks_exact(dim).zip(times).zip(&drive);
+        let rows = states.chunks_exact(dim).zip(&times).zip(&drive);
         for ((ai, fi), ((y, &t), &d)) in a.iter_mut().zip(f_stf.iter_mut()).zip(rows) {
             let f = self.osc.forces_with_drive(t, y, d, &mut dz)?;
             *ai = f.a;
             *fi = f.f_stf;
         }
         let out = Trajectory {
-            t: times.to_vec(),
+            t: times,
             x: column(0),
             v: column(1),
             a,
@@ -141,7 +145,7 @@ impl<'a> Simulation<'a> {
             phi: rotor.then_some(phi),
             omega: rotor.then_some(omega),
             z: (2..dim).map(column).collect(),
-            stats: sol.stats,
+            stats,
         };
         Ok(out)
     }

@@ -49,7 +49,7 @@ use super::approach::Approach;
 use super::dormand_prince::DormandPrince;
 use super::jacobian::spectral_radius;
 use super::rodas4::Rodas4;
-use super::{OdeSystem, Settings, SimError, Solution, Stats};
+use super::{OdeSystem, Settings, SimError, Stats};
 
 /// Which methods the driver may use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,7 +99,8 @@ pub(super) struct Work {
     pub to_stiff: u64,
 }
 
-/// Integrate with `policy`; the requests are checked by the caller.
+/// Integrate with `policy`: the sampled states, row after row, and the work. The requests are
+/// checked by the caller.
 pub(super) fn integrate(
     sys: &dyn OdeSystem,
     t0: f64,
@@ -107,15 +108,10 @@ pub(super) fn integrate(
     t_out: &[f64],
     s: &Settings,
     policy: Policy,
-) -> Result<Solution, SimError> {
+) -> Result<(Vec<f64>, Stats), SimError> {
     let mut work = Work::default();
     let states = run(sys, t0, y0, t_out, s, policy, &mut work)?;
-    Ok(Solution {
-        t: t_out.to_vec(),
-        states,
-        dim: y0.len(),
-        stats: work.stats,
-    })
+    Ok((states, work.stats))
 }
 
 /// The integration loop; returns the sampled states and counts its work in `work`.
