@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use super::acceptance;
 use super::candidate::Candidate;
+use super::choice;
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
 use super::holdout::HoldoutSplit;
@@ -25,14 +26,9 @@ struct Stage {
     values: Vec<f64>,
 }
 
-/// A model fitted on the training samples and scored on the held-out ones.
-struct Trial {
-    stage: Stage,
-    train: FitResult,
-    /// Residuals at the held-out samples.
-    holdout: Vec<f64>,
-    holdout_mse: f64,
-}
+/// A force-level model fitted on the training samples, its held-out residuals the units
+/// of the paired test.
+type Trial = choice::Trial<Stage>;
 
 impl Stage {
     fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
@@ -388,73 +384,6 @@ fn best_trial(
     }
 }
 
-/// How `trial` (a model with the candidate `name`, whose own parameters are its `n_own`
-/// before the offset) scores against `current`; `base_excess` is the base's held-out mean
-/// square above the noise floor.
-fn score_trial(
-    name: &str,
-    n_own: usize,
-    trial: &Trial,
-    current: &Trial,
-    base_excess: f64,
-    settings: &DiscoverySettings,
-) -> CandidateScore {
-    let h = trial.holdout_mse.sqrt();
-    let offset_len = usize::from(settings.fit_offset);
-    let np = trial.train.params.len();
-    let own = trial
-        .train
-        .params
-        .get(np.saturating_sub(offset_len + n_own)..np.saturating_sub(offset_len))
-        .map(<[_]>::to_vec)
-        .unwrap_or_default();
-    let failure = matches!(
-        trial.train.convergence,
-        crate::fit::Convergence::Failed { .. }
-    )
-    .then(|| format!("{:?}", trial.train.convergence));
-    let mut score = CandidateScore {
-        name: name.to_string(),
-        holdout_rms: h,
-        train_rms: trial.train.rms,
-        aic: trial.train.aic,
-        bic: trial.train.bic,
-        delta_aic: trial.train.aic - current.train.aic,
-        delta_bic: trial.train.bic - current.train.bic,
-        holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: acceptance::paired_z(&current.holdout, &trial.holdout),
-        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
-        params: own,
-        significant: false,
-        failure,
-        evaluations: trial.train.evaluations,
-        wall_seconds: trial.train.wall_seconds,
-    };
-    score.significant = acceptance::is_significant(&score, settings);
-    score
-}
-
-/// The score of a candidate whose fit failed.
-fn failed_score(name: &str, error: &DiscoveryError) -> CandidateScore {
-    CandidateScore {
-        name: name.to_string(),
-        holdout_rms: f64::NAN,
-        train_rms: f64::NAN,
-        aic: f64::NAN,
-        bic: f64::NAN,
-        delta_aic: f64::NAN,
-        delta_bic: f64::NAN,
-        holdout_gain: f64::NAN,
-        gain_z: f64::NAN,
-        explained_fraction: f64::NAN,
-        params: Vec::new(),
-        significant: false,
-        failure: Some(error.to_string()),
-        evaluations: 0,
-        wall_seconds: 0.0,
-    }
-}
-
 /// Find the effects missing from `base` among `candidates`, at force level.
 ///
 /// `data` holds the measured kinematics and F_STF; `cycles` cut it into whole cycles (e.g.
@@ -562,7 +491,6 @@ pub fn discover_force(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for _ in 0..settings.max_effects {
-        let current_h = current.holdout_mse.sqrt();
         let current_residual = current.stage.residuals(data, settings)?;
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
@@ -593,79 +521,35 @@ pub fn discover_force(
             );
             scored.push(match best {
                 Ok(trial) => (
-                    score_trial(&c.name, n_own, &trial, &current, base_excess, settings),
+                    choice::score(
+                        &c.name,
+                        n_own,
+                        &trial,
+                        &current,
+                        acceptance::paired_z,
+                        base_excess,
+                        settings,
+                    ),
                     Some(trial),
                 ),
-                Err(e) => (failed_score(&c.name, &e), None),
+                Err(e) => (choice::failed(&c.name, e.to_string()), None),
             });
         }
         if scored.is_empty() {
             break;
         }
-        scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-        let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
-        let holdout: Vec<&[f64]> = scored
-            .iter()
-            .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
-            .collect();
-        let choice = acceptance::choose(&scores, &holdout, settings);
-        let mut step = Step {
-            current: current.stage.name(),
-            current_holdout_rms: current_h,
-            candidates: scores,
-            accepted: None,
-            tie_with: Vec::new(),
-            verdict: String::new(),
-        };
-        let Some((winner, ties)) = choice else {
-            step.verdict = format!(
-                "no candidate lowers the held-out RMS ({current_h:.4} N) with a paired z above \
-                 {} and a BIC drop above {}: nothing is missing that the data demand",
-                settings.min_gain_sigma, settings.min_bic_drop
-            );
-            notes.push(step.verdict.clone());
-            steps.push(step);
-            break;
-        };
-        let tie_names: Vec<String> = ties
-            .iter()
-            .map(|&i| step.candidates[i].name.clone())
-            .collect();
-        let w = &step.candidates[winner];
-        let params: Vec<String> = w
-            .params
-            .iter()
-            .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
-            .collect();
-        step.verdict = format!(
-            "add `{}`: held-out RMS {current_h:.4} → {:.4} N (paired z {:.1}), ΔBIC \
-             {:.1}, explains {:.0} % of the base's held-out gap; {}",
-            w.name,
-            w.holdout_rms,
-            w.gain_z,
-            w.delta_bic,
-            100.0 * w.explained_fraction,
-            params.join(", ")
+        let (step, winner) = choice::decide(
+            &current,
+            current.stage.name(),
+            scored,
+            &choice::FORCE,
+            settings,
         );
-        if !tie_names.is_empty() {
-            step.verdict.push_str(&format!(
-                "; `{}` explain the data equally well (the best is not better by the held-out \
-                 test), `{}` is chosen as the simplest (fewest parameters, then lowest BIC)",
-                tie_names.join("`, `"),
-                w.name
-            ));
-        }
         notes.push(step.verdict.clone());
-        step.accepted = Some(w.name.clone());
-        step.tie_with = tie_names;
-        effects.push(w.name.clone());
-        let w_name = w.name.clone();
+        effects.extend(step.accepted.clone());
         steps.push(step);
         // The winner becomes the current model.
-        let Some(pos) = scored.iter().position(|s| s.0.name == w_name) else {
-            break;
-        };
-        let Some(trial) = scored.swap_remove(pos).1 else {
+        let Some(trial) = winner else {
             break;
         };
         current = trial;
@@ -830,7 +714,15 @@ fn reconsider(
                         .map(|p| p.params().len())
                         .sum();
                     let n_own = c.model.params().len();
-                    let mut score = score_trial(&label, 0, &trial, current, base_excess, settings);
+                    let mut score = choice::score(
+                        &label,
+                        0,
+                        &trial,
+                        current,
+                        acceptance::paired_z,
+                        base_excess,
+                        settings,
+                    );
                     score.params = trial
                         .train
                         .params
@@ -846,7 +738,7 @@ fn reconsider(
                     score.significant = wins || tie;
                     tried.push((score, Some(trial), j, k, tie));
                 }
-                Err(e) => tried.push((failed_score(&label, &e), None, j, k, false)),
+                Err(e) => tried.push((choice::failed(&label, e.to_string()), None, j, k, false)),
             }
         }
     }

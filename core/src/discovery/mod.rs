@@ -25,6 +25,7 @@
 
 pub mod acceptance;
 pub mod candidate;
+mod choice;
 pub mod engine;
 pub mod error;
 pub mod gap;

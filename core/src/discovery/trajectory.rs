@@ -26,17 +26,18 @@ use std::sync::Arc;
 
 use super::acceptance;
 use super::candidate::Candidate;
+use super::choice;
 use super::engine::inside;
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
 use super::report::Discovery;
-use super::score::{CandidateScore, Step};
+use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
 use super::subset_fit::{rms, rms_over};
 use super::trajectory_fit::{fit_on, Rig, Run};
 use super::trajectory_gap::locate_x_gap;
 use crate::excitation::Excitation;
-use crate::fit::{Convergence, FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
+use crate::fit::{FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
 use crate::model_sum::ModelSum;
@@ -130,14 +131,9 @@ struct Stage {
     values: Vec<f64>,
 }
 
-/// A stage fitted on the training samples and scored on the held-out ones.
-struct Trial {
-    stage: Stage,
-    train: FitResult,
-    /// RMS residual of each held-out cycle ([`cycle_rms`]): the units of the paired test.
-    holdout: Vec<f64>,
-    holdout_mse: f64,
-}
+/// A trajectory-level model fitted on the training samples, the RMS residuals of its
+/// held-out cycles ([`cycle_rms`]) the units of the paired test.
+type Trial = choice::Trial<Stage>;
 
 /// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
 /// scale: `dᵢ = 2·ln(reference_i / new_i)` (the log-ratio of cycle i's mean squared residual),
@@ -334,68 +330,6 @@ impl Stage {
     }
 }
 
-/// The score of `trial` (candidate `name`, `n_own` parameters of its own) against `current`.
-fn score_of(
-    name: &str,
-    trial: &Trial,
-    current: &Trial,
-    n_own: usize,
-    offset_len: usize,
-    base_excess: f64,
-    settings: &DiscoverySettings,
-) -> CandidateScore {
-    let h = trial.holdout_mse.sqrt();
-    let np = trial.train.params.len();
-    let own = trial
-        .train
-        .params
-        .get(np.saturating_sub(offset_len + n_own)..np.saturating_sub(offset_len))
-        .map(<[_]>::to_vec)
-        .unwrap_or_default();
-    let failure = matches!(trial.train.convergence, Convergence::Failed { .. })
-        .then(|| format!("{:?}", trial.train.convergence));
-    let mut score = CandidateScore {
-        name: name.to_string(),
-        holdout_rms: h,
-        train_rms: trial.train.rms,
-        aic: trial.train.aic,
-        bic: trial.train.bic,
-        delta_aic: trial.train.aic - current.train.aic,
-        delta_bic: trial.train.bic - current.train.bic,
-        holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: cycle_gain_z(&current.holdout, &trial.holdout),
-        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
-        params: own,
-        significant: false,
-        failure,
-        evaluations: trial.train.evaluations,
-        wall_seconds: trial.train.wall_seconds,
-    };
-    score.significant = acceptance::is_significant(&score, settings);
-    score
-}
-
-/// The score of a candidate whose fit could not run.
-fn failed(name: &str, why: String) -> CandidateScore {
-    CandidateScore {
-        name: name.to_string(),
-        holdout_rms: f64::NAN,
-        train_rms: f64::NAN,
-        aic: f64::NAN,
-        bic: f64::NAN,
-        delta_aic: f64::NAN,
-        delta_bic: f64::NAN,
-        holdout_gain: f64::NAN,
-        gain_z: f64::NAN,
-        explained_fraction: f64::NAN,
-        params: Vec::new(),
-        significant: false,
-        failure: Some(why),
-        evaluations: 0,
-        wall_seconds: 0.0,
-    }
-}
-
 /// Find the effects missing from `base` among `candidates`, at trajectory level.
 ///
 /// `data` is the measured displacement; `cycles` cut it into whole cycles (of the rotor, or
@@ -457,7 +391,6 @@ pub fn discover_trajectory(
     };
     let n_osc = setup.oscillator.len();
     let osc_start: Vec<f64> = setup.oscillator.iter().map(|p| p.value).collect();
-    let offset_len = usize::from(settings.fit_offset);
     let base_name = base.name().to_string();
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
@@ -498,7 +431,6 @@ pub fn discover_trajectory(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for _ in 0..settings.max_effects {
-        let current_h = current.holdout_mse.sqrt();
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
             let taken = in_base.iter().any(|b| b == c.model.name())
@@ -519,88 +451,34 @@ pub fn discover_trajectory(
             let n_own = c.model.params().len();
             scored.push(match stage.trial(&rig, setup, &split, settings) {
                 Ok(trial) => (
-                    score_of(
+                    choice::score(
                         &c.name,
+                        n_own,
                         &trial,
                         &current,
-                        n_own,
-                        offset_len,
+                        cycle_gain_z,
                         base_excess,
                         settings,
                     ),
                     Some(trial),
                 ),
-                Err(e) => (failed(&c.name, e.to_string()), None),
+                Err(e) => (choice::failed(&c.name, e.to_string()), None),
             });
         }
         if scored.is_empty() {
             break;
         }
-        scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-        let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
-        let holdout: Vec<&[f64]> = scored
-            .iter()
-            .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
-            .collect();
-        let choice = acceptance::choose(&scores, &holdout, settings);
-        let mut step = Step {
-            current: current.stage.name(),
-            current_holdout_rms: current_h,
-            candidates: scores,
-            accepted: None,
-            tie_with: Vec::new(),
-            verdict: String::new(),
-        };
-        let Some((winner, ties)) = choice else {
-            step.verdict = format!(
-                "no candidate lowers the held-out x RMS ({:.4} mm) with a paired z above {} \
-                 and a BIC drop above {}: nothing is missing that the data demand",
-                current_h * 1e3,
-                settings.min_gain_sigma,
-                settings.min_bic_drop
-            );
-            notes.push(step.verdict.clone());
-            steps.push(step);
-            break;
-        };
-        let tie_names: Vec<String> = ties
-            .iter()
-            .map(|&i| step.candidates[i].name.clone())
-            .collect();
-        let w = &step.candidates[winner];
-        let params: Vec<String> = w
-            .params
-            .iter()
-            .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
-            .collect();
-        step.verdict = format!(
-            "add `{}`: held-out x RMS {:.4} → {:.4} mm (paired z {:.1}), ΔBIC {:.1}, explains \
-             {:.0} % of the base's held-out gap; {}",
-            w.name,
-            current_h * 1e3,
-            w.holdout_rms * 1e3,
-            w.gain_z,
-            w.delta_bic,
-            100.0 * w.explained_fraction,
-            params.join(", ")
+        let (step, winner) = choice::decide(
+            &current,
+            current.stage.name(),
+            scored,
+            &choice::DISPLACEMENT,
+            settings,
         );
-        if !tie_names.is_empty() {
-            step.verdict.push_str(&format!(
-                "; `{}` explain the data equally well, `{}` is chosen for its lower BIC",
-                tie_names.join("`, `"),
-                w.name
-            ));
-        }
         notes.push(step.verdict.clone());
-        step.accepted = Some(w.name.clone());
-        step.tie_with = tie_names;
-        effects.push(w.name.clone());
-        let w_name = w.name.clone();
+        effects.extend(step.accepted.clone());
         steps.push(step);
-        let Some(pos) = scored.iter().position(|s| s.0.name == w_name) else {
-            break;
-        };
-        let Some(trial) = scored.swap_remove(pos).1 else {
+        let Some(trial) = winner else {
             break;
         };
         // The accepted model, polished from its trial fit at the final fit's tolerance: the
