@@ -12,40 +12,17 @@ use super::holdout::HoldoutSplit;
 use super::report::Discovery;
 use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
+use super::stage::Stage;
 use super::subset_fit::{fit_subset, residuals, rms, rms_over};
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, FORCE_OFFSET};
 use crate::force_model::ForceModel;
-use crate::model_sum::ModelSum;
 use crate::regimes::{noise_floor, Cycle};
-
-/// A model as it stands: its parts, and the values of its parameters (then the offset).
-#[derive(Clone)]
-struct Stage {
-    parts: Vec<Arc<dyn ForceModel>>,
-    /// Start (or fitted) values of every parameter of the sum, then the offset if fitted.
-    values: Vec<f64>,
-}
 
 /// A force-level model fitted on the training samples, its held-out residuals the units
 /// of the paired test.
 type Trial = choice::Trial<Stage>;
 
 impl Stage {
-    fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
-        Ok(match self.parts.as_slice() {
-            [one] => one.clone(),
-            _ => Arc::new(ModelSum::new(self.parts.clone())?),
-        })
-    }
-
-    fn name(&self) -> String {
-        self.parts
-            .iter()
-            .map(|p| p.name().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
-    }
-
     /// The force fit of this stage starting from its values (clamped into the bounds).
     fn force_fit(&self, settings: &DiscoverySettings) -> Result<ForceFit, DiscoveryError> {
         let model = self.model()?;
@@ -104,24 +81,6 @@ impl Stage {
             holdout: split.holdout.iter().map(|&i| r[i]).collect(),
             holdout_mse: h * h,
         })
-    }
-
-    /// This stage with `extra` added, its parameters at `start`.
-    fn with_values(
-        &self,
-        extra: &Arc<dyn ForceModel>,
-        start: &[f64],
-        settings: &DiscoverySettings,
-    ) -> Stage {
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let mut values = self.values[..n_model.min(self.values.len())].to_vec();
-        values.extend_from_slice(start);
-        if settings.fit_offset {
-            values.push(self.values.get(n_model).copied().unwrap_or(0.0));
-        }
-        let mut parts = self.parts.clone();
-        parts.push(extra.clone());
-        Stage { parts, values }
     }
 
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
@@ -494,14 +453,7 @@ pub fn discover_force(
         let current_residual = current.stage.residuals(data, settings)?;
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
-            let name_taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name())
-                || effects.contains(&c.name);
-            if name_taken {
+            if current.stage.holds(c, &in_base, &effects) {
                 continue;
             }
             let starts = candidate_starts(
@@ -514,7 +466,7 @@ pub fn discover_force(
             let n_own = c.model.params().len();
             let best = best_trial(
                 &starts,
-                |start| current.stage.with_values(&c.model, start, settings),
+                |start| current.stage.with(&c.model, start, 0),
                 data,
                 &split,
                 settings,
@@ -682,13 +634,7 @@ fn reconsider(
         let rest = current.stage.without(part);
         let rest_residual = rest.residuals(data, settings)?;
         for (k, c) in candidates.iter().enumerate() {
-            let taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name());
-            if taken {
+            if current.stage.holds(c, in_base, &[]) {
                 continue;
             }
             let label = format!("{} for {}", c.name, effects[j]);

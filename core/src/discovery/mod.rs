@@ -33,6 +33,7 @@ pub mod holdout;
 pub mod report;
 pub mod score;
 pub mod settings;
+mod stage;
 mod subset_fit;
 pub mod trajectory;
 mod trajectory_fit;

@@ -33,6 +33,7 @@ use super::holdout::HoldoutSplit;
 use super::report::Discovery;
 use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
+use super::stage::Stage;
 use super::subset_fit::{rms, rms_over};
 use super::trajectory_fit::{fit_on, Rig, Run};
 use super::trajectory_gap::locate_x_gap;
@@ -40,7 +41,6 @@ use crate::excitation::Excitation;
 use crate::fit::{FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
-use crate::model_sum::ModelSum;
 use crate::regimes::{noise_floor, Cycle};
 use crate::system::OscillatorParams;
 
@@ -123,14 +123,6 @@ pub struct TrajectoryDiscovery {
     pub x_after: Vec<f64>,
 }
 
-/// A model as it stands: its parts and the values of every parameter of the fit
-/// (oscillator's, model's, then the offset).
-#[derive(Clone)]
-struct Stage {
-    parts: Vec<Arc<dyn ForceModel>>,
-    values: Vec<f64>,
-}
-
 /// A trajectory-level model fitted on the training samples, the RMS residuals of its
 /// held-out cycles ([`cycle_rms`]) the units of the paired test.
 type Trial = choice::Trial<Stage>;
@@ -175,21 +167,6 @@ fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
 }
 
 impl Stage {
-    fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
-        Ok(match self.parts.as_slice() {
-            [one] => one.clone(),
-            _ => Arc::new(ModelSum::new(self.parts.clone())?),
-        })
-    }
-
-    fn name(&self) -> String {
-        self.parts
-            .iter()
-            .map(|p| p.name().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
-    }
-
     /// Every parameter of the fit, starting from this stage's values.
     fn params(&self, setup: &TrajectorySetup, model: &Arc<dyn ForceModel>) -> Vec<FitParam> {
         let mut out: Vec<FitParam> = Vec::with_capacity(self.values.len());
@@ -213,7 +190,7 @@ impl Stage {
     }
 
     /// Fit on `subset`: the stage with the fitted values, and the fit.
-    fn fit(
+    fn fit_simulated(
         &self,
         rig: &Rig,
         setup: &TrajectorySetup,
@@ -243,14 +220,14 @@ impl Stage {
     }
 
     /// Fit on the training samples and score on the held-out ones.
-    fn trial(
+    fn trial_simulated(
         &self,
         rig: &Rig,
         setup: &TrajectorySetup,
         split: &HoldoutSplit,
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
-        let (stage, train) = self.fit(rig, setup, &split.train, settings)?;
+        let (stage, train) = self.fit_simulated(rig, setup, &split.train, settings)?;
         let r = stage.run(rig)?.residual;
         let h = rms_over(&r, &split.holdout);
         Ok(Trial {
@@ -259,18 +236,6 @@ impl Stage {
             holdout: cycle_rms(&r, &split.holdout),
             holdout_mse: h * h,
         })
-    }
-
-    /// This stage with `extra` added, its parameters at their defaults.
-    fn with(&self, extra: &Arc<dyn ForceModel>, n_osc: usize) -> Stage {
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let cut = (n_osc + n_model).min(self.values.len());
-        let mut values = self.values[..cut].to_vec();
-        values.extend(extra.params().iter().map(|s| s.default));
-        values.extend_from_slice(&self.values[cut..]);
-        let mut parts = self.parts.clone();
-        parts.push(extra.clone());
-        Stage { parts, values }
     }
 }
 
@@ -408,7 +373,7 @@ pub fn discover_trajectory(
             .collect(),
         parts: vec![base.clone()],
     };
-    let (base_full, base_result) = start.fit(&rig, setup, &all, settings)?;
+    let (base_full, base_result) = start.fit_simulated(&rig, setup, &all, settings)?;
     let run_before = base_full.run(&rig)?;
     let gap_before = rms(&run_before.residual);
     let simulated = |run: &Run| -> Vec<f64> {
@@ -425,7 +390,7 @@ pub fn discover_trajectory(
     notes.push(format!("base `{base_name}`: {}", where_before.summary));
 
     // 3–4. Add effects while the held-out evidence demands one.
-    let mut current = start.trial(&rig, setup, &split, settings)?;
+    let mut current = start.trial_simulated(&rig, setup, &split, settings)?;
     let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
@@ -433,23 +398,17 @@ pub fn discover_trajectory(
     for _ in 0..settings.max_effects {
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
-            let taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name())
-                || effects.contains(&c.name);
-            if taken {
+            if current.stage.holds(c, &in_base, &effects) {
                 continue;
             }
-            let stage =
-                current
-                    .stage
-                    .with(&c.model, n_osc)
-                    .screened(&rig, &split.train, &osc_start);
+            let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+            let stage = current.stage.with(&c.model, &defaults, n_osc).screened(
+                &rig,
+                &split.train,
+                &osc_start,
+            );
             let n_own = c.model.params().len();
-            scored.push(match stage.trial(&rig, setup, &split, settings) {
+            scored.push(match stage.trial_simulated(&rig, setup, &split, settings) {
                 Ok(trial) => (
                     choice::score(
                         &c.name,
@@ -493,7 +452,7 @@ pub fn discover_trajectory(
                 .tol(settings.fit.tol.min(1e-9)),
             ..settings.clone()
         };
-        current = match trial.stage.trial(&rig, setup, &split, &polish) {
+        current = match trial.stage.trial_simulated(&rig, setup, &split, &polish) {
             Ok(polished) if polished.train.rms <= trial.train.rms => polished,
             _ => trial,
         };
@@ -508,7 +467,7 @@ pub fn discover_trajectory(
             fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
             ..settings.clone()
         };
-        let (refit, result) = current.stage.fit(&rig, setup, &all, &lm)?;
+        let (refit, result) = current.stage.fit_simulated(&rig, setup, &all, &lm)?;
         let refit_run = refit.run(&rig)?;
         let start_run = current.stage.run(&rig)?;
         if rms(&start_run.residual) < rms(&refit_run.residual) {
@@ -578,6 +537,7 @@ mod tests {
     use super::*;
     use crate::force_model::{ModelError, ModelState};
     use crate::interpolate::Linear;
+    use crate::model_sum::ModelSum;
     use crate::oscillator::Oscillator;
     use crate::params::ParamSpec;
     use crate::regimes::cycles_from_x;
