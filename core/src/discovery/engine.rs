@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use super::acceptance;
-use super::candidate::Candidate;
+use super::candidate::{self, Candidate};
 use super::choice;
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
@@ -16,7 +16,7 @@ use super::stage::Stage;
 use super::subset_fit::{fit_subset, residuals, rms, rms_over};
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, FORCE_OFFSET};
 use crate::force_model::ForceModel;
-use crate::regimes::{noise_floor, Cycle};
+use crate::regimes::Cycle;
 
 /// A force-level model fitted on the training samples, its held-out residuals the units
 /// of the paired test.
@@ -399,24 +399,9 @@ pub fn discover_force(
     settings.validate()?;
     let base_name = base.name().to_string();
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
-    for (i, c) in candidates.iter().enumerate() {
-        let twice = candidates[..i]
-            .iter()
-            .any(|d| d.name == c.name || d.model.name() == c.model.name());
-        if twice {
-            return Err(DiscoveryError::DuplicateCandidate(c.name.clone()));
-        }
-    }
+    candidate::distinct(candidates)?;
     let n = data.t.len();
-    let floor = match settings.noise_sigma {
-        Some(s) => s,
-        None => noise_floor(data.f)?,
-    };
-    if !(floor > 0.0 && floor.is_finite()) {
-        return Err(DiscoveryError::BadData(format!(
-            "the noise floor of the measured force is {floor} N; give `noise_sigma`"
-        )));
-    }
+    let floor = settings.floor_of(data.f, "force", "N")?;
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
     let all: Vec<usize> = (0..n).collect();
     let mut notes = Vec::new();

@@ -25,7 +25,7 @@
 use std::sync::Arc;
 
 use super::acceptance;
-use super::candidate::Candidate;
+use super::candidate::{self, Candidate};
 use super::choice;
 use super::engine::inside;
 use super::error::DiscoveryError;
@@ -41,7 +41,7 @@ use crate::excitation::Excitation;
 use crate::fit::{FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
-use crate::regimes::{noise_floor, Cycle};
+use crate::regimes::Cycle;
 use crate::system::OscillatorParams;
 
 /// The oscillator side of a trajectory-level discovery: its parameters, its drive, which of
@@ -318,14 +318,7 @@ pub fn discover_trajectory(
             data.x.len()
         )));
     }
-    for (i, c) in candidates.iter().enumerate() {
-        let twice = candidates[..i]
-            .iter()
-            .any(|d| d.name == c.name || d.model.name() == c.model.name());
-        if twice {
-            return Err(DiscoveryError::DuplicateCandidate(c.name.clone()));
-        }
-    }
+    candidate::distinct(candidates)?;
     for p in &setup.oscillator {
         if OscillatorParams::FORCED.get(&p.name).is_none() {
             return Err(DiscoveryError::BadSettings(format!(
@@ -335,15 +328,7 @@ pub fn discover_trajectory(
             )));
         }
     }
-    let floor = match settings.noise_sigma {
-        Some(s) => s,
-        None => noise_floor(data.x)?,
-    };
-    if !(floor > 0.0 && floor.is_finite()) {
-        return Err(DiscoveryError::BadData(format!(
-            "the noise floor of the measured displacement is {floor} m; give `noise_sigma`"
-        )));
-    }
+    let floor = settings.floor_of(data.x, "displacement", "m")?;
     let rig = Rig {
         system: setup.system,
         excitation: setup.excitation.clone(),
