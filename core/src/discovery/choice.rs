@@ -7,15 +7,16 @@
 //! cycles), passed here as the trial's `holdout` and the `gain_z` function.
 
 use super::acceptance;
+use super::error::DiscoveryError;
 use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
+use super::stage::Stage;
 use crate::fit::{Convergence, FitResult};
 
-/// A model (a stage `S` of either level) fitted on the training samples and scored on the
-/// held-out ones.
-pub(super) struct Trial<S> {
+/// A model fitted on the training samples and scored on the held-out ones.
+pub(super) struct Trial {
     /// The model with its fitted values.
-    pub stage: S,
+    pub stage: Stage,
     /// The fit on the training samples.
     pub train: FitResult,
     /// The units of the paired test: residuals at the held-out samples (force level) or RMS
@@ -53,11 +54,11 @@ pub(super) const DISPLACEMENT: Said = Said {
 /// before the offset) scores against `current`; `gain_z` is the level's paired test of
 /// `trial.holdout` against `current.holdout`, `base_excess` the base's held-out mean square
 /// above the noise floor.
-pub(super) fn score<S>(
+pub(super) fn score(
     name: &str,
     n_own: usize,
-    trial: &Trial<S>,
-    current: &Trial<S>,
+    trial: &Trial,
+    current: &Trial,
     gain_z: fn(&[f64], &[f64]) -> f64,
     base_excess: f64,
     settings: &DiscoverySettings,
@@ -94,6 +95,26 @@ pub(super) fn score<S>(
     score
 }
 
+/// The score of the candidate `name` (`n_own` parameters of its own) and its trial, if
+/// that ran (scored as [`score`]), or its failure ([`failed`]).
+pub(super) fn scored(
+    name: &str,
+    n_own: usize,
+    trial: Result<Trial, DiscoveryError>,
+    current: &Trial,
+    gain_z: fn(&[f64], &[f64]) -> f64,
+    base_excess: f64,
+    settings: &DiscoverySettings,
+) -> (CandidateScore, Option<Trial>) {
+    match trial {
+        Ok(trial) => (
+            score(name, n_own, &trial, current, gain_z, base_excess, settings),
+            Some(trial),
+        ),
+        Err(e) => (failed(name, e.to_string()), None),
+    }
+}
+
 /// The score of a candidate whose fit could not run, and why.
 pub(super) fn failed(name: &str, why: String) -> CandidateScore {
     CandidateScore {
@@ -119,13 +140,12 @@ pub(super) fn failed(name: &str, why: String) -> CandidateScore {
 /// to `current`: the candidates best held-out RMS first, the one accepted by
 /// [`acceptance::choose`] (and its ties) or none, and the verdict said as `said`. Returns the
 /// step and the accepted candidate's trial (`None` when nothing is accepted).
-pub(super) fn decide<S>(
-    current: &Trial<S>,
-    current_name: String,
-    mut scored: Vec<(CandidateScore, Option<Trial<S>>)>,
+pub(super) fn decide(
+    current: &Trial,
+    mut scored: Vec<(CandidateScore, Option<Trial>)>,
     said: &Said,
     settings: &DiscoverySettings,
-) -> (Step, Option<Trial<S>>) {
+) -> (Step, Option<Trial>) {
     let current_h = current.holdout_mse.sqrt();
     scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
     let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
@@ -135,7 +155,7 @@ pub(super) fn decide<S>(
         .collect();
     let choice = acceptance::choose(&scores, &holdout, settings);
     let mut step = Step {
-        current: current_name,
+        current: current.stage.name(),
         current_holdout_rms: current_h,
         candidates: scores,
         accepted: None,

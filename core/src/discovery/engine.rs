@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use super::acceptance;
 use super::candidate::{self, Candidate};
-use super::choice;
+use super::choice::{self, Trial};
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
 use super::holdout::HoldoutSplit;
@@ -17,10 +17,6 @@ use super::subset_fit::{fit_subset, residuals, rms, rms_over};
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, FORCE_OFFSET};
 use crate::force_model::ForceModel;
 use crate::regimes::Cycle;
-
-/// A force-level model fitted on the training samples, its held-out residuals the units
-/// of the paired test.
-type Trial = choice::Trial<Stage>;
 
 impl Stage {
     /// The force fit of this stage starting from its values (clamped into the bounds).
@@ -456,32 +452,20 @@ pub fn discover_force(
                 &split,
                 settings,
             );
-            scored.push(match best {
-                Ok(trial) => (
-                    choice::score(
-                        &c.name,
-                        n_own,
-                        &trial,
-                        &current,
-                        acceptance::paired_z,
-                        base_excess,
-                        settings,
-                    ),
-                    Some(trial),
-                ),
-                Err(e) => (choice::failed(&c.name, e.to_string()), None),
-            });
+            scored.push(choice::scored(
+                &c.name,
+                n_own,
+                best,
+                &current,
+                acceptance::paired_z,
+                base_excess,
+                settings,
+            ));
         }
         if scored.is_empty() {
             break;
         }
-        let (step, winner) = choice::decide(
-            &current,
-            current.stage.name(),
-            scored,
-            &choice::FORCE,
-            settings,
-        );
+        let (step, winner) = choice::decide(&current, scored, &choice::FORCE, settings);
         notes.push(step.verdict.clone());
         effects.extend(step.accepted.clone());
         steps.push(step);

@@ -26,7 +26,7 @@ use std::sync::Arc;
 
 use super::acceptance;
 use super::candidate::{self, Candidate};
-use super::choice;
+use super::choice::{self, Trial};
 use super::engine::inside;
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
@@ -122,10 +122,6 @@ pub struct TrajectoryDiscovery {
     /// The final model's simulated x (with the offset) at every sample, m.
     pub x_after: Vec<f64>,
 }
-
-/// A trajectory-level model fitted on the training samples, the RMS residuals of its
-/// held-out cycles ([`cycle_rms`]) the units of the paired test.
-type Trial = choice::Trial<Stage>;
 
 /// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
 /// scale: `dᵢ = 2·ln(reference_i / new_i)` (the log-ratio of cycle i's mean squared residual),
@@ -393,32 +389,20 @@ pub fn discover_trajectory(
                 &osc_start,
             );
             let n_own = c.model.params().len();
-            scored.push(match stage.trial_simulated(&rig, setup, &split, settings) {
-                Ok(trial) => (
-                    choice::score(
-                        &c.name,
-                        n_own,
-                        &trial,
-                        &current,
-                        cycle_gain_z,
-                        base_excess,
-                        settings,
-                    ),
-                    Some(trial),
-                ),
-                Err(e) => (choice::failed(&c.name, e.to_string()), None),
-            });
+            scored.push(choice::scored(
+                &c.name,
+                n_own,
+                stage.trial_simulated(&rig, setup, &split, settings),
+                &current,
+                cycle_gain_z,
+                base_excess,
+                settings,
+            ));
         }
         if scored.is_empty() {
             break;
         }
-        let (step, winner) = choice::decide(
-            &current,
-            current.stage.name(),
-            scored,
-            &choice::DISPLACEMENT,
-            settings,
-        );
+        let (step, winner) = choice::decide(&current, scored, &choice::DISPLACEMENT, settings);
         notes.push(step.verdict.clone());
         effects.extend(step.accepted.clone());
         steps.push(step);
