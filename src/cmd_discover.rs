@@ -18,7 +18,7 @@ use serde_json::json;
 use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, DiscoverySettings, TrajectorySetup,
 };
-use stf_core::fit::TrajectoryData;
+use stf_core::fit::{FittedParam, TrajectoryData};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
@@ -50,6 +50,31 @@ fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
         .map(|s| resolve(s.trim(), dir))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
+}
+
+/// The final model `name` (`a + b + …`) with the values of `params` as an experiment's
+/// `[[models]]` entry that `fit` and `compare` accept as it is.
+fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -> String {
+    let parts: Vec<&str> = name.split(" + ").collect();
+    let mut entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
+    if parts.len() > 1 {
+        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
+        entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
+    }
+    let values: Vec<String> = params
+        .map(|p| format!("\"{}\" = {}", p.name, p.value))
+        .collect();
+    entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
+    entry
+}
+
+/// The effects named, or `none`.
+fn named(effects: &[String]) -> String {
+    if effects.is_empty() {
+        "none".to_string()
+    } else {
+        effects.join(", ")
+    }
 }
 
 /// Run `stf-lab discover`.
@@ -118,24 +143,15 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let wall = started.elapsed().as_secs_f64();
 
     // The final model as an experiment entry that `fit` and `compare` accept as it is.
-    let parts: Vec<&str> = found.final_model_name.split(" + ").collect();
     let params: serde_json::Map<String, serde_json::Value> = found
         .final_params
         .iter()
         .map(|p| (p.name.clone(), json!(p.value)))
         .collect();
-    let mut toml_entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
-    if parts.len() > 1 {
-        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
-        toml_entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
-    }
-    let values: Vec<String> = found
-        .final_params
-        .iter()
-        .filter(|p| p.name != "f_off")
-        .map(|p| format!("\"{}\" = {}", p.name, p.value))
-        .collect();
-    toml_entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
+    let toml_entry = models_entry(
+        &found.final_model_name,
+        found.final_params.iter().filter(|p| p.name != "f_off"),
+    );
 
     let doc = json!({
         "experiment": exp.path.display().to_string(),
@@ -250,11 +266,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             &format!("Discovery: {}", exp.path.display()),
             vec![format!(
                 "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-                if found.effects.is_empty() {
-                    "none".to_string()
-                } else {
-                    found.effects.join(", ")
-                },
+                named(&found.effects),
                 found.gap_before,
                 found.gap_after,
                 found.noise_floor
@@ -273,11 +285,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     println!(
         "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
-        if found.effects.is_empty() {
-            "none".to_string()
-        } else {
-            found.effects.join(", ")
-        },
+        named(&found.effects),
         found.gap_before,
         found.gap_after,
         found.noise_floor,
@@ -352,22 +360,12 @@ fn run_trajectory(
     let tf = discover_trajectory(base, candidates, &td, cycles, &setup, &settings)?;
     let wall = started.elapsed().as_secs_f64();
     let found = &tf.discovery;
-    let model_params: Vec<&stf_core::fit::FittedParam> = found
+    let model_params: Vec<&FittedParam> = found
         .final_params
         .iter()
         .filter(|p| !names.contains(&p.name) && p.name != "x_off")
         .collect();
-    let parts: Vec<&str> = found.final_model_name.split(" + ").collect();
-    let mut toml_entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
-    if parts.len() > 1 {
-        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
-        toml_entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
-    }
-    let values: Vec<String> = model_params
-        .iter()
-        .map(|p| format!("\"{}\" = {}", p.name, p.value))
-        .collect();
-    toml_entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
+    let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied());
     let system_entry: String = std::iter::once("[system]\n".to_string())
         .chain(
             names
@@ -431,11 +429,7 @@ fn run_trajectory(
             vec![format!(
                 "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor \
                  {:.4} mm).",
-                if found.effects.is_empty() {
-                    "none".to_string()
-                } else {
-                    found.effects.join(", ")
-                },
+                named(&found.effects),
                 tf.s_before_mm2,
                 tf.s_after_mm2,
                 found.gap_before * 1e3,
@@ -451,11 +445,7 @@ fn run_trajectory(
     }
     println!(
         "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
-        if found.effects.is_empty() {
-            "none".to_string()
-        } else {
-            found.effects.join(", ")
-        },
+        named(&found.effects),
         tf.s_before_mm2,
         tf.s_after_mm2,
         found.noise_floor * 1e3,

@@ -2,6 +2,7 @@
 
 use std::sync::Arc;
 
+use super::error::DiscoveryError;
 use crate::force_model::ForceModel;
 
 /// An effect the discovery may add, by name (e.g. a name of DESIGN.md §5, or a script's).
@@ -24,6 +25,19 @@ impl Candidate {
             model,
         }
     }
+}
+
+/// Check that no two of `candidates` share a name or a model name.
+pub(super) fn distinct(candidates: &[Candidate]) -> Result<(), DiscoveryError> {
+    for (i, c) in candidates.iter().enumerate() {
+        let twice = candidates[..i]
+            .iter()
+            .any(|d| d.name == c.name || d.model.name() == c.model.name());
+        if twice {
+            return Err(DiscoveryError::DuplicateCandidate(c.name.clone()));
+        }
+    }
+    Ok(())
 }
 
 impl std::fmt::Debug for Candidate {

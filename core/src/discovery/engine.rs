@@ -4,52 +4,21 @@
 use std::sync::Arc;
 
 use super::acceptance;
-use super::candidate::Candidate;
+use super::candidate::{self, Candidate};
+use super::choice::{self, Trial};
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
 use super::holdout::HoldoutSplit;
 use super::report::Discovery;
 use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
+use super::stage::Stage;
 use super::subset_fit::{fit_subset, residuals, rms, rms_over};
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, FORCE_OFFSET};
 use crate::force_model::ForceModel;
-use crate::model_sum::ModelSum;
-use crate::regimes::{noise_floor, Cycle};
-
-/// A model as it stands: its parts, and the values of its parameters (then the offset).
-#[derive(Clone)]
-struct Stage {
-    parts: Vec<Arc<dyn ForceModel>>,
-    /// Start (or fitted) values of every parameter of the sum, then the offset if fitted.
-    values: Vec<f64>,
-}
-
-/// A model fitted on the training samples and scored on the held-out ones.
-struct Trial {
-    stage: Stage,
-    train: FitResult,
-    /// Residuals at the held-out samples.
-    holdout: Vec<f64>,
-    holdout_mse: f64,
-}
+use crate::regimes::Cycle;
 
 impl Stage {
-    fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
-        Ok(match self.parts.as_slice() {
-            [one] => one.clone(),
-            _ => Arc::new(ModelSum::new(self.parts.clone())?),
-        })
-    }
-
-    fn name(&self) -> String {
-        self.parts
-            .iter()
-            .map(|p| p.name().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
-    }
-
     /// The force fit of this stage starting from its values (clamped into the bounds).
     fn force_fit(&self, settings: &DiscoverySettings) -> Result<ForceFit, DiscoveryError> {
         let model = self.model()?;
@@ -108,24 +77,6 @@ impl Stage {
             holdout: split.holdout.iter().map(|&i| r[i]).collect(),
             holdout_mse: h * h,
         })
-    }
-
-    /// This stage with `extra` added, its parameters at `start`.
-    fn with_values(
-        &self,
-        extra: &Arc<dyn ForceModel>,
-        start: &[f64],
-        settings: &DiscoverySettings,
-    ) -> Stage {
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let mut values = self.values[..n_model.min(self.values.len())].to_vec();
-        values.extend_from_slice(start);
-        if settings.fit_offset {
-            values.push(self.values.get(n_model).copied().unwrap_or(0.0));
-        }
-        let mut parts = self.parts.clone();
-        parts.push(extra.clone());
-        Stage { parts, values }
     }
 
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
@@ -388,73 +339,6 @@ fn best_trial(
     }
 }
 
-/// How `trial` (a model with the candidate `name`, whose own parameters are its `n_own`
-/// before the offset) scores against `current`; `base_excess` is the base's held-out mean
-/// square above the noise floor.
-fn score_trial(
-    name: &str,
-    n_own: usize,
-    trial: &Trial,
-    current: &Trial,
-    base_excess: f64,
-    settings: &DiscoverySettings,
-) -> CandidateScore {
-    let h = trial.holdout_mse.sqrt();
-    let offset_len = usize::from(settings.fit_offset);
-    let np = trial.train.params.len();
-    let own = trial
-        .train
-        .params
-        .get(np.saturating_sub(offset_len + n_own)..np.saturating_sub(offset_len))
-        .map(<[_]>::to_vec)
-        .unwrap_or_default();
-    let failure = matches!(
-        trial.train.convergence,
-        crate::fit::Convergence::Failed { .. }
-    )
-    .then(|| format!("{:?}", trial.train.convergence));
-    let mut score = CandidateScore {
-        name: name.to_string(),
-        holdout_rms: h,
-        train_rms: trial.train.rms,
-        aic: trial.train.aic,
-        bic: trial.train.bic,
-        delta_aic: trial.train.aic - current.train.aic,
-        delta_bic: trial.train.bic - current.train.bic,
-        holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: acceptance::paired_z(&current.holdout, &trial.holdout),
-        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
-        params: own,
-        significant: false,
-        failure,
-        evaluations: trial.train.evaluations,
-        wall_seconds: trial.train.wall_seconds,
-    };
-    score.significant = acceptance::is_significant(&score, settings);
-    score
-}
-
-/// The score of a candidate whose fit failed.
-fn failed_score(name: &str, error: &DiscoveryError) -> CandidateScore {
-    CandidateScore {
-        name: name.to_string(),
-        holdout_rms: f64::NAN,
-        train_rms: f64::NAN,
-        aic: f64::NAN,
-        bic: f64::NAN,
-        delta_aic: f64::NAN,
-        delta_bic: f64::NAN,
-        holdout_gain: f64::NAN,
-        gain_z: f64::NAN,
-        explained_fraction: f64::NAN,
-        params: Vec::new(),
-        significant: false,
-        failure: Some(error.to_string()),
-        evaluations: 0,
-        wall_seconds: 0.0,
-    }
-}
-
 /// Find the effects missing from `base` among `candidates`, at force level.
 ///
 /// `data` holds the measured kinematics and F_STF; `cycles` cut it into whole cycles (e.g.
@@ -511,24 +395,9 @@ pub fn discover_force(
     settings.validate()?;
     let base_name = base.name().to_string();
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
-    for (i, c) in candidates.iter().enumerate() {
-        let twice = candidates[..i]
-            .iter()
-            .any(|d| d.name == c.name || d.model.name() == c.model.name());
-        if twice {
-            return Err(DiscoveryError::DuplicateCandidate(c.name.clone()));
-        }
-    }
+    candidate::distinct(candidates)?;
     let n = data.t.len();
-    let floor = match settings.noise_sigma {
-        Some(s) => s,
-        None => noise_floor(data.f)?,
-    };
-    if !(floor > 0.0 && floor.is_finite()) {
-        return Err(DiscoveryError::BadData(format!(
-            "the noise floor of the measured force is {floor} N; give `noise_sigma`"
-        )));
-    }
+    let floor = settings.floor_of(data.f, "force", "N")?;
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
     let all: Vec<usize> = (0..n).collect();
     let mut notes = Vec::new();
@@ -562,18 +431,10 @@ pub fn discover_force(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for _ in 0..settings.max_effects {
-        let current_h = current.holdout_mse.sqrt();
         let current_residual = current.stage.residuals(data, settings)?;
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
-            let name_taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name())
-                || effects.contains(&c.name);
-            if name_taken {
+            if current.stage.holds(c, &in_base, &effects) {
                 continue;
             }
             let starts = candidate_starts(
@@ -586,86 +447,30 @@ pub fn discover_force(
             let n_own = c.model.params().len();
             let best = best_trial(
                 &starts,
-                |start| current.stage.with_values(&c.model, start, settings),
+                |start| current.stage.with(&c.model, start, 0),
                 data,
                 &split,
                 settings,
             );
-            scored.push(match best {
-                Ok(trial) => (
-                    score_trial(&c.name, n_own, &trial, &current, base_excess, settings),
-                    Some(trial),
-                ),
-                Err(e) => (failed_score(&c.name, &e), None),
-            });
+            scored.push(choice::scored(
+                &c.name,
+                n_own,
+                best,
+                &current,
+                acceptance::paired_z,
+                base_excess,
+                settings,
+            ));
         }
         if scored.is_empty() {
             break;
         }
-        scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-        let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
-        let holdout: Vec<&[f64]> = scored
-            .iter()
-            .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
-            .collect();
-        let choice = acceptance::choose(&scores, &holdout, settings);
-        let mut step = Step {
-            current: current.stage.name(),
-            current_holdout_rms: current_h,
-            candidates: scores,
-            accepted: None,
-            tie_with: Vec::new(),
-            verdict: String::new(),
-        };
-        let Some((winner, ties)) = choice else {
-            step.verdict = format!(
-                "no candidate lowers the held-out RMS ({current_h:.4} N) with a paired z above \
-                 {} and a BIC drop above {}: nothing is missing that the data demand",
-                settings.min_gain_sigma, settings.min_bic_drop
-            );
-            notes.push(step.verdict.clone());
-            steps.push(step);
-            break;
-        };
-        let tie_names: Vec<String> = ties
-            .iter()
-            .map(|&i| step.candidates[i].name.clone())
-            .collect();
-        let w = &step.candidates[winner];
-        let params: Vec<String> = w
-            .params
-            .iter()
-            .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
-            .collect();
-        step.verdict = format!(
-            "add `{}`: held-out RMS {current_h:.4} → {:.4} N (paired z {:.1}), ΔBIC \
-             {:.1}, explains {:.0} % of the base's held-out gap; {}",
-            w.name,
-            w.holdout_rms,
-            w.gain_z,
-            w.delta_bic,
-            100.0 * w.explained_fraction,
-            params.join(", ")
-        );
-        if !tie_names.is_empty() {
-            step.verdict.push_str(&format!(
-                "; `{}` explain the data equally well (the best is not better by the held-out \
-                 test), `{}` is chosen as the simplest (fewest parameters, then lowest BIC)",
-                tie_names.join("`, `"),
-                w.name
-            ));
-        }
+        let (step, winner) = choice::decide(&current, scored, &choice::FORCE, settings);
         notes.push(step.verdict.clone());
-        step.accepted = Some(w.name.clone());
-        step.tie_with = tie_names;
-        effects.push(w.name.clone());
-        let w_name = w.name.clone();
+        effects.extend(step.accepted.clone());
         steps.push(step);
         // The winner becomes the current model.
-        let Some(pos) = scored.iter().position(|s| s.0.name == w_name) else {
-            break;
-        };
-        let Some(trial) = scored.swap_remove(pos).1 else {
+        let Some(trial) = winner else {
             break;
         };
         current = trial;
@@ -798,13 +603,7 @@ fn reconsider(
         let rest = current.stage.without(part);
         let rest_residual = rest.residuals(data, settings)?;
         for (k, c) in candidates.iter().enumerate() {
-            let taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name());
-            if taken {
+            if current.stage.holds(c, in_base, &[]) {
                 continue;
             }
             let label = format!("{} for {}", c.name, effects[j]);
@@ -830,7 +629,15 @@ fn reconsider(
                         .map(|p| p.params().len())
                         .sum();
                     let n_own = c.model.params().len();
-                    let mut score = score_trial(&label, 0, &trial, current, base_excess, settings);
+                    let mut score = choice::score(
+                        &label,
+                        0,
+                        &trial,
+                        current,
+                        acceptance::paired_z,
+                        base_excess,
+                        settings,
+                    );
                     score.params = trial
                         .train
                         .params
@@ -846,7 +653,7 @@ fn reconsider(
                     score.significant = wins || tie;
                     tried.push((score, Some(trial), j, k, tie));
                 }
-                Err(e) => tried.push((failed_score(&label, &e), None, j, k, false)),
+                Err(e) => tried.push((choice::failed(&label, e.to_string()), None, j, k, false)),
             }
         }
     }

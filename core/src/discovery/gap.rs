@@ -186,6 +186,28 @@ fn summarise(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
         "residual {total:.3} N RMS against a noise floor of {floor:.3} N ({:.1}×)",
         total / floor
     );
+    summary(
+        head,
+        total,
+        floor,
+        breakdowns,
+        "regimes, ω and states",
+        |v| format!("{v:.3} N"),
+    )
+}
+
+/// The one-line description of where a residual of RMS `total` lives, after `head` (the
+/// residual against the noise floor `floor`, in words): at the floor, spread evenly over
+/// what the `breakdowns` split on (`evenly_over`, in words), or the groups with the largest
+/// RMS of the three most contrasted breakdowns, each RMS said by `say` (with its unit).
+pub(super) fn summary(
+    head: String,
+    total: f64,
+    floor: f64,
+    breakdowns: &[GapBreakdown],
+    evenly_over: &str,
+    say: impl Fn(f64) -> String,
+) -> String {
     if total <= 1.2 * floor {
         return format!("{head}: at the noise floor, no gap to locate");
     }
@@ -195,7 +217,7 @@ fn summarise(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
         .collect();
     contrasted.sort_by(|a, b| b.contrast.total_cmp(&a.contrast));
     if contrasted.is_empty() {
-        return format!("{head}: spread evenly over regimes, ω and states");
+        return format!("{head}: spread evenly over {evenly_over}");
     }
     let parts: Vec<String> = contrasted
         .iter()
@@ -204,8 +226,11 @@ fn summarise(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
             let top = b.groups.iter().max_by(|x, y| x.rms.total_cmp(&y.rms))?;
             let low = b.groups.iter().min_by(|x, y| x.rms.total_cmp(&y.rms))?;
             Some(format!(
-                "{} ({:.3} N vs {:.3} N at {})",
-                top.label, top.rms, low.rms, low.label
+                "{} ({} vs {} at {})",
+                top.label,
+                say(top.rms),
+                say(low.rms),
+                low.label
             ))
         })
         .collect();

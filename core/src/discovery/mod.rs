@@ -25,6 +25,7 @@
 
 pub mod acceptance;
 pub mod candidate;
+mod choice;
 pub mod engine;
 pub mod error;
 pub mod gap;
@@ -32,6 +33,7 @@ pub mod holdout;
 pub mod report;
 pub mod score;
 pub mod settings;
+mod stage;
 mod subset_fit;
 pub mod trajectory;
 mod trajectory_fit;

@@ -129,4 +129,25 @@ impl DiscoverySettings {
         }
         Ok(())
     }
+
+    /// The noise floor σ of the search: `noise_sigma`, or else that of the measured `signal`
+    /// ([`crate::regimes::noise_floor`]); an error unless positive and finite. `what` names
+    /// the measured quantity and `unit` its unit, for the error.
+    pub(super) fn floor_of(
+        &self,
+        signal: &[f64],
+        what: &str,
+        unit: &str,
+    ) -> Result<f64, DiscoveryError> {
+        let floor = match self.noise_sigma {
+            Some(s) => s,
+            None => crate::regimes::noise_floor(signal)?,
+        };
+        if !(floor > 0.0 && floor.is_finite()) {
+            return Err(DiscoveryError::BadData(format!(
+                "the noise floor of the measured {what} is {floor} {unit}; give `noise_sigma`"
+            )));
+        }
+        Ok(floor)
+    }
 }

@@ -25,22 +25,23 @@
 use std::sync::Arc;
 
 use super::acceptance;
-use super::candidate::Candidate;
+use super::candidate::{self, Candidate};
+use super::choice::{self, Trial};
 use super::engine::inside;
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
 use super::report::Discovery;
-use super::score::{CandidateScore, Step};
+use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
+use super::stage::Stage;
 use super::subset_fit::{rms, rms_over};
 use super::trajectory_fit::{fit_on, Rig, Run};
 use super::trajectory_gap::locate_x_gap;
 use crate::excitation::Excitation;
-use crate::fit::{Convergence, FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
+use crate::fit::{FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
-use crate::model_sum::ModelSum;
-use crate::regimes::{noise_floor, Cycle};
+use crate::regimes::Cycle;
 use crate::system::OscillatorParams;
 
 /// The oscillator side of a trajectory-level discovery: its parameters, its drive, which of
@@ -122,23 +123,6 @@ pub struct TrajectoryDiscovery {
     pub x_after: Vec<f64>,
 }
 
-/// A model as it stands: its parts and the values of every parameter of the fit
-/// (oscillator's, model's, then the offset).
-#[derive(Clone)]
-struct Stage {
-    parts: Vec<Arc<dyn ForceModel>>,
-    values: Vec<f64>,
-}
-
-/// A stage fitted on the training samples and scored on the held-out ones.
-struct Trial {
-    stage: Stage,
-    train: FitResult,
-    /// RMS residual of each held-out cycle ([`cycle_rms`]): the units of the paired test.
-    holdout: Vec<f64>,
-    holdout_mse: f64,
-}
-
 /// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
 /// scale: `dᵢ = 2·ln(reference_i / new_i)` (the log-ratio of cycle i's mean squared residual),
 /// `z = mean(d) / (sd(d)/√N)`. A cycle is the unit: residuals within one are correlated. The
@@ -179,21 +163,6 @@ fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
 }
 
 impl Stage {
-    fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
-        Ok(match self.parts.as_slice() {
-            [one] => one.clone(),
-            _ => Arc::new(ModelSum::new(self.parts.clone())?),
-        })
-    }
-
-    fn name(&self) -> String {
-        self.parts
-            .iter()
-            .map(|p| p.name().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
-    }
-
     /// Every parameter of the fit, starting from this stage's values.
     fn params(&self, setup: &TrajectorySetup, model: &Arc<dyn ForceModel>) -> Vec<FitParam> {
         let mut out: Vec<FitParam> = Vec::with_capacity(self.values.len());
@@ -217,7 +186,7 @@ impl Stage {
     }
 
     /// Fit on `subset`: the stage with the fitted values, and the fit.
-    fn fit(
+    fn fit_simulated(
         &self,
         rig: &Rig,
         setup: &TrajectorySetup,
@@ -247,14 +216,14 @@ impl Stage {
     }
 
     /// Fit on the training samples and score on the held-out ones.
-    fn trial(
+    fn trial_simulated(
         &self,
         rig: &Rig,
         setup: &TrajectorySetup,
         split: &HoldoutSplit,
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
-        let (stage, train) = self.fit(rig, setup, &split.train, settings)?;
+        let (stage, train) = self.fit_simulated(rig, setup, &split.train, settings)?;
         let r = stage.run(rig)?.residual;
         let h = rms_over(&r, &split.holdout);
         Ok(Trial {
@@ -263,18 +232,6 @@ impl Stage {
             holdout: cycle_rms(&r, &split.holdout),
             holdout_mse: h * h,
         })
-    }
-
-    /// This stage with `extra` added, its parameters at their defaults.
-    fn with(&self, extra: &Arc<dyn ForceModel>, n_osc: usize) -> Stage {
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let cut = (n_osc + n_model).min(self.values.len());
-        let mut values = self.values[..cut].to_vec();
-        values.extend(extra.params().iter().map(|s| s.default));
-        values.extend_from_slice(&self.values[cut..]);
-        let mut parts = self.parts.clone();
-        parts.push(extra.clone());
-        Stage { parts, values }
     }
 }
 
@@ -334,68 +291,6 @@ impl Stage {
     }
 }
 
-/// The score of `trial` (candidate `name`, `n_own` parameters of its own) against `current`.
-fn score_of(
-    name: &str,
-    trial: &Trial,
-    current: &Trial,
-    n_own: usize,
-    offset_len: usize,
-    base_excess: f64,
-    settings: &DiscoverySettings,
-) -> CandidateScore {
-    let h = trial.holdout_mse.sqrt();
-    let np = trial.train.params.len();
-    let own = trial
-        .train
-        .params
-        .get(np.saturating_sub(offset_len + n_own)..np.saturating_sub(offset_len))
-        .map(<[_]>::to_vec)
-        .unwrap_or_default();
-    let failure = matches!(trial.train.convergence, Convergence::Failed { .. })
-        .then(|| format!("{:?}", trial.train.convergence));
-    let mut score = CandidateScore {
-        name: name.to_string(),
-        holdout_rms: h,
-        train_rms: trial.train.rms,
-        aic: trial.train.aic,
-        bic: trial.train.bic,
-        delta_aic: trial.train.aic - current.train.aic,
-        delta_bic: trial.train.bic - current.train.bic,
-        holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: cycle_gain_z(&current.holdout, &trial.holdout),
-        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
-        params: own,
-        significant: false,
-        failure,
-        evaluations: trial.train.evaluations,
-        wall_seconds: trial.train.wall_seconds,
-    };
-    score.significant = acceptance::is_significant(&score, settings);
-    score
-}
-
-/// The score of a candidate whose fit could not run.
-fn failed(name: &str, why: String) -> CandidateScore {
-    CandidateScore {
-        name: name.to_string(),
-        holdout_rms: f64::NAN,
-        train_rms: f64::NAN,
-        aic: f64::NAN,
-        bic: f64::NAN,
-        delta_aic: f64::NAN,
-        delta_bic: f64::NAN,
-        holdout_gain: f64::NAN,
-        gain_z: f64::NAN,
-        explained_fraction: f64::NAN,
-        params: Vec::new(),
-        significant: false,
-        failure: Some(why),
-        evaluations: 0,
-        wall_seconds: 0.0,
-    }
-}
-
 /// Find the effects missing from `base` among `candidates`, at trajectory level.
 ///
 /// `data` is the measured displacement; `cycles` cut it into whole cycles (of the rotor, or
@@ -419,14 +314,7 @@ pub fn discover_trajectory(
             data.x.len()
         )));
     }
-    for (i, c) in candidates.iter().enumerate() {
-        let twice = candidates[..i]
-            .iter()
-            .any(|d| d.name == c.name || d.model.name() == c.model.name());
-        if twice {
-            return Err(DiscoveryError::DuplicateCandidate(c.name.clone()));
-        }
-    }
+    candidate::distinct(candidates)?;
     for p in &setup.oscillator {
         if OscillatorParams::FORCED.get(&p.name).is_none() {
             return Err(DiscoveryError::BadSettings(format!(
@@ -436,15 +324,7 @@ pub fn discover_trajectory(
             )));
         }
     }
-    let floor = match settings.noise_sigma {
-        Some(s) => s,
-        None => noise_floor(data.x)?,
-    };
-    if !(floor > 0.0 && floor.is_finite()) {
-        return Err(DiscoveryError::BadData(format!(
-            "the noise floor of the measured displacement is {floor} m; give `noise_sigma`"
-        )));
-    }
+    let floor = settings.floor_of(data.x, "displacement", "m")?;
     let rig = Rig {
         system: setup.system,
         excitation: setup.excitation.clone(),
@@ -457,7 +337,6 @@ pub fn discover_trajectory(
     };
     let n_osc = setup.oscillator.len();
     let osc_start: Vec<f64> = setup.oscillator.iter().map(|p| p.value).collect();
-    let offset_len = usize::from(settings.fit_offset);
     let base_name = base.name().to_string();
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
@@ -475,7 +354,7 @@ pub fn discover_trajectory(
             .collect(),
         parts: vec![base.clone()],
     };
-    let (base_full, base_result) = start.fit(&rig, setup, &all, settings)?;
+    let (base_full, base_result) = start.fit_simulated(&rig, setup, &all, settings)?;
     let run_before = base_full.run(&rig)?;
     let gap_before = rms(&run_before.residual);
     let simulated = |run: &Run| -> Vec<f64> {
@@ -492,115 +371,42 @@ pub fn discover_trajectory(
     notes.push(format!("base `{base_name}`: {}", where_before.summary));
 
     // 3–4. Add effects while the held-out evidence demands one.
-    let mut current = start.trial(&rig, setup, &split, settings)?;
+    let mut current = start.trial_simulated(&rig, setup, &split, settings)?;
     let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for _ in 0..settings.max_effects {
-        let current_h = current.holdout_mse.sqrt();
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         for c in candidates {
-            let taken = in_base.iter().any(|b| b == c.model.name())
-                || current
-                    .stage
-                    .parts
-                    .iter()
-                    .any(|p| p.name() == c.model.name())
-                || effects.contains(&c.name);
-            if taken {
+            if current.stage.holds(c, &in_base, &effects) {
                 continue;
             }
-            let stage =
-                current
-                    .stage
-                    .with(&c.model, n_osc)
-                    .screened(&rig, &split.train, &osc_start);
+            let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+            let stage = current.stage.with(&c.model, &defaults, n_osc).screened(
+                &rig,
+                &split.train,
+                &osc_start,
+            );
             let n_own = c.model.params().len();
-            scored.push(match stage.trial(&rig, setup, &split, settings) {
-                Ok(trial) => (
-                    score_of(
-                        &c.name,
-                        &trial,
-                        &current,
-                        n_own,
-                        offset_len,
-                        base_excess,
-                        settings,
-                    ),
-                    Some(trial),
-                ),
-                Err(e) => (failed(&c.name, e.to_string()), None),
-            });
+            scored.push(choice::scored(
+                &c.name,
+                n_own,
+                stage.trial_simulated(&rig, setup, &split, settings),
+                &current,
+                cycle_gain_z,
+                base_excess,
+                settings,
+            ));
         }
         if scored.is_empty() {
             break;
         }
-        scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-        let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
-        let holdout: Vec<&[f64]> = scored
-            .iter()
-            .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
-            .collect();
-        let choice = acceptance::choose(&scores, &holdout, settings);
-        let mut step = Step {
-            current: current.stage.name(),
-            current_holdout_rms: current_h,
-            candidates: scores,
-            accepted: None,
-            tie_with: Vec::new(),
-            verdict: String::new(),
-        };
-        let Some((winner, ties)) = choice else {
-            step.verdict = format!(
-                "no candidate lowers the held-out x RMS ({:.4} mm) with a paired z above {} \
-                 and a BIC drop above {}: nothing is missing that the data demand",
-                current_h * 1e3,
-                settings.min_gain_sigma,
-                settings.min_bic_drop
-            );
-            notes.push(step.verdict.clone());
-            steps.push(step);
-            break;
-        };
-        let tie_names: Vec<String> = ties
-            .iter()
-            .map(|&i| step.candidates[i].name.clone())
-            .collect();
-        let w = &step.candidates[winner];
-        let params: Vec<String> = w
-            .params
-            .iter()
-            .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
-            .collect();
-        step.verdict = format!(
-            "add `{}`: held-out x RMS {:.4} → {:.4} mm (paired z {:.1}), ΔBIC {:.1}, explains \
-             {:.0} % of the base's held-out gap; {}",
-            w.name,
-            current_h * 1e3,
-            w.holdout_rms * 1e3,
-            w.gain_z,
-            w.delta_bic,
-            100.0 * w.explained_fraction,
-            params.join(", ")
-        );
-        if !tie_names.is_empty() {
-            step.verdict.push_str(&format!(
-                "; `{}` explain the data equally well, `{}` is chosen for its lower BIC",
-                tie_names.join("`, `"),
-                w.name
-            ));
-        }
+        let (step, winner) = choice::decide(&current, scored, &choice::DISPLACEMENT, settings);
         notes.push(step.verdict.clone());
-        step.accepted = Some(w.name.clone());
-        step.tie_with = tie_names;
-        effects.push(w.name.clone());
-        let w_name = w.name.clone();
+        effects.extend(step.accepted.clone());
         steps.push(step);
-        let Some(pos) = scored.iter().position(|s| s.0.name == w_name) else {
-            break;
-        };
-        let Some(trial) = scored.swap_remove(pos).1 else {
+        let Some(trial) = winner else {
             break;
         };
         // The accepted model, polished from its trial fit at the final fit's tolerance: the
@@ -615,7 +421,7 @@ pub fn discover_trajectory(
                 .tol(settings.fit.tol.min(1e-9)),
             ..settings.clone()
         };
-        current = match trial.stage.trial(&rig, setup, &split, &polish) {
+        current = match trial.stage.trial_simulated(&rig, setup, &split, &polish) {
             Ok(polished) if polished.train.rms <= trial.train.rms => polished,
             _ => trial,
         };
@@ -630,7 +436,7 @@ pub fn discover_trajectory(
             fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
             ..settings.clone()
         };
-        let (refit, result) = current.stage.fit(&rig, setup, &all, &lm)?;
+        let (refit, result) = current.stage.fit_simulated(&rig, setup, &all, &lm)?;
         let refit_run = refit.run(&rig)?;
         let start_run = current.stage.run(&rig)?;
         if rms(&start_run.residual) < rms(&refit_run.residual) {
@@ -700,6 +506,7 @@ mod tests {
     use super::*;
     use crate::force_model::{ModelError, ModelState};
     use crate::interpolate::Linear;
+    use crate::model_sum::ModelSum;
     use crate::oscillator::Oscillator;
     use crate::params::ParamSpec;
     use crate::regimes::cycles_from_x;

@@ -7,7 +7,7 @@
 //! measured STF force, which a trajectory-level record does not have (ω bands stand in for
 //! them on a sweep).
 
-use super::gap::{locate_gap, GapBreakdown, GapLocation, CONTRAST};
+use super::gap::{locate_gap, summary, GapBreakdown, GapLocation};
 use super::trajectory_fit::Run;
 use crate::fit::ForceData;
 use crate::regimes::Cycle;
@@ -39,33 +39,9 @@ fn summarise_mm(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
         mm(floor),
         total / floor
     );
-    if total <= 1.2 * floor {
-        return format!("{head}: at the noise floor, no gap to locate");
-    }
-    let mut contrasted: Vec<&GapBreakdown> = breakdowns
-        .iter()
-        .filter(|b| b.contrast >= CONTRAST)
-        .collect();
-    contrasted.sort_by(|a, b| b.contrast.total_cmp(&a.contrast));
-    if contrasted.is_empty() {
-        return format!("{head}: spread evenly over ω and states");
-    }
-    let parts: Vec<String> = contrasted
-        .iter()
-        .take(3)
-        .filter_map(|b| {
-            let top = b.groups.iter().max_by(|x, y| x.rms.total_cmp(&y.rms))?;
-            let low = b.groups.iter().min_by(|x, y| x.rms.total_cmp(&y.rms))?;
-            Some(format!(
-                "{} ({:.4} mm vs {:.4} mm at {})",
-                top.label,
-                mm(top.rms),
-                mm(low.rms),
-                low.label
-            ))
-        })
-        .collect();
-    format!("{head}: largest at {}", parts.join("; at "))
+    summary(head, total, floor, breakdowns, "ω and states", |v| {
+        format!("{:.4} mm", mm(v))
+    })
 }
 
 #[cfg(test)]
