@@ -28,6 +28,7 @@ use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
 use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
+    DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
 };
 use crate::reporting::{record_sections, write_report};
 
@@ -249,12 +250,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             fig,
             "Measured STF force against the base and the final model.",
         ));
-        let fig = measured_vs_fitted(
+        let fig = measured_vs_model(
             &dir,
             "discovery_residual",
+            STF_FORCE_RESIDUAL,
             &data.record.t,
             &found.residual_before,
-            &[("residual after", &found.residual_after)],
+            &[("final", &found.residual_after)],
         )?;
         s.figures.push(FigureRef::new(
             fig,
@@ -421,6 +423,27 @@ fn run_trajectory(
         s.figures.push(FigureRef::new(
             fig,
             "Measured displacement against the simulated base and final model.",
+        ));
+        let residual = |sim: &[f64]| {
+            data.record
+                .x
+                .iter()
+                .zip(sim)
+                .map(|(m, s)| (m - s) * 1e3)
+                .collect::<Vec<f64>>()
+        };
+        let fig = measured_vs_model(
+            &dir,
+            "discovery_x_residual",
+            DISPLACEMENT_RESIDUAL_MM,
+            &data.record.t,
+            &residual(&tf.x_before),
+            &[("final", &residual(&tf.x_after))],
+        )?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "Displacement residual (measured − simulated) of the base (grey band) and of the \
+             final model.",
         ));
         let mut sections = vec![s];
         sections.extend(record_sections(data, &[], out)?);

@@ -150,4 +150,20 @@ fn the_bundled_example_names_the_cubic_spring() {
     assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
     let k3 = doc["final_model"]["params"]["k3"].as_f64().unwrap();
     assert!((k3 / 1e4 - 1.0).abs() < 0.05, "k3 = {k3}");
+    // The report shows the x residual before and after, in mm: the final one is smaller.
+    let csv = std::fs::read_to_string(out.join("figures/discovery_x_residual.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "\"t, s\",\"base x residual, mm\",\"final: simulated x residual, mm\""
+    );
+    let (mut before, mut after, mut n) = (0.0, 0.0, 0.0);
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        before += v[1] * v[1];
+        after += v[2] * v[2];
+        n += 1.0;
+    }
+    let (before, after) = ((before / n).sqrt(), (after / n).sqrt());
+    assert!(after < 0.1 * before, "x residual {before} → {after} mm RMS");
 }

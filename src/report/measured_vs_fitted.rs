@@ -30,6 +30,8 @@ pub struct Quantity {
     pub label: &'static str,
     /// What a model curve is: `fitted` or `simulated`.
     pub model_word: &'static str,
+    /// Legend and CSV name of the grey band: `measured`, or what stands in its place.
+    pub band: &'static str,
 }
 
 /// The STF force against each model's fitted force.
@@ -37,6 +39,16 @@ pub const STF_FORCE: Quantity = Quantity {
     title: "STF force: measured and fitted",
     label: "F_STF, N",
     model_word: "fitted",
+    band: "measured",
+};
+
+/// The STF force residual (measured − modelled, N) of a base model, drawn as the band,
+/// against the final model's.
+pub const STF_FORCE_RESIDUAL: Quantity = Quantity {
+    title: "STF force residual: measured − modelled",
+    label: "F_STF residual, N",
+    model_word: "fitted",
+    band: "base",
 };
 
 /// The displacement against the oscillator simulated with each model (values in mm).
@@ -44,6 +56,16 @@ pub const DISPLACEMENT_MM: Quantity = Quantity {
     title: "Displacement: measured and simulated",
     label: "x, mm",
     model_word: "simulated",
+    band: "measured",
+};
+
+/// The displacement residual (measured − simulated, mm) of a base model, drawn as the band,
+/// against the final model's.
+pub const DISPLACEMENT_RESIDUAL_MM: Quantity = Quantity {
+    title: "Displacement residual: measured − simulated",
+    label: "x residual, mm",
+    model_word: "simulated",
+    band: "base",
 };
 
 struct MeasuredVsFittedPlot {
@@ -88,7 +110,7 @@ impl Draw for MeasuredVsFittedPlot {
                 MEASURED_GREY.stroke_width(6),
             ))
             .map_err(msg)?
-            .label("measured")
+            .label(self.quantity.band)
             .legend(|(x, y)| {
                 PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
             });
@@ -162,7 +184,7 @@ pub fn measured_vs_model(
     let mut columns = vec![
         Column::new("t, s", plot.t.clone()),
         Column::new(
-            format!("measured {}", quantity.label),
+            format!("{} {}", quantity.band, quantity.label),
             plot.measured.clone(),
         ),
     ];

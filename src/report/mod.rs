@@ -56,7 +56,8 @@ pub use html::write_html;
 pub use hysteresis::hysteresis;
 pub use markdown::write_markdown;
 pub use measured_vs_fitted::{
-    measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, STF_FORCE,
+    measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
+    STF_FORCE, STF_FORCE_RESIDUAL,
 };
 pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};
