@@ -107,7 +107,7 @@ impl Default for Settings {
         Settings {
             method: Method::default(),
             rtol: 1e-7,
-            atol: 1e-10,
+            atol: 1e-9,
             h_max: 0.0,
             max_steps: 50_000_000,
         }
