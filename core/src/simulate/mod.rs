@@ -1,5 +1,9 @@
 //! Simulation of the oscillator: samples of x, v, a and F_STF at a rate or at given times.
 //!
+//! A run integrates the oscillator once and then evaluates the forces at every sample; from
+//! 20 000 samples on it uses a second thread for the drive (during the integration) and for half
+//! of the samples' forces (after it), which leaves the integration as the run's critical path.
+//!
 //! ```
 //! use stf_core::{excitation::{Excitation, RotorAngle}, oscillator::Oscillator,
 //!                simulate::Simulation, system::OscillatorParams};
@@ -10,6 +14,10 @@
 
 use crate::integrate::{integrate_states, Method, Settings, SimError, Stats};
 use crate::oscillator::Oscillator;
+
+mod columns;
+
+use columns::{Columns, DriveColumns, Rows, PARALLEL_SAMPLES};
 
 /// Samples of a simulated run.
 #[derive(Clone, Debug, Default)]
@@ -102,52 +110,71 @@ impl<'a> Simulation<'a> {
             return Ok(Trajectory::default());
         };
         let y0 = self.osc.initial_state(self.x0, self.v0);
-        let (states, stats) = integrate_states(self.osc, t0, &y0, &times, &self.settings)?;
+        let excitation = &*self.osc.excitation;
+        let f0 = self.osc.params.f0;
+        // The drive and the rotor angle depend on time alone: on long runs they are evaluated
+        // on a second thread while the integration runs (one `sin` a sample is as much work as
+        // the integration of a smooth sweep).
+        let (integrated, drive) = if times.len() >= PARALLEL_SAMPLES {
+            std::thread::scope(|scope| {
+                let job = scope.spawn(|| DriveColumns::at(excitation, f0, &times));
+                let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
+                let drive = job
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+                (integrated, drive)
+            })
+        } else {
+            let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
+            (integrated, DriveColumns::at(excitation, f0, &times))
+        };
+        let (states, stats) = integrated?;
         let n = times.len();
         let dim = y0.len();
-        let column = |j: usize| -> Vec<f64> { states.chunks_exact(dim).map(|y| y[j]).collect() };
-        let rotor = self.osc.excitation.omega(t0).is_some();
-        let f0 = self.osc.params.f0;
-        // The rotor angle is evaluated once per sample, for the drive, φ and ω.
-        let mut drive = vec![0.0; n];
-        let (mut phi, mut omega) = if rotor {
-            (vec![0.0; n], vec![0.0; n])
-        } else {
-            (Vec::new(), Vec::new())
+        let (mut x, mut v, mut a, mut f_stf) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut z = vec![vec![0.0; n]; dim - 2];
+        let columns = Columns {
+            x: &mut x,
+            v: &mut v,
+            a: &mut a,
+            f_stf: &mut f_stf,
+            z: z.iter_mut().map(Vec::as_mut_slice).collect(),
         };
-        if rotor {
-            let rows = drive.iter_mut().zip(phi.iter_mut()).zip(omega.iter_mut());
-            for (((d, p), w), &t) in rows.zip(&times) {
-                let (force, angle) = self.osc.excitation.force_and_angle(t, f0);
-                *d = force;
-                (*p, *w) = angle.unwrap_or((0.0, 0.0));
-            }
+        let rows = Rows {
+            states: &states,
+            dim,
+            times: &times,
+            drive: &drive.force,
+        };
+        if n >= PARALLEL_SAMPLES {
+            // The samples are independent: each half is filled on its own thread.
+            let mid = n / 2;
+            let (first, second) = (rows.window(0, mid), rows.window(mid, n));
+            let (into_first, into_second) = columns.split_at(mid);
+            std::thread::scope(|scope| {
+                let job = scope.spawn(|| first.fill(self.osc, into_first));
+                let second = second.fill(self.osc, into_second);
+                let first = job
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+                first.and(second)
+            })?;
         } else {
-            for (d, &t) in drive.iter_mut().zip(&times) {
-                *d = self.osc.excitation.force(t, f0);
-            }
+            rows.fill(self.osc, columns)?;
         }
-        let (mut a, mut f_stf) = (vec![0.0; n], vec![0.0; n]);
-        let mut dz = vec![0.0; self.osc.n_internal()];
-        let rows = states.chunks_exact(dim).zip(&times).zip(&drive);
-        for ((ai, fi), ((y, &t), &d)) in a.iter_mut().zip(f_stf.iter_mut()).zip(rows) {
-            let f = self.osc.forces_with_drive(t, y, d, &mut dz)?;
-            *ai = f.a;
-            *fi = f.f_stf;
-        }
-        let out = Trajectory {
+        Ok(Trajectory {
             t: times,
-            x: column(0),
-            v: column(1),
+            x,
+            v,
             a,
             f_stf,
-            drive,
-            phi: rotor.then_some(phi),
-            omega: rotor.then_some(omega),
-            z: (2..dim).map(column).collect(),
+            drive: drive.force,
+            phi: drive.phi,
+            omega: drive.omega,
+            z,
             stats,
-        };
-        Ok(out)
+        })
     }
 }
 
@@ -182,6 +209,17 @@ mod tests {
             );
             assert_eq!(phi[i], osc.excitation.phi(run.t[i]).unwrap());
             assert_eq!(omega[i], osc.excitation.omega(run.t[i]).unwrap());
+        }
+        // A long run takes the drive from a second thread: the same columns.
+        let long = Simulation::new(&osc).rate(1000.0).run(0.0, 25.0).unwrap();
+        assert!(long.t.len() >= PARALLEL_SAMPLES);
+        let (phi, omega) = (long.phi.as_ref().unwrap(), long.omega.as_ref().unwrap());
+        for i in (0..long.t.len()).step_by(7) {
+            let t = long.t[i];
+            let f = osc.forces(t, &[long.x[i], long.v[i]], &mut []).unwrap();
+            assert_eq!((long.a[i], long.drive[i]), (f.a, f.drive));
+            assert_eq!(phi[i], osc.excitation.phi(t).unwrap());
+            assert_eq!(omega[i], osc.excitation.omega(t).unwrap());
         }
         let free = Oscillator::new(OscillatorParams::FREE, Excitation::None);
         let run = Simulation::new(&free)
