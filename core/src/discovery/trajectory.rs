@@ -215,6 +215,13 @@ impl Stage {
             .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
     }
 
+    /// The displacement residual of this stage at its values (the integration alone).
+    fn residual(&self, rig: &Rig) -> Result<Vec<f64>, DiscoveryError> {
+        let model = self.model()?;
+        rig.residual(&model, &self.values)
+            .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
+    }
+
     /// Fit on the training samples and score on the held-out ones.
     fn trial_simulated(
         &self,
@@ -224,7 +231,7 @@ impl Stage {
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
         let (stage, train) = self.fit_simulated(rig, setup, &split.train, settings)?;
-        let r = stage.run(rig)?.residual;
+        let r = stage.residual(rig)?;
         let h = rms_over(&r, &split.holdout);
         Ok(Trial {
             stage,
@@ -276,8 +283,8 @@ impl Stage {
             let mut values = base;
             for f in SCREEN {
                 values[i] = inside(spec.default * f, spec.min, spec.max);
-                if let Ok(run) = rig.run(&model, &values) {
-                    let s = rms_over(&run.residual, train);
+                if let Ok(residual) = rig.residual(&model, &values) {
+                    let s = rms_over(&residual, train);
                     if s < best.0 {
                         best = (s, values.clone());
                     }

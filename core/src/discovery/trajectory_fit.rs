@@ -14,7 +14,7 @@ use crate::fit::{
     fit_residuals, full_values, FitError, FitParam, FitResult, FitSettings, Residuals,
 };
 use crate::force_model::ForceModel;
-use crate::integrate::Settings;
+use crate::integrate::{integrate, Settings};
 use crate::oscillator::Oscillator;
 use crate::simulate::{Simulation, Trajectory};
 use crate::system::OscillatorParams;
@@ -33,6 +33,14 @@ pub(super) struct Rig<'a> {
     pub x: &'a [f64],
 }
 
+/// The oscillator of one evaluation, its initial state and the displacement offset.
+struct RigSetup {
+    osc: Oscillator,
+    x0: f64,
+    v0: f64,
+    offset: f64,
+}
+
 /// One evaluation: the model's simulated motion and the displacement residual.
 pub(super) struct Run {
     pub sim: Trajectory,
@@ -42,8 +50,37 @@ pub(super) struct Run {
 
 impl Rig<'_> {
     /// Simulate `model` on the rig with the full parameter vector `values` (oscillator's,
-    /// model's, offset).
+    /// model's, offset): the whole motion and the displacement residual.
     pub fn run(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Run, String> {
+        let setup = self.setup(model, values)?;
+        let sim = Simulation::new(&setup.osc)
+            .settings(self.sim.clone())
+            .initial(setup.x0, setup.v0)
+            .run_at(self.t)
+            .map_err(|e| e.to_string())?;
+        let residual = self.residual_of(&sim.x, setup.offset)?;
+        Ok(Run { sim, residual })
+    }
+
+    /// The displacement residual alone (measured − simulated − offset at every sample, m), at
+    /// the cost of the integration only: what a fit evaluates.
+    pub fn residual(
+        &self,
+        model: &Arc<dyn ForceModel>,
+        values: &[f64],
+    ) -> Result<Vec<f64>, String> {
+        let setup = self.setup(model, values)?;
+        let Some(&t0) = self.t.first() else {
+            return Ok(Vec::new());
+        };
+        let y0 = setup.osc.initial_state(setup.x0, setup.v0);
+        let sol = integrate(&setup.osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
+        let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
+        self.residual_of(&x, setup.offset)
+    }
+
+    /// The oscillator with `values` set, its initial state and the offset.
+    fn setup(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<RigSetup, String> {
         let n_osc = self.oscillator.len();
         let n_model = model.params().len();
         if values.len() != n_osc + n_model + usize::from(self.fit_offset) {
@@ -70,24 +107,29 @@ impl Rig<'_> {
         let (x0, v0) = self
             .initial
             .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
-        let sim = Simulation::new(&osc)
-            .settings(self.sim.clone())
-            .initial(x0 - offset, v0)
-            .run_at(self.t)
-            .map_err(|e| e.to_string())?;
-        if sim.x.len() != self.x.len() {
+        Ok(RigSetup {
+            osc,
+            x0: x0 - offset,
+            v0,
+            offset,
+        })
+    }
+
+    /// Measured − simulated − offset, checked for length and finiteness.
+    fn residual_of(&self, simulated: &[f64], offset: f64) -> Result<Vec<f64>, String> {
+        if simulated.len() != self.x.len() {
             return Err("the simulation returned too few samples".into());
         }
         let residual: Vec<f64> = self
             .x
             .iter()
-            .zip(&sim.x)
+            .zip(simulated)
             .map(|(m, s)| m - s - offset)
             .collect();
         if let Some(i) = residual.iter().position(|r| !r.is_finite()) {
             return Err(format!("non-finite displacement at sample {i}"));
         }
-        Ok(Run { sim, residual })
+        Ok(residual)
     }
 
     /// The oscillator's parameters with the fitted values of `values` set.
@@ -115,9 +157,9 @@ impl Residuals for SubsetProblem<'_> {
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
         let full = full_values(self.params, x)?;
-        let run = self.rig.run(self.model, &full)?;
+        let residual = self.rig.residual(self.model, &full)?;
         for (k, &i) in self.subset.iter().enumerate() {
-            sink(k, run.residual[i]);
+            sink(k, residual[i]);
         }
         Ok(())
     }
