@@ -23,7 +23,7 @@ use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, load_data, system_param, FitData};
+use crate::fitting::{load_data, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
 use crate::report::{
@@ -170,7 +170,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "final_model": {
             "name": found.final_model_name,
             "params": params,
-            "std_errors": found.final_params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "std_errors": std_errors_json(&found.final_params),
             "experiment_entry": toml_entry,
         },
         "notes": found.notes,
@@ -397,7 +397,7 @@ fn run_trajectory(
         "final_model": {
             "name": found.final_model_name,
             "params": model_params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-            "std_errors": found.final_params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "std_errors": std_errors_json(&found.final_params),
             "system": names.iter().filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), json!(v)))).collect::<serde_json::Map<_, _>>(),
             "experiment_entry": toml_entry,
             "system_entry": system_entry,

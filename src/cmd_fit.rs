@@ -14,7 +14,7 @@ use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, fit_all, load_data, system_param};
+use crate::fitting::{finite_or_null, fit_all, load_data, std_errors_json, system_param};
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
 
@@ -189,7 +189,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             "record": stage.data.display().to_string(),
             "free": stage.free,
             "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-            "std_errors": result.params.iter().map(|p| (p.name.clone(), finite_or_null(p.std_error))).collect::<serde_json::Map<_, _>>(),
+            "std_errors": std_errors_json(&result.params),
             "s_mm2": result.s_mm2,
             "rms": result.rms,
             "aic": finite_or_null(result.aic),

@@ -11,7 +11,9 @@ use std::sync::Arc;
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::fit::{
+    FitParam, FitResult, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit,
+};
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
 use stf_core::record::{ColumnNames, ReadOptions, Record};
@@ -185,12 +187,6 @@ impl ModelFit {
             .iter()
             .map(|p| (p.name.clone(), json!(p.value)))
             .collect();
-        let errors: serde_json::Map<String, Value> = self
-            .result
-            .params
-            .iter()
-            .map(|p| (p.name.clone(), finite_or_null(p.std_error)))
-            .collect();
         let fixed: Vec<&str> = self
             .result
             .params
@@ -203,7 +199,7 @@ impl ModelFit {
             "label": self.label,
             "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
             "params": params,
-            "std_errors": errors,
+            "std_errors": std_errors_json(&self.result.params),
             "fixed": fixed,
             "rms": self.result.rms,
             "rms_unit": match level { FitLevel::Force => "N", FitLevel::Trajectory => "m" },
@@ -220,6 +216,16 @@ impl ModelFit {
             "correlation": self.result.correlation.iter().map(|row| row.iter().map(|&c| finite_or_null(c)).collect::<Vec<_>>()).collect::<Vec<_>>(),
         })
     }
+}
+
+/// The standard errors of fitted parameters as a JSON object by name (null where unknown).
+pub fn std_errors_json(params: &[FittedParam]) -> Value {
+    Value::Object(
+        params
+            .iter()
+            .map(|p| (p.name.clone(), finite_or_null(p.std_error)))
+            .collect(),
+    )
 }
 
 /// JSON has no NaN or infinity: those become null.
