@@ -153,6 +153,97 @@ fn main() {
             .collect();
         println!("ln-direction to truth {d:?}");
     }
+    if mode == "synth" {
+        use stf_core::excitation::{Excitation, RotorAngle};
+        let a: Vec<f64> = std::env::args()
+            .skip(2)
+            .map(|a| a.parse().unwrap())
+            .collect();
+        let (w0, alpha, dur, rate, seed) = (a[0], a[1], a[2], a[3], a[4] as u64);
+        let f = &a[5..10];
+        let excitation = Arc::new(Excitation::Rotor(RotorAngle::sweep(w0, alpha, 0.0)));
+        let osc =
+            stf_core::oscillator::Oscillator::with_shared_excitation(truth, excitation.clone());
+        let run = stf_core::simulate::Simulation::new(&osc)
+            .rate(rate)
+            .run(0.0, dur)
+            .unwrap();
+        let rec = stf_core::synthetic::sample_record(
+            &run,
+            &stf_core::synthetic::SensorNoise::RIG,
+            seed,
+            true,
+        );
+        let data = TrajectoryData {
+            t: &rec.t,
+            x: &rec.x,
+        };
+        let (excitation, x0, v0) = if a.get(10) == Some(&1.0) {
+            let k = Kinematics::from_record(&rec, &KinematicsSettings::default()).unwrap();
+            (Arc::new(k.excitation()), k.x[0], k.v[0])
+        } else {
+            (excitation, rec.x[0], 0.0)
+        };
+        let clock = std::time::Instant::now();
+        let s_truth = TrajectoryFit::new(truth, excitation.clone())
+            .initial(x0, v0)
+            .fit(&data, None)
+            .unwrap()
+            .s_mm2
+            .unwrap();
+        let one = clock.elapsed().as_secs_f64();
+        let excitation_line = excitation.clone();
+        let mut fit = TrajectoryFit::new(truth, excitation).initial(x0, v0);
+        for (i, name) in ["k", "c", "T", "delta_T", "F0"].iter().enumerate() {
+            let v = truth.get(name).unwrap() * f[i];
+            fit = fit.free(FitParam::new(*name, v).bounds(v / 5.0, v * 5.0));
+        }
+        let r = fit.fit(&data, None).unwrap();
+        println!(
+            "n {} one {:.3}s S_truth {s_truth:.5} S {:.5} ratio {:.3} evals {} wall {:.2}",
+            rec.t.len(),
+            one,
+            r.s_mm2.unwrap(),
+            r.s_mm2.unwrap() / s_truth,
+            r.evaluations,
+            r.wall_seconds
+        );
+        if std::env::var("V").is_ok() {
+            for p in &r.params {
+                println!(
+                    "  {} {:.5} ({:+.2} %)",
+                    p.name,
+                    p.value,
+                    100.0 * (p.value / truth.get(&p.name).unwrap() - 1.0)
+                );
+            }
+            for l in &r.log {
+                println!("  {l}");
+            }
+        }
+        if std::env::var("LINE").is_ok() {
+            let mut end = truth;
+            for p in &r.params {
+                end.set(&p.name, p.value);
+            }
+            for i in 0..=20 {
+                let s = i as f64 / 20.0;
+                let mut q = truth;
+                for name in ["k", "c", "T", "delta_T", "F0"] {
+                    q.set(
+                        name,
+                        end.get(name).unwrap()
+                            + s * (truth.get(name).unwrap() - end.get(name).unwrap()),
+                    );
+                }
+                let fit = TrajectoryFit::new(q, excitation_line.clone()).initial(x0, v0);
+                println!(
+                    "  line s {s:.2} S {:.5}",
+                    fit.fit(&data, None).unwrap().s_mm2.unwrap()
+                );
+            }
+        }
+    }
     if mode == "noise" {
         for (label, p0) in [("truth", truth), ("stuck", stuck)] {
             for name in ["k", "T", "delta_T"] {
