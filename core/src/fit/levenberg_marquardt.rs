@@ -10,7 +10,10 @@
 //! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
 //! ```
 //!
-//! Steps are shortened to at most two scales of any parameter.
+//! Steps are shortened to at most two scales of any parameter. The Jacobian's difference
+//! steps start at `fd_step` and grow above the residuals' noise, measured once at the start
+//! (see [`super::jacobian`]): a column that is mostly integrator noise gives a step that
+//! raises the cost at every damping, and the refinement stopped far from the optimum.
 
 use nalgebra::{DMatrix, DVector};
 
