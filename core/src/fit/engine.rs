@@ -16,8 +16,8 @@ use rand::SeedableRng;
 
 use super::covariance;
 use super::error::FitError;
-use super::jacobian::forward_difference;
-use super::levenberg_marquardt;
+use super::jacobian::{forward_difference, residual_noise, StepFloor};
+use super::levenberg_marquardt::{self, MAX_FD_STEP, NOISE_PROBE};
 use super::objective::{LnCost, Objective, Residuals};
 use super::param::FitParam;
 use super::result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
@@ -246,14 +246,45 @@ fn finish(
     let p = free.len();
     let (std_errors, correlation) = if p > 0 {
         let mut jac = DMatrix::<f64>::zeros(n, p);
-        let steps: Vec<f64> = free
+        let mut steps: Vec<f64> = free
             .iter()
             .map(|q| settings.fd_step * q.effective_scale())
             .collect();
+        // Steps above the residuals' noise (a noisy column would make a noisy standard
+        // error), at most MAX_FD_STEP scales and short enough that one side stays in bounds.
+        let probe: Vec<f64> = free
+            .iter()
+            .zip(&x)
+            .map(|(q, v)| {
+                let e = NOISE_PROBE * q.effective_scale();
+                if v + e < q.max && v - e > q.min {
+                    e
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let noise = residual_noise(&x, &r0, &probe, &mut |point, out| {
+            obj.residuals_user(point, out).is_some()
+        })
+        .unwrap_or(0.0);
+        let floor = StepFloor {
+            noise,
+            max: free
+                .iter()
+                .zip(&steps)
+                .map(|(q, h)| {
+                    (MAX_FD_STEP * q.effective_scale())
+                        .min(0.49 * (q.max - q.min))
+                        .max(*h)
+                })
+                .collect(),
+        };
         forward_difference(
             &x,
             &r0,
-            &steps,
+            &mut steps,
+            &floor,
             &|j, v| !(v > free[j].min && v < free[j].max),
             &mut |point, out| obj.residuals_user(point, out).is_some(),
             &mut jac,

@@ -1,42 +1,118 @@
-//! Forward-difference Jacobians of residual vectors, column by column.
+//! Forward-difference Jacobians of residual vectors, column by column, with steps that rise
+//! above the residuals' noise.
 //!
 //! A step that fails (the model errs there) is retried in the opposite direction; a column
 //! whose both steps fail is NaN, and the parameter's standard error with it.
+//!
+//! Residuals from a simulation carry the integrator's error, which changes at random with any
+//! change of the parameters (the adaptive steps change): on the 150 s forced sweep, at
+//! `rtol` 1e-7, any perturbation (1e-9 or 1e-5 of a parameter alike) moves the residuals by
+//! 6e-4 mm rms, while a step of 3e-4 of ΔT moves them by only 2e-4 mm — that column was noise,
+//! and Levenberg–Marquardt stopped at S four times the optimum's. So the noise is measured
+//! ([`residual_noise`]) and each column's step is lengthened until the change it makes stands
+//! [`SIGNAL_TO_NOISE`] times above that noise (up to a largest step).
 
 use nalgebra::DMatrix;
 
+/// Change a difference step must make in the residuals, in multiples of their noise
+/// (rms over the samples): the noise then contributes about `√2 / SIGNAL_TO_NOISE` (5 %)
+/// to the column.
+pub const SIGNAL_TO_NOISE: f64 = 30.0;
+
+/// Tries at lengthening one column's step before the column is taken as it is.
+const LENGTHEN_TRIES: usize = 3;
+
+/// The noise of the residuals at `x` (rms per residual), from a second difference along all
+/// parameters at once: `r(x + e) + r(x − e) − 2·r(x)` with `e_j = probe[j]` cancels the
+/// residuals' slope and leaves their noise (variance 6σ²) plus a curvature term of order
+/// `probe²`, negligible for probes of 1e-6 of a scale. `None` if an evaluation fails.
+pub fn residual_noise(
+    x: &[f64],
+    r0: &[f64],
+    probe: &[f64],
+    eval: &mut dyn FnMut(&[f64], &mut [f64]) -> bool,
+) -> Option<f64> {
+    let n = r0.len();
+    let mut plus = vec![0.0; n];
+    let mut minus = vec![0.0; n];
+    let up: Vec<f64> = x.iter().zip(probe).map(|(x, e)| x + e).collect();
+    let down: Vec<f64> = x.iter().zip(probe).map(|(x, e)| x - e).collect();
+    if !(eval(&up, &mut plus) && eval(&down, &mut minus)) {
+        return None;
+    }
+    let ss: f64 = plus
+        .iter()
+        .zip(&minus)
+        .zip(r0)
+        .map(|((p, m), r)| (p + m - 2.0 * r).powi(2))
+        .sum();
+    let sigma = (ss / (6.0 * n.max(1) as f64)).sqrt();
+    sigma.is_finite().then_some(sigma)
+}
+
+/// How long the steps of a Jacobian may grow to rise above the residuals' noise.
+#[derive(Clone, Debug)]
+pub struct StepFloor {
+    /// Noise of the residuals, rms per residual (0: noiseless, steps never grow).
+    pub noise: f64,
+    /// Longest step of each parameter (same units as the steps).
+    pub max: Vec<f64>,
+}
+
 /// Fill `jac` (N × p) with ∂r/∂x_j at `x`, where `r0` are the residuals at `x`, `steps[j]`
-/// the signed step of parameter j and `eval(x, out)` computes residuals (false on failure).
+/// the step of parameter j and `eval(x, out)` computes residuals (false on failure).
 /// `flip(j, x)` tells whether parameter j's step must go the other way (a bound ahead).
+/// A column whose rms change is below `SIGNAL_TO_NOISE × floor.noise` is recomputed with a
+/// longer step (up to `floor.max[j]`); the steps used are written back to `steps`, so a
+/// caller that keeps them starts the next Jacobian from there.
 pub fn forward_difference(
     x: &[f64],
     r0: &[f64],
-    steps: &[f64],
+    steps: &mut [f64],
+    floor: &StepFloor,
     flip: &dyn Fn(usize, f64) -> bool,
     eval: &mut dyn FnMut(&[f64], &mut [f64]) -> bool,
     jac: &mut DMatrix<f64>,
 ) {
+    let n = r0.len().max(1) as f64;
+    let wanted = SIGNAL_TO_NOISE * floor.noise;
     let mut point = x.to_vec();
-    for (j, &h0) in steps.iter().enumerate() {
-        let mut h = if flip(j, x[j] + h0) { -h0 } else { h0 };
+    for j in 0..steps.len() {
+        let longest = floor.max.get(j).copied().unwrap_or(0.0);
+        let mut h0 = steps[j].abs();
         let mut column = jac.column_mut(j);
         let col = column.as_mut_slice();
         let mut ok = false;
-        for _ in 0..2 {
-            point[j] = x[j] + h;
-            let dx = point[j] - x[j];
-            if dx != 0.0 && eval(&point, col) {
-                for (c, r) in col.iter_mut().zip(r0) {
-                    *c = (*c - r) / dx;
+        for attempt in 0..=LENGTHEN_TRIES {
+            let mut h = if flip(j, x[j] + h0) { -h0 } else { h0 };
+            ok = false;
+            for _ in 0..2 {
+                point[j] = x[j] + h;
+                let dx = point[j] - x[j];
+                if dx != 0.0 && eval(&point, col) {
+                    for (c, r) in col.iter_mut().zip(r0) {
+                        *c = (*c - r) / dx;
+                    }
+                    ok = true;
+                    break;
                 }
-                ok = true;
+                h = -h;
+            }
+            point[j] = x[j];
+            if !ok || attempt == LENGTHEN_TRIES || h0 >= longest {
                 break;
             }
-            h = -h;
+            // The rms change this step made, against the noise it must stand above.
+            let change = h0 * (col.iter().map(|c| c * c).sum::<f64>() / n).sqrt();
+            if !(change < wanted) {
+                break;
+            }
+            let grow = if change > 0.0 { wanted / change } else { 10.0 };
+            h0 = (h0 * grow.clamp(2.0, 10.0)).min(longest);
         }
+        steps[j] = h0;
         if !ok {
             col.fill(f64::NAN);
         }
-        point[j] = x[j];
     }
 }

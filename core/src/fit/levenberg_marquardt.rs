@@ -10,11 +10,14 @@
 //! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
 //! ```
 //!
-//! Steps are shortened to at most two scales of any parameter.
+//! Steps are shortened to at most two scales of any parameter. The Jacobian's difference
+//! steps start at `fd_step` and grow above the residuals' noise, measured once at the start
+//! (see [`super::jacobian`]): a column that is mostly integrator noise gives a step that
+//! raises the cost at every damping, and the refinement stopped far from the optimum.
 
 use nalgebra::{DMatrix, DVector};
 
-use super::jacobian::forward_difference;
+use super::jacobian::{forward_difference, residual_noise, StepFloor};
 use super::objective::Objective;
 use super::result::Convergence;
 
@@ -30,6 +33,13 @@ pub struct Refined {
 
 /// Longest step in internal coordinates (units of the parameters' scales).
 const MAX_STEP: f64 = 2.0;
+
+/// Longest finite-difference step, in scales, that a column may grow to when the residuals
+/// are noisy (see [`super::jacobian`]).
+pub const MAX_FD_STEP: f64 = 0.1;
+
+/// Probe of the residuals' noise, in scales: far below any step, far above rounding.
+pub const NOISE_PROBE: f64 = 1e-6;
 
 /// Largest damping before the refinement decides no step can lower the cost.
 const LAMBDA_MAX: f64 = 1e16;
@@ -51,14 +61,24 @@ pub fn refine(obj: &Objective, u0: &[f64], max_iters: u64, tol: f64, fd_step: f6
         };
     };
     let mut jac = DMatrix::<f64>::zeros(n, p);
-    let steps = vec![fd_step; p];
+    let mut steps = vec![fd_step; p];
+    // The residuals' noise, measured once: the Jacobian's steps grow above it.
+    let noise = residual_noise(&u, &r, &vec![NOISE_PROBE; p], &mut |point, out| {
+        obj.residuals_user(&obj.to_user(point), out).is_some()
+    })
+    .unwrap_or(0.0);
+    let floor = StepFloor {
+        noise,
+        max: vec![MAX_FD_STEP.max(fd_step); p],
+    };
     let mut lambda = 1e-3;
     let mut nu = 2.0;
     for iter in 1..=max_iters {
         forward_difference(
             &u,
             &r,
-            &steps,
+            &mut steps,
+            &floor,
             &|_, _| false,
             &mut |point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
             &mut jac,
