@@ -86,6 +86,16 @@ impl RotorAngle {
         }
     }
 
+    /// The first time after `t` at which the angle's second derivative may jump: the next knot
+    /// of a profile or of measured samples; none for the analytic kinds.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match self {
+            RotorAngle::Constant { .. } | RotorAngle::Sweep { .. } => None,
+            RotorAngle::Profile { t: ts, .. } => ts.get(ts.partition_point(|&k| k <= t)).copied(),
+            RotorAngle::Measured(h) => h.next_knot(t),
+        }
+    }
+
     /// [`RotorAngle::at`] for the tabulated kinds (kept out of line so that the analytic ones
     /// inline into the right-hand side).
     #[inline(never)]
@@ -158,6 +168,17 @@ impl Excitation {
                 (f0 * omega * omega * phi.sin(), Some((phi, omega)))
             }
             _ => (self.force(t, f0), None),
+        }
+    }
+
+    /// The first time after `t` at which the driving force stops being smooth (the next knot of
+    /// a measured or piecewise-defined drive), if any: an integrator ends a step there rather
+    /// than stepping across it.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::None => None,
+            Excitation::Rotor(angle) => angle.next_breakpoint(t),
+            Excitation::Force(u) => u.next_knot(t),
         }
     }
 

@@ -24,6 +24,20 @@ fn locate(ts: &[f64], uniform_step: Option<f64>, t: f64) -> usize {
     ts.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2)
 }
 
+/// The first sample time strictly after `t` (before the span: the first one; none from the last
+/// one on, where the interpolant continues smoothly).
+fn next_knot(ts: &[f64], uniform_step: Option<f64>, t: f64) -> Option<f64> {
+    let (&first, &last) = (ts.first()?, ts.last()?);
+    if t < first {
+        return Some(first);
+    }
+    if t >= last {
+        return None;
+    }
+    let i = locate(ts, uniform_step, t);
+    ts[i..].iter().copied().find(|&knot| knot > t)
+}
+
 fn uniform_step(ts: &[f64]) -> Option<f64> {
     let n = ts.len();
     if n < 2 {
@@ -70,6 +84,12 @@ impl Linear {
     pub fn times(&self) -> &[f64] {
         &self.t
     }
+
+    /// The first sample time strictly after `t`, where the interpolant's slope may jump (none
+    /// from the last sample on).
+    pub fn next_knot(&self, t: f64) -> Option<f64> {
+        next_knot(&self.t, self.step, t)
+    }
 }
 
 /// Cubic Hermite interpolation of samples `(t_i, y_i)` with derivatives `dy_i`.
@@ -87,6 +107,12 @@ impl Hermite {
         debug_assert!(t.len() == y.len() && t.len() == dy.len());
         let step = uniform_step(&t);
         Hermite { t, y, dy, step }
+    }
+
+    /// The first sample time strictly after `t`, where the interpolant's second derivative may
+    /// jump (none from the last sample on).
+    pub fn next_knot(&self, t: f64) -> Option<f64> {
+        next_knot(&self.t, self.step, t)
     }
 
     /// Value and derivative at time `t` (outside the span: linear continuation of the end).
@@ -137,6 +163,27 @@ mod tests {
         assert_relative_eq!(l.at(0.437), 3.0 * 0.437 - 1.0, max_relative = 1e-12);
         assert_eq!(l.at(-5.0), -1.0);
         assert_relative_eq!(l.at(5.0), 2.0, max_relative = 1e-12);
+    }
+
+    #[test]
+    fn the_next_knot_is_strictly_after_t_on_uniform_and_uneven_grids() {
+        let uniform: Vec<f64> = (0..101).map(|i| 50.0 + i as f64 * 0.01).collect();
+        let uneven = vec![0.0, 0.3, 0.35, 1.0, 2.2];
+        for ts in [uniform, uneven] {
+            let l = Linear::new(ts.clone(), vec![0.0; ts.len()]);
+            let h = Hermite::new(ts.clone(), vec![0.0; ts.len()], vec![0.0; ts.len()]);
+            assert_eq!(l.next_knot(ts[0] - 1.0), Some(ts[0]));
+            for w in ts.windows(2) {
+                // From a knot itself, from inside an interval and from just before the next.
+                for t in [w[0], 0.5 * (w[0] + w[1]), w[1] - 1e-12] {
+                    assert_eq!(l.next_knot(t), Some(w[1]), "{t}");
+                    assert_eq!(h.next_knot(t), Some(w[1]), "{t}");
+                }
+            }
+            let end = ts[ts.len() - 1];
+            assert_eq!(l.next_knot(end), None);
+            assert_eq!(h.next_knot(end + 3.0), None);
+        }
     }
 
     #[test]

@@ -198,4 +198,9 @@ impl OdeSystem for Oscillator {
     fn switching_component(&self) -> Option<usize> {
         Some(1)
     }
+
+    /// The knots of a measured or piecewise-defined drive.
+    fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        self.excitation.next_breakpoint(t)
+    }
 }

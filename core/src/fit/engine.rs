@@ -17,7 +17,7 @@ use rand::SeedableRng;
 use super::covariance;
 use super::error::FitError;
 use super::jacobian::{forward_difference, residual_noise, StepFloor};
-use super::levenberg_marquardt::{self, MAX_FD_STEP, NOISE_PROBE};
+use super::levenberg_marquardt::{self, BoundStop, MAX_FD_STEP, NOISE_PROBE};
 use super::objective::{LnCost, Objective, Residuals};
 use super::param::FitParam;
 use super::result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
@@ -72,6 +72,10 @@ pub fn run(
             },
         )
     } else {
+        // In a trajectory fit a refinement that pins a parameter on a bound stops there; the
+        // parameter is then released (see `release_pinned`).
+        let at_bound = |u: &[f64]| !pinned(&obj, &free, u).is_empty();
+        let stop_at_bound: BoundStop = trajectory.then_some(&at_bound);
         let lm = |start: &[f64], iterations: &mut u64, log: &mut Vec<String>| {
             obj.set_stage(Stage::LevenbergMarquardt);
             let out = levenberg_marquardt::refine(
@@ -80,6 +84,7 @@ pub fn run(
                 settings.max_iters,
                 settings.tol,
                 settings.fd_step,
+                stop_at_bound,
             );
             *iterations += out.iterations;
             log.push(format!(
@@ -124,6 +129,19 @@ pub fn run(
             }
         }
     };
+    let (u, convergence) = if trajectory && p > 0 {
+        release_pinned(
+            &obj,
+            &free,
+            u,
+            convergence,
+            settings,
+            &mut iterations,
+            &mut log,
+        )
+    } else {
+        (u, convergence)
+    };
     // A fit never ends worse than its start: whatever the chain did, the start is kept if
     // it is better.
     let start_cost = obj.cost(&u0).unwrap_or(f64::INFINITY);
@@ -154,6 +172,91 @@ pub fn run(
         trajectory,
         clock,
     )
+}
+
+/// Closest a parameter may end to a bound, as a fraction of the box's width (or of its scale
+/// for a one-sided bound), before it counts as pinned there.
+const PINNED: f64 = 1e-6;
+
+/// The free parameters (by index) that `u` puts on one of their bounds, where the bound
+/// transform is flat.
+fn pinned(obj: &Objective, free: &[&FitParam], u: &[f64]) -> Vec<usize> {
+    let x = obj.to_user(u);
+    free.iter()
+        .zip(&x)
+        .enumerate()
+        .filter(|(_, (q, &v))| {
+            let width = q.max - q.min;
+            let span = if width.is_finite() {
+                width
+            } else {
+                q.effective_scale()
+            };
+            (v - q.min).abs() <= PINNED * span || (q.max - v).abs() <= PINNED * span
+        })
+        .map(|(j, _)| j)
+        .collect()
+}
+
+/// Trajectory fits: a parameter that the refinement drove onto a bound cannot come back, since
+/// its map is flat there, even when the cost falls away from the bound along a joint move with
+/// the others (from the identification's second stage, started from the free-vibration values,
+/// ΔT went to its bound with S 0.0178 mm², while the optimum inside has 0.0035). So the pinned
+/// parameters are released to their start values, the others kept, and Levenberg–Marquardt
+/// runs again from there; the better end is kept. (Force-level fits, cheap to refine, let the
+/// refinement run on along the bound instead: there a parameter often belongs on its bound.)
+fn release_pinned(
+    obj: &Objective,
+    free: &[&FitParam],
+    u: Vec<f64>,
+    convergence: Convergence,
+    settings: &FitSettings,
+    iterations: &mut u64,
+    log: &mut Vec<String>,
+) -> (Vec<f64>, Convergence) {
+    let stuck = pinned(obj, free, &u);
+    if stuck.is_empty() {
+        return (u, convergence);
+    }
+    let Some(cost) = obj.cost(&u) else {
+        return (u, convergence);
+    };
+    let mut restart = u.clone();
+    for &j in &stuck {
+        restart[j] = 0.0;
+    }
+    obj.set_stage(Stage::LevenbergMarquardt);
+    let out = levenberg_marquardt::refine(
+        obj,
+        &restart,
+        settings.max_iters,
+        settings.tol,
+        settings.fd_step,
+        Some(&|u: &[f64]| !pinned(obj, free, u).is_empty()),
+    );
+    *iterations += out.iterations;
+    let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
+    match obj.cost(&out.u) {
+        Some(c) if c < cost => {
+            log.push(format!(
+                "{} ended on a bound: released to the start, levenberg_marquardt again: {} \
+                 iterations, {:?} (mean square {cost:e} → {c:e})",
+                names.join(", "),
+                out.iterations,
+                out.convergence
+            ));
+            (out.u, out.convergence)
+        }
+        end => {
+            log.push(format!(
+                "{} ended on a bound: released to the start, the refinement ended no better \
+                 ({}); the bound is kept",
+                names.join(", "),
+                end.map_or("failed".to_string(), |c| format!("mean square {c:e}"))
+            ));
+            (u, convergence)
+        }
+    }
 }
 
 fn nelder_mead(

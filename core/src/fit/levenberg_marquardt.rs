@@ -44,8 +44,20 @@ pub const NOISE_PROBE: f64 = 1e-6;
 /// Largest damping before the refinement decides no step can lower the cost.
 const LAMBDA_MAX: f64 = 1e16;
 
-/// Refine `u0` by Levenberg–Marquardt; stops after `max_iters` Jacobians.
-pub fn refine(obj: &Objective, u0: &[f64], max_iters: u64, tol: f64, fd_step: f64) -> Refined {
+/// A test of internal coordinates that stops a refinement (see [`refine`]).
+pub type BoundStop<'a> = Option<&'a dyn Fn(&[f64]) -> bool>;
+
+/// Refine `u0` by Levenberg–Marquardt; stops after `max_iters` Jacobians, or as soon as an
+/// accepted point satisfies `stop_at_bound` (a parameter on a bound, where its map is flat and
+/// further iterations only creep: the caller decides what to do from there).
+pub fn refine(
+    obj: &Objective,
+    u0: &[f64],
+    max_iters: u64,
+    tol: f64,
+    fd_step: f64,
+    stop_at_bound: BoundStop,
+) -> Refined {
     let n = obj.len();
     let p = obj.dim();
     let mut u = u0.to_vec();
@@ -136,6 +148,15 @@ pub fn refine(obj: &Objective, u0: &[f64], max_iters: u64, tol: f64, fd_step: f6
                     std::mem::swap(&mut r, &mut trial);
                     lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                     nu = 2.0;
+                    if stop_at_bound.is_some_and(|pinned| pinned(&u)) {
+                        return Refined {
+                            u,
+                            iterations: iter,
+                            convergence: Convergence::Converged {
+                                reason: "stopped on a parameter's bound".into(),
+                            },
+                        };
+                    }
                     if drop < tol || step_size < 1e-12 {
                         return Refined {
                             u,

@@ -57,6 +57,14 @@ pub trait OdeSystem {
     fn switching_component(&self) -> Option<usize> {
         None
     }
+
+    /// The first time strictly after `t` at which the right-hand side has a kink in time (the
+    /// knots of an interpolated drive), if any. The default method and Rodas4 end a step there
+    /// instead of stepping across it, which an error-controlled method otherwise pays for with
+    /// rejected steps and a larger error; plain Dopri5 ignores it. Default: none.
+    fn next_breakpoint(&self, _t: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// Which integrator to use.

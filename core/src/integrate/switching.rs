@@ -184,9 +184,15 @@ pub(super) fn run(
             return Err(SimError::TooManySteps { time: t, steps });
         }
         let mut last = false;
+        let mut at_breakpoint = None;
         if t + 1.01 * h >= t_end {
             h = t_end - t;
             last = true;
+        } else if let Some(b) = breakpoint_after(sys, t).filter(|&b| b < t_end) {
+            if t + 1.01 * h >= b {
+                h = b - t;
+                at_breakpoint = Some(b);
+            }
         }
         let resolvable = h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
         if !resolvable {
@@ -201,7 +207,11 @@ pub(super) fn run(
             });
         }
         steps += 1;
-        let t_new = if last { t_end } else { t + h };
+        let t_new = match (last, at_breakpoint) {
+            (true, _) => t_end,
+            (false, Some(b)) => b,
+            (false, None) => t + h,
+        };
         match mode {
             Mode::Explicit => {
                 let trial = dp.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
@@ -363,6 +373,20 @@ fn fifth_root(x: f64) -> f64 {
         y = 0.8 * y + 0.2 * x / (y2 * y2);
     }
     y
+}
+
+/// The system's next breakpoint after `t` that a step can resolve: one closer than a few
+/// rounding errors of `t` (a step that ended just short of it) is passed over.
+fn breakpoint_after(sys: &dyn OdeSystem, t: f64) -> Option<f64> {
+    let near = 64.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
+    let mut b = sys.next_breakpoint(t)?;
+    for _ in 0..4 {
+        if b - t > near {
+            return Some(b);
+        }
+        b = sys.next_breakpoint(b)?;
+    }
+    None
 }
 
 fn check_finite(v: &[f64], time: f64, what: &str) -> Result<(), SimError> {
