@@ -27,6 +27,13 @@
 //! steps towards its zero are capped by [`Approach`] (see `approach.rs`), which removes most
 //! rejected steps at reversals. Rodas4 uses Gustafsson's predictive controller.
 //!
+//! Breakpoints: where the system names the next kink of its right-hand side in time
+//! ([`OdeSystem::next_breakpoint`], the samples of a measured drive), a step that would cross it
+//! ends on it. Across a kink every step's error estimate is wrong: on the source study's sweep
+//! driven by a record's measured rotor angle (a knot every 10 ms) the run took 34 000 rejected
+//! steps and still ended 4.7e-3 mm from a tight reference; ending steps on the knots gives
+//! 5 400 rejections, 44 % fewer right-hand-side calls and 3.1e-5 mm.
+//!
 //! Known limit: like every Rosenbrock method without the Prothero–Robinson conditions, Rodas4
 //! loses order on stiff problems of the form `y' = λ·(y − g(t)) + g'(t)` at tight tolerances
 //! (the error stays controlled, but steps shrink faster than `tol^(1/4)`); the stuck trolley is
