@@ -65,7 +65,7 @@ impl GapLocation {
 
 /// Locate the residual `r` (measured − modelled, N) of a model along `data`, cut into
 /// `cycles`, with noise floor `floor` (N, > 0). The regimes are those of the measured force
-/// ([`classify`] with default thresholds and this floor); if they cannot be classified, the
+/// ([`classify()`] with default thresholds and this floor); if they cannot be classified, the
 /// breakdown by regime is left out.
 pub fn locate_gap(r: &[f64], data: &ForceData, cycles: &[Cycle], floor: f64) -> GapLocation {
     let n = r.len();
