@@ -91,7 +91,7 @@ impl RotorAngle {
     pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
         match self {
             RotorAngle::Constant { .. } | RotorAngle::Sweep { .. } => None,
-            RotorAngle::Profile { t: ts, .. } => ts.get(ts.partition_point(|&k| k <= t)).copied(),
+            RotorAngle::Profile { t: ts, .. } => crate::interpolate::next_knot(ts, None, t),
             RotorAngle::Measured(h) => h.next_knot(t),
         }
     }

@@ -26,7 +26,7 @@ fn locate(ts: &[f64], uniform_step: Option<f64>, t: f64) -> usize {
 
 /// The first sample time strictly after `t` (before the span: the first one; none from the last
 /// one on, where the interpolant continues smoothly).
-fn next_knot(ts: &[f64], uniform_step: Option<f64>, t: f64) -> Option<f64> {
+pub(crate) fn next_knot(ts: &[f64], uniform_step: Option<f64>, t: f64) -> Option<f64> {
     let (&first, &last) = (ts.first()?, ts.last()?);
     if t < first {
         return Some(first);
