@@ -157,6 +157,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let doc = json!({
         "experiment": exp.path.display().to_string(),
         "record": data.record.source,
+        "drive": data.kinematics.drive,
         "base": spec.base,
         "effects": found.effects,
         "gap_before": found.gap_before,
@@ -378,6 +379,7 @@ fn run_trajectory(
     let doc = json!({
         "experiment": exp.path.display().to_string(),
         "record": data.record.source,
+        "drive": data.kinematics.drive,
         "level": "trajectory",
         "base": spec.base,
         "effects": found.effects,

@@ -37,6 +37,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
         "samples": data.record.len(),
         "motion_filter": { "order": data.kinematics.motion_filter.order(), "window": data.kinematics.motion_filter.window() },
+        "drive": data.kinematics.drive,
         "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
     });
     write_json(&out.join("fit.json"), &doc)?;
@@ -70,6 +71,9 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         data.record.len(),
         data.record.source
     );
+    if let Some(drive) = &data.kinematics.drive {
+        println!("  {drive}");
+    }
     for f in &fits {
         let params: Vec<String> = f
             .result

@@ -15,6 +15,7 @@ use stf_core::excitation::RotorAngle;
 use stf_core::fit::{FitSettings, Solver};
 use stf_core::integrate::{Method, Settings};
 use stf_core::kinematics::KinematicsSettings;
+use stf_core::reconstruct::DriveSmoothing;
 use stf_core::regimes::RegimeThresholds;
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
@@ -176,6 +177,31 @@ struct RawData {
     units: BTreeMap<String, String>,
     /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
     calibration: Option<RawCalibration>,
+    /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
+    drive: Option<RawDrive>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum RawDrive {
+    Named(String),
+    Filter(RawFilterSpec),
+}
+
+/// The drive reconstruction a `[data] drive` value asks for.
+fn drive_smoothing(raw: &RawDrive) -> Result<DriveSmoothing, String> {
+    match raw {
+        RawDrive::Named(name) => match name.as_str() {
+            "auto" => Ok(DriveSmoothing::Auto),
+            "samples" => Ok(DriveSmoothing::Samples(PolyFilter::paper_omega())),
+            other => Err(format!(
+                "unknown drive reconstruction `{other}`; known: auto, samples, or {{ order, window }}"
+            )),
+        },
+        RawDrive::Filter(spec) => PolyFilter::new(spec.order, spec.window)
+            .map(DriveSmoothing::Filter)
+            .map_err(|e| e.to_string()),
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -819,9 +845,9 @@ impl Experiment {
                 *m = m.boundary(boundary);
             }
             if let Some(o) = &f.omega {
-                kinematics.omega = make("filter.omega", o)?;
-            } else {
-                kinematics.omega = kinematics.omega.boundary(boundary);
+                kinematics.drive = DriveSmoothing::Filter(make("filter.omega", o)?);
+            } else if let DriveSmoothing::Samples(f) = &mut kinematics.drive {
+                *f = f.boundary(boundary);
             }
         }
 
@@ -904,6 +930,22 @@ impl Experiment {
                 data_spec.scale.insert(signal.clone(), scale);
             }
             data_spec.calibration = r.calibration.as_ref().map(|c| (c.a, c.b));
+            if let Some(drive) = &r.drive {
+                let omega_set = raw
+                    .filter
+                    .as_ref()
+                    .is_some_and(|f| f.get_ref().omega.is_some());
+                if omega_set {
+                    return Err(cx.at(
+                        span,
+                        "data.drive",
+                        "set either `[data] drive` or `[filter] omega`, not both (they are the same \
+                         setting)",
+                    ));
+                }
+                kinematics.drive =
+                    drive_smoothing(drive).map_err(|e| cx.at(span, "data.drive", e))?;
+            }
         }
         let mut data_line = 0;
         let data_file = match &raw.data {

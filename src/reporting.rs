@@ -32,6 +32,9 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
             k.motion_filter.window(),
             k.sigma_a
         ));
+        if let Some(drive) = &k.drive {
+            s.paragraphs.push(format!("Drive: {drive}."));
+        }
         let motion = Motion {
             t: &k.t,
             x: &k.x,

@@ -260,6 +260,27 @@ impl PolyFilter {
         Ok(out)
     }
 
+    /// RMS of `y` minus its smoothed value at every `stride`-th sample with a complete window
+    /// (interior samples only): how far the filter's polynomial passes from the samples. A
+    /// window that only averages noise leaves the noise's σ; one too long for the signal adds
+    /// its bias on top.
+    pub fn residual_rms(&self, y: &[f64], stride: usize) -> Result<f64, FilterError> {
+        let (n, w, lead) = (y.len(), self.window, self.lead());
+        if n < w {
+            return Err(FilterError::TooShort { len: n, window: w });
+        }
+        let weights = Fit::new(self.order, w)?.weights(lead, 0);
+        let (mut sum, mut count) = (0.0, 0usize);
+        for start in (0..=(n - w)).step_by(stride.max(1)) {
+            let window = &y[start..start + w];
+            let value: f64 = window.iter().zip(&weights).map(|(y, w)| y * w).sum();
+            let r = window[lead] - value;
+            sum += r * r;
+            count += 1;
+        }
+        Ok((sum / count.max(1) as f64).sqrt())
+    }
+
     /// White-noise gain of the `derivative`-th output (0 = value) at interior samples: the
     /// standard deviation of the output per unit standard deviation of independent input
     /// noise, `sqrt(Σ wⱼ²) / dtᵏ`. Zero for a derivative above the order; NaN only if the fit
@@ -406,6 +427,21 @@ fn dot3(y: &[f64], a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64, f64) {
         sb.iter().sum::<f64>() + rb,
         sc.iter().sum::<f64>() + rc,
     )
+}
+
+/// Robust σ of white noise on a smooth signal: the MAD of third differences (whose variance
+/// is 20σ² for white noise) over 0.6745·√20.
+pub fn noise_sigma(y: &[f64]) -> f64 {
+    if y.len() < 8 {
+        return 0.0;
+    }
+    let mut d: Vec<f64> = y
+        .windows(4)
+        .map(|w| (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).abs())
+        .collect();
+    let mid = d.len() / 2;
+    let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    *median / (0.6745 * 20f64.sqrt())
 }
 
 /// The mean sample step of increasing times `t`, after checking that every step is within

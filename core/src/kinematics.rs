@@ -23,9 +23,10 @@
 //! assert!((k.v[1000] - 0.06 * 6.0f64.cos()).abs() < 1e-6);
 //! ```
 
-use crate::derivative::{sample_step, Boundary, FilterError, PolyFilter};
+use crate::derivative::{noise_sigma, sample_step, Boundary, FilterError, PolyFilter};
 use crate::excitation::{Excitation, RotorAngle};
 use crate::interpolate::Linear;
+use crate::reconstruct::{reconstruct, DriveReport, DriveSignal, DriveSmoothing};
 use crate::record::Record;
 use crate::recover::{recover_force, rotor_drive};
 use crate::system::OscillatorParams;
@@ -34,8 +35,9 @@ use crate::unwrap::unwrap_phase;
 /// Which filters to use; `None` picks a window from the record's bandwidth.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KinematicsSettings {
-    /// Filter for ω from φ (default: the paper's order 2 over 800 samples, shifted edges).
-    pub omega: PolyFilter,
+    /// How the measured drive (φ and ω, or u) is reconstructed (default: smoothed with a
+    /// window chosen from the record).
+    pub drive: DriveSmoothing,
     /// Filter for v and a from x (default: order 3, window from the bandwidth).
     pub motion: Option<PolyFilter>,
     /// Order of the motion filter when its window is chosen from the bandwidth.
@@ -47,7 +49,7 @@ pub struct KinematicsSettings {
 impl Default for KinematicsSettings {
     fn default() -> Self {
         KinematicsSettings {
-            omega: PolyFilter::paper_omega(),
+            drive: DriveSmoothing::Auto,
             motion: None,
             motion_order: 3,
             boundary: Boundary::Shifted,
@@ -56,10 +58,11 @@ impl Default for KinematicsSettings {
 }
 
 impl KinematicsSettings {
-    /// The source study's filters: ω order 2 / 800, v and a order 3 / 40, zeroed edges.
+    /// The source study's filters: φ as recorded with ω from order 2 / 800, v and a order
+    /// 3 / 40, zeroed edges.
     pub fn paper() -> Self {
         KinematicsSettings {
-            omega: PolyFilter::paper_omega().boundary(Boundary::Zero),
+            drive: DriveSmoothing::Samples(PolyFilter::paper_omega().boundary(Boundary::Zero)),
             motion: Some(PolyFilter::paper_motion().boundary(Boundary::Zero)),
             motion_order: 3,
             boundary: Boundary::Zero,
@@ -78,12 +81,15 @@ pub struct Kinematics {
     pub v: Vec<f64>,
     /// Acceleration, m/s² (filtered).
     pub a: Vec<f64>,
-    /// Unwrapped rotor angle, rad (rotor rigs).
+    /// Unwrapped rotor angle, rad (rotor rigs), as reconstructed from the record.
     pub phi: Option<Vec<f64>>,
-    /// Rotor speed, rad/s (from the record's `omega` column, or filtered from φ).
+    /// Rotor speed, rad/s (from the record's `omega` column, or the slope of the
+    /// reconstructed φ).
     pub omega: Option<Vec<f64>>,
-    /// Measured drive force, N (shaker rigs).
+    /// Measured drive force, N (shaker rigs), as reconstructed from the record.
     pub u: Option<Vec<f64>>,
+    /// How the measured drive was reconstructed (none for free vibration).
+    pub drive: Option<DriveReport>,
     /// The motion filter used.
     pub motion_filter: PolyFilter,
     /// Estimated position noise σ, m.
@@ -94,19 +100,9 @@ pub struct Kinematics {
     pub sigma_a: f64,
 }
 
-/// Robust σ of white noise on a smooth signal: the MAD of third differences (whose variance
-/// is 20σ² for white noise) over 0.6745·√20.
+/// Robust σ of the position noise: [`noise_sigma`] of x.
 pub fn position_noise(x: &[f64]) -> f64 {
-    if x.len() < 8 {
-        return 0.0;
-    }
-    let mut d: Vec<f64> = x
-        .windows(4)
-        .map(|w| (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).abs())
-        .collect();
-    let mid = d.len() / 2;
-    let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    *median / (0.6745 * 20f64.sqrt())
+    noise_sigma(x)
 }
 
 impl Kinematics {
@@ -114,12 +110,7 @@ impl Kinematics {
     pub fn from_record(record: &Record, s: &KinematicsSettings) -> Result<Self, FilterError> {
         let dt = sample_step(&record.t)?;
         let rate = 1.0 / dt;
-        let phi = record.phi.as_deref().map(unwrap_phase);
-        let omega = match (&record.omega, &phi) {
-            (Some(w), _) => Some(w.clone()),
-            (None, Some(phi)) => Some(s.omega.apply(dt, phi)?.d1),
-            (None, None) => None,
-        };
+        let (phi, omega, u, drive) = reconstruct_drive(record, dt, &s.drive)?;
         let motion = match &s.motion {
             Some(f) => *f,
             None => {
@@ -149,7 +140,8 @@ impl Kinematics {
             a: d.d2,
             phi,
             omega,
-            u: record.u.clone(),
+            u,
+            drive,
             sigma_v: sigma_x * motion.noise_gain(dt, 1),
             sigma_a: sigma_x * motion.noise_gain(dt, 2),
             motion_filter: motion,
@@ -187,6 +179,28 @@ impl Kinematics {
             _ => Excitation::None,
         }
     }
+}
+
+/// The record's drive reconstructed as a smooth signal: `(φ, ω, u, report)`. A record's own
+/// `omega` column is kept as ω.
+type Drive = (
+    Option<Vec<f64>>,
+    Option<Vec<f64>>,
+    Option<Vec<f64>>,
+    Option<DriveReport>,
+);
+
+fn reconstruct_drive(record: &Record, dt: f64, how: &DriveSmoothing) -> Result<Drive, FilterError> {
+    if let Some(phi) = &record.phi {
+        let r = reconstruct(DriveSignal::Phi, dt, &unwrap_phase(phi), how)?;
+        let omega = record.omega.clone().unwrap_or(r.slope);
+        return Ok((Some(r.value), Some(omega), None, Some(r.report)));
+    }
+    if let Some(u) = &record.u {
+        let r = reconstruct(DriveSignal::U, dt, u, how)?;
+        return Ok((None, record.omega.clone(), Some(r.value), Some(r.report)));
+    }
+    Ok((None, record.omega.clone(), None, None))
 }
 
 /// The motion-filter window (odd, samples) that minimises the predicted RMS error of the

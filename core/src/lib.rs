@@ -38,6 +38,7 @@ pub mod kinematics;
 pub mod model_sum;
 pub mod oscillator;
 pub mod params;
+pub mod reconstruct;
 pub mod record;
 pub mod recover;
 pub mod regimes;
