@@ -168,12 +168,24 @@ impl Kinematics {
         crate::recover::recovery_noise(p, self.sigma_a, self.sigma_v)
     }
 
-    /// The record's drive as an excitation for simulations: the measured rotor angle
-    /// (Hermite-interpolated with the filtered ω) or the measured force.
+    /// The record's drive as an excitation for simulations: the reconstructed rotor angle
+    /// (Hermite-interpolated with ω) or the measured force.
+    ///
+    /// A smoothed φ carries nothing between knots a sixteenth of its window apart (a cubic
+    /// through values and slopes there matches it to ~1e-9 rad on the paper's sweep), so
+    /// only those knots are kept: an integrator ends a step at every knot, and a knot per
+    /// sample would cost a step per sample.
     pub fn excitation(&self) -> Excitation {
         match (&self.phi, &self.omega, &self.u) {
             (Some(phi), Some(w), _) => {
-                Excitation::Rotor(RotorAngle::measured(self.t.clone(), phi.clone(), w.clone()))
+                let stride = self.drive.as_ref().map_or(1, DriveReport::knot_stride);
+                let n = self.t.len();
+                let mut knots: Vec<usize> = (0..n).step_by(stride).collect();
+                if knots.last() != Some(&(n - 1)) {
+                    knots.push(n - 1);
+                }
+                let pick = |v: &[f64]| knots.iter().map(|&i| v[i]).collect::<Vec<_>>();
+                Excitation::Rotor(RotorAngle::measured(pick(&self.t), pick(phi), pick(w)))
             }
             (_, _, Some(u)) => Excitation::Force(Linear::new(self.t.clone(), u.clone())),
             _ => Excitation::None,

@@ -85,6 +85,18 @@ pub struct DriveReport {
     pub residual_over_step: Option<f64>,
 }
 
+impl DriveReport {
+    /// Every how many samples a simulation needs a knot of the reconstructed signal: a
+    /// sixteenth of the smoothing window (every sample when interpolated through them).
+    pub fn knot_stride(&self) -> usize {
+        if self.method == "samples" {
+            1
+        } else {
+            (self.window / 16).max(1)
+        }
+    }
+}
+
 impl std::fmt::Display for DriveReport {
     /// One sentence: what was reconstructed, how, and how far the samples scatter about it.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

@@ -5,12 +5,11 @@
 //! Records: the forced reference oscillator with a power law (K 20, n 1.5) through a sweep
 //! from ω 2.35 to 9.4 rad/s at the paper's 1 kHz, sampled through the rig's sensors (x noise
 //! 0.05 mm quantised to 0.01 mm) and an encoder of 1024, 2048 or 4096 counts. The x residual
-//! of the truth driven by the record must stay within 1.1× the x noise RMS. The sweep at the
-//! paper's 0.047 rad/s² and the fastest one run by default; the full grid (rates 0.03, 0.047,
-//! 0.08, 0.2 rad/s² × three encoders) is `--ignored` and prints its table:
+//! of the truth driven by the record must stay within 1.1× the x noise RMS over the grid of
+//! rates 0.03, 0.047, 0.08, 0.2 rad/s² × three encoders (4.5 s in release); the table:
 //!
 //! ```text
-//! cargo test --release -p stf-models --test drive_reconstruction -- --ignored --nocapture
+//! cargo test --release -p stf-models --test drive_reconstruction -- --nocapture
 //! ```
 
 use std::sync::Arc;
@@ -86,15 +85,6 @@ fn check(alpha: f64, counts: u32, seed: u64) -> Outcome {
 const HEADER: &str = "| α rad/s² | counts | seed | x residual mm | x noise mm | ratio | window |";
 
 #[test]
-fn the_truth_reaches_the_noise_at_the_papers_rate_and_a_fast_one() {
-    println!("{HEADER}");
-    for (alpha, counts, seed) in [(0.047, 2048, 1), (0.2, 1024, 2)] {
-        let o = check(alpha, counts, seed);
-        assert!(o.residual <= 1.1 * o.noise, "α {alpha}, {counts} counts");
-    }
-}
-
-#[test]
 fn samples_as_recorded_put_the_encoder_steps_into_x() {
     // The same record with φ interpolated through its encoder samples: the steps reach x.
     let smooth = truth_against_its_record(0.047, 2048, 1, DriveSmoothing::Auto);
@@ -114,7 +104,6 @@ fn samples_as_recorded_put_the_encoder_steps_into_x() {
 }
 
 #[test]
-#[ignore = "the full grid: 12 sweeps up to 235 s at 1 kHz (about a minute)"]
 fn the_truth_reaches_the_noise_over_the_whole_grid() {
     println!("{HEADER}");
     let mut worst: f64 = 0.0;
