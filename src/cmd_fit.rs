@@ -2,14 +2,17 @@
 //! oscillator identification stages of `[[identify]]`.
 //!
 //! Writes `DIR/fit.json` (for each model: `name`, `params`, `rms`, standard errors, AIC/BIC,
-//! convergence …) and `DIR/fitted.csv` (the measured signal and each model's fit).
+//! convergence, the noise floor, `warnings` …) and `DIR/fitted.csv` (the measured signal and
+//! each model's fit). The summary on the terminal prints each model's warnings under its line
+//! ([`stf_core::fit::fit_warnings`]: not converged, residual above the noise floor, a
+//! parameter on a bound or not determined, two parameters not told apart).
 
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use stf_core::fit::{TrajectoryData, TrajectoryFit};
+use stf_core::fit::{fit_warnings, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit};
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
 
@@ -90,17 +93,26 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                 "  (did not converge)"
             }
         );
+        print_warnings(&f.warnings);
     }
     if exp.output.report {
         let sections = crate::reporting::record_sections(&data, &fits, out)?;
+        let mut intro = vec![format!(
+            "stf-lab fitted {} model(s) of {} to {}.",
+            fits.len(),
+            exp.path.display(),
+            data.record.source
+        )];
+        let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
+        if warned > 0 {
+            intro.push(format!(
+                "⚠ {warned} of the {} fits carry warnings: see the box under Fits.",
+                fits.len()
+            ));
+        }
         crate::reporting::write_report(
             &format!("Fit: {}", exp.path.display()),
-            vec![format!(
-                "stf-lab fitted {} model(s) of {} to {}.",
-                fits.len(),
-                exp.path.display(),
-                data.record.source
-            )],
+            intro,
             sections,
             out,
         )?;
@@ -112,11 +124,19 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     Ok(())
 }
 
+/// Each warning on its own line, indented under the model's line.
+fn print_warnings(warnings: &[FitWarning]) {
+    for w in warnings {
+        println!("      warning: {w}");
+    }
+}
+
 /// The source study's identification: each stage fits the oscillator's parameters against a
 /// record's displacement, starting from the previous stage's values.
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
     let mut stages = Vec::new();
+    let mut all_warnings = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         if let Some(preset) = stage.preset {
             // A preset replaces only the parameters not found by earlier stages.
@@ -140,8 +160,13 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             .sim_settings(exp.integrator.clone())
             .settings(exp.fit.settings.clone())
             .initial(k.x[0], k.v[0]);
-        for name in &stage.free {
-            fit = fit.free(system_param(name, system.get(name).unwrap_or(0.0)));
+        let free: Vec<_> = stage
+            .free
+            .iter()
+            .map(|name| system_param(name, system.get(name).unwrap_or(0.0)))
+            .collect();
+        for p in &free {
+            fit = fit.free(p.clone());
         }
         let bar = progress.job(&format!("stage {}", i + 1));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));
@@ -185,6 +210,14 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
                 " (did not converge)"
             }
         );
+        let floor = NoiseFloor::displacement(k.sigma_x);
+        let warnings = fit_warnings(&result, &free, Some(&floor));
+        print_warnings(&warnings);
+        for w in &warnings {
+            let mut entry = serde_json::to_value(w.stated())?;
+            entry["stage"] = json!(i + 1);
+            all_warnings.push(entry);
+        }
         stages.push(json!({
             "record": stage.data.display().to_string(),
             "free": stage.free,
@@ -197,6 +230,8 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             "evaluations": result.evaluations,
             "converged": result.convergence.converged(),
             "convergence": result.convergence,
+            "noise_floor": floor,
+            "warnings": warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
         }));
     }
     let doc = json!({
@@ -208,6 +243,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             "name": "none",
             "params": serde_json::to_value(system)?,
             "rms": stages.last().and_then(|s| s["rms"].as_f64()),
+            "warnings": all_warnings,
         }],
     });
     write_json(&out.join("fit.json"), &doc)?;

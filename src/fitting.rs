@@ -12,7 +12,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use stf_core::fit::{
-    FitParam, FitResult, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit,
+    fit_warnings, FitParam, FitResult, FitWarning, FittedParam, ForceData, ForceFit, NoiseFloor,
+    TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
@@ -159,6 +160,10 @@ pub struct ModelFit {
     pub system: OscillatorParams,
     /// A label unique within the experiment (the name, numbered if it repeats).
     pub label: String,
+    /// The record's noise floor for this fit (none if it could not be estimated).
+    pub floor: Option<NoiseFloor>,
+    /// Why the result is not to be trusted as it stands (empty: no reason found).
+    pub warnings: Vec<FitWarning>,
 }
 
 impl ModelFit {
@@ -214,6 +219,8 @@ impl ModelFit {
             "convergence": self.result.convergence,
             "system": (level == FitLevel::Trajectory).then_some(self.system),
             "correlation": self.result.correlation.iter().map(|row| row.iter().map(|&c| finite_or_null(c)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+            "noise_floor": self.floor,
+            "warnings": self.warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
         })
     }
 }
@@ -288,12 +295,23 @@ pub fn fit_model(
                 .map(|p| result.value(&p.name).unwrap_or(p.value))
                 .collect();
             let fitted = fit.predict(&fd, &values)?;
+            let sensor = match exp.regimes.noise_sigma {
+                Some(s) => Some(s),
+                None => stf_core::regimes::noise_floor(fd.f).ok(),
+            };
+            let floor = sensor
+                .map(|s| fit.noise_floor(&fd, &values, s, data.kinematics.motion_noise()))
+                .transpose()
+                .with_context(|| format!("the noise floor of `{label}`"))?;
+            let warnings = fit_warnings(&result, &fit.params(), floor.as_ref());
             Ok(ModelFit {
                 configured: Some(c.clone()),
                 result,
                 fitted,
                 system: exp.system,
                 label,
+                floor,
+                warnings,
             })
         }
         FitLevel::Trajectory => {
@@ -303,18 +321,20 @@ pub fn fit_model(
                 .sim_settings(exp.integrator.clone())
                 .settings(exp.fit.settings.clone())
                 .initial(k.x[0], k.v[0]);
+            let mut free = Vec::new();
             if let Some(c) = configured {
                 fit = fit.model(c.model.clone(), c.values());
-                for p in fit_params(c).into_iter().filter(|p| !p.fixed) {
-                    fit = fit.free(p);
-                }
+                free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
             }
             for name in &exp.fit.system_free {
                 let value = exp.system.get(name).unwrap_or(0.0);
-                fit = fit.free(system_param(name, value));
+                free.push(system_param(name, value));
             }
             if exp.fit.offset {
-                fit = fit.free(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05));
+                free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+            }
+            for p in &free {
+                fit = fit.free(p.clone());
             }
             let td = TrajectoryData {
                 t: &data.record.t,
@@ -329,12 +349,15 @@ pub fn fit_model(
                     system.set(name, v);
                 }
             }
+            let floor = NoiseFloor::displacement(k.sigma_x);
             let mf = ModelFit {
                 configured: configured.cloned(),
+                warnings: fit_warnings(&result, &free, Some(&floor)),
                 result,
                 fitted: Vec::new(),
                 system,
                 label: label.clone(),
+                floor: Some(floor),
             };
             let x_off = mf.result.value("x_off").unwrap_or(0.0);
             let mut osc = Oscillator::with_shared_excitation(system, excitation);
