@@ -12,12 +12,16 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use stf_core::fit::{fit_warnings, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit};
+use stf_core::fit::{
+    fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
+};
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
 
-use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, fit_all, load_data, std_errors_json, system_param};
+use crate::experiment::{Experiment, FitLevel, StageSpec};
+use crate::fitting::{
+    finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData, ModelFit,
+};
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
 
@@ -57,44 +61,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
     write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
 
-    let unit = match level {
-        FitLevel::Force => "N",
-        FitLevel::Trajectory => "mm",
-    };
-    let scale = if level == FitLevel::Force { 1.0 } else { 1e3 };
-    println!(
-        "fitted {} model(s) at {} level on {} samples of {}",
-        fits.len(),
-        if level == FitLevel::Force {
-            "force"
-        } else {
-            "trajectory"
-        },
-        data.record.len(),
-        data.record.source
-    );
-    for f in &fits {
-        let params: Vec<String> = f
-            .result
-            .params
-            .iter()
-            .filter(|p| !p.fixed)
-            .map(|p| format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error))
-            .collect();
-        println!(
-            "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
-            f.label,
-            f.result.rms * scale,
-            f.result.aic,
-            params.join(", "),
-            if f.result.convergence.converged() {
-                ""
-            } else {
-                "  (did not converge)"
-            }
-        );
-        print_warnings(&f.warnings);
-    }
+    print_summary(&data, &fits);
     if exp.output.report {
         let sections = crate::reporting::record_sections(&data, &fits, out)?;
         let mut intro = vec![format!(
@@ -124,11 +91,103 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     Ok(())
 }
 
+/// The terminal summary: one line per model, its warnings under it.
+fn print_summary(data: &FitData, fits: &[ModelFit]) {
+    let unit = match data.level {
+        FitLevel::Force => "N",
+        FitLevel::Trajectory => "mm",
+    };
+    let scale = if data.level == FitLevel::Force {
+        1.0
+    } else {
+        1e3
+    };
+    println!(
+        "fitted {} model(s) at {} level on {} samples of {}",
+        fits.len(),
+        if data.level == FitLevel::Force {
+            "force"
+        } else {
+            "trajectory"
+        },
+        data.record.len(),
+        data.record.source
+    );
+    for f in fits {
+        let params: Vec<String> = f
+            .result
+            .params
+            .iter()
+            .filter(|p| !p.fixed)
+            .map(|p| format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error))
+            .collect();
+        println!(
+            "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
+            f.label,
+            f.result.rms * scale,
+            f.result.aic,
+            params.join(", "),
+            if f.result.convergence.converged() {
+                ""
+            } else {
+                "  (did not converge)"
+            }
+        );
+        print_warnings(&f.warnings);
+    }
+}
+
 /// Each warning on its own line, indented under the model's line.
 fn print_warnings(warnings: &[FitWarning]) {
     for w in warnings {
         println!("      warning: {w}");
     }
+}
+
+/// The terminal line of identification stage `i`, its warnings under it.
+fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitWarning]) {
+    println!(
+        "stage {} ({}): S(μ) = {:.4} mm², {}{}",
+        i + 1,
+        stage.data.display(),
+        result.s_mm2.unwrap_or(f64::NAN),
+        result
+            .params
+            .iter()
+            .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if result.convergence.converged() {
+            ""
+        } else {
+            " (did not converge)"
+        }
+    );
+    print_warnings(warnings);
+}
+
+/// The record of one identification stage in fit.json.
+fn stage_json(
+    stage: &StageSpec,
+    result: &FitResult,
+    floor: &NoiseFloor,
+    warnings: &[FitWarning],
+) -> serde_json::Value {
+    json!({
+        "record": stage.data.display().to_string(),
+        "free": stage.free,
+        "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
+        "std_errors": std_errors_json(&result.params),
+        "s_mm2": result.s_mm2,
+        "rms": result.rms,
+        "aic": finite_or_null(result.aic),
+        "bic": finite_or_null(result.bic),
+        "evaluations": result.evaluations,
+        "converged": result.convergence.converged(),
+        "convergence": result.convergence,
+        "noise_floor": floor,
+        "warnings": warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
+    })
 }
 
 /// The source study's identification: each stage fits the oscillator's parameters against a
@@ -193,46 +252,15 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
                 system.set(name, v);
             }
         }
-        println!(
-            "stage {} ({}): S(μ) = {:.4} mm², {}{}",
-            i + 1,
-            stage.data.display(),
-            result.s_mm2.unwrap_or(f64::NAN),
-            result
-                .params
-                .iter()
-                .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
-                .collect::<Vec<_>>()
-                .join(", "),
-            if result.convergence.converged() {
-                ""
-            } else {
-                " (did not converge)"
-            }
-        );
         let floor = NoiseFloor::displacement(k.sigma_x);
         let warnings = fit_warnings(&result, &free, Some(&floor));
-        print_warnings(&warnings);
+        print_stage(i, stage, &result, &warnings);
         for w in &warnings {
             let mut entry = serde_json::to_value(w.stated())?;
             entry["stage"] = json!(i + 1);
             all_warnings.push(entry);
         }
-        stages.push(json!({
-            "record": stage.data.display().to_string(),
-            "free": stage.free,
-            "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-            "std_errors": std_errors_json(&result.params),
-            "s_mm2": result.s_mm2,
-            "rms": result.rms,
-            "aic": finite_or_null(result.aic),
-            "bic": finite_or_null(result.bic),
-            "evaluations": result.evaluations,
-            "converged": result.convergence.converged(),
-            "convergence": result.convergence,
-            "noise_floor": floor,
-            "warnings": warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
-        }));
+        stages.push(stage_json(stage, &result, &floor, &warnings));
     }
     let doc = json!({
         "experiment": exp.path.display().to_string(),
