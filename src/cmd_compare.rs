@@ -295,6 +295,18 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             }
         }
     }
+    // Fits not to be trusted as they stand (`*` bullets: the report shows them in its own box).
+    let warned: Vec<String> = fits
+        .iter()
+        .flat_map(|f| {
+            f.warnings
+                .iter()
+                .map(move |w| format!("* {}: {w}", f.label))
+        })
+        .collect();
+    if !warned.is_empty() {
+        let _ = writeln!(md, "\n**Warnings**\n\n{}", warned.join("\n"));
+    }
     write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
     write_atomic(&out.join("compare.md"), md.as_bytes())?;
     if exp.output.report {

@@ -2,19 +2,26 @@
 //! oscillator identification stages of `[[identify]]`.
 //!
 //! Writes `DIR/fit.json` (for each model: `name`, `params`, `rms`, standard errors, AIC/BIC,
-//! convergence …) and `DIR/fitted.csv` (the measured signal and each model's fit).
+//! convergence, the noise floor, `warnings` …) and `DIR/fitted.csv` (the measured signal and
+//! each model's fit). The summary on the terminal prints each model's warnings under its line
+//! ([`stf_core::fit::fit_warnings`]: not converged, residual above the noise floor, a
+//! parameter on a bound or not determined, two parameters not told apart).
 
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use stf_core::fit::{TrajectoryData, TrajectoryFit};
+use stf_core::fit::{
+    fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
+};
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
 
-use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, fit_all, load_data, std_errors_json, system_param};
+use crate::experiment::{Experiment, FitLevel, StageSpec};
+use crate::fitting::{
+    finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData, ModelFit,
+};
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
 
@@ -55,15 +62,51 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
     write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
 
-    let unit = match level {
+    print_summary(&data, &fits);
+    if exp.output.report {
+        let sections = crate::reporting::record_sections(&data, &fits, out)?;
+        let mut intro = vec![format!(
+            "stf-lab fitted {} model(s) of {} to {}.",
+            fits.len(),
+            exp.path.display(),
+            data.record.source
+        )];
+        let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
+        if warned > 0 {
+            intro.push(format!(
+                "⚠ {warned} of the {} fits carry warnings: see the box under Fits.",
+                fits.len()
+            ));
+        }
+        crate::reporting::write_report(
+            &format!("Fit: {}", exp.path.display()),
+            intro,
+            sections,
+            out,
+        )?;
+    }
+    println!(
+        "wrote {0}/fit.json, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
+        out.display()
+    );
+    Ok(())
+}
+
+/// The terminal summary: one line per model, its warnings under it.
+fn print_summary(data: &FitData, fits: &[ModelFit]) {
+    let unit = match data.level {
         FitLevel::Force => "N",
         FitLevel::Trajectory => "mm",
     };
-    let scale = if level == FitLevel::Force { 1.0 } else { 1e3 };
+    let scale = if data.level == FitLevel::Force {
+        1.0
+    } else {
+        1e3
+    };
     println!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
-        if level == FitLevel::Force {
+        if data.level == FitLevel::Force {
             "force"
         } else {
             "trajectory"
@@ -74,7 +117,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     if let Some(drive) = &data.kinematics.drive {
         println!("  {drive}");
     }
-    for f in &fits {
+    for f in fits {
         let params: Vec<String> = f
             .result
             .params
@@ -94,26 +137,61 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                 "  (did not converge)"
             }
         );
+        print_warnings(&f.warnings);
     }
-    if exp.output.report {
-        let sections = crate::reporting::record_sections(&data, &fits, out)?;
-        crate::reporting::write_report(
-            &format!("Fit: {}", exp.path.display()),
-            vec![format!(
-                "stf-lab fitted {} model(s) of {} to {}.",
-                fits.len(),
-                exp.path.display(),
-                data.record.source
-            )],
-            sections,
-            out,
-        )?;
+}
+
+/// Each warning on its own line, indented under the model's line.
+fn print_warnings(warnings: &[FitWarning]) {
+    for w in warnings {
+        println!("      warning: {w}");
     }
+}
+
+/// The terminal line of identification stage `i`, its warnings under it.
+fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitWarning]) {
     println!(
-        "wrote {0}/fit.json, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
-        out.display()
+        "stage {} ({}): S(μ) = {:.4} mm², {}{}",
+        i + 1,
+        stage.data.display(),
+        result.s_mm2.unwrap_or(f64::NAN),
+        result
+            .params
+            .iter()
+            .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if result.convergence.converged() {
+            ""
+        } else {
+            " (did not converge)"
+        }
     );
-    Ok(())
+    print_warnings(warnings);
+}
+
+/// The record of one identification stage in fit.json.
+fn stage_json(
+    stage: &StageSpec,
+    result: &FitResult,
+    floor: &NoiseFloor,
+    warnings: &[FitWarning],
+) -> serde_json::Value {
+    json!({
+        "record": stage.data.display().to_string(),
+        "free": stage.free,
+        "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
+        "std_errors": std_errors_json(&result.params),
+        "s_mm2": result.s_mm2,
+        "rms": result.rms,
+        "aic": finite_or_null(result.aic),
+        "bic": finite_or_null(result.bic),
+        "evaluations": result.evaluations,
+        "converged": result.convergence.converged(),
+        "convergence": result.convergence,
+        "noise_floor": floor,
+        "warnings": warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
+    })
 }
 
 /// The source study's identification: each stage fits the oscillator's parameters against a
@@ -121,6 +199,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
     let mut stages = Vec::new();
+    let mut all_warnings = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         if let Some(preset) = stage.preset {
             // A preset replaces only the parameters not found by earlier stages.
@@ -144,8 +223,13 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             .sim_settings(exp.integrator.clone())
             .settings(exp.fit.settings.clone())
             .initial(k.x[0], k.v[0]);
-        for name in &stage.free {
-            fit = fit.free(system_param(name, system.get(name).unwrap_or(0.0)));
+        let free: Vec<_> = stage
+            .free
+            .iter()
+            .map(|name| system_param(name, system.get(name).unwrap_or(0.0)))
+            .collect();
+        for p in &free {
+            fit = fit.free(p.clone());
         }
         let bar = progress.job(&format!("stage {}", i + 1));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));
@@ -172,36 +256,15 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
                 system.set(name, v);
             }
         }
-        println!(
-            "stage {} ({}): S(μ) = {:.4} mm², {}{}",
-            i + 1,
-            stage.data.display(),
-            result.s_mm2.unwrap_or(f64::NAN),
-            result
-                .params
-                .iter()
-                .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
-                .collect::<Vec<_>>()
-                .join(", "),
-            if result.convergence.converged() {
-                ""
-            } else {
-                " (did not converge)"
-            }
-        );
-        stages.push(json!({
-            "record": stage.data.display().to_string(),
-            "free": stage.free,
-            "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-            "std_errors": std_errors_json(&result.params),
-            "s_mm2": result.s_mm2,
-            "rms": result.rms,
-            "aic": finite_or_null(result.aic),
-            "bic": finite_or_null(result.bic),
-            "evaluations": result.evaluations,
-            "converged": result.convergence.converged(),
-            "convergence": result.convergence,
-        }));
+        let floor = NoiseFloor::displacement(k.sigma_x);
+        let warnings = fit_warnings(&result, &free, Some(&floor));
+        print_stage(i, stage, &result, &warnings);
+        for w in &warnings {
+            let mut entry = serde_json::to_value(w.stated())?;
+            entry["stage"] = json!(i + 1);
+            all_warnings.push(entry);
+        }
+        stages.push(stage_json(stage, &result, &floor, &warnings));
     }
     let doc = json!({
         "experiment": exp.path.display().to_string(),
@@ -212,6 +275,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             "name": "none",
             "params": serde_json::to_value(system)?,
             "rms": stages.last().and_then(|s| s["rms"].as_f64()),
+            "warnings": all_warnings,
         }],
     });
     write_json(&out.join("fit.json"), &doc)?;

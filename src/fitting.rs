@@ -12,7 +12,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use stf_core::fit::{
-    FitParam, FitResult, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit,
+    fit_warnings, FitParam, FitResult, FitWarning, FittedParam, ForceData, ForceFit, NoiseFloor,
+    TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
@@ -159,6 +160,10 @@ pub struct ModelFit {
     pub system: OscillatorParams,
     /// A label unique within the experiment (the name, numbered if it repeats).
     pub label: String,
+    /// The record's noise floor for this fit (none if it could not be estimated).
+    pub floor: Option<NoiseFloor>,
+    /// Why the result is not to be trusted as it stands (empty: no reason found).
+    pub warnings: Vec<FitWarning>,
 }
 
 impl ModelFit {
@@ -214,6 +219,8 @@ impl ModelFit {
             "convergence": self.result.convergence,
             "system": (level == FitLevel::Trajectory).then_some(self.system),
             "correlation": self.result.correlation.iter().map(|row| row.iter().map(|&c| finite_or_null(c)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+            "noise_floor": self.floor,
+            "warnings": self.warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
         })
     }
 }
@@ -269,87 +276,124 @@ pub fn fit_model(
     let observer = |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     match data.level {
-        FitLevel::Force => {
-            let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
-            let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-            for p in fit_params(c) {
-                fit = fit.param(p);
-            }
-            if exp.fit.offset {
-                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
-            }
-            let fd = data.force_data();
-            let result = fit
-                .fit(&fd, Some(&observer))
-                .with_context(|| format!("fitting `{label}`"))?;
-            let values: Vec<f64> = fit
-                .params()
-                .iter()
-                .map(|p| result.value(&p.name).unwrap_or(p.value))
-                .collect();
-            let fitted = fit.predict(&fd, &values)?;
-            Ok(ModelFit {
-                configured: Some(c.clone()),
-                result,
-                fitted,
-                system: exp.system,
-                label,
-            })
-        }
-        FitLevel::Trajectory => {
-            let k = &data.kinematics;
-            let excitation = Arc::new(k.excitation());
-            let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
-                .sim_settings(exp.integrator.clone())
-                .settings(exp.fit.settings.clone())
-                .initial(k.x[0], k.v[0]);
-            if let Some(c) = configured {
-                fit = fit.model(c.model.clone(), c.values());
-                for p in fit_params(c).into_iter().filter(|p| !p.fixed) {
-                    fit = fit.free(p);
-                }
-            }
-            for name in &exp.fit.system_free {
-                let value = exp.system.get(name).unwrap_or(0.0);
-                fit = fit.free(system_param(name, value));
-            }
-            if exp.fit.offset {
-                fit = fit.free(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05));
-            }
-            let td = TrajectoryData {
-                t: &data.record.t,
-                x: &data.record.x,
-            };
-            let result = fit
-                .fit(&td, Some(&observer))
-                .with_context(|| format!("fitting `{label}`"))?;
-            let mut system = exp.system;
-            for name in &exp.fit.system_free {
-                if let Some(v) = result.value(name) {
-                    system.set(name, v);
-                }
-            }
-            let mf = ModelFit {
-                configured: configured.cloned(),
-                result,
-                fitted: Vec::new(),
-                system,
-                label: label.clone(),
-            };
-            let x_off = mf.result.value("x_off").unwrap_or(0.0);
-            let mut osc = Oscillator::with_shared_excitation(system, excitation);
-            if let Some(c) = configured {
-                osc = osc.with_model(c.model.clone(), mf.model_values())?;
-            }
-            let run = Simulation::new(&osc)
-                .settings(exp.integrator.clone())
-                .initial(k.x[0] - x_off, k.v[0])
-                .run_at(&data.record.t)
-                .with_context(|| format!("simulating the fitted `{label}`"))?;
-            let fitted = run.x.iter().map(|x| x + x_off).collect();
-            Ok(ModelFit { fitted, ..mf })
+        FitLevel::Force => fit_force(exp, data, configured, label, &observer),
+        FitLevel::Trajectory => fit_trajectory(exp, data, configured, label, &observer),
+    }
+}
+
+/// A progress observer.
+type Observer<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
+
+/// [`fit_model`] at force level, with the noise floor and the warnings.
+fn fit_force(
+    exp: &Experiment,
+    data: &FitData,
+    configured: Option<&ConfiguredModel>,
+    label: String,
+    observer: &Observer,
+) -> Result<ModelFit> {
+    let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
+    let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+    for p in fit_params(c) {
+        fit = fit.param(p);
+    }
+    if exp.fit.offset {
+        fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
+    }
+    let fd = data.force_data();
+    let result = fit
+        .fit(&fd, Some(observer))
+        .with_context(|| format!("fitting `{label}`"))?;
+    let values: Vec<f64> = fit
+        .params()
+        .iter()
+        .map(|p| result.value(&p.name).unwrap_or(p.value))
+        .collect();
+    let fitted = fit.predict(&fd, &values)?;
+    let sensor = match exp.regimes.noise_sigma {
+        Some(s) => Some(s),
+        None => stf_core::regimes::noise_floor(fd.f).ok(),
+    };
+    let floor = sensor
+        .map(|s| fit.noise_floor(&fd, &values, s, data.kinematics.motion_noise()))
+        .transpose()
+        .with_context(|| format!("the noise floor of `{label}`"))?;
+    let warnings = fit_warnings(&result, &fit.params(), floor.as_ref());
+    Ok(ModelFit {
+        configured: Some(c.clone()),
+        result,
+        fitted,
+        system: exp.system,
+        label,
+        floor,
+        warnings,
+    })
+}
+
+/// [`fit_model`] at trajectory level, with the noise floor and the warnings.
+fn fit_trajectory(
+    exp: &Experiment,
+    data: &FitData,
+    configured: Option<&ConfiguredModel>,
+    label: String,
+    observer: &Observer,
+) -> Result<ModelFit> {
+    let k = &data.kinematics;
+    let excitation = Arc::new(k.excitation());
+    let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
+        .sim_settings(exp.integrator.clone())
+        .settings(exp.fit.settings.clone())
+        .initial(k.x[0], k.v[0]);
+    let mut free = Vec::new();
+    if let Some(c) = configured {
+        fit = fit.model(c.model.clone(), c.values());
+        free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
+    }
+    for name in &exp.fit.system_free {
+        let value = exp.system.get(name).unwrap_or(0.0);
+        free.push(system_param(name, value));
+    }
+    if exp.fit.offset {
+        free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+    }
+    for p in &free {
+        fit = fit.free(p.clone());
+    }
+    let td = TrajectoryData {
+        t: &data.record.t,
+        x: &data.record.x,
+    };
+    let result = fit
+        .fit(&td, Some(observer))
+        .with_context(|| format!("fitting `{label}`"))?;
+    let mut system = exp.system;
+    for name in &exp.fit.system_free {
+        if let Some(v) = result.value(name) {
+            system.set(name, v);
         }
     }
+    let floor = NoiseFloor::displacement(k.sigma_x);
+    let mf = ModelFit {
+        configured: configured.cloned(),
+        warnings: fit_warnings(&result, &free, Some(&floor)),
+        result,
+        fitted: Vec::new(),
+        system,
+        label: label.clone(),
+        floor: Some(floor),
+    };
+    let x_off = mf.result.value("x_off").unwrap_or(0.0);
+    let mut osc = Oscillator::with_shared_excitation(system, excitation);
+    if let Some(c) = configured {
+        osc = osc.with_model(c.model.clone(), mf.model_values())?;
+    }
+    let run = Simulation::new(&osc)
+        .settings(exp.integrator.clone())
+        .initial(k.x[0] - x_off, k.v[0])
+        .run_at(&data.record.t)
+        .with_context(|| format!("simulating the fitted `{label}`"))?;
+    let fitted = run.x.iter().map(|x| x + x_off).collect();
+    Ok(ModelFit { fitted, ..mf })
 }
 
 /// Configure and fit every model of the experiment, in parallel.

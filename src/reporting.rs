@@ -7,6 +7,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
+use stf_core::fit::{CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR};
+
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::report::{
@@ -74,6 +76,7 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
                 "trajectory"
             }
         ));
+        s.paragraphs.push(warning_rules(fits));
         let mut table = Table {
             caption: "Fitted parameters (± standard error), RMS residual and information criteria."
                 .into(),
@@ -84,6 +87,7 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
                 "AIC",
                 "BIC",
                 "converged",
+                "warnings",
             ]
             .iter()
             .map(|c| c.to_string())
@@ -114,9 +118,17 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
                 } else {
                     "no".into()
                 },
+                match f.warnings.len() {
+                    0 => "none".into(),
+                    n => format!("⚠ {n} (above)"),
+                },
             ]);
         }
         s.tables.push(table);
+        s.warnings = fits
+            .iter()
+            .flat_map(|f| f.warnings.iter().map(move |w| format!("{}: {w}", f.label)))
+            .collect();
         let fitted: Vec<(&str, &[f64])> = fits
             .iter()
             .map(|f| (f.label.as_str(), f.fitted.as_slice()))
@@ -135,6 +147,32 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
         sections.push(s);
     }
     Ok(sections)
+}
+
+/// What the warnings check, with each fit's noise floor.
+fn warning_rules(fits: &[ModelFit]) -> String {
+    let floors: Vec<String> = fits
+        .iter()
+        .filter_map(|f| {
+            f.floor
+                .map(|n| format!("{} {}", f.label, n.quantity.show(n.sigma)))
+        })
+        .collect();
+    format!(
+        "A fit is flagged when it did not converge, when its RMS residual exceeds {}× the \
+         record's noise floor (measurement noise, with the kinematics' noise propagated through \
+         the model at force level; here {}), when a free parameter ends within {} % of its size \
+         (or of its box, if narrower) from a bound, when a standard error exceeds its |value| or \
+         is not finite, or when two free parameters correlate beyond {} in magnitude.",
+        RESIDUAL_OVER_FLOOR,
+        if floors.is_empty() {
+            "not estimated".to_string()
+        } else {
+            floors.join(", ")
+        },
+        NEAR_BOUND * 100.0,
+        CORRELATION_LIMIT
+    )
 }
 
 /// A section with the frequency response (local maxima of x against ω) of several runs.

@@ -121,3 +121,155 @@ fn output_report_false_writes_only_the_results() {
     assert!(dir.join("fit.json").exists() && dir.join("fitted.csv").exists());
     assert!(!dir.join("report.html").exists() && !dir.join("figures").exists());
 }
+
+/// Write `experiment` (with `[simulate]`) into `dir`, simulate its record `record`, fit it with
+/// `stf-lab fit` and return fit.json and the terminal output.
+fn simulate_and_fit(
+    dir: &std::path::Path,
+    name: &str,
+    experiment: &str,
+) -> (serde_json::Value, String) {
+    let exp = dir.join(format!("{name}.toml"));
+    std::fs::write(&exp, experiment).unwrap();
+    let sim = common::stf_lab()
+        .arg("simulate")
+        .arg(&exp)
+        .arg("--out")
+        .arg(dir.join(format!("{name}.csv")))
+        .output()
+        .unwrap();
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+    let out = dir.join(format!("{name}_fit"));
+    let output = run_ok("fit", &exp, &out);
+    (
+        read_json(&out.join("fit.json")),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+    )
+}
+
+/// The kinds of a model's warnings in fit.json; every warning has a message.
+fn warning_kinds(model: &serde_json::Value) -> Vec<String> {
+    model["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| {
+            assert!(!w["message"].as_str().unwrap().is_empty(), "{w}");
+            w["kind"].as_str().unwrap().to_string()
+        })
+        .collect()
+}
+
+/// A short sweep through resonance with sensor noise; the STF force is `truth`.
+fn record_of(truth: &str, models: &str) -> String {
+    format!(
+        "[data]\nfile = \"{{name}}.csv\"\n\n[simulate]\n\
+         sweep = {{ w0 = 4.0, alpha = 0.2, t0 = 0.0, t1 = 20.0 }}\nrate = 200.0\nnoise = true\n\
+         seed = 11\n\n[[simulate.truth]]\n{truth}\n\n{models}"
+    )
+}
+
+#[test]
+fn a_fit_that_misses_an_effect_or_sits_on_a_bound_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    // Strong thickening (n = 2.5): a viscous model misses it; a power law whose n may not
+    // exceed 1.5 ends on that bound; the true model does neither.
+    let exp = record_of(
+        "name = \"power_law\"\nparams = { K = 20.0, n = 2.5 }",
+        "[[models]]\nname = \"viscous\"\n\n[[models]]\nname = \"power_law\"\n\
+         params = { K = 5.0, n = { value = 1.2, min = 1.0, max = 1.5 } }\n\n\
+         [[models]]\nname = \"power_law\"\n",
+    )
+    .replace("{name}", "thick");
+    let (fit, stdout) = simulate_and_fit(dir.path(), "thick", &exp);
+    let models = fit["models"].as_array().unwrap();
+    let viscous = &models[0];
+    assert!(warning_kinds(viscous).contains(&"above_noise_floor".to_string()));
+    let w = &viscous["warnings"][0];
+    let floor = viscous["noise_floor"]["sigma"].as_f64().unwrap();
+    assert!((w["ratio"].as_f64().unwrap() - viscous["rms"].as_f64().unwrap() / floor).abs() < 1e-9);
+    assert!(w["message"].as_str().unwrap().contains("stf-lab discover"));
+    // The floor is the sensor's noise (σ 0.02 N) with a little derivative noise.
+    assert!(floor > 0.019 && floor < 0.025, "floor {floor}");
+
+    let capped = &models[1];
+    let on_bound: Vec<&serde_json::Value> = capped["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["kind"] == "on_bound")
+        .collect();
+    assert_eq!(on_bound.len(), 1, "{}", capped["warnings"]);
+    assert_eq!(on_bound[0]["param"], "n");
+    assert_eq!(on_bound[0]["side"], "upper");
+    assert!(on_bound[0]["message"]
+        .as_str()
+        .unwrap()
+        .contains("widen the bound of n or fix it"));
+
+    let truth = warning_kinds(&models[2]);
+    for kind in [
+        "above_noise_floor",
+        "on_bound",
+        "undetermined",
+        "not_converged",
+    ] {
+        assert!(
+            !truth.contains(&kind.to_string()),
+            "the true model: {truth:?}"
+        );
+    }
+    // Existing keys stay; the terminal prints the warnings under the model's line.
+    assert!(capped["params"]["n"].is_number() && capped["rms"].is_number());
+    assert_eq!(capped["name"], "power_law");
+    let lines: Vec<&str> = stdout.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("viscous"))
+        .unwrap();
+    assert!(
+        lines[at + 1].contains("warning: the residual is"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn the_true_model_on_its_own_record_draws_no_warning_and_a_cut_fit_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = record_of(
+        "name = \"viscous\"\nparams = { c_s = 3.0 }",
+        "[[models]]\nname = \"viscous\"\n",
+    )
+    .replace("{name}", "visc");
+    let (fit, stdout) = simulate_and_fit(dir.path(), "visc", &exp);
+    let model = &fit["models"][0];
+    assert_eq!(
+        warning_kinds(model),
+        Vec::<String>::new(),
+        "{}",
+        model["warnings"]
+    );
+    assert!(!stdout.contains("warning:"), "{stdout}");
+
+    // The same fit stopped after one iteration says it did not converge.
+    let cut = exp.replace("[[models]]", "[fit]\nmax_iters = 1\n\n[[models]]");
+    let (fit, stdout) = simulate_and_fit(
+        dir.path(),
+        "visc_cut",
+        &cut.replace("visc.csv", "visc_cut.csv"),
+    );
+    let kinds = warning_kinds(&fit["models"][0]);
+    assert_eq!(
+        kinds.first().map(String::as_str),
+        Some("not_converged"),
+        "{kinds:?}"
+    );
+    assert!(
+        stdout.contains("warning: the fit ran out of iterations"),
+        "{stdout}"
+    );
+}

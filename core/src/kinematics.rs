@@ -163,6 +163,15 @@ impl Kinematics {
         recover_force(p, &self.drive(p), &self.x, &self.v, &self.a)
     }
 
+    /// The noise σ of x as measured and of v and a as filtered.
+    pub fn motion_noise(&self) -> crate::fit::MotionNoise {
+        crate::fit::MotionNoise {
+            x: self.sigma_x,
+            v: self.sigma_v,
+            a: self.sigma_a,
+        }
+    }
+
     /// The noise floor of the recovered force, N (derivative noise through m and c).
     pub fn recovered_force_noise(&self, p: &OscillatorParams) -> f64 {
         crate::recover::recovery_noise(p, self.sigma_a, self.sigma_v)

@@ -25,13 +25,15 @@ impl Report {
     }
 }
 
-/// A section: heading, then paragraphs, tables and figures in that order.
+/// A section: heading, then paragraphs, warnings, tables and figures in that order.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Section {
     /// Heading.
     pub heading: String,
     /// Paragraphs (plain text).
     pub paragraphs: Vec<String>,
+    /// Warnings (plain text, one sentence each), shown prominently just above the tables.
+    pub warnings: Vec<String>,
     /// Tables.
     pub tables: Vec<Table>,
     /// Figures.

@@ -26,6 +26,11 @@ figure { margin: 1.5em 0; }
 figure img { display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }
 figcaption { margin-top: .4em; font-size: .95em; }
 figcaption .files { color: #666; font-size: .9em; }
+.warnings { border: 2px solid #d55e00; border-left-width: 8px; background: #fff4e5;
+            padding: .5em 1em; margin: 1em 0; }
+.warnings h3 { margin: .2em 0 .4em; font-size: 1.1em; color: #a33a00; }
+.warnings ul { margin: 0; padding-left: 1.3em; }
+.warnings li { margin: .25em 0; }
 footer { margin-top: 3em; color: #777; font-size: .85em; border-top: 1px solid #ddd; }
 "#;
 
@@ -118,6 +123,21 @@ fn table_html(out: &mut String, table: &Table) {
     out.push_str("</tbody>\n</table>\n");
 }
 
+fn warnings_html(out: &mut String, warnings: &[String]) {
+    if warnings.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "<div class=\"warnings\" role=\"alert\">\n<h3>⚠ Warnings: not to be trusted as it \
+         stands</h3>\n<ul>"
+    );
+    for w in warnings {
+        let _ = writeln!(out, "<li>{}</li>", escape(w));
+    }
+    out.push_str("</ul>\n</div>\n");
+}
+
 fn file_name(path: &Path) -> String {
     path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -169,6 +189,7 @@ pub fn to_html(report: &Report) -> Result<String, ReportError> {
         for p in &section.paragraphs {
             let _ = writeln!(out, "<p>{}</p>", escape(p));
         }
+        warnings_html(&mut out, &section.warnings);
         for table in &section.tables {
             table_html(&mut out, table);
         }
@@ -216,6 +237,21 @@ mod tests {
         assert!(html.contains("<td class=\"num\">1.5e3 N</td>"));
         assert!(html.contains("<td>&lt;n&gt;</td><td></td>"));
         assert!(!html.contains("http"), "no network reference");
+        assert!(!html.contains("class=\"warnings\""), "no warnings, no box");
+    }
+
+    #[test]
+    fn warnings_stand_in_a_box_above_the_tables() {
+        let mut report = Report::new("r");
+        let mut s = Section::new("Fits");
+        s.warnings
+            .push("viscous: the residual is 4.1× the noise floor <sic>".into());
+        s.tables.push(Table::default());
+        report.sections.push(s);
+        let html = to_html(&report).unwrap();
+        let b = html.find("<div class=\"warnings\"").unwrap();
+        assert!(b < html.find("<table>").unwrap());
+        assert!(html.contains("<li>viscous: the residual is 4.1× the noise floor &lt;sic&gt;</li>"));
     }
 
     #[test]

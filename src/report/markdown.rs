@@ -67,6 +67,13 @@ pub fn to_markdown(report: &Report, base: &Path) -> String {
         for p in &section.paragraphs {
             let _ = writeln!(out, "{p}\n");
         }
+        if !section.warnings.is_empty() {
+            let _ = writeln!(out, "> **⚠ Warnings: not to be trusted as it stands**\n>");
+            for w in &section.warnings {
+                let _ = writeln!(out, "> - {}", w.replace(['\n', '\r'], " "));
+            }
+            out.push('\n');
+        }
         for table in &section.tables {
             table_md(&mut out, table);
         }

@@ -14,7 +14,10 @@
 //! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
 //! with standard errors from a finite-difference Jacobian in the user's parameter space
 //! (`cov = s²·(JᵀJ)⁻¹`, `s² = RSS/(N − p)`), correlations, RMS, AIC and BIC, and says whether
-//! it converged ([`FitResult`]). A failure inside the fit (a simulation that diverges, a model
+//! it converged ([`FitResult`]). [`fit_warnings`] says, by the same rules for every kind of
+//! fit, when a result is not to be trusted as it stands ([`FitWarning`]): it did not
+//! converge, its residual is well above the record's [`NoiseFloor`], a parameter ended on a
+//! bound, is not determined, or cannot be told apart from another. A failure inside the fit (a simulation that diverges, a model
 //! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
 //! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
 
@@ -24,21 +27,28 @@ mod error;
 mod force;
 mod jacobian;
 mod levenberg_marquardt;
+mod noise_floor;
 mod objective;
 mod param;
 mod result;
 mod settings;
 mod trajectory;
 mod transform;
+mod warning;
 
 pub use error::FitError;
 pub use force::{ForceData, ForceFit, FORCE_OFFSET};
+pub use noise_floor::{MotionNoise, NoiseFloor, Quantity};
 pub use objective::Residuals;
 pub use param::{full_values, FitParam};
 pub use result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
 pub use settings::{FitSettings, Solver};
 pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};
 pub use transform::BoundTransform;
+pub use warning::{
+    fit_warnings, BoundSide, FitWarning, StatedWarning, CORRELATION_LIMIT, NEAR_BOUND,
+    RESIDUAL_OVER_FLOOR,
+};
 
 /// Fit any least-squares problem: `params` lists every parameter (free and fixed, in order);
 /// `problem` receives the user values of the free ones. For problems that are neither

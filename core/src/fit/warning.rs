@@ -1,0 +1,466 @@
+//! When a fit's result is not to be trusted as it stands, and what to try: one set of rules,
+//! applied by [`fit_warnings`] to a [`FitResult`], the parameters' bounds and the noise floor,
+//! for every kind of fit.
+//!
+//! | rule | fires when |
+//! |---|---|
+//! | [`FitWarning::NotConverged`] | the fit ran out of iterations or failed |
+//! | [`FitWarning::AboveNoiseFloor`] | RMS residual > [`RESIDUAL_OVER_FLOOR`] × the noise floor |
+//! | [`FitWarning::OnBound`] | a free parameter ends within [`NEAR_BOUND`] of its typical size (or of the box, if narrower) from a bound |
+//! | [`FitWarning::Undetermined`] | a free parameter's standard error exceeds its \|value\|, or is not finite |
+//! | [`FitWarning::Correlated`] | two free parameters correlate beyond [`CORRELATION_LIMIT`] in magnitude |
+//!
+//! Each warning's [`Display`](std::fmt::Display) is one sentence that says what is wrong and
+//! what to try; serialized, it is an object with a `kind` and the data
+//! ([`FitWarning::stated`] adds the `message`).
+
+use std::fmt;
+
+use serde::Serialize;
+
+use super::noise_floor::{NoiseFloor, Quantity};
+use super::param::FitParam;
+use super::result::{Convergence, FitResult};
+
+/// A fit whose RMS residual exceeds this multiple of the noise floor misses an effect.
+pub const RESIDUAL_OVER_FLOOR: f64 = 1.5;
+/// A free parameter this close to a bound — as a fraction of its typical size
+/// ([`FitParam::effective_scale`]), or of the box's width if that is smaller — ends on it.
+pub const NEAR_BOUND: f64 = 1e-3;
+/// Two free parameters whose correlation exceeds this in magnitude are not told apart.
+pub const CORRELATION_LIMIT: f64 = 0.99;
+
+/// Which bound of a parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundSide {
+    /// The lower bound.
+    Lower,
+    /// The upper bound.
+    Upper,
+}
+
+/// A reason not to trust a fit's result as it stands.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FitWarning {
+    /// The fit did not converge: the values may not be the optimum.
+    NotConverged {
+        /// How the fit ended.
+        convergence: Convergence,
+    },
+    /// The RMS residual is well above the noise floor: the model misses an effect.
+    AboveNoiseFloor {
+        /// What the residuals measure.
+        quantity: Quantity,
+        /// RMS residual (N or m).
+        rms: f64,
+        /// Noise floor σ (N or m).
+        floor: f64,
+        /// `rms / floor`.
+        ratio: f64,
+    },
+    /// A free parameter ended on one of its bounds: the data push it there or beyond.
+    OnBound {
+        /// Parameter.
+        param: String,
+        /// Its fitted value.
+        value: f64,
+        /// The bound.
+        bound: f64,
+        /// Which bound.
+        side: BoundSide,
+    },
+    /// A free parameter's standard error exceeds its |value| (or is not finite).
+    Undetermined {
+        /// Parameter.
+        param: String,
+        /// Its fitted value.
+        value: f64,
+        /// Its standard error (null in JSON if not finite).
+        std_error: f64,
+    },
+    /// Two free parameters correlate so strongly that the data do not tell them apart.
+    Correlated {
+        /// One parameter.
+        first: String,
+        /// The other.
+        second: String,
+        /// Their correlation.
+        correlation: f64,
+    },
+}
+
+/// A warning with its sentence, as written to `fit.json`: `kind`, `message` and the data.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StatedWarning<'a> {
+    /// The sentence ([`FitWarning`]'s `Display`).
+    pub message: String,
+    /// The warning's kind and data.
+    #[serde(flatten)]
+    pub warning: &'a FitWarning,
+}
+
+impl FitWarning {
+    /// The snake-case name of the rule (the `kind` of the JSON).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            FitWarning::NotConverged { .. } => "not_converged",
+            FitWarning::AboveNoiseFloor { .. } => "above_noise_floor",
+            FitWarning::OnBound { .. } => "on_bound",
+            FitWarning::Undetermined { .. } => "undetermined",
+            FitWarning::Correlated { .. } => "correlated",
+        }
+    }
+
+    /// The warning with its sentence, for serializing.
+    pub fn stated(&self) -> StatedWarning<'_> {
+        StatedWarning {
+            message: self.to_string(),
+            warning: self,
+        }
+    }
+}
+
+impl fmt::Display for FitWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FitWarning::NotConverged { convergence } => match convergence {
+                Convergence::Failed { reason } => write!(
+                    f,
+                    "the fit failed ({reason}): the values are not an optimum — check the start \
+                     values and bounds, or try another `fit.solver`"
+                ),
+                _ => write!(
+                    f,
+                    "the fit ran out of iterations: the values may not be the optimum — raise \
+                     `fit.max_iters` or start nearer the optimum"
+                ),
+            },
+            FitWarning::AboveNoiseFloor {
+                quantity,
+                rms,
+                floor,
+                ratio,
+            } => write!(
+                f,
+                "the residual is {ratio:.1}× the noise floor (RMS {} against {}): the model \
+                 misses an effect — try `stf-lab discover`",
+                quantity.show(*rms),
+                quantity.show(*floor)
+            ),
+            FitWarning::OnBound {
+                param,
+                value,
+                bound,
+                side,
+            } => {
+                let side = match side {
+                    BoundSide::Lower => "lower",
+                    BoundSide::Upper => "upper",
+                };
+                write!(
+                    f,
+                    "{param} ended on its {side} bound ({value:.5} at {bound}): the data push it \
+                     there or beyond — widen the bound of {param} or fix it"
+                )
+            }
+            FitWarning::Undetermined {
+                param,
+                value,
+                std_error,
+            } => {
+                if std_error.is_finite() {
+                    write!(
+                        f,
+                        "{param} = {value:.4e} has a standard error of {std_error:.2e}, larger \
+                         than itself: the data do not determine {param} — fix it or drop its term"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "{param} has no finite standard error: the data do not determine \
+                         {param} — fix it or drop its term"
+                    )
+                }
+            }
+            FitWarning::Correlated {
+                first,
+                second,
+                correlation,
+            } => write!(
+                f,
+                "{first} and {second} correlate at {correlation:.3}: the data do not tell them \
+                 apart — fix one or fit a record with a wider velocity range"
+            ),
+        }
+    }
+}
+
+/// Every warning about `result`: `params` are the fit's parameters as given (for their bounds
+/// and typical sizes, matched by name), `floor` the record's noise floor (none: the residual is
+/// not judged). Most serious first: convergence, residual, bounds, standard errors,
+/// correlations.
+pub fn fit_warnings(
+    result: &FitResult,
+    params: &[FitParam],
+    floor: Option<&NoiseFloor>,
+) -> Vec<FitWarning> {
+    let mut out = Vec::new();
+    if !result.convergence.converged() {
+        out.push(FitWarning::NotConverged {
+            convergence: result.convergence.clone(),
+        });
+    }
+    if let Some(floor) = floor.filter(|f| f.is_usable()) {
+        let ratio = result.rms / floor.sigma;
+        if ratio > RESIDUAL_OVER_FLOOR || ratio.is_nan() {
+            out.push(FitWarning::AboveNoiseFloor {
+                quantity: floor.quantity,
+                rms: result.rms,
+                floor: floor.sigma,
+                ratio,
+            });
+        }
+    }
+    let free: Vec<_> = result.params.iter().filter(|p| !p.fixed).collect();
+    for p in &free {
+        if let Some(q) = params.iter().find(|q| q.name == p.name) {
+            out.extend(on_bound(q, p.value));
+        }
+    }
+    for p in &free {
+        if p.std_error > p.value.abs() || !p.std_error.is_finite() {
+            out.push(FitWarning::Undetermined {
+                param: p.name.clone(),
+                value: p.value,
+                std_error: p.std_error,
+            });
+        }
+    }
+    for (i, row) in result.correlation.iter().enumerate() {
+        for (j, &c) in row.iter().enumerate().skip(i + 1) {
+            if c.abs() > CORRELATION_LIMIT && c.is_finite() {
+                if let (Some(a), Some(b)) = (free.get(i), free.get(j)) {
+                    out.push(FitWarning::Correlated {
+                        first: a.name.clone(),
+                        second: b.name.clone(),
+                        correlation: c,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether `value` of parameter `q` lies on one of its bounds (see [`NEAR_BOUND`]).
+fn on_bound(q: &FitParam, value: f64) -> Option<FitWarning> {
+    let width = q.max - q.min;
+    let size = q.effective_scale();
+    let reach = NEAR_BOUND * if width < size { width } else { size };
+    let side = if q.min.is_finite() && value - q.min <= reach {
+        (BoundSide::Lower, q.min)
+    } else if q.max.is_finite() && q.max - value <= reach {
+        (BoundSide::Upper, q.max)
+    } else {
+        return None;
+    };
+    Some(FitWarning::OnBound {
+        param: q.name.clone(),
+        value,
+        bound: side.1,
+        side: side.0,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::FittedParam;
+
+    fn param(name: &str, value: f64, std_error: f64) -> FittedParam {
+        FittedParam {
+            name: name.into(),
+            value,
+            std_error,
+            fixed: false,
+        }
+    }
+
+    /// A converged two-parameter fit with RMS 0.02, K = 4 ± 0.05, n = 1.5 ± 0.006,
+    /// correlation `c`.
+    fn result(c: f64) -> FitResult {
+        FitResult {
+            params: vec![param("K", 4.0, 0.05), param("n", 1.5, 0.006)],
+            correlation: vec![vec![1.0, c], vec![c, 1.0]],
+            n_points: 1000,
+            n_free: 2,
+            rss: 0.4,
+            rms: 0.02,
+            s_mm2: None,
+            aic: 0.0,
+            bic: 0.0,
+            evaluations: 10,
+            failures: 0,
+            last_failure: None,
+            iterations: 5,
+            wall_seconds: 0.0,
+            convergence: Convergence::Converged {
+                reason: "test".into(),
+            },
+            log: Vec::new(),
+        }
+    }
+
+    fn bounds() -> Vec<FitParam> {
+        vec![
+            FitParam::new("K", 2.0).bounds(0.0, 1e4),
+            FitParam::new("n", 1.2).bounds(1.0, 4.0),
+        ]
+    }
+
+    fn kinds(w: &[FitWarning]) -> Vec<&'static str> {
+        w.iter().map(FitWarning::kind).collect()
+    }
+
+    #[test]
+    fn a_sound_fit_draws_no_warning() {
+        let floor = NoiseFloor::force(0.02, 0.001);
+        assert!(fit_warnings(&result(0.98), &bounds(), Some(&floor)).is_empty());
+    }
+
+    #[test]
+    fn a_residual_well_above_the_floor_is_flagged_with_its_ratio() {
+        let floor = NoiseFloor::force(0.012, 0.0);
+        let w = fit_warnings(&result(0.0), &bounds(), Some(&floor));
+        assert_eq!(kinds(&w), ["above_noise_floor"]);
+        let FitWarning::AboveNoiseFloor { ratio, .. } = w[0] else {
+            unreachable!()
+        };
+        assert!((ratio - 0.02 / 0.012).abs() < 1e-12);
+        let text = w[0].to_string();
+        assert!(
+            text.contains("1.7× the noise floor") && text.contains("stf-lab discover"),
+            "{text}"
+        );
+        // Up to 1.5× the floor is noise; an unusable floor judges nothing.
+        let floor = NoiseFloor::force(0.014, 0.0);
+        assert!(fit_warnings(&result(0.0), &bounds(), Some(&floor)).is_empty());
+        let none = NoiseFloor::displacement(0.0);
+        assert!(fit_warnings(&result(0.0), &bounds(), Some(&none)).is_empty());
+        // Trajectory residuals read in mm.
+        let floor = NoiseFloor::displacement(0.005);
+        let w = fit_warnings(&result(0.0), &bounds(), Some(&floor));
+        assert!(w[0]
+            .to_string()
+            .contains("RMS 20.0000 mm against 5.0000 mm"));
+    }
+
+    #[test]
+    fn a_parameter_on_a_bound_is_flagged_and_one_near_it_is_not() {
+        let mut r = result(0.0);
+        r.params[1].value = 1.0 + 1e-4;
+        let w = fit_warnings(&r, &bounds(), None);
+        assert_eq!(
+            w,
+            [FitWarning::OnBound {
+                param: "n".into(),
+                value: 1.0001,
+                bound: 1.0,
+                side: BoundSide::Lower
+            }]
+        );
+        assert!(w[0].to_string().contains("widen the bound of n or fix it"));
+        // 1 % of its size from the bound is inside.
+        r.params[1].value = 1.012;
+        assert!(fit_warnings(&r, &bounds(), None).is_empty());
+        // The upper bound; a box narrower than the size sets the reach.
+        r.params[1].value = 4.0;
+        let w = fit_warnings(&r, &bounds(), None);
+        assert!(matches!(
+            w[..],
+            [FitWarning::OnBound {
+                side: BoundSide::Upper,
+                ..
+            }]
+        ));
+        let narrow = [FitParam::new("n", 1.2).bounds(1.0, 1.5)];
+        r.params[1].value = 1.0009;
+        assert!(fit_warnings(&r, &narrow, None).is_empty());
+        r.params[1].value = 1.0004;
+        assert_eq!(kinds(&fit_warnings(&r, &narrow, None)), ["on_bound"]);
+        // A fixed parameter on its bound is the user's choice.
+        r.params[1].fixed = true;
+        assert!(fit_warnings(&r, &narrow, None).is_empty());
+    }
+
+    #[test]
+    fn a_standard_error_above_the_value_or_not_finite_is_flagged() {
+        let mut r = result(0.0);
+        r.params[0].std_error = 4.1;
+        r.params[1].std_error = f64::INFINITY;
+        let w = fit_warnings(&r, &bounds(), None);
+        assert_eq!(kinds(&w), ["undetermined", "undetermined"]);
+        assert!(w[0].to_string().contains("larger than itself"));
+        assert!(w[1].to_string().contains("no finite standard error"));
+        r.params[0].std_error = f64::NAN;
+        r.params[1].std_error = 1.5;
+        assert_eq!(kinds(&fit_warnings(&r, &bounds(), None)), ["undetermined"]);
+    }
+
+    #[test]
+    fn a_correlation_beyond_the_limit_names_both_parameters() {
+        let w = fit_warnings(&result(-0.998), &bounds(), None);
+        assert_eq!(
+            w,
+            [FitWarning::Correlated {
+                first: "K".into(),
+                second: "n".into(),
+                correlation: -0.998
+            }]
+        );
+        assert!(w[0]
+            .to_string()
+            .starts_with("K and n correlate at -0.998: the data do not tell them apart"));
+        // Not determined (NaN) is the standard error's rule, not this one.
+        assert!(fit_warnings(&result(f64::NAN), &bounds(), None).is_empty());
+    }
+
+    #[test]
+    fn a_fit_that_did_not_converge_says_so_first() {
+        let mut r = result(0.0);
+        r.convergence = Convergence::MaxIterations;
+        let floor = NoiseFloor::force(0.01, 0.0);
+        let w = fit_warnings(&r, &bounds(), Some(&floor));
+        assert_eq!(kinds(&w), ["not_converged", "above_noise_floor"]);
+        assert!(w[0].to_string().contains("raise `fit.max_iters`"));
+        r.convergence = Convergence::Failed {
+            reason: "no solver improved on the start".into(),
+        };
+        let w = fit_warnings(&r, &bounds(), None);
+        assert!(w[0].to_string().contains("fit failed (no solver improved"));
+    }
+
+    #[test]
+    fn the_json_has_a_kind_a_message_and_the_data() {
+        let w = FitWarning::Undetermined {
+            param: "m_a".into(),
+            value: 1e-4,
+            std_error: f64::INFINITY,
+        };
+        let v = serde_json::to_value(w.stated()).unwrap();
+        assert_eq!(v["kind"], "undetermined");
+        assert_eq!(v["param"], "m_a");
+        assert!(v["std_error"].is_null());
+        assert_eq!(v["message"], w.to_string());
+        let v = serde_json::to_value(
+            FitWarning::NotConverged {
+                convergence: Convergence::MaxIterations,
+            }
+            .stated(),
+        )
+        .unwrap();
+        assert_eq!(v["convergence"]["status"], "max_iterations");
+    }
+}
