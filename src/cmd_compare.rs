@@ -73,7 +73,7 @@ fn simulated_response(
     }
     let run = Simulation::new(&osc)
         .settings(exp.integrator.clone())
-        .initial(k.x[0], k.v[0])
+        .initial(k.initial_state().0, k.initial_state().1)
         .run_at(&k.t)?;
     let p = peak(&run.t, &run.x, k.omega.as_deref()).context("empty simulation")?;
     Ok((

@@ -340,7 +340,7 @@ fn run_trajectory(
     let names = refitted(exp, data);
     let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
-        .initial(k.x[0], k.v[0]);
+        .initial(k.initial_state().0, k.initial_state().1);
     for name in &names {
         setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
     }

@@ -222,7 +222,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let mut fit = TrajectoryFit::new(system, Arc::new(k.excitation()))
             .sim_settings(exp.integrator.clone())
             .settings(exp.fit.settings.clone())
-            .initial(k.x[0], k.v[0]);
+            .initial(k.initial_state().0, k.initial_state().1);
         let free: Vec<_> = stage
             .free
             .iter()

@@ -343,7 +343,7 @@ fn fit_trajectory(
     let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
         .sim_settings(exp.integrator.clone())
         .settings(exp.fit.settings.clone())
-        .initial(k.x[0], k.v[0]);
+        .initial(k.initial_state().0, k.initial_state().1);
     let mut free = Vec::new();
     if let Some(c) = configured {
         fit = fit.model(c.model.clone(), c.values());
@@ -389,7 +389,7 @@ fn fit_trajectory(
     }
     let run = Simulation::new(&osc)
         .settings(exp.integrator.clone())
-        .initial(k.x[0] - x_off, k.v[0])
+        .initial(k.initial_state().0 - x_off, k.initial_state().1)
         .run_at(&data.record.t)
         .with_context(|| format!("simulating the fitted `{label}`"))?;
     let fitted = run.x.iter().map(|x| x + x_off).collect();

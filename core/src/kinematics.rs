@@ -90,6 +90,12 @@ pub struct Kinematics {
     pub u: Option<Vec<f64>>,
     /// How the measured drive was reconstructed (none for free vibration).
     pub drive: Option<DriveReport>,
+    /// Displacement at the first sample, m, smoothed by the motion filter (a simulation
+    /// started from the raw sample starts off by the noise, and a trolley that sticks keeps
+    /// that offset until it breaks away).
+    pub x0: f64,
+    /// Velocity at the first sample, m/s, from the same fit as `x0`.
+    pub v0: f64,
     /// The motion filter used.
     pub motion_filter: PolyFilter,
     /// Estimated position noise σ, m.
@@ -133,6 +139,12 @@ impl Kinematics {
         };
         let d = motion.apply(dt, &record.x)?;
         let sigma_x = position_noise(&record.x);
+        let fallback = if motion.boundary_handling() == Boundary::Shifted {
+            (d.value[0], d.d1[0])
+        } else {
+            (record.x[0], d.d1[0])
+        };
+        let (x0, v0) = initial_state(dt, &record.x, sigma_x, motion.window(), fallback)?;
         Ok(Kinematics {
             t: record.t.clone(),
             x: record.x.clone(),
@@ -142,11 +154,18 @@ impl Kinematics {
             omega,
             u,
             drive,
+            x0,
+            v0,
             sigma_v: sigma_x * motion.noise_gain(dt, 1),
             sigma_a: sigma_x * motion.noise_gain(dt, 2),
             motion_filter: motion,
             sigma_x,
         })
+    }
+
+    /// The state a simulation of the record starts from, (m, m/s): see [`initial_state`].
+    pub fn initial_state(&self) -> (f64, f64) {
+        (self.x0, self.v0)
     }
 
     /// The drive force at each sample, N: F0·ω²·sin φ for a rotor, u for a shaker, 0 without.
@@ -199,6 +218,43 @@ impl Kinematics {
             (_, _, Some(u)) => Excitation::Force(Linear::new(self.t.clone(), u.clone())),
             _ => Excitation::None,
         }
+    }
+}
+
+/// The state at the first sample, (x0 m, v0 m/s), from the longest opening stretch of the
+/// record that a quadratic follows to within its noise: the longest of 2 s, 1 s, 0.5 s … down to
+/// the motion filter's `window` whose residual RMS stays within 10 % of `sigma_x` (and of the
+/// quantum). The motion filter's own edge value is the `fallback`. A simulation started from a
+/// noisy first sample or an edge derivative (σ_v of several mm/s) kicks the trolley: a
+/// trolley that sticks keeps the offset that kick leaves until it breaks away.
+pub fn initial_state(
+    dt: f64,
+    x: &[f64],
+    sigma_x: f64,
+    window: usize,
+    fallback: (f64, f64),
+) -> Result<(f64, f64), FilterError> {
+    let scatter =
+        sigma_x.max(crate::reconstruct::quantisation_step(x).map_or(0.0, |q| q / 12f64.sqrt()));
+    if scatter <= 0.0 {
+        return Ok(fallback);
+    }
+    let mut seconds = 2.0;
+    loop {
+        let w = ((seconds / dt) as usize).min(x.len());
+        if w <= window.max(4) {
+            return Ok(fallback);
+        }
+        let fit = PolyFilter::new(2, w)?.apply(dt, &x[..w])?;
+        let rss: f64 = x[..w]
+            .iter()
+            .zip(&fit.value)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum();
+        if (rss / w as f64).sqrt() <= 1.1 * scatter {
+            return Ok((fit.value[0], fit.d1[0]));
+        }
+        seconds /= 2.0;
     }
 }
 
