@@ -200,6 +200,7 @@ impl ModelFit {
             "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
             "params": params,
             "std_errors": std_errors_json(&self.result.params),
+            "error_blocks": self.result.error_blocks,
             "fixed": fixed,
             "rms": self.result.rms,
             "rms_unit": match level { FitLevel::Force => "N", FitLevel::Trajectory => "m" },

@@ -12,9 +12,11 @@
 //! ([`Solver::Auto`]) runs a Levenberg–Marquardt refinement and falls back on Nelder–Mead
 //! (argmin) followed by another refinement if it does not converge; [`Solver::NelderMead`] is
 //! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
-//! with standard errors from a finite-difference Jacobian in the user's parameter space
-//! (`cov = s²·(JᵀJ)⁻¹`, `s² = RSS/(N − p)`), correlations, RMS, AIC and BIC, and says whether
-//! it converged ([`FitResult`]). A failure inside the fit (a simulation that diverges, a model
+//! with standard errors from a finite-difference Jacobian in the user's parameter space —
+//! cluster-robust over blocks of consecutive samples as long as the residuals' correlation
+//! ([`ErrorBlocks`]; the classical `s²·(JᵀJ)⁻¹`, too small for correlated residuals, is kept
+//! beside them) — correlations, RMS, AIC and BIC, and says whether it converged
+//! ([`FitResult`]). A failure inside the fit (a simulation that diverges, a model
 //! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
 //! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
 
@@ -35,7 +37,7 @@ pub use error::FitError;
 pub use force::{ForceData, ForceFit, FORCE_OFFSET};
 pub use objective::Residuals;
 pub use param::{full_values, FitParam};
-pub use result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
+pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
 pub use settings::{FitSettings, Solver};
 pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};
 pub use transform::BoundTransform;
