@@ -165,17 +165,18 @@ pub fn sandwich(jac: &DMatrix<f64>, r: &[f64], block: usize) -> Covariance {
     let mut cov = DMatrix::<f64>::zeros(p, p);
     let mut score = DVector::<f64>::zeros(p);
     let mut own = DMatrix::<f64>::zeros(p, p);
+    let mut row = DVector::<f64>::zeros(p);
     for b in 0..g {
         score.fill(0.0);
         own.fill(0.0);
         for i in b * n / g..(b + 1) * n / g {
-            let row: DVector<f64> = DVector::from_fn(p, |j, _| {
-                if nm.status[j] == Column::Bad {
+            for j in 0..p {
+                row[j] = if nm.status[j] == Column::Bad {
                     0.0
                 } else {
                     jac[(i, j)] * nm.d[j]
-                }
-            });
+                };
+            }
             score.axpy(r[i], &row, 1.0);
             own.ger(1.0, &row, &row, 1.0);
         }
@@ -223,20 +224,15 @@ fn chi2_99(k: usize) -> f64 {
 /// Sums of `scores` (N × p, in sample order) over `g` blocks split as [`sandwich`] splits
 /// them; per parameter, `G·ρ₁²`, with ρ₁ the lag-one autocorrelation of those sums.
 fn block_sums_test(scores: &DMatrix<f64>, g: usize) -> Vec<f64> {
-    let (n, p) = scores.shape();
-    let sums: Vec<DVector<f64>> = (0..g)
-        .map(|b| {
-            let mut s = DVector::<f64>::zeros(p);
-            for i in b * n / g..(b + 1) * n / g {
-                s += scores.row(i).transpose();
-            }
-            s
-        })
-        .collect();
-    (0..p)
-        .map(|j| {
-            let c0: f64 = sums.iter().map(|s| s[j] * s[j]).sum();
-            let c1: f64 = sums.windows(2).map(|w| w[0][j] * w[1][j]).sum();
+    let n = scores.nrows();
+    scores
+        .column_iter()
+        .map(|col| {
+            let sums: Vec<f64> = (0..g)
+                .map(|b| col.rows_range(b * n / g..(b + 1) * n / g).sum())
+                .collect();
+            let c0: f64 = sums.iter().map(|s| s * s).sum();
+            let c1: f64 = sums.windows(2).map(|w| w[0] * w[1]).sum();
             if c0 > 0.0 {
                 g as f64 * (c1 / c0).powi(2)
             } else {
