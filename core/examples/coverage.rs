@@ -11,13 +11,19 @@
 //!
 //! 1. Force level: the record through the rig's sensors ([`SensorNoise::RIG`]); v and a from
 //!    the derivative filter; K and n fitted to F_STF from K = 1, n = 1.2.
-//! 2. Trajectory level: the same sensors but an exact rotor angle (no encoder quantisation,
+//! 2. Force level on the force recovered from x through the equation of motion (the drive
+//!    − m·a − c·v − k·x) instead of the force sensor's, whose errors are the derivative
+//!    filter's, correlated over its window; the oscillator without dry friction (whose jumps
+//!    the filter cannot follow).
+//! 3. Trajectory level: the same sensors but an exact rotor angle (no encoder quantisation,
 //!    whose drive reconstruction is biased for now); the drive from that angle and its
 //!    filtered ω, as `stf-lab fit` builds it; K, n and the bearing's c fitted to x from 10 %
 //!    off, the simulations started at rest where the run starts.
-//! 3. The same, started as `stf-lab fit` starts them: from the first sample and the filtered
-//!    velocity there. That start is wrong by a common edge error plus noise; its transient
-//!    biases the fits far beyond their scatter — shown, not a test of the errors.
+//! 4. The same, started as `stf-lab fit` starts them: from the first sample and the filtered
+//!    velocity there. That start is off by the first sample's noise and by the filter's
+//!    velocity at the record's edge (a few mm/s here, where the run starts at rest); the
+//!    transient it leaves drags the fits far beyond the noise's scatter, and biases them —
+//!    shown, not a test of the errors.
 //!
 //! Per parameter: coverage of ±2σ by the robust (block) standard errors and by the naive
 //! per-sample ones, the mean |error|/σ (≈ 0.80 if σ is right) and mean σ of each; the
@@ -243,8 +249,8 @@ fn main() {
         .map(|s| force_fit(&smooth, s, Force::Recovered))
         .collect();
     report(
-        "force level on the force recovered from x (m·a + c·v + k·x from the filtered x, \
-         oscillator without dry friction), K and n:",
+        "force level on the force recovered from x (the drive − m·a − c·v − k·x, v and a \
+         filtered from x; rig sensors; oscillator without dry friction), K and n:",
         &fits,
         &[("K", TRUTH[0]), ("n", TRUTH[1])],
         clock.elapsed().as_secs_f64(),
@@ -264,8 +270,8 @@ fn main() {
         (
             Start::Filtered,
             "trajectory level, as above but started from the first sample and its filtered \
-             velocity (as `stf-lab fit` does): that start's error biases the fits, which no \
-             standard error can cover:",
+             velocity (as `stf-lab fit` does): that start's error drags and biases the fits, \
+             which no standard error of these residuals covers:",
         ),
     ] {
         let clock = Instant::now();

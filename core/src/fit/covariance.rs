@@ -1,13 +1,14 @@
 //! Standard errors and correlations from the Jacobian: the classical `cov = s²·(JᵀJ)⁻¹`
-//! (`s² = RSS/(N − p)`, right for independent residuals) and the cluster-robust ("sandwich")
-//! `cov = (JᵀJ)⁻¹·(Σ_b J_bᵀ r_b r_bᵀ J_b)·(JᵀJ)⁻¹·G/(G − 1)·(N − 1)/(N − p)` over `G` blocks
-//! `b` of consecutive samples, right when residuals are correlated over less than a block.
+//! (`s² = RSS/(N − p)`, right only for independent residuals) and a cluster-robust one over
+//! `G` blocks `b` of consecutive samples ([`sandwich`]: the sandwich
+//! `(JᵀJ)⁻¹·(Σ_b J_bᵀ r_b r_bᵀ J_b)·(JᵀJ)⁻¹` in its delete-one-block jackknife form), right
+//! when the residuals are correlated over less than a block. [`blocks`] chooses the blocks
+//! from the residuals themselves.
 //!
 //! JᵀJ is first scaled to unit diagonal, then inverted through its eigen-decomposition.
 //! Directions the data do not determine (eigenvalues below 1e-13 of the largest, a zero or NaN
 //! column) give an infinite (or NaN) variance to every parameter that takes part in them —
-//! never a small, confident-looking number. [`block_length`] chooses the blocks from the
-//! residuals' own autocorrelation.
+//! never a small, confident-looking number.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
@@ -211,7 +212,7 @@ pub const MIN_BLOCKS: usize = 10;
 /// Fewest blocks the block length may leave: the coarsest level [`blocks`] examines.
 const FEWEST_BLOCKS: usize = 6;
 
-/// Normal quantile of the test that block sums are uncorrelated (one-sided 99 %).
+/// The standard normal's 99 % point, for the χ² quantile of [`chi2_99`].
 const Z_99: f64 = 2.326;
 
 /// Upper 99 % quantile of χ² with `k` degrees of freedom (Wilson–Hilferty).
@@ -254,6 +255,13 @@ fn block_sums_test(scores: &DMatrix<f64>, g: usize) -> Vec<f64> {
 /// residuals are correlated over about the whole record, and the errors may still be low.
 pub fn blocks(jac: &DMatrix<f64>, r: &[f64]) -> ErrorBlocks {
     let (n, p) = jac.shape();
+    if r.len() != n || n == 0 {
+        return ErrorBlocks {
+            length: n.max(1),
+            count: usize::from(n > 0),
+            settled: false,
+        };
+    }
     let mut scores = DMatrix::<f64>::zeros(n, p);
     for j in 0..p {
         if jac.column(j).iter().all(|v| v.is_finite()) {
