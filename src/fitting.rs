@@ -205,6 +205,14 @@ impl ModelFit {
             "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
             "params": params,
             "std_errors": std_errors_json(&self.result.params),
+            "naive_std_errors": Value::Object(
+                self.result
+                    .params
+                    .iter()
+                    .map(|p| (p.name.clone(), finite_or_null(p.naive_std_error)))
+                    .collect(),
+            ),
+            "error_blocks": self.result.error_blocks,
             "fixed": fixed,
             "rms": self.result.rms,
             "rms_unit": match level { FitLevel::Force => "N", FitLevel::Trajectory => "m" },

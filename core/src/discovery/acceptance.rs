@@ -175,6 +175,7 @@ mod tests {
             name: name.into(),
             value: 1.0,
             std_error: 0.1,
+            naive_std_error: 0.1,
             fixed: false,
         };
         // Same held-out residuals: a tie. The four-parameter one has the lower BIC.

@@ -2,7 +2,8 @@
 //!
 //! It runs the stages of the chosen [`Solver`] on an [`Objective`], then computes the residuals
 //! and a forward-difference Jacobian at the best point in the user's parameter space (so the
-//! standard errors are those of the values reported, whatever the transforms), and the
+//! standard errors are those of the values reported, whatever the transforms; robust to
+//! residuals correlated over blocks of samples, which are chosen from the residuals), and the
 //! statistics of the result.
 
 use std::time::Instant;
@@ -14,13 +15,13 @@ use nalgebra::DMatrix;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 
-use super::covariance;
+use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::jacobian::{forward_difference, residual_noise, StepFloor};
 use super::levenberg_marquardt::{self, BoundStop, MAX_FD_STEP, NOISE_PROBE};
 use super::objective::{LnCost, Objective, Residuals};
 use super::param::FitParam;
-use super::result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
+use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
 use super::settings::{FitSettings, Solver};
 
 /// Fit the free members of `params` (all of them, in order) of `problem`, whose
@@ -347,55 +348,11 @@ fn finish(
     };
     let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
     let p = free.len();
-    let (std_errors, correlation) = if p > 0 {
-        let mut jac = DMatrix::<f64>::zeros(n, p);
-        let mut steps: Vec<f64> = free
-            .iter()
-            .map(|q| settings.fd_step * q.effective_scale())
-            .collect();
-        // Steps above the residuals' noise (a noisy column would make a noisy standard
-        // error), at most MAX_FD_STEP scales and short enough that one side stays in bounds.
-        let probe: Vec<f64> = free
-            .iter()
-            .zip(&x)
-            .map(|(q, v)| {
-                let e = NOISE_PROBE * q.effective_scale();
-                if v + e < q.max && v - e > q.min {
-                    e
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let noise = residual_noise(&x, &r0, &probe, &mut |point, out| {
-            obj.residuals_user(point, out).is_some()
-        })
-        .unwrap_or(0.0);
-        let floor = StepFloor {
-            noise,
-            max: free
-                .iter()
-                .zip(&steps)
-                .map(|(q, h)| {
-                    (MAX_FD_STEP * q.effective_scale())
-                        .min(0.49 * (q.max - q.min))
-                        .max(*h)
-                })
-                .collect(),
-        };
-        forward_difference(
-            &x,
-            &r0,
-            &mut steps,
-            &floor,
-            &|j, v| !(v > free[j].min && v < free[j].max),
-            &mut |point, out| obj.residuals_user(point, out).is_some(),
-            &mut jac,
-        );
-        let cov = covariance::from_jacobian(&jac, rss);
-        (cov.std_errors, cov.correlation)
+    let errors = if p > 0 {
+        let jac = jacobian(obj, &free, &x, &r0, settings);
+        Some(standard_errors(&jac, &r0, rss, &mut log))
     } else {
-        (vec![], vec![])
+        None
     };
     let mut fitted = Vec::with_capacity(params.len());
     let mut k = 0;
@@ -405,13 +362,15 @@ fn finish(
                 name: q.name.clone(),
                 value: q.value,
                 std_error: 0.0,
+                naive_std_error: 0.0,
                 fixed: true,
             });
-        } else {
+        } else if let Some(e) = &errors {
             fitted.push(FittedParam {
                 name: q.name.clone(),
                 value: x[k],
-                std_error: std_errors[k],
+                std_error: e.robust.std_errors[k],
+                naive_std_error: e.naive[k],
                 fixed: false,
             });
             k += 1;
@@ -432,9 +391,14 @@ fn finish(
             reason: "a parameter is not finite".into(),
         };
     }
+    let (correlation, error_blocks) = match errors {
+        Some(e) => (e.robust.correlation, Some(e.blocks)),
+        None => (vec![], None),
+    };
     Ok(FitResult {
         params: fitted,
         correlation,
+        error_blocks,
         n_points: n,
         n_free: p,
         rss,
@@ -450,6 +414,94 @@ fn finish(
         convergence,
         log,
     })
+}
+
+/// A forward-difference Jacobian of the residuals `r0` at the user values `x` of the free
+/// parameters `free`.
+fn jacobian(
+    obj: &Objective,
+    free: &[&FitParam],
+    x: &[f64],
+    r0: &[f64],
+    settings: &FitSettings,
+) -> DMatrix<f64> {
+    let (n, p) = (r0.len(), free.len());
+    let mut jac = DMatrix::<f64>::zeros(n, p);
+    let mut steps: Vec<f64> = free
+        .iter()
+        .map(|q| settings.fd_step * q.effective_scale())
+        .collect();
+    // Steps above the residuals' noise (a noisy column would make a noisy standard
+    // error), at most MAX_FD_STEP scales and short enough that one side stays in bounds.
+    let probe: Vec<f64> = free
+        .iter()
+        .zip(x)
+        .map(|(q, v)| {
+            let e = NOISE_PROBE * q.effective_scale();
+            if v + e < q.max && v - e > q.min {
+                e
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let noise = residual_noise(x, r0, &probe, &mut |point, out| {
+        obj.residuals_user(point, out).is_some()
+    })
+    .unwrap_or(0.0);
+    let floor = StepFloor {
+        noise,
+        max: free
+            .iter()
+            .zip(&steps)
+            .map(|(q, h)| {
+                (MAX_FD_STEP * q.effective_scale())
+                    .min(0.49 * (q.max - q.min))
+                    .max(*h)
+            })
+            .collect(),
+    };
+    forward_difference(
+        x,
+        r0,
+        &mut steps,
+        &floor,
+        &|j, v| !(v > free[j].min && v < free[j].max),
+        &mut |point, out| obj.residuals_user(point, out).is_some(),
+        &mut jac,
+    );
+    jac
+}
+
+/// The standard errors of a fit: robust over blocks chosen from the residuals, and naive.
+struct Errors {
+    robust: covariance::Covariance,
+    naive: Vec<f64>,
+    blocks: ErrorBlocks,
+}
+
+/// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`);
+/// a line in `log` when the blocks are too few for the errors to be sure.
+fn standard_errors(jac: &DMatrix<f64>, r: &[f64], rss: f64, log: &mut Vec<String>) -> Errors {
+    let blocks = covariance::blocks(jac, r);
+    if !blocks.settled {
+        log.push(format!(
+            "standard errors: the residuals are correlated over about the whole record (even \
+             {} blocks of {} samples are not long enough): the errors may still be too small",
+            blocks.count, blocks.length
+        ));
+    } else if blocks.count < MIN_BLOCKS {
+        log.push(format!(
+            "standard errors: the residuals are correlated over {} samples, only {} blocks: \
+             the errors are themselves uncertain",
+            blocks.length, blocks.count
+        ));
+    }
+    Errors {
+        robust: covariance::sandwich(jac, r, blocks.length),
+        naive: covariance::from_jacobian(jac, rss).std_errors,
+        blocks,
+    }
 }
 
 #[cfg(test)]

@@ -12,12 +12,15 @@
 //! ([`Solver::Auto`]) runs a Levenberg–Marquardt refinement and falls back on Nelder–Mead
 //! (argmin) followed by another refinement if it does not converge; [`Solver::NelderMead`] is
 //! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
-//! with standard errors from a finite-difference Jacobian in the user's parameter space
-//! (`cov = s²·(JᵀJ)⁻¹`, `s² = RSS/(N − p)`), correlations, RMS, AIC and BIC, and says whether
-//! it converged ([`FitResult`]). [`fit_warnings`] says, by the same rules for every kind of
-//! fit, when a result is not to be trusted as it stands ([`FitWarning`]): it did not
-//! converge, its residual is well above the record's [`NoiseFloor`], a parameter ended on a
-//! bound, is not determined, or cannot be told apart from another. A failure inside the fit (a simulation that diverges, a model
+//! with standard errors from a finite-difference Jacobian in the user's parameter space —
+//! cluster-robust over blocks of consecutive samples as long as the residuals' correlation
+//! ([`ErrorBlocks`]; the classical `s²·(JᵀJ)⁻¹`, too small for correlated residuals, is kept
+//! beside them) — correlations, RMS, AIC and BIC, and says whether it converged
+//! ([`FitResult`]). [`fit_warnings`] says, by the same rules for every kind of fit, when a
+//! result is not to be trusted as it stands ([`FitWarning`]): it did not converge, its
+//! residual is well above the record's [`NoiseFloor`], a parameter ended on a bound, is not
+//! determined, or cannot be told apart from another. A failure inside the fit (a simulation
+//! that diverges, a model
 //! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
 //! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
 
@@ -41,7 +44,7 @@ pub use force::{ForceData, ForceFit, FORCE_OFFSET};
 pub use noise_floor::{MotionNoise, NoiseFloor, Quantity};
 pub use objective::Residuals;
 pub use param::{full_values, FitParam};
-pub use result::{Convergence, FitProgress, FitResult, FittedParam, Stage};
+pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
 pub use settings::{FitSettings, Solver};
 pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};
 pub use transform::BoundTransform;

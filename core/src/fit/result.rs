@@ -1,5 +1,6 @@
-//! What a fit reports: values with standard errors and correlations, goodness of fit,
-//! information criteria, the work done, and whether it converged.
+//! What a fit reports: values with standard errors (robust to correlated residuals) and
+//! correlations, goodness of fit, information criteria, the work done, and whether it
+//! converged.
 
 use serde::Serialize;
 
@@ -61,10 +62,27 @@ pub struct FittedParam {
     /// Best value.
     pub value: f64,
     /// Standard error (infinite or NaN if the data do not determine the parameter; 0 if
-    /// fixed).
+    /// fixed), robust to residuals correlated within a block ([`ErrorBlocks`]).
     pub std_error: f64,
+    /// The classical standard error, `s²·(JᵀJ)⁻¹`, which takes every residual as
+    /// independent: too small when they are correlated (kept for comparison).
+    pub naive_std_error: f64,
     /// Held fixed.
     pub fixed: bool,
+}
+
+/// The blocks of consecutive samples over which the standard errors' residuals were taken as
+/// correlated: the cluster-robust covariance sums each block's scores before squaring them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct ErrorBlocks {
+    /// Samples per block.
+    pub length: usize,
+    /// Number of blocks: the effective number of independent pieces of data.
+    pub count: usize,
+    /// Whether blocks of this length were found long enough to hold the residuals'
+    /// correlation; if not, the residuals are correlated over about the whole record and
+    /// the standard errors may still be too small.
+    pub settled: bool,
 }
 
 /// The outcome of a fit.
@@ -74,6 +92,8 @@ pub struct FitResult {
     pub params: Vec<FittedParam>,
     /// Correlations of the free parameters, in their order in `params`.
     pub correlation: Vec<Vec<f64>>,
+    /// The blocks behind the standard errors (`None` without free parameters).
+    pub error_blocks: Option<ErrorBlocks>,
     /// Number of residuals (samples).
     pub n_points: usize,
     /// Number of free parameters.
