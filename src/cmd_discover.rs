@@ -344,6 +344,12 @@ fn run_trajectory(
     for name in &names {
         setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
     }
+    if exp.fit.fit_initial {
+        let (x0, v0) = k.initial_state();
+        for p in stf_core::fit::initial_state_params(x0, v0) {
+            setup = setup.refit(p);
+        }
+    }
     let settings = settings.clone().fit_offset(exp.fit.offset);
     let started = Instant::now();
     if !quiet {
@@ -366,7 +372,11 @@ fn run_trajectory(
     let model_params: Vec<&FittedParam> = found
         .final_params
         .iter()
-        .filter(|p| !names.contains(&p.name) && p.name != "x_off")
+        .filter(|p| {
+            !names.contains(&p.name)
+                && p.name != "x_off"
+                && !stf_core::fit::INITIAL_STATE.contains(&p.name.as_str())
+        })
         .collect();
     let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied());
     let system_entry: String = std::iter::once("[system]\n".to_string())

@@ -223,11 +223,15 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             .sim_settings(exp.integrator.clone())
             .settings(exp.fit.settings.clone())
             .initial(k.initial_state().0, k.initial_state().1);
-        let free: Vec<_> = stage
+        let mut free: Vec<_> = stage
             .free
             .iter()
             .map(|name| system_param(name, system.get(name).unwrap_or(0.0)))
             .collect();
+        if exp.fit.fit_initial {
+            let (x0, v0) = k.initial_state();
+            free.extend(stf_core::fit::initial_state_params(x0, v0));
+        }
         for p in &free {
             fit = fit.free(p.clone());
         }

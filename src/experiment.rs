@@ -251,6 +251,7 @@ struct RawFit {
     system: Vec<String>,
     #[serde(default)]
     offset: bool,
+    initial: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -357,6 +358,9 @@ pub struct FitSpec {
     pub system_free: Vec<String>,
     /// Fit a constant offset (force: `f_off`, trajectory: `x_off`).
     pub offset: bool,
+    /// Trajectory level: fit the initial state `x0`, `v0` (the default, `initial = "fit"`)
+    /// or take it from the record (`initial = "record"`).
+    pub fit_initial: bool,
 }
 
 /// One stage of an oscillator identification (`[[identify]]`).
@@ -762,6 +766,7 @@ impl Experiment {
             settings: FitSettings::default(),
             system_free: Vec::new(),
             offset: false,
+            fit_initial: true,
         };
         if let Some(f) = &raw.fit {
             let span = f.span();
@@ -811,6 +816,17 @@ impl Experiment {
             }
             fit.system_free = f.system.clone();
             fit.offset = f.offset;
+            fit.fit_initial = match f.initial.as_deref() {
+                None | Some("fit") => true,
+                Some("record") => false,
+                Some(other) => {
+                    return Err(cx.at(
+                        span,
+                        "fit.initial",
+                        format!("unknown initial state `{other}`; known: fit, record"),
+                    ))
+                }
+            };
         }
 
         let mut kinematics = KinematicsSettings::default();

@@ -12,8 +12,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use stf_core::fit::{
-    fit_warnings, FitParam, FitResult, FitWarning, FittedParam, ForceData, ForceFit, NoiseFloor,
-    TrajectoryData, TrajectoryFit,
+    fit_warnings, initial_state_params, FitParam, FitResult, FitWarning, FittedParam, ForceData,
+    ForceFit, NoiseFloor, TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
@@ -352,7 +352,7 @@ fn fit_trajectory(
         .sim_settings(exp.integrator.clone())
         .settings(exp.fit.settings.clone())
         .initial(k.initial_state().0, k.initial_state().1);
-    let mut free = Vec::new();
+    let mut free: Vec<FitParam> = Vec::new();
     if let Some(c) = configured {
         fit = fit.model(c.model.clone(), c.values());
         free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
@@ -363,6 +363,10 @@ fn fit_trajectory(
     }
     if exp.fit.offset {
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+    }
+    let (x0, v0) = k.initial_state();
+    if exp.fit.fit_initial {
+        free.extend(initial_state_params(x0, v0));
     }
     for p in &free {
         fit = fit.free(p.clone());
@@ -397,7 +401,10 @@ fn fit_trajectory(
     }
     let run = Simulation::new(&osc)
         .settings(exp.integrator.clone())
-        .initial(k.initial_state().0 - x_off, k.initial_state().1)
+        .initial(
+            mf.result.value("x0").unwrap_or(x0 - x_off),
+            mf.result.value("v0").unwrap_or(v0),
+        )
         .run_at(&data.record.t)
         .with_context(|| format!("simulating the fitted `{label}`"))?;
     let fitted = run.x.iter().map(|x| x + x_off).collect();

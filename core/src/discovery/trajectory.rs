@@ -323,9 +323,10 @@ pub fn discover_trajectory(
     }
     candidate::distinct(candidates)?;
     for p in &setup.oscillator {
-        if OscillatorParams::FORCED.get(&p.name).is_none() {
+        let initial = crate::fit::INITIAL_STATE.contains(&p.name.as_str());
+        if OscillatorParams::FORCED.get(&p.name).is_none() && !initial {
             return Err(DiscoveryError::BadSettings(format!(
-                "`{}` is not an oscillator parameter; known: {}",
+                "`{}` is not an oscillator parameter or the initial state; known: {}, x0, v0",
                 p.name,
                 OscillatorParams::NAMES.join(", ")
             )));

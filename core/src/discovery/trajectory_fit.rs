@@ -4,14 +4,16 @@
 //!
 //! The simulation always runs through the whole record, so the held-out cycles are driven by
 //! the same history as in reality, and the residuals of any samples can be read off one run.
-//! Parameters are, in order: the oscillator's free ones (by [`OscillatorParams`] name), every
-//! parameter of the model (in its order), then the displacement offset `x_off` if fitted.
+//! Parameters are, in order: the oscillator's free ones (by [`OscillatorParams`] name, or
+//! `x0`, `v0` for the initial state), every parameter of the model (in its order), then the
+//! displacement offset `x_off` if fitted.
 
 use std::sync::Arc;
 
 use crate::excitation::Excitation;
 use crate::fit::{
     fit_residuals, full_values, FitError, FitParam, FitResult, FitSettings, Residuals,
+    INITIAL_STATE,
 };
 use crate::force_model::ForceModel;
 use crate::integrate::{integrate, Settings};
@@ -91,8 +93,11 @@ impl Rig<'_> {
             ));
         }
         let mut system = self.system;
+        let mut initial: [Option<f64>; 2] = [None, None];
         for (name, &v) in self.oscillator.iter().zip(values) {
-            if !system.set(name, v) {
+            if let Some(i) = INITIAL_STATE.iter().position(|n| n == name) {
+                initial[i] = Some(v);
+            } else if !system.set(name, v) {
                 return Err(format!("`{name}` is not an oscillator parameter"));
             }
         }
@@ -109,8 +114,8 @@ impl Rig<'_> {
             .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
         Ok(RigSetup {
             osc,
-            x0: x0 - offset,
-            v0,
+            x0: initial[0].unwrap_or(x0 - offset),
+            v0: initial[1].unwrap_or(v0),
             offset,
         })
     }

@@ -181,17 +181,43 @@ pub fn sandwich(jac: &DMatrix<f64>, r: &[f64], block: usize) -> Covariance {
             score.axpy(r[i], &row, 1.0);
             own.ger(1.0, &row, &row, 1.0);
         }
-        // The shift on deleting the block; where the rest cannot determine a direction,
-        // the block's plain contribution.
-        let shift = (&c - &own)
-            .cholesky()
-            .map(|ch| ch.solve(&score))
-            .unwrap_or_else(|| &nm.pinv * &score);
+        // The shift on deleting the block; where the block holds most of what determines a
+        // direction (the rest cannot pin it down well), the block's plain contribution.
+        let shift = if leverage(&c, &own) <= MAX_BLOCK_LEVERAGE {
+            (&c - &own).cholesky().map(|ch| ch.solve(&score))
+        } else {
+            None
+        }
+        .unwrap_or_else(|| &nm.pinv * &score);
         cov.ger(1.0, &shift, &shift, 1.0);
     }
     let gf = g as f64;
     cov *= (gf - 1.0) / gf;
     assemble(&nm, &cov)
+}
+
+/// Above this share of the information in some direction, a block's delete-one shift is
+/// dominated by how little the other blocks know there, not by its residuals: a parameter
+/// that only one stretch of the record determines (the initial state, which only the opening
+/// transient shows) would get an error bar orders of magnitude too wide.
+const MAX_BLOCK_LEVERAGE: f64 = 0.5;
+
+/// The largest share of the information `c` (positive definite) that `own` holds in any
+/// direction: the largest generalised eigenvalue of `own` against `c` (∞ if `c` is not
+/// positive definite).
+fn leverage(c: &DMatrix<f64>, own: &DMatrix<f64>) -> f64 {
+    let Some(ch) = c.clone().cholesky() else {
+        return f64::INFINITY;
+    };
+    let l = ch.l();
+    let Some(l_inv) = l.clone().try_inverse() else {
+        return f64::INFINITY;
+    };
+    let m = &l_inv * own * l_inv.transpose();
+    let m = (&m + m.transpose()) * 0.5;
+    m.symmetric_eigenvalues()
+        .iter()
+        .fold(0.0_f64, |a, &b| a.max(b))
 }
 
 /// `D·JᵀJ·D` in the scaled coordinates of `nm` (bad columns zeroed).

@@ -46,7 +46,9 @@ pub use objective::Residuals;
 pub use param::{full_values, FitParam};
 pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
 pub use settings::{FitSettings, Solver};
-pub use trajectory::{TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET};
+pub use trajectory::{
+    initial_state_params, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, INITIAL_STATE,
+};
 pub use transform::BoundTransform;
 pub use warning::{
     fit_warnings, BoundSide, FitWarning, StatedWarning, CORRELATION_LIMIT, NEAR_BOUND,

@@ -2,9 +2,10 @@
 //! without an STF model) and minimise `S(μ) = mean((x_exp − x_sim − x_off)²)`, reported in mm².
 //!
 //! Free parameters are named: the oscillator's (`m`, `k`, `c`, `T`, `delta_T`, `F0`, `eta`),
-//! the STF model's (as its specs name them), and the displacement offset `x_off` (m). Each
-//! evaluation is one simulation from the first sample's time, from `(x0, v0)`: by default
-//! `x0 = x_exp[0] − x_off` and `v0 = 0`. A simulation that fails scores a penalty.
+//! the STF model's (as its specs name them), the displacement offset `x_off` (m) and the
+//! initial state `x0` (m), `v0` (m/s). Each evaluation is one simulation from the first
+//! sample's time, from `(x0, v0)`: fitted, or as set by [`TrajectoryFit::initial`], or by
+//! default `x0 = x_exp[0] − x_off` and `v0 = 0`. A simulation that fails scores a penalty.
 //!
 //! ```
 //! use std::sync::Arc;
@@ -46,6 +47,24 @@ pub struct TrajectoryData<'a> {
 /// Name of the constant displacement offset parameter, m.
 pub const DISPLACEMENT_OFFSET: &str = "x_off";
 
+/// Names of the initial displacement (m) and velocity (m/s) as fitted parameters: a record
+/// that starts in motion has an initial state its noisy first samples give only roughly, and
+/// the transient a wrong one leaves biases every other parameter.
+pub const INITIAL_STATE: [&str; 2] = ["x0", "v0"];
+
+/// The initial state as two parameters to fit, starting from an estimate `(x0, v0)` (m, m/s)
+/// such as [`crate::kinematics::Kinematics::initial_state`]: within 2 mm and 50 mm/s of it.
+pub fn initial_state_params(x0: f64, v0: f64) -> [FitParam; 2] {
+    [
+        FitParam::new(INITIAL_STATE[0], x0)
+            .bounds(x0 - 2e-3, x0 + 2e-3)
+            .scale(1e-4),
+        FitParam::new(INITIAL_STATE[1], v0)
+            .bounds(v0 - 0.05, v0 + 0.05)
+            .scale(1e-3),
+    ]
+}
+
 /// A trajectory-level fit of the oscillator and, optionally, an STF model.
 #[derive(Clone)]
 pub struct TrajectoryFit {
@@ -64,6 +83,7 @@ enum Slot {
     Oscillator(&'static str),
     Model(usize),
     Offset,
+    Initial(usize),
 }
 
 impl TrajectoryFit {
@@ -120,6 +140,9 @@ impl TrajectoryFit {
         if name == DISPLACEMENT_OFFSET {
             return Ok(Slot::Offset);
         }
+        if let Some(i) = INITIAL_STATE.iter().position(|n| *n == name) {
+            return Ok(Slot::Initial(i));
+        }
         let osc = OscillatorParams::NAMES.iter().find(|n| **n == name);
         let model = self
             .model
@@ -135,6 +158,7 @@ impl TrajectoryFit {
                     known.extend(m.params().iter().map(|s| s.name.as_str()));
                 }
                 known.push(DISPLACEMENT_OFFSET);
+                known.extend(INITIAL_STATE);
                 Err(FitError::UnknownParam {
                     name: name.to_string(),
                     known: known.join(", "),
@@ -209,6 +233,7 @@ impl Residuals for TrajectoryResiduals<'_> {
         let mut system = fit.system;
         let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
         let mut offset = 0.0;
+        let mut initial: [Option<f64>; 2] = [None, None];
         let mut free = x.iter();
         for (p, slot) in fit.free.iter().zip(&self.slots) {
             let value = if p.fixed {
@@ -226,6 +251,7 @@ impl Residuals for TrajectoryResiduals<'_> {
                     }
                 }
                 Slot::Offset => offset = value,
+                Slot::Initial(i) => initial[i] = Some(value),
             }
         }
         let mut osc = Oscillator::with_shared_excitation(system, fit.excitation.clone());
@@ -236,6 +262,7 @@ impl Residuals for TrajectoryResiduals<'_> {
         }
         let d = &self.data;
         let (x0, v0) = fit.initial.unwrap_or((d.x[0] - offset, 0.0));
+        let (x0, v0) = (initial[0].unwrap_or(x0), initial[1].unwrap_or(v0));
         let y0 = osc.initial_state(x0, v0);
         let sol = integrate(&osc, d.t[0], &y0, d.t, &fit.sim).map_err(|e| e.to_string())?;
         for (i, &xe) in d.x.iter().enumerate() {

@@ -22,6 +22,15 @@ use super::noise_floor::{NoiseFloor, Quantity};
 use super::param::FitParam;
 use super::result::{Convergence, FitResult};
 
+/// Parameters whose value is near zero by nature (offsets, the initial state): their error
+/// is not compared with their value.
+const ABOUT_ZERO: [&str; 4] = [
+    super::FORCE_OFFSET,
+    super::DISPLACEMENT_OFFSET,
+    super::INITIAL_STATE[0],
+    super::INITIAL_STATE[1],
+];
+
 /// A fit whose RMS residual exceeds this multiple of the noise floor misses an effect.
 pub const RESIDUAL_OVER_FLOOR: f64 = 1.5;
 /// A free parameter this close to a bound — as a fraction of its typical size
@@ -230,7 +239,10 @@ pub fn fit_warnings(
         }
     }
     for p in &free {
-        if p.std_error > p.value.abs() || !p.std_error.is_finite() {
+        // An offset or an initial state is near zero by nature: only an unbounded error
+        // says it is not determined.
+        let about_zero = ABOUT_ZERO.contains(&p.name.as_str());
+        if (p.std_error > p.value.abs() && !about_zero) || !p.std_error.is_finite() {
             out.push(FitWarning::Undetermined {
                 param: p.name.clone(),
                 value: p.value,
@@ -241,6 +253,15 @@ pub fn fit_warnings(
     for (i, row) in result.correlation.iter().enumerate() {
         for (j, &c) in row.iter().enumerate().skip(i + 1) {
             if c.abs() > CORRELATION_LIMIT && c.is_finite() {
+                let nuisance = |k: usize| {
+                    free.get(k)
+                        .is_some_and(|p| ABOUT_ZERO.contains(&p.name.as_str()))
+                };
+                // Two nuisances trading off (x0 against v0 while the trolley sticks) leave
+                // the physics parameters alone.
+                if nuisance(i) && nuisance(j) {
+                    continue;
+                }
                 if let (Some(a), Some(b)) = (free.get(i), free.get(j)) {
                     out.push(FitWarning::Correlated {
                         first: a.name.clone(),
@@ -284,6 +305,7 @@ mod tests {
             name: name.into(),
             value,
             std_error,
+            naive_std_error: std_error,
             fixed: false,
         }
     }
@@ -310,6 +332,7 @@ mod tests {
                 reason: "test".into(),
             },
             log: Vec::new(),
+            error_blocks: None,
         }
     }
 
