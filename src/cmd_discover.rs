@@ -344,6 +344,11 @@ fn run_trajectory(
     for name in &names {
         setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
     }
+    setup = setup.force_hint(stf_core::discovery::ForceHint {
+        v: k.v.clone(),
+        a: k.a.clone(),
+        f: k.recovered_force(&exp.system),
+    });
     if exp.fit.fit_initial {
         let (x0, v0) = k.initial_state();
         for p in stf_core::fit::initial_state_params(x0, v0) {

@@ -47,4 +47,4 @@ pub use holdout::HoldoutSplit;
 pub use report::Discovery;
 pub use score::{CandidateScore, Step};
 pub use settings::DiscoverySettings;
-pub use trajectory::{discover_trajectory, TrajectoryDiscovery, TrajectorySetup};
+pub use trajectory::{discover_trajectory, ForceHint, TrajectoryDiscovery, TrajectorySetup};

@@ -34,11 +34,14 @@ use super::report::Discovery;
 use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
 use super::stage::Stage;
-use super::subset_fit::{rms, rms_over};
+use super::subset_fit::{fit_subset, rms, rms_over};
 use super::trajectory_fit::{fit_on, Rig, Run};
 use super::trajectory_gap::locate_x_gap;
 use crate::excitation::Excitation;
-use crate::fit::{FitParam, FitResult, Solver, TrajectoryData, DISPLACEMENT_OFFSET};
+use crate::fit::{
+    FitParam, FitResult, FitSettings, ForceData, ForceFit, Solver, TrajectoryData,
+    DISPLACEMENT_OFFSET,
+};
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
 use crate::regimes::Cycle;
@@ -72,6 +75,21 @@ pub struct TrajectorySetup {
     pub initial: Option<(f64, f64)>,
     /// Integrator settings of the simulations.
     pub sim: Settings,
+    /// The STF force recovered from the record's kinematics with the setup's oscillator, if
+    /// known: every model is first fitted to it at force level (milliseconds) for its start.
+    pub force_hint: Option<ForceHint>,
+}
+
+/// The record's filtered velocity and acceleration and the STF force recovered from them
+/// (the drive − m·a − k·x − F_R(v), with the setup's oscillator).
+#[derive(Clone, Debug)]
+pub struct ForceHint {
+    /// Velocity, m/s.
+    pub v: Vec<f64>,
+    /// Acceleration, m/s².
+    pub a: Vec<f64>,
+    /// Recovered STF force, N.
+    pub f: Vec<f64>,
 }
 
 impl TrajectorySetup {
@@ -83,6 +101,7 @@ impl TrajectorySetup {
             oscillator: Vec::new(),
             initial: None,
             sim: Settings::default(),
+            force_hint: None,
         }
     }
     /// Refit this oscillator parameter with every model.
@@ -98,6 +117,11 @@ impl TrajectorySetup {
     /// Integrator settings.
     pub fn sim_settings(mut self, sim: Settings) -> Self {
         self.sim = sim;
+        self
+    }
+    /// Start every model from its force-level fit to `hint`.
+    pub fn force_hint(mut self, hint: ForceHint) -> Self {
+        self.force_hint = Some(hint);
         self
     }
 }
@@ -242,6 +266,47 @@ impl Stage {
     }
 }
 
+impl Stage {
+    /// This stage with its model's parameters fitted at force level to the recovered force of
+    /// `hint` on the `train` samples, from its values and from the models' defaults (the
+    /// better kept); the oscillator's values are kept. `None` if no fit succeeds.
+    fn force_started(&self, rig: &Rig, hint: &ForceHint, train: &[usize]) -> Option<Stage> {
+        let model = self.model().ok()?;
+        let n_osc = rig.oscillator.len();
+        let n_model = model.params().len();
+        let current = self.values.get(n_osc..n_osc + n_model)?;
+        let defaults: Vec<f64> = model.params().iter().map(|s| s.default).collect();
+        let data = ForceData {
+            t: rig.t,
+            x: rig.x,
+            v: &hint.v,
+            a: &hint.a,
+            f: &hint.f,
+        };
+        let settings = FitSettings::default().solver(Solver::LevenbergMarquardt);
+        let mut best: Option<(f64, Vec<f64>)> = None;
+        for start in [current, defaults.as_slice()] {
+            let mut fit = ForceFit::new(model.clone());
+            for (spec, &v) in model.params().iter().zip(start) {
+                fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
+            }
+            let Ok(r) = fit_subset(&fit, &data, train, &settings) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|(rms, _)| r.rms < *rms) {
+                best = Some((r.rms, r.params.iter().map(|p| p.value).collect()));
+            }
+        }
+        let (_, fitted) = best?;
+        let mut values = self.values.clone();
+        values[n_osc..n_osc + n_model].copy_from_slice(&fitted);
+        Some(Stage {
+            parts: self.parts.clone(),
+            values,
+        })
+    }
+}
+
 /// Factors of the new effect's first parameter tried before its fit (see
 /// [`Stage::screened`]).
 const SCREEN: [f64; 6] = [1.0, 3.0, 0.3, 0.1, 0.03, 0.01];
@@ -257,7 +322,13 @@ impl Stage {
     /// refits the oscillator into a basin of its own (a lower `k` standing in for a missing
     /// stiffening) from which the sum cannot climb out. Parameters with a negative lower bound
     /// or a non-positive default are not scaled.
-    fn screened(self, rig: &Rig, train: &[usize], osc_start: &[f64]) -> Stage {
+    fn screened(
+        self,
+        rig: &Rig,
+        train: &[usize],
+        osc_start: &[f64],
+        hinted: Option<&Stage>,
+    ) -> Stage {
         let Some(extra) = self.parts.last() else {
             return self;
         };
@@ -275,6 +346,12 @@ impl Stage {
             return self;
         };
         let mut best = (f64::INFINITY, self.values.clone());
+        // The force-level start, as it is.
+        if let Some(h) = hinted.filter(|h| h.values.len() == self.values.len()) {
+            if let Ok(residual) = rig.residual(&model, &h.values) {
+                best = (rms_over(&residual, train), h.values.clone());
+            }
+        }
         let mut from_start = self.values.clone();
         for (v, &s) in from_start.iter_mut().zip(osc_start) {
             *v = s;
@@ -348,7 +425,6 @@ pub fn discover_trajectory(
     let base_name = base.name().to_string();
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
-    let all: Vec<usize> = (0..n).collect();
     let mut notes = Vec::new();
 
     // 1. The base and the oscillator on the whole record: the gap before.
@@ -361,6 +437,11 @@ pub fn discover_trajectory(
             .chain(settings.fit_offset.then_some(0.0))
             .collect(),
         parts: vec![base.clone()],
+    };
+    let all: Vec<usize> = (0..n).collect();
+    let start = match &setup.force_hint {
+        Some(h) => start.force_started(&rig, h, &all).unwrap_or(start),
+        None => start,
     };
     let (base_full, base_result) = start.fit_simulated(&rig, setup, &all, settings)?;
     let run_before = base_full.run(&rig)?;
@@ -379,7 +460,9 @@ pub fn discover_trajectory(
     notes.push(format!("base `{base_name}`: {}", where_before.summary));
 
     // 3–4. Add effects while the held-out evidence demands one.
-    let mut current = start.trial_simulated(&rig, setup, &split, settings)?;
+    // The base's training fit starts from its whole-record fit: from the defaults it can end
+    // in a basin of its own, and every candidate would then be scored against that.
+    let mut current = base_full.trial_simulated(&rig, setup, &split, settings)?;
     let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
@@ -391,11 +474,12 @@ pub fn discover_trajectory(
                 continue;
             }
             let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
-            let stage = current.stage.with(&c.model, &defaults, n_osc).screened(
-                &rig,
-                &split.train,
-                &osc_start,
-            );
+            let with = current.stage.with(&c.model, &defaults, n_osc);
+            let hinted = setup
+                .force_hint
+                .as_ref()
+                .and_then(|h| with.force_started(&rig, h, &split.train));
+            let stage = with.screened(&rig, &split.train, &osc_start, hinted.as_ref());
             let n_own = c.model.params().len();
             scored.push(choice::scored(
                 &c.name,
