@@ -283,7 +283,13 @@ impl Stage {
             a: &hint.a,
             f: &hint.f,
         };
-        let settings = FitSettings::default().solver(Solver::LevenbergMarquardt);
+        // A start, not a result: a few dozen iterations at a loose tolerance (a degenerate
+        // effect — a vanishing yield force that leaves its smoothing speed free — otherwise
+        // creeps for seconds).
+        let settings = FitSettings::default()
+            .solver(Solver::LevenbergMarquardt)
+            .max_iters(40)
+            .tol(1e-6);
         let mut best: Option<(f64, Vec<f64>)> = None;
         for start in [current, defaults.as_slice()] {
             let mut fit = ForceFit::new(model.clone());
