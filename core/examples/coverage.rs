@@ -253,7 +253,7 @@ fn main() {
     let fits: Vec<FitResult> = (1..=seeds).map(|s| trajectory_fit(&run, s)).collect();
     report(
         "trajectory level (rig sensors, the drive reconstructed from the 2048-count encoder, \
-         started from the record's initial state as `stf-lab fit` starts it), K, n and c:",
+         the initial state fitted as `stf-lab fit` does), K, n and c:",
         &fits,
         &traj,
         clock.elapsed().as_secs_f64(),
