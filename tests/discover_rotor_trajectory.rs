@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::{read_json, run_ok, stf_lab};
+use common::{read_json, run_ok, simulate_ok};
 
 /// The x noise RMS of the records, mm (0.05 mm Gaussian, quantised to 0.01 mm).
 const X_NOISE_MM: f64 = 0.0501;
@@ -37,18 +37,7 @@ fn discover(hidden: Option<(&str, &str)>, seed: u64, refit: Option<&str>) -> ser
     )
     .unwrap();
     let record = dir.path().join("r.csv");
-    let sim = stf_lab()
-        .arg("simulate")
-        .arg(&exp)
-        .arg("--out")
-        .arg(&record)
-        .output()
-        .unwrap();
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
-    );
+    simulate_ok(&exp, &record);
     keep_columns(&record, &["t", "phi", "x"]);
     let out = dir.path().join("disc");
     run_ok("discover", &exp, &out);

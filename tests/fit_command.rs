@@ -140,18 +140,7 @@ fn simulate_and_fit(
 ) -> (serde_json::Value, String) {
     let exp = dir.join(format!("{name}.toml"));
     std::fs::write(&exp, experiment).unwrap();
-    let sim = common::stf_lab()
-        .arg("simulate")
-        .arg(&exp)
-        .arg("--out")
-        .arg(dir.join(format!("{name}.csv")))
-        .output()
-        .unwrap();
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
-    );
+    common::simulate_ok(&exp, &dir.join(format!("{name}.csv")));
     let out = dir.join(format!("{name}_fit"));
     let output = run_ok("fit", &exp, &out);
     (

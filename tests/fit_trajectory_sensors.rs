@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{read_json, run_ok, stf_lab};
+use common::{read_json, run_ok, simulate_ok};
 
 /// Simulate a sweep at `alpha` rad/s² (ω 3 → 9.4 rad/s) with `truth`, then fit `model` at
 /// trajectory level from its default starts; fit.json's model.
@@ -22,18 +22,7 @@ fn fit_from_defaults(alpha: f64, seed: u64, truth: &str, model: &str) -> serde_j
         ),
     )
     .unwrap();
-    let sim = stf_lab()
-        .arg("simulate")
-        .arg(&exp)
-        .arg("--out")
-        .arg(dir.path().join("r.csv"))
-        .output()
-        .unwrap();
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
-    );
+    simulate_ok(&exp, &dir.path().join("r.csv"));
     let out = dir.path().join("fit");
     run_ok("fit", &exp, &out);
     let fit = read_json(&out.join("fit.json"));

@@ -36,6 +36,22 @@ pub fn run_ok(command: &str, experiment: &Path, out: &Path) -> Output {
     output
 }
 
+/// `stf-lab simulate EXPERIMENT --out RECORD`, asserting success.
+pub fn simulate_ok(experiment: &Path, record: &Path) {
+    let sim = stf_lab()
+        .arg("simulate")
+        .arg(experiment)
+        .arg("--out")
+        .arg(record)
+        .output()
+        .unwrap();
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+}
+
 /// A JSON result file.
 pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
