@@ -1030,6 +1030,31 @@ mod tests {
     }
 
     #[test]
+    fn the_drive_reconstruction_and_initial_state_are_settings() {
+        use stf_core::reconstruct::DriveSmoothing;
+        let e = parse("[data]\nfile = \"r.csv\"\ndrive = \"samples\"\n").unwrap();
+        assert!(matches!(e.kinematics.drive, DriveSmoothing::Samples(_)));
+        let e = parse("[data]\nfile = \"r.csv\"\ndrive = { order = 2, window = 101 }\n").unwrap();
+        assert!(matches!(e.kinematics.drive, DriveSmoothing::Filter(f) if f.window() == 101));
+        let e = parse("[data]\nfile = \"r.csv\"\n").unwrap();
+        assert_eq!(e.kinematics.drive, DriveSmoothing::Auto);
+        assert!(e.fit.fit_initial);
+        let e = parse("[fit]\ninitial = \"record\"\n").unwrap();
+        assert!(!e.fit.fit_initial);
+        for (text, key) in [
+            ("[data]\nfile = \"r.csv\"\ndrive = \"smooth\"\n", "data.drive"),
+            (
+                "[data]\nfile = \"r.csv\"\ndrive = \"auto\"\n[filter]\nomega = { order = 2, window = 9 }\n",
+                "data.drive",
+            ),
+            ("[fit]\ninitial = \"guess\"\n", "fit.initial"),
+        ] {
+            let msg = format!("{:#}", parse(text).unwrap_err());
+            assert!(msg.contains(key) && msg.contains("exp.toml:"), "{msg}");
+        }
+    }
+
+    #[test]
     fn the_design_example_parses() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("record.csv"), "t,phi,x\n0,0,0\n").unwrap();
