@@ -34,9 +34,7 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
             k.motion_filter.window(),
             k.sigma_a
         ));
-        if let Some(drive) = &k.drive {
-            s.paragraphs.push(format!("Drive: {drive}."));
-        }
+
         let motion = Motion {
             t: &k.t,
             x: &k.x,
@@ -76,6 +74,9 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
                 "trajectory"
             }
         ));
+        if let Some(drive) = &k.drive {
+            s.paragraphs.push(format!("Drive: {drive}."));
+        }
         s.paragraphs.push(warning_rules(fits));
         let mut table = Table {
             caption: "Fitted parameters (± standard error), RMS residual and information criteria."
