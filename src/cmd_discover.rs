@@ -1,7 +1,7 @@
 //! `stf-lab discover EXP.toml --out DIR`: find where the base model and the measurement
 //! disagree, name the missing effect, add it, repeat, and show the gap shrink.
 //!
-//! Candidates are the effects of DESIGN.md §5 (the built-ins `viscous`, `power_law`,
+//! Candidates are the effects of docs/ARCHITECTURE.md §5 (the built-ins `viscous`, `power_law`,
 //! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`) not
 //! already in the base, plus any scripts `[discover] candidates` lists. Writes
 //! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
@@ -32,7 +32,7 @@ use crate::report::{
 };
 use crate::reporting::{record_sections, write_report};
 
-/// The effects of DESIGN.md §5, the default candidates.
+/// The effects of docs/ARCHITECTURE.md §5, the default candidates.
 pub const EFFECTS: [&str; 8] = [
     "viscous",
     "power_law",

@@ -296,7 +296,7 @@ struct RawDiscover {
 pub struct DiscoverSpec {
     /// The base model: a name, a script path, or `a + b`.
     pub base: String,
-    /// Candidate effects (default: the vocabulary of DESIGN.md §5).
+    /// Candidate effects (default: the vocabulary of docs/ARCHITECTURE.md §5).
     pub candidates: Option<Vec<String>>,
     /// At most this many effects are added.
     pub max_effects: Option<usize>,

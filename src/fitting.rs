@@ -184,7 +184,7 @@ impl ModelFit {
         })
     }
 
-    /// The fit as the JSON of DESIGN.md §6 (`name`, `params`, `rms`) and more.
+    /// The fit as the JSON of docs/ARCHITECTURE.md §6 (`name`, `params`, `rms`) and more.
     pub fn to_json(&self, level: FitLevel) -> Value {
         let params: serde_json::Map<String, Value> = self
             .result

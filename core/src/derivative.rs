@@ -665,7 +665,7 @@ mod tests {
 
     #[test]
     fn design_figure_acceleration_noise_of_the_paper_window() {
-        // DESIGN.md: 40-sample order-3 window at 1 kHz, σ = 0.05 mm → a ≈ 0.13 m/s².
+        // The source study's 40-sample order-3 window at 1 kHz, σ = 0.05 mm → a ≈ 0.13 m/s².
         let sigma = 0.05e-3;
         let a_noise = PolyFilter::paper_motion().noise_gain(1e-3, 2) * sigma;
         assert!((a_noise / 0.13 - 1.0).abs() < 0.2, "a noise {a_noise}");

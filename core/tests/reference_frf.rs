@@ -1,5 +1,5 @@
 //! The frequency response of the no-STF forced model on the 0.047 rad/s² sweep against an
-//! independent implementation (local maxima of x), and DESIGN.md's reference figures.
+//! independent implementation (local maxima of x), and the reference figures of docs/ARCHITECTURE.md §1.
 
 use stf_core::analysis::{breakaway, local_maxima, peak, BREAKAWAY_DISPLACEMENT};
 use stf_core::excitation::{Excitation, RotorAngle};

@@ -49,7 +49,7 @@ pub struct BuiltinEntry {
 }
 
 /// Every built-in model, in the order they are listed to users. The names are those of the
-/// discovery vocabulary (DESIGN.md §5).
+/// discovery vocabulary (docs/ARCHITECTURE.md §5).
 pub const BUILTINS: &[BuiltinEntry] = &[
     BuiltinEntry {
         name: "viscous",

@@ -1,4 +1,4 @@
-//! Discovery names each effect of the vocabulary (DESIGN.md §5) hidden in a sweep record.
+//! Discovery names each effect of the vocabulary (docs/ARCHITECTURE.md §5) hidden in a sweep record.
 //!
 //! Truth: a base model plus one effect contributing a share of the force; the record is the
 //! forced rig swept 4 → 10 rad/s at 0.1 rad/s², sampled at 200 Hz with the rig's sensor noise,

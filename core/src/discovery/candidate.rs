@@ -5,7 +5,7 @@ use std::sync::Arc;
 use super::error::DiscoveryError;
 use crate::force_model::ForceModel;
 
-/// An effect the discovery may add, by name (e.g. a name of DESIGN.md §5, or a script's).
+/// An effect the discovery may add, by name (e.g. a name of docs/ARCHITECTURE.md §5, or a script's).
 ///
 /// The model's parameters start at their defaults when the candidate is tried; its name in
 /// the sum is the model's own [`ForceModel::name`], `name` is what reports call the effect.

@@ -19,7 +19,7 @@
 //! oscillator's own parameters with every model ([`trajectory`]).
 //!
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
-//! DESIGN.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
+//! docs/ARCHITECTURE.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
 //!
 //! [`ForceData`]: crate::fit::ForceData
 

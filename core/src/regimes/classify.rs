@@ -1,6 +1,6 @@
 //! Labelling each cycle pre-resonance, resonance or post-resonance.
 //!
-//! The rules, with the thresholds of [`RegimeThresholds`] (DESIGN.md §1 describes the regimes
+//! The rules, with the thresholds of [`RegimeThresholds`] (docs/ARCHITECTURE.md §1 describes the regimes
 //! these defaults reproduce):
 //!
 //! 1. The noise σ of the force is `noise_sigma` if given, else [`noise_floor`] of the record.

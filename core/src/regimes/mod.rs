@@ -1,6 +1,6 @@
 //! Regimes of a sweep and metrics that compare force models regime by regime.
 //!
-//! The source study's STF behaves in three ways along a frequency sweep (DESIGN.md §1):
+//! The source study's STF behaves in three ways along a frequency sweep (docs/ARCHITECTURE.md §1):
 //! negligible force before resonance, a strong damper through resonance, an on–off impact
 //! force after it. This module makes that measurable on any record, measured or simulated:
 //!

@@ -1,5 +1,5 @@
 //! The thresholds of the regime classifier, with defaults that reproduce the source study's
-//! description of its sweep (DESIGN.md §1), overridable from an experiment file.
+//! description of its sweep (docs/ARCHITECTURE.md §1), overridable from an experiment file.
 //!
 //! | key | default | meaning |
 //! |---|---|---|
@@ -13,7 +13,7 @@
 //! | `resonance_amplitude` | 0.6 | … and a displacement amplitude of at least this fraction of the record's largest (within the resonance peak) |
 //! | `smoothing_cycles` | 5 | width of the median filter over the labels (odd; 1: none) |
 //!
-//! How the defaults reproduce DESIGN.md §1: pre-resonance is "F_STF ≤ 0.2 N", hence
+//! How the defaults reproduce docs/ARCHITECTURE.md §1: pre-resonance is "F_STF ≤ 0.2 N", hence
 //! `negligible_force`. The amplitude ratio 0.6 is a little below the half-power ratio 1/√2 of a
 //! linear resonance, because the measured boundary to post-resonance (9.22 rad/s) lies lower on
 //! the peak's flank than the half-power point: on a simulated 0.0333 rad/s² sweep with the

@@ -1,5 +1,5 @@
 //! Shared by the discovery tests: synthetic sweep records whose truth is a sum of built-ins,
-//! and the candidate vocabulary of DESIGN.md §5.
+//! and the candidate vocabulary of docs/ARCHITECTURE.md §5.
 //!
 //! A record: the forced reference oscillator driven by a rotor sweep ω = 4 → 10 rad/s at
 //! 0.1 rad/s² (60 s, through resonance at 5.9 rad/s), simulated with the truth model,
