@@ -26,6 +26,7 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{load_data, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
+use crate::progress::{discovery_observer, Progress};
 use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
@@ -120,14 +121,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         settings = settings.holdout_every(n);
     }
     let started = Instant::now();
-    if !quiet {
-        eprintln!(
-            "discovering from `{}` over {} candidates on {} cycles…",
-            spec.base,
-            candidates.len(),
-            cycles.len()
-        );
-    }
+    let progress = Progress::new(quiet);
+    let bar = progress.job("discover");
+    let (unit, scale) = match data.level {
+        FitLevel::Force => ("N", 1.0),
+        FitLevel::Trajectory => ("mm", 1e3),
+    };
+    settings.observer = discovery_observer(bar.clone(), unit, scale);
     if data.level == FitLevel::Trajectory {
         return run_trajectory(
             &exp,
@@ -137,10 +137,20 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             &cycles,
             &settings,
             out,
-            quiet,
+            (quiet, &bar),
         );
     }
-    let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings)?;
+    if !quiet {
+        eprintln!(
+            "discovering from `{}` over {} candidates on {} cycles…",
+            spec.base,
+            candidates.len(),
+            cycles.len()
+        );
+    }
+    let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings);
+    bar.finish_and_clear();
+    let found = found?;
     let wall = started.elapsed().as_secs_f64();
 
     // The final model as an experiment entry that `fit` and `compare` accept as it is.
@@ -331,7 +341,7 @@ fn run_trajectory(
     cycles: &[stf_core::regimes::Cycle],
     settings: &DiscoverySettings,
     out: &Path,
-    quiet: bool,
+    (quiet, bar): (bool, &indicatif::ProgressBar),
 ) -> Result<()> {
     let Some(spec) = &exp.discover else {
         bail!("{}: has no [discover] section", exp.path.display());
@@ -371,7 +381,9 @@ fn run_trajectory(
         t: &data.record.t,
         x: &data.record.x,
     };
-    let tf = discover_trajectory(base, candidates, &td, cycles, &setup, &settings)?;
+    let tf = discover_trajectory(base, candidates, &td, cycles, &setup, &settings);
+    bar.finish_and_clear();
+    let tf = tf?;
     let wall = started.elapsed().as_secs_f64();
     let found = &tf.discovery;
     let model_params: Vec<&FittedParam> = found

@@ -3,7 +3,11 @@
 
 use std::io::IsTerminal;
 
+use std::sync::Mutex;
+use std::time::Instant;
+
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use stf_core::discovery::{DiscoveryEvent, Observer};
 use stf_core::fit::FitProgress;
 
 /// A set of spinners, one per running job.
@@ -45,4 +49,72 @@ pub fn fit_message(p: &FitProgress) -> String {
         "{:?}: {} evaluations, best cost {:.4e}",
         p.stage, p.evaluations, p.best_cost
     )
+}
+
+/// The live display of a discovery run on `bar`: the step, the candidate being fitted (i of
+/// n), the best held-out score so far in the step (residuals in `unit`, scaled by `scale`
+/// from SI) and the time left in the step, from the mean time of its candidates so far.
+pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> Observer {
+    struct StepState {
+        step: usize,
+        started: Instant,
+        done: usize,
+        best: Option<(String, f64, f64)>,
+    }
+    let state = Mutex::new(StepState {
+        step: 0,
+        started: Instant::now(),
+        done: 0,
+        best: None,
+    });
+    Observer::new(move |event| {
+        let Ok(mut s) = state.lock() else {
+            return;
+        };
+        match event {
+            DiscoveryEvent::Base => bar.set_message("fitting the base on the whole record"),
+            DiscoveryEvent::Candidate {
+                step,
+                index,
+                of,
+                name,
+            } => {
+                if *step != s.step {
+                    *s = StepState {
+                        step: *step,
+                        started: Instant::now(),
+                        done: 0,
+                        best: None,
+                    };
+                }
+                let left = (s.done > 0).then(|| {
+                    let each = s.started.elapsed().as_secs_f64() / s.done as f64;
+                    format!(" · ~{:.0} s left in this step", each * (of - index) as f64)
+                });
+                let best = s.best.as_ref().map(|(n, rms, z)| {
+                    format!(
+                        " · best `{n}` held-out {:.4} {unit} (z {z:.1})",
+                        rms * scale
+                    )
+                });
+                bar.set_message(format!(
+                    "step {step} · candidate {}/{of} `{name}`{}{}",
+                    index + 1,
+                    best.unwrap_or_default(),
+                    left.unwrap_or_default()
+                ));
+            }
+            DiscoveryEvent::Scored {
+                name,
+                holdout_rms,
+                gain_z,
+                ..
+            } => {
+                s.done += 1;
+                if s.best.as_ref().is_none_or(|(_, r, _)| holdout_rms < r) {
+                    s.best = Some((name.clone(), *holdout_rms, *gain_z));
+                }
+            }
+        }
+    })
 }

@@ -9,6 +9,7 @@ use super::choice::{self, Trial};
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
 use super::holdout::HoldoutSplit;
+use super::progress::DiscoveryEvent;
 use super::report::Discovery;
 use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
@@ -402,6 +403,7 @@ pub fn discover_force(
     let all: Vec<usize> = (0..n).collect();
     let mut notes = Vec::new();
 
+    settings.observer.emit(DiscoveryEvent::Base);
     // 1. The base on the whole record: the gap before.
     let start = Stage {
         values: base
@@ -430,13 +432,20 @@ pub fn discover_force(
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
-    for _ in 0..settings.max_effects {
+    for step in 1..=settings.max_effects {
         let current_residual = current.stage.residuals(data, settings)?;
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
-        for c in candidates {
-            if current.stage.holds(c, &in_base, &effects) {
-                continue;
-            }
+        let tried: Vec<&Candidate> = candidates
+            .iter()
+            .filter(|c| !current.stage.holds(c, &in_base, &effects))
+            .collect();
+        for (index, c) in tried.iter().enumerate() {
+            settings.observer.emit(DiscoveryEvent::Candidate {
+                step,
+                index,
+                of: tried.len(),
+                name: c.name.clone(),
+            });
             let starts = candidate_starts(
                 &c.model,
                 data,
@@ -461,6 +470,7 @@ pub fn discover_force(
                 base_excess,
                 settings,
             ));
+            emit_scored(settings, step, scored.last());
         }
         if scored.is_empty() {
             break;
@@ -723,6 +733,22 @@ fn reconsider(
 /// transform; any other value is the start as it is. (This used to move values 1 % of the
 /// width below an upper bound, so a refit from a training fit with `p` = 3 started elsewhere;
 /// the stall it worked around was the transform moving interior starts, now fixed.)
+/// Report the score of the candidate just tried.
+pub(super) fn emit_scored(
+    settings: &DiscoverySettings,
+    step: usize,
+    last: Option<&(CandidateScore, Option<Trial>)>,
+) {
+    if let Some((score, _)) = last {
+        settings.observer.emit(DiscoveryEvent::Scored {
+            step,
+            name: score.name.clone(),
+            holdout_rms: score.holdout_rms,
+            gain_z: score.gain_z,
+        });
+    }
+}
+
 pub(super) fn inside(v: f64, min: f64, max: f64) -> f64 {
     v.clamp(min, max)
 }

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
+use super::progress::Observer;
 use crate::fit::FitSettings;
 
 /// How discovery fits, holds out data and decides that an effect is significant.
@@ -44,6 +45,9 @@ pub struct DiscoverySettings {
     /// over its nonlinear parameters, scored by variable projection on the current residual;
     /// the trial with the lowest training RMS is kept (default 1; 0: the defaults only).
     pub extra_starts: usize,
+    /// Called as the run goes (step, candidate, score): for a live display.
+    #[serde(skip)]
+    pub observer: Observer,
 }
 
 impl Default for DiscoverySettings {
@@ -57,6 +61,7 @@ impl Default for DiscoverySettings {
             noise_sigma: None,
             fit_offset: false,
             extra_starts: 1,
+            observer: Observer::default(),
         }
     }
 }

@@ -27,9 +27,10 @@ use std::sync::Arc;
 use super::acceptance;
 use super::candidate::{self, Candidate};
 use super::choice::{self, Trial};
-use super::engine::inside;
+use super::engine::{emit_scored, inside};
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
+use super::progress::DiscoveryEvent;
 use super::report::Discovery;
 use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
@@ -433,6 +434,7 @@ pub fn discover_trajectory(
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
     let mut notes = Vec::new();
 
+    settings.observer.emit(DiscoveryEvent::Base);
     // 1. The base and the oscillator on the whole record: the gap before.
     let start = Stage {
         values: setup
@@ -473,12 +475,19 @@ pub fn discover_trajectory(
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
-    for _ in 0..settings.max_effects {
+    for step in 1..=settings.max_effects {
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
-        for c in candidates {
-            if current.stage.holds(c, &in_base, &effects) {
-                continue;
-            }
+        let tried: Vec<&Candidate> = candidates
+            .iter()
+            .filter(|c| !current.stage.holds(c, &in_base, &effects))
+            .collect();
+        for (index, c) in tried.iter().enumerate() {
+            settings.observer.emit(DiscoveryEvent::Candidate {
+                step,
+                index,
+                of: tried.len(),
+                name: c.name.clone(),
+            });
             let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
             let with = current.stage.with(&c.model, &defaults, n_osc);
             let hinted = setup
@@ -496,6 +505,7 @@ pub fn discover_trajectory(
                 base_excess,
                 settings,
             ));
+            emit_scored(settings, step, scored.last());
         }
         if scored.is_empty() {
             break;
