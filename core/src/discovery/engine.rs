@@ -435,17 +435,11 @@ pub fn discover_force(
     for step in 1..=settings.max_effects {
         let current_residual = current.stage.residuals(data, settings)?;
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
-        let tried: Vec<&Candidate> = candidates
-            .iter()
-            .filter(|c| !current.stage.holds(c, &in_base, &effects))
-            .collect();
+        let tried = current.stage.to_try(candidates, &in_base, &effects);
         for (index, c) in tried.iter().enumerate() {
-            settings.observer.emit(DiscoveryEvent::Candidate {
-                step,
-                index,
-                of: tried.len(),
-                name: c.name.clone(),
-            });
+            settings
+                .observer
+                .candidate(step, index, tried.len(), &c.name);
             let starts = candidate_starts(
                 &c.model,
                 data,

@@ -48,6 +48,16 @@ impl Observer {
         Observer(Some(Arc::new(f)))
     }
 
+    /// Report that candidate `index` of `of`, `name`, is being fitted in `step`.
+    pub(crate) fn candidate(&self, step: usize, index: usize, of: usize, name: &str) {
+        self.emit(DiscoveryEvent::Candidate {
+            step,
+            index,
+            of,
+            name: name.to_string(),
+        });
+    }
+
     /// Report `event` (nothing without an observer).
     pub(crate) fn emit(&self, event: DiscoveryEvent) {
         if let Some(f) = &self.0 {

@@ -42,6 +42,19 @@ impl Stage {
             .join(" + ")
     }
 
+    /// The candidates a step tries: those this stage does not already hold ([`Stage::holds`]).
+    pub fn to_try<'a>(
+        &self,
+        candidates: &'a [Candidate],
+        in_base: &[String],
+        effects: &[String],
+    ) -> Vec<&'a Candidate> {
+        candidates
+            .iter()
+            .filter(|c| !self.holds(c, in_base, effects))
+            .collect()
+    }
+
     /// Whether candidate `c` is already in the model: its model is a part of the base (whose
     /// parts are named `in_base`) or of this stage, or its name is one of `effects`.
     pub fn holds(&self, c: &Candidate, in_base: &[String], effects: &[String]) -> bool {

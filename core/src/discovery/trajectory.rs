@@ -477,17 +477,11 @@ pub fn discover_trajectory(
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
         let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
-        let tried: Vec<&Candidate> = candidates
-            .iter()
-            .filter(|c| !current.stage.holds(c, &in_base, &effects))
-            .collect();
+        let tried = current.stage.to_try(candidates, &in_base, &effects);
         for (index, c) in tried.iter().enumerate() {
-            settings.observer.emit(DiscoveryEvent::Candidate {
-                step,
-                index,
-                of: tried.len(),
-                name: c.name.clone(),
-            });
+            settings
+                .observer
+                .candidate(step, index, tried.len(), &c.name);
             let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
             let with = current.stage.with(&c.model, &defaults, n_osc);
             let hinted = setup
