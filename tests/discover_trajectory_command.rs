@@ -6,23 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{read_json, root, run_ok, stf_lab};
-
-/// `stf-lab simulate EXP --out OUT`, asserting success.
-fn simulate(exp: &Path, out: &Path) {
-    let run = stf_lab()
-        .arg("simulate")
-        .arg(exp)
-        .arg("--out")
-        .arg(out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-}
+use common::{read_json, root, run_ok, simulate_ok};
 
 /// A 20 s chirp 0.5 → 1.5 Hz of 2 N through resonance at 200 Hz on the frictionless forced
 /// trolley, STF = 1·v + k3·x³, rig sensors; simulated by the program into `record.csv`.
@@ -42,7 +26,7 @@ fn write_record(dir: &Path, k3: f64) {
         ),
     )
     .unwrap();
-    simulate(&exp, &dir.join("record.csv"));
+    simulate_ok(&exp, &dir.join("record.csv"));
 }
 
 /// The discovery experiment on `record.csv`: the oscillator 2 % off the truth; m, k, c refitted
