@@ -71,9 +71,10 @@ fn simulated_response(
             osc = osc.with_model(c.model.clone(), f.model_values())?;
         }
     }
+    let (x0, v0) = k.initial_state();
     let run = Simulation::new(&osc)
         .settings(exp.integrator.clone())
-        .initial(k.initial_state().0, k.initial_state().1)
+        .initial(x0, v0)
         .run_at(&k.t)?;
     let p = peak(&run.t, &run.x, k.omega.as_deref()).context("empty simulation")?;
     Ok((

@@ -348,9 +348,10 @@ fn run_trajectory(
     };
     let k = &data.kinematics;
     let names = refitted(exp, data);
+    let (x0, v0) = k.initial_state();
     let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
-        .initial(k.initial_state().0, k.initial_state().1);
+        .initial(x0, v0);
     for name in &names {
         setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
     }
@@ -360,7 +361,6 @@ fn run_trajectory(
         f: k.recovered_force(&exp.system),
     });
     if exp.fit.fit_initial {
-        let (x0, v0) = k.initial_state();
         for p in stf_core::fit::initial_state_params(x0, v0) {
             setup = setup.refit(p);
         }

@@ -219,17 +219,17 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let record = Record::read(&stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
+        let (x0, v0) = k.initial_state();
         let mut fit = TrajectoryFit::new(system, Arc::new(k.excitation()))
             .sim_settings(exp.integrator.clone())
             .settings(exp.fit.settings.clone())
-            .initial(k.initial_state().0, k.initial_state().1);
+            .initial(x0, v0);
         let mut free: Vec<_> = stage
             .free
             .iter()
             .map(|name| system_param(name, system.get(name).unwrap_or(0.0)))
             .collect();
         if exp.fit.fit_initial {
-            let (x0, v0) = k.initial_state();
             free.extend(stf_core::fit::initial_state_params(x0, v0));
         }
         for p in &free {

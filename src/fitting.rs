@@ -348,10 +348,11 @@ fn fit_trajectory(
 ) -> Result<ModelFit> {
     let k = &data.kinematics;
     let excitation = Arc::new(k.excitation());
+    let (x0, v0) = k.initial_state();
     let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
         .sim_settings(exp.integrator.clone())
         .settings(exp.fit.settings.clone())
-        .initial(k.initial_state().0, k.initial_state().1);
+        .initial(x0, v0);
     let mut free: Vec<FitParam> = Vec::new();
     if let Some(c) = configured {
         fit = fit.model(c.model.clone(), c.values());
@@ -364,7 +365,6 @@ fn fit_trajectory(
     if exp.fit.offset {
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
     }
-    let (x0, v0) = k.initial_state();
     if exp.fit.fit_initial {
         free.extend(initial_state_params(x0, v0));
     }
