@@ -117,6 +117,7 @@ impl Kinematics {
         let dt = sample_step(&record.t)?;
         let rate = 1.0 / dt;
         let (phi, omega, u, drive) = reconstruct_drive(record, dt, &s.drive)?;
+        let sigma_x = position_noise(&record.x);
         let motion = match &s.motion {
             Some(f) => *f,
             None => {
@@ -126,19 +127,12 @@ impl Kinematics {
                     .x
                     .iter()
                     .fold(0.0_f64, |m, x| m.max((x - mean).abs()));
-                let window = choose_motion_window(
-                    rate,
-                    f,
-                    x_amp,
-                    position_noise(&record.x),
-                    s.motion_order,
-                    record.t.len(),
-                );
+                let window =
+                    choose_motion_window(rate, f, x_amp, sigma_x, s.motion_order, record.t.len());
                 PolyFilter::new(s.motion_order, window)?.boundary(s.boundary)
             }
         };
         let d = motion.apply(dt, &record.x)?;
-        let sigma_x = position_noise(&record.x);
         let fallback = if motion.boundary_handling() == Boundary::Shifted {
             (d.value[0], d.d1[0])
         } else {

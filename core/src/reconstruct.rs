@@ -60,13 +60,35 @@ pub enum DriveSignal {
     U,
 }
 
+/// How a drive signal was reconstructed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DriveMethod {
+    /// Smoothed with a window chosen from the record.
+    Auto,
+    /// Smoothed with the filter the experiment set.
+    Set,
+    /// Interpolated through the samples, not smoothed.
+    Samples,
+}
+
+impl std::fmt::Display for DriveMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            DriveMethod::Auto => "auto",
+            DriveMethod::Set => "set",
+            DriveMethod::Samples => "samples",
+        })
+    }
+}
+
 /// What the reconstruction did, for reports.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DriveReport {
     /// The signal reconstructed.
     pub signal: DriveSignal,
-    /// `auto`, `set` or `samples` (interpolated through the samples, not smoothed).
-    pub method: &'static str,
+    /// How the window was chosen, or that the signal was not smoothed.
+    pub method: DriveMethod,
     /// Polynomial order of the filter.
     pub order: usize,
     /// Window, samples.
@@ -89,7 +111,7 @@ impl DriveReport {
     /// Every how many samples a simulation needs a knot of the reconstructed signal: a
     /// sixteenth of the smoothing window (every sample when interpolated through them).
     pub fn knot_stride(&self) -> usize {
-        if self.method == "samples" {
+        if self.method == DriveMethod::Samples {
             1
         } else {
             (self.window / 16).max(1)
@@ -104,7 +126,7 @@ impl std::fmt::Display for DriveReport {
             DriveSignal::Phi => "rotor angle φ",
             DriveSignal::U => "drive force u",
         };
-        if self.method == "samples" {
+        if self.method == DriveMethod::Samples {
             return write!(
                 f,
                 "{what} interpolated through its samples (slope from order {} over {} samples)",
@@ -183,17 +205,17 @@ pub fn reconstruct(
         0.0
     };
     let (filter, method) = match how {
-        DriveSmoothing::Filter(f) => (*f, "set"),
-        DriveSmoothing::Samples(f) => (*f, "samples"),
+        DriveSmoothing::Filter(f) => (*f, DriveMethod::Set),
+        DriveSmoothing::Samples(f) => (*f, DriveMethod::Samples),
         DriveSmoothing::Auto if signal == DriveSignal::U && scatter > 0.0 => {
-            (force_window(dt, y, scatter)?, "auto")
+            (force_window(dt, y, scatter)?, DriveMethod::Auto)
         }
         DriveSmoothing::Auto => match choose_window(dt, y, scatter)? {
-            Some(f) => (f, "auto"),
-            None => (samples_filter(y.len())?, "samples"),
+            Some(f) => (f, DriveMethod::Auto),
+            None => (samples_filter(y.len())?, DriveMethod::Samples),
         },
     };
-    let smoothed = method != "samples";
+    let smoothed = method != DriveMethod::Samples;
     // A force interpolated through its samples needs no slope; a record shorter than the
     // window is an error otherwise (the automatic choice never picks such a window).
     let d = if !smoothed && signal == DriveSignal::U {
@@ -366,7 +388,7 @@ mod tests {
             .map(|i| (r.slope[i] - (3.0 + 0.05 * i as f64 * dt)).abs())
             .fold(0.0_f64, f64::max);
         assert!(w_err < 1e-3, "max |ω − ω_true| = {w_err:e}");
-        assert_eq!(r.report.method, "auto");
+        assert_eq!(r.report.method, DriveMethod::Auto);
         let ratio = r.report.residual_over_step.unwrap();
         assert!((ratio - 12f64.sqrt().recip()).abs() < 0.03, "{ratio}");
     }
@@ -432,7 +454,7 @@ mod tests {
                 .sqrt()
         };
         let (raw, smooth) = (rms(&measured), rms(&r.value));
-        assert_eq!(r.report.method, "auto");
+        assert_eq!(r.report.method, DriveMethod::Auto);
         assert!(
             smooth < 0.4 * raw,
             "raw {raw:.4} N, smoothed {smooth:.4} N: {:?}",
@@ -445,6 +467,6 @@ mod tests {
         let (dt, exact, _) = encoder_sweep(2048);
         let r = reconstruct(DriveSignal::Phi, dt, &exact, &DriveSmoothing::Auto).unwrap();
         assert_eq!(r.value, exact);
-        assert_eq!(r.report.method, "samples");
+        assert_eq!(r.report.method, DriveMethod::Samples);
     }
 }
