@@ -89,7 +89,10 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
                 }
                 let left = (s.done > 0).then(|| {
                     let each = s.started.elapsed().as_secs_f64() / s.done as f64;
-                    format!(" · ~{:.0} s left in this step", each * (of - index) as f64)
+                    format!(
+                        " · ~{:.0} s left in this step",
+                        each * of.saturating_sub(s.done) as f64
+                    )
                 });
                 let best = s.best.as_ref().map(|(n, rms, z)| {
                     format!(

@@ -3,6 +3,8 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use super::acceptance;
 use super::candidate::{self, Candidate};
 use super::choice::{self, Trial};
@@ -434,38 +436,43 @@ pub fn discover_force(
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
         let current_residual = current.stage.residuals(data, settings)?;
-        let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         let tried = current.stage.to_try(candidates, &in_base, &effects);
-        for (index, c) in tried.iter().enumerate() {
-            settings
-                .observer
-                .candidate(step, index, tried.len(), &c.name);
-            let starts = candidate_starts(
-                &c.model,
-                data,
-                &split.train,
-                &current_residual,
-                settings.extra_starts,
-            );
-            let n_own = c.model.params().len();
-            let best = best_trial(
-                &starts,
-                |start| current.stage.with(&c.model, start, 0),
-                data,
-                &split,
-                settings,
-            );
-            scored.push(choice::scored(
-                &c.name,
-                n_own,
-                best,
-                &current,
-                acceptance::paired_z,
-                base_excess,
-                settings,
-            ));
-            emit_scored(settings, step, scored.last());
-        }
+        // The candidates are independent trials against the same current model: fitted in
+        // parallel, scored in their order.
+        let scored: Vec<(CandidateScore, Option<Trial>)> = tried
+            .par_iter()
+            .enumerate()
+            .map(|(index, c)| {
+                settings
+                    .observer
+                    .candidate(step, index, tried.len(), &c.name);
+                let starts = candidate_starts(
+                    &c.model,
+                    data,
+                    &split.train,
+                    &current_residual,
+                    settings.extra_starts,
+                );
+                let best = best_trial(
+                    &starts,
+                    |start| current.stage.with(&c.model, start, 0),
+                    data,
+                    &split,
+                    settings,
+                );
+                let s = choice::scored(
+                    &c.name,
+                    c.model.params().len(),
+                    best,
+                    &current,
+                    acceptance::paired_z,
+                    base_excess,
+                    settings,
+                );
+                emit_scored(settings, step, Some(&s));
+                s
+            })
+            .collect();
         if scored.is_empty() {
             break;
         }

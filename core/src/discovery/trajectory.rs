@@ -24,6 +24,8 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use super::acceptance;
 use super::candidate::{self, Candidate};
 use super::choice::{self, Trial};
@@ -45,6 +47,7 @@ use crate::fit::{
 };
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
+use crate::params::ParamSpec;
 use crate::regimes::Cycle;
 use crate::system::OscillatorParams;
 
@@ -315,70 +318,125 @@ impl Stage {
 }
 
 /// Factors of the new effect's first parameter tried before its fit (see
-/// [`Stage::screened`]).
+/// [`Stage::starts`]).
 const SCREEN: [f64; 6] = [1.0, 3.0, 0.3, 0.1, 0.03, 0.01];
 
+/// Iterations of the short Levenberg–Marquardt fit that ranks a candidate's starts (see
+/// [`Stage::started`]).
+const START_ITERS: u64 = 6;
+
 impl Stage {
-    /// This stage (with a new effect last) with the effect's first parameter — its amplitude,
-    /// by the models' convention — set to the one of `SCREEN` × its default that gives the
-    /// lowest training S, one simulation each. A trajectory is a strongly non-linear function
-    /// of a stiffness or a force amplitude, so a fit from a default far from the data's value
-    /// ends in a local minimum worse than the model without the effect; the screen starts it
-    /// near the right size. The oscillator's parameters are screened too, between their
-    /// current values and `osc_start` (the setup's): a base that lacks an effect often
-    /// refits the oscillator into a basin of its own (a lower `k` standing in for a missing
-    /// stiffening) from which the sum cannot climb out. Parameters with a negative lower bound
-    /// or a non-positive default are not scaled.
-    fn screened(
-        self,
+    /// The starts of this stage's fit (a new effect last), one from each family, without
+    /// repeats: the force-level start `hinted`, and three bases — the current values, the
+    /// current model on the setup's oscillator (`osc_start`), and every parameter at its
+    /// default on the setup's oscillator — each with the effect's first parameter (its
+    /// amplitude, by the models' convention) set to the one of `SCREEN` × its default that
+    /// gives the lowest training S, one simulation each.
+    ///
+    /// A trajectory is a strongly non-linear function of a stiffness or a force amplitude, so
+    /// a fit from a default far from the data's value ends in a local minimum worse than the
+    /// model without the effect; the screen starts it near the right size. A base that lacks
+    /// an effect often refits the oscillator, and its own law, into a basin of their own (a
+    /// lower `k` standing in for a missing stiffening, a power law gone linear standing in for
+    /// a missing yield force) from which the sum cannot climb out; the fresh bases start
+    /// outside it. The lowest starting S is not the best basin, so each family's start is
+    /// kept. Parameters with a negative lower bound or a non-positive default are not scaled.
+    fn starts(
+        &self,
         rig: &Rig,
         train: &[usize],
         osc_start: &[f64],
         hinted: Option<&Stage>,
-    ) -> Stage {
-        let Some(extra) = self.parts.last() else {
-            return self;
-        };
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let Some(i) = (rig.oscillator.len() + n_model).checked_sub(extra.params().len()) else {
-            return self;
-        };
-        let Some(spec) = extra.params().first() else {
-            return self;
-        };
-        if !(spec.min >= 0.0 && spec.default > 0.0) || i >= self.values.len() {
-            return self;
-        }
-        let Ok(model) = self.model() else {
-            return self;
-        };
-        let mut best = (f64::INFINITY, self.values.clone());
-        // The force-level start, as it is.
-        if let Some(h) = hinted.filter(|h| h.values.len() == self.values.len()) {
-            if let Ok(residual) = rig.residual(&model, &h.values) {
-                best = (rms_over(&residual, train), h.values.clone());
+    ) -> Vec<Stage> {
+        let mut out: Vec<Stage> = hinted
+            .filter(|h| h.values.len() == self.values.len())
+            .into_iter()
+            .cloned()
+            .collect();
+        let screen = self.amplitude(osc_start.len()).zip(self.model().ok());
+        for values in self.bases(osc_start) {
+            let mut best = (f64::INFINITY, values.clone());
+            if let Some(((i, spec), model)) = &screen {
+                let mut values = values;
+                for f in SCREEN {
+                    values[*i] = inside(spec.default * f, spec.min, spec.max);
+                    if let Ok(residual) = rig.residual(model, &values) {
+                        let s = rms_over(&residual, train);
+                        if s < best.0 {
+                            best = (s, values.clone());
+                        }
+                    }
+                }
+            }
+            if !out.iter().any(|o| o.values == best.1) {
+                out.push(Stage {
+                    parts: self.parts.clone(),
+                    values: best.1,
+                });
             }
         }
+        out
+    }
+
+    /// The current values; the current model on the oscillator `osc_start`; every parameter
+    /// at its default on `osc_start` (the offset, if any, as it is).
+    fn bases(&self, osc_start: &[f64]) -> [Vec<f64>; 3] {
         let mut from_start = self.values.clone();
         for (v, &s) in from_start.iter_mut().zip(osc_start) {
             *v = s;
         }
-        for base in [self.values.clone(), from_start] {
-            let mut values = base;
-            for f in SCREEN {
-                values[i] = inside(spec.default * f, spec.min, spec.max);
-                if let Ok(residual) = rig.residual(&model, &values) {
-                    let s = rms_over(&residual, train);
-                    if s < best.0 {
-                        best = (s, values.clone());
-                    }
-                }
+        let mut fresh = from_start.clone();
+        let defaults = self
+            .parts
+            .iter()
+            .flat_map(|p| p.params().iter().map(|s| s.default));
+        for (v, d) in fresh.iter_mut().skip(osc_start.len()).zip(defaults) {
+            *v = d;
+        }
+        [self.values.clone(), from_start, fresh]
+    }
+
+    /// The last part's first parameter and its index in `values` (after `n_osc` oscillator
+    /// values), if it can be screened: a non-negative lower bound and a positive default.
+    fn amplitude(&self, n_osc: usize) -> Option<(usize, ParamSpec)> {
+        let extra = self.parts.last()?;
+        let spec = extra.params().first()?;
+        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
+        let i = (n_osc + n_model).checked_sub(extra.params().len())?;
+        (spec.min >= 0.0 && spec.default > 0.0 && i < self.values.len()).then(|| (i, spec.clone()))
+    }
+
+    /// The best of `starts` after a short fit of each (`START_ITERS` Levenberg–Marquardt
+    /// iterations on the training samples): the stage a full fit continues from. One start
+    /// is returned as it is.
+    fn started(
+        starts: Vec<Stage>,
+        rig: &Rig,
+        setup: &TrajectorySetup,
+        train: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Option<Stage> {
+        if starts.len() < 2 {
+            return starts.into_iter().next();
+        }
+        let short = DiscoverySettings {
+            fit: settings
+                .fit
+                .clone()
+                .solver(Solver::LevenbergMarquardt)
+                .max_iters(START_ITERS),
+            ..settings.clone()
+        };
+        let mut best: Option<(f64, Stage)> = None;
+        for start in &starts {
+            let Ok((stage, fit)) = start.fit_simulated(rig, setup, train, &short) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|(rms, _)| fit.rms < *rms) {
+                best = Some((fit.rms, stage));
             }
         }
-        Stage {
-            parts: self.parts,
-            values: best.1,
-        }
+        best.map(|(_, s)| s).or_else(|| starts.into_iter().next())
     }
 }
 
@@ -476,31 +534,38 @@ pub fn discover_trajectory(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
-        let mut scored: Vec<(CandidateScore, Option<Trial>)> = Vec::new();
         let tried = current.stage.to_try(candidates, &in_base, &effects);
-        for (index, c) in tried.iter().enumerate() {
-            settings
-                .observer
-                .candidate(step, index, tried.len(), &c.name);
-            let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
-            let with = current.stage.with(&c.model, &defaults, n_osc);
-            let hinted = setup
-                .force_hint
-                .as_ref()
-                .and_then(|h| with.force_started(&rig, h, &split.train));
-            let stage = with.screened(&rig, &split.train, &osc_start, hinted.as_ref());
-            let n_own = c.model.params().len();
-            scored.push(choice::scored(
-                &c.name,
-                n_own,
-                stage.trial_simulated(&rig, setup, &split, settings),
-                &current,
-                cycle_gain_z,
-                base_excess,
-                settings,
-            ));
-            emit_scored(settings, step, scored.last());
-        }
+        // Independent trials against the same current model: fitted in parallel, scored in
+        // their order.
+        let scored: Vec<(CandidateScore, Option<Trial>)> = tried
+            .par_iter()
+            .enumerate()
+            .map(|(index, c)| {
+                settings
+                    .observer
+                    .candidate(step, index, tried.len(), &c.name);
+                let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+                let with = current.stage.with(&c.model, &defaults, n_osc);
+                let hinted = setup
+                    .force_hint
+                    .as_ref()
+                    .and_then(|h| with.force_started(&rig, h, &split.train));
+                let starts = with.starts(&rig, &split.train, &osc_start, hinted.as_ref());
+                let stage =
+                    Stage::started(starts, &rig, setup, &split.train, settings).unwrap_or(with);
+                let s = choice::scored(
+                    &c.name,
+                    c.model.params().len(),
+                    stage.trial_simulated(&rig, setup, &split, settings),
+                    &current,
+                    cycle_gain_z,
+                    base_excess,
+                    settings,
+                );
+                emit_scored(settings, step, Some(&s));
+                s
+            })
+            .collect();
         if scored.is_empty() {
             break;
         }
