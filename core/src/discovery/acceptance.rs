@@ -63,11 +63,13 @@ pub fn is_significant(score: &CandidateScore, settings: &DiscoverySettings) -> b
 
 /// The accepted candidate (its index in `scores`: of the ties, the one with the fewest own
 /// `params`, then the lowest BIC) and the indices of its ties, from scores
-/// whose `significant` flag is set and their held-out residuals `holdout` (same order);
-/// `None` if none is significant.
+/// whose `significant` flag is set and their held-out units `holdout` (same order), compared
+/// by the level's paired test `gain_z` ([`paired_z`] over samples, the log-ratio over cycles
+/// at trajectory level); `None` if none is significant.
 pub fn choose(
     scores: &[CandidateScore],
     holdout: &[&[f64]],
+    gain_z: fn(&[f64], &[f64]) -> f64,
     settings: &DiscoverySettings,
 ) -> Option<(usize, Vec<usize>)> {
     let best = (0..scores.len())
@@ -76,7 +78,7 @@ pub fn choose(
     let tied: Vec<usize> = (0..scores.len())
         .filter(|&i| {
             scores[i].significant
-                && (i == best || paired_z(holdout[i], holdout[best]) <= settings.min_gain_sigma)
+                && (i == best || gain_z(holdout[i], holdout[best]) <= settings.min_gain_sigma)
         })
         .collect();
     let &winner = tied.iter().min_by(|&&a, &&b| {
@@ -160,11 +162,11 @@ mod tests {
         let flags: Vec<bool> = scores.iter().map(|s| s.significant).collect();
         assert_eq!(flags, [true, true, true, false, false]);
         let holdout: Vec<&[f64]> = vec![&ra, &rb, &rc, &rd, &re];
-        let (winner, ties) = choose(&scores, &holdout, &s).unwrap();
+        let (winner, ties) = choose(&scores, &holdout, paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "b");
         assert_eq!(ties, [0]);
         scores.iter_mut().for_each(|s| s.significant = false);
-        assert!(choose(&scores, &holdout, &s).is_none());
+        assert!(choose(&scores, &holdout, paired_z, &s).is_none());
     }
 
     #[test]
@@ -187,13 +189,13 @@ mod tests {
         for sc in &mut scores {
             sc.significant = is_significant(sc, &s);
         }
-        let (winner, ties) = choose(&scores, &[&e, &e], &s).unwrap();
+        let (winner, ties) = choose(&scores, &[&e, &e], paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "one");
         assert_eq!(ties, [0]);
         // A clear held-out gain is not a tie: the better one wins whatever its size.
         let better: Vec<f64> = e.iter().map(|v| v * 0.8).collect();
         scores[0].holdout_rms = 0.8;
-        let (winner, ties) = choose(&scores, &[&better, &e], &s).unwrap();
+        let (winner, ties) = choose(&scores, &[&better, &e], paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "four");
         assert!(ties.is_empty());
     }

@@ -34,6 +34,9 @@ pub(super) struct Said {
     pub unit: &'static str,
     /// The factor from the residual's SI value to `unit`.
     pub scale: f64,
+    /// The paired test of the level's held-out units (samples or cycles): the z of the gain
+    /// of the second over the first.
+    pub gain_z: fn(&[f64], &[f64]) -> f64,
 }
 
 /// Force level: held-out RMS in N.
@@ -41,6 +44,7 @@ pub(super) const FORCE: Said = Said {
     quantity: "held-out RMS",
     unit: "N",
     scale: 1.0,
+    gain_z: acceptance::paired_z,
 };
 
 /// Trajectory level: held-out x RMS in mm.
@@ -48,6 +52,7 @@ pub(super) const DISPLACEMENT: Said = Said {
     quantity: "held-out x RMS",
     unit: "mm",
     scale: 1e3,
+    gain_z: super::trajectory::cycle_gain_z,
 };
 
 /// How `trial` (a model with the candidate `name`, whose own parameters are its `n_own`
@@ -153,7 +158,7 @@ pub(super) fn decide(
         .iter()
         .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
         .collect();
-    let choice = acceptance::choose(&scores, &holdout, settings);
+    let choice = acceptance::choose(&scores, &holdout, said.gain_z, settings);
     let mut step = Step {
         current: current.stage.name(),
         current_holdout_rms: current_h,
