@@ -5,9 +5,10 @@
 //! alone, discovery names exactly the hidden effect — or nothing — and the x residual after
 //! is within 1.2× the noise.
 //!
-//! `yield` (≈ F_y·sign v) has the form of the bearing's Coulomb friction T: with T refitted
-//! the base absorbs it (T 0.54 → 0.70 N, c 3.7 → 8.6 N·s/m) and no candidate is demanded, so
-//! that case refits k and c only, as after an identification of the rig (T known).
+//! `yield` (≈ F_y·sign v) has nearly the form of the bearing's Coulomb friction T, which is
+//! refitted: a yield force of 0.3 N is named, one of 0.2 N is mostly absorbed by T (0.54 →
+//! 0.70 N) and the step says its "nothing is missing" is not to be trusted, naming `yield` as
+//! the candidate that came closest.
 
 mod common;
 
@@ -121,10 +122,28 @@ fn a_hidden_added_mass_is_named() {
 }
 
 #[test]
-fn a_hidden_yield_is_named_on_an_identified_rig() {
-    let d = discover(Some(("yield", ", F_y = 0.3")), 5, Some("[\"k\", \"c\"]"));
+fn a_hidden_yield_is_named() {
+    let d = discover(Some(("yield", ", F_y = 0.3")), 5, None);
     assert_eq!(effects(&d), ["yield"], "{:?}", d["notes"]);
     assert_at_the_noise(&d);
+}
+
+#[test]
+fn a_yield_the_bearing_friction_absorbs_is_flagged_not_denied() {
+    let d = discover(Some(("yield", ", F_y = 0.2")), 5, None);
+    let notes: Vec<&str> = d["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n.as_str())
+        .collect();
+    let flagged = notes
+        .iter()
+        .any(|n| n.starts_with("not to be trusted") && n.contains("`yield` comes closest"));
+    assert!(
+        effects(&d) == ["yield"] || flagged,
+        "neither named nor flagged: {notes:?}"
+    );
 }
 
 /// The full set on the source study's sweep (150 001 samples; about a minute or two each):
@@ -140,6 +159,7 @@ fn on_the_papers_sweep_exactly_the_hidden_effect_is_named() {
     let cases = [
         ("cubic_stiffness", ", k3 = 1e4", None),
         ("added_mass", ", m_a = 0.5", None),
+        ("yield", ", F_y = 0.3", None),
         ("yield", ", F_y = 0.3", Some("[\"k\", \"c\"]")),
     ];
     for (name, params, refit) in cases {

@@ -219,3 +219,43 @@ pub(super) fn decide(
         .and_then(|pos| scored.swap_remove(pos).1);
     (step, trial)
 }
+
+/// When nothing was accepted although the current model's held-out RMS stands above 1.2× the
+/// noise `floor`: a warning that the verdict "nothing is missing" is not to be trusted, with
+/// the candidate that came closest (the lowest held-out RMS below the current one), its z and
+/// the share of the excess it explains; `units` says what the paired test counted (`15
+/// held-out cycles`). An effect that acts in a few cycles only (a yield
+/// force near the breakaway) can explain the whole excess and still fall short of the paired
+/// test on few held-out cycles; a longer record, or one that dwells where the effect acts,
+/// tells.
+pub(super) fn unresolved(step: &Step, units: &str, floor: f64, said: &Said) -> Option<String> {
+    if step.accepted.is_some() || !(step.current_holdout_rms > 1.2 * floor) {
+        return None;
+    }
+    let excess = step.current_holdout_rms.powi(2) - floor * floor;
+    let closest = step
+        .candidates
+        .iter()
+        .filter(|c| c.failure.is_none() && c.holdout_rms < step.current_holdout_rms)
+        .min_by(|a, b| a.holdout_rms.total_cmp(&b.holdout_rms));
+    let lead = format!(
+        "not to be trusted: the held-out RMS ({:.4} {}) is {:.1}× the noise floor, so \
+         something is missing",
+        step.current_holdout_rms * said.scale,
+        said.unit,
+        step.current_holdout_rms / floor
+    );
+    Some(match closest {
+        Some(c) => format!(
+            "{lead}; `{}` comes closest ({:.4} {}, {:.0} % of the excess over the floor) but \
+             its paired z is {:.1} on {units} — a longer record, or one that \
+             dwells where the gap is, would tell",
+            c.name,
+            c.holdout_rms * said.scale,
+            said.unit,
+            100.0 * (step.current_holdout_rms.powi(2) - c.holdout_rms.powi(2)) / excess,
+            c.gain_z
+        ),
+        None => format!("{lead} that no candidate of the vocabulary explains"),
+    })
+}

@@ -674,6 +674,12 @@ pub fn discover_trajectory(
         }
         let (step, winner) = choice::decide(&current, scored, &choice::DISPLACEMENT, settings);
         notes.push(step.verdict.clone());
+        notes.extend(choice::unresolved(
+            &step,
+            &format!("{} held-out cycles", split.holdout_cycles),
+            floor,
+            &choice::DISPLACEMENT,
+        ));
         effects.extend(step.accepted.clone());
         steps.push(step);
         let Some(trial) = winner else {
