@@ -4,7 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
 use super::progress::Observer;
-use crate::fit::FitSettings;
+use crate::fit::{FitSettings, MotionNoise};
+use crate::kinematics::Kinematics;
 
 /// How discovery fits, holds out data and decides that an effect is significant.
 ///
@@ -29,6 +30,11 @@ pub struct DiscoverySettings {
     /// The BIC (on the training samples) must fall by more than this (default 10: "very
     /// strong" evidence on Kass and Raftery's scale).
     pub min_bic_drop: f64,
+    /// A significant candidate must also remove at least this share of the current model's
+    /// held-out excess over the noise floor, `(MSE_current − MSE_candidate) / (MSE_current −
+    /// σ²)` (default 0.1; see [`super::acceptance`]): a real but small gain — a flexible
+    /// candidate bending to follow the derivative filter's bias — is not the missing physics.
+    pub min_explained: f64,
     /// Settings of every fit (default: [`FitSettings::default`] with at most 200 iterations
     /// per stage, to bound the time of a candidate whose fit wanders, and a relative cost
     /// tolerance of 1e-6: a candidate whose scale parameter creeps to zero along its bound map
@@ -41,6 +47,19 @@ pub struct DiscoverySettings {
     pub noise_sigma: Option<f64>,
     /// Fit a constant force offset `f_off` with every model (default false).
     pub fit_offset: bool,
+    /// Noise of the kinematics the force-level models are evaluated along (x as measured, v
+    /// and a as filtered): propagated through the current model into the force noise floor
+    /// ([`crate::fit::ForceFit::noise_floor`]). `None`: the floor is the force sensor's alone,
+    /// and the verdict says the kinematics' part is missing. Set from the record by
+    /// [`DiscoverySettings::kinematics`]; not read from a file.
+    #[serde(skip)]
+    pub motion_noise: Option<MotionNoise>,
+    /// Window of the derivative filter that made v and a, samples: the filtered noise is
+    /// correlated over it, so the force-level paired test's blocks are at least twice as long
+    /// (see [`super::blocks`]). `None`: the block length is estimated from the residual's
+    /// autocorrelation alone. Set by [`DiscoverySettings::kinematics`]; not read from a file.
+    #[serde(skip)]
+    pub filter_window: Option<usize>,
     /// Starts of a candidate's trial besides its defaults: the best points of a coarse grid
     /// over its nonlinear parameters, scored by variable projection on the current residual;
     /// the trial with the lowest training RMS is kept (default 1; 0: the defaults only).
@@ -57,9 +76,12 @@ impl Default for DiscoverySettings {
             holdout_every: 4,
             min_gain_sigma: 3.0,
             min_bic_drop: 10.0,
+            min_explained: 0.1,
             fit: FitSettings::default().max_iters(200).tol(1e-7),
             noise_sigma: None,
             fit_offset: false,
+            motion_noise: None,
+            filter_window: None,
             extra_starts: 1,
             observer: Observer::default(),
         }
@@ -85,6 +107,18 @@ impl DiscoverySettings {
     /// Least fall of the BIC.
     pub fn min_bic_drop(mut self, d: f64) -> Self {
         self.min_bic_drop = d;
+        self
+    }
+    /// Least share of the current model's excess over the floor a candidate must explain.
+    pub fn min_explained(mut self, share: f64) -> Self {
+        self.min_explained = share;
+        self
+    }
+    /// The noise and the derivative filter of the kinematics `k` the force data were derived
+    /// with: their noise enters the floor, the filter's window the length of the test's blocks.
+    pub fn kinematics(mut self, k: &Kinematics) -> Self {
+        self.motion_noise = Some(k.motion_noise());
+        self.filter_window = Some(k.motion_filter.window());
         self
     }
     /// Settings of every fit.
@@ -123,13 +157,18 @@ impl DiscoverySettings {
             && self.min_gain_sigma.is_finite()
             && self.min_bic_drop >= 0.0
             && self.min_bic_drop.is_finite()
+            && (0.0..=1.0).contains(&self.min_explained)
             && sigma_ok;
         if !ok {
             return Err(DiscoveryError::BadSettings(format!(
                 "need holdout_every ≥ 2, finite min_gain_sigma ≥ 0 and min_bic_drop ≥ 0, \
-                 a positive finite noise_sigma (got holdout_every {}, min_gain_sigma {}, \
-                 min_bic_drop {}, noise_sigma {:?})",
-                self.holdout_every, self.min_gain_sigma, self.min_bic_drop, self.noise_sigma
+                 min_explained in [0, 1], a positive finite noise_sigma (got holdout_every {}, \
+                 min_gain_sigma {}, min_bic_drop {}, min_explained {}, noise_sigma {:?})",
+                self.holdout_every,
+                self.min_gain_sigma,
+                self.min_bic_drop,
+                self.min_explained,
+                self.noise_sigma
             )));
         }
         Ok(())

@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use super::acceptance;
 use super::candidate::{self, Candidate};
-use super::choice::{self, Trial};
+use super::choice::{self, Trial, Yardstick};
 use super::engine::{emit_scored, inside};
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
@@ -531,6 +531,13 @@ pub fn discover_trajectory(
     let mut current = base_full.trial_simulated(&rig, setup, &split, settings)?;
     let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
+    let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
+    let yardstick = Yardstick {
+        gain_z: &test,
+        base_excess,
+        floor: crate::fit::NoiseFloor::displacement(floor),
+        block_samples: None,
+    };
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
@@ -558,8 +565,7 @@ pub fn discover_trajectory(
                     c.model.params().len(),
                     stage.trial_simulated(&rig, setup, &split, settings),
                     &current,
-                    cycle_gain_z,
-                    base_excess,
+                    &yardstick,
                     settings,
                 );
                 emit_scored(settings, step, Some(&s));
@@ -569,7 +575,13 @@ pub fn discover_trajectory(
         if scored.is_empty() {
             break;
         }
-        let (step, winner) = choice::decide(&current, scored, &choice::DISPLACEMENT, settings);
+        let (step, winner) = choice::decide(
+            &current,
+            scored,
+            &choice::DISPLACEMENT,
+            &yardstick,
+            settings,
+        );
         notes.push(step.verdict.clone());
         effects.extend(step.accepted.clone());
         steps.push(step);
@@ -646,6 +658,7 @@ pub fn discover_trajectory(
             effects,
             steps,
             noise_floor: floor,
+            noise_floor_parts: yardstick.floor,
             holdout_cycles: split.holdout_cycles,
             holdout_samples: split.holdout.len(),
             gap_before,

@@ -37,6 +37,9 @@ pub struct Case {
     pub phi: Vec<f64>,
     /// The true STF force of each part of the truth, N (noise-free).
     pub part_forces: Vec<Vec<f64>>,
+    /// The kinematics v and a were filtered with (none with exact kinematics): their noise
+    /// enters the floor, their filter's window the test's blocks.
+    pub kinematics: Option<Kinematics>,
 }
 
 impl Case {
@@ -98,11 +101,11 @@ pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
         z_off += nz;
         part_forces.push(f);
     }
-    let (v, a) = if exact_kinematics {
-        (run.v.clone(), run.a.clone())
+    let (v, a, kinematics) = if exact_kinematics {
+        (run.v.clone(), run.a.clone(), None)
     } else {
         let k = Kinematics::from_record(&rec, &KinematicsSettings::default()).unwrap();
-        (k.v, k.a)
+        (k.v.clone(), k.a.clone(), Some(k))
     };
     Case {
         t: rec.t.clone(),
@@ -112,6 +115,7 @@ pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
         f: rec.f_stf.clone().unwrap(),
         phi: rec.phi.clone().unwrap(),
         part_forces,
+        kinematics,
     }
 }
 
@@ -123,9 +127,14 @@ pub fn vocabulary() -> Vec<Candidate> {
         .collect()
 }
 
-/// Run discovery from the built-in `base` with the whole vocabulary.
+/// Run discovery from the built-in `base` with the whole vocabulary, the record's kinematics
+/// noise in the floor and its filter's window setting the test's blocks.
 pub fn discover(case: &Case, base: &str, settings: &DiscoverySettings) -> Discovery {
     let cycles = cycles_from_phase(&case.t, &case.phi).unwrap();
+    let settings = &match &case.kinematics {
+        Some(k) => settings.clone().kinematics(k),
+        None => settings.clone(),
+    };
     discover_force(
         find(base).unwrap(),
         &vocabulary(),
@@ -146,12 +155,13 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
         eprintln!("   step on `{}`: {}", s.current, s.verdict);
         for c in &s.candidates {
             eprintln!(
-                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} ΔBIC {:+9.1} expl {:5.2} sig {} {} evals {} {:.2}s {:?}",
+                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} n {:4} ΔBIC {:+9.1} expl {:5.2} share {:5.2} sig {} {} evals {} {:.2}s {:?}",
                 c.name, c.train_rms,
                 c.holdout_rms,
-                c.holdout_gain, c.gain_z,
+                c.holdout_gain, c.gain_z, c.effective_n,
                 c.delta_bic,
                 c.explained_fraction,
+                c.explained_share,
                 c.significant,
                 c.failure.as_deref().unwrap_or(""),
                 c.evaluations,
@@ -160,11 +170,13 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
         }
     }
     eprintln!(
-        "   effects {:?}; gap {:.4} → {:.4} N, floor {:.4} N ({:.2}×); {}",
+        "   effects {:?}; gap {:.4} → {:.4} N, floor {:.4} N (sensor {:.4}, kinematics {:.4}) ({:.2}×); {}",
         d.effects,
         d.gap_before,
         d.gap_after,
         d.noise_floor,
+        d.noise_floor_parts.measured,
+        d.noise_floor_parts.propagated,
         d.gap_after / d.noise_floor,
         d.where_before.summary
     );
