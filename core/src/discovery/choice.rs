@@ -60,6 +60,9 @@ pub(super) type GainTest<'a> = &'a (dyn Fn(&[f64], &[f64]) -> (f64, usize) + Syn
 pub(super) struct Yardstick<'a> {
     /// The paired test.
     pub gain_z: GainTest<'a>,
+    /// The paired test that decides whether the best candidate beats another (a tie when
+    /// not): per-unit RMS residuals, the other's first.
+    pub tie_z: fn(&[f64], &[f64]) -> f64,
     /// The base's held-out mean square above the noise floor (at least what is resolved).
     pub base_excess: f64,
     /// The current model's noise floor.
@@ -208,7 +211,7 @@ pub(super) fn decide(
         .iter()
         .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
         .collect();
-    let choice = acceptance::choose(&scores, &holdout, settings);
+    let choice = acceptance::choose(&scores, &holdout, yardstick.tie_z, settings);
     let mut step = step_on(current, scores, yardstick);
     let Some((winner, ties)) = choice else {
         step.verdict = rejected(&step, said, settings);

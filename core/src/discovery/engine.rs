@@ -623,6 +623,7 @@ impl Search<'_> {
         let test = force_test(floor.sigma);
         let yardstick = Yardstick {
             gain_z: &test,
+            tie_z: acceptance::block_gain_z,
             base_excess,
             floor,
             block_samples: Some(blocks.length),
@@ -696,6 +697,7 @@ impl Search<'_> {
         let test = force_test(floor.sigma);
         let yardstick = Yardstick {
             gain_z: &test,
+            tie_z: acceptance::block_gain_z,
             base_excess,
             floor,
             block_samples: Some(blocks.length),
