@@ -34,6 +34,7 @@
 //! yield base: on-off jamming, with four parameters, had a BIC 27 below the viscous damper's
 //! on the training cycles and the same held-out RMS). Nothing significant ends the search.
 
+use super::blocks::Blocks;
 use super::score::CandidateScore;
 use super::settings::DiscoverySettings;
 
@@ -69,63 +70,47 @@ pub fn mean_z(d: &[f64]) -> f64 {
     }
 }
 
-/// The force-level paired test of per-block RMS residuals `new` over `reference`: the
-/// log-ratio of each block's mean square, `dᵦ = 2·ln(reference_b / new_b)`, its mean over its
-/// standard error read through Student's t ([`t_as_z`]). The log makes blocks of small and
-/// large misfit count alike: an effect that grows with amplitude removes most of each
-/// block's misfit, a share that differs little between blocks, while the differences of
-/// mean squares span orders of magnitude between resonance and the rest (a wall taking the
-/// held-out RMS from 0.087 to 0.037 N scored z = 2.5 by differences over 46 blocks). +∞ for a
-/// consistent gain without spread, 0 with fewer than two blocks or a non-finite ratio.
-pub fn block_gain_z(reference: &[f64], new: &[f64]) -> f64 {
-    let d: Vec<f64> = reference
-        .iter()
-        .zip(new)
-        .map(|(a, b)| 2.0 * (a.max(f64::MIN_POSITIVE) / b.max(f64::MIN_POSITIVE)).ln())
-        .collect();
-    if d.iter().any(|v| !v.is_finite()) {
-        return 0.0;
+/// The force-level paired test of the held-out residuals `new` over `reference` (the same
+/// held-out samples), with `blocks` as the independent units; the z and the number of blocks.
+///
+/// The gain is `G = Σᵢ (reference_i² − new_i²)`. With `δ = reference − new` — the difference
+/// of the two models' forces, fixed by their training fits — each term is `2·δᵢ·newᵢ + δᵢ²`,
+/// and the held-out noise `e` enters only through `2·δᵢ·eᵢ`. Its variance is estimated from
+/// the block sums `Uᵦ = Σᵢ∈ᵦ 2·δᵢ·newᵢ` (blocks as long as the noise's correlation, so their
+/// sums are independent): `z = G / √(Σᵦ Uᵦ²)`, read through Student's t over the blocks
+/// ([`t_as_z`]). The candidate's residual stands for the noise: where it leaves a misfit the
+/// estimate only grows, so the test errs towards "not significant". Unlike the spread of the
+/// blocks' gains, this does not count the variation of a real gain across the record as noise
+/// (an effect near resonance gains in a few cycles only: a wall taking the held-out RMS from
+/// 0.087 to 0.037 N scored z = 2.5 by the spread of 46 blocks' mean-square differences).
+pub fn block_gain_z(reference: &[f64], new: &[f64], blocks: &Blocks) -> (f64, usize) {
+    let (mut gain, mut var) = (0.0, 0.0);
+    for &(from, to) in &blocks.ranges {
+        let mut u = 0.0;
+        for k in from..to.min(reference.len()).min(new.len()) {
+            let (a, b) = (reference[k], new[k]);
+            gain += a * a - b * b;
+            u += 2.0 * (a - b) * b;
+        }
+        var += u * u;
     }
-    t_as_z(mean_z(&d), d.len())
+    let n = blocks.count();
+    let z = if !(gain.is_finite() && var.is_finite()) {
+        0.0
+    } else if var > 0.0 {
+        gain / var.sqrt()
+    } else if gain > 0.0 {
+        f64::INFINITY
+    } else {
+        0.0
+    };
+    (t_as_z(z, n), n)
 }
 
 /// A unit holds an excess over the noise floor σ when its mean squared residual is at least
-/// this many times σ²: noise alone over a block of tens of samples does not give it.
+/// this many times σ²: noise alone over a block of tens of samples does not give it (see
+/// [`super::choice`]).
 pub const EXCESS_UNIT: f64 = 2.0;
-
-/// The paired test `gain_z` of per-unit RMS residuals `new` over `reference`, and the units
-/// it is over: the larger of the test over every unit and over the units where `reference`
-/// holds an excess over the floor `sigma` ([`EXCESS_UNIT`]; at least two). An effect that
-/// lives in a few cycles (a cubic spring or a wall near resonance) removes most of their
-/// misfit and nothing elsewhere; over all units the spread of that mixture hides it, over the
-/// units that hold the misfit it is consistent. Choosing the units by the reference alone
-/// keeps the test fair: under "nothing is missing" a candidate fitted on the training cycles
-/// gains on them no more than elsewhere. Taking the larger of two tests at most doubles the
-/// chance of a z above the threshold by luck.
-pub fn excess_gain_z(
-    reference: &[f64],
-    new: &[f64],
-    gain_z: fn(&[f64], &[f64]) -> f64,
-    sigma: f64,
-) -> (f64, usize) {
-    let all = (gain_z(reference, new), reference.len());
-    let bar = EXCESS_UNIT * sigma * sigma;
-    let (r, n): (Vec<f64>, Vec<f64>) = reference
-        .iter()
-        .zip(new)
-        .filter(|(a, _)| *a * *a >= bar)
-        .map(|(a, b)| (*a, *b))
-        .unzip();
-    if r.len() < 2 || r.len() == reference.len() {
-        return all;
-    }
-    let above = (gain_z(&r, &n), r.len());
-    if above.0 > all.0 {
-        above
-    } else {
-        all
-    }
-}
 
 /// The normal z of the same one-sided tail as Student's `t` over `n` pairs (n − 1 degrees of
 /// freedom), by Wallace's approximation `√(ν·ln(1 + t²/ν))·(8ν + 1)/(8ν + 3)` (within 0.1 of
@@ -161,7 +146,7 @@ pub fn is_significant(score: &CandidateScore, settings: &DiscoverySettings) -> b
 pub fn choose(
     scores: &[CandidateScore],
     holdout: &[&[f64]],
-    tie_z: fn(&[f64], &[f64]) -> f64,
+    tie_z: &dyn Fn(&[f64], &[f64]) -> f64,
     settings: &DiscoverySettings,
 ) -> Option<(usize, Vec<usize>)> {
     let best = (0..scores.len())
@@ -256,11 +241,11 @@ mod tests {
         let flags: Vec<bool> = scores.iter().map(|s| s.significant).collect();
         assert_eq!(flags, [true, true, true, false, false]);
         let holdout: Vec<&[f64]> = vec![&ra, &rb, &rc, &rd, &re];
-        let (winner, ties) = choose(&scores, &holdout, paired_z, &s).unwrap();
+        let (winner, ties) = choose(&scores, &holdout, &paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "b");
         assert_eq!(ties, [0]);
         scores.iter_mut().for_each(|s| s.significant = false);
-        assert!(choose(&scores, &holdout, paired_z, &s).is_none());
+        assert!(choose(&scores, &holdout, &paired_z, &s).is_none());
     }
 
     #[test]
@@ -283,13 +268,13 @@ mod tests {
         for sc in &mut scores {
             sc.significant = is_significant(sc, &s);
         }
-        let (winner, ties) = choose(&scores, &[&e, &e], paired_z, &s).unwrap();
+        let (winner, ties) = choose(&scores, &[&e, &e], &paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "one");
         assert_eq!(ties, [0]);
         // A clear held-out gain is not a tie: the better one wins whatever its size.
         let better: Vec<f64> = e.iter().map(|v| v * 0.8).collect();
         scores[0].holdout_rms = 0.8;
-        let (winner, ties) = choose(&scores, &[&better, &e], paired_z, &s).unwrap();
+        let (winner, ties) = choose(&scores, &[&better, &e], &paired_z, &s).unwrap();
         assert_eq!(scores[winner].name, "four");
         assert!(ties.is_empty());
     }
@@ -305,21 +290,56 @@ mod tests {
     }
 
     #[test]
-    fn a_gain_in_the_units_that_hold_the_misfit_is_seen() {
-        // Four units of misfit (RMS 5σ) fixed, twelve at the floor unchanged but for noise.
-        let e = noise(16, 5);
-        let reference: Vec<f64> = (0..16)
-            .map(|i| if i % 4 == 0 { 5.0 } else { 1.0 + 0.05 * e[i] })
+    fn the_block_test_sees_a_gain_in_a_few_blocks_and_not_a_refit_of_noise() {
+        let e = noise(2000, 5);
+        let split = crate::discovery::HoldoutSplit {
+            train: Vec::new(),
+            holdout: (0..2000).collect(),
+            holdout_cycles: 1,
+        };
+        let blocks = Blocks::new(&split, 40);
+        // A misfit of 3σ in 4 of 50 blocks, removed by the candidate.
+        let reference: Vec<f64> = (0..2000)
+            .map(|i| e[i] + if (i / 40) % 12 == 0 { 3.0 } else { 0.0 })
             .collect();
-        let new: Vec<f64> = (0..16).map(|i| 1.0 + 0.05 * e[(i + 7) % 16]).collect();
-        let over_all = block_gain_z(&reference, &new);
-        let (z, n) = excess_gain_z(&reference, &new, block_gain_z, 1.0);
-        assert!(over_all < 3.0 && z > 4.0, "{over_all} {z}");
-        assert_eq!(n, 4);
-        // At the floor everywhere: the test over all units.
-        let other: Vec<f64> = (0..16).map(|i| 1.0 + 0.05 * e[(i + 3) % 16]).collect();
-        let (z, n) = excess_gain_z(&new, &other, block_gain_z, 1.0);
-        assert_eq!((z, n), (block_gain_z(&new, &other), 16));
+        let (z, n) = block_gain_z(&reference, &e, &blocks);
+        assert_eq!(n, 50);
+        assert!(z > 10.0, "{z}");
+        // A candidate that fits a little noise: a small smooth force, no gain.
+        let overfit: Vec<f64> = (0..2000)
+            .map(|i| e[i] - 0.05 * (i as f64 / 300.0).sin())
+            .collect();
+        let (z, _) = block_gain_z(&e, &overfit, &blocks);
+        assert!(z < 1.0, "{z}");
+    }
+
+    #[test]
+    fn blocks_keep_z_of_order_one_where_samples_overstate_it() {
+        // Noise correlated over 20 samples (a moving sum, as a derivative filter leaves) and
+        // two models equally far from the truth, on either side: no gain in expectation.
+        let split = crate::discovery::HoldoutSplit {
+            train: Vec::new(),
+            holdout: (0..2000).collect(),
+            holdout_cycles: 1,
+        };
+        let blocks = Blocks::new(&split, 40);
+        let g: Vec<f64> = (0..2000).map(|i| 0.05 * (i as f64 / 25.0).sin()).collect();
+        let (mut by_blocks, mut by_samples) = (Vec::new(), Vec::new());
+        for seed in 0..200 {
+            let w = noise(2020, 100 + seed);
+            let e: Vec<f64> = (0..2000)
+                .map(|i| w[i..i + 20].iter().sum::<f64>() / 20f64.sqrt())
+                .collect();
+            let r0: Vec<f64> = e.iter().zip(&g).map(|(e, g)| e + g).collect();
+            let r1: Vec<f64> = e.iter().zip(&g).map(|(e, g)| e - g).collect();
+            by_blocks.push(block_gain_z(&r0, &r1, &blocks).0);
+            by_samples.push(paired_z(&r0, &r1));
+        }
+        let sd = |z: &[f64]| (z.iter().map(|v| v * v).sum::<f64>() / z.len() as f64).sqrt();
+        assert!((0.7..1.4).contains(&sd(&by_blocks)), "{}", sd(&by_blocks));
+        assert!(sd(&by_samples) > 2.5, "{}", sd(&by_samples));
+        let false_alarms = by_blocks.iter().filter(|&&z| z > 3.0).count();
+        assert!(false_alarms <= 2, "{false_alarms} of 200");
     }
 
     #[test]

@@ -21,22 +21,27 @@ use super::holdout::HoldoutSplit;
 /// The autocorrelation below which residuals a lag apart count as uncorrelated.
 pub const DECORRELATED: f64 = 0.1;
 
-/// Blocks of held-out samples: index ranges into the record.
+/// Blocks of held-out samples: ranges of positions in the held-out samples (`split.holdout`),
+/// so a residual taken at the held-out samples is cut by them directly.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Blocks {
     /// The target length, samples.
     pub length: usize,
-    /// Each block's first sample and one past its last.
+    /// Each block's first position and one past its last.
     pub ranges: Vec<(usize, usize)>,
 }
 
-/// The runs of consecutive indices of `holdout` (increasing): its held-out cycles, as ranges.
-fn runs(holdout: &[usize]) -> Vec<(usize, usize)> {
-    let mut out: Vec<(usize, usize)> = Vec::new();
-    for &i in holdout {
+/// The runs of consecutive indices of `holdout` (increasing) — its held-out cycles — as
+/// ranges of record indices and of positions in `holdout`.
+fn runs(holdout: &[usize]) -> Vec<((usize, usize), (usize, usize))> {
+    let mut out: Vec<((usize, usize), (usize, usize))> = Vec::new();
+    for (k, &i) in holdout.iter().enumerate() {
         match out.last_mut() {
-            Some(last) if last.1 == i => last.1 = i + 1,
-            _ => out.push((i, i + 1)),
+            Some((index, at)) if index.1 == i => {
+                index.1 = i + 1;
+                at.1 = k + 1;
+            }
+            _ => out.push(((i, i + 1), (k, k + 1))),
         }
     }
     out
@@ -49,7 +54,7 @@ pub fn block_length(residual: &[f64], split: &HoldoutSplit, window: Option<usize
     if let Some(w) = window {
         return (2 * w).max(1);
     }
-    let cycles = runs(&split.holdout);
+    let cycles: Vec<(usize, usize)> = runs(&split.holdout).into_iter().map(|r| r.0).collect();
     let longest = cycles.iter().map(|c| c.1 - c.0).max().unwrap_or(0);
     let at = |i: usize| residual.get(i).copied().unwrap_or(0.0);
     let (sum, n) = cycles.iter().fold((0.0, 0usize), |(s, n), c| {
@@ -85,7 +90,7 @@ impl Blocks {
     pub fn new(split: &HoldoutSplit, length: usize) -> Self {
         let length = length.max(1);
         let mut ranges = Vec::new();
-        for (start, end) in runs(&split.holdout) {
+        for (_, (start, end)) in runs(&split.holdout) {
             let whole = ((end - start) / length).max(1);
             for b in 0..whole {
                 let from = start + b * length;
@@ -96,7 +101,7 @@ impl Blocks {
         Blocks { length, ranges }
     }
 
-    /// The RMS of `r` (a residual at every sample of the record) over each block.
+    /// The RMS of `r` (a residual at the held-out samples) over each block.
     pub fn rms(&self, r: &[f64]) -> Vec<f64> {
         self.ranges
             .iter()
@@ -131,9 +136,9 @@ mod tests {
     fn cycles_are_cut_into_whole_blocks_the_remainder_joined_to_the_last() {
         let s = split((10..35).chain(60..65).collect());
         let b = Blocks::new(&s, 10);
-        assert_eq!(b.ranges, [(10, 20), (20, 35), (60, 65)]);
+        assert_eq!(b.ranges, [(0, 10), (10, 25), (25, 30)]);
         assert_eq!(b.count(), 3);
-        let r: Vec<f64> = (0..70).map(|i| if i < 20 { 2.0 } else { 1.0 }).collect();
+        let r: Vec<f64> = (0..30).map(|i| if i < 10 { 2.0 } else { 1.0 }).collect();
         assert_eq!(b.rms(&r), [2.0, 1.0, 1.0]);
     }
 
@@ -146,11 +151,15 @@ mod tests {
         use rand_distr::{Distribution, StandardNormal};
         let mut rng = rand::rngs::StdRng::seed_from_u64(7);
         let white: Vec<f64> = (0..1200).map(|_| StandardNormal.sample(&mut rng)).collect();
-        assert!(block_length(&white, &s, None) <= 4, "{}", block_length(&white, &s, None));
+        assert!(
+            block_length(&white, &s, None) <= 4,
+            "{}",
+            block_length(&white, &s, None)
+        );
         // A moving sum over 20 samples of it: correlated over 20 lags (1 − k/20 > 0.1 for
         // k < 18).
         let smooth: Vec<f64> = (0..1200)
-            .map(|i| white[i.saturating_sub(19)..=i].iter().sum())
+            .map(|i: usize| white[i.saturating_sub(19)..=i].iter().sum())
             .collect();
         let l = block_length(&smooth, &s, None);
         assert!((30..=40).contains(&l), "{l}");

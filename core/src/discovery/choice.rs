@@ -21,8 +21,9 @@ pub(super) struct Trial {
     pub stage: Stage,
     /// The fit on the training samples.
     pub train: FitResult,
-    /// The units of the paired test: the RMS residual over each block of held-out samples
-    /// (force level, [`super::blocks`]) or each held-out cycle (trajectory level).
+    /// What the paired test reads: the residual at the held-out samples (force level, cut
+    /// into blocks by the test, [`super::blocks`]) or the RMS residual of each held-out cycle
+    /// (trajectory level).
     pub holdout: Vec<f64>,
     /// Mean square residual over the held-out samples.
     pub holdout_mse: f64,
@@ -52,17 +53,22 @@ pub(super) const DISPLACEMENT: Said = Said {
     scale: 1e3,
 };
 
-/// The level's paired test of per-unit RMS residuals, candidate (second) against the
-/// current model (first): the z and the units it is over.
+/// The level's paired test of two trials' `holdout`, the candidate (second) against the
+/// current model (first): the z and the independent units it is over.
 pub(super) type GainTest<'a> = &'a (dyn Fn(&[f64], &[f64]) -> (f64, usize) + Sync);
+
+/// The RMS residual of each independent unit of a trial's `holdout`.
+pub(super) type Units<'a> = &'a (dyn Fn(&[f64]) -> Vec<f64> + Sync);
 
 /// What a step measures a candidate's held-out gain with and against.
 pub(super) struct Yardstick<'a> {
     /// The paired test.
     pub gain_z: GainTest<'a>,
     /// The paired test that decides whether the best candidate beats another (a tie when
-    /// not): per-unit RMS residuals, the other's first.
-    pub tie_z: fn(&[f64], &[f64]) -> f64,
+    /// not): the trials' `holdout`, the other's first.
+    pub tie_z: &'a (dyn Fn(&[f64], &[f64]) -> f64 + Sync),
+    /// The units of a trial's `holdout`.
+    pub units: Units<'a>,
     /// The base's held-out mean square above the noise floor (at least what is resolved).
     pub base_excess: f64,
     /// The current model's noise floor.
@@ -71,20 +77,15 @@ pub(super) struct Yardstick<'a> {
     pub block_samples: Option<usize>,
 }
 
-/// The held-out mean square of `trial` above the floor `sigma`², counted as at least what the
-/// held-out units resolve: `min_gain_sigma` standard errors of the mean of the mean squares
-/// of the units at the floor (below [`acceptance::EXCESS_UNIT`]·σ², whose spread is the
-/// noise's, not the misfit's). A model at the floor, or one whose floor is overestimated,
-/// would otherwise divide a gain by nothing. 0 with fewer than two units at the floor and no
-/// excess.
-pub(super) fn excess(trial: &Trial, sigma: f64, settings: &DiscoverySettings) -> f64 {
+/// The held-out mean square `mse` of a trial above the floor `sigma`², counted as at least
+/// what the held-out units resolve: `min_gain_sigma` standard errors of the mean of the mean
+/// squares of the `units` (their RMS residuals) at the floor (below
+/// [`acceptance::EXCESS_UNIT`]·σ², whose spread is the noise's, not the misfit's). A model at
+/// the floor, or one whose floor is overestimated, would otherwise divide a gain by nothing.
+/// 0 with fewer than two units at the floor and no excess.
+pub(super) fn excess(units: &[f64], mse: f64, sigma: f64, settings: &DiscoverySettings) -> f64 {
     let bar = acceptance::EXCESS_UNIT * sigma * sigma;
-    let ms: Vec<f64> = trial
-        .holdout
-        .iter()
-        .map(|r| r * r)
-        .filter(|&m| m < bar)
-        .collect();
+    let ms: Vec<f64> = units.iter().map(|r| r * r).filter(|&m| m < bar).collect();
     let n = ms.len();
     let resolved = if n < 2 {
         0.0
@@ -93,7 +94,7 @@ pub(super) fn excess(trial: &Trial, sigma: f64, settings: &DiscoverySettings) ->
         let var = ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
         settings.min_gain_sigma * (var / n as f64).sqrt()
     };
-    (trial.holdout_mse - sigma * sigma).max(resolved).max(0.0)
+    (mse - sigma * sigma).max(resolved).max(0.0)
 }
 
 /// `gain` over `excess`, 0 when there is no excess to explain.
@@ -140,7 +141,15 @@ pub(super) fn score(
         gain_z,
         effective_n,
         explained_fraction: share(gain, yardstick.base_excess),
-        explained_share: share(gain, excess(current, yardstick.floor.sigma, settings)),
+        explained_share: share(
+            gain,
+            excess(
+                &(yardstick.units)(&current.holdout),
+                current.holdout_mse,
+                yardstick.floor.sigma,
+                settings,
+            ),
+        ),
         params: own,
         significant: false,
         failure,
@@ -249,7 +258,7 @@ pub(super) fn step_on(
     Step {
         current: current.stage.name(),
         current_holdout_rms: current.holdout_mse.sqrt(),
-        effective_n: current.holdout.len(),
+        effective_n: (yardstick.units)(&current.holdout).len(),
         block_samples: yardstick.block_samples,
         floor: yardstick.floor,
         candidates,

@@ -68,12 +68,11 @@ impl Stage {
         Ok((stage, fit, result))
     }
 
-    /// Fit on the training samples and score on the held-out ones, by `blocks`.
+    /// Fit on the training samples and score on the held-out ones.
     fn trial(
         &self,
         data: &ForceData,
         split: &HoldoutSplit,
-        blocks: &Blocks,
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
         let (stage, fit, train) = self.fit(data, &split.train, settings)?;
@@ -85,7 +84,7 @@ impl Stage {
         Ok(Trial {
             stage,
             train,
-            holdout: blocks.rms(&r),
+            holdout: split.holdout.iter().map(|&i| r[i]).collect(),
             holdout_mse: h * h,
         })
     }
@@ -325,7 +324,6 @@ fn best_trial(
     stage: impl Fn(&[f64]) -> Stage,
     data: &ForceData,
     split: &HoldoutSplit,
-    blocks: &Blocks,
     settings: &DiscoverySettings,
 ) -> Result<Trial, DiscoveryError> {
     let mut stages: Vec<Stage> = starts.iter().map(|s| stage(s)).collect();
@@ -336,7 +334,7 @@ fn best_trial(
     let mut first_error = None;
     let (mut evaluations, mut wall) = (0, 0.0);
     for stage in &stages {
-        match stage.trial(data, split, blocks, settings) {
+        match stage.trial(data, split, settings) {
             Ok(trial) => {
                 evaluations += trial.train.evaluations;
                 wall += trial.train.wall_seconds;
@@ -465,13 +463,18 @@ pub fn discover_force(
         sensor,
         settings,
     };
-    let first_blocks = search.blocks(&start.residuals(data, settings)?);
-    let mut current = start.trial(data, &split, &first_blocks, settings)?;
-    let base_excess = choice::excess(&current, floor_before.sigma, settings);
+    let mut current = start.trial(data, &split, settings)?;
+    let first_blocks = search.blocks(&current.stage.residuals(data, settings)?);
+    let base_excess = choice::excess(
+        &first_blocks.rms(&current.holdout),
+        current.holdout_mse,
+        floor_before.sigma,
+        settings,
+    );
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
-        let Some((step, winner)) = search.step(step, &mut current, &effects, base_excess)? else {
+        let Some((step, winner)) = search.step(step, &current, &effects, base_excess)? else {
             break;
         };
         notes.push(step.verdict.clone());
@@ -588,14 +591,6 @@ struct Search<'a> {
     settings: &'a DiscoverySettings,
 }
 
-/// The force-level paired test of per-block RMS residuals against the floor `sigma`:
-/// [`acceptance::excess_gain_z`] of [`acceptance::block_gain_z`].
-fn force_test(sigma: f64) -> impl Fn(&[f64], &[f64]) -> (f64, usize) + Sync {
-    move |reference, new| {
-        acceptance::excess_gain_z(reference, new, acceptance::block_gain_z, sigma)
-    }
-}
-
 impl Search<'_> {
     /// The blocks of the paired test for a model whose residual is `r` (every sample).
     fn blocks(&self, r: &[f64]) -> Blocks {
@@ -607,29 +602,30 @@ impl Search<'_> {
 
     /// One step: every candidate not in `current` added to it, fitted and scored against it
     /// on blocks cut for its residual and its floor; the step and the accepted trial, or
-    /// `None` when there is nothing left to try. `current`'s held-out units are recut.
+    /// `None` when there is nothing left to try.
     fn step(
         &self,
         step: usize,
-        current: &mut Trial,
+        current: &Trial,
         effects: &[String],
         base_excess: f64,
     ) -> Result<Option<(Step, Option<Trial>)>, DiscoveryError> {
         let (data, split, settings) = (self.data, self.split, self.settings);
         let current_residual = current.stage.residuals(data, settings)?;
         let blocks = self.blocks(&current_residual);
-        current.holdout = blocks.rms(&current_residual);
         let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        let test = force_test(floor.sigma);
+        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
+        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
+        let units = |h: &[f64]| blocks.rms(h);
         let yardstick = Yardstick {
-            gain_z: &test,
-            tie_z: acceptance::block_gain_z,
+            gain_z: &gain_z,
+            tie_z: &tie_z,
+            units: &units,
             base_excess,
             floor,
             block_samples: Some(blocks.length),
         };
         let tried = current.stage.to_try(self.candidates, self.in_base, effects);
-        let current: &Trial = current;
         // The candidates are independent trials against the same current model: fitted in
         // parallel, scored in their order.
         let scored: Vec<(CandidateScore, Option<Trial>)> = tried
@@ -651,7 +647,6 @@ impl Search<'_> {
                     |start| current.stage.with(&c.model, start, 0),
                     data,
                     split,
-                    &blocks,
                     settings,
                 );
                 let n_own = c.model.params().len();
@@ -689,15 +684,16 @@ impl Search<'_> {
     ) -> Result<Option<Step>, DiscoveryError> {
         let (data, split, settings) = (self.data, self.split, self.settings);
         let (candidates, in_base) = (self.candidates, self.in_base);
-        // The accepted trial's units are this step's blocks; its floor is its own.
-        let r = current.stage.residuals(data, settings)?;
-        let blocks = self.blocks(&r);
-        current.holdout = blocks.rms(&r);
+        // Blocks cut for the accepted model's residual, and its own floor.
+        let blocks = self.blocks(&current.stage.residuals(data, settings)?);
         let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        let test = force_test(floor.sigma);
+        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
+        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
+        let units = |h: &[f64]| blocks.rms(h);
         let yardstick = Yardstick {
-            gain_z: &test,
-            tie_z: acceptance::block_gain_z,
+            gain_z: &gain_z,
+            tie_z: &tie_z,
+            units: &units,
             base_excess,
             floor,
             block_samples: Some(blocks.length),
@@ -730,7 +726,6 @@ impl Search<'_> {
                     |start| rest.inserting(part, &c.model, start),
                     data,
                     split,
-                    &blocks,
                     settings,
                 );
                 match best {
@@ -758,7 +753,9 @@ impl Search<'_> {
                         score.significant = wins || tie;
                         tried.push((score, Some(trial), j, k, tie));
                     }
-                    Err(e) => tried.push((choice::failed(&label, e.to_string()), None, j, k, false)),
+                    Err(e) => {
+                        tried.push((choice::failed(&label, e.to_string()), None, j, k, false))
+                    }
                 }
             }
         }

@@ -534,7 +534,8 @@ pub fn discover_trajectory(
     let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
     let yardstick = Yardstick {
         gain_z: &test,
-        tie_z: acceptance::paired_z,
+        tie_z: &acceptance::paired_z,
+        units: &|h: &[f64]| h.to_vec(),
         base_excess,
         floor: crate::fit::NoiseFloor::displacement(floor),
         block_samples: None,

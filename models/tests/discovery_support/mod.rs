@@ -69,6 +69,11 @@ fn build(parts: &[Part]) -> (Arc<dyn ForceModel>, Vec<f64>) {
 
 /// Simulate `truth` over the sweep and sample it with the rig's noise (`seed`).
 pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
+    record_at(truth, seed, exact_kinematics, 200.0, 60.0)
+}
+
+/// The same sampled at `rate` (Hz) over the first `t1` seconds of the sweep.
+pub fn record_at(truth: &[Part], seed: u64, exact_kinematics: bool, rate: f64, t1: f64) -> Case {
     let (model, values) = build(truth);
     let osc = Oscillator::new(
         OscillatorParams::FORCED,
@@ -76,7 +81,7 @@ pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
     )
     .with_model(model, values)
     .unwrap();
-    let run = Simulation::new(&osc).rate(200.0).run(0.0, 60.0).unwrap();
+    let run = Simulation::new(&osc).rate(rate).run(0.0, t1).unwrap();
     let rec = sample_record(&run, &SensorNoise::RIG, seed, true);
     // The force of each part alone along the true motion (a part with internal state gets
     // its share of the simulated state).
