@@ -73,17 +73,27 @@ pub(super) struct Yardstick<'a> {
     pub base_excess: f64,
     /// The current model's noise floor.
     pub floor: NoiseFloor,
+    /// The width of the floor's uncertainty in mean square (N² or m²): a gain is measured
+    /// against at least this much excess ([`excess`]).
+    pub floor_band: f64,
     /// The length of the test's blocks, samples (`None`: whole cycles).
     pub block_samples: Option<usize>,
 }
 
 /// The held-out mean square `mse` of a trial above the floor `sigma`², counted as at least
-/// what the held-out units resolve: `min_gain_sigma` standard errors of the mean of the mean
-/// squares of the `units` (their RMS residuals) at the floor (below
-/// [`acceptance::EXCESS_UNIT`]·σ², whose spread is the noise's, not the misfit's). A model at
-/// the floor, or one whose floor is overestimated, would otherwise divide a gain by nothing.
-/// 0 with fewer than two units at the floor and no excess.
-pub(super) fn excess(units: &[f64], mse: f64, sigma: f64, settings: &DiscoverySettings) -> f64 {
+/// the floor's own uncertainty `band` (mean square) and at least what the held-out units
+/// resolve: `min_gain_sigma` standard errors of the mean of the mean squares of the `units`
+/// (their RMS residuals) at the floor (below [`acceptance::EXCESS_UNIT`]·σ², whose spread is
+/// the noise's, not the misfit's). A model at the floor, or one whose floor is misestimated,
+/// would otherwise divide a gain by nothing, and any consistent gain would explain "all" of
+/// it. 0 with fewer than two units at the floor, no band and no excess.
+pub(super) fn excess(
+    units: &[f64],
+    mse: f64,
+    sigma: f64,
+    band: f64,
+    settings: &DiscoverySettings,
+) -> f64 {
     let bar = acceptance::EXCESS_UNIT * sigma * sigma;
     let ms: Vec<f64> = units.iter().map(|r| r * r).filter(|&m| m < bar).collect();
     let n = ms.len();
@@ -94,7 +104,7 @@ pub(super) fn excess(units: &[f64], mse: f64, sigma: f64, settings: &DiscoverySe
         let var = ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
         settings.min_gain_sigma * (var / n as f64).sqrt()
     };
-    (mse - sigma * sigma).max(resolved).max(0.0)
+    (mse - sigma * sigma).max(band).max(resolved).max(0.0)
 }
 
 /// `gain` over `excess`, 0 when there is no excess to explain.
@@ -147,6 +157,7 @@ pub(super) fn score(
                 &(yardstick.units)(&current.holdout),
                 current.holdout_mse,
                 yardstick.floor.sigma,
+                yardstick.floor_band,
                 settings,
             ),
         ),
@@ -285,7 +296,7 @@ fn accepted(step: &Step, winner: usize, said: &Said) -> String {
         .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
         .collect();
     format!(
-        "add `{}`: {} {:.4} → {:.4} {} (paired z {:.1} over {} of {}), ΔBIC {:.1}, explains \
+        "add `{}`: {} {:.4} → {:.4} {} (paired z {:.1} over {}), ΔBIC {:.1}, explains \
          {:.0} % of the current model's held-out excess over its noise floor ({:.4} {}) and \
          {:.0} % of the base's held-out gap; {}",
         w.name,
@@ -294,7 +305,6 @@ fn accepted(step: &Step, winner: usize, said: &Said) -> String {
         w.holdout_rms * said.scale,
         said.unit,
         w.gain_z,
-        w.effective_n,
         units(step),
         w.delta_bic,
         100.0 * w.explained_share,

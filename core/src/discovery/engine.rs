@@ -469,6 +469,7 @@ pub fn discover_force(
         &first_blocks.rms(&current.holdout),
         current.holdout_mse,
         floor_before.sigma,
+        settings.floor_band(floor_before.propagated),
         settings,
     );
     let mut effects: Vec<String> = Vec::new();
@@ -623,6 +624,7 @@ impl Search<'_> {
             units: &units,
             base_excess,
             floor,
+            floor_band: settings.floor_band(floor.propagated),
             block_samples: Some(blocks.length),
         };
         let tried = current.stage.to_try(self.candidates, self.in_base, effects);
@@ -696,6 +698,7 @@ impl Search<'_> {
             units: &units,
             base_excess,
             floor,
+            floor_band: settings.floor_band(floor.propagated),
             block_samples: Some(blocks.length),
         };
         let n_base = current.stage.parts.len().saturating_sub(effects.len());
@@ -819,8 +822,8 @@ impl Search<'_> {
 /// Where the final floor `floor` is itself uncertain, given the final gap `gap_after` (N):
 /// sentences for the verdict notes. The floor rests on estimates — the force sensor's noise
 /// from the record's third differences, the kinematics' noise from the filter's gain, carried
-/// through the model by a linearisation — and leaves out the derivative filter's bias, which
-/// a model with an added mass multiplies.
+/// through the model by a linearisation — and leaves out the derivative filter's error where
+/// ẍ jumps (stick–slip), which a model with an added mass multiplies.
 fn floor_doubts(floor: &NoiseFloor, gap_after: f64, settings: &DiscoverySettings) -> Vec<String> {
     let mut doubts = Vec::new();
     if settings.motion_noise.is_none() {
@@ -834,8 +837,15 @@ fn floor_doubts(floor: &NoiseFloor, gap_after: f64, settings: &DiscoverySettings
         doubts.push(format!(
             "the noise floor is uncertain: its larger part ({:.4} of {:.4} N) is the \
              kinematics' noise propagated through the model, an estimate from the derivative \
-             filter's gain that leaves out the filter's bias",
-            floor.propagated, floor.sigma
+             filter's gain that leaves out the filter's error where ẍ jumps (stick–slip); an \
+             effect smaller than that uncertainty (the floor with this part {}× larger: {:.4} N) \
+             is not named",
+            floor.propagated,
+            floor.sigma,
+            settings.kinematics_uncertainty,
+            floor
+                .measured
+                .hypot(settings.kinematics_uncertainty * floor.propagated)
         ));
     }
     if gap_after > 1.2 * floor.sigma {

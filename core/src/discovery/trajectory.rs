@@ -538,6 +538,7 @@ pub fn discover_trajectory(
         units: &|h: &[f64]| h.to_vec(),
         base_excess,
         floor: crate::fit::NoiseFloor::displacement(floor),
+        floor_band: 0.0,
         block_samples: None,
     };
     let mut effects: Vec<String> = Vec::new();
