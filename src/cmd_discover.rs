@@ -416,6 +416,7 @@ fn run_trajectory(
         "gap_before": found.gap_before,
         "gap_after": found.gap_after,
         "noise_floor": found.noise_floor,
+        "noise_floor_parts": found.noise_floor_parts,
         "gap_unit": "m",
         "s_before_mm2": tf.s_before_mm2,
         "s_after_mm2": tf.s_after_mm2,

@@ -127,3 +127,23 @@ fn two_hidden_effects_are_named_in_order_of_size() {
     assert!(d.gap_after <= 1.2 * d.noise_floor, "{}", d.gap_after);
     check_evidence(&case, &d);
 }
+
+/// The case at the paper's rate: 1 kHz (the filter's window 121 samples), 30 s of the
+/// sweep. Slow (minutes): `cargo test --release -p stf-models --test discovery_null_and_two
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore = "a 1 kHz record: minutes of fitting"]
+fn nothing_is_named_after_a_large_added_mass_at_1_khz() {
+    let case = discovery_support::record_at(
+        &[("power_law", &[20.0, 1.5]), ("added_mass", &[1.5])],
+        1,
+        false,
+        1000.0,
+        30.0,
+    );
+    let d = discover(&case, "power_law", &DiscoverySettings::default());
+    print("large added mass, 1 kHz", &case, &d);
+    assert_eq!(d.effects, ["added_mass"], "{:#?}", d.notes);
+    let window = case.kinematics.as_ref().unwrap().motion_filter.window();
+    assert!(d.steps.iter().all(|s| s.block_samples == Some(2 * window)));
+}
