@@ -129,10 +129,8 @@ fn two_hidden_effects_are_named_in_order_of_size() {
 }
 
 /// The case at the paper's rate: 1 kHz (the filter's window 121 samples), 30 s of the
-/// sweep. Slow (minutes): `cargo test --release -p stf-models --test discovery_null_and_two
-/// -- --ignored --nocapture`.
+/// sweep.
 #[test]
-#[ignore = "a 1 kHz record: minutes of fitting"]
 fn nothing_is_named_after_a_large_added_mass_at_1_khz() {
     let case = discovery_support::record_at(
         &[("power_law", &[20.0, 1.5]), ("added_mass", &[1.5])],
@@ -146,4 +144,30 @@ fn nothing_is_named_after_a_large_added_mass_at_1_khz() {
     assert_eq!(d.effects, ["added_mass"], "{:#?}", d.notes);
     let window = case.kinematics.as_ref().unwrap().motion_filter.window();
     assert!(d.steps.iter().all(|s| s.block_samples == Some(2 * window)));
+}
+
+/// The records in full: the paper's sweep (150 001 samples at 1 kHz, rig sensors),
+/// power law K 20, n 1.5 alone and with an added mass of 1.5 kg. Slow: `cargo test --release
+/// -p stf-models --test discovery_null_and_two -- --ignored --nocapture`.
+#[test]
+#[ignore = "150 001-sample records: minutes of fitting"]
+fn the_paper_sweep_names_nothing_false() {
+    let cases: [(&[discovery_support::Part], &[&str]); 2] = [
+        (&[("power_law", &[20.0, 1.5])], &[]),
+        (
+            &[("power_law", &[20.0, 1.5]), ("added_mass", &[1.5])],
+            &["added_mass"],
+        ),
+    ];
+    for (truth, expected) in cases {
+        let case = discovery_support::paper_record(truth, 1);
+        let started = std::time::Instant::now();
+        let d = discover(&case, "power_law", &DiscoverySettings::default());
+        let label = format!(
+            "paper sweep {truth:?} ({:.0} s)",
+            started.elapsed().as_secs_f64()
+        );
+        print(&label, &case, &d);
+        assert_eq!(d.effects, expected, "{:#?}", d.notes);
+    }
 }

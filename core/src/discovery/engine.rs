@@ -593,6 +593,30 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
+    /// `then` called with the yardstick of a step on a model whose held-out units are
+    /// `blocks` and whose floor is `floor`: the block test ([`acceptance::block_gain_z`]) and
+    /// the floor's uncertainty band.
+    fn measured<T>(
+        &self,
+        blocks: &Blocks,
+        floor: NoiseFloor,
+        base_excess: f64,
+        then: impl FnOnce(&Yardstick) -> T,
+    ) -> T {
+        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks);
+        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks).0;
+        let units = |h: &[f64]| blocks.rms(h);
+        then(&Yardstick {
+            gain_z: &gain_z,
+            tie_z: &tie_z,
+            units: &units,
+            base_excess,
+            floor,
+            floor_band: self.settings.floor_band(floor.propagated),
+            block_samples: Some(blocks.length),
+        })
+    }
+
     /// The blocks of the paired test for a model whose residual is `r` (every sample).
     fn blocks(&self, r: &[f64]) -> Blocks {
         Blocks::new(
@@ -615,57 +639,46 @@ impl Search<'_> {
         let current_residual = current.stage.residuals(data, settings)?;
         let blocks = self.blocks(&current_residual);
         let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
-        let units = |h: &[f64]| blocks.rms(h);
-        let yardstick = Yardstick {
-            gain_z: &gain_z,
-            tie_z: &tie_z,
-            units: &units,
-            base_excess,
-            floor,
-            floor_band: settings.floor_band(floor.propagated),
-            block_samples: Some(blocks.length),
-        };
         let tried = current.stage.to_try(self.candidates, self.in_base, effects);
-        // The candidates are independent trials against the same current model: fitted in
-        // parallel, scored in their order.
-        let scored: Vec<(CandidateScore, Option<Trial>)> = tried
-            .par_iter()
-            .enumerate()
-            .map(|(index, c)| {
-                settings
-                    .observer
-                    .candidate(step, index, tried.len(), &c.name);
-                let starts = candidate_starts(
-                    &c.model,
-                    data,
-                    &split.train,
-                    &current_residual,
-                    settings.extra_starts,
-                );
-                let best = best_trial(
-                    &starts,
-                    |start| current.stage.with(&c.model, start, 0),
-                    data,
-                    split,
-                    settings,
-                );
-                let n_own = c.model.params().len();
-                let s = choice::scored(&c.name, n_own, best, current, &yardstick, settings);
-                emit_scored(settings, step, Some(&s));
-                s
-            })
-            .collect();
-        if scored.is_empty() {
+        if tried.is_empty() {
             return Ok(None);
         }
-        Ok(Some(choice::decide(
-            current,
-            scored,
-            &choice::FORCE,
-            &yardstick,
-            settings,
+        // The candidates are independent trials against the same current model: fitted in
+        // parallel, scored in their order.
+        Ok(Some(self.measured(
+            &blocks,
+            floor,
+            base_excess,
+            |yardstick| {
+                let scored: Vec<(CandidateScore, Option<Trial>)> = tried
+                    .par_iter()
+                    .enumerate()
+                    .map(|(index, c)| {
+                        settings
+                            .observer
+                            .candidate(step, index, tried.len(), &c.name);
+                        let starts = candidate_starts(
+                            &c.model,
+                            data,
+                            &split.train,
+                            &current_residual,
+                            settings.extra_starts,
+                        );
+                        let best = best_trial(
+                            &starts,
+                            |start| current.stage.with(&c.model, start, 0),
+                            data,
+                            split,
+                            settings,
+                        );
+                        let n_own = c.model.params().len();
+                        let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
+                        emit_scored(settings, step, Some(&s));
+                        s
+                    })
+                    .collect();
+                choice::decide(current, scored, &choice::FORCE, yardstick, settings)
+            },
         )))
     }
 
@@ -684,23 +697,23 @@ impl Search<'_> {
         effects: &mut [String],
         base_excess: f64,
     ) -> Result<Option<Step>, DiscoveryError> {
-        let (data, split, settings) = (self.data, self.split, self.settings);
-        let (candidates, in_base) = (self.candidates, self.in_base);
+        let (data, settings) = (self.data, self.settings);
         // Blocks cut for the accepted model's residual, and its own floor.
         let blocks = self.blocks(&current.stage.residuals(data, settings)?);
         let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
-        let units = |h: &[f64]| blocks.rms(h);
-        let yardstick = Yardstick {
-            gain_z: &gain_z,
-            tie_z: &tie_z,
-            units: &units,
-            base_excess,
-            floor,
-            floor_band: settings.floor_band(floor.propagated),
-            block_samples: Some(blocks.length),
-        };
+        self.measured(&blocks, floor, base_excess, |yardstick| {
+            self.replace_one(current, effects, yardstick)
+        })
+    }
+
+    /// [`Search::reconsider`] with the step's `yardstick`.
+    fn replace_one(
+        &self,
+        current: &mut Trial,
+        effects: &mut [String],
+        yardstick: &Yardstick,
+    ) -> Result<Option<Step>, DiscoveryError> {
+        let (data, settings) = (self.data, self.settings);
         let n_base = current.stage.parts.len().saturating_sub(effects.len());
         // (score, trial, effect index, candidate index, a tie rather than a win)
         let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
@@ -712,54 +725,20 @@ impl Search<'_> {
             };
             let rest = current.stage.without(part);
             let rest_residual = rest.residuals(data, settings)?;
-            for (k, c) in candidates.iter().enumerate() {
-                if current.stage.holds(c, in_base, &[]) {
+            for (k, c) in self.candidates.iter().enumerate() {
+                if current.stage.holds(c, self.in_base, &[]) {
                     continue;
                 }
                 let label = format!("{} for {}", c.name, effects[j]);
-                let starts = candidate_starts(
-                    &c.model,
-                    data,
-                    &split.train,
-                    &rest_residual,
-                    settings.extra_starts,
-                );
-                let best = best_trial(
-                    &starts,
-                    |start| rest.inserting(part, &c.model, start),
-                    data,
-                    split,
-                    settings,
-                );
-                match best {
-                    Ok(trial) => {
-                        // Its own parameters are not last here: take them by position.
-                        let from: usize = rest.parts[..part.min(rest.parts.len())]
-                            .iter()
-                            .map(|p| p.params().len())
-                            .sum();
-                        let n_own = c.model.params().len();
-                        let mut score =
-                            choice::score(&label, 0, &trial, current, &yardstick, settings);
-                        score.params = trial
-                            .train
-                            .params
-                            .get(from..from + n_own)
-                            .map(<[_]>::to_vec)
-                            .unwrap_or_default();
-                        let wins = score.significant;
-                        let tie = !wins
-                            && score.failure.is_none()
-                            && score.gain_z >= -settings.min_gain_sigma
-                            && n_own < old.params().len()
-                            && score.delta_bic < 0.0;
-                        score.significant = wins || tie;
-                        tried.push((score, Some(trial), j, k, tie));
-                    }
-                    Err(e) => {
-                        tried.push((choice::failed(&label, e.to_string()), None, j, k, false))
-                    }
-                }
+                let replaced = Replaced {
+                    rest: &rest,
+                    residual: &rest_residual,
+                    part,
+                    old_len: old.params().len(),
+                };
+                let (score, trial, tie) =
+                    self.replacement(c, &label, current, &replaced, yardstick);
+                tried.push((score, trial, j, k, tie));
             }
         }
         if tried.is_empty() {
@@ -775,9 +754,8 @@ impl Search<'_> {
                     .filter(|&i| tried[i].0.significant)
                     .min_by(|&a, &b| tried[a].0.bic.total_cmp(&tried[b].0.bic))
             });
-        let current_h = current.holdout_mse.sqrt();
         let scores = tried.iter().map(|t| t.0.clone()).collect();
-        let mut step = choice::step_on(current, scores, &yardstick);
+        let mut step = choice::step_on(current, scores, yardstick);
         let Some(i) = pick else {
             return Ok(None);
         };
@@ -786,29 +764,9 @@ impl Search<'_> {
             return Ok(None);
         };
         let old_name = effects[j].clone();
-        let new_name = candidates[k].name.clone();
-        step.verdict = if tie {
-            format!(
-                "replace `{old_name}` by `{new_name}`: with `{}` in the model they explain the \
-                 data equally well (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1}, not \
-                 beyond ±{}), and `{new_name}` is simpler (ΔBIC {:.1})",
-                effects.last().map_or("", String::as_str),
-                score.holdout_rms,
-                score.gain_z,
-                settings.min_gain_sigma,
-                score.delta_bic
-            )
-        } else {
-            format!(
-                "replace `{old_name}` by `{new_name}`: with `{}` in the model the held-out \
-                 evidence demands it (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1}, ΔBIC \
-                 {:.1})",
-                effects.last().map_or("", String::as_str),
-                score.holdout_rms,
-                score.gain_z,
-                score.delta_bic
-            )
-        };
+        let new_name = self.candidates[k].name.clone();
+        let with = effects.last().map_or("", String::as_str);
+        step.verdict = replaced_verdict(&step, [&old_name, &new_name, with], &score, tie, settings);
         step.accepted = Some(new_name.clone());
         if tie {
             step.tie_with = vec![old_name];
@@ -816,6 +774,110 @@ impl Search<'_> {
         effects[j] = new_name;
         *current = trial;
         Ok(Some(step))
+    }
+}
+
+/// A model with one of its effects taken out, for a replacement to be inserted in its place.
+struct Replaced<'a> {
+    /// The model without the effect.
+    rest: &'a Stage,
+    /// Its residual at every sample.
+    residual: &'a [f64],
+    /// The index of the part taken out.
+    part: usize,
+    /// How many parameters the part taken out had.
+    old_len: usize,
+}
+
+impl Search<'_> {
+    /// The candidate `c` put in the place of `replaced`, fitted and scored against `current`
+    /// as `label`: its score (significant when it wins, or ties with fewer parameters and a
+    /// lower BIC), its trial, and whether it is a tie rather than a win.
+    fn replacement(
+        &self,
+        c: &Candidate,
+        label: &str,
+        current: &Trial,
+        replaced: &Replaced,
+        yardstick: &Yardstick,
+    ) -> (CandidateScore, Option<Trial>, bool) {
+        let (data, settings, part) = (self.data, self.settings, replaced.part);
+        let starts = candidate_starts(
+            &c.model,
+            data,
+            &self.split.train,
+            replaced.residual,
+            settings.extra_starts,
+        );
+        let rest = replaced.rest;
+        let best = best_trial(
+            &starts,
+            |start| rest.inserting(part, &c.model, start),
+            data,
+            self.split,
+            settings,
+        );
+        let trial = match best {
+            Ok(trial) => trial,
+            Err(e) => return (choice::failed(label, e.to_string()), None, false),
+        };
+        // Its own parameters are not last here: take them by position.
+        let from: usize = rest.parts[..part.min(rest.parts.len())]
+            .iter()
+            .map(|p| p.params().len())
+            .sum();
+        let n_own = c.model.params().len();
+        let mut score = choice::score(label, 0, &trial, current, yardstick, settings);
+        score.params = trial
+            .train
+            .params
+            .get(from..from + n_own)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default();
+        let wins = score.significant;
+        let tie = !wins
+            && score.failure.is_none()
+            && score.gain_z >= -settings.min_gain_sigma
+            && n_own < replaced.old_len
+            && score.delta_bic < 0.0;
+        score.significant = wins || tie;
+        (score, Some(trial), tie)
+    }
+}
+
+/// The verdict of a replacement step on `step`: `names` are the effect replaced, its
+/// replacement and the effect whose acceptance called for it; `score` the replacement's.
+fn replaced_verdict(
+    step: &Step,
+    names: [&str; 3],
+    score: &CandidateScore,
+    tie: bool,
+    settings: &DiscoverySettings,
+) -> String {
+    let [old_name, new_name, with] = names;
+    let current_h = step.current_holdout_rms;
+    if tie {
+        format!(
+            "replace `{old_name}` by `{new_name}`: with `{with}` in the model they explain the \
+             data equally well (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
+             blocks, not beyond ±{}), and `{new_name}` is simpler (ΔBIC {:.1})",
+            score.holdout_rms,
+            score.gain_z,
+            score.effective_n,
+            settings.min_gain_sigma,
+            score.delta_bic
+        )
+    } else {
+        format!(
+            "replace `{old_name}` by `{new_name}`: with `{with}` in the model the held-out \
+             evidence demands it (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
+             blocks, ΔBIC {:.1}, {:.0} % of the excess over the floor)",
+            score.holdout_rms,
+            score.gain_z,
+            score.effective_n,
+            score.delta_bic,
+            100.0 * score.explained_share
+        )
     }
 }
 
