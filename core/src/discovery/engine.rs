@@ -1034,6 +1034,30 @@ mod tests {
     }
 
     #[test]
+    fn an_uncertain_floor_is_said() {
+        let with = DiscoverySettings {
+            motion_noise: Some(crate::fit::MotionNoise::default()),
+            ..DiscoverySettings::default()
+        };
+        // The sensor's noise dominates and the gap is at the floor: nothing to say.
+        let sure = NoiseFloor::force(0.02, 0.005);
+        assert!(floor_doubts(&sure, sure.sigma, &with).is_empty());
+        // The kinematics' part dominates: said, with the floor at its uncertainty.
+        let kin = NoiseFloor::force(0.02, 0.04);
+        let d = floor_doubts(&kin, kin.sigma, &with);
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert!(
+            d[0].contains("uncertain") && d[0].contains("0.0825"),
+            "{d:?}"
+        );
+        // No kinematics' noise known; a gap far above or below the floor.
+        let none = floor_doubts(&sure, sure.sigma, &DiscoverySettings::default());
+        assert!(none[0].contains("sensor's alone"), "{none:?}");
+        assert!(floor_doubts(&sure, 1.3 * sure.sigma, &with)[0].contains("1.30×"));
+        assert!(floor_doubts(&sure, 0.8 * sure.sigma, &with)[0].contains("overestimated"));
+    }
+
+    #[test]
     fn only_parameters_pinned_on_a_bound_are_released() {
         let stage = |values: Vec<f64>| Stage {
             parts: vec![smooth()],
