@@ -33,7 +33,7 @@ use rayon::prelude::*;
 
 use super::acceptance;
 use super::candidate::{self, Candidate};
-use super::choice::{self, Trial};
+use super::choice::{self, Trial, Yardstick};
 use super::engine::{emit_scored, inside};
 use super::error::DiscoveryError;
 use super::holdout::HoldoutSplit;
@@ -466,7 +466,7 @@ struct Trials<'a, 'r> {
     setup: &'a TrajectorySetup,
     split: &'a HoldoutSplit,
     osc_start: &'a [f64],
-    base_excess: f64,
+    yardstick: &'a Yardstick<'a>,
     settings: &'a DiscoverySettings,
 }
 
@@ -558,8 +558,7 @@ impl Trials<'_, '_> {
             c.model.params().len(),
             stage.trial_simulated(self.rig, self.setup, self.split, self.settings),
             current,
-            cycle_gain_z,
-            self.base_excess,
+            self.yardstick,
             self.settings,
         )
     }
@@ -656,6 +655,16 @@ pub fn discover_trajectory(
     let mut current = base_full.trial_simulated(&rig, setup, &split, settings)?;
     let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
     let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
+    let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
+    let yardstick = Yardstick {
+        gain_z: &test,
+        tie_z: &cycle_gain_z,
+        units: &|h: &[f64]| h.to_vec(),
+        base_excess,
+        floor: crate::fit::NoiseFloor::displacement(floor),
+        floor_band: 0.0,
+        block_samples: None,
+    };
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
@@ -665,21 +674,22 @@ pub fn discover_trajectory(
             setup,
             split: &split,
             osc_start: &osc_start,
-            base_excess,
+            yardstick: &yardstick,
             settings,
         };
         let scored = trials.step(step, &tried, &current);
         if scored.is_empty() {
             break;
         }
-        let (step, winner) = choice::decide(&current, scored, &choice::DISPLACEMENT, settings);
-        notes.push(step.verdict.clone());
-        notes.extend(choice::unresolved(
-            &step,
-            &format!("{} held-out cycles", split.holdout_cycles),
-            floor,
+        let (step, winner) = choice::decide(
+            &current,
+            scored,
             &choice::DISPLACEMENT,
-        ));
+            &yardstick,
+            settings,
+        );
+        notes.push(step.verdict.clone());
+        notes.extend(choice::unresolved(&step, &choice::DISPLACEMENT));
         effects.extend(step.accepted.clone());
         steps.push(step);
         let Some(trial) = winner else {
@@ -754,6 +764,7 @@ pub fn discover_trajectory(
             effects,
             steps,
             noise_floor: floor,
+            noise_floor_parts: yardstick.floor,
             holdout_cycles: split.holdout_cycles,
             holdout_samples: split.holdout.len(),
             gap_before,
