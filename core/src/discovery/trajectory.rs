@@ -286,13 +286,6 @@ impl Stage {
         let n_model = model.params().len();
         let current = self.values.get(n_osc..n_osc + n_model)?;
         let defaults: Vec<f64> = model.params().iter().map(|s| s.default).collect();
-        let data = ForceData {
-            t: rig.t,
-            x: rig.x,
-            v: &hint.v,
-            a: &hint.a,
-            f: &hint.f,
-        };
         // A start, not a result: a few dozen iterations at a loose tolerance (a degenerate
         // effect — a vanishing yield force that leaves its smoothing speed free — otherwise
         // creeps for seconds).
@@ -301,16 +294,33 @@ impl Stage {
             .max_iters(40)
             .tol(1e-6);
         // Every k-th sample, at most `HINT_SAMPLES`: the recovered force is filtered, so a
-        // thinned record holds the same information for a start.
+        // thinned record holds the same information for a start. A model without internal
+        // state is evaluated at those samples only; one with state along the whole record.
         let stride = train.len().div_ceil(HINT_SAMPLES).max(1);
         let train: Vec<usize> = train.iter().copied().step_by(stride).collect();
+        let thin = |v: &[f64]| -> Vec<f64> { train.iter().map(|&i| v[i]).collect() };
+        let stateless = model.n_internal() == 0;
+        let thinned = stateless.then(|| [rig.t, rig.x, &hint.v, &hint.a, &hint.f].map(thin));
+        let (data, subset) = match &thinned {
+            Some([t, x, v, a, f]) => (ForceData { t, x, v, a, f }, (0..train.len()).collect()),
+            None => (
+                ForceData {
+                    t: rig.t,
+                    x: rig.x,
+                    v: &hint.v,
+                    a: &hint.a,
+                    f: &hint.f,
+                },
+                train,
+            ),
+        };
         let mut best: Option<(f64, Vec<f64>)> = None;
         for start in [current, defaults.as_slice()] {
             let mut fit = ForceFit::new(model.clone());
             for (spec, &v) in model.params().iter().zip(start) {
                 fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
             }
-            let Ok(r) = fit_subset(&fit, &data, &train, &settings) else {
+            let Ok(r) = fit_subset(&fit, &data, &subset, &settings) else {
                 continue;
             };
             if best.as_ref().is_none_or(|(rms, _)| r.rms < *rms) {
