@@ -104,6 +104,24 @@ fn nothing_hidden_nothing_named() {
         let d = discover(None, seed, None);
         assert!(effects(&d).is_empty(), "seed {seed}: {:?}", d["notes"]);
         assert_at_the_noise(&d);
+        assert_screened(&d);
+    }
+}
+
+/// Every step fitted three candidates at trajectory level and said of each other one that the
+/// force-level screen left it out.
+fn assert_screened(d: &serde_json::Value) {
+    for step in d["steps"].as_array().unwrap() {
+        let candidates = step["candidates"].as_array().unwrap();
+        let left_out = candidates
+            .iter()
+            .filter(|c| {
+                c["failure"]
+                    .as_str()
+                    .is_some_and(|f| f.starts_with("not fitted at trajectory level"))
+            })
+            .count();
+        assert_eq!(left_out, candidates.len().saturating_sub(3), "{step}");
     }
 }
 

@@ -294,26 +294,22 @@ impl Stage {
             .max_iters(40)
             .tol(1e-6);
         // Every k-th sample, at most `HINT_SAMPLES`: the recovered force is filtered, so a
-        // thinned record holds the same information for a start. A model without internal
-        // state is evaluated at those samples only; one with state along the whole record.
+        // thinned record holds the same information for a start. The model is evaluated at
+        // those samples only — a model with internal state too, its state stepped across the
+        // wider spacing (a few ms at most on a rig record; a relaxation faster than that makes
+        // a poorer start, and the screened start remains).
         let stride = train.len().div_ceil(HINT_SAMPLES).max(1);
-        let train: Vec<usize> = train.iter().copied().step_by(stride).collect();
-        let thin = |v: &[f64]| -> Vec<f64> { train.iter().map(|&i| v[i]).collect() };
-        let stateless = model.n_internal() == 0;
-        let thinned = stateless.then(|| [rig.t, rig.x, &hint.v, &hint.a, &hint.f].map(thin));
-        let (data, subset) = match &thinned {
-            Some([t, x, v, a, f]) => (ForceData { t, x, v, a, f }, (0..train.len()).collect()),
-            None => (
-                ForceData {
-                    t: rig.t,
-                    x: rig.x,
-                    v: &hint.v,
-                    a: &hint.a,
-                    f: &hint.f,
-                },
-                train,
-            ),
+        let kept: Vec<usize> = train.iter().copied().step_by(stride).collect();
+        let [t, x, v, a, f] = [rig.t, rig.x, &hint.v, &hint.a, &hint.f]
+            .map(|s| kept.iter().map(|&i| s[i]).collect::<Vec<f64>>());
+        let data = ForceData {
+            t: &t,
+            x: &x,
+            v: &v,
+            a: &a,
+            f: &f,
         };
+        let subset: Vec<usize> = (0..kept.len()).collect();
         let mut best: Option<(f64, Vec<f64>)> = None;
         for start in [current, defaults.as_slice()] {
             let mut fit = ForceFit::new(model.clone());
