@@ -466,6 +466,9 @@ impl Stage {
 /// screen of [`Trials::step`].
 const SCREEN_KEEP: usize = 3;
 
+/// Most Levenberg–Marquardt iterations of a candidate's trial at trajectory level.
+const TRIAL_ITERS: u64 = 60;
+
 /// What every candidate trial of a run shares.
 struct Trials<'a, 'r> {
     rig: &'a Rig<'r>,
@@ -559,10 +562,22 @@ impl Trials<'_, '_> {
         let starts = with.starts(self.rig, train, self.osc_start, hinted);
         let stage =
             Stage::started(starts, self.rig, self.setup, train, self.settings).unwrap_or(with);
+        // Levenberg–Marquardt alone, from the best start, at most `TRIAL_ITERS` iterations: a
+        // candidate whose fit does not settle by then (a stiff relaxation wandering through
+        // thousands of simulations) is scored where it stopped, not chased by Nelder–Mead.
+        let settings = DiscoverySettings {
+            fit: self
+                .settings
+                .fit
+                .clone()
+                .solver(Solver::LevenbergMarquardt)
+                .max_iters(self.settings.fit.max_iters.min(TRIAL_ITERS)),
+            ..self.settings.clone()
+        };
         choice::scored(
             &c.name,
             c.model.params().len(),
-            stage.trial_simulated(self.rig, self.setup, self.split, self.settings),
+            stage.trial_simulated(self.rig, self.setup, self.split, &settings),
             current,
             self.yardstick,
             self.settings,
