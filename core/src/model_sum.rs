@@ -150,6 +150,42 @@ impl ForceModel for ModelSum {
         }
         Ok(total)
     }
+
+    fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+        for (i, part) in self.parts.iter().enumerate() {
+            let n = part.n_internal();
+            if n == 0 {
+                continue;
+            }
+            let o = self.state_offsets[i];
+            let local = ModelState {
+                z: &s.z[o..o + n],
+                ..*s
+            };
+            part.rates(self.part_slices(i, p), &local, &mut dz[o..o + n])?;
+        }
+        Ok(())
+    }
+
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        if self.n_internal > 0 {
+            return Ok(false);
+        }
+        for (i, part) in self.parts.iter().enumerate() {
+            let start = self.param_offsets[i];
+            let end = start + part.params().len();
+            if !part.gradient(&p[start..end], s, a, &mut grad[start..end])? {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
 }
 
 #[cfg(test)]

@@ -308,7 +308,23 @@ fn best_trial(
     let mut first_error = None;
     let (mut evaluations, mut wall) = (0, 0.0);
     for stage in &stages {
-        match stage.trial(data, split, settings) {
+        let trace_clock = std::time::Instant::now();
+        let outcome = stage.trial(data, split, settings);
+        if std::env::var_os("STF_TRACE").is_some() {
+            if let Ok(t) = &outcome {
+                eprintln!(
+                    "TRACE {} start {:?} evals {} wall {:.2} (trial {:.2}) rms {:.6} log {:?}",
+                    stage.name(),
+                    stage.values,
+                    t.train.evaluations,
+                    t.train.wall_seconds,
+                    trace_clock.elapsed().as_secs_f64(),
+                    t.train.rms,
+                    t.train.log
+                );
+            }
+        }
+        match outcome {
             Ok(trial) => {
                 evaluations += trial.train.evaluations;
                 wall += trial.train.wall_seconds;

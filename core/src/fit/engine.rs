@@ -416,8 +416,8 @@ fn finish(
     })
 }
 
-/// A forward-difference Jacobian of the residuals `r0` at the user values `x` of the free
-/// parameters `free`.
+/// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
+/// exact where the problem gives one, else by forward differences.
 fn jacobian(
     obj: &Objective,
     free: &[&FitParam],
@@ -427,6 +427,9 @@ fn jacobian(
 ) -> DMatrix<f64> {
     let (n, p) = (r0.len(), free.len());
     let mut jac = DMatrix::<f64>::zeros(n, p);
+    if obj.jacobian_user(x, &mut jac) == Some(true) {
+        return jac;
+    }
     let mut steps: Vec<f64> = free
         .iter()
         .map(|q| settings.fd_step * q.effective_scale())

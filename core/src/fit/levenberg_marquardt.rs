@@ -10,10 +10,12 @@
 //! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
 //! ```
 //!
-//! Steps are shortened to at most two scales of any parameter. The Jacobian's difference
-//! steps start at `fd_step` and grow above the residuals' noise, measured once at the start
-//! (see [`super::jacobian`]): a column that is mostly integrator noise gives a step that
-//! raises the cost at every damping, and the refinement stopped far from the optimum.
+//! Steps are shortened to at most two scales of any parameter. The Jacobian is exact where the
+//! problem gives one ([`super::objective::Residuals::jacobian`]: force fits of built-ins
+//! without state); else its difference steps start at `fd_step` and grow above the residuals'
+//! noise, measured once (see [`super::jacobian`]): a column that is mostly integrator noise
+//! gives a step that raises the cost at every damping, and the refinement stopped far from
+//! the optimum.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -74,27 +76,34 @@ pub fn refine(
     };
     let mut jac = DMatrix::<f64>::zeros(n, p);
     let mut steps = vec![fd_step; p];
-    // The residuals' noise, measured once: the Jacobian's steps grow above it.
-    let noise = residual_noise(&u, &r, &vec![NOISE_PROBE; p], &mut |point, out| {
-        obj.residuals_user(&obj.to_user(point), out).is_some()
-    })
-    .unwrap_or(0.0);
-    let floor = StepFloor {
-        noise,
-        max: vec![MAX_FD_STEP.max(fd_step); p],
-    };
+    // An exact Jacobian where the problem gives one; else differences whose steps grow above
+    // the residuals' noise, measured once (lazily: an exact Jacobian needs no noise).
+    let mut exact = obj.jacobian_internal(&u, &mut jac) == Some(true);
+    let mut floor: Option<StepFloor> = None;
     let mut lambda = 1e-3;
     let mut nu = 2.0;
     for iter in 1..=max_iters {
-        forward_difference(
-            &u,
-            &r,
-            &mut steps,
-            &floor,
-            &|_, _| false,
-            &mut |point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
-            &mut jac,
-        );
+        if iter > 1 && exact {
+            exact = obj.jacobian_internal(&u, &mut jac) == Some(true);
+        }
+        if !exact {
+            let floor = floor.get_or_insert_with(|| StepFloor {
+                noise: residual_noise(&u, &r, &vec![NOISE_PROBE; p], &mut |point, out| {
+                    obj.residuals_user(&obj.to_user(point), out).is_some()
+                })
+                .unwrap_or(0.0),
+                max: vec![MAX_FD_STEP.max(fd_step); p],
+            });
+            forward_difference(
+                &u,
+                &r,
+                &mut steps,
+                floor,
+                &|_, _| false,
+                &mut |point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
+                &mut jac,
+            );
+        }
         jac.iter_mut()
             .filter(|v| !v.is_finite())
             .for_each(|v| *v = 0.0);

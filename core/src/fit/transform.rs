@@ -137,6 +137,19 @@ impl BoundTransform {
         }
     }
 
+    /// The slope `dx/du` of the map at internal coordinate `u`.
+    pub fn slope(&self, u: f64) -> f64 {
+        match self.shape {
+            Shape::Free => self.scale,
+            Shape::Lower { d } => self.scale * (self.scale * u / d).exp(),
+            Shape::Upper { d } => self.scale * (-self.scale * u / d).exp(),
+            Shape::Both { w0, c } => {
+                let s = logistic(w0 + c * u);
+                (self.max - self.min) * s * (1.0 - s) * c
+            }
+        }
+    }
+
     /// The internal coordinate of user value `x`; `None` outside the open interior.
     pub fn to_internal(&self, x: f64) -> Option<f64> {
         let u = match self.shape {
