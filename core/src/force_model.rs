@@ -106,7 +106,9 @@ pub trait ForceModel: Send + Sync {
     /// The gradient of the whole force `m_a·a + f` with respect to the parameters at state
     /// `s` and acceleration `a`, written to `grad` (one entry per parameter); `Ok(false)` when
     /// the model does not provide it (the default), and the fitter differences instead. Only
-    /// models without internal state provide it (a state would need its sensitivities).
+    /// models without internal state provide it (a state would need its sensitivities); a sum
+    /// gives its memoryless parts' entries and leaves NaN in those of its parts with state,
+    /// which the fitter differences.
     fn gradient(
         &self,
         _p: &[f64],

@@ -174,17 +174,23 @@ impl ForceModel for ModelSum {
         a: f64,
         grad: &mut [f64],
     ) -> Result<bool, ModelError> {
-        if self.n_internal > 0 {
-            return Ok(false);
-        }
+        // A part with state gets NaN entries (differenced by the fitter); a memoryless part
+        // sees no state. Without any part's gradient there is none.
+        let mut any = false;
         for (i, part) in self.parts.iter().enumerate() {
             let start = self.param_offsets[i];
             let end = start + part.params().len();
-            if !part.gradient(&p[start..end], s, a, &mut grad[start..end])? {
-                return Ok(false);
+            let own = &mut grad[start..end];
+            let given = part.n_internal() == 0 && {
+                let local = ModelState { z: &[], ..*s };
+                part.gradient(&p[start..end], &local, a, own)?
+            };
+            if !given {
+                own.fill(f64::NAN);
             }
+            any |= given;
         }
-        Ok(true)
+        Ok(any)
     }
 }
 

@@ -147,7 +147,7 @@ impl ForceModel for JammingOnOff {
         // dG/dq = ½·sech²(q), q = (|v| − v_c)/w; a hard switch (w = 0) has no slope.
         let (dvc, dw) = if w > 0.0 {
             let q = (speed - v_c) / w;
-            let slope = 0.5 * (1.0 - q.tanh().powi(2)) * power_law_force(k_j, n_j, s.v);
+            let slope = 0.5 / q.cosh().powi(2) * power_law_force(k_j, n_j, s.v);
             (-slope / w, -slope * q / w)
         } else {
             (0.0, 0.0)

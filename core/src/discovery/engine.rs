@@ -598,6 +598,86 @@ pub fn discover_force(
     })
 }
 
+/// A replacement tried by [`reconsider`]: its score, its trial (when the fit ran), the index
+/// of the effect replaced, the candidate's index, and whether it is a tie rather than a win.
+type Replacement = (CandidateScore, Option<Trial>, usize, usize, bool);
+
+/// The effect `j` (part `part`, model `old`) of the current model, and the model without it
+/// (`rest`, whose residual is `rest_residual`): where [`reconsider`] tries each candidate.
+struct Slot<'a> {
+    j: usize,
+    part: usize,
+    old: &'a dyn ForceModel,
+    rest: &'a Stage,
+    rest_residual: &'a [f64],
+    effect: &'a str,
+}
+
+impl Slot<'_> {
+    /// Candidate `c` (index `k`) in this slot, fitted on the training cycles and scored
+    /// against `current`.
+    #[allow(clippy::too_many_arguments)]
+    fn replace(
+        &self,
+        k: usize,
+        c: &Candidate,
+        current: &Trial,
+        data: &ForceData,
+        split: &HoldoutSplit,
+        base_excess: f64,
+        settings: &DiscoverySettings,
+    ) -> Replacement {
+        let label = format!("{} for {}", c.name, self.effect);
+        let starts = candidate_starts(
+            &c.model,
+            data,
+            &split.train,
+            self.rest_residual,
+            settings.extra_starts,
+        );
+        let best = best_trial(
+            &starts,
+            |start| self.rest.inserting(self.part, &c.model, start),
+            data,
+            split,
+            settings,
+        );
+        let trial = match best {
+            Ok(trial) => trial,
+            Err(e) => return (choice::failed(&label, e.to_string()), None, self.j, k, false),
+        };
+        // Its own parameters are not last here: take them by position.
+        let from: usize = self.rest.parts[..self.part.min(self.rest.parts.len())]
+            .iter()
+            .map(|p| p.params().len())
+            .sum();
+        let n_own = c.model.params().len();
+        let mut score = choice::score(
+            &label,
+            0,
+            &trial,
+            current,
+            acceptance::paired_z,
+            base_excess,
+            settings,
+        );
+        score.params = trial
+            .train
+            .params
+            .get(from..from + n_own)
+            .map(<[_]>::to_vec)
+            .unwrap_or_default();
+        let wins = score.significant;
+        let tie = !wins
+            && score.failure.is_none()
+            && score.gain_z >= -settings.min_gain_sigma
+            && n_own < self.old.params().len()
+            && score.delta_bic < 0.0;
+        score.significant = wins || tie;
+        (score, Some(trial), self.j, k, tie)
+    }
+}
+
 /// After an effect is accepted, the earlier ones are tried again in its light: each is
 /// replaced in turn by every candidate not in the model (refitted on the training cycles). An
 /// effect chosen first can have won only because the one found later was missing (an added
@@ -619,9 +699,7 @@ fn reconsider(
     settings: &DiscoverySettings,
 ) -> Result<Option<Step>, DiscoveryError> {
     let n_base = current.stage.parts.len().saturating_sub(effects.len());
-    // (score, trial, effect index, candidate index, a tie rather than a win)
-    let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
-    #[allow(clippy::needless_range_loop)] // `j` also names the part and the effect replaced
+    let mut tried: Vec<Replacement> = Vec::new();
     for j in 0..effects.len().saturating_sub(1) {
         let part = n_base + j;
         let Some(old) = current.stage.parts.get(part).cloned() else {
@@ -629,60 +707,30 @@ fn reconsider(
         };
         let rest = current.stage.without(part);
         let rest_residual = rest.residuals(data, settings)?;
-        for (k, c) in candidates.iter().enumerate() {
-            if current.stage.holds(c, in_base, &[]) {
-                continue;
-            }
-            let label = format!("{} for {}", c.name, effects[j]);
-            let starts = candidate_starts(
-                &c.model,
-                data,
-                &split.train,
-                &rest_residual,
-                settings.extra_starts,
-            );
-            let best = best_trial(
-                &starts,
-                |start| rest.inserting(part, &c.model, start),
+        let to_try: Vec<usize> = (0..candidates.len())
+            .filter(|&k| !current.stage.holds(&candidates[k], in_base, &[]))
+            .collect();
+        // Independent trials against the same current model: fitted in parallel, kept in
+        // their order.
+        let slot = Slot {
+            j,
+            part,
+            old: old.as_ref(),
+            rest: &rest,
+            rest_residual: &rest_residual,
+            effect: &effects[j],
+        };
+        tried.par_extend(to_try.par_iter().map(|&k| {
+            slot.replace(
+                k,
+                &candidates[k],
+                current,
                 data,
                 split,
+                base_excess,
                 settings,
-            );
-            match best {
-                Ok(trial) => {
-                    // Its own parameters are not last here: take them by position.
-                    let from: usize = rest.parts[..part.min(rest.parts.len())]
-                        .iter()
-                        .map(|p| p.params().len())
-                        .sum();
-                    let n_own = c.model.params().len();
-                    let mut score = choice::score(
-                        &label,
-                        0,
-                        &trial,
-                        current,
-                        acceptance::paired_z,
-                        base_excess,
-                        settings,
-                    );
-                    score.params = trial
-                        .train
-                        .params
-                        .get(from..from + n_own)
-                        .map(<[_]>::to_vec)
-                        .unwrap_or_default();
-                    let wins = score.significant;
-                    let tie = !wins
-                        && score.failure.is_none()
-                        && score.gain_z >= -settings.min_gain_sigma
-                        && n_own < old.params().len()
-                        && score.delta_bic < 0.0;
-                    score.significant = wins || tie;
-                    tried.push((score, Some(trial), j, k, tie));
-                }
-                Err(e) => tried.push((choice::failed(&label, e.to_string()), None, j, k, false)),
-            }
-        }
+            )
+        }));
     }
     if tried.is_empty() {
         return Ok(None);

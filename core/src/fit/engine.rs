@@ -427,7 +427,10 @@ fn jacobian(
 ) -> DMatrix<f64> {
     let (n, p) = (r0.len(), free.len());
     let mut jac = DMatrix::<f64>::zeros(n, p);
-    if obj.jacobian_user(x, &mut jac) == Some(true) {
+    let exact = obj
+        .jacobian_user(x, &mut jac)
+        .unwrap_or_else(|| vec![false; p]);
+    if exact.iter().all(|&e| e) {
         return jac;
     }
     let mut steps: Vec<f64> = free
@@ -471,6 +474,7 @@ fn jacobian(
         &floor,
         &|j, v| !(v > free[j].min && v < free[j].max),
         &mut |point, out| obj.residuals_user(point, out).is_some(),
+        &exact,
         &mut jac,
     );
     jac

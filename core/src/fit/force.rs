@@ -296,11 +296,13 @@ impl Residuals for ForceResiduals<'_> {
         .map_err(err)
     }
 
-    /// Exact for models that give their [`ForceModel::gradient`] (those without state).
+    /// Exact for models that give their [`ForceModel::gradient`]: built-ins without state,
+    /// and the memoryless parts of a sum (a part with state leaves NaN columns). A
+    /// memoryless part's gradient needs no state, so nothing is integrated here.
     fn jacobian(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Result<(), String>> {
         let m = self.model;
         let n_model = m.params().len();
-        if m.n_internal() > 0 || self.is_empty() {
+        if self.is_empty() {
             return None;
         }
         let full = match full_values(self.all, x) {
@@ -311,6 +313,8 @@ impl Residuals for ForceResiduals<'_> {
         // Column of each free parameter among all (the offset is the last).
         let free: Vec<usize> = (0..self.all.len()).filter(|&j| !self.all[j].fixed).collect();
         let mut grad = vec![0.0; n_model];
+        // A placeholder state: only memoryless parts give their gradient.
+        let state = vec![0.0; m.n_internal()];
         let d = &self.data;
         for k in 0..self.len() {
             let i = self.row(k);
@@ -318,7 +322,7 @@ impl Residuals for ForceResiduals<'_> {
                 t: d.t[i],
                 x: d.x[i],
                 v: d.v[i],
-                z: &[],
+                z: &state,
             };
             match m.gradient(p, &s, d.a[i], &mut grad) {
                 Ok(true) => {}

@@ -165,38 +165,37 @@ impl<'a> Objective<'a> {
         })
     }
 
-    /// The exact Jacobian at user values `x` into `jac`, when the problem gives one: `None`
-    /// when it does not, `Some(false)` when it failed (counted and remembered). Counted as an
-    /// evaluation.
-    pub fn jacobian_user(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<bool> {
+    /// The exact columns of the Jacobian at user values `x`, written into `jac`: which
+    /// columns are exact (finite throughout; the others are to be differenced), or `None`
+    /// when the problem gives none or it failed. Counted as an evaluation.
+    pub fn jacobian_user(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
+        if std::env::var_os("STF_NO_EXACT").is_some() {
+            return None;
+        }
         let outcome = self.problem.jacobian(x, jac)?;
         self.evaluations.fetch_add(1, Ordering::Relaxed);
-        Some(match outcome {
-            Ok(()) if jac.iter().all(|v| v.is_finite()) => true,
-            Ok(()) => {
-                self.failures.fetch_add(1, Ordering::Relaxed);
-                *lock(&self.last_failure) = Some("a Jacobian entry is not finite".into());
-                false
-            }
-            Err(e) => {
-                self.failures.fetch_add(1, Ordering::Relaxed);
-                *lock(&self.last_failure) = Some(e);
-                false
-            }
-        })
+        if let Err(e) = outcome {
+            *lock(&self.last_failure) = Some(e);
+            return None;
+        }
+        let exact: Vec<bool> = jac
+            .column_iter()
+            .map(|c| c.iter().all(|v| v.is_finite()))
+            .collect();
+        exact.iter().any(|&e| e).then_some(exact)
     }
 
-    /// The exact Jacobian in internal coordinates `u` (the user Jacobian times each
-    /// transform's slope), as [`Objective::jacobian_user`].
-    pub fn jacobian_internal(&self, u: &[f64], jac: &mut DMatrix<f64>) -> Option<bool> {
-        let ok = self.jacobian_user(&self.to_user(u), jac)?;
-        if ok {
-            for (j, (t, &uj)) in self.transforms.iter().zip(u).enumerate() {
+    /// The exact columns of the Jacobian in internal coordinates `u` (the user Jacobian
+    /// times each transform's slope), as [`Objective::jacobian_user`].
+    pub fn jacobian_internal(&self, u: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
+        let exact = self.jacobian_user(&self.to_user(u), jac)?;
+        for (j, (t, &uj)) in self.transforms.iter().zip(u).enumerate() {
+            if exact[j] {
                 let slope = t.slope(uj);
                 jac.column_mut(j).iter_mut().for_each(|c| *c *= slope);
             }
         }
-        Some(ok)
+        Some(exact)
     }
 
     /// Mean squared residual at internal coordinates `u`; `None` on failure.
