@@ -150,6 +150,12 @@ impl BoundTransform {
         }
     }
 
+    /// Whether the map is flat at `u` (its slope below 1 % of the scale): the parameter
+    /// presses on a bound.
+    pub fn saturated(&self, u: f64) -> bool {
+        self.slope(u) < 1e-2 * self.scale
+    }
+
     /// The internal coordinate of user value `x`; `None` outside the open interior.
     pub fn to_internal(&self, x: f64) -> Option<f64> {
         let u = match self.shape {
