@@ -286,12 +286,8 @@ impl Residuals for ForceResiduals<'_> {
             }
             return Ok(());
         }
-        let mut next = 0;
-        integrate_state(m, p, d, &mut |i, ma, f| {
-            if self.rows.is_none_or(|r| r.get(next) == Some(&i)) {
-                sink(next, d.f[i] - (ma * d.a[i] + f + offset));
-                next += 1;
-            }
+        integrate_state(m, p, d, self.rows, &mut |k, i, ma, f| {
+            sink(k, d.f[i] - (ma * d.a[i] + f + offset));
         })
         .map_err(err)
     }
@@ -338,13 +334,15 @@ impl Residuals for ForceResiduals<'_> {
 }
 
 /// Integrate the internal state of `m` (parameters `p`) along the kinematics of `d` with one
-/// RK4 step per sample interval, calling `each(i, m_a, f)` at every sample with the added
-/// mass and the rest of the force there.
+/// RK4 step per sample interval, calling `each(k, i, m_a, f)` at the `k`-th of the samples
+/// `rows` (strictly increasing; `None`: all), sample `i`, with the added mass and the rest of
+/// the force there; elsewhere only the state's rates are evaluated.
 fn integrate_state(
     m: &dyn ForceModel,
     p: &[f64],
     d: &ForceData,
-    each: &mut dyn FnMut(usize, f64, f64),
+    rows: Option<&[usize]>,
+    each: &mut dyn FnMut(usize, usize, f64, f64),
 ) -> Result<(), crate::force_model::ModelError> {
     let nz = m.n_internal();
     // z, stage rates k1..k4, stage state.
@@ -356,6 +354,7 @@ fn integrate_state(
     let (k4, zs) = rest.split_at_mut(nz);
     m.initial_internal(p, z);
     let last = d.t.len() - 1;
+    let mut next = 0;
     for i in 0..=last {
         let s = ModelState {
             t: d.t[i],
@@ -363,9 +362,15 @@ fn integrate_state(
             v: d.v[i],
             z,
         };
-        let ma = m.added_mass(p, &s)?;
-        let f = m.force(p, &s, k1)?;
-        each(i, ma, f);
+        let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
+        if let Some(k) = k {
+            let ma = m.added_mass(p, &s)?;
+            let f = m.force(p, &s, k1)?;
+            each(k, i, ma, f);
+            next += 1;
+        } else {
+            m.rates(p, &s, k1)?;
+        }
         if i == last {
             break;
         }
