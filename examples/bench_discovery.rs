@@ -72,7 +72,11 @@ fn experiment(case: &Case, record: &str) -> String {
 fn run(case: &Case, dir: &Path) -> Result<(f64, String)> {
     let stem = format!(
         "{}_{}",
-        if case.trajectory { "trajectory" } else { "force" },
+        if case.trajectory {
+            "trajectory"
+        } else {
+            "force"
+        },
         case.hidden.unwrap_or("none")
     );
     let record = format!("sweep_{}.csv", case.hidden.unwrap_or("none"));
@@ -89,7 +93,11 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, String)> {
         serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
     let effects: Vec<String> = json["effects"]
         .as_array()
-        .map(|a| a.iter().filter_map(|e| e.as_str().map(String::from)).collect())
+        .map(|a| {
+            a.iter()
+                .filter_map(|e| e.as_str().map(String::from))
+                .collect()
+        })
         .unwrap_or_default();
     let named = if effects.is_empty() {
         "nothing named".to_string()

@@ -44,9 +44,18 @@ fn check(model: &dyn ForceModel, p: &[f64], x: f64, v: f64, a: f64) {
     if !differentiable(model, p, v) {
         return;
     }
-    let s = ModelState { t: 0.0, x, v, z: &[] };
+    let s = ModelState {
+        t: 0.0,
+        x,
+        v,
+        z: &[],
+    };
     let mut grad = vec![f64::NAN; p.len()];
-    assert!(model.gradient(p, &s, a, &mut grad).unwrap(), "{}", model.name());
+    assert!(
+        model.gradient(p, &s, a, &mut grad).unwrap(),
+        "{}",
+        model.name()
+    );
     let fd = differences(model, p, &s, a);
     // Relative to the entry, beyond the differences' rounding noise (a saturated gate's
     // slope of 1e-11 differences to 0). A wrong formula is off by far more.
@@ -109,7 +118,11 @@ fn at_rest_and_out_of_contact_the_gradient_is_finite() {
         };
         let mut grad = vec![f64::NAN; p.len()];
         assert!(model.gradient(&p, &s, 0.0, &mut grad).unwrap());
-        assert!(grad.iter().all(|g| g.is_finite()), "{}: {grad:?}", entry.name);
+        assert!(
+            grad.iter().all(|g| g.is_finite()),
+            "{}: {grad:?}",
+            entry.name
+        );
     }
 }
 

@@ -308,23 +308,7 @@ fn best_trial(
     let mut first_error = None;
     let (mut evaluations, mut wall) = (0, 0.0);
     for stage in &stages {
-        let trace_clock = std::time::Instant::now();
-        let outcome = stage.trial(data, split, settings);
-        if std::env::var_os("STF_TRACE").is_some() {
-            if let Ok(t) = &outcome {
-                eprintln!(
-                    "TRACE {} start {:?} evals {} wall {:.2} (trial {:.2}) rms {:.6} log {:?}",
-                    stage.name(),
-                    stage.values,
-                    t.train.evaluations,
-                    t.train.wall_seconds,
-                    trace_clock.elapsed().as_secs_f64(),
-                    t.train.rms,
-                    t.train.log
-                );
-            }
-        }
-        match outcome {
+        match stage.trial(data, split, settings) {
             Ok(trial) => {
                 evaluations += trial.train.evaluations;
                 wall += trial.train.wall_seconds;
@@ -644,7 +628,15 @@ impl Slot<'_> {
         );
         let trial = match best {
             Ok(trial) => trial,
-            Err(e) => return (choice::failed(&label, e.to_string()), None, self.j, k, false),
+            Err(e) => {
+                return (
+                    choice::failed(&label, e.to_string()),
+                    None,
+                    self.j,
+                    k,
+                    false,
+                )
+            }
         };
         // Its own parameters are not last here: take them by position.
         let from: usize = self.rest.parts[..self.part.min(self.rest.parts.len())]
@@ -700,7 +692,8 @@ fn reconsider(
 ) -> Result<Option<Step>, DiscoveryError> {
     let n_base = current.stage.parts.len().saturating_sub(effects.len());
     let mut tried: Vec<Replacement> = Vec::new();
-    for j in 0..effects.len().saturating_sub(1) {
+    let earlier = effects.len().saturating_sub(1);
+    for (j, effect) in effects.iter().enumerate().take(earlier) {
         let part = n_base + j;
         let Some(old) = current.stage.parts.get(part).cloned() else {
             continue;
@@ -718,7 +711,7 @@ fn reconsider(
             old: old.as_ref(),
             rest: &rest,
             rest_residual: &rest_residual,
-            effect: &effects[j],
+            effect,
         };
         tried.par_extend(to_try.par_iter().map(|&k| {
             slot.replace(

@@ -307,7 +307,9 @@ impl Residuals for ForceResiduals<'_> {
         };
         let p = &full[..n_model];
         // Column of each free parameter among all (the offset is the last).
-        let free: Vec<usize> = (0..self.all.len()).filter(|&j| !self.all[j].fixed).collect();
+        let free: Vec<usize> = (0..self.all.len())
+            .filter(|&j| !self.all[j].fixed)
+            .collect();
         let mut grad = vec![0.0; n_model];
         // A placeholder state: only memoryless parts give their gradient.
         let state = vec![0.0; m.n_internal()];

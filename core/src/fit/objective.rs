@@ -169,9 +169,6 @@ impl<'a> Objective<'a> {
     /// columns are exact (finite throughout; the others are to be differenced), or `None`
     /// when the problem gives none or it failed. Counted as an evaluation.
     pub fn jacobian_user(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
-        if std::env::var_os("STF_NO_EXACT").is_some() {
-            return None;
-        }
         let outcome = self.problem.jacobian(x, jac)?;
         self.evaluations.fetch_add(1, Ordering::Relaxed);
         if let Err(e) = outcome {
