@@ -96,6 +96,17 @@ pub trait ForceModel: Send + Sync {
     /// with a plus sign on the left-hand side). Writes the rates of the internal state to `dz`.
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError>;
 
+    /// The added mass and the rest of the force at once (what a fitter needs at every
+    /// sample): `(added_mass, force)`. The default calls both; a sum visits its parts once.
+    fn mass_and_force(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        dz: &mut [f64],
+    ) -> Result<(f64, f64), ModelError> {
+        Ok((self.added_mass(p, s)?, self.force(p, s, dz)?))
+    }
+
     /// Only the rates of the internal state, written to `dz` (the intermediate stages of an
     /// integration step need no force). The default calls [`ForceModel::force`]; a sum
     /// evaluates only its parts with state.

@@ -155,6 +155,26 @@ impl ForceModel for ModelSum {
         Ok(total)
     }
 
+    fn mass_and_force(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        dz: &mut [f64],
+    ) -> Result<(f64, f64), ModelError> {
+        let (mut mass, mut force) = (0.0, 0.0);
+        for (i, part) in self.parts.iter().enumerate() {
+            let states = self.states(i);
+            let local = ModelState {
+                z: &s.z[states.clone()],
+                ..*s
+            };
+            let (m, f) = part.mass_and_force(self.part_slices(i, p), &local, &mut dz[states])?;
+            mass += m;
+            force += f;
+        }
+        Ok((mass, force))
+    }
+
     fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
         for (i, part) in self.parts.iter().enumerate() {
             let states = self.states(i);

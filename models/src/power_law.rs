@@ -74,9 +74,10 @@ pub fn power_law_gradient(k: f64, n: f64, v: f64) -> (f64, f64) {
     if v == 0.0 {
         return (0.0, 0.0);
     }
-    let speed = v.abs();
-    let unit = speed.powf(n) * v.signum();
-    (unit, k * unit * speed.ln())
+    // exp(n·ln|v|): one logarithm serves both entries (a gradient needs no last-bit power).
+    let ln = v.abs().ln();
+    let unit = (n * ln).exp() * v.signum();
+    (unit, k * unit * ln)
 }
 
 impl ForceModel for PowerLaw {

@@ -280,8 +280,7 @@ impl Residuals for ForceResiduals<'_> {
                     v: d.v[i],
                     z: &[],
                 };
-                let ma = m.added_mass(p, &s).map_err(err)?;
-                let f = m.force(p, &s, &mut []).map_err(err)?;
+                let (ma, f) = m.mass_and_force(p, &s, &mut []).map_err(err)?;
                 sink(k, d.f[i] - (ma * d.a[i] + f + offset));
             }
             return Ok(());
@@ -366,8 +365,7 @@ fn integrate_state(
         };
         let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
         if let Some(k) = k {
-            let ma = m.added_mass(p, &s)?;
-            let f = m.force(p, &s, k1)?;
+            let (ma, f) = m.mass_and_force(p, &s, k1)?;
             each(k, i, ma, f);
             next += 1;
         } else {
