@@ -119,10 +119,15 @@ fn main() -> Result<()> {
     let trajectory = std::env::args().any(|a| a == "--trajectory");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/bench_discovery");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    println!("| case | wall | verdict |\n|---|---|---|");
+    // The commands print their own summaries as they go; the table comes last.
+    let mut rows = Vec::new();
     for case in CASES.iter().filter(|c| trajectory || !c.trajectory) {
         let (wall, verdict) = run(case, &dir).with_context(|| case.label)?;
-        println!("| {} | {wall:.1} s | {verdict} |", case.label);
+        rows.push(format!("| {} | {wall:.1} s | {verdict} |", case.label));
+    }
+    println!("\n| case | wall | verdict |\n|---|---|---|");
+    for row in rows {
+        println!("{row}");
     }
     Ok(())
 }
