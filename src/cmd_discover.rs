@@ -167,6 +167,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             cycles.len()
         );
     }
+    // The record's kinematics noise enters the floor, its filter the test's blocks.
+    let settings = settings.kinematics(&data.kinematics);
     let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings);
     bar.finish_and_clear();
     let found = found?;
@@ -192,6 +194,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "gap_before": found.gap_before,
         "gap_after": found.gap_after,
         "noise_floor": found.noise_floor,
+        "noise_floor_parts": found.noise_floor_parts,
         "gap_unit": "N",
         "holdout_cycles": found.holdout_cycles,
         "where_before": found.where_before,
@@ -242,8 +245,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                     "candidate",
                     "held-out RMS, N",
                     "ΔBIC",
-                    "gain (σ)",
-                    "explains",
+                    "paired z (units)",
+                    "explains of the excess",
                     "significant",
                 ]
                 .iter()
@@ -257,8 +260,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                             c.name.clone(),
                             format!("{:.5}", c.holdout_rms),
                             format!("{:.1}", c.delta_bic),
-                            format!("{:.1}", c.gain_z),
-                            format!("{:.0} %", 100.0 * c.explained_fraction),
+                            format!("{:.1} ({})", c.gain_z, c.effective_n),
+                            format!("{:.0} %", 100.0 * c.explained_share),
                             if c.significant {
                                 "yes".into()
                             } else {
@@ -432,6 +435,7 @@ fn run_trajectory(
         "gap_before": found.gap_before,
         "gap_after": found.gap_after,
         "noise_floor": found.noise_floor,
+        "noise_floor_parts": found.noise_floor_parts,
         "gap_unit": "m",
         "s_before_mm2": tf.s_before_mm2,
         "s_after_mm2": tf.s_after_mm2,

@@ -16,6 +16,34 @@ fn discovery_names_the_hidden_cubic_spring_and_the_gap_shrinks_to_the_noise() {
     let floor = doc["noise_floor"].as_f64().unwrap();
     assert!(after < before / 3.0, "gap {before} → {after}");
     assert!(after <= 1.2 * floor, "gap after {after}, floor {floor}");
+    // The floor's parts, and every step's evidence with its effective sample size: blocks of
+    // held-out samples, far fewer than the samples.
+    let parts = &doc["noise_floor_parts"];
+    let (measured, propagated) = (
+        parts["measured"].as_f64().unwrap(),
+        parts["propagated"].as_f64().unwrap(),
+    );
+    assert!(measured > 0.0 && propagated > 0.0, "{parts}");
+    assert!(
+        (measured.hypot(propagated) - floor).abs() < 1e-12,
+        "{parts}"
+    );
+    let held_out = doc["holdout_cycles"].as_u64().unwrap();
+    for step in doc["steps"].as_array().unwrap() {
+        let blocks = step["effective_n"].as_u64().unwrap();
+        let length = step["block_samples"].as_u64().unwrap();
+        assert!(
+            blocks >= held_out && length >= 10,
+            "{blocks} blocks of {length}"
+        );
+        assert!(step["floor"]["sigma"].as_f64().unwrap() > 0.0, "{step}");
+        for c in step["candidates"].as_array().unwrap() {
+            assert!(
+                c["explained_share"].is_number() || c["failure"].is_string(),
+                "{c}"
+            );
+        }
+    }
     let k3 = doc["final_model"]["params"]["k3"].as_f64().unwrap();
     assert!((k3 / 2e4 - 1.0).abs() < 0.05, "k3 = {k3}");
     // The final model is an experiment entry that `fit` accepts as it is.

@@ -5,9 +5,10 @@
 //! alone, discovery names exactly the hidden effect — or nothing — and the x residual after
 //! is within 1.2× the noise.
 //!
-//! `yield` (≈ F_y·sign v) has the form of the bearing's Coulomb friction T: with T refitted
-//! the base absorbs it (T 0.54 → 0.70 N, c 3.7 → 8.6 N·s/m) and no candidate is demanded, so
-//! that case refits k and c only, as after an identification of the rig (T known).
+//! `yield` (≈ F_y·sign v) has nearly the form of the bearing's Coulomb friction T, which is
+//! refitted: a yield force of 0.3 N is named, one of 0.2 N is mostly absorbed by T (0.54 →
+//! 0.70 N) and the step says its "nothing is missing" is not to be trusted, naming `yield` as
+//! the candidate that came closest.
 
 mod common;
 
@@ -16,9 +17,25 @@ use common::{read_json, run_ok, simulate_ok};
 /// The x noise RMS of the records, mm (0.05 mm Gaussian, quantised to 0.01 mm).
 const X_NOISE_MM: f64 = 0.0501;
 
-/// Simulate the truth `power_law` + `hidden` (seed `seed`), drop every column but t, φ and x,
-/// and discover from `power_law`; discovery.json.
+/// The CI records: ω 3 → 9.4 rad/s at 0.1 rad/s², 200 Hz.
+const SHORT: &str = "sweep = { w0 = 3.0, alpha = 0.1, t0 = 0.0, t1 = 64.0 }\nrate = 200.0";
+
+/// The source study's sweep: ω = 0.047·t for t 50 → 200 s at 1 kHz (150 001 samples).
+const PAPER: &str = "sweep = { w0 = 2.35, alpha = 0.047, t0 = 50.0, t1 = 200.0 }\nrate = 1000.0";
+
+/// Simulate the truth `power_law` + `hidden` (seed `seed`) on the CI sweep, drop every column
+/// but t, φ and x, and discover from `power_law`; discovery.json.
 fn discover(hidden: Option<(&str, &str)>, seed: u64, refit: Option<&str>) -> serde_json::Value {
+    discover_on(SHORT, hidden, seed, refit)
+}
+
+/// [`discover`] on the record `sweep` (the `[simulate]` lines of its sweep and rate).
+fn discover_on(
+    sweep: &str,
+    hidden: Option<(&str, &str)>,
+    seed: u64,
+    refit: Option<&str>,
+) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     let (plus, extra) = hidden.map_or((String::new(), ""), |(name, params)| {
         (format!("plus = [\"{name}\"]\n"), params)
@@ -28,8 +45,7 @@ fn discover(hidden: Option<(&str, &str)>, seed: u64, refit: Option<&str>) -> ser
     std::fs::write(
         &exp,
         format!(
-            "[data]\nfile = \"r.csv\"\n\n{fit}[simulate]\n\
-             sweep = {{ w0 = 3.0, alpha = 0.1, t0 = 0.0, t1 = 64.0 }}\nrate = 200.0\n\
+            "[data]\nfile = \"r.csv\"\n\n{fit}[simulate]\n{sweep}\n\
              noise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n{plus}\
              params = {{ K = 20.0, n = 1.5{extra} }}\n\n[discover]\nbase = \"power_law\"\n\
              level = \"trajectory\"\n"
@@ -106,8 +122,49 @@ fn a_hidden_added_mass_is_named() {
 }
 
 #[test]
-fn a_hidden_yield_is_named_on_an_identified_rig() {
-    let d = discover(Some(("yield", ", F_y = 0.2")), 5, Some("[\"k\", \"c\"]"));
+fn a_hidden_yield_is_named() {
+    let d = discover(Some(("yield", ", F_y = 0.3")), 5, None);
     assert_eq!(effects(&d), ["yield"], "{:?}", d["notes"]);
     assert_at_the_noise(&d);
+}
+
+#[test]
+fn a_yield_the_bearing_friction_absorbs_is_flagged_not_denied() {
+    let d = discover(Some(("yield", ", F_y = 0.2")), 5, None);
+    let notes: Vec<&str> = d["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n.as_str())
+        .collect();
+    let flagged = notes
+        .iter()
+        .any(|n| n.starts_with("not to be trusted") && n.contains("`yield` comes closest"));
+    assert!(
+        effects(&d) == ["yield"] || flagged,
+        "neither named nor flagged: {notes:?}"
+    );
+}
+
+/// The full set on the source study's sweep (150 001 samples; about a minute or two each):
+/// `cargo test --release --test discover_rotor_trajectory -- --ignored`.
+#[test]
+#[ignore]
+fn on_the_papers_sweep_exactly_the_hidden_effect_is_named() {
+    for seed in [1, 2, 3] {
+        let d = discover_on(PAPER, None, seed, None);
+        assert!(effects(&d).is_empty(), "seed {seed}: {:?}", d["notes"]);
+        assert_at_the_noise(&d);
+    }
+    let cases = [
+        ("cubic_stiffness", ", k3 = 1e4", None),
+        ("added_mass", ", m_a = 0.5", None),
+        ("yield", ", F_y = 0.3", None),
+        ("yield", ", F_y = 0.3", Some("[\"k\", \"c\"]")),
+    ];
+    for (name, params, refit) in cases {
+        let d = discover_on(PAPER, Some((name, params)), 5, refit);
+        assert_eq!(effects(&d), [name], "{:?}", d["notes"]);
+        assert_at_the_noise(&d);
+    }
 }

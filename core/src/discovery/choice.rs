@@ -3,15 +3,17 @@
 //! in the level's unit (N at force level, mm at trajectory level).
 //!
 //! What differs between the levels stays with them: how a trial is fitted (force fits
-//! against simulations) and the paired test's units (held-out samples against held-out
-//! cycles), passed here as the trial's `holdout` and the `gain_z` function.
+//! against simulations), the paired test's units (blocks of held-out samples against held-out
+//! cycles) and the noise floor (the force sensor's with the kinematics' noise propagated
+//! through the current model, or the position noise), passed here as the trial's `holdout`
+//! and the [`Yardstick`].
 
 use super::acceptance;
 use super::error::DiscoveryError;
 use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
 use super::stage::Stage;
-use crate::fit::{Convergence, FitResult};
+use crate::fit::{Convergence, FitResult, NoiseFloor};
 
 /// A model fitted on the training samples and scored on the held-out ones.
 pub(super) struct Trial {
@@ -19,8 +21,9 @@ pub(super) struct Trial {
     pub stage: Stage,
     /// The fit on the training samples.
     pub train: FitResult,
-    /// The units of the paired test: residuals at the held-out samples (force level) or RMS
-    /// residuals of the held-out cycles (trajectory level).
+    /// What the paired test reads: the residual at the held-out samples (force level, cut
+    /// into blocks by the test, [`super::blocks`]) or the RMS residual of each held-out cycle
+    /// (trajectory level).
     pub holdout: Vec<f64>,
     /// Mean square residual over the held-out samples.
     pub holdout_mse: f64,
@@ -50,17 +53,77 @@ pub(super) const DISPLACEMENT: Said = Said {
     scale: 1e3,
 };
 
+/// The level's paired test of two trials' `holdout`, the candidate (second) against the
+/// current model (first): the z and the independent units it is over.
+pub(super) type GainTest<'a> = &'a (dyn Fn(&[f64], &[f64]) -> (f64, usize) + Sync);
+
+/// The RMS residual of each independent unit of a trial's `holdout`.
+pub(super) type Units<'a> = &'a (dyn Fn(&[f64]) -> Vec<f64> + Sync);
+
+/// What a step measures a candidate's held-out gain with and against.
+pub(super) struct Yardstick<'a> {
+    /// The paired test.
+    pub gain_z: GainTest<'a>,
+    /// The paired test that decides whether the best candidate beats another (a tie when
+    /// not): the trials' `holdout`, the other's first.
+    pub tie_z: &'a (dyn Fn(&[f64], &[f64]) -> f64 + Sync),
+    /// The units of a trial's `holdout`.
+    pub units: Units<'a>,
+    /// The base's held-out mean square above the noise floor (at least what is resolved).
+    pub base_excess: f64,
+    /// The current model's noise floor.
+    pub floor: NoiseFloor,
+    /// The width of the floor's uncertainty in mean square (N² or m²): a gain is measured
+    /// against at least this much excess ([`excess`]).
+    pub floor_band: f64,
+    /// The length of the test's blocks, samples (`None`: whole cycles).
+    pub block_samples: Option<usize>,
+}
+
+/// The held-out mean square `mse` of a trial above the floor `sigma`², counted as at least
+/// the floor's own uncertainty `band` (mean square) and at least what the held-out units
+/// resolve: `min_gain_sigma` standard errors of the mean of the mean squares of the `units`
+/// (their RMS residuals) at the floor (below [`acceptance::EXCESS_UNIT`]·σ², whose spread is
+/// the noise's, not the misfit's). A model at the floor, or one whose floor is misestimated,
+/// would otherwise divide a gain by nothing, and any consistent gain would explain "all" of
+/// it. 0 with fewer than two units at the floor, no band and no excess.
+pub(super) fn excess(
+    units: &[f64],
+    mse: f64,
+    sigma: f64,
+    band: f64,
+    settings: &DiscoverySettings,
+) -> f64 {
+    let bar = acceptance::EXCESS_UNIT * sigma * sigma;
+    let ms: Vec<f64> = units.iter().map(|r| r * r).filter(|&m| m < bar).collect();
+    let n = ms.len();
+    let resolved = if n < 2 {
+        0.0
+    } else {
+        let mean = ms.iter().sum::<f64>() / n as f64;
+        let var = ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        settings.min_gain_sigma * (var / n as f64).sqrt()
+    };
+    (mse - sigma * sigma).max(band).max(resolved).max(0.0)
+}
+
+/// `gain` over `excess`, 0 when there is no excess to explain.
+fn share(gain: f64, excess: f64) -> f64 {
+    if excess > 0.0 {
+        gain / excess
+    } else {
+        0.0
+    }
+}
+
 /// How `trial` (a model with the candidate `name`, whose own parameters are its `n_own`
-/// before the offset) scores against `current`; `gain_z` is the level's paired test of
-/// `trial.holdout` against `current.holdout`, `base_excess` the base's held-out mean square
-/// above the noise floor.
+/// before the offset) scores against `current`, measured by `yardstick`.
 pub(super) fn score(
     name: &str,
     n_own: usize,
     trial: &Trial,
     current: &Trial,
-    gain_z: fn(&[f64], &[f64]) -> f64,
-    base_excess: f64,
+    yardstick: &Yardstick,
     settings: &DiscoverySettings,
 ) -> CandidateScore {
     let h = trial.holdout_mse.sqrt();
@@ -74,6 +137,8 @@ pub(super) fn score(
         .unwrap_or_default();
     let failure = matches!(trial.train.convergence, Convergence::Failed { .. })
         .then(|| format!("{:?}", trial.train.convergence));
+    let (gain_z, effective_n) = (yardstick.gain_z)(&current.holdout, &trial.holdout);
+    let gain = current.holdout_mse - trial.holdout_mse;
     let mut score = CandidateScore {
         name: name.to_string(),
         holdout_rms: h,
@@ -83,8 +148,19 @@ pub(super) fn score(
         delta_aic: trial.train.aic - current.train.aic,
         delta_bic: trial.train.bic - current.train.bic,
         holdout_gain: current.holdout_mse.sqrt() - h,
-        gain_z: gain_z(&current.holdout, &trial.holdout),
-        explained_fraction: (current.holdout_mse - trial.holdout_mse) / base_excess,
+        gain_z,
+        effective_n,
+        explained_fraction: share(gain, yardstick.base_excess),
+        explained_share: share(
+            gain,
+            excess(
+                &(yardstick.units)(&current.holdout),
+                current.holdout_mse,
+                yardstick.floor.sigma,
+                yardstick.floor_band,
+                settings,
+            ),
+        ),
         params: own,
         significant: false,
         failure,
@@ -102,13 +178,12 @@ pub(super) fn scored(
     n_own: usize,
     trial: Result<Trial, DiscoveryError>,
     current: &Trial,
-    gain_z: fn(&[f64], &[f64]) -> f64,
-    base_excess: f64,
+    yardstick: &Yardstick,
     settings: &DiscoverySettings,
 ) -> (CandidateScore, Option<Trial>) {
     match trial {
         Ok(trial) => (
-            score(name, n_own, &trial, current, gain_z, base_excess, settings),
+            score(name, n_own, &trial, current, yardstick, settings),
             Some(trial),
         ),
         Err(e) => (failed(name, e.to_string()), None),
@@ -127,7 +202,9 @@ pub(super) fn failed(name: &str, why: String) -> CandidateScore {
         delta_bic: f64::NAN,
         holdout_gain: f64::NAN,
         gain_z: f64::NAN,
+        effective_n: 0,
         explained_fraction: f64::NAN,
+        explained_share: f64::NAN,
         params: Vec::new(),
         significant: false,
         failure: Some(why),
@@ -138,74 +215,42 @@ pub(super) fn failed(name: &str, why: String) -> CandidateScore {
 
 /// The step that adds one of the candidates `scored` (each with its trial when its fit ran)
 /// to `current`: the candidates best held-out RMS first, the one accepted by
-/// [`acceptance::choose`] (and its ties) or none, and the verdict said as `said`. Returns the
-/// step and the accepted candidate's trial (`None` when nothing is accepted).
+/// [`acceptance::choose`] (and its ties) or none, and the verdict said as `said`, with the
+/// units and the floor of `yardstick`. Returns the step and the accepted candidate's trial
+/// (`None` when nothing is accepted).
 pub(super) fn decide(
     current: &Trial,
     mut scored: Vec<(CandidateScore, Option<Trial>)>,
     said: &Said,
+    yardstick: &Yardstick,
     settings: &DiscoverySettings,
 ) -> (Step, Option<Trial>) {
-    let current_h = current.holdout_mse.sqrt();
     scored.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
     let scores: Vec<CandidateScore> = scored.iter().map(|s| s.0.clone()).collect();
     let holdout: Vec<&[f64]> = scored
         .iter()
         .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
         .collect();
-    let choice = acceptance::choose(&scores, &holdout, settings);
-    let mut step = Step {
-        current: current.stage.name(),
-        current_holdout_rms: current_h,
-        candidates: scores,
-        accepted: None,
-        tie_with: Vec::new(),
-        verdict: String::new(),
-    };
+    let choice = acceptance::choose(&scores, &holdout, yardstick.tie_z, settings);
+    let mut step = step_on(current, scores, yardstick);
     let Some((winner, ties)) = choice else {
-        step.verdict = format!(
-            "no candidate lowers the {} ({:.4} {}) with a paired z above {} and a BIC drop \
-             above {}: nothing is missing that the data demand",
-            said.quantity,
-            current_h * said.scale,
-            said.unit,
-            settings.min_gain_sigma,
-            settings.min_bic_drop
-        );
+        step.verdict = rejected(&step, said, settings);
         return (step, None);
     };
     let tie_names: Vec<String> = ties
         .iter()
         .map(|&i| step.candidates[i].name.clone())
         .collect();
-    let w = &step.candidates[winner];
-    let params: Vec<String> = w
-        .params
-        .iter()
-        .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
-        .collect();
-    step.verdict = format!(
-        "add `{}`: {} {:.4} → {:.4} {} (paired z {:.1}), ΔBIC {:.1}, explains {:.0} % of the \
-         base's held-out gap; {}",
-        w.name,
-        said.quantity,
-        current_h * said.scale,
-        w.holdout_rms * said.scale,
-        said.unit,
-        w.gain_z,
-        w.delta_bic,
-        100.0 * w.explained_fraction,
-        params.join(", ")
-    );
+    step.verdict = accepted(&step, winner, said);
     if !tie_names.is_empty() {
         step.verdict.push_str(&format!(
             "; `{}` explain the data equally well (the best is not better by the held-out \
              test), `{}` is chosen as the simplest (fewest parameters, then lowest BIC)",
             tie_names.join("`, `"),
-            w.name
+            step.candidates[winner].name
         ));
     }
-    let w_name = w.name.clone();
+    let w_name = step.candidates[winner].name.clone();
     step.accepted = Some(w_name.clone());
     step.tie_with = tie_names;
     let trial = scored
@@ -213,4 +258,143 @@ pub(super) fn decide(
         .position(|s| s.0.name == w_name)
         .and_then(|pos| scored.swap_remove(pos).1);
     (step, trial)
+}
+
+/// A step on `current` with the `candidates` scored against it and nothing decided yet.
+pub(super) fn step_on(
+    current: &Trial,
+    candidates: Vec<CandidateScore>,
+    yardstick: &Yardstick,
+) -> Step {
+    Step {
+        current: current.stage.name(),
+        current_holdout_rms: current.holdout_mse.sqrt(),
+        effective_n: (yardstick.units)(&current.holdout).len(),
+        block_samples: yardstick.block_samples,
+        floor: yardstick.floor,
+        candidates,
+        accepted: None,
+        tie_with: Vec::new(),
+        verdict: String::new(),
+    }
+}
+
+/// The units of `step` in words: `48 blocks of ≥ 38 held-out samples` or `16 held-out cycles`.
+fn units(step: &Step) -> String {
+    match step.block_samples {
+        Some(l) => format!("{} blocks of ≥ {l} held-out samples", step.effective_n),
+        None => format!("{} held-out cycles", step.effective_n),
+    }
+}
+
+/// The verdict of a step that accepts its candidate `winner`.
+fn accepted(step: &Step, winner: usize, said: &Said) -> String {
+    let w = &step.candidates[winner];
+    let params: Vec<String> = w
+        .params
+        .iter()
+        .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
+        .collect();
+    format!(
+        "add `{}`: {} {:.4} → {:.4} {} (paired z {:.1} over {}), ΔBIC {:.1}, explains \
+         {:.0} % of the current model's held-out excess over its noise floor ({:.4} {}) and \
+         {:.0} % of the base's held-out gap; {}",
+        w.name,
+        said.quantity,
+        step.current_holdout_rms * said.scale,
+        w.holdout_rms * said.scale,
+        said.unit,
+        w.gain_z,
+        units(step),
+        w.delta_bic,
+        100.0 * w.explained_share,
+        step.floor.sigma * said.scale,
+        said.unit,
+        100.0 * w.explained_fraction,
+        params.join(", ")
+    )
+}
+
+/// The verdict of a step that accepts nothing: the rule, and the candidates that passed both
+/// tests but explain too little of the excess over the floor.
+fn rejected(step: &Step, said: &Said, settings: &DiscoverySettings) -> String {
+    let mut verdict = format!(
+        "no candidate lowers the {} ({:.4} {}) with a paired z above {} over {}, a BIC drop \
+         above {} and at least {:.0} % of the held-out excess over the noise floor ({:.4} {}): \
+         nothing is missing that the data demand",
+        said.quantity,
+        step.current_holdout_rms * said.scale,
+        said.unit,
+        settings.min_gain_sigma,
+        units(step),
+        settings.min_bic_drop,
+        100.0 * settings.min_explained,
+        step.floor.sigma * said.scale,
+        said.unit,
+    );
+    let small: Vec<String> = step
+        .candidates
+        .iter()
+        .filter(|c| acceptance::passes_tests(c, settings))
+        .map(|c| {
+            format!(
+                "`{}` ({:.4} {}, paired z {:.1} over {} units, ΔBIC {:.1}) explains only {:.1} %",
+                c.name,
+                c.holdout_rms * said.scale,
+                said.unit,
+                c.gain_z,
+                c.effective_n,
+                c.delta_bic,
+                100.0 * c.explained_share
+            )
+        })
+        .collect();
+    if !small.is_empty() {
+        verdict.push_str(&format!(
+            "; significant but explaining too little of the excess: {}",
+            small.join(", ")
+        ));
+    }
+    verdict
+}
+
+/// When nothing was accepted although the current model's held-out RMS stands above 1.2× the
+/// noise floor: a warning that the verdict "nothing is missing" is not to be trusted, with
+/// the candidate that came closest (the lowest held-out RMS below the current one), its z,
+/// the units it is over and the share of the excess it explains. An effect that acts in a
+/// few cycles only (a yield force near the breakaway) can explain the whole excess and still
+/// fall short of the paired test on few held-out cycles; a longer record, or one that dwells
+/// where the effect acts, tells.
+pub(super) fn unresolved(step: &Step, said: &Said) -> Option<String> {
+    let floor = step.floor.sigma;
+    if step.accepted.is_some() || !(step.current_holdout_rms > 1.2 * floor) {
+        return None;
+    }
+    let excess = step.current_holdout_rms.powi(2) - floor * floor;
+    let closest = step
+        .candidates
+        .iter()
+        .filter(|c| c.failure.is_none() && c.holdout_rms < step.current_holdout_rms)
+        .min_by(|a, b| a.holdout_rms.total_cmp(&b.holdout_rms));
+    let lead = format!(
+        "not to be trusted: the held-out RMS ({:.4} {}) is {:.1}× the noise floor, so \
+         something is missing",
+        step.current_holdout_rms * said.scale,
+        said.unit,
+        step.current_holdout_rms / floor
+    );
+    Some(match closest {
+        Some(c) => format!(
+            "{lead}; `{}` comes closest ({:.4} {}, {:.0} % of the excess over the floor) but \
+             its paired z is {:.1} over {} — a longer record, or one that dwells where the gap \
+             is, would tell",
+            c.name,
+            c.holdout_rms * said.scale,
+            said.unit,
+            100.0 * (step.current_holdout_rms.powi(2) - c.holdout_rms.powi(2)) / excess,
+            c.gain_z,
+            units(step)
+        ),
+        None => format!("{lead} that no candidate of the vocabulary explains"),
+    })
 }

@@ -1,13 +1,20 @@
 //! The discovery loop at force level: fit the base, locate its gap, try every candidate on
 //! held-out cycles, add the one the data demand, repeat.
+//!
+//! Each step cuts the held-out cycles into blocks at least as long as the residual's
+//! correlation ([`super::blocks`]) and measures the current model's noise floor — the force
+//! sensor's noise with the kinematics' noise propagated through that model
+//! ([`ForceFit::noise_floor`]) — so that a candidate is judged by independent units and by the
+//! share of the excess over that floor it removes ([`super::acceptance`]).
 
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use super::acceptance;
+use super::blocks::{block_length, Blocks};
 use super::candidate::{self, Candidate};
-use super::choice::{self, Trial};
+use super::choice::{self, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::gap::locate_gap;
 use super::holdout::HoldoutSplit;
@@ -17,7 +24,7 @@ use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
 use super::stage::Stage;
 use super::subset_fit::{fit_subset, residuals, rms, rms_over};
-use crate::fit::{FitParam, FitResult, ForceData, ForceFit, FORCE_OFFSET};
+use crate::fit::{FitParam, FitResult, ForceData, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::force_model::ForceModel;
 use crate::regimes::Cycle;
 
@@ -134,6 +141,25 @@ impl Stage {
         let mut parts = self.parts.clone();
         parts.insert(index, extra.clone());
         Stage { parts, values }
+    }
+
+    /// The force noise floor of this stage at its values: the sensor's `sensor` (N) with the
+    /// kinematics' noise of `settings.motion_noise` propagated through the model.
+    fn noise_floor(
+        &self,
+        data: &ForceData,
+        sensor: f64,
+        settings: &DiscoverySettings,
+    ) -> Result<NoiseFloor, DiscoveryError> {
+        let Some(motion) = settings.motion_noise else {
+            return Ok(NoiseFloor::force(sensor, 0.0));
+        };
+        let fit = self.force_fit(settings)?;
+        fit.noise_floor(data, &self.values, sensor, motion)
+            .map_err(|source| DiscoveryError::Fit {
+                model: self.name(),
+                source,
+            })
     }
 
     /// Measured minus modelled force at every sample.
@@ -400,7 +426,7 @@ pub fn discover_force(
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
     candidate::distinct(candidates)?;
     let n = data.t.len();
-    let floor = settings.floor_of(data.f, "force", "N")?;
+    let sensor = settings.floor_of(data.f, "force", "N")?;
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
     let all: Vec<usize> = (0..n).collect();
     let mut notes = Vec::new();
@@ -424,59 +450,34 @@ pub fn discover_force(
         })?;
     let gap_before = rms(&residual_before);
     // 2. Where the gap lives.
-    let where_before = locate_gap(&residual_before, data, cycles, floor);
+    let floor_before = base_full.noise_floor(data, sensor, settings)?;
+    let where_before = locate_gap(&residual_before, data, cycles, floor_before.sigma);
     notes.push(format!("base `{base_name}`: {}", where_before.summary));
 
     // 3–4. Add effects while the held-out evidence demands one.
+    let search = Search {
+        candidates,
+        in_base: &in_base,
+        data,
+        split: &split,
+        sensor,
+        settings,
+    };
     let mut current = start.trial(data, &split, settings)?;
-    // The base's held-out gap in mean square; at least what a gain of 3σ/√N_h in RMS is.
-    let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
-    let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
+    let first_blocks = search.blocks(&current.stage.residuals(data, settings)?);
+    let base_excess = choice::excess(
+        &first_blocks.rms(&current.holdout),
+        current.holdout_mse,
+        floor_before.sigma,
+        settings.floor_band(floor_before.propagated),
+        settings,
+    );
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
-        let current_residual = current.stage.residuals(data, settings)?;
-        let tried = current.stage.to_try(candidates, &in_base, &effects);
-        // The candidates are independent trials against the same current model: fitted in
-        // parallel, scored in their order.
-        let scored: Vec<(CandidateScore, Option<Trial>)> = tried
-            .par_iter()
-            .enumerate()
-            .map(|(index, c)| {
-                settings
-                    .observer
-                    .candidate(step, index, tried.len(), &c.name);
-                let starts = candidate_starts(
-                    &c.model,
-                    data,
-                    &split.train,
-                    &current_residual,
-                    settings.extra_starts,
-                );
-                let best = best_trial(
-                    &starts,
-                    |start| current.stage.with(&c.model, start, 0),
-                    data,
-                    &split,
-                    settings,
-                );
-                let s = choice::scored(
-                    &c.name,
-                    c.model.params().len(),
-                    best,
-                    &current,
-                    acceptance::paired_z,
-                    base_excess,
-                    settings,
-                );
-                emit_scored(settings, step, Some(&s));
-                s
-            })
-            .collect();
-        if scored.is_empty() {
+        let Some((step, winner)) = search.step(step, &current, &effects, base_excess)? else {
             break;
-        }
-        let (step, winner) = choice::decide(&current, scored, &choice::FORCE, settings);
+        };
         notes.push(step.verdict.clone());
         effects.extend(step.accepted.clone());
         steps.push(step);
@@ -486,16 +487,7 @@ pub fn discover_force(
         };
         current = trial;
         if effects.len() >= 2 {
-            if let Some(step) = reconsider(
-                &mut current,
-                &mut effects,
-                candidates,
-                &in_base,
-                data,
-                &split,
-                base_excess,
-                settings,
-            )? {
+            if let Some(step) = search.reconsider(&mut current, &mut effects, base_excess)? {
                 notes.push(step.verdict.clone());
                 steps.push(step);
             }
@@ -553,18 +545,25 @@ pub fn discover_force(
     };
     let final_model = final_stage.model()?;
     let gap_after = rms(&residual_after);
-    let where_after = locate_gap(&residual_after, data, cycles, floor);
+    let floor = final_stage.noise_floor(data, sensor, settings)?;
+    let where_after = locate_gap(&residual_after, data, cycles, floor.sigma);
     notes.push(format!(
-        "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {floor:.4} N); final `{}`: {}",
+        "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {:.4} N: force sensor {:.4} N, \
+         kinematics through the model {:.4} N); final `{}`: {}",
+        floor.sigma,
+        floor.measured,
+        floor.propagated,
         final_stage.name(),
         where_after.summary
     ));
+    notes.extend(floor_doubts(&floor, gap_after, settings));
     let n_model = final_model.params().len();
     Ok(Discovery {
         base: base_name,
         effects,
         steps,
-        noise_floor: floor,
+        noise_floor: floor.sigma,
+        noise_floor_parts: floor,
         holdout_cycles: split.holdout_cycles,
         holdout_samples: split.holdout.len(),
         gap_before,
@@ -582,77 +581,257 @@ pub fn discover_force(
     })
 }
 
-/// A replacement tried by [`reconsider`]: its score, its trial (when the fit ran), the index
-/// of the effect replaced, the candidate's index, and whether it is a tie rather than a win.
-type Replacement = (CandidateScore, Option<Trial>, usize, usize, bool);
-
-/// The effect `j` (part `part`, model `old`) of the current model, and the model without it
-/// (`rest`, whose residual is `rest_residual`): where [`reconsider`] tries each candidate.
-struct Slot<'a> {
-    j: usize,
-    part: usize,
-    old: &'a dyn ForceModel,
-    rest: &'a Stage,
-    rest_residual: &'a [f64],
-    effect: &'a str,
+/// What the search at force level works with: the candidates, the record, the split, the
+/// force sensor's noise and the settings.
+struct Search<'a> {
+    candidates: &'a [Candidate],
+    in_base: &'a [String],
+    data: &'a ForceData<'a>,
+    split: &'a HoldoutSplit,
+    sensor: f64,
+    settings: &'a DiscoverySettings,
 }
 
-impl Slot<'_> {
-    /// Candidate `c` (index `k`) in this slot, fitted on the training cycles and scored
-    /// against `current`.
-    #[allow(clippy::too_many_arguments)]
-    fn replace(
+impl Search<'_> {
+    /// `then` called with the yardstick of a step on a model whose held-out units are
+    /// `blocks` and whose floor is `floor`: the block test ([`acceptance::block_gain_z`]) and
+    /// the floor's uncertainty band.
+    fn measured<T>(
         &self,
-        k: usize,
-        c: &Candidate,
-        current: &Trial,
-        data: &ForceData,
-        split: &HoldoutSplit,
+        blocks: &Blocks,
+        floor: NoiseFloor,
         base_excess: f64,
-        settings: &DiscoverySettings,
-    ) -> Replacement {
-        let label = format!("{} for {}", c.name, self.effect);
+        then: impl FnOnce(&Yardstick) -> T,
+    ) -> T {
+        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks);
+        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks).0;
+        let units = |h: &[f64]| blocks.rms(h);
+        then(&Yardstick {
+            gain_z: &gain_z,
+            tie_z: &tie_z,
+            units: &units,
+            base_excess,
+            floor,
+            floor_band: self.settings.floor_band(floor.propagated),
+            block_samples: Some(blocks.length),
+        })
+    }
+
+    /// The blocks of the paired test for a model whose residual is `r` (every sample).
+    fn blocks(&self, r: &[f64]) -> Blocks {
+        Blocks::new(
+            self.split,
+            block_length(r, self.split, self.settings.filter_window),
+        )
+    }
+
+    /// One step: every candidate not in `current` added to it, fitted and scored against it
+    /// on blocks cut for its residual and its floor; the step and the accepted trial, or
+    /// `None` when there is nothing left to try.
+    fn step(
+        &self,
+        step: usize,
+        current: &Trial,
+        effects: &[String],
+        base_excess: f64,
+    ) -> Result<Option<(Step, Option<Trial>)>, DiscoveryError> {
+        let (data, split, settings) = (self.data, self.split, self.settings);
+        let current_residual = current.stage.residuals(data, settings)?;
+        let blocks = self.blocks(&current_residual);
+        let floor = current.stage.noise_floor(data, self.sensor, settings)?;
+        let tried = current.stage.to_try(self.candidates, self.in_base, effects);
+        if tried.is_empty() {
+            return Ok(None);
+        }
+        // The candidates are independent trials against the same current model: fitted in
+        // parallel, scored in their order.
+        Ok(Some(self.measured(
+            &blocks,
+            floor,
+            base_excess,
+            |yardstick| {
+                let scored: Vec<(CandidateScore, Option<Trial>)> = tried
+                    .par_iter()
+                    .enumerate()
+                    .map(|(index, c)| {
+                        settings
+                            .observer
+                            .candidate(step, index, tried.len(), &c.name);
+                        let starts = candidate_starts(
+                            &c.model,
+                            data,
+                            &split.train,
+                            &current_residual,
+                            settings.extra_starts,
+                        );
+                        let best = best_trial(
+                            &starts,
+                            |start| current.stage.with(&c.model, start, 0),
+                            data,
+                            split,
+                            settings,
+                        );
+                        let n_own = c.model.params().len();
+                        let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
+                        emit_scored(settings, step, Some(&s));
+                        s
+                    })
+                    .collect();
+                choice::decide(current, scored, &choice::FORCE, yardstick, settings)
+            },
+        )))
+    }
+
+    /// After an effect is accepted, the earlier ones are tried again in its light: each is
+    /// replaced in turn by every candidate not in the model (refitted on the training cycles). An
+    /// effect chosen first can have won only because the one found later was missing (an added
+    /// mass hidden under a cubic spring made `wall_impact`, whose gap and exponent bend to mimic
+    /// both, beat `cubic_stiffness`). A replacement is made when the held-out evidence demands it
+    /// (the acceptance rule of [`acceptance`] against the current model), or when the held-out
+    /// evidence cannot separate the two (the current model is not better by the paired test) and
+    /// the replacement has fewer parameters and a lower BIC: the simpler is kept and the tie
+    /// named. At most one replacement per call; it is reported as a step of its own.
+    fn reconsider(
+        &self,
+        current: &mut Trial,
+        effects: &mut [String],
+        base_excess: f64,
+    ) -> Result<Option<Step>, DiscoveryError> {
+        let (data, settings) = (self.data, self.settings);
+        // Blocks cut for the accepted model's residual, and its own floor.
+        let blocks = self.blocks(&current.stage.residuals(data, settings)?);
+        let floor = current.stage.noise_floor(data, self.sensor, settings)?;
+        self.measured(&blocks, floor, base_excess, |yardstick| {
+            self.replace_one(current, effects, yardstick)
+        })
+    }
+
+    /// [`Search::reconsider`] with the step's `yardstick`.
+    fn replace_one(
+        &self,
+        current: &mut Trial,
+        effects: &mut [String],
+        yardstick: &Yardstick,
+    ) -> Result<Option<Step>, DiscoveryError> {
+        let (data, settings) = (self.data, self.settings);
+        let n_base = current.stage.parts.len().saturating_sub(effects.len());
+        // (score, trial, effect index, candidate index, a tie rather than a win)
+        let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
+        let earlier = effects.len().saturating_sub(1);
+        for (j, effect) in effects.iter().enumerate().take(earlier) {
+            let part = n_base + j;
+            let Some(old) = current.stage.parts.get(part).cloned() else {
+                continue;
+            };
+            let rest = current.stage.without(part);
+            let rest_residual = rest.residuals(data, settings)?;
+            let replaced = Replaced {
+                rest: &rest,
+                residual: &rest_residual,
+                part,
+                old_len: old.params().len(),
+            };
+            let to_try: Vec<usize> = (0..self.candidates.len())
+                .filter(|&k| !current.stage.holds(&self.candidates[k], self.in_base, &[]))
+                .collect();
+            // Independent trials against the same current model: fitted in parallel, kept in
+            // their order.
+            let current = &*current;
+            tried.par_extend(to_try.par_iter().map(|&k| {
+                let c = &self.candidates[k];
+                let label = format!("{} for {effect}", c.name);
+                let (score, trial, tie) =
+                    self.replacement(c, &label, current, &replaced, yardstick);
+                (score, trial, j, k, tie)
+            }));
+        }
+        if tried.is_empty() {
+            return Ok(None);
+        }
+        tried.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
+        // A win (lowest held-out RMS) before a tie (lowest BIC).
+        let pick = tried
+            .iter()
+            .position(|t| t.0.significant && !t.4)
+            .or_else(|| {
+                (0..tried.len())
+                    .filter(|&i| tried[i].0.significant)
+                    .min_by(|&a, &b| tried[a].0.bic.total_cmp(&tried[b].0.bic))
+            });
+        let scores = tried.iter().map(|t| t.0.clone()).collect();
+        let mut step = choice::step_on(current, scores, yardstick);
+        let Some(i) = pick else {
+            return Ok(None);
+        };
+        let (score, trial, j, k, tie) = tried.swap_remove(i);
+        let Some(trial) = trial else {
+            return Ok(None);
+        };
+        let old_name = effects[j].clone();
+        let new_name = self.candidates[k].name.clone();
+        let with = effects.last().map_or("", String::as_str);
+        step.verdict = replaced_verdict(&step, [&old_name, &new_name, with], &score, tie, settings);
+        step.accepted = Some(new_name.clone());
+        if tie {
+            step.tie_with = vec![old_name];
+        }
+        effects[j] = new_name;
+        *current = trial;
+        Ok(Some(step))
+    }
+}
+
+/// A model with one of its effects taken out, for a replacement to be inserted in its place.
+struct Replaced<'a> {
+    /// The model without the effect.
+    rest: &'a Stage,
+    /// Its residual at every sample.
+    residual: &'a [f64],
+    /// The index of the part taken out.
+    part: usize,
+    /// How many parameters the part taken out had.
+    old_len: usize,
+}
+
+impl Search<'_> {
+    /// The candidate `c` put in the place of `replaced`, fitted and scored against `current`
+    /// as `label`: its score (significant when it wins, or ties with fewer parameters and a
+    /// lower BIC), its trial, and whether it is a tie rather than a win.
+    fn replacement(
+        &self,
+        c: &Candidate,
+        label: &str,
+        current: &Trial,
+        replaced: &Replaced,
+        yardstick: &Yardstick,
+    ) -> (CandidateScore, Option<Trial>, bool) {
+        let (data, settings, part) = (self.data, self.settings, replaced.part);
         let starts = candidate_starts(
             &c.model,
             data,
-            &split.train,
-            self.rest_residual,
+            &self.split.train,
+            replaced.residual,
             settings.extra_starts,
         );
+        let rest = replaced.rest;
         let best = best_trial(
             &starts,
-            |start| self.rest.inserting(self.part, &c.model, start),
+            |start| rest.inserting(part, &c.model, start),
             data,
-            split,
+            self.split,
             settings,
         );
         let trial = match best {
             Ok(trial) => trial,
-            Err(e) => {
-                return (
-                    choice::failed(&label, e.to_string()),
-                    None,
-                    self.j,
-                    k,
-                    false,
-                )
-            }
+            Err(e) => return (choice::failed(label, e.to_string()), None, false),
         };
         // Its own parameters are not last here: take them by position.
-        let from: usize = self.rest.parts[..self.part.min(self.rest.parts.len())]
+        let from: usize = rest.parts[..part.min(rest.parts.len())]
             .iter()
             .map(|p| p.params().len())
             .sum();
         let n_own = c.model.params().len();
-        let mut score = choice::score(
-            &label,
-            0,
-            &trial,
-            current,
-            acceptance::paired_z,
-            base_excess,
-            settings,
-        );
+        let mut score = choice::score(label, 0, &trial, current, yardstick, settings);
         score.params = trial
             .train
             .params
@@ -663,134 +842,95 @@ impl Slot<'_> {
         let tie = !wins
             && score.failure.is_none()
             && score.gain_z >= -settings.min_gain_sigma
-            && n_own < self.old.params().len()
+            && n_own < replaced.old_len
             && score.delta_bic < 0.0;
         score.significant = wins || tie;
-        (score, Some(trial), self.j, k, tie)
+        (score, Some(trial), tie)
     }
 }
 
-/// After an effect is accepted, the earlier ones are tried again in its light: each is
-/// replaced in turn by every candidate not in the model (refitted on the training cycles). An
-/// effect chosen first can have won only because the one found later was missing (an added
-/// mass hidden under a cubic spring made `wall_impact`, whose gap and exponent bend to mimic
-/// both, beat `cubic_stiffness`). A replacement is made when the held-out evidence demands it
-/// (the acceptance rule of [`acceptance`] against the current model), or when the held-out
-/// evidence cannot separate the two (the current model is not better by the paired test) and
-/// the replacement has fewer parameters and a lower BIC: the simpler is kept and the tie
-/// named. At most one replacement per call; it is reported as a step of its own.
-#[allow(clippy::too_many_arguments)]
-fn reconsider(
-    current: &mut Trial,
-    effects: &mut [String],
-    candidates: &[Candidate],
-    in_base: &[String],
-    data: &ForceData,
-    split: &HoldoutSplit,
-    base_excess: f64,
+/// The verdict of a replacement step on `step`: `names` are the effect replaced, its
+/// replacement and the effect whose acceptance called for it; `score` the replacement's.
+fn replaced_verdict(
+    step: &Step,
+    names: [&str; 3],
+    score: &CandidateScore,
+    tie: bool,
     settings: &DiscoverySettings,
-) -> Result<Option<Step>, DiscoveryError> {
-    let n_base = current.stage.parts.len().saturating_sub(effects.len());
-    let mut tried: Vec<Replacement> = Vec::new();
-    let earlier = effects.len().saturating_sub(1);
-    for (j, effect) in effects.iter().enumerate().take(earlier) {
-        let part = n_base + j;
-        let Some(old) = current.stage.parts.get(part).cloned() else {
-            continue;
-        };
-        let rest = current.stage.without(part);
-        let rest_residual = rest.residuals(data, settings)?;
-        let to_try: Vec<usize> = (0..candidates.len())
-            .filter(|&k| !current.stage.holds(&candidates[k], in_base, &[]))
-            .collect();
-        // Independent trials against the same current model: fitted in parallel, kept in
-        // their order.
-        let slot = Slot {
-            j,
-            part,
-            old: old.as_ref(),
-            rest: &rest,
-            rest_residual: &rest_residual,
-            effect,
-        };
-        tried.par_extend(to_try.par_iter().map(|&k| {
-            slot.replace(
-                k,
-                &candidates[k],
-                current,
-                data,
-                split,
-                base_excess,
-                settings,
-            )
-        }));
-    }
-    if tried.is_empty() {
-        return Ok(None);
-    }
-    tried.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-    // A win (lowest held-out RMS) before a tie (lowest BIC).
-    let pick = tried
-        .iter()
-        .position(|t| t.0.significant && !t.4)
-        .or_else(|| {
-            (0..tried.len())
-                .filter(|&i| tried[i].0.significant)
-                .min_by(|&a, &b| tried[a].0.bic.total_cmp(&tried[b].0.bic))
-        });
-    let current_h = current.holdout_mse.sqrt();
-    let mut step = Step {
-        current: current.stage.name(),
-        current_holdout_rms: current_h,
-        candidates: tried.iter().map(|t| t.0.clone()).collect(),
-        accepted: None,
-        tie_with: Vec::new(),
-        verdict: String::new(),
-    };
-    let Some(i) = pick else {
-        return Ok(None);
-    };
-    let (score, trial, j, k, tie) = tried.swap_remove(i);
-    let Some(trial) = trial else {
-        return Ok(None);
-    };
-    let old_name = effects[j].clone();
-    let new_name = candidates[k].name.clone();
-    step.verdict = if tie {
+) -> String {
+    let [old_name, new_name, with] = names;
+    let current_h = step.current_holdout_rms;
+    if tie {
         format!(
-            "replace `{old_name}` by `{new_name}`: with `{}` in the model they explain the \
-             data equally well (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1}, not \
-             beyond ±{}), and `{new_name}` is simpler (ΔBIC {:.1})",
-            effects.last().map_or("", String::as_str),
+            "replace `{old_name}` by `{new_name}`: with `{with}` in the model they explain the \
+             data equally well (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
+             blocks, not beyond ±{}), and `{new_name}` is simpler (ΔBIC {:.1})",
             score.holdout_rms,
             score.gain_z,
+            score.effective_n,
             settings.min_gain_sigma,
             score.delta_bic
         )
     } else {
         format!(
-            "replace `{old_name}` by `{new_name}`: with `{}` in the model the held-out \
-             evidence demands it (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1}, ΔBIC \
-             {:.1})",
-            effects.last().map_or("", String::as_str),
+            "replace `{old_name}` by `{new_name}`: with `{with}` in the model the held-out \
+             evidence demands it (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
+             blocks, ΔBIC {:.1}, {:.0} % of the excess over the floor)",
             score.holdout_rms,
             score.gain_z,
-            score.delta_bic
+            score.effective_n,
+            score.delta_bic,
+            100.0 * score.explained_share
         )
-    };
-    step.accepted = Some(new_name.clone());
-    if tie {
-        step.tie_with = vec![old_name];
     }
-    effects[j] = new_name;
-    *current = trial;
-    Ok(Some(step))
 }
 
-/// `v` clamped into `[min, max]`. A value on a bound is moved inside by the fit's bound
-/// transform; any other value is the start as it is. (This used to move values 1 % of the
-/// width below an upper bound, so a refit from a training fit with `p` = 3 started elsewhere;
-/// the stall it worked around was the transform moving interior starts, now fixed.)
+/// Where the final floor `floor` is itself uncertain, given the final gap `gap_after` (N):
+/// sentences for the verdict notes. The floor rests on estimates — the force sensor's noise
+/// from the record's third differences, the kinematics' noise from the filter's gain, carried
+/// through the model by a linearisation — and leaves out the derivative filter's error where
+/// ẍ jumps (stick–slip), which a model with an added mass multiplies.
+fn floor_doubts(floor: &NoiseFloor, gap_after: f64, settings: &DiscoverySettings) -> Vec<String> {
+    let mut doubts = Vec::new();
+    if settings.motion_noise.is_none() {
+        doubts.push(
+            "the noise floor is the force sensor's alone: the kinematics' noise is not known \
+             here, so the floor may be too low and an effect that only follows the kinematics' \
+             noise or the filter's bias could pass the share test"
+                .to_string(),
+        );
+    } else if floor.propagated > floor.measured {
+        doubts.push(format!(
+            "the noise floor is uncertain: its larger part ({:.4} of {:.4} N) is the \
+             kinematics' noise propagated through the model, an estimate from the derivative \
+             filter's gain that leaves out the filter's error where ẍ jumps (stick–slip); an \
+             effect smaller than that uncertainty (the floor with this part {}× larger: {:.4} N) \
+             is not named",
+            floor.propagated,
+            floor.sigma,
+            settings.kinematics_uncertainty,
+            floor
+                .measured
+                .hypot(settings.kinematics_uncertainty * floor.propagated)
+        ));
+    }
+    if gap_after > 1.2 * floor.sigma {
+        doubts.push(format!(
+            "the final residual ({gap_after:.4} N) is {:.2}× the noise floor: either an effect \
+             the candidates cannot express is missing, or the floor leaves out what the \
+             kinematics carry (the derivative filter's bias); do not read the model as complete",
+            gap_after / floor.sigma
+        ));
+    } else if gap_after < 0.9 * floor.sigma {
+        doubts.push(format!(
+            "the final residual ({gap_after:.4} N) is below the noise floor ({:.4} N): the floor \
+             is overestimated, and shares of the excess over it are understated",
+            floor.sigma
+        ));
+    }
+    doubts
+}
+
 /// Report the score of the candidate just tried.
 pub(super) fn emit_scored(
     settings: &DiscoverySettings,
@@ -807,6 +947,10 @@ pub(super) fn emit_scored(
     }
 }
 
+/// `v` clamped into `[min, max]`. A value on a bound is moved inside by the fit's bound
+/// transform; any other value is the start as it is. (This used to move values 1 % of the
+/// width below an upper bound, so a refit from a training fit with `p` = 3 started elsewhere;
+/// the stall it worked around was the transform moving interior starts, now fixed.)
 pub(super) fn inside(v: f64, min: f64, max: f64) -> f64 {
     v.clamp(min, max)
 }
@@ -891,6 +1035,30 @@ mod tests {
         assert!((starts[1][0] - 0.5).abs() < 0.25, "{starts:?}");
         // No extra start asked: the defaults only.
         assert_eq!(candidate_starts(&smooth(), &data, &all, &r, 0).len(), 1);
+    }
+
+    #[test]
+    fn an_uncertain_floor_is_said() {
+        let with = DiscoverySettings {
+            motion_noise: Some(crate::fit::MotionNoise::default()),
+            ..DiscoverySettings::default()
+        };
+        // The sensor's noise dominates and the gap is at the floor: nothing to say.
+        let sure = NoiseFloor::force(0.02, 0.005);
+        assert!(floor_doubts(&sure, sure.sigma, &with).is_empty());
+        // The kinematics' part dominates: said, with the floor at its uncertainty.
+        let kin = NoiseFloor::force(0.02, 0.04);
+        let d = floor_doubts(&kin, kin.sigma, &with);
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert!(
+            d[0].contains("uncertain") && d[0].contains("0.0825"),
+            "{d:?}"
+        );
+        // No kinematics' noise known; a gap far above or below the floor.
+        let none = floor_doubts(&sure, sure.sigma, &DiscoverySettings::default());
+        assert!(none[0].contains("sensor's alone"), "{none:?}");
+        assert!(floor_doubts(&sure, 1.3 * sure.sigma, &with)[0].contains("1.30×"));
+        assert!(floor_doubts(&sure, 0.8 * sure.sigma, &with)[0].contains("overestimated"));
     }
 
     #[test]

@@ -24,6 +24,7 @@
 //! [`ForceData`]: crate::fit::ForceData
 
 pub mod acceptance;
+pub mod blocks;
 pub mod candidate;
 mod choice;
 pub mod engine;

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::gap::GapLocation;
 use super::score::Step;
-use crate::fit::{FitResult, FittedParam};
+use crate::fit::{FitResult, FittedParam, NoiseFloor};
 use crate::force_model::ForceModel;
 
 /// The outcome of [`super::discover_force`].
@@ -19,8 +19,11 @@ pub struct Discovery {
     pub effects: Vec<String>,
     /// Every step: the scores of every candidate and what was decided.
     pub steps: Vec<Step>,
-    /// σ of the force noise used, N.
+    /// The final model's noise floor σ, N: the force sensor's noise with the kinematics'
+    /// noise propagated through the final model.
     pub noise_floor: f64,
+    /// Its parts: the sensor's noise (`measured`) and the kinematics' (`propagated`).
+    pub noise_floor_parts: NoiseFloor,
     /// Held-out cycles and samples.
     pub holdout_cycles: usize,
     /// Held-out samples.

@@ -37,6 +37,9 @@ pub struct Case {
     pub phi: Vec<f64>,
     /// The true STF force of each part of the truth, N (noise-free).
     pub part_forces: Vec<Vec<f64>>,
+    /// The kinematics v and a were filtered with (none with exact kinematics): their noise
+    /// enters the floor, their filter's window the test's blocks.
+    pub kinematics: Option<Kinematics>,
 }
 
 impl Case {
@@ -66,14 +69,35 @@ fn build(parts: &[Part]) -> (Arc<dyn ForceModel>, Vec<f64>) {
 
 /// Simulate `truth` over the sweep and sample it with the rig's noise (`seed`).
 pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
+    record_at(truth, seed, exact_kinematics, 200.0, 60.0)
+}
+
+/// The same sampled at `rate` (Hz) over the first `t1` seconds of the sweep.
+pub fn record_at(truth: &[Part], seed: u64, exact_kinematics: bool, rate: f64, t1: f64) -> Case {
+    let sweep = RotorAngle::sweep(4.0, 0.1, 0.0);
+    record_swept(truth, seed, exact_kinematics, rate, (sweep, t1))
+}
+
+/// The paper's sweep, ω 2.35 → 9.4 rad/s at 0.047 rad/s² (150 s), sampled at 1 kHz: 150 001
+/// samples.
+pub fn paper_record(truth: &[Part], seed: u64) -> Case {
+    let sweep = RotorAngle::sweep(2.35, 0.047, 0.0);
+    record_swept(truth, seed, false, 1000.0, (sweep, 150.0))
+}
+
+/// The same over the rotor `sweep` (its angle and its end, s).
+fn record_swept(
+    truth: &[Part],
+    seed: u64,
+    exact_kinematics: bool,
+    rate: f64,
+    (sweep, t1): (RotorAngle, f64),
+) -> Case {
     let (model, values) = build(truth);
-    let osc = Oscillator::new(
-        OscillatorParams::FORCED,
-        Excitation::Rotor(RotorAngle::sweep(4.0, 0.1, 0.0)),
-    )
-    .with_model(model, values)
-    .unwrap();
-    let run = Simulation::new(&osc).rate(200.0).run(0.0, 60.0).unwrap();
+    let osc = Oscillator::new(OscillatorParams::FORCED, Excitation::Rotor(sweep))
+        .with_model(model, values)
+        .unwrap();
+    let run = Simulation::new(&osc).rate(rate).run(0.0, t1).unwrap();
     let rec = sample_record(&run, &SensorNoise::RIG, seed, true);
     // The force of each part alone along the true motion (a part with internal state gets
     // its share of the simulated state).
@@ -98,11 +122,11 @@ pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
         z_off += nz;
         part_forces.push(f);
     }
-    let (v, a) = if exact_kinematics {
-        (run.v.clone(), run.a.clone())
+    let (v, a, kinematics) = if exact_kinematics {
+        (run.v.clone(), run.a.clone(), None)
     } else {
         let k = Kinematics::from_record(&rec, &KinematicsSettings::default()).unwrap();
-        (k.v, k.a)
+        (k.v.clone(), k.a.clone(), Some(k))
     };
     Case {
         t: rec.t.clone(),
@@ -112,6 +136,7 @@ pub fn record(truth: &[Part], seed: u64, exact_kinematics: bool) -> Case {
         f: rec.f_stf.clone().unwrap(),
         phi: rec.phi.clone().unwrap(),
         part_forces,
+        kinematics,
     }
 }
 
@@ -123,9 +148,14 @@ pub fn vocabulary() -> Vec<Candidate> {
         .collect()
 }
 
-/// Run discovery from the built-in `base` with the whole vocabulary.
+/// Run discovery from the built-in `base` with the whole vocabulary, the record's kinematics
+/// noise in the floor and its filter's window setting the test's blocks.
 pub fn discover(case: &Case, base: &str, settings: &DiscoverySettings) -> Discovery {
     let cycles = cycles_from_phase(&case.t, &case.phi).unwrap();
+    let settings = &match &case.kinematics {
+        Some(k) => settings.clone().kinematics(k),
+        None => settings.clone(),
+    };
     discover_force(
         find(base).unwrap(),
         &vocabulary(),
@@ -146,12 +176,13 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
         eprintln!("   step on `{}`: {}", s.current, s.verdict);
         for c in &s.candidates {
             eprintln!(
-                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} ΔBIC {:+9.1} expl {:5.2} sig {} {} evals {} {:.2}s {:?}",
+                "      {:<16} train {:.4} holdout {:.4} gain {:+.4} z {:6.1} n {:4} ΔBIC {:+9.1} expl {:5.2} share {:5.2} sig {} {} evals {} {:.2}s {:?}",
                 c.name, c.train_rms,
                 c.holdout_rms,
-                c.holdout_gain, c.gain_z,
+                c.holdout_gain, c.gain_z, c.effective_n,
                 c.delta_bic,
                 c.explained_fraction,
+                c.explained_share,
                 c.significant,
                 c.failure.as_deref().unwrap_or(""),
                 c.evaluations,
@@ -160,11 +191,13 @@ pub fn print(label: &str, case: &Case, d: &Discovery) {
         }
     }
     eprintln!(
-        "   effects {:?}; gap {:.4} → {:.4} N, floor {:.4} N ({:.2}×); {}",
+        "   effects {:?}; gap {:.4} → {:.4} N, floor {:.4} N (sensor {:.4}, kinematics {:.4}) ({:.2}×); {}",
         d.effects,
         d.gap_before,
         d.gap_after,
         d.noise_floor,
+        d.noise_floor_parts.measured,
+        d.noise_floor_parts.propagated,
         d.gap_after / d.noise_floor,
         d.where_before.summary
     );
