@@ -95,4 +95,38 @@ pub trait ForceModel: Send + Sync {
     /// The rest of the force, N, positive when it opposes positive x (it enters the equation
     /// with a plus sign on the left-hand side). Writes the rates of the internal state to `dz`.
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError>;
+
+    /// The added mass and the rest of the force at once (what a fitter needs at every
+    /// sample): `(added_mass, force)`. The default calls both; a sum visits its parts once.
+    fn mass_and_force(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        dz: &mut [f64],
+    ) -> Result<(f64, f64), ModelError> {
+        Ok((self.added_mass(p, s)?, self.force(p, s, dz)?))
+    }
+
+    /// Only the rates of the internal state, written to `dz` (the intermediate stages of an
+    /// integration step need no force). The default calls [`ForceModel::force`]; a sum
+    /// evaluates only its parts with state.
+    fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+        self.force(p, s, dz).map(|_| ())
+    }
+
+    /// The gradient of the whole force `m_a·a + f` with respect to the parameters at state
+    /// `s` and acceleration `a`, written to `grad` (one entry per parameter); `Ok(false)` when
+    /// the model does not provide it (the default), and the fitter differences instead. Only
+    /// models without internal state provide it (a state would need its sensitivities); a sum
+    /// gives its memoryless parts' entries and leaves NaN in those of its parts with state,
+    /// which the fitter differences.
+    fn gradient(
+        &self,
+        _p: &[f64],
+        _s: &ModelState,
+        _a: f64,
+        _grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        Ok(false)
+    }
 }

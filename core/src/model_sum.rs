@@ -15,9 +15,10 @@ pub struct ModelSum {
     name: String,
     parts: Vec<Arc<dyn ForceModel>>,
     specs: Vec<ParamSpec>,
-    /// Start of each part's parameters in `specs`.
+    /// Start of each part's parameters in `specs`, then their end (one entry more than the
+    /// parts: no part is asked its sizes per sample).
     param_offsets: Vec<usize>,
-    /// Start of each part's internal states.
+    /// Start of each part's internal states, then their end.
     state_offsets: Vec<usize>,
     n_internal: usize,
 }
@@ -55,6 +56,8 @@ impl ModelSum {
                 specs.push(spec);
             }
         }
+        param_offsets.push(specs.len());
+        state_offsets.push(n_internal);
         let name = if parts.is_empty() {
             "none".to_string()
         } else {
@@ -95,8 +98,12 @@ impl ModelSum {
     }
 
     fn part_slices<'a>(&self, i: usize, p: &'a [f64]) -> &'a [f64] {
-        let start = self.param_offsets[i];
-        &p[start..start + self.parts[i].params().len()]
+        &p[self.param_offsets[i]..self.param_offsets[i + 1]]
+    }
+
+    /// The internal states of part `i` (their range in the sum's).
+    fn states(&self, i: usize) -> std::ops::Range<usize> {
+        self.state_offsets[i]..self.state_offsets[i + 1]
     }
 }
 
@@ -119,17 +126,15 @@ impl ForceModel for ModelSum {
 
     fn initial_internal(&self, p: &[f64], z0: &mut [f64]) {
         for (i, part) in self.parts.iter().enumerate() {
-            let s = self.state_offsets[i];
-            part.initial_internal(self.part_slices(i, p), &mut z0[s..s + part.n_internal()]);
+            part.initial_internal(self.part_slices(i, p), &mut z0[self.states(i)]);
         }
     }
 
     fn added_mass(&self, p: &[f64], s: &ModelState) -> Result<f64, ModelError> {
         let mut total = 0.0;
         for (i, part) in self.parts.iter().enumerate() {
-            let o = self.state_offsets[i];
             let local = ModelState {
-                z: &s.z[o..o + part.n_internal()],
+                z: &s.z[self.states(i)],
                 ..*s
             };
             total += part.added_mass(self.part_slices(i, p), &local)?;
@@ -140,15 +145,74 @@ impl ForceModel for ModelSum {
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
         let mut total = 0.0;
         for (i, part) in self.parts.iter().enumerate() {
-            let o = self.state_offsets[i];
-            let n = part.n_internal();
+            let states = self.states(i);
             let local = ModelState {
-                z: &s.z[o..o + n],
+                z: &s.z[states.clone()],
                 ..*s
             };
-            total += part.force(self.part_slices(i, p), &local, &mut dz[o..o + n])?;
+            total += part.force(self.part_slices(i, p), &local, &mut dz[states])?;
         }
         Ok(total)
+    }
+
+    fn mass_and_force(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        dz: &mut [f64],
+    ) -> Result<(f64, f64), ModelError> {
+        let (mut mass, mut force) = (0.0, 0.0);
+        for (i, part) in self.parts.iter().enumerate() {
+            let states = self.states(i);
+            let local = ModelState {
+                z: &s.z[states.clone()],
+                ..*s
+            };
+            let (m, f) = part.mass_and_force(self.part_slices(i, p), &local, &mut dz[states])?;
+            mass += m;
+            force += f;
+        }
+        Ok((mass, force))
+    }
+
+    fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+        for (i, part) in self.parts.iter().enumerate() {
+            let states = self.states(i);
+            if states.is_empty() {
+                continue;
+            }
+            let local = ModelState {
+                z: &s.z[states.clone()],
+                ..*s
+            };
+            part.rates(self.part_slices(i, p), &local, &mut dz[states])?;
+        }
+        Ok(())
+    }
+
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        // A part with state gets NaN entries (differenced by the fitter); a memoryless part
+        // sees no state. Without any part's gradient there is none.
+        let mut any = false;
+        for (i, part) in self.parts.iter().enumerate() {
+            let (start, end) = (self.param_offsets[i], self.param_offsets[i + 1]);
+            let own = &mut grad[start..end];
+            let given = self.states(i).is_empty() && {
+                let local = ModelState { z: &[], ..*s };
+                part.gradient(&p[start..end], &local, a, own)?
+            };
+            if !given {
+                own.fill(f64::NAN);
+            }
+            any |= given;
+        }
+        Ok(any)
     }
 }
 

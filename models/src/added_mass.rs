@@ -67,6 +67,17 @@ impl ForceModel for AddedMass {
         take::<1>(self.name(), p)?;
         Ok(0.0)
     }
+    fn gradient(
+        &self,
+        p: &[f64],
+        _s: &ModelState,
+        a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        take::<1>(self.name(), p)?;
+        grad[0] = a;
+        Ok(true)
+    }
 }
 
 #[cfg(test)]

@@ -60,6 +60,17 @@ impl ForceModel for CubicStiffness {
         let [k3] = take(self.name(), p)?;
         Ok(k3 * s.x * s.x * s.x)
     }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        take::<1>(self.name(), p)?;
+        grad[0] = s.x * s.x * s.x;
+        Ok(true)
+    }
 }
 
 #[cfg(test)]

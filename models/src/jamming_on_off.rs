@@ -47,7 +47,7 @@
 use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::ParamSpec;
 
-use crate::power_law::power_law_force;
+use crate::power_law::{power_law_force, power_law_gradient};
 use crate::values::take;
 
 /// One line for listings.
@@ -132,6 +132,28 @@ impl ForceModel for JammingOnOff {
     fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
         let [k_j, n_j, v_c, w] = take(self.name(), p)?;
         Ok(power_law_force(k_j, n_j, s.v) * jamming_gate(s.v.abs(), v_c, w))
+    }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let [k_j, n_j, v_c, w] = take(self.name(), p)?;
+        let speed = s.v.abs();
+        let (dk, dn) = power_law_gradient(k_j, n_j, s.v);
+        let gate = jamming_gate(speed, v_c, w);
+        // dG/dq = ½·sech²(q), q = (|v| − v_c)/w; a hard switch (w = 0) has no slope.
+        let (dvc, dw) = if w > 0.0 {
+            let q = (speed - v_c) / w;
+            let slope = 0.5 / q.cosh().powi(2) * power_law_force(k_j, n_j, s.v);
+            (-slope / w, -slope * q / w)
+        } else {
+            (0.0, 0.0)
+        };
+        grad[..4].copy_from_slice(&[dk * gate, dn * gate, dvc, dw]);
+        Ok(true)
     }
 }
 

@@ -67,6 +67,19 @@ pub fn power_law_force(k: f64, n: f64, v: f64) -> f64 {
     }
 }
 
+/// `(∂F/∂K, ∂F/∂n)` of [`power_law_force`]: `|v|ⁿ·sign v` and `K·|v|ⁿ·ln|v|·sign v`, both
+/// zero at v = 0.
+#[inline]
+pub fn power_law_gradient(k: f64, n: f64, v: f64) -> (f64, f64) {
+    if v == 0.0 {
+        return (0.0, 0.0);
+    }
+    // exp(n·ln|v|): one logarithm serves both entries (a gradient needs no last-bit power).
+    let ln = v.abs().ln();
+    let unit = (n * ln).exp() * v.signum();
+    (unit, k * unit * ln)
+}
+
 impl ForceModel for PowerLaw {
     fn name(&self) -> &str {
         "power_law"
@@ -81,6 +94,18 @@ impl ForceModel for PowerLaw {
     fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
         let [k, n] = take(self.name(), p)?;
         Ok(power_law_force(k, n, s.v))
+    }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let [k, n] = take(self.name(), p)?;
+        let (dk, dn) = power_law_gradient(k, n, s.v);
+        grad[..2].copy_from_slice(&[dk, dn]);
+        Ok(true)
     }
 }
 

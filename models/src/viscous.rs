@@ -59,6 +59,17 @@ impl ForceModel for Viscous {
         let [c_s] = take(self.name(), p)?;
         Ok(c_s * s.v)
     }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        take::<1>(self.name(), p)?;
+        grad[0] = s.v;
+        Ok(true)
+    }
 }
 
 #[cfg(test)]

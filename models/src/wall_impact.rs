@@ -74,6 +74,29 @@ pub fn hunt_crossley(k_w: f64, gap: f64, p: f64, c_r: f64, x: f64, v: f64) -> f6
     side * magnitude.max(0.0)
 }
 
+/// `(∂F/∂k_w, ∂F/∂gap, ∂F/∂p, ∂F/∂c_r)` of [`hunt_crossley`]; zero out of contact and where
+/// the damping term cancels the contact force.
+#[inline]
+pub fn hunt_crossley_gradient(k_w: f64, gap: f64, p: f64, c_r: f64, x: f64, v: f64) -> [f64; 4] {
+    let delta = x.abs() - gap;
+    if delta.is_nan() || delta <= 0.0 {
+        return [0.0; 4];
+    }
+    let side = x.signum();
+    let damping = 1.0 + 1.5 * c_r * v * side;
+    let elastic = delta.powf(p);
+    if k_w * elastic * damping <= 0.0 {
+        return [0.0; 4];
+    }
+    let f = side * k_w * elastic * damping;
+    [
+        side * elastic * damping,
+        -f * p / delta,
+        f * delta.ln(),
+        k_w * elastic * 1.5 * v,
+    ]
+}
+
 impl ForceModel for WallImpact {
     fn name(&self) -> &str {
         "wall_impact"
@@ -88,6 +111,17 @@ impl ForceModel for WallImpact {
     fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
         let [k_w, gap, expo, c_r] = take(self.name(), p)?;
         Ok(hunt_crossley(k_w, gap, expo, c_r, s.x, s.v))
+    }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let [k_w, gap, expo, c_r] = take(self.name(), p)?;
+        grad[..4].copy_from_slice(&hunt_crossley_gradient(k_w, gap, expo, c_r, s.x, s.v));
+        Ok(true)
     }
 }
 

@@ -70,6 +70,23 @@ impl ForceModel for Yield {
         let norm = s.v.hypot(v_s);
         Ok(if norm > 0.0 { f_y * s.v / norm } else { 0.0 })
     }
+    fn gradient(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        _a: f64,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let [f_y, v_s] = take(self.name(), p)?;
+        let norm = s.v.hypot(v_s);
+        let (df, dv) = if norm > 0.0 {
+            (s.v / norm, -f_y * s.v * v_s / (norm * norm * norm))
+        } else {
+            (0.0, 0.0)
+        };
+        grad[..2].copy_from_slice(&[df, dv]);
+        Ok(true)
+    }
 }
 
 #[cfg(test)]

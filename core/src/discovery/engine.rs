@@ -717,29 +717,33 @@ impl Search<'_> {
         let n_base = current.stage.parts.len().saturating_sub(effects.len());
         // (score, trial, effect index, candidate index, a tie rather than a win)
         let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
-        #[allow(clippy::needless_range_loop)] // `j` also names the part and the effect replaced
-        for j in 0..effects.len().saturating_sub(1) {
+        let earlier = effects.len().saturating_sub(1);
+        for (j, effect) in effects.iter().enumerate().take(earlier) {
             let part = n_base + j;
             let Some(old) = current.stage.parts.get(part).cloned() else {
                 continue;
             };
             let rest = current.stage.without(part);
             let rest_residual = rest.residuals(data, settings)?;
-            for (k, c) in self.candidates.iter().enumerate() {
-                if current.stage.holds(c, self.in_base, &[]) {
-                    continue;
-                }
-                let label = format!("{} for {}", c.name, effects[j]);
-                let replaced = Replaced {
-                    rest: &rest,
-                    residual: &rest_residual,
-                    part,
-                    old_len: old.params().len(),
-                };
+            let replaced = Replaced {
+                rest: &rest,
+                residual: &rest_residual,
+                part,
+                old_len: old.params().len(),
+            };
+            let to_try: Vec<usize> = (0..self.candidates.len())
+                .filter(|&k| !current.stage.holds(&self.candidates[k], self.in_base, &[]))
+                .collect();
+            // Independent trials against the same current model: fitted in parallel, kept in
+            // their order.
+            let current = &*current;
+            tried.par_extend(to_try.par_iter().map(|&k| {
+                let c = &self.candidates[k];
+                let label = format!("{} for {effect}", c.name);
                 let (score, trial, tie) =
                     self.replacement(c, &label, current, &replaced, yardstick);
-                tried.push((score, trial, j, k, tie));
-            }
+                (score, trial, j, k, tie)
+            }));
         }
         if tried.is_empty() {
             return Ok(None);

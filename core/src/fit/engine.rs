@@ -416,8 +416,8 @@ fn finish(
     })
 }
 
-/// A forward-difference Jacobian of the residuals `r0` at the user values `x` of the free
-/// parameters `free`.
+/// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
+/// exact where the problem gives one, else by forward differences.
 fn jacobian(
     obj: &Objective,
     free: &[&FitParam],
@@ -427,6 +427,12 @@ fn jacobian(
 ) -> DMatrix<f64> {
     let (n, p) = (r0.len(), free.len());
     let mut jac = DMatrix::<f64>::zeros(n, p);
+    let exact = obj
+        .jacobian_user(x, &mut jac)
+        .unwrap_or_else(|| vec![false; p]);
+    if exact.iter().all(|&e| e) {
+        return jac;
+    }
     let mut steps: Vec<f64> = free
         .iter()
         .map(|q| settings.fd_step * q.effective_scale())
@@ -468,6 +474,7 @@ fn jacobian(
         &floor,
         &|j, v| !(v > free[j].min && v < free[j].max),
         &mut |point, out| obj.residuals_user(point, out).is_some(),
+        &exact,
         &mut jac,
     );
     jac

@@ -33,6 +33,8 @@
 
 use std::sync::Arc;
 
+use nalgebra::DMatrix;
+
 use super::engine;
 use super::error::FitError;
 use super::objective::Residuals;
@@ -161,6 +163,20 @@ impl ForceFit {
         data: &ForceData,
         observer: Option<&(dyn Fn(FitProgress) + Sync)>,
     ) -> Result<FitResult, FitError> {
+        self.fit_rows(data, None, &self.settings, observer)
+    }
+
+    /// Fit on the samples `rows` only (strictly increasing; `None`: all) with `settings`
+    /// instead of the fit's own; statistics (RMS, AIC, BIC, standard errors) are those of
+    /// the rows. The model is still evaluated along the whole record where it has internal
+    /// state, so the state evolves through the samples left out as it would in reality.
+    pub fn fit_rows(
+        &self,
+        data: &ForceData,
+        rows: Option<&[usize]>,
+        settings: &FitSettings,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
         if let Some(name) = self.unknown.first() {
             return Err(FitError::UnknownParam {
                 name: name.clone(),
@@ -174,13 +190,22 @@ impl ForceFit {
             });
         }
         data.validate()?;
+        if let Some(rows) = rows {
+            let n = data.t.len();
+            if rows.windows(2).any(|w| w[0] >= w[1]) || rows.last().is_some_and(|&l| l >= n) {
+                return Err(FitError::BadData(format!(
+                    "the samples to fit must increase strictly and lie within the {n} samples"
+                )));
+            }
+        }
         let all = self.params();
         let problem = ForceResiduals {
             model: self.model.as_ref(),
             data: *data,
             all: &all,
+            rows,
         };
-        engine::run(&problem, &all, &self.settings, observer, false)
+        engine::run(&problem, &all, settings, observer, false)
     }
 }
 
@@ -205,6 +230,7 @@ impl ForceFit {
             model: self.model.as_ref(),
             data: *data,
             all: &all,
+            rows: None,
         };
         let mut out = data.f.to_vec();
         problem
@@ -214,17 +240,27 @@ impl ForceFit {
     }
 }
 
-/// The residuals of a force-level fit.
+/// The residuals of a force-level fit, at every sample or at the samples `rows` only.
 struct ForceResiduals<'a> {
     model: &'a dyn ForceModel,
     data: ForceData<'a>,
     /// Model parameters, then the offset if any.
     all: &'a [FitParam],
+    /// The samples whose residuals count (strictly increasing), or `None` for all. A model
+    /// with internal state is still integrated along every sample.
+    rows: Option<&'a [usize]>,
+}
+
+impl ForceResiduals<'_> {
+    /// The sample behind residual `k`.
+    fn row(&self, k: usize) -> usize {
+        self.rows.map_or(k, |r| r[k])
+    }
 }
 
 impl Residuals for ForceResiduals<'_> {
     fn len(&self) -> usize {
-        self.data.t.len()
+        self.rows.map_or(self.data.t.len(), <[usize]>::len)
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
@@ -234,74 +270,140 @@ impl Residuals for ForceResiduals<'_> {
         let offset = full.get(n_model).copied().unwrap_or(0.0);
         let d = &self.data;
         let m = self.model;
-        let nz = m.n_internal();
         let err = |e: crate::force_model::ModelError| e.to_string();
-        if nz == 0 {
-            for i in 0..d.t.len() {
+        if m.n_internal() == 0 {
+            for k in 0..self.len() {
+                let i = self.row(k);
                 let s = ModelState {
                     t: d.t[i],
                     x: d.x[i],
                     v: d.v[i],
                     z: &[],
                 };
-                let ma = m.added_mass(p, &s).map_err(err)?;
-                let f = m.force(p, &s, &mut []).map_err(err)?;
-                sink(i, d.f[i] - (ma * d.a[i] + f + offset));
+                let (ma, f) = m.mass_and_force(p, &s, &mut []).map_err(err)?;
+                sink(k, d.f[i] - (ma * d.a[i] + f + offset));
             }
             return Ok(());
         }
-        // z, stage rates k1..k4, stage state.
-        let mut buf = vec![0.0; 6 * nz];
-        let (z, rest) = buf.split_at_mut(nz);
-        let (k1, rest) = rest.split_at_mut(nz);
-        let (k2, rest) = rest.split_at_mut(nz);
-        let (k3, rest) = rest.split_at_mut(nz);
-        let (k4, zs) = rest.split_at_mut(nz);
-        m.initial_internal(p, z);
-        let last = d.t.len() - 1;
-        for i in 0..=last {
+        integrate_state(m, p, d, self.rows, &mut |k, i, ma, f| {
+            sink(k, d.f[i] - (ma * d.a[i] + f + offset));
+        })
+        .map_err(err)
+    }
+
+    /// Exact for models that give their [`ForceModel::gradient`]: built-ins without state,
+    /// and the memoryless parts of a sum (a part with state leaves NaN columns). A
+    /// memoryless part's gradient needs no state, so nothing is integrated here.
+    fn jacobian(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Result<(), String>> {
+        let m = self.model;
+        let n_model = m.params().len();
+        if self.is_empty() {
+            return None;
+        }
+        let full = match full_values(self.all, x) {
+            Ok(f) => f,
+            Err(e) => return Some(Err(e)),
+        };
+        let p = &full[..n_model];
+        // Column of each free parameter among all (the offset is the last).
+        let free: Vec<usize> = (0..self.all.len())
+            .filter(|&j| !self.all[j].fixed)
+            .collect();
+        let mut grad = vec![0.0; n_model];
+        // A placeholder state: only memoryless parts give their gradient.
+        let state = vec![0.0; m.n_internal()];
+        let d = &self.data;
+        for k in 0..self.len() {
+            let i = self.row(k);
             let s = ModelState {
                 t: d.t[i],
                 x: d.x[i],
                 v: d.v[i],
-                z,
+                z: &state,
             };
-            let ma = m.added_mass(p, &s).map_err(err)?;
-            let f = m.force(p, &s, k1).map_err(err)?;
-            sink(i, d.f[i] - (ma * d.a[i] + f + offset));
-            if i == last {
-                break;
+            match m.gradient(p, &s, d.a[i], &mut grad) {
+                Ok(true) => {}
+                Ok(false) => return None,
+                Err(e) => return Some(Err(e.to_string())),
             }
-            let h = d.t[i + 1] - d.t[i];
-            let (tm, xm, vm) = (
-                0.5 * (d.t[i] + d.t[i + 1]),
-                0.5 * (d.x[i] + d.x[i + 1]),
-                0.5 * (d.v[i] + d.v[i + 1]),
-            );
-            for j in 0..nz {
-                zs[j] = z[j] + 0.5 * h * k1[j];
-            }
-            m.force(p, &midpoint(tm, xm, vm, zs), k2).map_err(err)?;
-            for j in 0..nz {
-                zs[j] = z[j] + 0.5 * h * k2[j];
-            }
-            m.force(p, &midpoint(tm, xm, vm, zs), k3).map_err(err)?;
-            for j in 0..nz {
-                zs[j] = z[j] + h * k3[j];
-            }
-            let se = ModelState {
-                t: d.t[i + 1],
-                x: d.x[i + 1],
-                v: d.v[i + 1],
-                z: zs,
-            };
-            m.force(p, &se, k4).map_err(err)?;
-            for j in 0..nz {
-                z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+            for (c, &j) in free.iter().enumerate() {
+                jac[(k, c)] = -grad.get(j).copied().unwrap_or(1.0);
             }
         }
-        Ok(())
+        Some(Ok(()))
     }
+}
+
+/// Integrate the internal state of `m` (parameters `p`) along the kinematics of `d` with one
+/// RK4 step per sample interval, calling `each(k, i, m_a, f)` at the `k`-th of the samples
+/// `rows` (strictly increasing; `None`: all), sample `i`, with the added mass and the rest of
+/// the force there; elsewhere only the state's rates are evaluated.
+fn integrate_state(
+    m: &dyn ForceModel,
+    p: &[f64],
+    d: &ForceData,
+    rows: Option<&[usize]>,
+    each: &mut dyn FnMut(usize, usize, f64, f64),
+) -> Result<(), crate::force_model::ModelError> {
+    let nz = m.n_internal();
+    // z, stage rates k1..k4, stage state.
+    let mut buf = vec![0.0; 6 * nz];
+    let (z, rest) = buf.split_at_mut(nz);
+    let (k1, rest) = rest.split_at_mut(nz);
+    let (k2, rest) = rest.split_at_mut(nz);
+    let (k3, rest) = rest.split_at_mut(nz);
+    let (k4, zs) = rest.split_at_mut(nz);
+    m.initial_internal(p, z);
+    let last = d.t.len() - 1;
+    let mut next = 0;
+    for i in 0..=last {
+        let s = ModelState {
+            t: d.t[i],
+            x: d.x[i],
+            v: d.v[i],
+            z,
+        };
+        let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
+        if let Some(k) = k {
+            let (ma, f) = m.mass_and_force(p, &s, k1)?;
+            each(k, i, ma, f);
+            next += 1;
+        } else {
+            m.rates(p, &s, k1)?;
+        }
+        if i == last {
+            break;
+        }
+        let h = d.t[i + 1] - d.t[i];
+        let (tm, xm, vm) = (
+            0.5 * (d.t[i] + d.t[i + 1]),
+            0.5 * (d.x[i] + d.x[i + 1]),
+            0.5 * (d.v[i] + d.v[i + 1]),
+        );
+        // The intermediate stages need only the rates, not the force.
+        for j in 0..nz {
+            zs[j] = z[j] + 0.5 * h * k1[j];
+        }
+        m.rates(p, &midpoint(tm, xm, vm, zs), k2)?;
+        for j in 0..nz {
+            zs[j] = z[j] + 0.5 * h * k2[j];
+        }
+        m.rates(p, &midpoint(tm, xm, vm, zs), k3)?;
+        for j in 0..nz {
+            zs[j] = z[j] + h * k3[j];
+        }
+        let se = ModelState {
+            t: d.t[i + 1],
+            x: d.x[i + 1],
+            v: d.v[i + 1],
+            z: zs,
+        };
+        m.rates(p, &se, k4)?;
+        for j in 0..nz {
+            z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+        }
+    }
+    Ok(())
 }
 
 fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {

@@ -64,7 +64,9 @@ pub struct StepFloor {
 /// `flip(j, x)` tells whether parameter j's step must go the other way (a bound ahead).
 /// A column whose rms change is below `SIGNAL_TO_NOISE × floor.noise` is recomputed with a
 /// longer step (up to `floor.max[j]`); the steps used are written back to `steps`, so a
-/// caller that keeps them starts the next Jacobian from there.
+/// caller that keeps them starts the next Jacobian from there. Columns marked in `exact` are
+/// left as they are (known exactly).
+#[allow(clippy::too_many_arguments)]
 pub fn forward_difference(
     x: &[f64],
     r0: &[f64],
@@ -72,12 +74,16 @@ pub fn forward_difference(
     floor: &StepFloor,
     flip: &dyn Fn(usize, f64) -> bool,
     eval: &mut dyn FnMut(&[f64], &mut [f64]) -> bool,
+    exact: &[bool],
     jac: &mut DMatrix<f64>,
 ) {
     let n = r0.len().max(1) as f64;
     let wanted = SIGNAL_TO_NOISE * floor.noise;
     let mut point = x.to_vec();
     for j in 0..steps.len() {
+        if exact.get(j).copied().unwrap_or(false) {
+            continue;
+        }
         let longest = floor.max.get(j).copied().unwrap_or(0.0);
         let mut h0 = steps[j].abs();
         let mut column = jac.column_mut(j);

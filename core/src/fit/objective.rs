@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 use argmin::core::{CostFunction, Error as ArgminError};
+use nalgebra::DMatrix;
 
 use super::result::{FitProgress, Stage};
 use super::transform::BoundTransform;
@@ -27,6 +28,13 @@ pub trait Residuals: Sync {
     /// Stream the residuals at free values `x` to `sink(i, r_i)`, in any order, each once;
     /// an error (a failed simulation, a model error) as text.
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String>;
+
+    /// The exact Jacobian `∂r_i/∂x_j` at free values `x`, written to `jac` (`len` × free),
+    /// when the problem can give it; `None` (the default): the fitter differences the
+    /// residuals instead.
+    fn jacobian(&self, _x: &[f64], _jac: &mut DMatrix<f64>) -> Option<Result<(), String>> {
+        None
+    }
 }
 
 /// ln of the cost that stands for a failed evaluation in the optimisers (cost 1e300).
@@ -155,6 +163,36 @@ impl<'a> Objective<'a> {
                 *slot = r;
             }
         })
+    }
+
+    /// The exact columns of the Jacobian at user values `x`, written into `jac`: which
+    /// columns are exact (finite throughout; the others are to be differenced), or `None`
+    /// when the problem gives none or it failed. Counted as an evaluation.
+    pub fn jacobian_user(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
+        let outcome = self.problem.jacobian(x, jac)?;
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        if let Err(e) = outcome {
+            *lock(&self.last_failure) = Some(e);
+            return None;
+        }
+        let exact: Vec<bool> = jac
+            .column_iter()
+            .map(|c| c.iter().all(|v| v.is_finite()))
+            .collect();
+        exact.iter().any(|&e| e).then_some(exact)
+    }
+
+    /// The exact columns of the Jacobian in internal coordinates `u` (the user Jacobian
+    /// times each transform's slope), as [`Objective::jacobian_user`].
+    pub fn jacobian_internal(&self, u: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
+        let exact = self.jacobian_user(&self.to_user(u), jac)?;
+        for (j, (t, &uj)) in self.transforms.iter().zip(u).enumerate() {
+            if exact[j] {
+                let slope = t.slope(uj);
+                jac.column_mut(j).iter_mut().for_each(|c| *c *= slope);
+            }
+        }
+        Some(exact)
     }
 
     /// Mean squared residual at internal coordinates `u`; `None` on failure.

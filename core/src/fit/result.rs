@@ -15,6 +15,12 @@ pub enum Convergence {
     },
     /// The last stage ran out of iterations: the values may not be the optimum.
     MaxIterations,
+    /// The last stage stopped making progress although its exact gradient says the cost can
+    /// still fall: the values are not an optimum (a crawl along a curved valley).
+    Stalled {
+        /// Where and how.
+        reason: String,
+    },
     /// The optimiser failed.
     Failed {
         /// Why.

@@ -137,6 +137,25 @@ impl BoundTransform {
         }
     }
 
+    /// The slope `dx/du` of the map at internal coordinate `u`.
+    pub fn slope(&self, u: f64) -> f64 {
+        match self.shape {
+            Shape::Free => self.scale,
+            Shape::Lower { d } => self.scale * (self.scale * u / d).exp(),
+            Shape::Upper { d } => self.scale * (-self.scale * u / d).exp(),
+            Shape::Both { w0, c } => {
+                let s = logistic(w0 + c * u);
+                (self.max - self.min) * s * (1.0 - s) * c
+            }
+        }
+    }
+
+    /// Whether the map is flat at `u` (its slope below 1 % of the scale): the parameter
+    /// presses on a bound.
+    pub fn saturated(&self, u: f64) -> bool {
+        self.slope(u) < 1e-2 * self.scale
+    }
+
     /// The internal coordinate of user value `x`; `None` outside the open interior.
     pub fn to_internal(&self, x: f64) -> Option<f64> {
         let u = match self.shape {

@@ -140,6 +140,11 @@ impl fmt::Display for FitWarning {
                     "the fit failed ({reason}): the values are not an optimum — check the start \
                      values and bounds, or try another `fit.solver`"
                 ),
+                Convergence::Stalled { reason } => write!(
+                    f,
+                    "the fit stalled ({reason}): the values are not an optimum — start nearer \
+                     the optimum or try another `fit.solver`"
+                ),
                 _ => write!(
                     f,
                     "the fit ran out of iterations: the values may not be the optimum — raise \
