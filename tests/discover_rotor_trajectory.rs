@@ -104,14 +104,13 @@ fn nothing_hidden_nothing_named() {
         let d = discover(None, seed, None);
         assert!(effects(&d).is_empty(), "seed {seed}: {:?}", d["notes"]);
         assert_at_the_noise(&d);
-        assert_screened(&d);
     }
 }
 
-/// Every step fitted three candidates at trajectory level and said of each other one that the
-/// force-level screen left it out.
+/// The first step fitted three candidates at trajectory level and said of each other one that
+/// the force-level screen left it out (the recovered force asks for the hidden effect).
 fn assert_screened(d: &serde_json::Value) {
-    for step in d["steps"].as_array().unwrap() {
+    for step in d["steps"].as_array().unwrap().iter().take(1) {
         let candidates = step["candidates"].as_array().unwrap();
         let left_out = candidates
             .iter()
@@ -137,6 +136,7 @@ fn a_hidden_added_mass_is_named() {
     let d = discover(Some(("added_mass", ", m_a = 0.5")), 5, None);
     assert_eq!(effects(&d), ["added_mass"], "{:?}", d["notes"]);
     assert_at_the_noise(&d);
+    assert_screened(&d);
 }
 
 #[test]
