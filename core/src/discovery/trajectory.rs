@@ -14,12 +14,12 @@
 //!    paired test and the BIC on the training samples ([`super::acceptance`]). The paired
 //!    test pairs whole held-out cycles (their mean squared residual), not samples: a
 //!    simulated x residual is correlated over a cycle, so per-sample pairs would count one
-//!    cycle's misfit hundreds of times and overstate the evidence;
-//!    With a force hint (the force recovered from the record's kinematics), a screen comes
-//!    first: every candidate is fitted at force level to that force, and only the few that
-//!    lower it most (three) are fitted at trajectory level; each of those starts
-//!    from the best of its starts after a short fit (the force-level fit, and a screen of
-//!    its amplitude on three bases), and the candidates run in parallel;
+//!    cycle's misfit hundreds of times and overstate the evidence. With a force hint (the
+//!    force recovered from the record's kinematics) a screen comes first: every candidate is
+//!    fitted at force level to that force, and when one lowers it clearly, only the three
+//!    that lower it most are fitted at trajectory level. Each candidate fitted starts from the
+//!    best of its starts after a short fit (its force-level fit, and a screen of its
+//!    amplitude on three bases); the candidates run in parallel;
 //! 4. repeat until nothing is significant or `max_effects` are added;
 //! 5. refit the final model and the oscillator on the whole record: gap before and after.
 //!
@@ -277,9 +277,9 @@ impl Stage {
 
 impl Stage {
     /// This stage with its model's parameters fitted at force level to the recovered force of
-    /// `hint` on the `train` samples, from its values and from the models' defaults (the
-    /// better kept), and that fit's RMS residual; the oscillator's values are kept. `None` if
-    /// no fit succeeds.
+    /// `hint` on (every k-th of) the `train` samples — from its values, from them with the
+    /// last part's amplitude near zero, and from the models' defaults, the best kept — and
+    /// that fit's RMS residual; the oscillator's values are kept. `None` if no fit succeeds.
     fn force_started(&self, rig: &Rig, hint: &ForceHint, train: &[usize]) -> Option<(Stage, f64)> {
         let model = self.model().ok()?;
         let n_osc = rig.oscillator.len();
@@ -383,13 +383,13 @@ impl Stage {
         // tried on that oscillator, and on the current one.
         let mut out: Vec<Stage> = Vec::new();
         if let Some(h) = hinted.filter(|h| h.values.len() == self.values.len()) {
-            let mut on_setup = h.clone();
-            for (v, &s) in on_setup.values.iter_mut().zip(osc_start) {
-                *v = s;
-            }
             out.push(h.clone());
-            if on_setup.values != h.values {
-                out.push(on_setup);
+            let on_setup = h.on_oscillator(osc_start);
+            if on_setup != h.values {
+                out.push(Stage {
+                    parts: self.parts.clone(),
+                    values: on_setup,
+                });
             }
         }
         let screen = self.amplitude(osc_start.len()).zip(self.model().ok());
@@ -420,10 +420,7 @@ impl Stage {
     /// The current values; the current model on the oscillator `osc_start`; every parameter
     /// at its default on `osc_start` (the offset, if any, as it is).
     fn bases(&self, osc_start: &[f64]) -> [Vec<f64>; 3] {
-        let mut from_start = self.values.clone();
-        for (v, &s) in from_start.iter_mut().zip(osc_start) {
-            *v = s;
-        }
+        let from_start = self.on_oscillator(osc_start);
         let mut fresh = from_start.clone();
         let defaults = self
             .parts
@@ -433,6 +430,15 @@ impl Stage {
             *v = d;
         }
         [self.values.clone(), from_start, fresh]
+    }
+
+    /// This stage's values with the oscillator's (the first ones) set to `osc`.
+    fn on_oscillator(&self, osc: &[f64]) -> Vec<f64> {
+        let mut values = self.values.clone();
+        for (v, &s) in values.iter_mut().zip(osc) {
+            *v = s;
+        }
+        values
     }
 
     /// The last part's first parameter and its index in `values` (after `n_osc` oscillator
@@ -506,11 +512,11 @@ impl Trials<'_, '_> {
     /// A screen first (when the setup has a force hint): each candidate, added to the current
     /// model, is fitted at force level to the force recovered from the kinematics (a
     /// fraction of a second each), and ranked by how much it lowers that fit's mean square
-    /// below the current model's. The best [`SCREEN_KEEP`] are fitted at trajectory level —
-    /// starts, short fits, the trial — in parallel; the others are reported as not fitted,
-    /// with their force-level gain and rank — when the best gain is at least
-    /// [`SCREEN_MIN_GAIN`] of the current model's mean square; otherwise all are fitted. A
-    /// trajectory fit costs hundreds of simulations.
+    /// below the current model's. When the best gain is at least [`SCREEN_MIN_GAIN`] of the
+    /// current model's mean square, only the best [`SCREEN_KEEP`] are fitted at trajectory
+    /// level (starts, short fits, the trial; in parallel) and the others are reported as not
+    /// fitted, with their gain and rank; otherwise all are fitted. A trajectory fit costs
+    /// hundreds of simulations.
     fn step(
         &self,
         step: usize,
@@ -543,7 +549,10 @@ impl Trials<'_, '_> {
             let g = |i: usize| gains[i].unwrap_or(f64::INFINITY);
             g(b).total_cmp(&g(a))
         });
-        let rank = |i: usize| order.iter().position(|&o| o == i).unwrap_or(0);
+        let mut rank = vec![0; tried.len()];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i] = r;
+        }
         // The screen ranks only when the recovered force asks for something: its best gain
         // at least `SCREEN_MIN_GAIN` of the current model's mean square. Otherwise every
         // candidate is fitted — a small stiffening (k3·x³ of 0.01 N) is lost in the recovered
@@ -558,11 +567,11 @@ impl Trials<'_, '_> {
             .into_par_iter()
             .map(|i| {
                 let c = &tried[i];
-                if screened && rank(i) >= SCREEN_KEEP {
+                if screened && rank[i] >= SCREEN_KEEP {
                     let why = format!(
                         "not fitted at trajectory level: the force-level screen ranks it {} of \
                          {} (it lowers the recovered force's mean square by {:.3e} N²)",
-                        rank(i) + 1,
+                        rank[i] + 1,
                         tried.len(),
                         gains[i].unwrap_or(f64::NAN)
                     );
@@ -719,16 +728,16 @@ pub fn discover_trajectory(
     };
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
+    let trials = Trials {
+        rig: &rig,
+        setup,
+        split: &split,
+        osc_start: &osc_start,
+        yardstick: &yardstick,
+        settings,
+    };
     for step in 1..=settings.max_effects {
         let tried = current.stage.to_try(candidates, &in_base, &effects);
-        let trials = Trials {
-            rig: &rig,
-            setup,
-            split: &split,
-            osc_start: &osc_start,
-            yardstick: &yardstick,
-            settings,
-        };
         let scored = trials.step(step, &tried, &current);
         if scored.is_empty() {
             break;
@@ -764,6 +773,7 @@ pub fn discover_trajectory(
             _ => trial,
         };
     }
+
     // 5. The final model and the oscillator on the whole record: the gap after.
     let (final_stage, final_result, run_after) = if effects.is_empty() {
         (base_full.clone(), base_result.clone(), run_before)
