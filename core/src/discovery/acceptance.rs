@@ -2,14 +2,13 @@
 //!
 //! The evidence is a paired test on held-out **units** long enough to be independent: at
 //! force level blocks of consecutive held-out samples at least twice the derivative filter's
-//! window ([`super::blocks`]), at trajectory level whole held-out cycles. With `m₀ᵦ` the
-//! current model's mean squared residual over unit b and `m₁ᵦ` the candidate's (each fitted on
-//! the training cycles only), `dᵦ = ln(m₀ᵦ / m₁ᵦ)` and `z = mean(d) / (sd(d)/√N)`, at force
-//! level read as a normal z through Student's t over N − 1 degrees of freedom ([`t_as_z`],
-//! [`block_gain_z`]). At force level the test is over every block,
-//! or over the blocks where the current model holds an excess over the noise floor
-//! ([`excess_gain_z`]) when that gives the larger z: an effect near resonance shows in a few
-//! cycles only. N — the blocks or cycles the test is over — is its **effective sample size**,
+//! window ([`super::blocks`]), at trajectory level whole held-out cycles. At force level the
+//! test is [`block_gain_z`]: the held-out gain of squared residuals over its noise-only spread
+//! estimated from block sums, read through Student's t ([`t_as_z`]); the spread of the blocks'
+//! own gains would count a real gain that varies across the record as noise (an effect near
+//! resonance gains in a few cycles only). At trajectory level `dᵦ = ln(m₀ᵦ / m₁ᵦ)`, `m` a
+//! cycle's mean squared residual, and `z = mean(d) / (sd(d)/√N)` ([`mean_z`]). N — the blocks
+//! or cycles the test is over — is its **effective sample size**,
 //! stated with every score. Pairing samples instead counted one stretch of correlated misfit
 //! many times: a 1 % fall of the held-out force RMS scored z = 20.9 over 37 500 samples. Under
 //! "nothing is missing" the candidate's extra parameters only fit training noise, which the
@@ -23,7 +22,7 @@
 //!    over the noise floor, `(MSE_current − MSE_candidate) / (MSE_current − σ²)`, σ the floor
 //!    of the current model (force level: the sensor's noise with the kinematics' noise
 //!    propagated through the model) and the excess counted as at least what the held-out
-//!    units resolve (see [`super::choice`]): a real but small gain — a flexible candidate
+//!    units resolve (`choice::excess`): a real but small gain — a flexible candidate
 //!    bending to follow the derivative filter's bias — is not the missing physics.
 //!
 //! Among significant candidates, the one with the lowest held-out RMS is the best; those the
@@ -109,7 +108,7 @@ pub fn block_gain_z(reference: &[f64], new: &[f64], blocks: &Blocks) -> (f64, us
 
 /// A unit holds an excess over the noise floor σ when its mean squared residual is at least
 /// this many times σ²: noise alone over a block of tens of samples does not give it (see
-/// [`super::choice`]).
+/// `choice::excess`).
 pub const EXCESS_UNIT: f64 = 2.0;
 
 /// The normal z of the same one-sided tail as Student's `t` over `n` pairs (n − 1 degrees of
