@@ -375,7 +375,7 @@ fn run_trajectory(
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0);
     for name in &names {
-        setup = setup.refit(system_param(name, exp.system.get(name).unwrap_or(0.0)));
+        setup = setup.refit(system_param(name, &exp.system, k));
     }
     setup = setup.force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),

@@ -227,7 +227,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let mut free: Vec<_> = stage
             .free
             .iter()
-            .map(|name| system_param(name, system.get(name).unwrap_or(0.0)))
+            .map(|name| system_param(name, &system, &k))
             .collect();
         if exp.fit.fit_initial {
             free.extend(stf_core::fit::initial_state_params(x0, v0));

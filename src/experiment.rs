@@ -73,6 +73,9 @@ struct RawSystem {
     delta_T: Option<f64>,
     F0: Option<f64>,
     eta: Option<f64>,
+    f_off: Option<f64>,
+    phi_off: Option<f64>,
+    u_off: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, Serialize, Clone)]
@@ -557,11 +560,15 @@ impl Experiment {
                 ("delta_T", s.delta_T),
                 ("F0", s.F0),
                 ("eta", s.eta),
+                ("f_off", s.f_off),
+                ("phi_off", s.phi_off),
+                ("u_off", s.u_off),
             ];
             for (name, value) in given {
                 if let Some(v) = value {
                     let must_be_positive = matches!(name, "m" | "k" | "eta");
-                    if !v.is_finite() || v < 0.0 || (must_be_positive && v == 0.0) {
+                    let signed = OscillatorParams::OFFSETS.contains(&name);
+                    if !v.is_finite() || (v < 0.0 && !signed) || (must_be_positive && v == 0.0) {
                         return Err(cx.at(
                             span.clone(),
                             &format!("system.{name}"),

@@ -6,6 +6,7 @@
 //! (against `f_stf`, along the kinematics) or trajectory level (against `x`, simulating the
 //! oscillator driven as in the record).
 
+use std::f64::consts::PI;
 use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
@@ -264,14 +265,28 @@ fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
 }
 
 /// Bounds for an oscillator parameter freed in a trajectory fit: a factor 5 around its
-/// start (from 0 when it starts at 0).
-pub fn system_param(name: &str, value: f64) -> FitParam {
-    let (min, max) = if value > 0.0 {
-        (value / 5.0, value * 5.0)
-    } else {
-        (0.0, 10.0)
+/// start (from 0 when it starts at 0). An offset starts where it is set and may take either
+/// sign: `phi_off` within ±π, `f_off` and `u_off` within ± the record's force scale (the
+/// largest drive plus the spring's force at the largest |x|).
+pub fn system_param(name: &str, system: &OscillatorParams, k: &Kinematics) -> FitParam {
+    let value = system.get(name).unwrap_or(0.0);
+    let (min, max, scale) = match name {
+        "phi_off" => (-PI, PI, 0.01),
+        "f_off" | "u_off" => {
+            let x_max = k.x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let drive_max = k.drive(system).iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+            let f = (drive_max + system.k * x_max).max(f64::MIN_POSITIVE);
+            (value - f, value + f, 1e-3 * f)
+        }
+        _ if value > 0.0 => (value / 5.0, value * 5.0, 0.0),
+        _ => (0.0, 10.0, 0.0),
     };
-    FitParam::new(name, value).bounds(min, max)
+    let p = FitParam::new(name, value).bounds(min, max);
+    if scale > 0.0 {
+        p.scale(scale)
+    } else {
+        p
+    }
 }
 
 /// Fit one configured model (or, with `None`, the bare oscillator) to `data`.
@@ -359,8 +374,7 @@ fn fit_trajectory(
         free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
     }
     for name in &exp.fit.system_free {
-        let value = exp.system.get(name).unwrap_or(0.0);
-        free.push(system_param(name, value));
+        free.push(system_param(name, &exp.system, k));
     }
     if exp.fit.offset {
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));

@@ -6,6 +6,7 @@
 //! from the derivative filter. Rigs driven by a shaker use a measured force `u` (N) instead.
 
 use crate::interpolate::{Hermite, Linear};
+use crate::system::OscillatorParams;
 
 /// How the rotor angle φ(t) is given.
 #[derive(Clone, Debug)]
@@ -144,30 +145,35 @@ pub enum Excitation {
 }
 
 impl Excitation {
-    /// The driving force at time `t`, N, for unbalance `f0` (kg·m).
+    /// The driving force at time `t`, N, for the oscillator's unbalance `F0` (kg·m) and drive
+    /// offsets: `F0·ω²·sin(φ − phi_off)` for a rotor, `u(t) − u_off` for a measured force.
     #[inline]
-    pub fn force(&self, t: f64, f0: f64) -> f64 {
+    pub fn force(&self, t: f64, p: &OscillatorParams) -> f64 {
         match self {
             Excitation::None => 0.0,
             Excitation::Rotor(angle) => {
                 let (phi, omega) = angle.at(t);
-                f0 * omega * omega * phi.sin()
+                p.f0 * omega * omega * (phi - p.phi_off).sin()
             }
-            Excitation::Force(u) => u.at(t),
+            Excitation::Force(u) => u.at(t) - p.u_off,
         }
     }
 
-    /// The driving force at `t` (N, for unbalance `f0`) together with the rotor angle and speed
-    /// `(φ, ω)` if a rotor drives the oscillator: one evaluation of the angle for all three
-    /// (the same values as [`Excitation::force`], [`Excitation::phi`], [`Excitation::omega`]).
+    /// The driving force at `t` (N, as [`Excitation::force`]) together with the rotor angle
+    /// and speed `(φ, ω)` if a rotor drives the oscillator: one evaluation of the angle for all
+    /// three (the same values as [`Excitation::force`], [`Excitation::phi`],
+    /// [`Excitation::omega`]).
     #[inline]
-    pub fn force_and_angle(&self, t: f64, f0: f64) -> (f64, Option<(f64, f64)>) {
+    pub fn force_and_angle(&self, t: f64, p: &OscillatorParams) -> (f64, Option<(f64, f64)>) {
         match self {
             Excitation::Rotor(angle) => {
                 let (phi, omega) = angle.at(t);
-                (f0 * omega * omega * phi.sin(), Some((phi, omega)))
+                (
+                    p.f0 * omega * omega * (phi - p.phi_off).sin(),
+                    Some((phi, omega)),
+                )
             }
-            _ => (self.force(t, f0), None),
+            _ => (self.force(t, p), None),
         }
     }
 
@@ -218,15 +224,18 @@ mod tests {
     fn force_and_angle_agrees_with_the_separate_evaluations() {
         let rotor = Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0));
         for t in [50.0, 77.7, 199.9] {
-            let (drive, angle) = rotor.force_and_angle(t, 0.0462);
-            assert_eq!(drive, rotor.force(t, 0.0462));
+            let (drive, angle) = rotor.force_and_angle(t, &OscillatorParams::FORCED);
+            assert_eq!(drive, rotor.force(t, &OscillatorParams::FORCED));
             assert_eq!(
                 angle,
                 Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap()))
             );
         }
         let free = Excitation::None;
-        assert_eq!(free.force_and_angle(3.0, 0.0462), (0.0, None));
+        assert_eq!(
+            free.force_and_angle(3.0, &OscillatorParams::FORCED),
+            (0.0, None)
+        );
     }
 
     #[test]

@@ -162,11 +162,12 @@ impl Kinematics {
         (self.x0, self.v0)
     }
 
-    /// The drive force at each sample, N: F0·ω²·sin φ for a rotor, u for a shaker, 0 without.
+    /// The drive force at each sample, N: F0·ω²·sin(φ − phi_off) for a rotor, u − u_off for
+    /// a shaker, 0 without.
     pub fn drive(&self, p: &OscillatorParams) -> Vec<f64> {
         match (&self.phi, &self.omega, &self.u) {
             (Some(phi), Some(w), _) => rotor_drive(p, phi, w),
-            (_, _, Some(u)) => u.clone(),
+            (_, _, Some(u)) => u.iter().map(|u| u - p.u_off).collect(),
             _ => vec![0.0; self.t.len()],
         }
     }

@@ -1,7 +1,7 @@
 //! The oscillator with a pluggable STF force model, as an ODE system.
 //!
 //! ```text
-//! (m + m_a)·ẍ = excitation(t) − k·x − F_R(ẋ) − f(t, x, ẋ, z),    ż = g(t, x, ẋ, z)
+//! (m + m_a)·ẍ = excitation(t) − f_off − k·x − F_R(ẋ) − f(t, x, ẋ, z),    ż = g(t, x, ẋ, z)
 //! ```
 //!
 //! The state is `[x, v, z…]`. The model's added mass `m_a` is moved to the left-hand side; a
@@ -111,7 +111,7 @@ impl Oscillator {
     /// The forces at `(t, y)`; writes the rates of the internal states to `dz`.
     #[inline]
     pub fn forces(&self, t: f64, y: &[f64], dz: &mut [f64]) -> Result<Forces, SimError> {
-        let drive = self.excitation.force(t, self.params.f0);
+        let drive = self.excitation.force(t, &self.params);
         self.forces_with_drive(t, y, drive, dz)
     }
 
@@ -147,7 +147,7 @@ impl Oscillator {
         if !(mass > 0.0) {
             return Err(SimError::NonPositiveMass { time: t, mass });
         }
-        let a = (drive - p.k * x - f_r - f) / mass;
+        let a = (drive - p.f_off - p.k * x - f_r - f) / mass;
         if !a.is_finite() {
             return Err(SimError::NonFinite {
                 time: t,

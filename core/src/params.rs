@@ -21,6 +21,9 @@ pub struct ParamSpec {
     pub max: f64,
     /// One line saying what the parameter is.
     pub doc: String,
+    /// The oscillator parameter this one duplicates, if any (a fluid's linear damping `c_s` is
+    /// the same term as the oscillator's `c`): a fit may free one of the two, never both.
+    pub same_as: Option<&'static str>,
 }
 
 impl ParamSpec {
@@ -33,7 +36,14 @@ impl ParamSpec {
             min,
             max,
             doc: doc.to_string(),
+            same_as: None,
         }
+    }
+
+    /// The same parameter, marked as the same term as the oscillator's parameter `name`.
+    pub fn same_as(mut self, name: &'static str) -> Self {
+        self.same_as = Some(name);
+        self
     }
 
     /// Whether `value` lies within the bounds.

@@ -1,7 +1,8 @@
 //! The STF force recovered from a record's kinematics.
 //!
 //! ```text
-//! F_STF = drive(t) − m·ẍ − k·x − F_R(ẋ),     drive = F0·ω²·sin φ (rotor) or u (shaker)
+//! F_STF = drive(t) − f_off − m·ẍ − k·x − F_R(ẋ),
+//! drive = F0·ω²·sin(φ − phi_off) (rotor) or u − u_off (shaker)
 //! ```
 //!
 //! The velocity and acceleration come from the derivative filter; its noise passes straight
@@ -11,7 +12,7 @@ use crate::resistance::bearing_resistance;
 use crate::system::OscillatorParams;
 
 /// Recovered STF force at each sample, N. `drive` is the driving force at each sample
-/// (F0·ω²·sin φ for a rotor, u for a shaker); all slices have the same length.
+/// (with its offsets applied, as [`rotor_drive`] gives it); all slices have the same length.
 pub fn recover_force(
     p: &OscillatorParams,
     drive: &[f64],
@@ -24,7 +25,7 @@ pub fn recover_force(
         .zip(x)
         .zip(v)
         .zip(a)
-        .map(|(((&u, &x), &v), &a)| u - p.m * a - p.k * x - bearing_resistance(p, v))
+        .map(|(((&u, &x), &v), &a)| u - p.f_off - p.m * a - p.k * x - bearing_resistance(p, v))
         .collect()
 }
 
@@ -32,7 +33,7 @@ pub fn recover_force(
 pub fn rotor_drive(p: &OscillatorParams, phi: &[f64], omega: &[f64]) -> Vec<f64> {
     phi.iter()
         .zip(omega)
-        .map(|(&phi, &w)| p.f0 * w * w * phi.sin())
+        .map(|(&phi, &w)| p.f0 * w * w * (phi - p.phi_off).sin())
         .collect()
 }
 

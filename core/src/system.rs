@@ -22,6 +22,22 @@ pub struct OscillatorParams {
     pub f0: f64,
     /// Decay rate of static friction with speed, s/m; also sets the smoothing ε = 1e-3/η.
     pub eta: f64,
+    /// A constant force on the trolley, N, on the side of the STF force:
+    /// `m·ẍ + k·x + F_R + F_STF + f_off = drive`. A force sensor's or a rig's static offset;
+    /// with a nonlinear force it is not the same as a displacement offset.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub f_off: f64,
+    /// The rotor angle's zero offset, rad: the drive is `F0·ω²·sin(φ − phi_off)`.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub phi_off: f64,
+    /// The measured drive force's offset, N: the drive is `u(t) − u_off`. On a shaker rig it is
+    /// the same term as `f_off` (a fit refuses to free both).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub u_off: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl OscillatorParams {
@@ -34,6 +50,9 @@ impl OscillatorParams {
         delta_t: 0.0947,
         f0: 0.0462,
         eta: 1e3,
+        f_off: 0.0,
+        phi_off: 0.0,
+        u_off: 0.0,
     };
 
     /// The source study's identification from free vibration (no rotor, no static excess).
@@ -45,10 +64,19 @@ impl OscillatorParams {
         delta_t: 0.0,
         f0: 0.0,
         eta: 1e3,
+        f_off: 0.0,
+        phi_off: 0.0,
+        u_off: 0.0,
     };
 
     /// Names of the parameters, in the order of [`OscillatorParams::to_vec`].
-    pub const NAMES: [&'static str; 7] = ["m", "k", "c", "T", "delta_T", "F0", "eta"];
+    pub const NAMES: [&'static str; 10] = [
+        "m", "k", "c", "T", "delta_T", "F0", "eta", "f_off", "phi_off", "u_off",
+    ];
+
+    /// The offsets among [`OscillatorParams::NAMES`]: additive terms that start at 0 and may
+    /// take either sign.
+    pub const OFFSETS: [&'static str; 3] = ["f_off", "phi_off", "u_off"];
 
     /// A preset by name: `forced` or `free`.
     pub fn preset(name: &str) -> Option<OscillatorParams> {
@@ -60,7 +88,7 @@ impl OscillatorParams {
     }
 
     /// The values in the order of [`OscillatorParams::NAMES`].
-    pub fn to_vec(&self) -> [f64; 7] {
+    pub fn to_vec(&self) -> [f64; 10] {
         [
             self.m,
             self.k,
@@ -69,6 +97,9 @@ impl OscillatorParams {
             self.delta_t,
             self.f0,
             self.eta,
+            self.f_off,
+            self.phi_off,
+            self.u_off,
         ]
     }
 
@@ -82,6 +113,9 @@ impl OscillatorParams {
             "delta_T" => self.delta_t = value,
             "F0" => self.f0 = value,
             "eta" => self.eta = value,
+            "f_off" => self.f_off = value,
+            "phi_off" => self.phi_off = value,
+            "u_off" => self.u_off = value,
             _ => return false,
         }
         true

@@ -36,7 +36,8 @@ impl AddedMass {
                 0.0,
                 20.0,
                 "mass of fluid carried along with the blade",
-            )],
+            )
+            .same_as("m")],
         }
     }
 }

@@ -33,7 +33,8 @@ impl Viscous {
                 0.0,
                 1e4,
                 "damping coefficient of the fluid",
-            )],
+            )
+            .same_as("c")],
         }
     }
 }

@@ -45,6 +45,9 @@ pub enum FitError {
         /// Upper bound.
         max: f64,
     },
+    /// Two free parameters that are one term of the equation, or an offset that does nothing.
+    #[error("{0}")]
+    SameTerm(String),
     /// The data cannot be fitted (lengths differ, too few samples, NaN, …).
     #[error("bad data: {0}")]
     BadData(String),

@@ -34,6 +34,7 @@ mod noise_floor;
 mod objective;
 mod param;
 mod result;
+mod same_term;
 mod settings;
 mod trajectory;
 mod transform;
@@ -45,6 +46,7 @@ pub use noise_floor::{MotionNoise, NoiseFloor, Quantity};
 pub use objective::Residuals;
 pub use param::{full_values, FitParam};
 pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
+pub use same_term::check_same_terms;
 pub use settings::{FitSettings, Solver};
 pub use trajectory::{
     initial_state_params, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, INITIAL_STATE,

@@ -28,11 +28,13 @@ use super::error::FitError;
 use super::objective::Residuals;
 use super::param::FitParam;
 use super::result::{FitProgress, FitResult};
+use super::same_term::check_same_terms;
 use super::settings::FitSettings;
 use crate::excitation::Excitation;
 use crate::force_model::ForceModel;
 use crate::integrate::{integrate, Settings};
 use crate::oscillator::Oscillator;
+use crate::params::ParamSpec;
 use crate::system::OscillatorParams;
 
 /// A measured displacement record (SI units, equal lengths, time strictly increasing).
@@ -207,6 +209,7 @@ impl TrajectoryFit {
             .iter()
             .map(|p| self.resolve(&p.name))
             .collect::<Result<Vec<_>, _>>()?;
+        self.check_same_terms(&slots)?;
         let problem = TrajectoryResiduals {
             fit: self,
             data: *data,
@@ -214,6 +217,34 @@ impl TrajectoryFit {
         };
         let settings = self.settings.clone().for_simulation(self.sim.rtol);
         engine::run(&problem, &self.free, &settings, observer, true)
+    }
+}
+
+impl TrajectoryFit {
+    /// [`check_same_terms`] on the parameters this fit frees.
+    fn check_same_terms(&self, slots: &[Slot]) -> Result<(), FitError> {
+        let free = |i: usize| {
+            self.free
+                .iter()
+                .zip(slots)
+                .any(|(p, s)| !p.fixed && matches!(s, Slot::Model(j) if *j == i))
+        };
+        let model: Vec<(&ParamSpec, bool)> = self
+            .model
+            .iter()
+            .flat_map(|(m, _)| m.params().iter().enumerate())
+            .map(|(i, spec)| (spec, free(i)))
+            .collect();
+        let oscillator: Vec<&str> = self
+            .free
+            .iter()
+            .zip(slots)
+            .filter_map(|(p, s)| match s {
+                Slot::Oscillator(name) if !p.fixed => Some(*name),
+                _ => None,
+            })
+            .collect();
+        check_same_terms(&model, &oscillator, &self.excitation)
     }
 }
 

@@ -8,6 +8,7 @@
 use crate::excitation::Excitation;
 use crate::integrate::SimError;
 use crate::oscillator::Oscillator;
+use crate::system::OscillatorParams;
 
 /// Sampled states with their times and driving forces (a window of a run's samples).
 #[derive(Clone, Copy)]
@@ -101,13 +102,13 @@ pub(super) struct DriveColumns {
 }
 
 impl DriveColumns {
-    pub(super) fn at(excitation: &Excitation, f0: f64, times: &[f64]) -> Self {
+    pub(super) fn at(excitation: &Excitation, p: &OscillatorParams, times: &[f64]) -> Self {
         let rotor = times
             .first()
             .is_some_and(|&t| excitation.omega(t).is_some());
         if !rotor {
             return DriveColumns {
-                force: times.iter().map(|&t| excitation.force(t, f0)).collect(),
+                force: times.iter().map(|&t| excitation.force(t, p)).collect(),
                 phi: None,
                 omega: None,
             };
@@ -119,7 +120,7 @@ impl DriveColumns {
             Vec::with_capacity(n),
         );
         for &t in times {
-            let (d, angle) = excitation.force_and_angle(t, f0);
+            let (d, angle) = excitation.force_and_angle(t, p);
             let (p, w) = angle.unwrap_or((0.0, 0.0));
             force.push(d);
             phi.push(p);

@@ -111,13 +111,13 @@ impl<'a> Simulation<'a> {
         };
         let y0 = self.osc.initial_state(self.x0, self.v0);
         let excitation = &*self.osc.excitation;
-        let f0 = self.osc.params.f0;
+        let params = &self.osc.params;
         // The drive and the rotor angle depend on time alone: on long runs they are evaluated
         // on a second thread while the integration runs (one `sin` a sample is as much work as
         // the integration of a smooth sweep).
         let (integrated, drive) = if times.len() >= PARALLEL_SAMPLES {
             std::thread::scope(|scope| {
-                let job = scope.spawn(|| DriveColumns::at(excitation, f0, &times));
+                let job = scope.spawn(|| DriveColumns::at(excitation, params, &times));
                 let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
                 let drive = job
                     .join()
@@ -126,7 +126,7 @@ impl<'a> Simulation<'a> {
             })
         } else {
             let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
-            (integrated, DriveColumns::at(excitation, f0, &times))
+            (integrated, DriveColumns::at(excitation, params, &times))
         };
         let (states, stats) = integrated?;
         let n = times.len();
