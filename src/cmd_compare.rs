@@ -111,8 +111,8 @@ fn regime_json(c: &Comparison) -> Value {
 
 /// Run `stf-lab compare`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
-    let exp = Experiment::load(exp_path)?;
-    let data = load_data(&exp)?;
+    let mut exp = Experiment::load(exp_path)?;
+    let data = load_data(&mut exp)?;
     if data.level != FitLevel::Force {
         bail!(
             "{}: compare scores models on the measured STF force; the record needs `f_stf`",

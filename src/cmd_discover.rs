@@ -23,7 +23,7 @@ use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{load_data, std_errors_json, system_param, FitData};
+use crate::fitting::{estimate_line, load_data_at, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
 use crate::progress::{discovery_observer, Progress};
@@ -96,22 +96,20 @@ fn force_fit_settings(from: &FitSettings) -> FitSettings {
 }
 
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
-    let exp = Experiment::load(exp_path)?;
-    let Some(spec) = &exp.discover else {
+    let mut exp = Experiment::load(exp_path)?;
+    let Some(spec) = exp.discover.clone() else {
         bail!(
             "{}: has no [discover] section (base = \"…\")",
             exp_path.display()
         );
     };
-    let mut data = load_data(&exp)?;
-    if let Some(level) = spec.level {
-        if level == FitLevel::Force && data.record.f_stf.is_none() {
-            bail!(
-                "{}: `discover.level = \"force\"` needs an `f_stf` column in the record",
-                exp_path.display()
-            );
-        }
-        data.level = level;
+    let data = load_data_at(&mut exp, spec.level).with_context(|| match spec.level {
+        Some(FitLevel::Force) => "`discover.level = \"force\"` needs an `f_stf` column".to_string(),
+        _ => "reading the record to discover on".to_string(),
+    })?;
+    let spec = &spec;
+    if let Some(line) = estimate_line(&data) {
+        println!("{line}");
     }
     prepare_dir(out, force)?;
     let base = model_from(&spec.base, &exp.dir)
@@ -429,6 +427,7 @@ fn run_trajectory(
         "experiment": exp.path.display().to_string(),
         "record": data.record.source,
         "drive": data.kinematics.drive,
+        "system_estimate": data.system_estimate,
         "level": "trajectory",
         "base": spec.base,
         "effects": found.effects,

@@ -20,21 +20,25 @@ use stf_core::record::Record;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{
-    finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData, ModelFit,
+    estimate_line, finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData,
+    ModelFit,
 };
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
 
 /// Run `stf-lab fit`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
-    let exp = Experiment::load(exp_path)?;
+    let mut exp = Experiment::load(exp_path)?;
     let progress = Progress::new(quiet);
     if !exp.identify.is_empty() {
         prepare_dir(out, force)?;
         return identify(&exp, out, &progress);
     }
-    let data = load_data(&exp)?;
+    let data = load_data(&mut exp)?;
     prepare_dir(out, force)?;
+    if let Some(line) = estimate_line(&data) {
+        println!("{line}");
+    }
     let fits = fit_all(&exp, &data, &progress)?;
 
     let level = data.level;
@@ -45,6 +49,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "samples": data.record.len(),
         "motion_filter": { "order": data.kinematics.motion_filter.order(), "window": data.kinematics.motion_filter.window() },
         "drive": data.kinematics.drive,
+        "system_estimate": data.system_estimate,
         "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
     });
     write_json(&out.join("fit.json"), &doc)?;

@@ -464,6 +464,9 @@ pub struct Experiment {
     pub dir: PathBuf,
     /// The oscillator's parameters.
     pub system: OscillatorParams,
+    /// Whether the file has a `[system]` section; without one, a rig driven by a measured
+    /// force starts from the oscillator its record shows (see [`crate::fitting::load_data`]).
+    pub system_given: bool,
     /// Integrator settings.
     pub integrator: Settings,
     /// Models to fit or compare.
@@ -999,6 +1002,7 @@ impl Experiment {
             data_line,
             dir,
             system,
+            system_given: raw.system.is_some(),
             integrator,
             models,
             simulate,
@@ -1112,7 +1116,7 @@ params = { K = 4.0, n = 1.5 }
     #[test]
     fn a_missing_record_names_the_file_line_and_key() {
         let exp = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap();
-        let err = crate::fitting::load_data(&exp).err().unwrap();
+        let err = crate::fitting::load_data(&mut exp).err().unwrap();
         let msg = format!("{err:#}");
         assert!(
             msg.contains("exp.toml:2") && msg.contains("data.file"),

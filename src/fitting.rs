@@ -12,6 +12,7 @@ use std::sync::Arc;
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use stf_core::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::fit::{
     fit_warnings, initial_state_params, FitParam, FitResult, FitWarning, FittedParam, ForceData,
     ForceFit, NoiseFloor, TrajectoryData, TrajectoryFit,
@@ -34,6 +35,9 @@ pub struct FitData {
     pub kinematics: Kinematics,
     /// The level fits run at.
     pub level: FitLevel,
+    /// The linear oscillator the record shows, where the experiment's oscillator was taken
+    /// from it (a trajectory-level fit of a rig driven by `u` with no `[system]`).
+    pub system_estimate: Option<LinearEstimate>,
 }
 
 impl FitData {
@@ -90,8 +94,15 @@ pub fn read_record(exp: &Experiment, file: &std::path::Path) -> Result<Record> {
     Ok(record)
 }
 
-/// Read the experiment's record and derive its kinematics.
-pub fn load_data(exp: &Experiment) -> Result<FitData> {
+/// Read the experiment's record and derive its kinematics. A trajectory-level experiment on
+/// a rig driven by a measured force `u` with no `[system]` takes its oscillator from the
+/// record: `m`, `c`, `k` of its linear ARX model ([`linear_oscillator`]), no dry friction.
+pub fn load_data(exp: &mut Experiment) -> Result<FitData> {
+    load_data_at(exp, None)
+}
+
+/// [`load_data`] at a level a command asks for (`[discover] level`), else the experiment's.
+pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<FitData> {
     let Some(file) = &exp.data_file else {
         bail!("{}: has no [data] file to fit", exp.path.display());
     };
@@ -117,7 +128,7 @@ pub fn load_data(exp: &Experiment) -> Result<FitData> {
     }
     let kinematics = Kinematics::from_record(&record, &exp.kinematics)
         .with_context(|| format!("cannot derive the kinematics of {}", file.display()))?;
-    let level = match exp.fit.level {
+    let level = match asked.or(exp.fit.level) {
         Some(l) => l,
         None if record.f_stf.is_some() && (!exp.models.is_empty() || exp.discover.is_some()) => {
             FitLevel::Force
@@ -131,10 +142,43 @@ pub fn load_data(exp: &Experiment) -> Result<FitData> {
             file.display()
         );
     }
+    let system_estimate = match (&record.u, level, exp.system_given) {
+        (Some(u), FitLevel::Trajectory, false) => {
+            let dt = record.sample_step().unwrap_or(f64::NAN);
+            let e = linear_oscillator(&record.x, u, dt)
+                .with_context(|| format!("estimating the oscillator of {}", file.display()))?;
+            exp.system = OscillatorParams {
+                m: e.m,
+                k: e.k,
+                c: e.c,
+                t_friction: 0.0,
+                delta_t: 0.0,
+                f0: 0.0,
+                ..OscillatorParams::FORCED
+            };
+            Some(e)
+        }
+        _ => None,
+    };
     Ok(FitData {
         record,
         kinematics,
         level,
+        system_estimate,
+    })
+}
+
+/// The terminal line saying where the oscillator came from, if the record gave it.
+pub fn estimate_line(data: &FitData) -> Option<String> {
+    data.system_estimate.map(|e| {
+        format!(
+            "oscillator from the record (a linear ARX model, no [system] given): m {:.4e}, \
+             c {:.4e}, k {:.4e}; one-step error {:.2} % of x",
+            e.m,
+            e.c,
+            e.k,
+            100.0 * e.one_step_error
+        )
     })
 }
 

@@ -29,6 +29,7 @@
 pub mod analysis;
 pub mod derivative;
 pub mod discovery;
+pub mod estimate;
 pub mod excitation;
 pub mod fit;
 pub mod force_model;

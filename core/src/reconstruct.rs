@@ -208,7 +208,10 @@ pub fn reconstruct(
         DriveSmoothing::Filter(f) => (*f, DriveMethod::Set),
         DriveSmoothing::Samples(f) => (*f, DriveMethod::Samples),
         DriveSmoothing::Auto if signal == DriveSignal::U && scatter > 0.0 => {
-            (force_window(dt, y, scatter)?, DriveMethod::Auto)
+            match force_window(dt, y, scatter)? {
+                Some(f) => (f, DriveMethod::Auto),
+                None => (samples_filter(y.len())?, DriveMethod::Samples),
+            }
         }
         DriveSmoothing::Auto => match choose_window(dt, y, scatter)? {
             Some(f) => (f, DriveMethod::Auto),
@@ -267,18 +270,17 @@ fn samples_filter(n: usize) -> Result<PolyFilter, FilterError> {
 /// into the oscillator (at the drive frequency, where a shaker puts it near resonance), while
 /// its noise is mostly filtered by the oscillator, so the window minimises the predicted RMS
 /// error of the value, bias (the filter's response at that frequency times the amplitude)
-/// and noise (`scatter` times the filter's noise gain) together.
-fn force_window(dt: f64, y: &[f64], scatter: f64) -> Result<PolyFilter, FilterError> {
+/// and noise (`scatter` times the filter's noise gain) together. `None`: no window beats the
+/// samples as they are (error `scatter`), as when a period spans a few samples and every
+/// window would bend the force more than its noise.
+fn force_window(dt: f64, y: &[f64], scatter: f64) -> Result<Option<PolyFilter>, FilterError> {
     let f = highest_frequency(y, dt);
     let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
     let amplitude = y.iter().fold(0.0_f64, |m, v| m.max((v - mean).abs()));
     let largest = ((0.5 / (f * dt)) as usize)
         .min(y.len() / 2)
         .max(DRIVE_ORDER + 3);
-    let mut best = (
-        f64::INFINITY,
-        PolyFilter::new(DRIVE_ORDER, DRIVE_ORDER + 3)?,
-    );
+    let mut best = (scatter, None);
     let mut window = DRIVE_ORDER + 3;
     while window <= largest {
         let filter = PolyFilter::new(DRIVE_ORDER, window)?;
@@ -286,7 +288,7 @@ fn force_window(dt: f64, y: &[f64], scatter: f64) -> Result<PolyFilter, FilterEr
         let bias = (re - 1.0).hypot(im) * amplitude;
         let error = bias.hypot(scatter * filter.noise_gain(dt, 0));
         if error < best.0 {
-            best = (error, filter);
+            best = (error, Some(filter));
         }
         window += 2 * (1 + window / 64);
     }
