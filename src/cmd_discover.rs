@@ -381,7 +381,7 @@ fn run_trajectory(
         f: k.recovered_force(&exp.system),
     });
     if exp.fit.fit_initial {
-        for p in stf_core::fit::initial_state_params(x0, v0) {
+        for p in k.initial_state_params() {
             setup = setup.refit(p);
         }
     }

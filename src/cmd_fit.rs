@@ -235,7 +235,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             .map(|name| system_param(name, &system, &k))
             .collect();
         if exp.fit.fit_initial {
-            free.extend(stf_core::fit::initial_state_params(x0, v0));
+            free.extend(k.initial_state_params());
         }
         for p in &free {
             fit = fit.free(p.clone());

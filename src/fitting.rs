@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use stf_core::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::fit::{
-    fit_warnings, initial_state_params, FitParam, FitResult, FitWarning, FittedParam, ForceData,
-    ForceFit, NoiseFloor, TrajectoryData, TrajectoryFit,
+    fit_warnings, FitParam, FitResult, FitWarning, FittedParam, ForceData, ForceFit, NoiseFloor,
+    TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
@@ -424,7 +424,7 @@ fn fit_trajectory(
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
     }
     if exp.fit.fit_initial {
-        free.extend(initial_state_params(x0, v0));
+        free.extend(k.initial_state_params());
     }
     for p in &free {
         fit = fit.free(p.clone());

@@ -162,6 +162,15 @@ impl Kinematics {
         (self.x0, self.v0)
     }
 
+    /// The initial state as parameters to fit, bounded by the record's own range of x and v
+    /// ([`crate::fit::initial_state_params`]).
+    pub fn initial_state_params(&self) -> [crate::fit::FitParam; 2] {
+        let mean = self.x.iter().sum::<f64>() / self.x.len().max(1) as f64;
+        let x_span = self.x.iter().fold(0.0_f64, |m, x| m.max((x - mean).abs()));
+        let v_span = self.v.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        crate::fit::initial_state_params(self.x0, self.v0, x_span, v_span)
+    }
+
     /// The drive force at each sample, N: F0·ω²·sin(φ − phi_off) for a rotor, u − u_off for
     /// a shaker, 0 without.
     pub fn drive(&self, p: &OscillatorParams) -> Vec<f64> {

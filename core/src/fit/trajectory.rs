@@ -55,15 +55,20 @@ pub const DISPLACEMENT_OFFSET: &str = "x_off";
 pub const INITIAL_STATE: [&str; 2] = ["x0", "v0"];
 
 /// The initial state as two parameters to fit, starting from an estimate `(x0, v0)` (m, m/s)
-/// such as [`crate::kinematics::Kinematics::initial_state`]: within 2 mm and 50 mm/s of it.
-pub fn initial_state_params(x0: f64, v0: f64) -> [FitParam; 2] {
+/// such as [`crate::kinematics::Kinematics::initial_state`], within a tenth of the record's
+/// own range of x and of v (`x_span`, `v_span`: the largest |x − mean| and |v|), so that the
+/// bounds follow the record's scale, whatever its units (within 4 mm and 25 mm/s on the source
+/// study's sweep).
+pub fn initial_state_params(x0: f64, v0: f64, x_span: f64, v_span: f64) -> [FitParam; 2] {
+    let positive = |s: f64| if s > 0.0 && s.is_finite() { s } else { 1.0 };
+    let (dx, dv) = (0.1 * positive(x_span), 0.1 * positive(v_span));
     [
         FitParam::new(INITIAL_STATE[0], x0)
-            .bounds(x0 - 2e-3, x0 + 2e-3)
-            .scale(1e-4),
+            .bounds(x0 - dx, x0 + dx)
+            .scale(0.025 * dx),
         FitParam::new(INITIAL_STATE[1], v0)
-            .bounds(v0 - 0.05, v0 + 0.05)
-            .scale(1e-3),
+            .bounds(v0 - dv, v0 + dv)
+            .scale(0.04 * dv),
     ]
 }
 
