@@ -43,7 +43,12 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         Drive::Free => (Excitation::None, false),
         Drive::Force(chirp) => {
             let u = times.iter().map(|&t| chirp.at(t)).collect();
-            (Excitation::Force(Linear::new(times.clone(), u)), false)
+            let held = if chirp.held {
+                Linear::held(times.clone(), u)
+            } else {
+                Linear::new(times.clone(), u)
+            };
+            (Excitation::Force(held), false)
         }
     };
     let free = matches!(spec.drive, Drive::Free);

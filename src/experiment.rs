@@ -123,6 +123,9 @@ struct RawChirp {
     #[serde(default)]
     t0: f64,
     t1: f64,
+    /// How the shaker's amplifier holds each sample: `"linear"` (default) or `"zoh"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hold: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -197,8 +200,9 @@ fn drive_smoothing(raw: &RawDrive) -> Result<DriveSmoothing, String> {
         RawDrive::Named(name) => match name.as_str() {
             "auto" => Ok(DriveSmoothing::Auto),
             "samples" => Ok(DriveSmoothing::Samples(PolyFilter::paper_omega())),
+            "zoh" => Ok(DriveSmoothing::Held),
             other => Err(format!(
-                "unknown drive reconstruction `{other}`; known: auto, samples, or {{ order, window }}"
+                "unknown drive reconstruction `{other}`; known: auto, samples, zoh, or {{ order, window }}"
             )),
         },
         RawDrive::Filter(spec) => PolyFilter::new(spec.order, spec.window)
@@ -419,6 +423,9 @@ pub struct Chirp {
     pub t0: f64,
     /// End time, s.
     pub t1: f64,
+    /// The force is held from each sample to the next (a DAC's zero-order hold), instead of
+    /// varying linearly between them.
+    pub held: bool,
 }
 
 impl Chirp {
@@ -724,12 +731,24 @@ impl Experiment {
                             format!("{} must be a positive force, N", c.amplitude),
                         ));
                     }
+                    let held = match c.hold.as_deref() {
+                        None | Some("linear") => false,
+                        Some("zoh") => true,
+                        Some(other) => {
+                            return Err(cx.at(
+                                at,
+                                "simulate.chirp.hold",
+                                format!("unknown hold `{other}`; known: linear, zoh"),
+                            ))
+                        }
+                    };
                     let chirp = Chirp {
                         f0: c.f0,
                         f1: c.f1,
                         amplitude: c.amplitude,
                         t0: c.t0,
                         t1: c.t1,
+                        held,
                     };
                     (
                         Drive::Force(chirp),

@@ -49,6 +49,9 @@ pub const BANDWIDTH_ERROR: f64 = 0.01;
 /// Why a filter could not be built or applied.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FilterError {
+    /// A zero-order hold asked of a rotor angle, which is continuous.
+    #[error("a zero-order hold (`drive = \"zoh\"`) applies to a measured force u, not to a rotor angle φ, which is continuous")]
+    HeldAngle,
     /// The polynomial order is zero.
     #[error("the polynomial order must be at least 1 (got {order})")]
     BadOrder {

@@ -66,6 +66,27 @@ impl Linear {
         Linear { t, y, step }
     }
 
+    /// Samples held by a zero-order hold (a DAC's staircase): each value holds until the
+    /// next sample. Built as a linear interpolant whose knots step from one value to the next
+    /// within a thousandth of the sample step, so that an integrator, which ends its steps at
+    /// knots, sees a constant drive over each step but for a ramp too short to matter (an
+    /// equivalent delay of 5e-4 of a step).
+    pub fn held(t: Vec<f64>, y: Vec<f64>) -> Self {
+        debug_assert_eq!(t.len(), y.len());
+        let n = t.len();
+        let mut times = Vec::with_capacity(2 * n);
+        let mut values = Vec::with_capacity(2 * n);
+        for i in 0..n {
+            if i > 0 {
+                times.push(t[i] - 1e-3 * (t[i] - t[i - 1]));
+                values.push(y[i - 1]);
+            }
+            times.push(t[i]);
+            values.push(y[i]);
+        }
+        Linear::new(times, values)
+    }
+
     /// Value at time `t`.
     pub fn at(&self, t: f64) -> f64 {
         match self.t.len() {
@@ -154,6 +175,23 @@ impl Hermite {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn a_held_signal_keeps_each_sample_until_the_next() {
+        let h = Linear::held(vec![0.0, 1.0, 2.0], vec![1.0, 3.0, -1.0]);
+        for (t, want) in [
+            (0.0, 1.0),
+            (0.5, 1.0),
+            (0.998, 1.0),
+            (1.0, 3.0),
+            (1.7, 3.0),
+            (2.5, -1.0),
+        ] {
+            assert_relative_eq!(h.at(t), want);
+        }
+        assert_eq!(h.next_knot(0.5), Some(0.999));
+        assert_eq!(h.next_knot(0.999), Some(1.0));
+    }
 
     #[test]
     fn linear_is_exact_on_lines_and_holds_ends() {

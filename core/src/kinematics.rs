@@ -26,7 +26,7 @@
 use crate::derivative::{noise_sigma, sample_step, Boundary, FilterError, PolyFilter};
 use crate::excitation::{Excitation, RotorAngle};
 use crate::interpolate::Linear;
-use crate::reconstruct::{reconstruct, DriveReport, DriveSignal, DriveSmoothing};
+use crate::reconstruct::{reconstruct, DriveMethod, DriveReport, DriveSignal, DriveSmoothing};
 use crate::record::Record;
 use crate::recover::{recover_force, rotor_drive};
 use crate::system::OscillatorParams;
@@ -219,7 +219,18 @@ impl Kinematics {
                 let pick = |v: &[f64]| knots.iter().map(|&i| v[i]).collect::<Vec<_>>();
                 Excitation::Rotor(RotorAngle::measured(pick(&self.t), pick(phi), pick(w)))
             }
-            (_, _, Some(u)) => Excitation::Force(Linear::new(self.t.clone(), u.clone())),
+            (_, _, Some(u)) => {
+                let held = self
+                    .drive
+                    .as_ref()
+                    .is_some_and(|d| d.method == DriveMethod::Held);
+                let (t, u) = (self.t.clone(), u.clone());
+                Excitation::Force(if held {
+                    Linear::held(t, u)
+                } else {
+                    Linear::new(t, u)
+                })
+            }
             _ => Excitation::None,
         }
     }

@@ -48,6 +48,10 @@ pub enum DriveSmoothing {
     /// Interpolate through the measured samples, with the derivative from this filter (the
     /// source study's treatment: φ as recorded, ω from order 2 over 800 samples).
     Samples(PolyFilter),
+    /// A measured force `u` as a DAC held it: each sample holds until the next (zero-order
+    /// hold). Interpolating such a record linearly leads the true drive by half a sample, a
+    /// delay that a model with memory will "explain".
+    Held,
 }
 
 /// Which signal drives the rig.
@@ -70,6 +74,8 @@ pub enum DriveMethod {
     Set,
     /// Interpolated through the samples, not smoothed.
     Samples,
+    /// Held from each sample to the next (a measured force only).
+    Held,
 }
 
 impl std::fmt::Display for DriveMethod {
@@ -78,6 +84,7 @@ impl std::fmt::Display for DriveMethod {
             DriveMethod::Auto => "auto",
             DriveMethod::Set => "set",
             DriveMethod::Samples => "samples",
+            DriveMethod::Held => "held",
         })
     }
 }
@@ -111,7 +118,7 @@ impl DriveReport {
     /// Every how many samples a simulation needs a knot of the reconstructed signal: a
     /// sixteenth of the smoothing window (every sample when interpolated through them).
     pub fn knot_stride(&self) -> usize {
-        if self.method == DriveMethod::Samples {
+        if matches!(self.method, DriveMethod::Samples | DriveMethod::Held) {
             1
         } else {
             (self.window / 16).max(1)
@@ -126,12 +133,24 @@ impl std::fmt::Display for DriveReport {
             DriveSignal::Phi => "rotor angle φ",
             DriveSignal::U => "drive force u",
         };
-        if self.method == DriveMethod::Samples {
-            return write!(
-                f,
-                "{what} interpolated through its samples (slope from order {} over {} samples)",
-                self.order, self.window
-            );
+        match (self.method, self.signal) {
+            (DriveMethod::Held, _) => {
+                return write!(
+                    f,
+                    "{what} held from each sample to the next (zero-order hold)"
+                )
+            }
+            (DriveMethod::Samples, DriveSignal::U) => {
+                return write!(f, "{what} interpolated linearly between its samples")
+            }
+            (DriveMethod::Samples, DriveSignal::Phi) => {
+                return write!(
+                    f,
+                    "{what} interpolated through its samples (slope from order {} over {} samples)",
+                    self.order, self.window
+                )
+            }
+            _ => {}
         }
         write!(
             f,
@@ -207,6 +226,10 @@ pub fn reconstruct(
     let (filter, method) = match how {
         DriveSmoothing::Filter(f) => (*f, DriveMethod::Set),
         DriveSmoothing::Samples(f) => (*f, DriveMethod::Samples),
+        DriveSmoothing::Held if signal == DriveSignal::U => {
+            (samples_filter(y.len())?, DriveMethod::Held)
+        }
+        DriveSmoothing::Held => return Err(FilterError::HeldAngle),
         DriveSmoothing::Auto if signal == DriveSignal::U && scatter > 0.0 => {
             match force_window(dt, y, scatter)? {
                 Some(f) => (f, DriveMethod::Auto),
@@ -218,7 +241,7 @@ pub fn reconstruct(
             None => (samples_filter(y.len())?, DriveMethod::Samples),
         },
     };
-    let smoothed = method != DriveMethod::Samples;
+    let smoothed = !matches!(method, DriveMethod::Samples | DriveMethod::Held);
     // A force interpolated through its samples needs no slope; a record shorter than the
     // window is an error otherwise (the automatic choice never picks such a window).
     let d = if !smoothed && signal == DriveSignal::U {
