@@ -253,7 +253,10 @@ fn resolve(
         .iter()
         .any(|p| matches!(p.signal, Signal::Phi | Signal::U))
     {
-        let extra = format!(" (or `{}` for a force-driven rig)", column_name(opts, Signal::U));
+        let extra = format!(
+            " (or `{}` for a force-driven rig)",
+            column_name(opts, Signal::U)
+        );
         return Err(missing(source, opts, Signal::Phi, header, line, &extra));
     }
     Ok(Found {
@@ -702,7 +705,13 @@ mod tests {
     use super::super::{Column, DecimalMark, Offset, Separator, Signal, Unit};
 
     /// Read `text` with `opts`, expecting an error at `row`, `column`, containing `words`.
-    fn expect_with(opts: &ReadOptions, text: &str, row: Option<usize>, column: Option<&str>, words: &str) {
+    fn expect_with(
+        opts: &ReadOptions,
+        text: &str,
+        row: Option<usize>,
+        column: Option<&str>,
+        words: &str,
+    ) {
         let e = opts.read_csv_from(text.as_bytes(), "lab.csv").unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (row, column), "{e}");
         assert!(e.message.contains(words), "{e}");
@@ -723,11 +732,25 @@ mod tests {
         let r = Record::read_csv_from("t;x;phi\n0;1.5;2\n".as_bytes(), "lab.csv").unwrap();
         assert_eq!(r.x, [1.5]);
         let set = ReadOptions::default().separator(Separator::Semicolon);
-        let r = set.read_csv_from("t;x;a,b;phi\n0;1;2;3\n".as_bytes(), "lab.csv").unwrap();
+        let r = set
+            .read_csv_from("t;x;a,b;phi\n0;1;2;3\n".as_bytes(), "lab.csv")
+            .unwrap();
         assert_eq!(r.len(), 1);
         // A decimal point in a decimal-comma file, on editor line 4 after a blank line.
-        expect_with(&comma, "t;x;phi\n0;1,5;2\n\n1;2.5;2\n", Some(4), Some("x"), "decimal mark is a comma");
-        expect_with(&comma, "t x phi\n0 1,5 2\n", Some(1), None, "cannot tell the separator");
+        expect_with(
+            &comma,
+            "t;x;phi\n0;1,5;2\n\n1;2.5;2\n",
+            Some(4),
+            Some("x"),
+            "decimal mark is a comma",
+        );
+        expect_with(
+            &comma,
+            "t x phi\n0 1,5 2\n",
+            Some(1),
+            None,
+            "cannot tell the separator",
+        );
     }
 
     #[test]
@@ -737,11 +760,31 @@ mod tests {
         expect_with(&opts, text, Some(5), Some("x"), "not a number: `zz`");
         let text = "a\nb\nt;x;phi\n0;0;0\n0;0;0\n";
         expect_with(&opts, text, Some(5), Some("t"), "not strictly increasing");
-        expect_with(&opts, "a\nb\nt;x\n0;0\n", Some(3), Some("phi"), "missing column `phi`");
+        expect_with(
+            &opts,
+            "a\nb\nt;x\n0;0\n",
+            Some(3),
+            Some("phi"),
+            "missing column `phi`",
+        );
         expect_with(&opts, "a\nb\nt;x;phi\n", Some(4), None, "no data rows");
-        expect_with(&opts, "a\nb\n", Some(3), None, "nothing after the 2 skipped line(s)");
-        expect_with(&opts, "a\n", None, None, "`skip` = 2 passes over the whole file");
-        let r = opts.read_csv_from("x;y\n# c\nt;x;phi\n0;1;2\n".as_bytes(), "lab.csv").unwrap();
+        expect_with(
+            &opts,
+            "a\nb\n",
+            Some(3),
+            None,
+            "nothing after the 2 skipped line(s)",
+        );
+        expect_with(
+            &opts,
+            "a\n",
+            None,
+            None,
+            "`skip` = 2 passes over the whole file",
+        );
+        let r = opts
+            .read_csv_from("x;y\n# c\nt;x;phi\n0;1;2\n".as_bytes(), "lab.csv")
+            .unwrap();
         assert_eq!(r.x, [1.0]);
     }
 
@@ -750,22 +793,50 @@ mod tests {
         let opts = ReadOptions::default()
             .column(Signal::X, Column::Number(3))
             .column(Signal::U, Column::Number(2));
-        let r = opts.read_csv_from("t,drive,disp\n0,5,1\n1,6,2\n".as_bytes(), "lab.csv").unwrap();
+        let r = opts
+            .read_csv_from("t,drive,disp\n0,5,1\n1,6,2\n".as_bytes(), "lab.csv")
+            .unwrap();
         assert_eq!((r.x, r.u.unwrap()), (vec![1.0, 2.0], vec![5.0, 6.0]));
-        expect_with(&opts, "t,drive,disp\n0,5,zz\n", Some(2), Some("disp"), "`zz`");
+        expect_with(
+            &opts,
+            "t,drive,disp\n0,5,zz\n",
+            Some(2),
+            Some("disp"),
+            "`zz`",
+        );
         let bare = opts
             .clone()
             .header(false)
             .column(Signal::T, Column::Number(1));
-        let r = bare.read_csv_from("\n0,5,1\n1,6,2\n".as_bytes(), "lab.csv").unwrap();
+        let r = bare
+            .read_csv_from("\n0,5,1\n1,6,2\n".as_bytes(), "lab.csv")
+            .unwrap();
         assert_eq!(r.t, [0.0, 1.0]);
-        expect_with(&bare, "0,5,1\n1,6\n", Some(2), Some("3"), "short row: 2 cell(s), the first row has 3");
-        expect_with(&bare, "0,5\n", Some(1), Some("3"), "`x` is in column 3, but the first row has 2");
+        expect_with(
+            &bare,
+            "0,5,1\n1,6\n",
+            Some(2),
+            Some("3"),
+            "short row: 2 cell(s), the first row has 3",
+        );
+        expect_with(
+            &bare,
+            "0,5\n",
+            Some(1),
+            Some("3"),
+            "`x` is in column 3, but the first row has 2",
+        );
         let no_drive = ReadOptions::default()
             .header(false)
             .column(Signal::T, Column::Number(1))
             .column(Signal::X, Column::Number(2));
-        expect_with(&no_drive, "0,5\n", Some(1), Some("phi"), "takes columns by number");
+        expect_with(
+            &no_drive,
+            "0,5\n",
+            Some(1),
+            Some("phi"),
+            "takes columns by number",
+        );
     }
 
     #[test]
@@ -783,14 +854,21 @@ mod tests {
         assert_eq!(r.t, [2.0, 2.01, 2.02]);
         assert_eq!(r.x, [-1e-3, 1e-3, 5e-3]);
         let phi = r.phi.unwrap();
-        assert!((phi[2] - 2.0 * std::f64::consts::PI).abs() < 1e-12, "{phi:?}");
+        assert!(
+            (phi[2] - 2.0 * std::f64::consts::PI).abs() < 1e-12,
+            "{phi:?}"
+        );
         let bad = opts.clone().rest(9.0, 10.0);
         expect_with(&bad, "x,phi\n1,1\n", None, Some("x"), "holds no samples");
         let e = ReadOptions::default()
             .rate(-1.0, 0.0)
             .read_csv_from("x,phi\n1,1\n".as_bytes(), "lab.csv")
             .unwrap_err();
-        assert!(e.to_string().starts_with("lab.csv: cannot be read with this layout (`rate`)"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("lab.csv: cannot be read with this layout (`rate`)"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -549,7 +549,7 @@ impl ReadOptions {
                         "columns",
                         format!(
                             "`{signal}` is by name (\"{name}\"), but a file without a header \
-                             row takes columns by number, from 1: e.g. columns = {{ {signal} = 2 }}"
+                             row takes columns by number, from 1: e.g. columns = {{ t = 1, x = 2, phi = 3 }}"
                         ),
                     )
                 }
@@ -570,7 +570,10 @@ impl ReadOptions {
                     return invalid("offsets", "`t` takes no offset (set `t0`)".into())
                 }
                 Some(Offset::Value(v)) if !v.is_finite() => {
-                    return invalid("offsets", format!("`{signal}` = {v} is not a finite number"))
+                    return invalid(
+                        "offsets",
+                        format!("`{signal}` = {v} is not a finite number"),
+                    )
                 }
                 Some(Offset::Rest) if self.rest.is_none() => {
                     return invalid(
@@ -781,7 +784,10 @@ mod tests {
         let e = Unit::parse(Signal::Phi, "counts", None, None).unwrap_err();
         assert!(e.to_string().contains("needs `per_rev`"), "{e}");
         let e = Unit::parse(Signal::Phi, "deg", Some(1.0), None).unwrap_err();
-        assert!(e.to_string().contains("`gain` belongs to the unit `V`"), "{e}");
+        assert!(
+            e.to_string().contains("`gain` belongs to the unit `V`"),
+            "{e}"
+        );
         let e = Unit::parse(Signal::Phi, "counts", None, Some(-5.0)).unwrap_err();
         assert_eq!(e.setting(), "units");
         assert!(Unit::parse(Signal::X, "V", Some(2.0), None).is_err());
@@ -794,7 +800,10 @@ mod tests {
         assert!(d().check().is_ok());
         assert_eq!(setting(d().column(Signal::U, Column::Number(0))), "columns");
         assert_eq!(
-            setting(d().header(false).column(Signal::X, Column::Name("a".into()))),
+            setting(
+                d().header(false)
+                    .column(Signal::X, Column::Name("a".into()))
+            ),
             "columns"
         );
         assert_eq!(setting(d().header(false)), "columns");
@@ -803,8 +812,16 @@ mod tests {
             .column(Signal::T, Column::Number(1))
             .column(Signal::X, Column::Number(2));
         assert!(by_number.check().is_ok());
-        assert!(d().header(false).rate(10.0, 0.0).column(Signal::X, Column::Number(1)).check().is_ok());
-        assert_eq!(setting(d().offset(Signal::T, Offset::Value(1.0))), "offsets");
+        assert!(d()
+            .header(false)
+            .rate(10.0, 0.0)
+            .column(Signal::X, Column::Number(1))
+            .check()
+            .is_ok());
+        assert_eq!(
+            setting(d().offset(Signal::T, Offset::Value(1.0))),
+            "offsets"
+        );
         assert_eq!(setting(d().offset(Signal::X, Offset::Rest)), "offsets");
         assert_eq!(setting(d().rest(0.0, 1.0)), "rest");
         assert_eq!(
@@ -822,10 +839,7 @@ mod tests {
             "units"
         );
         assert_eq!(
-            setting(
-                d().decimal(DecimalMark::Comma)
-                    .separator(Separator::Comma)
-            ),
+            setting(d().decimal(DecimalMark::Comma).separator(Separator::Comma)),
             "decimal"
         );
         assert_eq!(setting(d().calibration(f64::INFINITY, 0.0)), "calibration");
@@ -872,8 +886,14 @@ mod tests {
     #[test]
     fn apply_makes_time_from_a_rate() {
         let opts = ReadOptions::default().rate(200.0, 1.0);
-        let out = apply(&opts, raw(&[], &[1.0, 2.0, 3.0], None), "r", &labels(), &|i| i)
-            .unwrap();
+        let out = apply(
+            &opts,
+            raw(&[], &[1.0, 2.0, 3.0], None),
+            "r",
+            &labels(),
+            &|i| i,
+        )
+        .unwrap();
         assert_eq!(out[0].as_deref(), Some(&[1.0, 1.005, 1.01][..]));
     }
 
@@ -882,19 +902,32 @@ mod tests {
         let opts = ReadOptions::default()
             .offset(Signal::X, Offset::Rest)
             .rest(5.0, 6.0);
-        let e = apply(&opts, raw(&[0.0, 1.0], &[1.0, 2.0], None), "r.csv", &labels(), &|i| i)
-            .unwrap_err();
+        let e = apply(
+            &opts,
+            raw(&[0.0, 1.0], &[1.0, 2.0], None),
+            "r.csv",
+            &labels(),
+            &|i| i,
+        )
+        .unwrap_err();
         assert_eq!(e.column.as_deref(), Some("x"));
-        assert!(e.message.contains("holds no samples: the record runs from 0 s to 1 s"));
+        assert!(e
+            .message
+            .contains("holds no samples: the record runs from 0 s to 1 s"));
         let opts = ReadOptions::default().offset(Signal::FStf, Offset::Value(1.0));
-        let e = apply(&opts, raw(&[0.0], &[1.0], None), "r.csv", &labels(), &|i| i)
-            .unwrap_err();
+        let e = apply(&opts, raw(&[0.0], &[1.0], None), "r.csv", &labels(), &|i| i).unwrap_err();
         assert_eq!(e.column.as_deref(), Some("f_stf"));
         let opts = ReadOptions::default()
             .offset(Signal::X, Offset::Rest)
             .rest(0.0, 6.0);
-        let e = apply(&opts, raw(&[0.0, 1.0], &[1.0, f64::NAN], None), "r", &labels(), &|i| i + 1)
-            .unwrap_err();
+        let e = apply(
+            &opts,
+            raw(&[0.0, 1.0], &[1.0, f64::NAN], None),
+            "r",
+            &labels(),
+            &|i| i + 1,
+        )
+        .unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(2), Some("x")));
     }
 }

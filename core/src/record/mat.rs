@@ -64,8 +64,16 @@ pub(super) fn read_bytes(
         }
     }
     if raw[Signal::Phi.index()].is_none() && raw[Signal::U.index()].is_none() {
-        let extra = format!(" (or `{}` for a force-driven rig)", labels[Signal::U.index()]);
-        return Err(missing(&source, &file, &labels[Signal::Phi.index()], &extra));
+        let extra = format!(
+            " (or `{}` for a force-driven rig)",
+            labels[Signal::U.index()]
+        );
+        return Err(missing(
+            &source,
+            &file,
+            &labels[Signal::Phi.index()],
+            &extra,
+        ));
     }
     let raw = layout::apply(opts, raw, &source, &labels, &|i| i + 1)?;
     Columns(raw).into_record(&source, &labels, &|i| i + 1)
@@ -291,7 +299,10 @@ mod tests {
     #[test]
     fn the_layout_applies_to_mat_files() {
         use super::super::{Offset, Unit};
-        let bytes = mat_v5(&[col("disp_mm", &[1.0, 2.0, 4.0], true), col("phi", &PHI[..3], true)]);
+        let bytes = mat_v5(&[
+            col("disp_mm", &[1.0, 2.0, 4.0], true),
+            col("phi", &PHI[..3], true),
+        ]);
         let opts = ReadOptions::default()
             .column(Signal::X, Column::Name("disp_mm".into()))
             .unit(Signal::X, Unit::Millimetre)
@@ -308,7 +319,14 @@ mod tests {
         assert!(e.message.contains("a .mat file names its variables"), "{e}");
         let e = ReadOptions::default()
             .column(Signal::FStf, Column::Name("gauge".into()))
-            .read_mat_bytes(&mat_v5(&[col("t", &T, true), col("x", &X, true), col("phi", &PHI, true)]), "m.mat")
+            .read_mat_bytes(
+                &mat_v5(&[
+                    col("t", &T, true),
+                    col("x", &X, true),
+                    col("phi", &PHI, true),
+                ]),
+                "m.mat",
+            )
             .unwrap_err();
         assert_eq!(e.column.as_deref(), Some("gauge"), "{e}");
     }

@@ -34,8 +34,8 @@ mod mat;
 
 pub use error::RecordError;
 pub use layout::{
-    Calibration, Channel, Column, DecimalMark, LayoutError, Offset, ReadOptions, Separator,
-    Signal, TimeBase, Unit,
+    Calibration, Channel, Column, DecimalMark, LayoutError, Offset, ReadOptions, Separator, Signal,
+    TimeBase, Unit,
 };
 
 use std::path::Path;
