@@ -397,6 +397,30 @@ calibration = { a = 0.5, b = 0.1 }
     }
 
     #[test]
+    fn a_logger_file_without_header_or_time_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("logger.csv"), "20.5,0,100\n22.5,512,-50\n").unwrap();
+        let e = Experiment::parse(
+            &dir.path().join("exp.toml"),
+            r#"[data]
+file = "logger.csv"
+header = false
+rate = 1000.0
+columns = { x = 1, phi = 2, u = 3 }
+units = { x = "um", phi = { unit = "counts", per_rev = 2048 }, u = "mN" }
+offsets = { x = 12.5 }
+"#,
+        )
+        .unwrap();
+        let r = crate::fitting::read_record(&e, e.data_file.as_ref().unwrap()).unwrap();
+        assert_eq!(r.t, [0.0, 0.001]);
+        assert!((r.x[0] - 8e-6).abs() < 1e-18 && (r.x[1] - 10e-6).abs() < 1e-18);
+        let phi = r.phi.unwrap();
+        assert!((phi[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        assert_eq!(r.u.unwrap(), [0.1, -0.05]);
+    }
+
+    #[test]
     fn unknown_values_list_the_accepted_ones_at_their_line() {
         expect(
             "units = { x = \"furlong\" }\n",
