@@ -871,6 +871,37 @@ mod tests {
         );
     }
 
+    proptest::proptest! {
+        /// Any text read with any layout is a record or an error, never a panic.
+        #[test]
+        fn any_text_with_any_layout_never_panics(
+            text in "[0-9a-z,;.\t\n\r\" -]{0,200}",
+            skip in 0usize..4,
+            header: bool,
+            comma: bool,
+            separator in 0usize..4,
+            x in 0usize..5,
+            rate: bool,
+        ) {
+            let mut opts = ReadOptions::default()
+                .skip(skip)
+                .header(header)
+                .separator([Separator::Auto, Separator::Comma, Separator::Semicolon, Separator::Tab][separator])
+                .column(Signal::X, Column::Number(x))
+                .offset(Signal::X, Offset::Rest)
+                .rest(0.0, 1.0);
+            if comma {
+                opts = opts.decimal(DecimalMark::Comma);
+            }
+            opts = if rate {
+                opts.rate(10.0, 0.0)
+            } else {
+                opts.column(Signal::T, Column::Number(1))
+            };
+            let _ = opts.read_csv_from(text.as_bytes(), "p.csv");
+        }
+    }
+
     #[test]
     fn write_then_read_round_trips_exactly() {
         let mut rng = StdRng::seed_from_u64(3);
