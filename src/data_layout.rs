@@ -21,9 +21,9 @@ use crate::experiment::{Ctx, RawDrive};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawData {
-    pub file: String,
+    file: String,
     /// Time window to use, s.
-    pub window: Option<[f64; 2]>,
+    window: Option<[f64; 2]>,
     /// Where each signal is: a column (variable) name or a CSV column number from 1.
     #[serde(default)]
     columns: BTreeMap<String, Spanned<Value>>,

@@ -2,7 +2,7 @@
 //! which offset, how the text is separated, and where the time comes from.
 //!
 //! A [`ReadOptions`] describes the layout; the CSV and `.mat` readers find the columns it
-//! names and then [`apply`] it, turning the recorded values into the SI values of a
+//! names and then apply it, turning the recorded values into the SI values of a
 //! [`Record`](super::Record): the time from its column (or `t0 + i/rate`), and for every other
 //! signal `scale · (recorded − offset)` — the offset is in the file's units, given or estimated
 //! as the mean over a rest stretch — followed, for `f_stf`, by a calibration `a·F + b`.
