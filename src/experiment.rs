@@ -16,9 +16,12 @@ use stf_core::fit::{FitSettings, Solver};
 use stf_core::integrate::{Method, Settings};
 use stf_core::kinematics::KinematicsSettings;
 use stf_core::reconstruct::DriveSmoothing;
+use stf_core::record::ReadOptions;
 use stf_core::regimes::RegimeThresholds;
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
+
+use crate::data_layout::{self, RawData};
 
 /// A parameter value: a number, or a table with value / min / max / fixed.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -169,27 +172,10 @@ struct RawIntegrator {
     h_max: Option<f64>,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawData {
-    file: String,
-    /// Time window to use, s.
-    window: Option<[f64; 2]>,
-    /// Column (CSV) or variable (.mat) names, where they differ from the contract's.
-    #[serde(default)]
-    columns: BTreeMap<String, String>,
-    /// Units of the columns, where they are not SI (`x = "mm"`, `phi = "deg"`, `t = "ms"`).
-    #[serde(default)]
-    units: BTreeMap<String, String>,
-    /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
-    calibration: Option<RawCalibration>,
-    /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
-    drive: Option<RawDrive>,
-}
-
+/// A `[data] drive` value as written.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
-enum RawDrive {
+pub(crate) enum RawDrive {
     Named(String),
     Filter(RawFilterSpec),
 }
@@ -213,42 +199,6 @@ fn drive_smoothing(raw: &RawDrive) -> Result<DriveSmoothing, String> {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawCalibration {
-    a: f64,
-    b: f64,
-}
-
-/// How to read the experiment's record: names, units and the force calibration.
-#[derive(Clone, Debug, Default)]
-pub struct DataSpec {
-    /// Column names by signal (`t`, `x`, `phi`, `f_stf`, `omega`, `u`).
-    pub columns: BTreeMap<String, String>,
-    /// Scale to SI by signal (e.g. `x` in mm: 1e-3).
-    pub scale: BTreeMap<String, f64>,
-    /// F = a·signal + b applied to `f_stf`.
-    pub calibration: Option<(f64, f64)>,
-}
-
-const SIGNALS: [&str; 6] = ["t", "x", "phi", "f_stf", "omega", "u"];
-
-/// The factor that brings `unit` of `signal` to SI, if known.
-fn unit_scale(signal: &str, unit: &str) -> Option<f64> {
-    match (signal, unit) {
-        ("t", "s") | ("x", "m") | ("phi", "rad") | ("omega", "rad/s") => Some(1.0),
-        ("f_stf" | "u", "N") => Some(1.0),
-        ("t", "ms") => Some(1e-3),
-        ("x", "mm") => Some(1e-3),
-        ("x", "um" | "µm") => Some(1e-6),
-        ("phi", "deg") => Some(std::f64::consts::PI / 180.0),
-        ("omega", "rpm") => Some(std::f64::consts::TAU / 60.0),
-        ("omega", "Hz") => Some(std::f64::consts::TAU),
-        ("f_stf" | "u", "mN") => Some(1e-3),
-        _ => None,
-    }
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawFit {
     level: Option<String>,
     solver: Option<String>,
@@ -263,7 +213,7 @@ struct RawFit {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawFilterSpec {
+pub(crate) struct RawFilterSpec {
     order: usize,
     window: usize,
 }
@@ -486,8 +436,8 @@ pub struct Experiment {
     pub data_line: usize,
     /// Time window of the data, s.
     pub data_window: Option<(f64, f64)>,
-    /// Column names, units and calibration of the record.
-    pub data_spec: DataSpec,
+    /// How to read the record: its layout (`[data]` columns, units, offsets, …).
+    pub data_layout: ReadOptions,
     /// `[fit]`.
     pub fit: FitSpec,
     /// `[filter]`.
@@ -507,13 +457,25 @@ pub fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].matches('\n').count() + 1
 }
 
-struct Ctx<'a> {
+/// Where errors point: the experiment file and its text.
+pub(crate) struct Ctx<'a> {
     file: &'a Path,
     text: &'a str,
 }
 
 impl Ctx<'_> {
-    fn at(&self, span: Range<usize>, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    /// The 1-based line of a byte offset.
+    pub(crate) fn line(&self, offset: usize) -> usize {
+        line_of(self.text, offset)
+    }
+
+    /// An error at `span`'s line, about `key`.
+    pub(crate) fn at(
+        &self,
+        span: Range<usize>,
+        key: &str,
+        msg: impl std::fmt::Display,
+    ) -> anyhow::Error {
         anyhow::anyhow!(
             "{}:{}: `{}`: {}",
             self.file.display(),
@@ -945,71 +907,29 @@ impl Experiment {
             }
         };
 
-        let data_window = raw
-            .data
-            .as_ref()
-            .and_then(|d| d.get_ref().window)
-            .map(|[a, b]| (a, b));
-        let mut data_spec = DataSpec::default();
+        let data = data_layout::parse(&cx, raw.data.as_ref(), &dir)?;
         if let Some(d) = &raw.data {
-            let span = d.span();
-            let r = d.get_ref();
-            for (signal, name) in &r.columns {
-                if !SIGNALS.contains(&signal.as_str()) {
-                    return Err(cx.at(
-                        span.clone(),
-                        &format!("data.columns.{signal}"),
-                        format!("unknown signal; known: {}", SIGNALS.join(", ")),
-                    ));
-                }
-                data_spec.columns.insert(signal.clone(), name.clone());
-            }
-            for (signal, unit) in &r.units {
-                let scale = unit_scale(signal, unit).ok_or_else(|| {
-                    cx.at(
-                        span.clone(),
-                        &format!("data.units.{signal}"),
-                        format!("unknown unit `{unit}` for `{signal}`"),
-                    )
-                })?;
-                data_spec.scale.insert(signal.clone(), scale);
-            }
-            data_spec.calibration = r.calibration.as_ref().map(|c| (c.a, c.b));
-            if let Some(drive) = &r.drive {
+            if let Some(drive) = &d.get_ref().drive {
                 let omega_set = raw
                     .filter
                     .as_ref()
                     .is_some_and(|f| f.get_ref().omega.is_some());
                 if omega_set {
                     return Err(cx.at(
-                        span,
+                        d.span(),
                         "data.drive",
                         "set either `[data] drive` or `[filter] omega`, not both (they are the same \
                          setting)",
                     ));
                 }
                 kinematics.drive =
-                    drive_smoothing(drive).map_err(|e| cx.at(span, "data.drive", e))?;
+                    drive_smoothing(drive).map_err(|e| cx.at(d.span(), "data.drive", e))?;
             }
         }
-        let mut data_line = 0;
-        let data_file = match &raw.data {
-            None => None,
-            Some(d) => {
-                let file = dir.join(&d.get_ref().file);
-                data_line = line_of(text, d.span().start);
-                if let Some((a, b)) = data_window {
-                    if !(b > a) {
-                        return Err(cx.at(d.span(), "data.window", format!("[{a}, {b}] is empty")));
-                    }
-                }
-                Some(file)
-            }
-        };
         Ok(Experiment {
             path: path.to_path_buf(),
-            data_window,
-            data_spec,
+            data_window: data.window,
+            data_layout: data.layout,
             fit,
             kinematics,
             identify,
@@ -1017,8 +937,8 @@ impl Experiment {
             output: OutputSpec {
                 report: raw.output.as_ref().and_then(|o| o.report).unwrap_or(true),
             },
-            data_file,
-            data_line,
+            data_file: data.file,
+            data_line: data.line,
             dir,
             system,
             system_given: raw.system.is_some(),

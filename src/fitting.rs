@@ -19,7 +19,7 @@ use stf_core::fit::{
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::oscillator::Oscillator;
-use stf_core::record::{ColumnNames, ReadOptions, Record};
+use stf_core::record::Record;
 use stf_core::simulate::Simulation;
 use stf_core::system::OscillatorParams;
 
@@ -61,37 +61,9 @@ impl FitData {
     }
 }
 
-/// Read a record as the experiment's `[data]` says: column names, units, calibration.
+/// Read a record as the experiment's `[data]` layout says (columns, units, offsets, …).
 pub fn read_record(exp: &Experiment, file: &std::path::Path) -> Result<Record> {
-    let spec = &exp.data_spec;
-    let mut names = ColumnNames::default();
-    for (signal, name) in &spec.columns {
-        let slot = match signal.as_str() {
-            "t" => &mut names.t,
-            "x" => &mut names.x,
-            "phi" => &mut names.phi,
-            "f_stf" => &mut names.f_stf,
-            "omega" => &mut names.omega,
-            _ => &mut names.u,
-        };
-        *slot = name.clone();
-    }
-    let mut record = ReadOptions::default().columns(names).read(file)?;
-    let scale = |v: &mut Vec<f64>, k: f64| v.iter_mut().for_each(|x| *x *= k);
-    for (signal, &k) in &spec.scale {
-        match signal.as_str() {
-            "t" => scale(&mut record.t, k),
-            "x" => scale(&mut record.x, k),
-            "phi" => record.phi.iter_mut().for_each(|v| scale(v, k)),
-            "f_stf" => record.f_stf.iter_mut().for_each(|v| scale(v, k)),
-            "omega" => record.omega.iter_mut().for_each(|v| scale(v, k)),
-            _ => record.u.iter_mut().for_each(|v| scale(v, k)),
-        }
-    }
-    if let (Some((a, b)), Some(f)) = (spec.calibration, record.f_stf.as_mut()) {
-        f.iter_mut().for_each(|v| *v = a * *v + b);
-    }
-    Ok(record)
+    Ok(exp.data_layout.read(file)?)
 }
 
 /// Read the experiment's record and derive its kinematics. A trajectory-level experiment on
@@ -559,8 +531,9 @@ calibration = { a = 0.2942906, b = 0.0044168 }
         .unwrap_err();
         let msg = format!("{err:#}");
         assert!(
-            msg.contains("exp.toml:1") && msg.contains("data.units.x"),
+            msg.contains("exp.toml:3") && msg.contains("data.units.x"),
             "{msg}"
         );
+        assert!(msg.contains("known: m, mm, um"), "{msg}");
     }
 }

@@ -5,25 +5,28 @@
 //! `matfile` reader, turned into clear errors: v4 and v7.3 (HDF5) files cannot be read; an
 //! `int32` variable anywhere in the file makes the whole file unreadable; `char`, `struct` and
 //! `cell` variables are invisible. Rows in errors are the 1-based element of the vector.
+//! The layout's names, units, offsets, rest stretch, rate and calibration apply as to a CSV
+//! file; its text settings (separator, decimal mark, skipped lines, header) do not.
 
-use super::{ColumnNames, Columns, Record, RecordError};
+use super::layout::{self, Raw};
+use super::{Column, Columns, ReadOptions, Record, RecordError, Signal};
 use std::path::Path;
 
 const SAVE_HINT: &str = "save the signals as double vectors with `save(file, ..., '-v7')`";
 
 /// Read a record from a `.mat` file.
-pub(super) fn read(path: &Path, names: &ColumnNames) -> Result<Record, RecordError> {
+pub(super) fn read(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
     let source = path.display().to_string();
     let bytes =
         std::fs::read(path).map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
-    read_bytes(&bytes, &source, names)
+    read_bytes(&bytes, &source, opts)
 }
 
 /// Read a record from the bytes of a `.mat` file; `source` names it in errors.
 pub(super) fn read_bytes(
     bytes: &[u8],
     source: &str,
-    names: &ColumnNames,
+    opts: &ReadOptions,
 ) -> Result<Record, RecordError> {
     let source = source.to_string();
     check_header(&source, bytes)?;
@@ -37,42 +40,61 @@ pub(super) fn read_bytes(
             ),
         )
     })?;
-    let get = |name: &str| vector(&source, &file, name);
-    let missing = |name: &str, extra: &str| {
-        let known: Vec<&str> = file.arrays().iter().map(|a| a.name()).collect();
-        RecordError::new(
-            &source,
-            format!(
-                "missing variable `{name}`{extra}; numeric variables in the file: {} \
-                 (char, struct and cell variables are not read: {SAVE_HINT})",
-                if known.is_empty() {
-                    "none".to_string()
-                } else {
-                    known.join(", ")
-                }
-            ),
-        )
-        .in_column(name)
-    };
-    let t = get(&names.t)?.ok_or_else(|| missing(&names.t, ""))?;
-    let x = get(&names.x)?.ok_or_else(|| missing(&names.x, ""))?;
-    let phi = get(&names.phi)?;
-    let u = get(&names.u)?;
-    if phi.is_none() && u.is_none() {
+    let mut raw: Raw = Default::default();
+    let mut labels = Signal::ALL.map(|s| s.name().to_string());
+    for (signal, ch) in opts.wanted() {
+        let name = match &ch.column {
+            Column::Name(name) => name,
+            Column::Number(k) => {
+                return Err(RecordError::new(
+                    &source,
+                    format!(
+                        "`{signal}` is given as column {k}: a .mat file names its variables, \
+                         so give the variable's name"
+                    ),
+                )
+                .in_column(k.to_string()))
+            }
+        };
+        labels[signal.index()].clone_from(name);
+        raw[signal.index()] = vector(&source, &file, name)?;
+        let must = opts.needs(signal);
+        if must && raw[signal.index()].is_none() {
+            return Err(missing(&source, &file, name, ""));
+        }
+    }
+    if raw[Signal::Phi.index()].is_none() && raw[Signal::U.index()].is_none() {
+        let extra = format!(
+            " (or `{}` for a force-driven rig)",
+            labels[Signal::U.index()]
+        );
         return Err(missing(
-            &names.phi,
-            &format!(" (or `{}` for a force-driven rig)", names.u),
+            &source,
+            &file,
+            &labels[Signal::Phi.index()],
+            &extra,
         ));
     }
-    Columns {
-        t,
-        x,
-        phi,
-        f_stf: get(&names.f_stf)?,
-        omega: get(&names.omega)?,
-        u,
-    }
-    .into_record(&source, names, &|i| i + 1)
+    let raw = layout::apply(opts, raw, &source, &labels, &|i| i + 1)?;
+    Columns(raw).into_record(&source, &labels, &|i| i + 1)
+}
+
+/// The variable `name` is not in the file (or not readable).
+fn missing(source: &str, file: &matfile::MatFile, name: &str, extra: &str) -> RecordError {
+    let known: Vec<&str> = file.arrays().iter().map(|a| a.name()).collect();
+    RecordError::new(
+        source,
+        format!(
+            "missing variable `{name}`{extra}; numeric variables in the file: {} \
+             (char, struct and cell variables are not read: {SAVE_HINT})",
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        ),
+    )
+    .in_column(name)
 }
 
 /// Recognise v4 and v7.3 files before the parser fails on them obscurely.
@@ -272,6 +294,41 @@ mod tests {
         assert_eq!(mat.f_stf, csv.f_stf);
         assert_eq!(mat.omega, None);
         assert!(mat.source.ends_with("r.mat"));
+    }
+
+    #[test]
+    fn the_layout_applies_to_mat_files() {
+        use super::super::{Offset, Unit};
+        let bytes = mat_v5(&[
+            col("disp_mm", &[1.0, 2.0, 4.0], true),
+            col("phi", &PHI[..3], true),
+        ]);
+        let opts = ReadOptions::default()
+            .column(Signal::X, Column::Name("disp_mm".into()))
+            .unit(Signal::X, Unit::Millimetre)
+            .offset(Signal::X, Offset::Rest)
+            .rest(0.0, 0.5)
+            .rate(2.0, 0.0);
+        let r = opts.read_mat_bytes(&bytes, "m.mat").unwrap();
+        assert_eq!(r.t, [0.0, 0.5, 1.0]);
+        assert_eq!(r.x, [-0.5e-3, 0.5e-3, 2.5e-3]);
+        let e = opts
+            .column(Signal::U, Column::Number(2))
+            .read_mat_bytes(&bytes, "m.mat")
+            .unwrap_err();
+        assert!(e.message.contains("a .mat file names its variables"), "{e}");
+        let e = ReadOptions::default()
+            .column(Signal::FStf, Column::Name("gauge".into()))
+            .read_mat_bytes(
+                &mat_v5(&[
+                    col("t", &T, true),
+                    col("x", &X, true),
+                    col("phi", &PHI, true),
+                ]),
+                "m.mat",
+            )
+            .unwrap_err();
+        assert_eq!(e.column.as_deref(), Some("gauge"), "{e}");
     }
 
     #[test]

@@ -7,8 +7,12 @@
 //!
 //! Records are read from CSV files with a header row ([`Record::read_csv`]) and from MATLAB
 //! `.mat` v5/v7 files with variables of the same names ([`Record::read_mat`]). Extra columns
-//! are ignored; other column names can be mapped with [`ReadOptions`]. Bad input is an error
-//! naming the file, the row and the column ([`RecordError`]).
+//! are ignored. A lab's own layout — other column names or column numbers, units (ms, mm,
+//! deg, encoder counts, rpm, volts with a gain, …), offsets given or estimated over a rest
+//! stretch, a sample rate instead of a time column, `;` or tab separators, decimal commas,
+//! lines before the header, no header at all — is described by [`ReadOptions`] (module
+//! `layout`), which both readers apply. Bad input is an error naming the file, the row (the
+//! editor's line) and the column ([`RecordError`]).
 //!
 //! ```
 //! use stf_core::record::{ColumnNames, ReadOptions, Record};
@@ -25,9 +29,14 @@
 
 mod csv;
 mod error;
+mod layout;
 mod mat;
 
 pub use error::RecordError;
+pub use layout::{
+    Calibration, Channel, Column, DecimalMark, LayoutError, Offset, ReadOptions, Separator, Signal,
+    TimeBase, Unit,
+};
 
 use std::path::Path;
 
@@ -84,20 +93,7 @@ impl Default for ColumnNames {
     }
 }
 
-/// How to read a record: which names hold which signal.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct ReadOptions {
-    /// Column / variable names.
-    pub columns: ColumnNames,
-}
-
 impl ReadOptions {
-    /// Read with these column names.
-    pub fn columns(mut self, columns: ColumnNames) -> Self {
-        self.columns = columns;
-        self
-    }
-
     /// Read a `.csv` or `.mat` file, chosen by the extension (case-insensitive).
     pub fn read(&self, path: &Path) -> Result<Record, RecordError> {
         let ext = path
@@ -117,12 +113,13 @@ impl ReadOptions {
         }
     }
 
-    /// Read a CSV file with a header row.
+    /// Read a CSV file laid out as these options say.
     pub fn read_csv(&self, path: &Path) -> Result<Record, RecordError> {
         let source = path.display().to_string();
+        self.checked(&source)?;
         let file = std::fs::File::open(path)
             .map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
-        csv::read(std::io::BufReader::new(file), &source, &self.columns)
+        csv::read(std::io::BufReader::new(file), &source, self)
     }
 
     /// Read CSV text from `reader`; `source` names it in errors.
@@ -131,95 +128,112 @@ impl ReadOptions {
         reader: R,
         source: &str,
     ) -> Result<Record, RecordError> {
-        csv::read(reader, source, &self.columns)
+        self.checked(source)?;
+        csv::read(reader, source, self)
     }
 
     /// Read a MATLAB `.mat` file (v5/v7; not v4 or v7.3) with a vector variable per signal.
     pub fn read_mat(&self, path: &Path) -> Result<Record, RecordError> {
-        mat::read(path, &self.columns)
+        self.checked(&path.display().to_string())?;
+        mat::read(path, self)
     }
 
     /// Read the bytes of a MATLAB `.mat` file; `source` names it in errors.
     pub fn read_mat_bytes(&self, bytes: &[u8], source: &str) -> Result<Record, RecordError> {
-        mat::read_bytes(bytes, source, &self.columns)
+        self.checked(source)?;
+        mat::read_bytes(bytes, source, self)
+    }
+
+    /// [`ReadOptions::check`] as an error about reading `source`.
+    fn checked(&self, source: &str) -> Result<(), RecordError> {
+        self.check().map_err(|e| {
+            RecordError::new(
+                source,
+                format!("cannot be read with this layout (`{}`): {e}", e.setting()),
+            )
+        })
     }
 }
 
-/// The signals of a record while it is being assembled, before validation.
-pub(crate) struct Columns {
-    pub t: Vec<f64>,
-    pub x: Vec<f64>,
-    pub phi: Option<Vec<f64>>,
-    pub f_stf: Option<Vec<f64>>,
-    pub omega: Option<Vec<f64>>,
-    pub u: Option<Vec<f64>>,
-}
+/// The signals of a record while it is being assembled, before validation, by
+/// [`Signal`] index; `t` and `x` are present.
+pub(crate) struct Columns(pub layout::Raw);
 
 impl Columns {
     /// Check the signals and make a record: equal lengths, at least one sample, finite
-    /// values, strictly increasing time, φ or u present. `row_of` turns a 0-based sample
-    /// index into the row a user sees.
+    /// values, strictly increasing time, φ or u present. `labels` name the columns (by
+    /// [`Signal`] index) and `row_of` turns a 0-based sample index into the row a user sees.
     pub(crate) fn into_record(
         self,
         source: &str,
-        names: &ColumnNames,
+        labels: &[String; 6],
         row_of: &dyn Fn(usize) -> usize,
     ) -> Result<Record, RecordError> {
-        let n = self.t.len();
+        let [t, x, phi, f_stf, omega, u] = self.0;
+        let (t, x) = (t.unwrap_or_default(), x.unwrap_or_default());
+        let n = t.len();
         let err = |message: String| RecordError::new(source, message);
+        let label = |s: Signal| labels[s.index()].as_str();
         if n == 0 {
             return Err(err("no data: the record has no samples".into()));
         }
         let named = [
-            (&names.t, Some(&self.t)),
-            (&names.x, Some(&self.x)),
-            (&names.phi, self.phi.as_ref()),
-            (&names.f_stf, self.f_stf.as_ref()),
-            (&names.omega, self.omega.as_ref()),
-            (&names.u, self.u.as_ref()),
+            (Signal::T, Some(&t)),
+            (Signal::X, Some(&x)),
+            (Signal::Phi, phi.as_ref()),
+            (Signal::FStf, f_stf.as_ref()),
+            (Signal::Omega, omega.as_ref()),
+            (Signal::U, u.as_ref()),
         ];
-        for (name, values) in named {
+        for (signal, values) in named {
             let Some(values) = values else { continue };
             if values.len() != n {
                 return Err(err(format!(
                     "has {} values but `{}` has {n}: all signals need the same length",
                     values.len(),
-                    names.t
+                    label(Signal::T)
                 ))
-                .in_column(name.as_str()));
+                .in_column(label(signal)));
             }
             if let Some(i) = values.iter().position(|v| !v.is_finite()) {
                 return Err(err(format!("not a finite number: `{}`", values[i]))
                     .at_row(row_of(i))
-                    .in_column(name.as_str()));
+                    .in_column(label(signal)));
             }
         }
-        if let Some(i) = self.t.windows(2).position(|w| w[1] <= w[0]) {
+        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
             return Err(err(format!(
                 "time is not strictly increasing: {} s follows {} s",
-                self.t[i + 1],
-                self.t[i]
+                t[i + 1],
+                t[i]
             ))
             .at_row(row_of(i + 1))
-            .in_column(names.t.as_str()));
+            .in_column(label(Signal::T)));
         }
-        if self.phi.is_none() && self.u.is_none() {
+        if phi.is_none() && u.is_none() {
             return Err(err(format!(
                 "missing column `{}` (or `{}` for a force-driven rig)",
-                names.phi, names.u
+                label(Signal::Phi),
+                label(Signal::U)
             ))
-            .in_column(names.phi.as_str()));
+            .in_column(label(Signal::Phi)));
         }
         Ok(Record {
             source: source.to_string(),
-            t: self.t,
-            x: self.x,
-            phi: self.phi,
-            f_stf: self.f_stf,
-            omega: self.omega,
-            u: self.u,
+            t,
+            x,
+            phi,
+            f_stf,
+            omega,
+            u,
         })
     }
+}
+
+/// The contract's names of the signals, by [`Signal`] index (the labels of a record in
+/// memory).
+fn contract_labels() -> [String; 6] {
+    Signal::ALL.map(|s| s.name().to_string())
 }
 
 impl Record {
@@ -247,15 +261,15 @@ impl Record {
     /// at least one sample, finite values, strictly increasing `t`, `phi` or `u` present.
     /// Rows in errors are 1-based sample numbers.
     pub fn validate(&self) -> Result<(), RecordError> {
-        Columns {
-            t: self.t.clone(),
-            x: self.x.clone(),
-            phi: self.phi.clone(),
-            f_stf: self.f_stf.clone(),
-            omega: self.omega.clone(),
-            u: self.u.clone(),
-        }
-        .into_record(&self.source, &ColumnNames::default(), &|i| i + 1)
+        Columns([
+            Some(self.t.clone()),
+            Some(self.x.clone()),
+            self.phi.clone(),
+            self.f_stf.clone(),
+            self.omega.clone(),
+            self.u.clone(),
+        ])
+        .into_record(&self.source, &contract_labels(), &|i| i + 1)
         .map(|_| ())
     }
 
