@@ -49,7 +49,9 @@ pub const EFFECTS: [&str; 8] = [
 fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
     let parts = spec
         .split('+')
-        .map(|s| resolve(s.trim(), dir))
+        .map(str::trim)
+        .filter(|s| *s != "none")
+        .map(|s| resolve(s, dir))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
 }

@@ -103,3 +103,29 @@ fn parameters_that_are_one_term_are_refused() {
         assert!(!out.status.success() && err.contains(says), "{free}: {err}");
     }
 }
+
+/// `base = "none"`: the oscillator alone, refitted with its force offset, is the base; the
+/// hidden cubic spring is named, the offset recovered, and `viscous` (the same term as the
+/// refitted `c`) is left out with a note instead of being fitted twice.
+#[test]
+fn a_linear_base_finds_the_spring_and_leaves_out_the_duplicate_of_c() {
+    let dir = tempfile::tempdir().unwrap();
+    let (make, _) = experiments(1, 0.3, "");
+    let make_path = dir.path().join("make.toml");
+    std::fs::write(&make_path, make).unwrap();
+    simulate_ok(&make_path, &dir.path().join("r.csv"));
+    let discover = "[data]\nfile = \"r.csv\"\n\n[system]\nT = 0.0\ndelta_T = 0.0\n\n\
+                    [fit]\nsystem = [\"k\", \"c\", \"f_off\"]\n\n[discover]\nbase = \"none\"\n\
+                    candidates = [\"cubic_stiffness\", \"viscous\", \"power_law\"]\n\
+                    level = \"trajectory\"\n";
+    let path = dir.path().join("discover.toml");
+    std::fs::write(&path, discover).unwrap();
+    let out = dir.path().join("d");
+    run_ok("discover", &path, &out);
+    let found = read_json(&out.join("discovery.json"));
+    assert_eq!(found["effects"], serde_json::json!(["cubic_stiffness"]), "{found}");
+    let f_off = found["system"]["f_off"].as_f64().unwrap();
+    assert!((f_off - 0.3).abs() < 0.01, "f_off {f_off}");
+    let notes = found["notes"].to_string();
+    assert!(notes.contains("`viscous` not tried"), "{notes}");
+}

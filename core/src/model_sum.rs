@@ -25,8 +25,13 @@ pub struct ModelSum {
 
 impl ModelSum {
     /// The sum of `parts`. Two parts of the same name are an error (their parameters could
-    /// not be told apart); an empty sum is the zero force.
+    /// not be told apart); an empty sum is the zero force, named `none`, and drops out of any
+    /// sum it is a part of (`none + cubic_stiffness` is `cubic_stiffness`).
     pub fn new(parts: Vec<Arc<dyn ForceModel>>) -> Result<Self, ModelError> {
+        let parts: Vec<Arc<dyn ForceModel>> = parts
+            .into_iter()
+            .filter(|p| !(p.name() == "none" && p.params().is_empty() && p.n_internal() == 0))
+            .collect();
         for (i, a) in parts.iter().enumerate() {
             if parts[..i].iter().any(|b| b.name() == a.name()) {
                 return Err(ModelError::new(

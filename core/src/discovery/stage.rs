@@ -33,13 +33,12 @@ impl Stage {
         })
     }
 
-    /// The parts' names joined by ` + ` (`power_law + viscous`).
+    /// The parts' names joined by ` + ` (`power_law + viscous`; the zero force `none` drops out
+    /// once another part joins it).
     pub fn name(&self) -> String {
-        self.parts
-            .iter()
-            .map(|p| p.name().to_string())
-            .collect::<Vec<_>>()
-            .join(" + ")
+        let names: Vec<&str> = self.parts.iter().map(|p| p.name()).collect();
+        let real: Vec<&str> = names.iter().copied().filter(|n| *n != "none").collect();
+        if real.is_empty() { names } else { real }.join(" + ")
     }
 
     /// The candidates a step tries: those this stage does not already hold ([`Stage::holds`]).

@@ -47,8 +47,8 @@ use super::trajectory_fit::{fit_on, Rig, Run};
 use super::trajectory_gap::locate_x_gap;
 use crate::excitation::Excitation;
 use crate::fit::{
-    FitParam, FitResult, FitSettings, ForceData, ForceFit, Solver, TrajectoryData,
-    DISPLACEMENT_OFFSET,
+    check_same_terms, FitParam, FitResult, FitSettings, ForceData, ForceFit, Solver,
+    TrajectoryData, DISPLACEMENT_OFFSET,
 };
 use crate::force_model::ForceModel;
 use crate::integrate::Settings;
@@ -676,6 +676,10 @@ pub fn discover_trajectory(
     let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
     let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
     let mut notes = Vec::new();
+    let (kept, skipped) =
+        without_refitted_terms(&base, candidates, &rig.oscillator, &setup.excitation)?;
+    let candidates = kept.as_slice();
+    notes.extend(skipped);
 
     settings.observer.emit(DiscoveryEvent::Base);
     // 1. The base and the oscillator on the whole record: the gap before.
@@ -847,6 +851,38 @@ pub fn discover_trajectory(
             notes,
         },
     })
+}
+
+/// The candidates a discovery may try beside the refitted oscillator parameters: a candidate
+/// with a parameter that is the same term as a refitted one (`viscous` while `c` is refitted)
+/// would be fitted twice over the same valley, so it is left out with a note saying why. A
+/// base with such a parameter, or refitted offsets that clash, is an error.
+fn without_refitted_terms(
+    base: &Arc<dyn ForceModel>,
+    candidates: &[Candidate],
+    refitted: &[&str],
+    excitation: &Excitation,
+) -> Result<(Vec<Candidate>, Vec<String>), DiscoveryError> {
+    let base_params: Vec<(&ParamSpec, bool)> = base.params().iter().map(|s| (s, true)).collect();
+    check_same_terms(&base_params, refitted, excitation)
+        .map_err(|e| DiscoveryError::BadSettings(format!("the base `{}`: {e}", base.name())))?;
+    let mut kept = Vec::new();
+    let mut notes = Vec::new();
+    for c in candidates {
+        match c
+            .model
+            .params()
+            .iter()
+            .find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)))
+        {
+            Some((spec, osc)) => notes.push(format!(
+                "`{}` not tried: its `{}` is the same term as the refitted oscillator's `{osc}`",
+                c.name, spec.name
+            )),
+            None => kept.push(c.clone()),
+        }
+    }
+    Ok((kept, notes))
 }
 
 #[cfg(test)]
