@@ -123,7 +123,11 @@ fn a_linear_base_finds_the_spring_and_leaves_out_the_duplicate_of_c() {
     let out = dir.path().join("d");
     run_ok("discover", &path, &out);
     let found = read_json(&out.join("discovery.json"));
-    assert_eq!(found["effects"], serde_json::json!(["cubic_stiffness"]), "{found}");
+    assert_eq!(
+        found["effects"],
+        serde_json::json!(["cubic_stiffness"]),
+        "{found}"
+    );
     let f_off = found["system"]["f_off"].as_f64().unwrap();
     assert!((f_off - 0.3).abs() < 0.01, "f_off {f_off}");
     let notes = found["notes"].to_string();

@@ -129,4 +129,37 @@ pub trait ForceModel: Send + Sync {
     ) -> Result<bool, ModelError> {
         Ok(false)
     }
+
+    /// The simpler built-in these fitted values `p` make this model over a record that
+    /// reaches `reach`, with that model's values: a wall with no gap and exponent 3 is a cubic
+    /// spring, a gate that is open at every speed the record reaches is its ungated law.
+    /// `None` (the default) when the model is what its name says. Discovery names the
+    /// simpler effect.
+    fn reduces_to(&self, _p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
+        None
+    }
 }
+
+/// How far a record goes: the largest |x| (m) and |ẋ| (m/s) it reaches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reach {
+    /// Largest |x|, m.
+    pub x: f64,
+    /// Largest |ẋ|, m/s.
+    pub v: f64,
+}
+
+impl Reach {
+    /// The reach of displacement and velocity samples.
+    pub fn of(x: &[f64], v: &[f64]) -> Self {
+        let max = |s: &[f64]| s.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        Reach {
+            x: max(x),
+            v: max(v),
+        }
+    }
+}
+
+/// What share of a record's reach counts as nothing: a gap, a threshold speed or a damping
+/// term below 5 % of it does not change the force where the record goes.
+pub const NEGLIGIBLE_SHARE: f64 = 0.05;

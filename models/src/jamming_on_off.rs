@@ -44,7 +44,7 @@
 //! | `v_c` | m/s | 0.05 | [0, 1] | critical speed of jamming onset |
 //! | `w` | m/s | 0.002 | [1e-4, 0.1] | width of the onset gate |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
 use stf_core::params::ParamSpec;
 
 use crate::power_law::{power_law_force, power_law_gradient};
@@ -154,6 +154,13 @@ impl ForceModel for JammingOnOff {
         };
         grad[..4].copy_from_slice(&[dk * gate, dn * gate, dvc, dw]);
         Ok(true)
+    }
+    /// A gate open at every speed but the slowest 5 % of the record's (`v_c + 2w` below it):
+    /// the ungated `power_law`.
+    fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
+        let [k_j, n_j, v_c, w] = take(self.name(), p).ok()?;
+        (v_c + 2.0 * w < NEGLIGIBLE_SHARE * reach.v)
+            .then(|| ("power_law".to_string(), vec![k_j, n_j]))
     }
 }
 

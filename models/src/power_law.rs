@@ -12,7 +12,7 @@
 //! | `K` | N·(s/m)ⁿ | 5 | [0, 1e4] | consistency: the force at 1 m/s |
 //! | `n` | — | 1.6 | [1, 4] | flow index; n > 1 thickens |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach};
 use stf_core::params::ParamSpec;
 
 use crate::values::take;
@@ -106,6 +106,11 @@ impl ForceModel for PowerLaw {
         let (dk, dn) = power_law_gradient(k, n, s.v);
         grad[..2].copy_from_slice(&[dk, dn]);
         Ok(true)
+    }
+    /// An exponent of 1 (within 0.02): `K·v`, the `viscous` law.
+    fn reduces_to(&self, p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
+        let [k, n] = take(self.name(), p).ok()?;
+        ((n - 1.0).abs() < 0.02).then(|| ("viscous".to_string(), vec![k]))
     }
 }
 

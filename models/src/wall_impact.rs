@@ -22,7 +22,7 @@
 //! | `p` | — | 1.5 | [1, 3] | contact exponent (Hertz: 1.5) |
 //! | `c_r` | s/m | 0.5 | [0, 10] | Hunt–Crossley damping factor α |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
 use stf_core::params::ParamSpec;
 
 use crate::values::take;
@@ -122,6 +122,14 @@ impl ForceModel for WallImpact {
         let [k_w, gap, expo, c_r] = take(self.name(), p)?;
         grad[..4].copy_from_slice(&hunt_crossley_gradient(k_w, gap, expo, c_r, s.x, s.v));
         Ok(true)
+    }
+    /// No gap, exponent 3 (within 0.1) and negligible damping: `k_w·x³`, a cubic spring.
+    fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
+        let [k_w, gap, expo, c_r] = take(self.name(), p).ok()?;
+        let cubic = gap < NEGLIGIBLE_SHARE * reach.x
+            && (expo - 3.0).abs() < 0.1
+            && c_r * reach.v < NEGLIGIBLE_SHARE;
+        cubic.then(|| ("cubic_stiffness".to_string(), vec![k_w]))
     }
 }
 

@@ -14,6 +14,7 @@ use super::score::{CandidateScore, Step};
 use super::settings::DiscoverySettings;
 use super::stage::Stage;
 use crate::fit::{Convergence, FitResult, NoiseFloor};
+use crate::force_model::Reach;
 
 /// A model fitted on the training samples and scored on the held-out ones.
 pub(super) struct Trial {
@@ -78,6 +79,9 @@ pub(super) struct Yardstick<'a> {
     pub floor_band: f64,
     /// The length of the test's blocks, samples (`None`: whole cycles).
     pub block_samples: Option<usize>,
+    /// How far the record goes, to judge whether a fitted gap or threshold is nothing
+    /// ([`crate::force_model::ForceModel::reduces_to`]).
+    pub reach: Reach,
 }
 
 /// The held-out mean square `mse` of a trial above the floor `sigma`², counted as at least
@@ -250,7 +254,11 @@ pub(super) fn decide(
             step.candidates[winner].name
         ));
     }
-    let w_name = step.candidates[winner].name.clone();
+    let mut w_name = step.candidates[winner].name.clone();
+    if let Some((simpler, why)) = reduced(&scored, &w_name, yardstick.reach) {
+        step.verdict.push_str(&why);
+        w_name = simpler;
+    }
     step.accepted = Some(w_name.clone());
     step.tie_with = tie_names;
     let trial = scored
@@ -258,6 +266,41 @@ pub(super) fn decide(
         .position(|s| s.0.name == w_name)
         .and_then(|pos| scored.swap_remove(pos).1);
     (step, trial)
+}
+
+/// The simpler candidate that the trial of `winner` is in effect (its model's
+/// [`crate::force_model::ForceModel::reduces_to`] at its fitted values), if that candidate was fitted in this step
+/// too, with a sentence saying so: the step names it instead. Without a fit of it, the
+/// sentence alone says what the winner amounts to.
+fn reduced(
+    scored: &[(CandidateScore, Option<Trial>)],
+    winner: &str,
+    reach: Reach,
+) -> Option<(String, String)> {
+    let (score, trial) = scored.iter().find(|s| s.0.name == winner)?;
+    let model = trial.as_ref()?.stage.parts.last()?;
+    let values: Vec<f64> = score.params.iter().map(|p| p.value).collect();
+    let (simpler, _) = model.reduces_to(&values, reach)?;
+    let shown: Vec<String> = score
+        .params
+        .iter()
+        .map(|p| format!("{} = {:.3e}", p.name, p.value))
+        .collect();
+    let fitted = scored
+        .iter()
+        .any(|s| s.0.name == simpler && s.1.is_some() && s.0.failure.is_none());
+    let what = format!(
+        "; the fitted `{winner}` ({}) is in effect `{simpler}` where this record goes (|x| ≤ \
+         {:.3e} m, |v| ≤ {:.3e} m/s)",
+        shown.join(", "),
+        reach.x,
+        reach.v
+    );
+    Some(if fitted {
+        (simpler.clone(), format!("{what}: `{simpler}` is named"))
+    } else {
+        (winner.to_string(), what)
+    })
 }
 
 /// A step on `current` with the `candidates` scored against it and nothing decided yet.

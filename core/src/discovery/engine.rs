@@ -25,7 +25,7 @@ use super::settings::DiscoverySettings;
 use super::stage::Stage;
 use super::subset_fit::{fit_subset, residuals, rms, rms_over};
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, NoiseFloor, FORCE_OFFSET};
-use crate::force_model::ForceModel;
+use crate::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
 impl Stage {
@@ -614,6 +614,7 @@ impl Search<'_> {
             floor,
             floor_band: self.settings.floor_band(floor.propagated),
             block_samples: Some(blocks.length),
+            reach: Reach::of(self.data.x, self.data.v),
         })
     }
 

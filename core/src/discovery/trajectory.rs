@@ -50,7 +50,7 @@ use crate::fit::{
     check_same_terms, FitParam, FitResult, FitSettings, ForceData, ForceFit, Solver,
     TrajectoryData, DISPLACEMENT_OFFSET,
 };
-use crate::force_model::ForceModel;
+use crate::force_model::{ForceModel, Reach};
 use crate::integrate::Settings;
 use crate::params::ParamSpec;
 use crate::regimes::Cycle;
@@ -729,6 +729,7 @@ pub fn discover_trajectory(
         floor: crate::fit::NoiseFloor::displacement(floor),
         floor_band: 0.0,
         block_samples: None,
+        reach: reach_of(data, setup),
     };
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
@@ -851,6 +852,20 @@ pub fn discover_trajectory(
             notes,
         },
     })
+}
+
+/// How far the record goes: its largest |x|, and the largest |v| of the force hint's
+/// filtered velocity or, without one, of central differences of x.
+fn reach_of(data: &TrajectoryData, setup: &TrajectorySetup) -> Reach {
+    match &setup.force_hint {
+        Some(h) => Reach::of(data.x, &h.v),
+        None => {
+            let v: Vec<f64> = (1..data.x.len().saturating_sub(1))
+                .map(|i| (data.x[i + 1] - data.x[i - 1]) / (data.t[i + 1] - data.t[i - 1]))
+                .collect();
+            Reach::of(data.x, &v)
+        }
+    }
 }
 
 /// The candidates a discovery may try beside the refitted oscillator parameters: a candidate
