@@ -20,6 +20,9 @@ use stf_core::regimes::RegimeThresholds;
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
+mod validate;
+pub use validate::ValidateSpec;
+
 /// A parameter value: a number, or a table with value / min / max / fixed.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(untagged)]
@@ -323,6 +326,7 @@ struct RawExperiment {
     identify: Vec<Spanned<RawStage>>,
     regimes: Option<Spanned<toml::Value>>,
     output: Option<RawOutput>,
+    validate: Option<Spanned<validate::RawValidate>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -487,11 +491,18 @@ pub struct Experiment {
     pub regimes: RegimeThresholds,
     /// `[discover] base`.
     pub discover: Option<DiscoverSpec>,
+    /// `[validate]`: the second record every fitted model is scored on.
+    pub validate: Option<ValidateSpec>,
 }
 
 /// 1-based line of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// `FILE:LINE: `KEY`: MSG`, the form of every error about a value in an experiment file.
+pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{}:{}: `{}`: {}", file.display(), line, key, msg)
 }
 
 struct Ctx<'a> {
@@ -501,13 +512,7 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     fn at(&self, span: Range<usize>, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
-        anyhow::anyhow!(
-            "{}:{}: `{}`: {}",
-            self.file.display(),
-            line_of(self.text, span.start),
-            key,
-            msg
-        )
+        error_at(self.file, line_of(self.text, span.start), key, msg)
     }
 }
 
@@ -978,6 +983,7 @@ impl Experiment {
             }
         };
         Ok(Experiment {
+            validate: validate::spec(raw.validate.as_ref(), &cx, &dir)?,
             path: path.to_path_buf(),
             data_window,
             data_spec,

@@ -21,3 +21,4 @@ pub mod output;
 pub mod progress;
 pub mod report;
 pub mod reporting;
+pub mod validation;
