@@ -13,6 +13,7 @@ pub mod cmd_discover;
 pub mod cmd_fit;
 pub mod cmd_models;
 pub mod cmd_simulate;
+pub mod discovery_curves;
 pub mod experiment;
 pub mod fitting;
 pub mod interrupt;

@@ -163,7 +163,8 @@ pub fn validation_intro(rec: &ValidationRecord, fits: &[ModelFit]) -> String {
         .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms));
     match best {
         Some((f, s)) => format!(
-            "Validated on a second record, {}: the smallest error there is `{}`'s, RMS {:.4}              {unit} ({:.3} of the measured RMS); see Validation.",
+            "Validated on a second record, {}: the smallest error there is `{}`'s, RMS {:.4} \
+             {unit} ({:.3} of the measured RMS); see Validation.",
             rec.spec.given,
             f.label,
             s.rms * scale,
@@ -197,7 +198,8 @@ pub fn validation_section(
     let (unit, scale) = unit_of(rec.data.level);
     let mut s = Section::new("Validation on a second record");
     s.paragraphs.push(format!(
-        "Every model scored on {} ({} samples; the estimation record's column mapping, filters          and drive reconstruction) with the parameters fitted on the estimation record{}.",
+        "Every model scored on {} ({} samples; the estimation record's column mapping, filters \
+         and drive reconstruction) with the parameters fitted on the estimation record{}.",
         rec.spec.given,
         rec.data.record.len(),
         match rec.data.level {

@@ -238,8 +238,8 @@ pub struct DiscoveryScore {
     pub measured_rms: Option<f64>,
     /// Samples scored.
     pub samples: usize,
-    /// Whether the initial state was fitted to the record (trajectory level).
-    pub initial_fitted: bool,
+    /// Whether the initial state was fitted to the record (trajectory level only).
+    pub initial_fitted: Option<bool>,
     /// Why the models could not be scored, if they could not.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -267,7 +267,8 @@ impl DiscoveryScore {
             normalised_after: after.as_ref().and_then(|a| finite(a.normalised)),
             measured_rms: after.as_ref().map(|a| a.measured_rms),
             samples: rec.data.record.len(),
-            initial_fitted: after.as_ref().is_some_and(|a| a.initial_fitted),
+            initial_fitted: (rec.data.level == FitLevel::Trajectory)
+                .then(|| after.as_ref().is_some_and(|a| a.initial_fitted)),
             error,
             predicted_after: after.map(|a| a.predicted).unwrap_or_default(),
         }
