@@ -67,6 +67,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         return Err(spec.error(key, msg));
     }
     let mut record = read_record(exp, &spec.file).map_err(|e| spec.error(key, format!("{e:#}")))?;
+    check_columns(exp, spec, &record, estimation)?;
     if let Some((t0, t1)) = spec.window {
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
@@ -78,7 +79,6 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
             return Err(spec.error("validate.window", msg));
         }
     }
-    check_columns(exp, spec, &record, estimation)?;
     let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
         spec.error(
             key,
