@@ -1234,6 +1234,10 @@ name = "viscous"
 
 [regimes]
 on_k = 3.0
+
+[validate]
+file = "v.csv"
+window = [0.0, 5.0]
 "#;
 
     proptest::proptest! {
