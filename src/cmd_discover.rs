@@ -23,7 +23,7 @@ use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
-use crate::experiment::{Experiment, FitLevel};
+use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{load_data, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
@@ -117,31 +117,9 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     let validation = crate::validation::load(&exp, &data)?;
     prepare_dir(out, force)?;
-    let base = model_from(&spec.base, &exp.dir)
-        .with_context(|| format!("{}: `discover.base`", exp_path.display()))?;
-    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
-    let mut candidates = Vec::new();
-    let names: Vec<String> = match &spec.candidates {
-        Some(list) => list.clone(),
-        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
-    };
-    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
-        let model = resolve(name, &exp.dir)
-            .with_context(|| format!("{}: `discover.candidates`", exp_path.display()))?;
-        candidates.push(Candidate::new(model.name().to_string(), model));
-    }
+    let (base, candidates) = models_of(&exp, spec)?;
     let cycles = crate::fitting::cycles_of(&data)?;
-    let fit = match data.level {
-        FitLevel::Force => force_fit_settings(&exp.fit.settings),
-        FitLevel::Trajectory => exp.fit.settings.clone(),
-    };
-    let mut settings = DiscoverySettings::default().fit(fit);
-    if let Some(n) = spec.max_effects {
-        settings = settings.max_effects(n);
-    }
-    if let Some(n) = spec.holdout_every {
-        settings = settings.holdout_every(n);
-    }
+    let mut settings = settings_of(&exp, spec, data.level);
     let started = Instant::now();
     let progress = Progress::new(quiet);
     let bar = progress.job("discover");
@@ -188,6 +166,56 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         force_report(&exp, &data, &found, score.as_ref(), out)?;
     }
 
+    print_force(spec, &found, score.as_ref(), (&toml_entry, wall), out);
+    Ok(())
+}
+
+/// The base model and the candidates of `[discover]`: the vocabulary of
+/// docs/ARCHITECTURE.md §5, or the list given, less what the base holds.
+fn models_of(
+    exp: &Experiment,
+    spec: &DiscoverSpec,
+) -> Result<(Arc<dyn ForceModel>, Vec<Candidate>)> {
+    let base = model_from(&spec.base, &exp.dir)
+        .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
+    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
+    let mut candidates = Vec::new();
+    let names: Vec<String> = match &spec.candidates {
+        Some(list) => list.clone(),
+        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
+    };
+    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
+        let model = resolve(name, &exp.dir)
+            .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
+        candidates.push(Candidate::new(model.name().to_string(), model));
+    }
+    Ok((base, candidates))
+}
+
+/// Discovery's settings from `[fit]` and `[discover]` at `level`.
+fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> DiscoverySettings {
+    let fit = match level {
+        FitLevel::Force => force_fit_settings(&exp.fit.settings),
+        FitLevel::Trajectory => exp.fit.settings.clone(),
+    };
+    let mut settings = DiscoverySettings::default().fit(fit);
+    if let Some(n) = spec.max_effects {
+        settings = settings.max_effects(n);
+    }
+    if let Some(n) = spec.holdout_every {
+        settings = settings.holdout_every(n);
+    }
+    settings
+}
+
+/// The terminal summary of a force-level discovery.
+fn print_force(
+    spec: &DiscoverSpec,
+    found: &Discovery,
+    score: Option<&DiscoveryScore>,
+    (toml_entry, wall): (&str, f64),
+    out: &Path,
+) {
     println!(
         "base `{}`: gap {:.4} N; {}",
         spec.base, found.gap_before, found.where_before.summary
@@ -205,7 +233,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     );
     println!(
         "  {}",
-        held_out_and_validation(found.holdout_cycles, score.as_ref(), "N", 1.0)
+        held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
     );
     for note in &found.notes {
         println!("  note: {note}");
@@ -216,7 +244,6 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
          {0}/figures/",
         out.display()
     );
-    Ok(())
 }
 
 /// The held-out cycles every step was scored on and, with `[validate]`, the base's and the

@@ -33,6 +33,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let exp = Experiment::load(exp_path)?;
     let progress = Progress::new(quiet);
     if !exp.identify.is_empty() {
+        if let Some(spec) = &exp.validate {
+            let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
+            return Err(spec.error("validate", msg));
+        }
         prepare_dir(out, force)?;
         return identify(&exp, out, &progress);
     }

@@ -209,47 +209,21 @@ pub fn validation_section(
                  state (fitted on it when the fit fits x0, v0)",
         }
     ));
-    let mut columns: Vec<String> = [
-        "model",
-        &format!("validation RMS, {unit}"),
-        "of the measured RMS",
-    ]
-    .iter()
-    .map(|c| c.to_string())
-    .collect();
-    columns.extend(Regime::ALL.iter().map(|r| format!("{}, {unit}", r.name())));
-    columns.push(format!("estimation RMS, {unit}"));
-    let mut table = Table {
-        caption: "Error on the validation record (fitted parameters held).".into(),
-        columns,
-        rows: Vec::new(),
-    };
-    let mut predicted: Vec<(&str, Vec<f64>)> = Vec::new();
-    for f in fits {
-        let v = f.validation.as_ref();
-        let score = v.and_then(|v| v.score.as_ref());
-        let cell =
-            |x: Option<f64>, digits: usize| x.map_or("—".into(), |x| format!("{x:.digits$}"));
-        let mut row = vec![
-            f.label.clone(),
-            cell(score.map(|s| s.rms * scale), 4),
-            cell(score.map(|s| s.normalised), 3),
-        ];
-        for r in Regime::ALL {
-            let e = v.and_then(|v| v.per_regime.as_ref()).and_then(|p| p.get(r));
-            row.push(cell(e.map(|e| e.rms * scale), 4));
-        }
-        row.push(format!("{:.4}", f.result.rms * scale));
-        table.rows.push(row);
-        s.warnings.extend(v.and_then(|v| v.error.clone()));
-        if let Some(score) = score {
-            predicted.push((
-                &f.label,
+    s.tables.push(validation_table(fits, unit, scale));
+    s.warnings = fits
+        .iter()
+        .filter_map(|f| f.validation.as_ref()?.error.clone())
+        .collect();
+    let predicted: Vec<(&str, Vec<f64>)> = fits
+        .iter()
+        .filter_map(|f| {
+            let score = f.validation.as_ref()?.score.as_ref()?;
+            Some((
+                f.label.as_str(),
                 score.predicted.iter().map(|x| x * scale).collect(),
-            ));
-        }
-    }
-    s.tables.push(table);
+            ))
+        })
+        .collect();
     if !predicted.is_empty() {
         let quantity = match rec.data.level {
             FitLevel::Force => STF_FORCE_VALIDATION,
@@ -272,6 +246,42 @@ pub fn validation_section(
         ));
     }
     Ok(s)
+}
+
+/// The table of each model's error on the validation record: overall, against the measured
+/// RMS, per regime, and its RMS on the estimation record (in `unit`, `scale` from SI).
+fn validation_table(fits: &[ModelFit], unit: &str, scale: f64) -> Table {
+    let mut columns: Vec<String> = ["model", "validation RMS", "of the measured RMS"]
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    columns[1].push_str(&format!(", {unit}"));
+    columns.extend(Regime::ALL.iter().map(|r| format!("{}, {unit}", r.name())));
+    columns.push(format!("estimation RMS, {unit}"));
+    let cell = |x: Option<f64>, digits: usize| x.map_or("—".into(), |x| format!("{x:.digits$}"));
+    let rows = fits
+        .iter()
+        .map(|f| {
+            let v = f.validation.as_ref();
+            let score = v.and_then(|v| v.score.as_ref());
+            let mut row = vec![
+                f.label.clone(),
+                cell(score.map(|s| s.rms * scale), 4),
+                cell(score.map(|s| s.normalised), 3),
+            ];
+            for r in Regime::ALL {
+                let e = v.and_then(|v| v.per_regime.as_ref()).and_then(|p| p.get(r));
+                row.push(cell(e.map(|e| e.rms * scale), 4));
+            }
+            row.push(format!("{:.4}", f.result.rms * scale));
+            row
+        })
+        .collect();
+    Table {
+        caption: "Error on the validation record (fitted parameters held).".into(),
+        columns,
+        rows,
+    }
 }
 
 /// What the warnings check, with each fit's noise floor.
