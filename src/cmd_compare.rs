@@ -5,7 +5,8 @@
 //! kinematics, is scored per regime (force RMS error, energy per cycle, on–off duty, peak
 //! force, label agreement, boundary error), and the oscillator with the model plugged in is
 //! simulated against the record for the resonance peak. Writes `compare.json`, `compare.md`
-//! and `compare.csv` (models × regimes).
+//! and `compare.csv` (models × regimes). With `[validate]`, each model's `fit` in
+//! compare.json carries its error on the second record, as in fit.json.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -119,9 +120,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             exp_path.display()
         );
     }
+    let validation = crate::validation::load(&exp, &data)?;
     prepare_dir(out, force)?;
     let measured = measured_regimes(&exp, &data)?;
-    let fits = fit_all(&exp, &data, &Progress::new(quiet))?;
+    let mut fits = fit_all(&exp, &data, &Progress::new(quiet))?;
+    if let Some(rec) = &validation {
+        crate::validation::score_fits(&mut fits, rec);
+    }
     let sig = signals(&data);
     let comparisons: Vec<Comparison> = fits
         .iter()

@@ -16,13 +16,14 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use stf_core::discovery::{
-    discover_force, discover_trajectory, Candidate, DiscoverySettings, TrajectorySetup,
+    discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
+    TrajectoryDiscovery, TrajectorySetup,
 };
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
-use crate::experiment::{Experiment, FitLevel};
+use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::{prepare_dir, write_json};
@@ -32,6 +33,7 @@ use crate::report::{
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
 };
 use crate::reporting::{record_sections, write_report};
+use crate::validation::{DiscoveryScore, ValidationRecord};
 
 /// The effects of docs/ARCHITECTURE.md §5, the default candidates.
 pub const EFFECTS: [&str; 8] = [
@@ -81,7 +83,6 @@ fn named(effects: &[String]) -> String {
     }
 }
 
-/// Run `stf-lab discover`.
 /// The fit settings of force-level discovery: discovery's own stopping rule
 /// ([`DiscoverySettings::default`]: at most 200 iterations a stage, relative cost change
 /// 1e-7, far below what moves a BIC by its threshold), with the solver and seed of `[fit]`,
@@ -97,6 +98,7 @@ fn force_fit_settings(from: &FitSettings) -> FitSettings {
     fit
 }
 
+/// Run `stf-lab discover`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let mut exp = Experiment::load(exp_path)?;
     let Some(spec) = exp.discover.clone() else {
@@ -113,32 +115,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     if let Some(line) = estimate_line(&data) {
         println!("{line}");
     }
+    let validation = crate::validation::load(&exp, &data)?;
     prepare_dir(out, force)?;
-    let base = model_from(&spec.base, &exp.dir)
-        .with_context(|| format!("{}: `discover.base`", exp_path.display()))?;
-    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
-    let mut candidates = Vec::new();
-    let names: Vec<String> = match &spec.candidates {
-        Some(list) => list.clone(),
-        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
-    };
-    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
-        let model = resolve(name, &exp.dir)
-            .with_context(|| format!("{}: `discover.candidates`", exp_path.display()))?;
-        candidates.push(Candidate::new(model.name().to_string(), model));
-    }
+    let (base, candidates) = models_of(&exp, spec)?;
     let cycles = crate::fitting::cycles_of(&data)?;
-    let fit = match data.level {
-        FitLevel::Force => force_fit_settings(&exp.fit.settings),
-        FitLevel::Trajectory => exp.fit.settings.clone(),
-    };
-    let mut settings = DiscoverySettings::default().fit(fit);
-    if let Some(n) = spec.max_effects {
-        settings = settings.max_effects(n);
-    }
-    if let Some(n) = spec.holdout_every {
-        settings = settings.holdout_every(n);
-    }
+    let mut settings = settings_of(&exp, spec, data.level);
     let started = Instant::now();
     let progress = Progress::new(quiet);
     let bar = progress.job("discover");
@@ -155,7 +136,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             &candidates,
             &cycles,
             &settings,
-            out,
+            (out, validation.as_ref()),
             (quiet, &bar),
         );
     }
@@ -173,23 +154,133 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     bar.finish_and_clear();
     let found = found?;
     let wall = started.elapsed().as_secs_f64();
+    let score = validation
+        .as_ref()
+        .map(|rec| crate::validation::score_force_discovery(&found, rec));
+    let toml_entry = models_entry(
+        &found.final_model_name,
+        found.final_params.iter().filter(|p| p.name != "f_off"),
+    );
+    write_force_results(&exp, &data, &found, score.as_ref(), &toml_entry, out)?;
+    if exp.output.report {
+        force_report(&exp, &data, &found, score.as_ref(), out)?;
+    }
 
-    // The final model as an experiment entry that `fit` and `compare` accept as it is.
+    print_force(spec, &found, score.as_ref(), (&toml_entry, wall), out);
+    Ok(())
+}
+
+/// The base model and the candidates of `[discover]`: the vocabulary of
+/// docs/ARCHITECTURE.md §5, or the list given, less what the base holds.
+fn models_of(
+    exp: &Experiment,
+    spec: &DiscoverSpec,
+) -> Result<(Arc<dyn ForceModel>, Vec<Candidate>)> {
+    let base = model_from(&spec.base, &exp.dir)
+        .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
+    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
+    let mut candidates = Vec::new();
+    let names: Vec<String> = match &spec.candidates {
+        Some(list) => list.clone(),
+        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
+    };
+    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
+        let model = resolve(name, &exp.dir)
+            .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
+        candidates.push(Candidate::new(model.name().to_string(), model));
+    }
+    Ok((base, candidates))
+}
+
+/// Discovery's settings from `[fit]` and `[discover]` at `level`.
+fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> DiscoverySettings {
+    let fit = match level {
+        FitLevel::Force => force_fit_settings(&exp.fit.settings),
+        FitLevel::Trajectory => exp.fit.settings.clone(),
+    };
+    let mut settings = DiscoverySettings::default().fit(fit);
+    if let Some(n) = spec.max_effects {
+        settings = settings.max_effects(n);
+    }
+    if let Some(n) = spec.holdout_every {
+        settings = settings.holdout_every(n);
+    }
+    settings
+}
+
+/// The terminal summary of a force-level discovery.
+fn print_force(
+    spec: &DiscoverSpec,
+    found: &Discovery,
+    score: Option<&DiscoveryScore>,
+    (toml_entry, wall): (&str, f64),
+    out: &Path,
+) {
+    println!(
+        "base `{}`: gap {:.4} N; {}",
+        spec.base, found.gap_before, found.where_before.summary
+    );
+    for step in &found.steps {
+        println!("  {}", step.verdict);
+    }
+    println!(
+        "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
+        named(&found.effects),
+        found.gap_before,
+        found.gap_after,
+        found.noise_floor,
+        wall
+    );
+    println!(
+        "  {}",
+        held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
+    );
+    for note in &found.notes {
+        println!("  note: {note}");
+    }
+    println!("final model, as an experiment entry:\n{toml_entry}");
+    println!(
+        "wrote {0}/discovery.json, {0}/discovered.csv, {0}/report.html, {0}/report.md and \
+         {0}/figures/",
+        out.display()
+    );
+}
+
+/// The held-out cycles every step was scored on and, with `[validate]`, the base's and the
+/// final model's errors on the validation record, in one sentence (errors shown in `unit`,
+/// `scale` from SI).
+fn held_out_and_validation(
+    holdout_cycles: usize,
+    score: Option<&DiscoveryScore>,
+    unit: &str,
+    scale: f64,
+) -> String {
+    let held_out = format!("held out: {holdout_cycles} cycles of the record");
+    match score {
+        Some(score) => format!("{held_out}; {}", score.summary(unit, scale)),
+        None => held_out,
+    }
+}
+
+/// `discovery.json` and `discovered.csv` of a force-level discovery.
+fn write_force_results(
+    exp: &Experiment,
+    data: &FitData,
+    found: &Discovery,
+    score: Option<&DiscoveryScore>,
+    toml_entry: &str,
+    out: &Path,
+) -> Result<()> {
     let params: serde_json::Map<String, serde_json::Value> = found
         .final_params
         .iter()
         .map(|p| (p.name.clone(), json!(p.value)))
         .collect();
-    let toml_entry = models_entry(
-        &found.final_model_name,
-        found.final_params.iter().filter(|p| p.name != "f_off"),
-    );
-
-    let doc = json!({
+    let mut doc = json!({
         "experiment": exp.path.display().to_string(),
         "record": data.record.source,
         "drive": data.kinematics.drive,
-        "base": spec.base,
+        "base": base_of(exp, found),
         "effects": found.effects,
         "gap_before": found.gap_before,
         "gap_after": found.gap_after,
@@ -206,135 +297,150 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             "std_errors": std_errors_json(&found.final_params),
             "experiment_entry": toml_entry,
         },
+        "fitted": crate::discovery_curves::force_curves(found, exp.system),
         "notes": found.notes,
     });
+    if let Some(score) = score {
+        doc["validation"] = serde_json::to_value(score)?;
+    }
     write_json(&out.join("discovery.json"), &doc)?;
-
-    if exp.output.report {
-        // Report.
-        let dir = out.join("figures");
-        std::fs::create_dir_all(&dir)?;
-        let f = data.record.f_stf.as_deref().unwrap_or(&[]);
-        let before: Vec<f64> = f
-            .iter()
-            .zip(&found.residual_before)
-            .map(|(m, r)| m - r)
-            .collect();
-        let after: Vec<f64> = f
-            .iter()
-            .zip(&found.residual_after)
-            .map(|(m, r)| m - r)
-            .collect();
-        let mut s = Section::new("Discovery");
-        s.paragraphs.push(format!(
-            "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
-            spec.base, found.gap_before, found.noise_floor, found.where_before.summary
-        ));
-        for step in &found.steps {
-            s.paragraphs.push(step.verdict.clone());
-        }
-        s.paragraphs.push(format!(
-            "Final `{}`: gap {:.4} N. {}",
-            found.final_model_name, found.gap_after, found.where_after.summary
-        ));
-        s.paragraphs.extend(found.notes.iter().cloned());
-        for (i, step) in found.steps.iter().enumerate() {
-            s.tables.push(Table {
-                caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
-                columns: [
-                    "candidate",
-                    "held-out RMS, N",
-                    "ΔBIC",
-                    "paired z (units)",
-                    "explains of the excess",
-                    "significant",
-                ]
-                .iter()
-                .map(|c| c.to_string())
-                .collect(),
-                rows: step
-                    .candidates
-                    .iter()
-                    .map(|c| {
-                        vec![
-                            c.name.clone(),
-                            format!("{:.5}", c.holdout_rms),
-                            format!("{:.1}", c.delta_bic),
-                            format!("{:.1} ({})", c.gain_z, c.effective_n),
-                            format!("{:.0} %", 100.0 * c.explained_share),
-                            if c.significant {
-                                "yes".into()
-                            } else {
-                                "no".into()
-                            },
-                        ]
-                    })
-                    .collect(),
-            });
-        }
-        let fig = measured_vs_fitted(
-            &dir,
-            "discovery_force",
-            &data.record.t,
-            f,
-            &[("base", &before), ("final", &after)],
-        )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            "Measured STF force against the base and the final model.",
-        ));
-        let fig = measured_vs_model(
-            &dir,
-            "discovery_residual",
-            STF_FORCE_RESIDUAL,
-            &data.record.t,
-            &found.residual_before,
-            &[("final", &found.residual_after)],
-        )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            "Residual (measured − model) of the base (grey band) and of the final model.",
-        ));
-        let mut sections = vec![s];
-        sections.extend(record_sections(&data, &[], out)?);
-        write_report(
-            &format!("Discovery: {}", exp.path.display()),
-            vec![format!(
-                "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-                named(&found.effects),
-                found.gap_before,
-                found.gap_after,
-                found.noise_floor
-            )],
-            sections,
-            out,
-        )?;
-    }
-
-    println!(
-        "base `{}`: gap {:.4} N; {}",
-        spec.base, found.gap_before, found.where_before.summary
+    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
+    let (before, after) = (
+        minus(f, &found.residual_before),
+        minus(f, &found.residual_after),
     );
+    crate::discovery_curves::write_curves(out, "f_stf", &data.record.t, f, (&before, &after))
+}
+
+/// The base model as `[discover] base` names it.
+fn base_of<'a>(exp: &'a Experiment, found: &'a Discovery) -> &'a str {
+    exp.discover
+        .as_ref()
+        .map_or(found.base.as_str(), |d| d.base.as_str())
+}
+
+/// `measured − residual`, sample by sample: the modelled curve.
+fn minus(measured: &[f64], residual: &[f64]) -> Vec<f64> {
+    measured.iter().zip(residual).map(|(m, r)| m - r).collect()
+}
+
+/// The report of a force-level discovery.
+fn force_report(
+    exp: &Experiment,
+    data: &FitData,
+    found: &Discovery,
+    score: Option<&DiscoveryScore>,
+    out: &Path,
+) -> Result<()> {
+    let dir = out.join("figures");
+    std::fs::create_dir_all(&dir)?;
+    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
+    let (before, after) = (
+        minus(f, &found.residual_before),
+        minus(f, &found.residual_after),
+    );
+    let mut s = Section::new("Discovery");
+    s.paragraphs.push(format!(
+        "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
+        base_of(exp, found),
+        found.gap_before,
+        found.noise_floor,
+        found.where_before.summary
+    ));
     for step in &found.steps {
-        println!("  {}", step.verdict);
+        s.paragraphs.push(step.verdict.clone());
     }
-    println!(
-        "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
+    s.paragraphs.push(format!(
+        "Final `{}`: gap {:.4} N. {}",
+        found.final_model_name, found.gap_after, found.where_after.summary
+    ));
+    s.paragraphs.push(format!(
+        "{}.",
+        held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
+    ));
+    s.paragraphs.extend(found.notes.iter().cloned());
+    s.tables.extend(
+        found
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(i, step)| step_table(i, step)),
+    );
+    let fig = measured_vs_fitted(
+        &dir,
+        "discovery_force",
+        &data.record.t,
+        f,
+        &[("base", &before), ("final", &after)],
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "Measured STF force against the base and the final model.",
+    ));
+    let fig = measured_vs_model(
+        &dir,
+        "discovery_residual",
+        STF_FORCE_RESIDUAL,
+        &data.record.t,
+        &found.residual_before,
+        &[("final", &found.residual_after)],
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "Residual (measured − model) of the base (grey band) and of the final model.",
+    ));
+    let mut sections = vec![s];
+    sections.extend(record_sections(data, &[], out)?);
+    let mut intro = vec![format!(
+        "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
         named(&found.effects),
         found.gap_before,
         found.gap_after,
-        found.noise_floor,
-        wall
-    );
-    for note in &found.notes {
-        println!("  note: {note}");
+        found.noise_floor
+    )];
+    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("N", 1.0))));
+    write_report(
+        &format!("Discovery: {}", exp.path.display()),
+        intro,
+        sections,
+        out,
+    )
+}
+
+/// The table of step `i`'s candidates (force level).
+fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
+    Table {
+        caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
+        columns: [
+            "candidate",
+            "held-out RMS, N",
+            "ΔBIC",
+            "paired z (units)",
+            "explains of the excess",
+            "significant",
+        ]
+        .iter()
+        .map(|c| c.to_string())
+        .collect(),
+        rows: step
+            .candidates
+            .iter()
+            .map(|c| {
+                vec![
+                    c.name.clone(),
+                    format!("{:.5}", c.holdout_rms),
+                    format!("{:.1}", c.delta_bic),
+                    format!("{:.1} ({})", c.gain_z, c.effective_n),
+                    format!("{:.0} %", 100.0 * c.explained_share),
+                    if c.significant {
+                        "yes".into()
+                    } else {
+                        "no".into()
+                    },
+                ]
+            })
+            .collect(),
     }
-    println!("final model, as an experiment entry:\n{toml_entry}");
-    println!(
-        "wrote {0}/discovery.json, {0}/report.html, {0}/report.md and {0}/figures/",
-        out.display()
-    );
-    Ok(())
 }
 
 /// The oscillator parameters refitted with every model at trajectory level: `[fit] system`,
@@ -362,31 +468,14 @@ fn run_trajectory(
     candidates: &[Candidate],
     cycles: &[stf_core::regimes::Cycle],
     settings: &DiscoverySettings,
-    out: &Path,
+    (out, validation): (&Path, Option<&ValidationRecord>),
     (quiet, bar): (bool, &indicatif::ProgressBar),
 ) -> Result<()> {
     let Some(spec) = &exp.discover else {
         bail!("{}: has no [discover] section", exp.path.display());
     };
-    let k = &data.kinematics;
     let names = refitted(exp, data);
-    let (x0, v0) = k.initial_state();
-    let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
-        .sim_settings(exp.integrator.clone())
-        .initial(x0, v0);
-    for name in &names {
-        setup = setup.refit(system_param(name, &exp.system, k));
-    }
-    setup = setup.force_hint(stf_core::discovery::ForceHint {
-        v: k.v.clone(),
-        a: k.a.clone(),
-        f: k.recovered_force(&exp.system),
-    });
-    if exp.fit.fit_initial {
-        for p in k.initial_state_params() {
-            setup = setup.refit(p);
-        }
-    }
+    let setup = trajectory_setup(exp, data, &names);
     let settings = settings.clone().fit_offset(exp.fit.offset);
     let started = Instant::now();
     if !quiet {
@@ -407,6 +496,71 @@ fn run_trajectory(
     bar.finish_and_clear();
     let tf = tf?;
     let wall = started.elapsed().as_secs_f64();
+    let score = validation.map(|rec| crate::validation::score_trajectory_discovery(exp, &tf, rec));
+    let (toml_entry, system_entry) =
+        write_trajectory_results(exp, data, &tf, &names, score.as_ref(), (out, wall))?;
+    if exp.output.report {
+        trajectory_report(exp, data, &tf, score.as_ref(), out)?;
+    }
+    let found = &tf.discovery;
+    for step in &found.steps {
+        println!("  {}", step.verdict);
+    }
+    println!(
+        "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
+        named(&found.effects),
+        tf.s_before_mm2,
+        tf.s_after_mm2,
+        found.noise_floor * 1e3,
+        wall
+    );
+    println!(
+        "  {}",
+        held_out_and_validation(found.holdout_cycles, score.as_ref(), "mm", 1e3)
+    );
+    println!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
+    println!(
+        "wrote {0}/discovery.json and {0}/discovered.csv",
+        out.display()
+    );
+    Ok(())
+}
+
+/// The oscillator side of a trajectory-level discovery: the record's drive and initial
+/// state, the parameters `names` refitted with every model (and `x0`, `v0` unless
+/// `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
+fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[String]) -> TrajectorySetup {
+    let k = &data.kinematics;
+    let (x0, v0) = k.initial_state();
+    let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
+        .sim_settings(exp.integrator.clone())
+        .initial(x0, v0);
+    for name in names {
+        setup = setup.refit(system_param(name, &exp.system, k));
+    }
+    setup = setup.force_hint(stf_core::discovery::ForceHint {
+        v: k.v.clone(),
+        a: k.a.clone(),
+        f: k.recovered_force(&exp.system),
+    });
+    if exp.fit.fit_initial {
+        for p in k.initial_state_params() {
+            setup = setup.refit(p);
+        }
+    }
+    setup
+}
+
+/// `discovery.json` and `discovered.csv` of a trajectory-level discovery; returns the final
+/// model's `[[models]]` and `[system]` entries.
+fn write_trajectory_results(
+    exp: &Experiment,
+    data: &FitData,
+    tf: &TrajectoryDiscovery,
+    names: &[String],
+    score: Option<&DiscoveryScore>,
+    (out, wall): (&Path, f64),
+) -> Result<(String, String)> {
     let found = &tf.discovery;
     let model_params: Vec<&FittedParam> = found
         .final_params
@@ -425,13 +579,13 @@ fn run_trajectory(
                 .filter_map(|n| tf.system_after.get(n).map(|v| format!("{n} = {v}\n"))),
         )
         .collect();
-    let doc = json!({
+    let mut doc = json!({
         "experiment": exp.path.display().to_string(),
         "record": data.record.source,
         "drive": data.kinematics.drive,
         "system_estimate": data.system_estimate,
         "level": "trajectory",
-        "base": spec.base,
+        "base": base_of(exp, found),
         "effects": found.effects,
         "gap_before": found.gap_before,
         "gap_after": found.gap_after,
@@ -455,79 +609,80 @@ fn run_trajectory(
             "experiment_entry": toml_entry,
             "system_entry": system_entry,
         },
+        "fitted": crate::discovery_curves::trajectory_curves(tf),
         "wall_seconds": wall,
         "notes": found.notes,
     });
+    if let Some(score) = score {
+        doc["validation"] = serde_json::to_value(score)?;
+    }
     write_json(&out.join("discovery.json"), &doc)?;
-    if exp.output.report {
-        let dir = out.join("figures");
-        std::fs::create_dir_all(&dir)?;
-        let mut s = Section::new("Discovery (trajectory level)");
-        s.paragraphs.extend(found.notes.iter().cloned());
-        let mm = |x: &[f64]| x.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
-        let fig = measured_vs_model(
-            &dir,
-            "discovery_x",
-            DISPLACEMENT_MM,
-            &data.record.t,
-            &mm(&data.record.x),
-            &[("base", &mm(&tf.x_before)), ("final", &mm(&tf.x_after))],
-        )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            "Measured displacement against the simulated base and final model.",
-        ));
-        let residual = |sim: &[f64]| {
-            data.record
-                .x
-                .iter()
-                .zip(sim)
-                .map(|(m, s)| (m - s) * 1e3)
-                .collect::<Vec<f64>>()
-        };
-        let fig = measured_vs_model(
-            &dir,
-            "discovery_x_residual",
-            DISPLACEMENT_RESIDUAL_MM,
-            &data.record.t,
-            &residual(&tf.x_before),
-            &[("final", &residual(&tf.x_after))],
-        )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            "Displacement residual (measured − simulated) of the base (grey band) and of the \
-             final model.",
-        ));
-        let mut sections = vec![s];
-        sections.extend(record_sections(data, &[], out)?);
-        write_report(
-            &format!("Discovery: {}", exp.path.display()),
-            vec![format!(
-                "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor \
-                 {:.4} mm).",
-                named(&found.effects),
-                tf.s_before_mm2,
-                tf.s_after_mm2,
-                found.gap_before * 1e3,
-                found.gap_after * 1e3,
-                found.noise_floor * 1e3
-            )],
-            sections,
-            out,
-        )?;
-    }
-    for step in &found.steps {
-        println!("  {}", step.verdict);
-    }
-    println!(
-        "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
+    let x = &data.record.x;
+    let curves = (tf.x_before.as_slice(), tf.x_after.as_slice());
+    crate::discovery_curves::write_curves(out, "x", &data.record.t, x, curves)?;
+    Ok((toml_entry, system_entry))
+}
+
+/// The report of a trajectory-level discovery.
+fn trajectory_report(
+    exp: &Experiment,
+    data: &FitData,
+    tf: &TrajectoryDiscovery,
+    score: Option<&DiscoveryScore>,
+    out: &Path,
+) -> Result<()> {
+    let found = &tf.discovery;
+    let dir = out.join("figures");
+    std::fs::create_dir_all(&dir)?;
+    let mut s = Section::new("Discovery (trajectory level)");
+    s.paragraphs.extend(found.notes.iter().cloned());
+    s.paragraphs.push(format!(
+        "{}.",
+        held_out_and_validation(found.holdout_cycles, score, "mm", 1e3)
+    ));
+    let mm = |x: &[f64]| x.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
+    let fig = measured_vs_model(
+        &dir,
+        "discovery_x",
+        DISPLACEMENT_MM,
+        &data.record.t,
+        &mm(&data.record.x),
+        &[("base", &mm(&tf.x_before)), ("final", &mm(&tf.x_after))],
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "Measured displacement against the simulated base and final model.",
+    ));
+    let residual = |sim: &[f64]| mm(&minus(&data.record.x, sim));
+    let fig = measured_vs_model(
+        &dir,
+        "discovery_x_residual",
+        DISPLACEMENT_RESIDUAL_MM,
+        &data.record.t,
+        &residual(&tf.x_before),
+        &[("final", &residual(&tf.x_after))],
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "Displacement residual (measured − simulated) of the base (grey band) and of the \
+         final model.",
+    ));
+    let mut sections = vec![s];
+    sections.extend(record_sections(data, &[], out)?);
+    let mut intro = vec![format!(
+        "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor {:.4} mm).",
         named(&found.effects),
         tf.s_before_mm2,
         tf.s_after_mm2,
-        found.noise_floor * 1e3,
-        wall
-    );
-    println!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
-    println!("wrote {}/discovery.json", out.display());
-    Ok(())
+        found.gap_before * 1e3,
+        found.gap_after * 1e3,
+        found.noise_floor * 1e3
+    )];
+    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("mm", 1e3))));
+    write_report(
+        &format!("Discovery: {}", exp.path.display()),
+        intro,
+        sections,
+        out,
+    )
 }

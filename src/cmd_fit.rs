@@ -2,7 +2,8 @@
 //! oscillator identification stages of `[[identify]]`.
 //!
 //! Writes `DIR/fit.json` (for each model: `name`, `params`, `rms`, standard errors, AIC/BIC,
-//! convergence, the noise floor, `warnings` …) and `DIR/fitted.csv` (the measured signal and
+//! convergence, the noise floor, `warnings` …; with `[validate]`, `validation_rms` and
+//! `validation`, its error on the second record, [`crate::validation`]) and `DIR/fitted.csv` (the measured signal and
 //! each model's fit). The summary on the terminal prints each model's warnings under its line
 //! ([`stf_core::fit::fit_warnings`]: not converged, residual above the noise floor, a
 //! parameter on a bound or not determined, two parameters not told apart).
@@ -25,21 +26,31 @@ use crate::fitting::{
 };
 use crate::output::{prepare_dir, write_columns, write_json};
 use crate::progress::{fit_message, Progress};
+use crate::validation::ValidationRecord;
+use stf_core::regimes::Regime;
 
 /// Run `stf-lab fit`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let mut exp = Experiment::load(exp_path)?;
     let progress = Progress::new(quiet);
     if !exp.identify.is_empty() {
+        if let Some(spec) = &exp.validate {
+            let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
+            return Err(spec.error("validate", msg));
+        }
         prepare_dir(out, force)?;
         return identify(&exp, out, &progress);
     }
     let data = load_data(&mut exp)?;
+    let validation = crate::validation::load(&exp, &data)?;
     prepare_dir(out, force)?;
     if let Some(line) = estimate_line(&data) {
         println!("{line}");
     }
-    let fits = fit_all(&exp, &data, &progress)?;
+    let mut fits = fit_all(&exp, &data, &progress)?;
+    if let Some(rec) = &validation {
+        crate::validation::score_fits(&mut fits, rec);
+    }
 
     let level = data.level;
     let doc = json!({
@@ -68,14 +79,24 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
 
     print_summary(&data, &fits);
+    if let Some(rec) = &validation {
+        print_validation(rec, &fits);
+    }
     if exp.output.report {
-        let sections = crate::reporting::record_sections(&data, &fits, out)?;
+        let mut sections = Vec::new();
+        if let Some(rec) = &validation {
+            sections.push(crate::reporting::validation_section(rec, &fits, out)?);
+        }
+        sections.extend(crate::reporting::record_sections(&data, &fits, out)?);
         let mut intro = vec![format!(
             "stf-lab fitted {} model(s) of {} to {}.",
             fits.len(),
             exp.path.display(),
             data.record.source
         )];
+        if let Some(rec) = &validation {
+            intro.push(crate::reporting::validation_intro(rec, &fits));
+        }
         let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
         if warned > 0 {
             intro.push(format!(
@@ -143,6 +164,54 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
             }
         );
         print_warnings(&f.warnings);
+    }
+}
+
+/// The validation block: each model's error on the `[validate]` record, per regime where
+/// the record has them.
+fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
+    let (unit, scale) = match rec.data.level {
+        FitLevel::Force => ("N", 1.0),
+        FitLevel::Trajectory => ("mm", 1e3),
+    };
+    println!(
+        "validation on {} ({} samples), fitted parameters held{}:",
+        rec.spec.given,
+        rec.data.record.len(),
+        if rec.data.level == FitLevel::Trajectory {
+            ", initial state as in the fit"
+        } else {
+            ""
+        }
+    );
+    for f in fits {
+        let Some(v) = &f.validation else { continue };
+        let Some(score) = &v.score else {
+            println!(
+                "  {:<24} not scored: {}",
+                f.label,
+                v.error.as_deref().unwrap_or("?")
+            );
+            continue;
+        };
+        let regimes: Vec<String> = v
+            .per_regime
+            .iter()
+            .flat_map(|p| Regime::ALL.map(|r| p.get(r).map(|e| (r, e.rms))))
+            .flatten()
+            .map(|(r, rms)| format!("{} {:.4}", r.name(), rms * scale))
+            .collect();
+        println!(
+            "  {:<24} rms {:.4} {unit} ({:.3} of the measured RMS){}",
+            f.label,
+            score.rms * scale,
+            score.normalised,
+            if regimes.is_empty() {
+                String::new()
+            } else {
+                format!("; {}", regimes.join(", "))
+            }
+        );
     }
 }
 

@@ -23,6 +23,9 @@ use toml::Spanned;
 
 use crate::data_layout::{self, RawData};
 
+mod validate;
+pub use validate::ValidateSpec;
+
 /// A parameter value: a number, or a table with value / min / max / fixed.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(untagged)]
@@ -280,6 +283,7 @@ struct RawExperiment {
     identify: Vec<Spanned<RawStage>>,
     regimes: Option<Spanned<toml::Value>>,
     output: Option<RawOutput>,
+    validate: Option<Spanned<validate::RawValidate>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -450,11 +454,18 @@ pub struct Experiment {
     pub regimes: RegimeThresholds,
     /// `[discover] base`.
     pub discover: Option<DiscoverSpec>,
+    /// `[validate]`: the second record every fitted model is scored on.
+    pub validate: Option<ValidateSpec>,
 }
 
 /// 1-based line of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// `FILE:LINE: `KEY`: MSG`, the form of every error about a value in an experiment file.
+pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{}:{}: `{}`: {}", file.display(), line, key, msg)
 }
 
 /// Where errors point: the experiment file and its text.
@@ -476,13 +487,7 @@ impl Ctx<'_> {
         key: &str,
         msg: impl std::fmt::Display,
     ) -> anyhow::Error {
-        anyhow::anyhow!(
-            "{}:{}: `{}`: {}",
-            self.file.display(),
-            line_of(self.text, span.start),
-            key,
-            msg
-        )
+        error_at(self.file, line_of(self.text, span.start), key, msg)
     }
 }
 
@@ -927,6 +932,7 @@ impl Experiment {
             }
         }
         Ok(Experiment {
+            validate: validate::spec(raw.validate.as_ref(), &cx, &dir)?,
             path: path.to_path_buf(),
             data_window: data.window,
             data_layout: data.layout,
@@ -1178,6 +1184,10 @@ name = "viscous"
 
 [regimes]
 on_k = 3.0
+
+[validate]
+file = "v.csv"
+window = [0.0, 5.0]
 "#;
 
     proptest::proptest! {

@@ -18,9 +18,7 @@ use stf_core::fit::{
     TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
-use stf_core::oscillator::Oscillator;
 use stf_core::record::Record;
-use stf_core::simulate::Simulation;
 use stf_core::system::OscillatorParams;
 
 use crate::experiment::{Experiment, FitLevel};
@@ -165,6 +163,15 @@ pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
     })
 }
 
+/// The fit a model's prediction comes from, to predict again on other data.
+#[derive(Clone)]
+pub enum Predictor {
+    /// A force-level fit: the model's force along a record's kinematics.
+    Force(ForceFit),
+    /// A trajectory-level fit: the oscillator with the model, simulated.
+    Trajectory(TrajectoryFit),
+}
+
 /// One fitted model.
 pub struct ModelFit {
     /// The model as configured (start values and bounds).
@@ -181,6 +188,13 @@ pub struct ModelFit {
     pub floor: Option<NoiseFloor>,
     /// Why the result is not to be trusted as it stands (empty: no reason found).
     pub warnings: Vec<FitWarning>,
+    /// The fit, to predict with `values` on other data.
+    pub predictor: Predictor,
+    /// The fitted values in the predictor's order: the model's parameters then the offset
+    /// (force level), or the free parameters as listed (trajectory level).
+    pub values: Vec<f64>,
+    /// The model's error on the `[validate]` record, once scored.
+    pub validation: Option<crate::validation::ModelValidation>,
 }
 
 impl ModelFit {
@@ -201,8 +215,19 @@ impl ModelFit {
         })
     }
 
-    /// The fit as the JSON of docs/ARCHITECTURE.md §6 (`name`, `params`, `rms`) and more.
+    /// The fit as the JSON of docs/ARCHITECTURE.md §6 (`name`, `params`, `rms`) and more;
+    /// with a validation record, `validation_rms` and `validation`.
     pub fn to_json(&self, level: FitLevel) -> Value {
+        let mut doc = self.fit_json(level);
+        if let Some(v) = &self.validation {
+            doc["validation_rms"] = v.rms().map_or(Value::Null, |r| json!(r));
+            doc["validation"] = serde_json::to_value(v).unwrap_or(Value::Null);
+        }
+        doc
+    }
+
+    /// The fit's own part of [`ModelFit::to_json`].
+    fn fit_json(&self, level: FitLevel) -> Value {
         let params: serde_json::Map<String, Value> = self
             .result
             .params
@@ -366,6 +391,9 @@ fn fit_force(
         label,
         floor,
         warnings,
+        predictor: Predictor::Force(fit),
+        values,
+        validation: None,
     })
 }
 
@@ -380,7 +408,7 @@ fn fit_trajectory(
     let k = &data.kinematics;
     let excitation = Arc::new(k.excitation());
     let (x0, v0) = k.initial_state();
-    let mut fit = TrajectoryFit::new(exp.system, excitation.clone())
+    let mut fit = TrajectoryFit::new(exp.system, excitation)
         .sim_settings(exp.integrator.clone())
         .settings(exp.fit.settings.clone())
         .initial(x0, v0);
@@ -415,30 +443,25 @@ fn fit_trajectory(
         }
     }
     let floor = NoiseFloor::displacement(k.sigma_x);
-    let mf = ModelFit {
+    let values: Vec<f64> = free
+        .iter()
+        .map(|p| result.value(&p.name).unwrap_or(p.value))
+        .collect();
+    let fitted = fit
+        .predict(&td, &values)
+        .with_context(|| format!("simulating the fitted `{label}`"))?;
+    Ok(ModelFit {
         configured: configured.cloned(),
         warnings: fit_warnings(&result, &free, Some(&floor)),
         result,
-        fitted: Vec::new(),
+        fitted,
         system,
-        label: label.clone(),
+        label,
         floor: Some(floor),
-    };
-    let x_off = mf.result.value("x_off").unwrap_or(0.0);
-    let mut osc = Oscillator::with_shared_excitation(system, excitation);
-    if let Some(c) = configured {
-        osc = osc.with_model(c.model.clone(), mf.model_values())?;
-    }
-    let run = Simulation::new(&osc)
-        .settings(exp.integrator.clone())
-        .initial(
-            mf.result.value("x0").unwrap_or(x0 - x_off),
-            mf.result.value("v0").unwrap_or(v0),
-        )
-        .run_at(&data.record.t)
-        .with_context(|| format!("simulating the fitted `{label}`"))?;
-    let fitted = run.x.iter().map(|x| x + x_off).collect();
-    Ok(ModelFit { fitted, ..mf })
+        predictor: Predictor::Trajectory(fit),
+        values,
+        validation: None,
+    })
 }
 
 /// Configure and fit every model of the experiment, in parallel.

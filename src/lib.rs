@@ -1,7 +1,8 @@
 //! `stf_lab`: the library behind the `stf-lab` program of the shear-thickening fluid lab. It
 //! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
-//! compare, discover, models), and writes results, figures and reports ([`output`],
-//! [`report`], [`reporting`]). The binary (`src/main.rs`) only parses the command line and
+//! compare, discover, models), scores fitted models on a second record ([`validation`]), and
+//! writes results, figures and reports ([`output`], [`report`], [`reporting`],
+//! [`discovery_curves`]). The binary (`src/main.rs`) only parses the command line and
 //! calls one `cmd_*::run`; integration tests and fuzz targets use the same functions.
 
 // `!(a > b)` is how this crate says "not greater, or NaN": the NaN case is meant.
@@ -14,6 +15,7 @@ pub mod cmd_fit;
 pub mod cmd_models;
 pub mod cmd_simulate;
 pub mod data_layout;
+pub mod discovery_curves;
 pub mod experiment;
 pub mod fitting;
 pub mod interrupt;
@@ -22,3 +24,4 @@ pub mod output;
 pub mod progress;
 pub mod report;
 pub mod reporting;
+pub mod validation;

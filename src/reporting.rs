@@ -1,7 +1,8 @@
 //! The standard report of a command's results: the figures of the source study (time
 //! histories of x, v, a against F_STF; hysteresis loops against x, v and a; measured against
 //! fitted; the frequency response), a table per command, `report.html` (self-contained) and
-//! `report.md`, with a CSV of every plotted series under `DIR/figures/`.
+//! `report.md`, with a CSV of every plotted series under `DIR/figures/`. With a `[validate]`
+//! record, its section comes first ([`validation_section`]).
 
 use std::path::Path;
 
@@ -12,9 +13,12 @@ use stf_core::fit::{CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::report::{
-    frequency_response, hysteresis, measured_vs_fitted, time_history, write_html, write_markdown,
-    FigureRef, FrfCurve, Motion, Report, Section, Smoothing, Table,
+    frequency_response, hysteresis, measured_vs_fitted, measured_vs_model, time_history,
+    write_html, write_markdown, FigureRef, FrfCurve, Motion, Report, Section, Smoothing, Table,
+    DISPLACEMENT_VALIDATION_MM, STF_FORCE_VALIDATION,
 };
+use crate::validation::ValidationRecord;
+use stf_core::regimes::Regime;
 
 /// A section of the figures of a record and its fits.
 pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<Vec<Section>> {
@@ -148,6 +152,136 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
         sections.push(s);
     }
     Ok(sections)
+}
+
+/// The sentence of the report's intro on the validation record: the best model there.
+pub fn validation_intro(rec: &ValidationRecord, fits: &[ModelFit]) -> String {
+    let (unit, scale) = unit_of(rec.data.level);
+    let best = fits
+        .iter()
+        .filter_map(|f| Some((f, f.validation.as_ref()?.score.as_ref()?)))
+        .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms));
+    match best {
+        Some((f, s)) => format!(
+            "Validated on a second record, {}: the smallest error there is `{}`'s, RMS {:.4} \
+             {unit} ({:.3} of the measured RMS); see Validation.",
+            rec.spec.given,
+            f.label,
+            s.rms * scale,
+            s.normalised
+        ),
+        None => format!(
+            "Validated on a second record, {}: no model could be scored there.",
+            rec.spec.given
+        ),
+    }
+}
+
+/// The unit errors are shown in at a fit level, and the factor from SI.
+fn unit_of(level: FitLevel) -> (&'static str, f64) {
+    match level {
+        FitLevel::Force => ("N", 1.0),
+        FitLevel::Trajectory => ("mm", 1e3),
+    }
+}
+
+/// The section of the validation record: each model's error there (overall, against the
+/// measured RMS, and per regime) beside its error on the estimation record, and the figure of
+/// the record against each model's prediction.
+pub fn validation_section(
+    rec: &ValidationRecord,
+    fits: &[ModelFit],
+    out: &Path,
+) -> Result<Section> {
+    let dir = out.join("figures");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let (unit, scale) = unit_of(rec.data.level);
+    let mut s = Section::new("Validation on a second record");
+    s.paragraphs.push(format!(
+        "Every model scored on {} ({} samples; the estimation record's column mapping, filters \
+         and drive reconstruction) with the parameters fitted on the estimation record{}.",
+        rec.spec.given,
+        rec.data.record.len(),
+        match rec.data.level {
+            FitLevel::Force => ": the STF force predicted from its kinematics",
+            FitLevel::Trajectory =>
+                ": the fitted oscillator and model driven by its drive, from its own initial \
+                 state (fitted on it when the fit fits x0, v0)",
+        }
+    ));
+    s.tables.push(validation_table(fits, unit, scale));
+    s.warnings = fits
+        .iter()
+        .filter_map(|f| f.validation.as_ref()?.error.clone())
+        .collect();
+    let predicted: Vec<(&str, Vec<f64>)> = fits
+        .iter()
+        .filter_map(|f| {
+            let score = f.validation.as_ref()?.score.as_ref()?;
+            Some((
+                f.label.as_str(),
+                score.predicted.iter().map(|x| x * scale).collect(),
+            ))
+        })
+        .collect();
+    if !predicted.is_empty() {
+        let quantity = match rec.data.level {
+            FitLevel::Force => STF_FORCE_VALIDATION,
+            FitLevel::Trajectory => DISPLACEMENT_VALIDATION_MM,
+        };
+        let measured: Vec<f64> = rec.data.target().iter().map(|x| x * scale).collect();
+        let curves: Vec<(&str, &[f64])> =
+            predicted.iter().map(|(l, p)| (*l, p.as_slice())).collect();
+        let fig = measured_vs_model(
+            &dir,
+            "validation",
+            quantity,
+            &rec.data.record.t,
+            &measured,
+            &curves,
+        )?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "The validation record against each model's prediction with its fitted parameters.",
+        ));
+    }
+    Ok(s)
+}
+
+/// The table of each model's error on the validation record: overall, against the measured
+/// RMS, per regime, and its RMS on the estimation record (in `unit`, `scale` from SI).
+fn validation_table(fits: &[ModelFit], unit: &str, scale: f64) -> Table {
+    let mut columns: Vec<String> = ["model", "validation RMS", "of the measured RMS"]
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    columns[1].push_str(&format!(", {unit}"));
+    columns.extend(Regime::ALL.iter().map(|r| format!("{}, {unit}", r.name())));
+    columns.push(format!("estimation RMS, {unit}"));
+    let cell = |x: Option<f64>, digits: usize| x.map_or("—".into(), |x| format!("{x:.digits$}"));
+    let rows = fits
+        .iter()
+        .map(|f| {
+            let v = f.validation.as_ref();
+            let score = v.and_then(|v| v.score.as_ref());
+            let mut row = vec![
+                f.label.clone(),
+                cell(score.map(|s| s.rms * scale), 4),
+                cell(score.map(|s| s.normalised), 3),
+            ];
+            for r in Regime::ALL {
+                let e = v.and_then(|v| v.per_regime.as_ref()).and_then(|p| p.get(r));
+                row.push(cell(e.map(|e| e.rms * scale), 4));
+            }
+            row.push(format!("{:.4}", f.result.rms * scale));
+            row
+        })
+        .collect();
+    Table {
+        caption: "Error on the validation record (fitted parameters held).".into(),
+        columns,
+        rows,
+    }
 }
 
 /// What the warnings check, with each fit's noise floor.

@@ -63,3 +63,78 @@ fn discovery_names_the_hidden_cubic_spring_and_the_gap_shrinks_to_the_noise() {
     .unwrap();
     let _ = run_ok("fit", &exp, &out.path().join("refit"));
 }
+
+/// The bundled discovery record for estimation, and a validation record of the same truth
+/// (power law K 4, n 1.5 and a cubic spring k3 2e4) on another sweep (ω 3.5 → 9.5 rad/s over
+/// 40 s) with another noise seed, made by `stf-lab simulate`; the experiment discovers from
+/// the power law with `[validate]`.
+fn validated_discovery(dir: &std::path::Path) -> std::path::PathBuf {
+    let sim = dir.join("validation.toml");
+    std::fs::write(
+        &sim,
+        "[simulate]\nsweep = { w0 = 3.5, alpha = 0.15, t0 = 0.0, t1 = 40.0 }\nrate = 200.0\n\
+         seed = 12\n\n[[simulate.truth]]\nname = \"power_law\"\nplus = [\"cubic_stiffness\"]\n\
+         params = { K = 4.0, n = 1.5, k3 = 2e4 }\n",
+    )
+    .unwrap();
+    common::simulate_ok(&sim, &dir.join("validation.csv"));
+    let exp = dir.join("exp.toml");
+    let record = root().join("experiments/records/discovery_sweep.csv");
+    std::fs::write(
+        &exp,
+        format!(
+            "[data]\nfile = {:?}\n\n[validate]\nfile = \"validation.csv\"\n\n\
+             [discover]\nbase = \"power_law\"\n",
+            record.display().to_string()
+        ),
+    )
+    .unwrap();
+    exp
+}
+
+#[test]
+fn discovery_is_validated_on_a_second_record_and_its_json_redraws_its_curves() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = validated_discovery(tmp.path());
+    let out = tmp.path().join("disc");
+    let stdout = String::from_utf8_lossy(&run_ok("discover", &exp, &out).stdout).into_owned();
+    let doc = read_json(&out.join("discovery.json"));
+    assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
+    let v = &doc["validation"];
+    assert_eq!(v["file"], "validation.csv");
+    let (before, after) = (
+        v["rms_before"].as_f64().unwrap(),
+        v["rms_after"].as_f64().unwrap(),
+    );
+    // The final model predicts the other record to the force sensor's noise (σ 0.02 N); the
+    // base misses the spring there too.
+    let floor = doc["noise_floor"].as_f64().unwrap();
+    eprintln!("validation RMS {before} → {after} N, floor {floor} N");
+    assert!(after < 1.15 * floor, "{after} against a floor of {floor}");
+    assert!(before > 4.0 * after, "{before} → {after}");
+    assert!(stdout.contains("held out: 14 cycles of the record; validation on validation.csv"));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("validation on validation.csv (8001 samples)"));
+
+    // The fitted values alone, with the record's kinematics read as the experiment reads
+    // them, predict the curves discovered.csv holds.
+    let experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
+    let data = stf_lab::fitting::load_data(&experiment).unwrap();
+    let csv = out.join("discovered.csv");
+    for (which, column) in [("base", "f_stf_base"), ("final", "f_stf_final")] {
+        let entry = &doc["fitted"][which];
+        let (model, mut values) = common::fitted_model(entry);
+        let mut fit = stf_core::fit::ForceFit::new(model);
+        if let Some(off) = entry["offset"]["value"].as_f64() {
+            fit = fit.offset(stf_core::fit::FitParam::new("f_off", off));
+            values.push(off);
+        }
+        let redrawn = fit.predict(&data.force_data(), &values).unwrap();
+        let written = common::csv_column(&csv, column);
+        let diff = common::max_difference(&redrawn, &written);
+        assert!(diff < 1e-12, "{which}: redrawn differs by {diff} N");
+    }
+    let entry = &doc["fitted"]["final"];
+    assert_eq!(entry["name"], "power_law + cubic_stiffness");
+    assert_eq!(entry["params"]["k3"], doc["final_model"]["params"]["k3"]);
+}

@@ -151,3 +151,81 @@ fn the_bundled_example_names_the_cubic_spring() {
     let (before, after) = ((before / n).sqrt(), (after / n).sqrt());
     assert!(after < 0.1 * before, "x residual {before} → {after} mm RMS");
 }
+
+#[test]
+fn trajectory_discovery_is_validated_on_a_second_record_and_its_json_redraws_its_curves() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = experiment(tmp.path(), 1e4);
+    // The validation record: the same rig and truth under another chirp (0.6 → 1.4 Hz of
+    // 1.8 N over 15 s) with another noise seed.
+    let sim = tmp.path().join("validation.toml");
+    std::fs::write(
+        &sim,
+        "[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n[simulate]\n\
+         chirp = { f0 = 0.6, f1 = 1.4, amplitude = 1.8, t1 = 15.0 }\nrate = 200.0\nseed = 8\n\n\
+         [[simulate.truth]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n\
+         params = { c_s = 1.0, k3 = 1e4 }\n",
+    )
+    .unwrap();
+    simulate_ok(&sim, &tmp.path().join("validation.csv"));
+    let text = std::fs::read_to_string(&exp).unwrap();
+    std::fs::write(
+        &exp,
+        format!("{text}\n[validate]\nfile = \"validation.csv\"\n"),
+    )
+    .unwrap();
+    let out = tmp.path().join("disc");
+    let stdout = String::from_utf8_lossy(&run_ok("discover", &exp, &out).stdout).into_owned();
+    let doc = read_json(&out.join("discovery.json"));
+    assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
+    let v = &doc["validation"];
+    assert_eq!(
+        (&v["file"], &v["unit"]),
+        (&"validation.csv".into(), &"m".into())
+    );
+    let (before, after) = (
+        v["rms_before"].as_f64().unwrap(),
+        v["rms_after"].as_f64().unwrap(),
+    );
+    // x noise σ 0.05 mm: the final model simulates the other record to it, the base does not.
+    let floor = doc["noise_floor"].as_f64().unwrap();
+    eprintln!("validation RMS {before} → {after} m, floor {floor} m");
+    assert!(after < 1.15 * floor, "{after} against a floor of {floor}");
+    assert!(before > 10.0 * after, "{before} → {after}");
+    assert_eq!(v["initial_fitted"], true);
+    assert!(
+        stdout.contains("validation on validation.csv (3001 samples)"),
+        "{stdout}"
+    );
+
+    // The fitted values alone — oscillator, model, offset, initial state — with the record's
+    // drive read as the experiment reads it, simulate the curves discovered.csv holds.
+    let experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
+    let data = stf_lab::fitting::load_data(&experiment).unwrap();
+    let drive = std::sync::Arc::new(data.kinematics.excitation());
+    let csv = out.join("discovered.csv");
+    for (which, column) in [("base", "x_base"), ("final", "x_final")] {
+        let entry = &doc["fitted"][which];
+        let (model, values) = common::fitted_model(entry);
+        let system: stf_core::system::OscillatorParams =
+            serde_json::from_value(entry["system"].clone()).unwrap();
+        let osc = stf_core::oscillator::Oscillator::with_shared_excitation(system, drive.clone())
+            .with_model(model, values)
+            .unwrap();
+        let initial = &entry["initial"];
+        let run = stf_core::simulate::Simulation::new(&osc)
+            .settings(experiment.integrator.clone())
+            .initial(
+                initial["x0"].as_f64().unwrap(),
+                initial["v0"].as_f64().unwrap(),
+            )
+            .run_at(&data.record.t)
+            .unwrap();
+        let offset = entry["offset"]["value"].as_f64().unwrap_or(0.0);
+        let redrawn: Vec<f64> = run.x.iter().map(|x| x + offset).collect();
+        let diff = common::max_difference(&redrawn, &common::csv_column(&csv, column));
+        assert!(diff < 1e-12, "{which}: redrawn differs by {diff} m");
+    }
+    // The refitted oscillator is the one discovery.json reports.
+    assert_eq!(doc["fitted"]["final"]["system"], doc["system"]);
+}

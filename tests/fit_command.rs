@@ -271,3 +271,158 @@ fn the_true_model_on_its_own_record_draws_no_warning_and_a_cut_fit_says_so() {
         "{stdout}"
     );
 }
+
+/// Write `NAME.toml` simulating a sweep `sweep` (w0, alpha, t1) at 200 Hz with the rig's
+/// sensors and seed `seed` through a power law K 150, n 2.5, and its record `NAME.csv`.
+fn sweep_record(dir: &std::path::Path, name: &str, (w0, alpha, t1): (f64, f64, f64), seed: u64) {
+    let exp = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &exp,
+        format!(
+            "[simulate]\nsweep = {{ w0 = {w0:?}, alpha = {alpha:?}, t0 = 0.0, t1 = {t1:?} }}\n\
+             rate = 200.0\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
+             params = {{ K = 150.0, n = 2.5 }}\n"
+        ),
+    )
+    .unwrap();
+    common::simulate_ok(&exp, &dir.join(format!("{name}.csv")));
+}
+
+/// An estimation record (ω 4 → 8 rad/s over 20 s, seed 11) and a validation record of another
+/// sweep (ω 3 → 9.3 rad/s over 18 s, seed 12) of the same truth, and the experiment fitting a
+/// viscous model (wrong) and a power law (the truth) at `level` with `[validate]`.
+fn validation_experiment(dir: &std::path::Path, level: &str) -> std::path::PathBuf {
+    sweep_record(dir, "estimation", (4.0, 0.2, 20.0), 11);
+    sweep_record(dir, "validation", (3.0, 0.35, 18.0), 12);
+    let exp = dir.join(format!("fit_{level}.toml"));
+    std::fs::write(
+        &exp,
+        format!(
+            "[data]\nfile = \"estimation.csv\"\n\n[fit]\nlevel = \"{level}\"\n\n\
+             [validate]\nfile = \"validation.csv\"\n\n[[models]]\nname = \"viscous\"\n\n\
+             [[models]]\nname = \"power_law\"\n"
+        ),
+    )
+    .unwrap();
+    exp
+}
+
+/// The validation RMS of a model in fit.json, checked against its `validation` object.
+fn validation_rms(model: &serde_json::Value) -> f64 {
+    let rms = model["validation_rms"].as_f64().unwrap();
+    let v = &model["validation"];
+    assert_eq!(v["file"], "validation.csv");
+    assert_eq!(v["rms"].as_f64().unwrap(), rms);
+    let normalised = v["normalised"].as_f64().unwrap();
+    assert!((normalised - rms / v["measured_rms"].as_f64().unwrap()).abs() < 1e-12);
+    rms
+}
+
+#[test]
+fn fit_scores_every_model_on_the_validation_record_at_force_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = validation_experiment(dir.path(), "force");
+    let out = dir.path().join("fit");
+    let stdout = String::from_utf8_lossy(&run_ok("fit", &exp, &out).stdout).into_owned();
+    let fit = read_json(&out.join("fit.json"));
+    let models = fit["models"].as_array().unwrap();
+    let (wrong, truth) = (validation_rms(&models[0]), validation_rms(&models[1]));
+    // The true model predicts the other record to its noise (the sensor's σ 0.02 N and a
+    // little of the kinematics'); the viscous one misses by far more.
+    let floor = models[1]["noise_floor"]["sigma"].as_f64().unwrap();
+    eprintln!("validation RMS: viscous {wrong} N, power law {truth} N, floor {floor} N");
+    assert!(truth < 1.15 * floor, "{truth} against a floor of {floor}");
+    assert!(wrong > 3.0 * truth, "viscous {wrong}, power law {truth}");
+    // Per regime of the rotor's cycles: every regime of the sweep has cycles, all at the noise.
+    let per_regime = &models[1]["validation"]["per_regime"];
+    for regime in ["pre_resonance", "resonance", "post_resonance"] {
+        let e = &per_regime[regime];
+        assert!(e["cycles"].as_u64().unwrap() >= 3, "{per_regime}");
+        assert!(e["rms"].as_f64().unwrap() < 1.3 * floor, "{per_regime}");
+    }
+    assert_eq!(models[1]["validation"]["unit"], "N");
+    // On the terminal, and first in the report.
+    assert!(
+        stdout.contains("validation on validation.csv (3601 samples)"),
+        "{stdout}"
+    );
+    let line = stdout
+        .lines()
+        .rev()
+        .find(|l| l.trim_start().starts_with("power_law"))
+        .unwrap();
+    assert!(line.contains("of the measured RMS"), "{stdout}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let first = report.lines().find(|l| l.starts_with("## ")).unwrap();
+    assert_eq!(first, "## Validation on a second record");
+    assert!(out.join("figures/validation.csv").exists());
+}
+
+#[test]
+fn fit_scores_every_model_on_the_validation_record_at_trajectory_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let exp = validation_experiment(dir.path(), "trajectory");
+    let out = dir.path().join("fit");
+    run_ok("fit", &exp, &out);
+    let fit = read_json(&out.join("fit.json"));
+    let models = fit["models"].as_array().unwrap();
+    let (wrong, truth) = (validation_rms(&models[0]), validation_rms(&models[1]));
+    // x noise σ 0.05 mm (quantised 0.01 mm) on both records.
+    let floor = models[1]["noise_floor"]["sigma"].as_f64().unwrap();
+    eprintln!("validation RMS: viscous {wrong} m, power law {truth} m, floor {floor} m");
+    assert!(truth < 1.15 * floor, "{truth} against a floor of {floor}");
+    assert!(wrong > 5.0 * truth, "viscous {wrong}, power law {truth}");
+    let v = &models[1]["validation"];
+    assert_eq!(v["unit"], "m");
+    // The record's own initial state is fitted, as the fit fits x0, v0.
+    assert_eq!(v["initial_fitted"], true);
+    assert_eq!(v["initial"].as_array().unwrap().len(), 2);
+    assert!(v["per_regime"]["resonance"]["rms"].as_f64().unwrap() < 1.3 * floor);
+}
+
+#[test]
+fn a_missing_validation_record_or_column_is_an_error_before_any_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = root().join("experiments/records/power_law_sweep.csv");
+    // t, phi, x: no f_stf for a force-level fit.
+    std::fs::write(dir.path().join("no_force.csv"), "t,phi,x\n0,0,0\n").unwrap();
+    // A shaker's record (t, x, f_stf, u): no rotor angle to drive the estimation rig.
+    let mut no_drive = String::from("t,x,f_stf,u\n");
+    for i in 0..50 {
+        no_drive.push_str(&format!("{},0,0,0\n", f64::from(i) * 0.01));
+    }
+    std::fs::write(dir.path().join("no_drive.csv"), no_drive).unwrap();
+    for (level, file, expected) in [
+        ("force", "nowhere.csv", "no such record"),
+        ("force", "no_force.csv", "has no `f_stf` column"),
+        (
+            "trajectory",
+            "no_drive.csv",
+            "has no `phi` or `omega` column",
+        ),
+    ] {
+        let exp = dir.path().join("exp.toml");
+        std::fs::write(
+            &exp,
+            format!(
+                "[data]\nfile = {:?}\n\n[fit]\nlevel = \"{level}\"\n\n[validate]\n\
+                 window = [0.0, 10.0]\nfile = \"{file}\"\n\n[[models]]\nname = \"viscous\"\n",
+                record.display().to_string()
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join("fit");
+        let started = std::time::Instant::now();
+        let output = run("fit", &exp, &out);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success());
+        assert!(
+            stderr.contains("exp.toml:9: `validate.file`") && stderr.contains(expected),
+            "{stderr}"
+        );
+        assert!(stderr.contains(file), "{stderr}");
+        // Before any long work: nothing written, well under the time of a fit.
+        assert!(!out.exists(), "{stderr}");
+        assert!(started.elapsed().as_secs_f64() < 5.0);
+    }
+}

@@ -59,6 +59,24 @@ pub const DISPLACEMENT_MM: Quantity = Quantity {
     band: "measured",
 };
 
+/// The STF force of a validation record against each model's prediction from its
+/// kinematics, with the parameters fitted on another record.
+pub const STF_FORCE_VALIDATION: Quantity = Quantity {
+    title: "Validation record: STF force measured and predicted",
+    label: "F_STF, N",
+    model_word: "predicted",
+    band: "measured",
+};
+
+/// The displacement of a validation record against the oscillator simulated with each model
+/// as fitted on another record (values in mm).
+pub const DISPLACEMENT_VALIDATION_MM: Quantity = Quantity {
+    title: "Validation record: displacement measured and predicted",
+    label: "x, mm",
+    model_word: "predicted",
+    band: "measured",
+};
+
 /// The displacement residual (measured − simulated, mm) of a base model, drawn as the band,
 /// against the final model's.
 pub const DISPLACEMENT_RESIDUAL_MM: Quantity = Quantity {

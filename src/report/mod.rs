@@ -57,7 +57,7 @@ pub use hysteresis::hysteresis;
 pub use markdown::write_markdown;
 pub use measured_vs_fitted::{
     measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
-    STF_FORCE, STF_FORCE_RESIDUAL,
+    DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
 pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};

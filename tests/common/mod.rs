@@ -56,3 +56,50 @@ pub fn simulate_ok(experiment: &Path, record: &Path) {
 pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
+
+/// A CSV of numbers with a header row: the column named `name`.
+pub fn csv_column(path: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column `{name}` in {header:?}"));
+    lines
+        .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// The model of a `fitted` entry of discovery.json (`a + b`, built-ins) with its values in
+/// the model's order.
+pub fn fitted_model(
+    entry: &serde_json::Value,
+) -> (
+    std::sync::Arc<dyn stf_core::force_model::ForceModel>,
+    Vec<f64>,
+) {
+    let parts = entry["name"]
+        .as_str()
+        .unwrap()
+        .split(" + ")
+        .map(|p| stf_lab::model_config::resolve(p, root()).unwrap())
+        .collect();
+    let model: std::sync::Arc<dyn stf_core::force_model::ForceModel> =
+        std::sync::Arc::new(stf_core::model_sum::ModelSum::new(parts).unwrap());
+    let values = model
+        .params()
+        .iter()
+        .map(|s| entry["params"][&s.name].as_f64().unwrap())
+        .collect();
+    (model, values)
+}
+
+/// The largest |a − b| over two equal-length series.
+pub fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}

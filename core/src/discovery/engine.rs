@@ -449,6 +449,8 @@ pub fn discover_force(
             source,
         })?;
     let gap_before = rms(&residual_before);
+    let base_values = base_full.values[..base.params().len().min(base_full.values.len())].to_vec();
+    let base_params = base_result.params.clone();
     // 2. Where the gap lives.
     let floor_before = base_full.noise_floor(data, sensor, settings)?;
     let where_before = locate_gap(&residual_before, data, cycles, floor_before.sigma);
@@ -572,6 +574,9 @@ pub fn discover_force(
         where_after,
         residual_before,
         residual_after,
+        base_model: base,
+        base_values,
+        base_params,
         final_model_name: final_stage.name(),
         final_model,
         final_values: final_stage.values[..n_model.min(final_stage.values.len())].to_vec(),

@@ -18,6 +18,8 @@
 //! runs the same workflow on the simulated oscillator against the measured x, refitting the
 //! oscillator's own parameters with every model ([`trajectory`]).
 //!
+//! Either result scores its base and final models on another record ([`validation`]).
+//!
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
 //! docs/ARCHITECTURE.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
 //!
@@ -40,6 +42,7 @@ mod subset_fit;
 pub mod trajectory;
 mod trajectory_fit;
 mod trajectory_gap;
+pub mod validation;
 
 pub use candidate::Candidate;
 pub use engine::discover_force;
@@ -51,3 +54,4 @@ pub use report::Discovery;
 pub use score::{CandidateScore, Step};
 pub use settings::DiscoverySettings;
 pub use trajectory::{discover_trajectory, ForceHint, TrajectoryDiscovery, TrajectorySetup};
+pub use validation::DiscoveryValidation;

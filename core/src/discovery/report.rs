@@ -42,6 +42,15 @@ pub struct Discovery {
     /// Measured − modelled force of the final model at every sample, N (not serialized).
     #[serde(skip)]
     pub residual_after: Vec<f64>,
+    /// The base model (not serialized; its name is `base`).
+    #[serde(skip)]
+    pub base_model: Arc<dyn ForceModel>,
+    /// The base's parameter values fitted on the whole record, in its own order (without the
+    /// offset).
+    pub base_values: Vec<f64>,
+    /// That fit's parameters with standard errors: the base's, the offset if fitted, and at
+    /// trajectory level the refitted oscillator parameters and initial state.
+    pub base_params: Vec<FittedParam>,
     /// The final model: the base, or a [`crate::model_sum::ModelSum`] of the base and the
     /// effects (not serialized; its name is `final_model_name`).
     #[serde(skip)]

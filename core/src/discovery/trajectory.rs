@@ -150,6 +150,11 @@ pub struct TrajectoryDiscovery {
     pub s_before_mm2: f64,
     /// S(μ) of the final model on the whole record, mm².
     pub s_after_mm2: f64,
+    /// The state (x0 m, v0 m/s) the base's simulation starts from: fitted, or the setup's
+    /// estimate less the offset.
+    pub initial_before: [f64; 2],
+    /// The same for the final model.
+    pub initial_after: [f64; 2],
     /// The base's simulated x (with the offset) at every sample, m.
     pub x_before: Vec<f64>,
     /// The final model's simulated x (with the offset) at every sample, m.
@@ -710,6 +715,12 @@ pub fn discover_trajectory(
     };
     let x_before = simulated(&run_before);
     let residual_before = run_before.residual.clone();
+    let n_base = base.params().len();
+    let base_values = base_full.values[n_osc..n_osc + n_base].to_vec();
+    let base_params = base_result.params.clone();
+    let initial_before = rig
+        .start(&base, &base_full.values)
+        .map_err(DiscoveryError::BadData)?;
     // 2. Where the gap lives.
     let where_before = locate_x_gap(&run_before, cycles, floor);
     notes.push(format!("base `{base_name}`: {}", where_before.summary));
@@ -804,6 +815,9 @@ pub fn discover_trajectory(
         }
     };
     let final_model = final_stage.model()?;
+    let initial_after = rig
+        .start(&final_model, &final_stage.values)
+        .map_err(DiscoveryError::BadData)?;
     let gap_after = rms(&run_after.residual);
     let where_after = locate_x_gap(&run_after, cycles, floor);
     let s_mm2 = |g: f64| g * g * 1e6;
@@ -824,6 +838,8 @@ pub fn discover_trajectory(
         system_after: rig.system_of(&final_stage.values),
         s_before_mm2: s_mm2(gap_before),
         s_after_mm2: s_mm2(gap_after),
+        initial_before,
+        initial_after,
         x_before,
         x_after: simulated(&run_after),
         discovery: Discovery {
@@ -840,6 +856,9 @@ pub fn discover_trajectory(
             where_after,
             residual_before,
             residual_after: run_after.residual.clone(),
+            base_model: base,
+            base_values,
+            base_params,
             final_model_name: final_stage.name(),
             final_model,
             final_values: final_stage

@@ -81,6 +81,13 @@ impl Rig<'_> {
         self.residual_of(&x, setup.offset)
     }
 
+    /// The state (x0 m, v0 m/s) a simulation with `values` starts from: fitted, or the
+    /// setup's estimate less the offset.
+    pub fn start(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<[f64; 2], String> {
+        let setup = self.setup(model, values)?;
+        Ok([setup.x0, setup.v0])
+    }
+
     /// The oscillator with `values` set, its initial state and the offset.
     fn setup(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<RigSetup, String> {
         let n_osc = self.oscillator.len();

@@ -23,6 +23,8 @@
 //! that diverges, a model
 //! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
 //! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
+//! A fitted model is scored on another record ([`Validation`]) by [`ForceFit::validate`] and
+//! [`TrajectoryFit::validate`].
 
 mod covariance;
 mod engine;
@@ -38,6 +40,7 @@ mod same_term;
 mod settings;
 mod trajectory;
 mod transform;
+mod validation;
 mod warning;
 
 pub use error::FitError;
@@ -52,6 +55,7 @@ pub use trajectory::{
     initial_state_params, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, INITIAL_STATE,
 };
 pub use transform::BoundTransform;
+pub use validation::Validation;
 pub use warning::{
     fit_warnings, BoundSide, FitWarning, StatedWarning, CORRELATION_LIMIT, NEAR_BOUND,
     RESIDUAL_OVER_FLOOR,

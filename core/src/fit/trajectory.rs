@@ -32,7 +32,7 @@ use super::same_term::check_same_terms;
 use super::settings::FitSettings;
 use crate::excitation::Excitation;
 use crate::force_model::ForceModel;
-use crate::integrate::{integrate, Settings};
+use crate::integrate::{integrate, Settings, Solution};
 use crate::oscillator::Oscillator;
 use crate::params::ParamSpec;
 use crate::system::OscillatorParams;
@@ -174,12 +174,79 @@ impl TrajectoryFit {
         }
     }
 
-    /// Run the fit; `observer` is called after every simulation.
-    pub fn fit(
+    /// The same fit driven by another excitation: another record's drive, for
+    /// [`TrajectoryFit::validate`] (set that record's initial estimate with
+    /// [`TrajectoryFit::initial`]).
+    pub fn excitation(mut self, excitation: Arc<Excitation>) -> Self {
+        self.excitation = excitation;
+        self
+    }
+
+    /// The names of the parameters given to [`TrajectoryFit::free`], in order.
+    pub fn free_names(&self) -> Vec<String> {
+        self.free.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// Whether the initial state `x0`, `v0` is fitted.
+    pub(super) fn initial_is_free(&self) -> bool {
+        self.free
+            .iter()
+            .any(|p| !p.fixed && INITIAL_STATE.contains(&p.name.as_str()))
+    }
+
+    /// The initial state given to [`TrajectoryFit::initial`], if any.
+    pub(super) fn initial_estimate(&self) -> Option<(f64, f64)> {
+        self.initial
+    }
+
+    /// The same fit with the parameter list `free` instead.
+    pub(super) fn with_free(&self, free: Vec<FitParam>) -> Self {
+        TrajectoryFit {
+            free,
+            ..self.clone()
+        }
+    }
+
+    /// The simulated displacement with the offset at the samples of `data` for `values`
+    /// (one per parameter given to [`TrajectoryFit::free`], in order; fixed or not): the
+    /// fitted curve, when `values` are a fit's.
+    pub fn predict(&self, data: &TrajectoryData, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        Ok(self.simulate(data, values)?.0)
+    }
+
+    /// [`TrajectoryFit::predict`] and the initial state (x0, v0) the simulation started from.
+    pub(super) fn simulate(
         &self,
         data: &TrajectoryData,
-        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
-    ) -> Result<FitResult, FitError> {
+        values: &[f64],
+    ) -> Result<(Vec<f64>, [f64; 2]), FitError> {
+        self.check(data)?;
+        if values.len() != self.free.len() {
+            return Err(FitError::BadData(format!(
+                "{} values given for {} parameters",
+                values.len(),
+                self.free.len()
+            )));
+        }
+        let held = self.with_free(
+            self.free
+                .iter()
+                .zip(values)
+                .map(|(p, &v)| FitParam {
+                    value: v,
+                    fixed: true,
+                    ..p.clone()
+                })
+                .collect(),
+        );
+        let problem = held.problem(data)?;
+        let (sol, offset, initial) = problem.solve(&[]).map_err(FitError::BadData)?;
+        let x = sol.states.iter().step_by(sol.dim).map(|x| x + offset);
+        Ok((x.collect(), initial))
+    }
+
+    /// Check `data` and the model's values.
+    fn check(&self, data: &TrajectoryData) -> Result<(), FitError> {
         let n = data.t.len();
         if data.x.len() != n || n < 2 {
             return Err(FitError::BadData(format!(
@@ -209,17 +276,35 @@ impl TrajectoryFit {
                 )));
             }
         }
+        Ok(())
+    }
+
+    /// The residuals of this fit on `data`.
+    fn problem<'a>(
+        &'a self,
+        data: &TrajectoryData<'a>,
+    ) -> Result<TrajectoryResiduals<'a>, FitError> {
         let slots = self
             .free
             .iter()
             .map(|p| self.resolve(&p.name))
             .collect::<Result<Vec<_>, _>>()?;
         self.check_same_terms(&slots)?;
-        let problem = TrajectoryResiduals {
+        Ok(TrajectoryResiduals {
             fit: self,
             data: *data,
             slots,
-        };
+        })
+    }
+
+    /// Run the fit; `observer` is called after every simulation.
+    pub fn fit(
+        &self,
+        data: &TrajectoryData,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
+        self.check(data)?;
+        let problem = self.problem(data)?;
         let settings = self.settings.clone().for_simulation(self.sim.rtol);
         engine::run(&problem, &self.free, &settings, observer, true)
     }
@@ -259,12 +344,10 @@ struct TrajectoryResiduals<'a> {
     slots: Vec<Slot>,
 }
 
-impl Residuals for TrajectoryResiduals<'_> {
-    fn len(&self) -> usize {
-        self.data.t.len()
-    }
-
-    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+impl TrajectoryResiduals<'_> {
+    /// One simulation for the free values `x`: the integrator's solution, the displacement
+    /// offset and the initial state (x0, v0) it started from.
+    fn solve(&self, x: &[f64]) -> Result<(Solution, f64, [f64; 2]), String> {
         let fit = self.fit;
         let mut system = fit.system;
         let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
@@ -301,7 +384,18 @@ impl Residuals for TrajectoryResiduals<'_> {
         let (x0, v0) = (initial[0].unwrap_or(x0), initial[1].unwrap_or(v0));
         let y0 = osc.initial_state(x0, v0);
         let sol = integrate(&osc, d.t[0], &y0, d.t, &fit.sim).map_err(|e| e.to_string())?;
-        for (i, &xe) in d.x.iter().enumerate() {
+        Ok((sol, offset, [x0, v0]))
+    }
+}
+
+impl Residuals for TrajectoryResiduals<'_> {
+    fn len(&self) -> usize {
+        self.data.t.len()
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        let (sol, offset, _) = self.solve(x)?;
+        for (i, &xe) in self.data.x.iter().enumerate() {
             sink(i, xe - sol.states[i * sol.dim] - offset);
         }
         Ok(())

@@ -14,7 +14,9 @@
 //!    [`Regime::PostResonance`] with the thresholds of [`RegimeThresholds`], smooths the labels
 //!    along the sweep and finds the [`boundaries`] in rad/s with an uncertainty;
 //! 5. [`metrics`] compares a model's force on the same kinematics with the measured force,
-//!    per measured regime, and [`ranking`] names the best model per regime and overall.
+//!    per measured regime, and [`ranking`] names the best model per regime and overall;
+//!    [`prediction`] gives any prediction's RMS error per regime (a model scored on a second
+//!    record).
 //!
 //! Everything works on plain slices; nothing here fits or simulates.
 //!
@@ -41,6 +43,7 @@ pub mod error;
 pub mod features;
 pub mod metrics;
 pub mod noise;
+pub mod prediction;
 pub mod ranking;
 pub mod thresholds;
 
@@ -51,5 +54,6 @@ pub use error::RegimeError;
 pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
 pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};
 pub use noise::noise_floor;
+pub use prediction::{rms_by_regime, RegimeRms};
 pub use ranking::{rank_models, Ranking, Score};
 pub use thresholds::RegimeThresholds;
