@@ -1060,7 +1060,7 @@ params = { K = 4.0, n = 1.5 }
 
     #[test]
     fn a_missing_record_names_the_file_line_and_key() {
-        let exp = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap();
+        let mut exp = parse("# comment\n[data]\nfile = \"nowhere.csv\"\n").unwrap();
         let err = crate::fitting::load_data(&mut exp).err().unwrap();
         let msg = format!("{err:#}");
         assert!(
