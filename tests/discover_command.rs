@@ -118,8 +118,8 @@ fn discovery_is_validated_on_a_second_record_and_its_json_redraws_its_curves() {
 
     // The fitted values alone, with the record's kinematics read as the experiment reads
     // them, predict the curves discovered.csv holds.
-    let experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
-    let data = stf_lab::fitting::load_data(&experiment).unwrap();
+    let mut experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
+    let data = stf_lab::fitting::load_data(&mut experiment).unwrap();
     let csv = out.join("discovered.csv");
     for (which, column) in [("base", "f_stf_base"), ("final", "f_stf_final")] {
         let entry = &doc["fitted"][which];
