@@ -200,8 +200,8 @@ fn trajectory_discovery_is_validated_on_a_second_record_and_its_json_redraws_its
 
     // The fitted values alone — oscillator, model, offset, initial state — with the record's
     // drive read as the experiment reads it, simulate the curves discovered.csv holds.
-    let experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
-    let data = stf_lab::fitting::load_data(&experiment).unwrap();
+    let mut experiment = stf_lab::experiment::Experiment::load(&exp).unwrap();
+    let data = stf_lab::fitting::load_data(&mut experiment).unwrap();
     let drive = std::sync::Arc::new(data.kinematics.excitation());
     let csv = out.join("discovered.csv");
     for (which, column) in [("base", "x_base"), ("final", "x_final")] {
