@@ -444,8 +444,10 @@ fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
 }
 
 /// The oscillator parameters refitted with every model at trajectory level: `[fit] system`,
-/// or `m`, `k`, `c` for a rig driven by a measured force `u`, `k`, `c`, `T` for the rotor.
-fn refitted(exp: &Experiment, data: &FitData) -> Vec<String> {
+/// or by default `m`, `k`, `c` for a rig driven by a measured force `u`, `k`, `c`, `T` for the
+/// rotor — less those the base repeats (a `viscous` base carries the linear damping, so `c`
+/// stays as set), said on the terminal.
+fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool) -> Vec<String> {
     if !exp.fit.system_free.is_empty() {
         return exp.fit.system_free.clone();
     }
@@ -456,7 +458,23 @@ fn refitted(exp: &Experiment, data: &FitData) -> Vec<String> {
     } else {
         &["m", "k", "c"]
     };
-    names.iter().map(|s| s.to_string()).collect()
+    let repeated: Vec<(&str, &str)> = base
+        .params()
+        .iter()
+        .filter_map(|s| s.same_as.map(|o| (s.name.as_str(), o)))
+        .collect();
+    let mut kept = Vec::new();
+    for name in names {
+        match repeated.iter().find(|(_, o)| o == name) {
+            Some((p, _)) if !quiet => eprintln!(
+                "`{name}` is not refitted: the base's `{p}` is the same term (give `[fit] system` \
+                 to choose)"
+            ),
+            Some(_) => {}
+            None => kept.push(name.to_string()),
+        }
+    }
+    kept
 }
 
 /// `discover` at trajectory level: the simulated oscillator against the measured x.
@@ -474,7 +492,7 @@ fn run_trajectory(
     let Some(spec) = &exp.discover else {
         bail!("{}: has no [discover] section", exp.path.display());
     };
-    let names = refitted(exp, data);
+    let names = refitted(exp, data, base.as_ref(), quiet);
     let setup = trajectory_setup(exp, data, &names);
     let settings = settings.clone().fit_offset(exp.fit.offset);
     let started = Instant::now();

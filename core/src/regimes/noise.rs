@@ -7,6 +7,11 @@
 //! 1.4826 (MAD → σ of a Gaussian) and divided by √20, is σ; being a median, it ignores the few
 //! samples where an on–off force switches abruptly.
 //!
+//! Third differences keep the signal itself where a period spans few samples (a record of an
+//! electronic oscillator at 9 samples a period read 4.7 mV of "noise" below 0.1 mV of real
+//! noise), so the floor is the smaller of this estimate and the floor of the spectrum's upper
+//! half ([`crate::derivative::spectral_floor_sigma`]), each of which can only err high.
+//!
 //! Caveat: noise that is not white — a force recovered from kinematics through a derivative
 //! filter is low-pass — has less power at the highest frequencies, so this underestimates its
 //! σ. Such records should override the floor ([`RegimeThresholds::noise_sigma`], e.g. from
@@ -19,7 +24,8 @@ use super::error::{check_finite, RegimeError};
 /// Scale from the median absolute deviation to σ for Gaussian samples.
 pub const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 
-/// Robust σ of the white noise on `f` (same unit as `f`), from third differences.
+/// Robust σ of the white noise on `f` (same unit as `f`), from third differences or the
+/// spectrum's floor, whichever is smaller.
 pub fn noise_floor(f: &[f64]) -> Result<f64, RegimeError> {
     check_finite("f", f)?;
     if f.len() < 8 {
@@ -35,7 +41,8 @@ pub fn noise_floor(f: &[f64]) -> Result<f64, RegimeError> {
         .collect();
     let med = median(&mut d);
     let mut dev: Vec<f64> = d.iter().map(|x| (x - med).abs()).collect();
-    Ok(MAD_TO_SIGMA * median(&mut dev) / 20f64.sqrt())
+    let third = MAD_TO_SIGMA * median(&mut dev) / 20f64.sqrt();
+    Ok(third.min(crate::derivative::spectral_floor_sigma(f).unwrap_or(f64::INFINITY)))
 }
 
 /// Median of `x` (reorders it); 0 for an empty slice.
