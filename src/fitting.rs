@@ -152,25 +152,24 @@ pub fn estimate_line(data: &FitData) -> Option<String> {
     })
 }
 
-/// The record's rotor cycles (from φ, or ω integrated, or upward crossings of x).
+/// The record's rotor cycles (from φ, or ω integrated, or upward crossings of x); a record
+/// with fewer than [`MIN_CYCLES`] of them (a positioning stroke) is cut into that many equal
+/// stretches instead, so that some can be held out.
 pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
-    use stf_core::regimes::{cycles_from_phase, cycles_from_x, phase_from_omega};
+    use stf_core::regimes::{cycles_from_phase, cycles_from_x, phase_from_omega, segments};
     let k = &data.kinematics;
     Ok(match (&k.phi, &k.omega) {
         (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
         (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
-        _ => cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?,
+        _ => match cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)? {
+            few if few.len() < MIN_CYCLES => segments(&k.t, MIN_CYCLES),
+            cycles => cycles,
+        },
     })
 }
 
-/// The fit a model's prediction comes from, to predict again on other data.
-#[derive(Clone)]
-pub enum Predictor {
-    /// A force-level fit: the model's force along a record's kinematics.
-    Force(ForceFit),
-    /// A trajectory-level fit: the oscillator with the model, simulated.
-    Trajectory(TrajectoryFit),
-}
+/// The fewest cycles of x a record is scored by; fewer, and equal stretches stand in.
+pub const MIN_CYCLES: usize = 32;
 
 /// One fitted model.
 pub struct ModelFit {

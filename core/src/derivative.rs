@@ -432,8 +432,7 @@ fn dot3(y: &[f64], a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64, f64) {
     )
 }
 
-/// Robust σ of white noise on a signal: the smaller of two estimates, each of which can only
-/// err high.
+/// Robust σ of white noise on a signal, from two estimates that can each only err high:
 ///
 /// - [`third_difference_sigma`]: the MAD of third differences, robust to spikes, but it counts
 ///   the signal's own third differences as noise when a period spans few samples (a sine with
@@ -441,11 +440,22 @@ fn dot3(y: &[f64], a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64, f64) {
 /// - [`spectral_floor_sigma`]: the floor of the spectrum's upper half, which holds at a few
 ///   samples per period as long as some band of the upper half is free of signal.
 ///
-/// On a smooth, densely sampled record the two agree; on an electronic oscillator sampled at 9
-/// points a period the first read 4.66 mV of "noise" where the noise is below 0.1 mV.
+/// The first is the estimate unless it reads more than [`SIGNAL_IN_DIFFERENCES`] times the
+/// second: then the differences hold signal and the spectrum's floor is taken. On a densely
+/// sampled record the two agree within it and the first stands; on an electronic oscillator
+/// sampled at 9 points a period the first read 4.66 mV of "noise" where the noise is below
+/// 0.1 mV.
 pub fn noise_sigma(y: &[f64]) -> f64 {
-    third_difference_sigma(y).min(spectral_floor_sigma(y).unwrap_or(f64::INFINITY))
+    let third = third_difference_sigma(y);
+    match spectral_floor_sigma(y) {
+        Some(floor) if third > SIGNAL_IN_DIFFERENCES * floor => floor,
+        _ => third,
+    }
 }
+
+/// How many times the spectrum's floor the third-difference estimate may read before it is
+/// taken to hold signal ([`noise_sigma`]).
+pub const SIGNAL_IN_DIFFERENCES: f64 = 2.0;
 
 /// σ of white noise from the MAD of third differences (whose variance is 20σ² for white noise),
 /// over 0.6745·√20.

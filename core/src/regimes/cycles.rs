@@ -83,6 +83,27 @@ pub fn cycles_from_phase(t: &[f64], phi: &[f64]) -> Result<Vec<Cycle>, RegimeErr
         .collect())
 }
 
+/// `count` equal stretches of a record that has too few cycles of its own to hold some out
+/// (a positioning stroke, a single transient): each stretch is scored as a cycle would be,
+/// with `omega` 2π over its duration.
+pub fn segments(t: &[f64], count: usize) -> Vec<Cycle> {
+    let n = t.len();
+    let count = count.clamp(1, n.max(1));
+    (0..count)
+        .map(|i| (i * n / count, (i + 1) * n / count))
+        .filter(|(a, b)| b > a)
+        .map(|(start, end)| {
+            let span = (t[end - 1] - t[start]).max(f64::MIN_POSITIVE);
+            Cycle {
+                start,
+                end,
+                t_mid: 0.5 * (t[start] + t[end - 1]),
+                omega: std::f64::consts::TAU / span,
+            }
+        })
+        .collect()
+}
+
 /// Cycles of the displacement `x` (m) at times `t` (s): upward zero crossings, each armed by a
 /// dip below `−hysteresis` (m, ≥ 0; e.g. a few σ of the position noise).
 pub fn cycles_from_x(t: &[f64], x: &[f64], hysteresis: f64) -> Result<Vec<Cycle>, RegimeError> {

@@ -49,7 +49,7 @@ pub mod thresholds;
 
 pub use boundaries::{find_boundaries, Boundaries, Boundary};
 pub use classify::{classify, label_cycles, median_filter, Classification, Regime};
-pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, Cycle};
+pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, segments, Cycle};
 pub use error::RegimeError;
 pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
 pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};

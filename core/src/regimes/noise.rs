@@ -9,8 +9,8 @@
 //!
 //! Third differences keep the signal itself where a period spans few samples (a record of an
 //! electronic oscillator at 9 samples a period read 4.7 mV of "noise" below 0.1 mV of real
-//! noise), so the floor is the smaller of this estimate and the floor of the spectrum's upper
-//! half ([`crate::derivative::spectral_floor_sigma`]), each of which can only err high.
+//! noise), so where this estimate reads more than twice the floor of the spectrum's upper half
+//! ([`crate::derivative::spectral_floor_sigma`]) that floor is taken ([`crate::derivative::noise_sigma`]'s rule).
 //!
 //! Caveat: noise that is not white — a force recovered from kinematics through a derivative
 //! filter is low-pass — has less power at the highest frequencies, so this underestimates its
@@ -24,8 +24,8 @@ use super::error::{check_finite, RegimeError};
 /// Scale from the median absolute deviation to σ for Gaussian samples.
 pub const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 
-/// Robust σ of the white noise on `f` (same unit as `f`), from third differences or the
-/// spectrum's floor, whichever is smaller.
+/// Robust σ of the white noise on `f` (same unit as `f`), from third differences, or the
+/// spectrum's floor where the differences hold signal.
 pub fn noise_floor(f: &[f64]) -> Result<f64, RegimeError> {
     check_finite("f", f)?;
     if f.len() < 8 {
@@ -42,7 +42,10 @@ pub fn noise_floor(f: &[f64]) -> Result<f64, RegimeError> {
     let med = median(&mut d);
     let mut dev: Vec<f64> = d.iter().map(|x| (x - med).abs()).collect();
     let third = MAD_TO_SIGMA * median(&mut dev) / 20f64.sqrt();
-    Ok(third.min(crate::derivative::spectral_floor_sigma(f).unwrap_or(f64::INFINITY)))
+    Ok(match crate::derivative::spectral_floor_sigma(f) {
+        Some(floor) if third > crate::derivative::SIGNAL_IN_DIFFERENCES * floor => floor,
+        _ => third,
+    })
 }
 
 /// Median of `x` (reorders it); 0 for an empty slice.
