@@ -171,6 +171,15 @@ pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
 /// The fewest cycles of x a record is scored by; fewer, and equal stretches stand in.
 pub const MIN_CYCLES: usize = 32;
 
+/// The fit a model's prediction comes from, to predict again on other data.
+#[derive(Clone)]
+pub enum Predictor {
+    /// A force-level fit: the model's force along a record's kinematics.
+    Force(ForceFit),
+    /// A trajectory-level fit: the oscillator with the model, simulated.
+    Trajectory(TrajectoryFit),
+}
+
 /// One fitted model.
 pub struct ModelFit {
     /// The model as configured (start values and bounds).
