@@ -15,6 +15,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
+use stf_core::data_bounds::{widened, DataScales};
 use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
     TrajectoryDiscovery, TrajectorySetup,
@@ -117,7 +118,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     let validation = crate::validation::load(&exp, &data)?;
     prepare_dir(out, force)?;
-    let (base, candidates) = models_of(&exp, spec)?;
+    let (base, candidates) = models_of(&exp, spec, &data)?;
     let cycles = crate::fitting::cycles_of(&data)?;
     let mut settings = settings_of(&exp, spec, data.level);
     let started = Instant::now();
@@ -175,9 +176,12 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
 fn models_of(
     exp: &Experiment,
     spec: &DiscoverSpec,
+    data: &FitData,
 ) -> Result<(Arc<dyn ForceModel>, Vec<Candidate>)> {
+    let scales = data_scales(exp, data);
     let base = model_from(&spec.base, &exp.dir)
         .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
+    let base = widened(base, &scales);
     let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
     let mut candidates = Vec::new();
     let names: Vec<String> = match &spec.candidates {
@@ -187,9 +191,23 @@ fn models_of(
     for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
         let model = resolve(name, &exp.dir)
             .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
-        candidates.push(Candidate::new(model.name().to_string(), model));
+        candidates.push(Candidate::new(
+            model.name().to_string(),
+            widened(model, &scales),
+        ));
     }
     Ok((base, candidates))
+}
+
+/// The sizes the models' bounds are widened to ([`widened`]): the measured force at force
+/// level, the force recovered with the experiment's oscillator at trajectory level.
+fn data_scales(exp: &Experiment, data: &FitData) -> DataScales {
+    let k = &data.kinematics;
+    let force = match (data.level, &data.record.f_stf) {
+        (FitLevel::Force, Some(f)) => f.clone(),
+        _ => k.recovered_force(&exp.system),
+    };
+    DataScales::of(&force, &k.x, &k.v, &k.a)
 }
 
 /// Discovery's settings from `[fit]` and `[discover]` at `level`.
@@ -198,7 +216,9 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
         FitLevel::Force => force_fit_settings(&exp.fit.settings),
         FitLevel::Trajectory => exp.fit.settings.clone(),
     };
-    let mut settings = DiscoverySettings::default().fit(fit);
+    let mut settings = DiscoverySettings::default()
+        .fit(fit)
+        .fit_offset(exp.fit.offset);
     if let Some(n) = spec.max_effects {
         settings = settings.max_effects(n);
     }
@@ -494,7 +514,7 @@ fn run_trajectory(
     };
     let names = refitted(exp, data, base.as_ref(), quiet);
     let setup = trajectory_setup(exp, data, &names);
-    let settings = settings.clone().fit_offset(exp.fit.offset);
+    let settings = settings.clone();
     let started = Instant::now();
     if !quiet {
         eprintln!(
