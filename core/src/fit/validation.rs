@@ -112,7 +112,7 @@ fn v_span(data: &TrajectoryData) -> f64 {
 impl TrajectoryFit {
     /// Score the fitted `values` (one per parameter given to [`TrajectoryFit::free`], in that
     /// order) on `data`, a record driven by this fit's excitation: see the
-    /// [module doc](self). With `x0`, `v0` free, they are refitted from the estimate given to
+    /// doc of [`Validation`]. With `x0`, `v0` free, they are refitted from the estimate given to
     /// [`TrajectoryFit::initial`] (within a tenth of the record's range of x and v).
     pub fn validate(&self, data: &TrajectoryData, values: &[f64]) -> Result<Validation, FitError> {
         let names = self.free_names();
