@@ -60,6 +60,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "samples": data.record.len(),
         "motion_filter": { "order": data.kinematics.motion_filter.order(), "window": data.kinematics.motion_filter.window() },
         "drive": data.kinematics.drive,
+        "noise_estimate": data.noise_estimate(),
         "system_estimate": data.system_estimate,
         "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
     });

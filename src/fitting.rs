@@ -39,6 +39,12 @@ pub struct FitData {
 }
 
 impl FitData {
+    /// How the noise of the signal fits aim at was estimated (both estimates and the one
+    /// taken: [`stf_core::derivative::noise_estimate`]).
+    pub fn noise_estimate(&self) -> stf_core::derivative::NoiseEstimate {
+        stf_core::derivative::noise_estimate(self.target())
+    }
+
     /// The measured signal fits aim at: `f_stf` (force level) or `x` (trajectory level).
     pub fn target(&self) -> &[f64] {
         match self.level {

@@ -446,10 +446,35 @@ fn dot3(y: &[f64], a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64, f64) {
 /// sampled at 9 points a period the first read 4.66 mV of "noise" where the noise is below
 /// 0.1 mV.
 pub fn noise_sigma(y: &[f64]) -> f64 {
+    noise_estimate(y).sigma
+}
+
+/// How [`noise_sigma`] was estimated: both estimates and the one taken.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct NoiseEstimate {
+    /// The σ taken.
+    pub sigma: f64,
+    /// Which estimate it is: `"third_differences"` or `"spectrum_floor"`.
+    pub method: &'static str,
+    /// The third differences' estimate.
+    pub third_differences: f64,
+    /// The spectrum's floor (`None` on records shorter than a segment).
+    pub spectrum_floor: Option<f64>,
+}
+
+/// [`noise_sigma`] with how it was estimated.
+pub fn noise_estimate(y: &[f64]) -> NoiseEstimate {
     let third = third_difference_sigma(y);
-    match spectral_floor_sigma(y) {
-        Some(floor) if third > SIGNAL_IN_DIFFERENCES * floor => floor,
-        _ => third,
+    let floor = spectral_floor_sigma(y);
+    let (sigma, method) = match floor {
+        Some(f) if third > SIGNAL_IN_DIFFERENCES * f => (f, "spectrum_floor"),
+        _ => (third, "third_differences"),
+    };
+    NoiseEstimate {
+        sigma,
+        method,
+        third_differences: third,
+        spectrum_floor: floor,
     }
 }
 
@@ -634,6 +659,8 @@ mod tests {
         let sparse = noisy_tones(9.0, 50_000);
         assert!(third_difference_sigma(&sparse) > 5.0 * 1e-4);
         assert_relative_eq!(noise_sigma(&sparse), 1e-4, max_relative = 0.1);
+        assert_eq!(noise_estimate(&sparse).method, "spectrum_floor");
+        assert_eq!(noise_estimate(&dense).method, "third_differences");
         assert!(spectral_floor_sigma(&sparse[..100]).is_none());
     }
 
