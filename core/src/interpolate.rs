@@ -15,10 +15,17 @@ fn locate(ts: &[f64], uniform_step: Option<f64>, t: f64) -> usize {
         return n - 2;
     }
     if let Some(dt) = uniform_step {
-        let guess = (((t - ts[0]) / dt) as usize).min(n - 2);
-        // Floating point may put the guess one off.
-        if ts[guess] <= t && t < ts[guess + 1] {
-            return guess;
+        // On a grid uniform within [`NEARLY_UNIFORM`] (times written with a few decimals,
+        // a DAQ's jitter), the guess from the mean step is at most a step or two off: walk.
+        let mut i = (((t - ts[0]) / dt) as usize).min(n - 2);
+        for _ in 0..WALK {
+            if ts[i] > t {
+                i -= 1;
+            } else if ts[i + 1] <= t {
+                i += 1;
+            } else {
+                return i;
+            }
         }
     }
     ts.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2)
@@ -38,6 +45,13 @@ pub(crate) fn next_knot(ts: &[f64], uniform_step: Option<f64>, t: f64) -> Option
     ts[i..].iter().copied().find(|&knot| knot > t)
 }
 
+/// How far a step may stray from the mean (as a fraction of it) for the grid to count as
+/// uniform: a located guess is then off by at most a step.
+const NEARLY_UNIFORM: f64 = 0.1;
+
+/// Steps [`locate`] walks from its guess before it falls back to a binary search.
+const WALK: usize = 4;
+
 fn uniform_step(ts: &[f64]) -> Option<f64> {
     let n = ts.len();
     if n < 2 {
@@ -46,7 +60,7 @@ fn uniform_step(ts: &[f64]) -> Option<f64> {
     let dt = (ts[n - 1] - ts[0]) / (n - 1) as f64;
     let uniform = ts
         .windows(2)
-        .all(|w| ((w[1] - w[0]) - dt).abs() <= 1e-6 * dt);
+        .all(|w| ((w[1] - w[0]) - dt).abs() <= NEARLY_UNIFORM * dt);
     uniform.then_some(dt)
 }
 
@@ -175,6 +189,22 @@ impl Hermite {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    /// Times written with a few decimals are not exactly uniform: located by a walk from the
+    /// mean step, they give the interval a binary search gives.
+    #[test]
+    fn a_nearly_uniform_grid_is_located_as_a_binary_search_does() {
+        let dt = 1.0 / 610.35;
+        let ts: Vec<f64> = (0..5000)
+            .map(|i| ((66.6 + i as f64 * dt) * 1e7).round() / 1e7)
+            .collect();
+        let step = uniform_step(&ts);
+        assert!(step.is_some());
+        for k in 0..20_000 {
+            let t = 66.59 + k as f64 * 4.1e-4;
+            assert_eq!(locate(&ts, step, t), locate(&ts, None, t), "t = {t}");
+        }
+    }
 
     #[test]
     fn a_held_signal_keeps_each_sample_until_the_next() {
