@@ -75,6 +75,16 @@ fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -
     entry
 }
 
+/// The terminal's account of a discovery: each step's verdict, the `summary` line and the
+/// `held_out` line (the held-out cycles and the validation record).
+fn print_steps(found: &Discovery, summary: &str, held_out: &str) {
+    for step in &found.steps {
+        println!("  {}", step.verdict);
+    }
+    println!("{summary}");
+    println!("  {held_out}");
+}
+
 /// The effects named, or `none`.
 fn named(effects: &[String]) -> String {
     if effects.is_empty() {
@@ -240,10 +250,7 @@ fn print_force(
         "base `{}`: gap {:.4} N; {}",
         spec.base, found.gap_before, found.where_before.summary
     );
-    for step in &found.steps {
-        println!("  {}", step.verdict);
-    }
-    println!(
+    let summary = format!(
         "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
         named(&found.effects),
         found.gap_before,
@@ -251,9 +258,10 @@ fn print_force(
         found.noise_floor,
         wall
     );
-    println!(
-        "  {}",
-        held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
+    print_steps(
+        found,
+        &summary,
+        &held_out_and_validation(found.holdout_cycles, score, "N", 1.0),
     );
     for note in &found.notes {
         println!("  note: {note}");
@@ -542,10 +550,7 @@ fn run_trajectory(
         trajectory_report(exp, data, &tf, score.as_ref(), out)?;
     }
     let found = &tf.discovery;
-    for step in &found.steps {
-        println!("  {}", step.verdict);
-    }
-    println!(
+    let summary = format!(
         "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
         named(&found.effects),
         tf.s_before_mm2,
@@ -553,10 +558,8 @@ fn run_trajectory(
         found.noise_floor * 1e3,
         wall
     );
-    println!(
-        "  {}",
-        held_out_and_validation(found.holdout_cycles, score.as_ref(), "mm", 1e3)
-    );
+    let held_out = held_out_and_validation(found.holdout_cycles, score.as_ref(), "mm", 1e3);
+    print_steps(found, &summary, &held_out);
     println!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
     println!(
         "wrote {0}/discovery.json and {0}/discovered.csv",
