@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
-use stf_core::data_bounds::{widened, DataScales};
+use stf_core::data_bounds::widened;
 use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
     TrajectoryDiscovery, TrajectorySetup,
@@ -188,7 +188,7 @@ fn models_of(
     spec: &DiscoverSpec,
     data: &FitData,
 ) -> Result<(Arc<dyn ForceModel>, Vec<Candidate>)> {
-    let scales = data_scales(exp, data);
+    let scales = data.scales(&exp.system);
     let base = model_from(&spec.base, &exp.dir)
         .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
     let base = widened(base, &scales);
@@ -207,17 +207,6 @@ fn models_of(
         ));
     }
     Ok((base, candidates))
-}
-
-/// The sizes the models' bounds are widened to ([`widened`]): the measured force at force
-/// level, the force recovered with the experiment's oscillator at trajectory level.
-fn data_scales(exp: &Experiment, data: &FitData) -> DataScales {
-    let k = &data.kinematics;
-    let force = match (data.level, &data.record.f_stf) {
-        (FitLevel::Force, Some(f)) => f.clone(),
-        _ => k.recovered_force(&exp.system),
-    };
-    DataScales::of(&force, &k.x, &k.v, &k.a)
 }
 
 /// Discovery's settings from `[fit]` and `[discover]` at `level`.

@@ -22,8 +22,9 @@ use stf_core::record::Record;
 use stf_core::system::OscillatorParams;
 
 use crate::experiment::{Experiment, FitLevel};
-use crate::model_config::{configure, ConfiguredModel};
+use crate::model_config::{configure_for, ConfiguredModel};
 use crate::progress::{fit_message, Progress};
+use stf_core::data_bounds::DataScales;
 
 /// A record with its kinematics, ready to fit.
 pub struct FitData {
@@ -39,6 +40,18 @@ pub struct FitData {
 }
 
 impl FitData {
+    /// The sizes the models' bounds are widened to ([`stf_core::data_bounds`]): the measured
+    /// force at force level, the force recovered with the oscillator `system` at trajectory
+    /// level, along the record's motion.
+    pub fn scales(&self, system: &OscillatorParams) -> DataScales {
+        let k = &self.kinematics;
+        let force = match (self.level, &self.record.f_stf) {
+            (FitLevel::Force, Some(f)) => f.clone(),
+            _ => k.recovered_force(system),
+        };
+        DataScales::of(&force, &k.x, &k.v, &k.a)
+    }
+
     /// How the noise of the signal fits aim at was estimated (both estimates and the one
     /// taken: [`stf_core::derivative::noise_estimate`]).
     pub fn noise_estimate(&self) -> stf_core::derivative::NoiseEstimate {
@@ -478,8 +491,10 @@ fn fit_trajectory(
     })
 }
 
-/// Configure and fit every model of the experiment, in parallel.
+/// Configure and fit every model of the experiment, in parallel (bounds widened where the
+/// record needs it: [`FitData::scales`]).
 pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<Vec<ModelFit>> {
+    let scales = data.scales(&exp.system);
     let configured: Vec<Option<ConfiguredModel>> = if exp.models.is_empty() {
         if data.level == FitLevel::Force {
             bail!("{}: no [[models]] to fit", exp.path.display());
@@ -494,7 +509,9 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
     } else {
         exp.models
             .iter()
-            .map(|m| configure(std::slice::from_ref(m), &exp.path, &exp.dir).map(Some))
+            .map(|m| {
+                configure_for(std::slice::from_ref(m), &exp.path, &exp.dir, Some(&scales)).map(Some)
+            })
             .collect::<Result<_>>()?
     };
     let bars: Vec<_> = configured

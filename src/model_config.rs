@@ -5,6 +5,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{anyhow, Result};
+use stf_core::data_bounds::{widened, DataScales};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
@@ -50,6 +51,17 @@ pub fn resolve(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
 /// are applied. `file` is the experiment file, `dir` its folder.
 pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<ConfiguredModel> {
+    configure_for(entries, file, dir, None)
+}
+
+/// [`configure`] for a record of sizes `scales`: each model's bounds are widened where the
+/// record needs it ([`widened`]) before the entries' own values and bounds apply.
+pub fn configure_for(
+    entries: &[ModelEntry],
+    file: &Path,
+    dir: &Path,
+    scales: Option<&DataScales>,
+) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
         let at = |msg: String| {
@@ -68,7 +80,11 @@ pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<Conf
             .or(raw.script.as_deref())
             .ok_or_else(|| at("a model needs `name` or `script`".into()))?;
         for spec in std::iter::once(first).chain(raw.plus.iter().map(String::as_str)) {
-            parts.push(resolve(spec, dir).map_err(|e| at(format!("{e:#}")))?);
+            let model = resolve(spec, dir).map_err(|e| at(format!("{e:#}")))?;
+            parts.push(match scales {
+                Some(s) => widened(model, s),
+                None => model,
+            });
         }
     }
     let sum = ModelSum::new(parts).map_err(|e| {
