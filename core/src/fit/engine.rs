@@ -175,8 +175,11 @@ pub fn run(
     )
 }
 
-/// Closest a parameter may end to a bound, as a fraction of the box's width (or of its scale
-/// for a one-sided bound), before it counts as pinned there.
+/// Closest a parameter may end to a bound, as a fraction of its typical size (its scale: the
+/// start value's magnitude, or a tenth of the box), before it counts as pinned there. A
+/// fraction of the box's width would not do: in a wide box ([0, 1e9] for a cubic stiffness)
+/// it pinned any value below 1000, where the map, exponential near its lower bound, is far
+/// from flat (a volt-unit record's k3 ≈ 4 stopped the fit at once, 3× the residual).
 const PINNED: f64 = 1e-6;
 
 /// The free parameters (by index) that `u` puts on one of their bounds, where the bound
@@ -188,11 +191,7 @@ fn pinned(obj: &Objective, free: &[&FitParam], u: &[f64]) -> Vec<usize> {
         .enumerate()
         .filter(|(_, (q, &v))| {
             let width = q.max - q.min;
-            let span = if width.is_finite() {
-                width
-            } else {
-                q.effective_scale()
-            };
+            let span = q.effective_scale().min(width);
             (v - q.min).abs() <= PINNED * span || (q.max - v).abs() <= PINNED * span
         })
         .map(|(j, _)| j)
