@@ -224,6 +224,9 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
     if let Some(n) = spec.holdout_every {
         settings = settings.holdout_every(n);
     }
+    if let Some(n) = spec.scout_from {
+        settings = settings.scout_from(n);
+    }
     settings
 }
 

@@ -249,6 +249,7 @@ struct RawDiscover {
     max_effects: Option<usize>,
     holdout_every: Option<usize>,
     level: Option<String>,
+    scout_from: Option<usize>,
 }
 
 /// A validated `[discover]` section.
@@ -262,6 +263,8 @@ pub struct DiscoverSpec {
     pub max_effects: Option<usize>,
     /// Every k-th cycle is held out for scoring.
     pub holdout_every: Option<usize>,
+    /// Records of at least this many samples are scouted at trajectory level (0: never).
+    pub scout_from: Option<usize>,
     /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
     /// `f_stf`.
     pub level: Option<FitLevel>,
@@ -971,6 +974,7 @@ impl Experiment {
                     candidates: d.candidates,
                     max_effects: d.max_effects,
                     holdout_every: d.holdout_every,
+                    scout_from: d.scout_from,
                 }),
             },
         })

@@ -16,6 +16,10 @@
 //! | `m` | X |
 //! | `m/s` | V |
 //!
+//! A default start more than [`FAR`] typical sizes from the record's (either way) starts at the
+//! typical size instead: a cubic spring's 1e5 N/m³ is a start for the trolley, and for an
+//! electronic oscillator in volts (k3 ≈ 4 V/V³) a start in another basin.
+//!
 //! A model whose bounds change is wrapped ([`Widened`]): it forces as the original and only
 //! reports other specs.
 
@@ -28,6 +32,10 @@ use crate::params::ParamSpec;
 pub const ROOM: f64 = 10.0;
 /// A widened upper bound is this many typical sizes.
 pub const WIDE: f64 = 1000.0;
+
+/// A positive default more than this many typical sizes from the record's, either way, is
+/// moved to the typical size.
+pub const FAR: f64 = 100.0;
 
 /// The typical sizes of a record's force and motion.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,12 +78,17 @@ impl DataScales {
         (s > 0.0 && s.is_finite()).then_some(s)
     }
 
-    /// `spec` with its upper bound widened where the record needs it.
+    /// `spec` with its upper bound widened where the record needs it, and its default moved
+    /// to the typical size where it is more than [`FAR`] from it.
     pub fn widen(&self, spec: &ParamSpec) -> ParamSpec {
         let mut spec = spec.clone();
         if let Some(size) = self.size_of(&spec.unit) {
             if spec.max.is_finite() && spec.max < ROOM * size {
                 spec.max = WIDE * size;
+            }
+            let far = spec.default > FAR * size || spec.default < size / FAR;
+            if spec.default > 0.0 && far && (spec.min..=spec.max).contains(&size) {
+                spec.default = size;
             }
         }
         spec
@@ -180,5 +193,30 @@ mod tests {
             50.0,
             "unknown unit: as is"
         );
+    }
+
+    /// An electronic oscillator in volts (x ≈ 0.2 V, a force of 0.05 V RMS): the cubic
+    /// spring's trolley start 1e5 moves to the record's size F/X³ ≈ 6; the trolley keeps it.
+    #[test]
+    fn a_default_far_from_the_record_starts_at_its_size() {
+        let volts = DataScales {
+            force: 0.05,
+            x: 0.2,
+            v: 50.0,
+            a: 2e4,
+        };
+        let k3 = ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "");
+        let moved = volts.widen(&k3);
+        assert!((moved.default - 6.25).abs() < 1e-9, "{}", moved.default);
+        assert_eq!(moved.max, 1e9);
+        let trolley = DataScales {
+            force: 5.0,
+            x: 0.03,
+            v: 0.3,
+            a: 5.0,
+        };
+        assert_eq!(trolley.widen(&k3).default, 1e5);
+        let below = ParamSpec::new("c", "N·s/m", 1e-6, 0.0, 1e3, "");
+        assert_eq!(trolley.widen(&below).default, 5.0 / 0.3);
     }
 }

@@ -36,6 +36,7 @@ pub mod holdout;
 pub mod progress;
 pub mod report;
 pub mod score;
+mod scout;
 pub mod settings;
 mod stage;
 mod subset_fit;

@@ -73,6 +73,11 @@ pub struct DiscoverySettings {
     /// over its nonlinear parameters, scored by variable projection on the current residual;
     /// the trial with the lowest training RMS is kept (default 1; 0: the defaults only).
     pub extra_starts: usize,
+    /// Records of at least this many samples are scouted at trajectory level: a candidate's
+    /// values are searched on a few short pieces of the record (one sample in eight) and its
+    /// trial on the whole record starts from there (default
+    /// [`super::scout::SCOUT_FROM`]; 0: never). Scores and verdicts are the whole record's.
+    pub scout_from: usize,
     /// Called as the run goes (step, candidate, score): for a live display.
     #[serde(skip)]
     pub observer: Observer,
@@ -93,6 +98,7 @@ impl Default for DiscoverySettings {
             motion_noise: None,
             filter_window: None,
             extra_starts: 1,
+            scout_from: super::scout::SCOUT_FROM,
             observer: Observer::default(),
         }
     }
@@ -160,6 +166,12 @@ impl DiscoverySettings {
     /// Starts of a candidate's trial besides its defaults.
     pub fn extra_starts(mut self, n: usize) -> Self {
         self.extra_starts = n;
+        self
+    }
+
+    /// Scout records of at least `n` samples (0: never).
+    pub fn scout_from(mut self, n: usize) -> Self {
+        self.scout_from = n;
         self
     }
 

@@ -40,10 +40,11 @@ use super::holdout::HoldoutSplit;
 use super::progress::DiscoveryEvent;
 use super::report::Discovery;
 use super::score::CandidateScore;
+use super::scout::Scout;
 use super::settings::DiscoverySettings;
 use super::stage::Stage;
 use super::subset_fit::{fit_subset, rms, rms_over};
-use super::trajectory_fit::{fit_on, Rig, Run};
+use super::trajectory_fit::{fit_on, Rig, Run, Track};
 use super::trajectory_gap::locate_x_gap;
 use crate::excitation::Excitation;
 use crate::fit::{
@@ -226,14 +227,19 @@ impl Stage {
     /// Fit on `subset`: the stage with the fitted values, and the fit.
     fn fit_simulated(
         &self,
-        rig: &Rig,
+        track: &dyn Track,
         setup: &TrajectorySetup,
         subset: &[usize],
         settings: &DiscoverySettings,
     ) -> Result<(Stage, FitResult), DiscoveryError> {
         let model = self.model()?;
-        let params = self.params(setup, &model);
-        let result = fit_on(rig, &model, &params, subset, &settings.fit).map_err(|source| {
+        let mut params = self.params(setup, &model);
+        if track.fixes_start() {
+            for p in &mut params {
+                p.fixed |= crate::fit::INITIAL_STATE.contains(&p.name.as_str());
+            }
+        }
+        let result = fit_on(track, &model, &params, subset, &settings.fit).map_err(|source| {
             DiscoveryError::Fit {
                 model: self.name(),
                 source,
@@ -379,7 +385,7 @@ impl Stage {
     /// a non-positive default are not scaled.
     fn starts(
         &self,
-        rig: &Rig,
+        track: &dyn Track,
         train: &[usize],
         osc_start: &[f64],
         hinted: Option<&Stage>,
@@ -404,7 +410,7 @@ impl Stage {
                 let mut values = values;
                 for f in SCREEN {
                     values[*i] = inside(spec.default * f, spec.min, spec.max);
-                    if let Ok(residual) = rig.residual(model, &values) {
+                    if let Ok(residual) = track.residual(model, &values) {
                         let s = rms_over(&residual, train);
                         if s < best.0 {
                             best = (s, values.clone());
@@ -461,7 +467,7 @@ impl Stage {
     /// is returned as it is.
     fn started(
         starts: Vec<Stage>,
-        rig: &Rig,
+        track: &dyn Track,
         setup: &TrajectorySetup,
         train: &[usize],
         settings: &DiscoverySettings,
@@ -479,7 +485,7 @@ impl Stage {
         };
         let mut best: Option<(f64, Stage)> = None;
         for start in &starts {
-            let Ok((stage, fit)) = start.fit_simulated(rig, setup, train, &short) else {
+            let Ok((stage, fit)) = start.fit_simulated(track, setup, train, &short) else {
                 continue;
             };
             if best.as_ref().is_none_or(|(rms, _)| fit.rms < *rms) {
@@ -506,6 +512,10 @@ const SCREEN_MIN_SAMPLES: usize = 20;
 /// Most Levenberg–Marquardt iterations of a candidate's trial at trajectory level.
 const TRIAL_ITERS: u64 = 60;
 
+/// Most Levenberg–Marquardt iterations of a candidate's trial on the whole record after its
+/// scout (see [`super::scout`]).
+const SCOUTED_TRIAL_ITERS: u64 = 15;
+
 /// What every candidate trial of a run shares.
 struct Trials<'a, 'r> {
     rig: &'a Rig<'r>,
@@ -517,6 +527,31 @@ struct Trials<'a, 'r> {
     /// Whether the force-level screen may rank candidates (enough samples a cycle for the
     /// recovered force to mean something).
     screen: bool,
+    /// Where a candidate's values are searched before its trial on the whole record, on a
+    /// long record.
+    scout: Option<&'a Scout<'r>>,
+}
+
+/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples, its pieces
+/// starting from `current`'s whole-record run; `None` for a shorter record, or when the record
+/// makes no scout.
+fn scout_of<'r>(
+    rig: &Rig<'r>,
+    current: &Stage,
+    cycles: &[Cycle],
+    train: &[usize],
+    settings: &DiscoverySettings,
+) -> Option<Scout<'r>> {
+    if settings.scout_from == 0 || rig.t.len() < settings.scout_from {
+        return None;
+    }
+    let run = current.run(rig).ok()?;
+    let offset = if rig.fit_offset {
+        current.values.last().copied().unwrap_or(0.0)
+    } else {
+        0.0
+    };
+    Scout::new(rig, &run, offset, cycles, train)
 }
 
 impl Trials<'_, '_> {
@@ -612,10 +647,12 @@ impl Trials<'_, '_> {
         hinted: Option<&Stage>,
         current: &Trial,
     ) -> (CandidateScore, Option<Trial>) {
-        let train = &self.split.train;
-        let starts = with.starts(self.rig, train, self.osc_start, hinted);
-        let stage =
-            Stage::started(starts, self.rig, self.setup, train, self.settings).unwrap_or(with);
+        let (track, train): (&dyn Track, &[usize]) = match self.scout {
+            Some(scout) => (scout, &scout.train),
+            None => (self.rig, &self.split.train),
+        };
+        let starts = with.starts(track, train, self.osc_start, hinted);
+        let stage = Stage::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
         // Levenberg–Marquardt alone, from the best start, at most `TRIAL_ITERS` iterations: a
         // candidate whose fit does not settle by then (a stiff relaxation wandering through
         // thousands of simulations) is scored where it stopped, not chased by Nelder–Mead.
@@ -628,6 +665,18 @@ impl Trials<'_, '_> {
                 .max_iters(self.settings.fit.max_iters.min(TRIAL_ITERS)),
             ..self.settings.clone()
         };
+        // Scouted, the search is done: the whole record's trial polishes, at most
+        // `SCOUTED_TRIAL_ITERS` iterations (a candidate still wandering then is scored where it
+        // stopped, as one wandering on the whole record is after `TRIAL_ITERS`).
+        let (stage, settings) = match self.scout {
+            Some(scout) => {
+                let stage = self.scouted(stage, scout, &settings);
+                let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
+                let fit = settings.fit.clone().max_iters(iters);
+                (stage, DiscoverySettings { fit, ..settings })
+            }
+            None => (stage, settings),
+        };
         choice::scored(
             &c.name,
             c.model.params().len(),
@@ -636,6 +685,25 @@ impl Trials<'_, '_> {
             self.yardstick,
             self.settings,
         )
+    }
+}
+
+impl Trials<'_, '_> {
+    /// `stage` fitted on `scout`, if that lowers the whole record's training RMS (one
+    /// simulation of each): where the trial on the whole record starts.
+    fn scouted(&self, stage: Stage, scout: &Scout, settings: &DiscoverySettings) -> Stage {
+        let Ok((fitted, _)) = stage.fit_simulated(scout, self.setup, &scout.train, settings) else {
+            return stage;
+        };
+        let train_rms = |s: &Stage| {
+            s.residual(self.rig)
+                .map_or(f64::INFINITY, |r| rms_over(&r, &self.split.train))
+        };
+        if train_rms(&fitted) < train_rms(&stage) {
+            fitted
+        } else {
+            stage
+        }
     }
 }
 
@@ -681,6 +749,7 @@ pub fn discover_trajectory(
         initial: setup.initial,
         sim: setup.sim.clone(),
         fit_offset: settings.fit_offset,
+        fixed_start: false,
         t: data.t,
         x: data.x,
     };
@@ -762,16 +831,26 @@ pub fn discover_trajectory(
              fitted at trajectory level"
         ));
     }
-    let trials = Trials {
-        rig: &rig,
-        setup,
-        split: &split,
-        osc_start: &osc_start,
-        yardstick: &yardstick,
-        settings,
-        screen,
-    };
     for step in 1..=settings.max_effects {
+        let scout = scout_of(&rig, &current.stage, cycles, &split.train, settings);
+        if let (Some(s), 1) = (&scout, step) {
+            notes.push(format!(
+                "scouted: each candidate's values are searched on {} pieces of the record \
+                 ({} samples of {n}), then fitted on the whole record from there",
+                s.pieces(),
+                s.samples
+            ));
+        }
+        let trials = Trials {
+            rig: &rig,
+            setup,
+            split: &split,
+            osc_start: &osc_start,
+            yardstick: &yardstick,
+            settings,
+            screen,
+            scout: scout.as_ref(),
+        };
         let tried = current.stage.to_try(candidates, &in_base, &effects);
         let scored = trials.step(step, &tried, &current);
         if scored.is_empty() {
@@ -1002,15 +1081,26 @@ mod tests {
     /// The trolley without friction, driven by a chirp force 0.5 → 1.5 Hz over 20 s at
     /// 200 Hz through the rig's displacement sensor; STF = 1.0·v (+ k3·x³).
     fn record(k3: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams) {
+        record_of(k3, 20.0, 200.0)
+    }
+
+    /// A record of `seconds` at `rate` Hz: a sweep from 0.5 Hz at 0.05 Hz/s.
+    fn record_of(
+        k3: f64,
+        seconds: f64,
+        rate: f64,
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams) {
         let system = OscillatorParams {
             t_friction: 0.0,
             delta_t: 0.0,
             ..OscillatorParams::FORCED
         };
-        let t: Vec<f64> = (0..4001).map(|i| i as f64 / 200.0).collect();
+        let n = (seconds * rate).round() as usize + 1;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+        let sweep = 0.5 / seconds;
         let u: Vec<f64> = t
             .iter()
-            .map(|&t| 2.0 * (std::f64::consts::TAU * (0.5 * t + 0.025 * t * t)).sin())
+            .map(|&t| 2.0 * (std::f64::consts::TAU * (0.5 * t + sweep * t * t)).sin())
             .collect();
         let drive = Arc::new(Excitation::Force(Linear::new(t.clone(), u)));
         let mut parts = vec![viscous()];
@@ -1029,7 +1119,13 @@ mod tests {
     }
 
     fn discover(k3: f64) -> TrajectoryDiscovery {
-        let (t, x, u, system) = record(k3);
+        discover_on(record(k3), &DiscoverySettings::default())
+    }
+
+    fn discover_on(
+        (t, x, u, system): (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
+        settings: &DiscoverySettings,
+    ) -> TrajectoryDiscovery {
         let cycles = cycles_from_x(&t, &x, 1.5e-4).unwrap();
         // Start the oscillator 2 % off.
         let start = |name: &str| {
@@ -1053,9 +1149,36 @@ mod tests {
             &TrajectoryData { t: &t, x: &x },
             &cycles,
             &setup,
-            &DiscoverySettings::default(),
+            settings,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn a_scouted_long_record_names_the_effect_and_its_values_as_the_whole_record_does() {
+        // 200 s at 50 Hz: 400 cycles, enough for pieces of six cycles at one sample in eight.
+        let rec = record_of(1e4, 200.0, 50.0);
+        let whole = discover_on(rec.clone(), &DiscoverySettings::default().scout_from(0));
+        let scouted = discover_on(rec, &DiscoverySettings::default().scout_from(1));
+        let (w, s) = (&whole.discovery, &scouted.discovery);
+        eprintln!(
+            "whole {:?} k3 {:?} S {}; scouted {:?} k3 {:?} S {}; {:?}",
+            w.effects,
+            w.value("k3"),
+            whole.s_after_mm2,
+            s.effects,
+            s.value("k3"),
+            scouted.s_after_mm2,
+            s.notes
+        );
+        assert!(s.notes.iter().any(|n| n.starts_with("scouted")));
+        assert!(!w.notes.iter().any(|n| n.starts_with("scouted")));
+        assert_eq!(s.effects, ["cubic_stiffness"]);
+        assert_eq!(w.effects, s.effects);
+        let (kw, ks) = (w.value("k3").unwrap(), s.value("k3").unwrap());
+        assert!((ks / 1e4 - 1.0).abs() < 0.2, "k3 = {ks}");
+        assert!((ks / kw - 1.0).abs() < 0.01, "k3 {ks} scouted, {kw} whole");
+        assert!(scouted.s_after_mm2 < 1.01 * whole.s_after_mm2);
     }
 
     #[test]

@@ -31,8 +31,34 @@ pub(super) struct Rig<'a> {
     pub initial: Option<(f64, f64)>,
     pub sim: Settings,
     pub fit_offset: bool,
+    /// Whether every simulation starts from `initial` whatever values `x0`, `v0` are given
+    /// (the pieces of a [`super::scout::Scout`]: their starts come from a whole-record run).
+    pub fixed_start: bool,
     pub t: &'a [f64],
     pub x: &'a [f64],
+}
+
+/// What a trajectory-level fit evaluates: a model's displacement residual along some stretch
+/// of the record, for the full parameter vector (oscillator's, model's, offset).
+pub(super) trait Track: Sync {
+    /// Measured − simulated − offset at every sample of the track, m.
+    fn residual(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String>;
+    /// Relative tolerance of the track's integrator (sets the finite-difference step).
+    fn rtol(&self) -> f64;
+    /// Whether the initial state `x0`, `v0` has no effect (and must be held fixed).
+    fn fixes_start(&self) -> bool;
+}
+
+impl Track for Rig<'_> {
+    fn residual(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String> {
+        Rig::residual(self, model, values)
+    }
+    fn rtol(&self) -> f64 {
+        self.sim.rtol
+    }
+    fn fixes_start(&self) -> bool {
+        self.fixed_start
+    }
 }
 
 /// The oscillator of one evaluation, its initial state and the displacement offset.
@@ -103,7 +129,9 @@ impl Rig<'_> {
         let mut initial: [Option<f64>; 2] = [None, None];
         for (name, &v) in self.oscillator.iter().zip(values) {
             if let Some(i) = INITIAL_STATE.iter().position(|n| n == name) {
-                initial[i] = Some(v);
+                if !self.fixed_start {
+                    initial[i] = Some(v);
+                }
             } else if !system.set(name, v) {
                 return Err(format!("`{name}` is not an oscillator parameter"));
             }
@@ -156,7 +184,7 @@ impl Rig<'_> {
 
 /// The residuals of the rig with `model` at the samples `subset`.
 struct SubsetProblem<'a> {
-    rig: &'a Rig<'a>,
+    track: &'a dyn Track,
     model: &'a Arc<dyn ForceModel>,
     params: &'a [FitParam],
     subset: &'a [usize],
@@ -169,7 +197,7 @@ impl Residuals for SubsetProblem<'_> {
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
         let full = full_values(self.params, x)?;
-        let residual = self.rig.residual(self.model, &full)?;
+        let residual = self.track.residual(self.model, &full)?;
         for (k, &i) in self.subset.iter().enumerate() {
             sink(k, residual[i]);
         }
@@ -177,23 +205,23 @@ impl Residuals for SubsetProblem<'_> {
     }
 }
 
-/// Fit `params` (all of them, in the rig's order) of `model` on the rig at the samples
+/// Fit `params` (all of them, in the rig's order) of `model` along `track` at its samples
 /// `subset`; statistics are those of the subset, and `s_mm2` is set. The finite-difference
-/// step follows the rig's integrator ([`FitSettings::for_simulation`]).
+/// step follows the track's integrator ([`FitSettings::for_simulation`]).
 pub(super) fn fit_on(
-    rig: &Rig,
+    track: &dyn Track,
     model: &Arc<dyn ForceModel>,
     params: &[FitParam],
     subset: &[usize],
     settings: &FitSettings,
 ) -> Result<FitResult, FitError> {
     let problem = SubsetProblem {
-        rig,
+        track,
         model,
         params,
         subset,
     };
-    let settings = settings.clone().for_simulation(rig.sim.rtol);
+    let settings = settings.clone().for_simulation(track.rtol());
     let mut result = fit_residuals(&problem, params, &settings, None)?;
     result.s_mm2 = Some(result.rms * result.rms * 1e6);
     Ok(result)

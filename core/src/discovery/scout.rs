@@ -1,0 +1,129 @@
+//! The scout of a long record: a few short pieces of it, spread evenly over its length, each
+//! simulated from the state the current model's whole-record run reaches there.
+//!
+//! A trajectory fit simulates the whole record at every evaluation, and a candidate's trial
+//! (its starts, their short fits, then up to [`super::trajectory`]'s iteration limit) costs
+//! hundreds of evaluations. On a long record the search for a candidate's values runs on the
+//! scout instead — an eighth of the samples, so each evaluation costs about an eighth — and
+//! the trial on the whole record continues from where the scout ended, a few
+//! Levenberg–Marquardt iterations from its optimum. The scout only chooses where the whole
+//! record's fit starts: every score, held-out residual and verdict is still the whole
+//! record's.
+//!
+//! A piece starts from the current model's simulated state, not from the candidate's own
+//! (which would need the whole run): the first quarter of each piece, where that start's
+//! error dies away, is simulated but not fitted. Pieces spread over the record see every part
+//! of a sweep. The pieces are simulated one after the other; the candidates already run in
+//! parallel.
+
+use std::sync::Arc;
+
+use super::trajectory_fit::{Rig, Run, Track};
+use crate::force_model::ForceModel;
+use crate::regimes::Cycle;
+
+/// Fewest samples for a record to be scouted (see [`Scout::new`]).
+pub const SCOUT_FROM: usize = 12_000;
+
+/// Pieces of a scout, at most.
+const PIECES: usize = 8;
+
+/// The scout's share of the record: its pieces hold about one sample in this many.
+const SHARE: usize = 8;
+
+/// Fewest cycles a piece spans.
+const PIECE_CYCLES: usize = 6;
+
+/// Fewest pieces for a scout to stand for the record.
+const MIN_PIECES: usize = 3;
+
+/// Short pieces of a record, each a rig of its own, that stand in for it while a candidate's
+/// values are searched for.
+pub(super) struct Scout<'a> {
+    pieces: Vec<Rig<'a>>,
+    /// Positions, in the pieces' joined residual, of the samples that train: training samples
+    /// of the record past each piece's first quarter.
+    pub train: Vec<usize>,
+    /// Samples of the record the pieces hold.
+    pub samples: usize,
+}
+
+impl<'a> Scout<'a> {
+    /// The scout of `rig`'s record, its pieces starting from the state of `run` (the current
+    /// model's whole-record run, with its displacement offset `offset`), or `None` when the
+    /// record is too short for pieces of [`PIECE_CYCLES`] of `cycles` to make a scout of at
+    /// least [`MIN_PIECES`] at one sample in [`SHARE`]. `train` are the record's training
+    /// samples (increasing).
+    pub fn new(
+        rig: &Rig<'a>,
+        run: &Run,
+        offset: f64,
+        cycles: &[Cycle],
+        train: &[usize],
+    ) -> Option<Self> {
+        let n = rig.t.len();
+        let mut lengths: Vec<usize> = cycles.iter().map(|c| c.end - c.start).collect();
+        lengths.sort_unstable();
+        let cycle = lengths.get(lengths.len() / 2).copied().unwrap_or(n);
+        let length = (n / (PIECES * SHARE)).max(PIECE_CYCLES * cycle);
+        let count = (n / SHARE / length.max(1)).min(PIECES);
+        if count < MIN_PIECES || run.sim.x.len() != n || run.sim.v.len() != n {
+            return None;
+        }
+        let mut is_train = vec![false; n];
+        for &i in train {
+            if let Some(slot) = is_train.get_mut(i) {
+                *slot = true;
+            }
+        }
+        let mut pieces = Vec::with_capacity(count);
+        let mut positions = Vec::new();
+        let mut joined = 0;
+        for k in 0..count {
+            let start = ((2 * k + 1) * n / (2 * count)).saturating_sub(length / 2);
+            let end = (start + length).min(n);
+            let burn = (end - start) / 4;
+            positions.extend(
+                (start + burn..end)
+                    .filter(|&i| is_train[i])
+                    .map(|i| joined + i - start),
+            );
+            joined += end - start;
+            pieces.push(Rig {
+                initial: Some((run.sim.x[start] + offset, run.sim.v[start])),
+                fixed_start: true,
+                t: &rig.t[start..end],
+                x: &rig.x[start..end],
+                ..rig.clone()
+            });
+        }
+        Some(Scout {
+            pieces,
+            train: positions,
+            samples: joined,
+        })
+    }
+}
+
+impl Scout<'_> {
+    /// Number of pieces.
+    pub fn pieces(&self) -> usize {
+        self.pieces.len()
+    }
+}
+
+impl Track for Scout<'_> {
+    fn residual(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String> {
+        let mut out = Vec::with_capacity(self.samples);
+        for piece in &self.pieces {
+            out.extend(piece.residual(model, values)?);
+        }
+        Ok(out)
+    }
+    fn rtol(&self) -> f64 {
+        self.pieces.first().map_or(1e-6, |p| p.sim.rtol)
+    }
+    fn fixes_start(&self) -> bool {
+        true
+    }
+}
