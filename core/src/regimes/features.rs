@@ -18,12 +18,17 @@
 //!   turning points (in phase with the acceleration, as the paper observed post-resonance) have
 //!   `corr_a` and `corr_x` near 1. The correlation is 0 when either signal is constant over the
 //!   cycle (nothing to align). A correlation is used rather than the lag between single peaks
-//!   because it uses every sample and does not jump when two peaks of a cycle are nearly equal.
+//!   because it uses every sample and does not jump when two peaks of a cycle are nearly equal;
+//! - `f_peak_smooth`, `c_eq`, `phase_x`, `phase_v`: what the field reads from the loop — the
+//!   peak of the lightly smoothed force (the negligible-force test reads it), the equivalent
+//!   viscous damping and the phase of the force's fundamental against x and v
+//!   ([`super::loops`]).
 
 use serde::Serialize;
 
 use super::cycles::Cycle;
 use super::error::{check_finite, check_len, RegimeError};
+use super::loops::{equivalent_damping, peak_window, phase_deg, smoothed_peak};
 use super::thresholds::RegimeThresholds;
 
 /// The signals of a record, sampled together: kinematics and the STF force.
@@ -84,6 +89,14 @@ pub struct CycleFeatures {
     pub corr_v: f64,
     /// Correlation of |F| with |a|.
     pub corr_a: f64,
+    /// Largest |F| of the force smoothed over about 1/25 of the cycle, N.
+    pub f_peak_smooth: f64,
+    /// Equivalent viscous damping ∮F dx / (π·ω·X²), N·s/m.
+    pub c_eq: f64,
+    /// Phase of the force's fundamental against x's, degrees (NaN: no fundamental).
+    pub phase_x: f64,
+    /// Phase of the force's fundamental against v's, degrees (NaN: no fundamental).
+    pub phase_v: f64,
 }
 
 /// Fraction of a cycle in which the force `f` (the cycle's samples) is on.
@@ -211,6 +224,10 @@ pub fn cycle_features(
         corr_x: abs_correlation(f, x),
         corr_v: abs_correlation(f, &sig.v[s..e]),
         corr_a: abs_correlation(f, &sig.a[s..e]),
+        f_peak_smooth: smoothed_peak(f, peak_window(f.len())),
+        c_eq: equivalent_damping(energy, cycle.omega, amplitude),
+        phase_x: phase_deg(&sig.t[s..e], f, x),
+        phase_v: phase_deg(&sig.t[s..e], f, &sig.v[s..e]),
     })
 }
 

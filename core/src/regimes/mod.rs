@@ -41,13 +41,15 @@ pub mod classify;
 pub mod cycles;
 pub mod error;
 pub mod features;
+pub mod loops;
 pub mod metrics;
 pub mod noise;
 pub mod prediction;
 pub mod ranking;
+pub mod rules;
 pub mod thresholds;
 
-pub use boundaries::{find_boundaries, Boundaries, Boundary};
+pub use boundaries::{find_boundaries, Boundaries, Boundary, BoundaryRule};
 pub use classify::{classify, label_cycles, median_filter, Classification, Regime};
 pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, segments, Cycle};
 pub use error::RegimeError;
@@ -56,4 +58,5 @@ pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics}
 pub use noise::noise_floor;
 pub use prediction::{rms_by_regime, RegimeRms};
 pub use ranking::{rank_models, Ranking, Score};
+pub use rules::{behaviour, place, Behaviour};
 pub use thresholds::RegimeThresholds;
