@@ -116,7 +116,10 @@ fn check(
     let found_pair = found.map(|b| (b.omega, b.rule));
     let (ok, err) = match (truth, found_pair) {
         (None, None) => (true, "—".to_string()),
-        (Some((w, r)), Some((v, q))) => ((v - w).abs() <= TOLERANCE && r == q, format!("{:+.3}", v - w)),
+        (Some((w, r)), Some((v, q))) => (
+            (v - w).abs() <= TOLERANCE && r == q,
+            format!("{:+.3}", v - w),
+        ),
         _ => (false, "missing".to_string()),
     };
     println!(
@@ -159,7 +162,9 @@ const CASES: [(&str, &str); 3] = [
 ];
 
 fn run_all(cases: &[(&'static str, &'static str)], seeds: &[u64]) -> usize {
-    println!("| truth | α rad/s² | seed | boundary | truth ω (rule) | found ω (rule) | error rad/s |");
+    println!(
+        "| truth | α rad/s² | seed | boundary | truth ω (rule) | found ω (rule) | error rad/s |"
+    );
     println!("|---|---|---|---|---|---|---|");
     let mut failed = 0;
     for &(model, params) in cases {

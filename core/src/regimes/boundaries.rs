@@ -46,11 +46,19 @@ impl BoundaryRule {
     /// A sentence saying what placed the boundary, for reports.
     pub fn describe(self) -> &'static str {
         match self {
-            BoundaryRule::ForceOnset => "the force stops being negligible (its peak passes the negligible level)",
-            BoundaryRule::OnOff => "the force becomes on–off (zero for at least the stated share of the cycle)",
+            BoundaryRule::ForceOnset => {
+                "the force stops being negligible (its peak passes the negligible level)"
+            }
+            BoundaryRule::OnOff => {
+                "the force becomes on–off (zero for at least the stated share of the cycle)"
+            }
             BoundaryRule::ForceGone => "the force falls back to negligible after the resonance",
-            BoundaryRule::OnOffFromOnset => "the force is on–off from its onset: no cycle has it on for most of the cycle",
-            BoundaryRule::Amplitude => "the amplitude criterion (a fraction of the record's largest amplitude)",
+            BoundaryRule::OnOffFromOnset => {
+                "the force is on–off from its onset: no cycle has it on for most of the cycle"
+            }
+            BoundaryRule::Amplitude => {
+                "the amplitude criterion (a fraction of the record's largest amplitude)"
+            }
         }
     }
 }

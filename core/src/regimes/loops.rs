@@ -147,11 +147,11 @@ mod tests {
         // A half sine of 1 N over 200 samples keeps its peak within 0.3 %; an alternating
         // ±0.1 N "noise" averages out over 5 samples to 0.02 N inside, and over the 3 samples
         // the window keeps at the ends to 0.1/3 N.
-        let f: Vec<f64> = (0..200)
-            .map(|i| (PI * i as f64 / 199.0).sin())
-            .collect();
+        let f: Vec<f64> = (0..200).map(|i| (PI * i as f64 / 199.0).sin()).collect();
         assert!((smoothed_peak(&f, peak_window(200)) - 1.0).abs() < 3e-3);
-        let noise: Vec<f64> = (0..100).map(|i| if i % 2 == 0 { 0.1 } else { -0.1 }).collect();
+        let noise: Vec<f64> = (0..100)
+            .map(|i| if i % 2 == 0 { 0.1 } else { -0.1 })
+            .collect();
         assert!((smoothed_peak(&noise, 5) - 0.1 / 3.0).abs() < 1e-12);
         assert!(smoothed_peak(&noise[2..98], 5) > 0.0);
         assert_eq!(smoothed_peak(&[], 5), 0.0);

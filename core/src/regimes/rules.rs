@@ -83,7 +83,13 @@ fn median_bool(x: &[bool], window: usize) -> Vec<bool> {
 
 /// The boundary at position `j` of the sweep order (`j ≥ 1`), where `new_side` tells which
 /// unsmoothed cycles belong to the side after the change.
-fn boundary_at(omega: &[f64], new_side: &[bool], j: usize, window: usize, rule: BoundaryRule) -> Boundary {
+fn boundary_at(
+    omega: &[f64],
+    new_side: &[bool],
+    j: usize,
+    window: usize,
+    rule: BoundaryRule,
+) -> Boundary {
     let n = omega.len();
     let w = window.max(3);
     let (lo_n, hi_n) = (j.saturating_sub(w), (j + w).min(n));
@@ -92,7 +98,9 @@ fn boundary_at(omega: &[f64], new_side: &[bool], j: usize, window: usize, rule: 
     let (lo, hi) = (first_new.min(j - 1), last_old.max(j));
     let (a, b) = omega[lo..=hi]
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| (a.min(w), b.max(w)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| {
+            (a.min(w), b.max(w))
+        });
     Boundary {
         omega: 0.5 * (omega[j - 1] + omega[j]),
         uncertainty: 0.5 * (b - a),
@@ -131,7 +139,11 @@ fn changes(beh: &[Behaviour], window: usize) -> (Option<usize>, Option<(usize, B
 pub fn place(features: &[CycleFeatures], th: &RegimeThresholds, negligible_level: f64) -> Placed {
     let n = features.len();
     let down = n > 1 && features[n - 1].omega < features[0].omega;
-    let order: Vec<usize> = if down { (0..n).rev().collect() } else { (0..n).collect() };
+    let order: Vec<usize> = if down {
+        (0..n).rev().collect()
+    } else {
+        (0..n).collect()
+    };
     let beh: Vec<Behaviour> = order
         .iter()
         .map(|&i| behaviour(&features[i], th, negligible_level))
@@ -147,13 +159,20 @@ pub fn place(features: &[CycleFeatures], th: &RegimeThresholds, negligible_level
     let mut boundaries = Boundaries {
         pre_resonance: b1.map(|j| boundary_at(&omega, &forced, j, w, BoundaryRule::ForceOnset)),
         resonance_post: b2.map(|(j, rule)| {
-            let side = if rule == BoundaryRule::OnOffFromOnset { &forced } else { &not_on };
+            let side = if rule == BoundaryRule::OnOffFromOnset {
+                &forced
+            } else {
+                &not_on
+            };
             boundary_at(&omega, side, j, w, rule)
         }),
     };
-    for b in [&mut boundaries.pre_resonance, &mut boundaries.resonance_post]
-        .into_iter()
-        .flatten()
+    for b in [
+        &mut boundaries.pre_resonance,
+        &mut boundaries.resonance_post,
+    ]
+    .into_iter()
+    .flatten()
     {
         b.cycle = order[b.cycle];
     }
@@ -226,7 +245,9 @@ mod tests {
         // median over 5 cycles places each change after them, and the raw mix spans both cycles
         // of the change.
         let mut c = vec![NEG; 6];
-        c.extend([ON, NEG, ON, ON, ON, ON, SPIKES, ON, SPIKES, SPIKES, SPIKES, SPIKES]);
+        c.extend([
+            ON, NEG, ON, ON, ON, ON, SPIKES, ON, SPIKES, SPIKES, SPIKES, SPIKES,
+        ]);
         let p = run(&c);
         let b1 = p.boundaries.pre_resonance.unwrap();
         assert_eq!((b1.cycle, b1.rule), (7, BoundaryRule::ForceOnset));
@@ -263,7 +284,10 @@ mod tests {
         let mut c = vec![NEG; 5];
         c.extend([SPIKES; 8]);
         let p = run(&c);
-        let (b1, b2) = (p.boundaries.pre_resonance.unwrap(), p.boundaries.resonance_post.unwrap());
+        let (b1, b2) = (
+            p.boundaries.pre_resonance.unwrap(),
+            p.boundaries.resonance_post.unwrap(),
+        );
         assert_eq!(b1.omega, b2.omega);
         assert_eq!(b2.rule, BoundaryRule::OnOffFromOnset);
         assert_eq!(p.count_res(), 0);
