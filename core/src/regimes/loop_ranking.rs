@@ -6,14 +6,16 @@
 //!
 //! | metric | per-cycle error | score in a regime |
 //! |---|---|---|
-//! | `force` | RMS of F_model − F_measured over the cycle, N | mean over its cycles ÷ mean measured RMS force there (floored at the on-threshold) |
+//! | `force` | RMS of F_model − F_measured over the cycle, N | mean over its cycles ÷ mean measured RMS force there |
 //! | `energy` | \|Δ∮F dx\|, J | mean ÷ mean \|measured ∮F dx\| there |
 //! | `c_eq` | \|Δ equivalent viscous damping\|, N·s/m | mean ÷ mean \|measured c_eq\| there |
 //! | `phase_x`, `phase_v` | \|Δ phase of the fundamental\| against x, v, wrapped to 180° | mean, degrees (cycles where both have a fundamental) |
 //! | `duty` | \|Δ on-fraction\| | mean |
 //! | `peak_force` | \|Δ peak \|F\|\|, N | mean ÷ mean measured peak there |
 //!
-//! Lower is better. The overall score is the mean of the per-regime scores (each regime weighs
+//! Each cycle's measured scale is at least what a force at the on-threshold would give (that
+//! RMS and peak; the energy π·F·X and c_eq F/(ω·X) of a damper of that peak), so a regime whose
+//! measured force is only noise does not divide by ≈ 0. Lower is better. The overall score is the mean of the per-regime scores (each regime weighs
 //! the same, as in [`super::ranking`]). The **test behind each ranking**: in each regime the
 //! best model's per-cycle errors are paired, cycle by cycle, with the runner-up's; `z` is the
 //! mean of the differences over its standard error (whole cycles are the units, as evidence
@@ -85,17 +87,28 @@ impl LoopMetric {
         }
     }
 
-    /// Error of cycle `i` (model against measured), and the measured value's scale there.
+    /// Error of cycle `i` (model against measured), and the measured value's scale there:
+    /// at least what a force at the on-threshold `thr` would give (its RMS and peak, the
+    /// energy and c_eq of a damper of that peak force), so a regime whose measured force is
+    /// only noise does not divide by ≈ 0.
     fn cycle(self, i: usize, meas: &Classification, c: &Comparison) -> (f64, f64) {
         let (a, b) = (&meas.features[i], &c.model_features[i]);
+        let thr = meas.on_threshold;
+        let damper = |x: f64| if x.is_finite() { x } else { 0.0 };
         match self {
-            LoopMetric::Force => (c.cycle_force_rms_error[i], a.f_rms),
-            LoopMetric::Energy => ((b.energy - a.energy).abs(), a.energy.abs()),
-            LoopMetric::CEq => ((b.c_eq - a.c_eq).abs(), a.c_eq.abs()),
+            LoopMetric::Force => (c.cycle_force_rms_error[i], a.f_rms.max(thr)),
+            LoopMetric::Energy => (
+                (b.energy - a.energy).abs(),
+                a.energy.abs().max(std::f64::consts::PI * thr * a.amplitude),
+            ),
+            LoopMetric::CEq => (
+                (b.c_eq - a.c_eq).abs(),
+                a.c_eq.abs().max(damper(thr / (a.omega * a.amplitude))),
+            ),
             LoopMetric::PhaseX => (phase_error(a.phase_x, b.phase_x), f64::NAN),
             LoopMetric::PhaseV => (phase_error(a.phase_v, b.phase_v), f64::NAN),
             LoopMetric::Duty => ((b.duty - a.duty).abs(), f64::NAN),
-            LoopMetric::PeakForce => ((b.f_peak - a.f_peak).abs(), a.f_peak),
+            LoopMetric::PeakForce => ((b.f_peak - a.f_peak).abs(), a.f_peak.max(thr)),
         }
     }
 
@@ -185,11 +198,6 @@ fn rank_regime(
     meas: &Classification,
     results: &[(&str, &Comparison)],
 ) -> RegimeRank {
-    let floor = if metric == LoopMetric::Force {
-        meas.on_threshold
-    } else {
-        0.0
-    };
     let errors: Vec<(Vec<f64>, &str)> = results
         .iter()
         .map(|(name, c)| {
@@ -208,7 +216,7 @@ fn rank_regime(
                     .map_or(f64::NAN, |(_, c)| metric.cycle(i, meas, c).1)
             })
             .collect();
-        mean_finite(&s).max(floor)
+        mean_finite(&s)
     } else {
         1.0
     };
