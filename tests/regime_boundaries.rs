@@ -1,7 +1,7 @@
 //! The regime boundaries of `compare` against the truth, on records made by `stf-lab simulate`
 //! with the rig's sensors (noise on x and F_STF, x quantised, φ from a 2048-count encoder).
 //!
-//! For each truth (`power_law`, `jamming_on_off`, `wall_impact`) and each of the source study's
+//! For each truth (`power_law`, `jamming_on_off`, `wall_impact`, at their defaults) and each of the source study's
 //! sweep rates (0.0333 and 0.047 rad/s², ω 3 → 14 rad/s at 100 Hz) the same experiment is
 //! simulated twice: with the sensors (the record `compare` classifies, through the program's own
 //! loading, filters and cycles) and without them (the truth). From the noise-free truth the test
@@ -30,21 +30,21 @@ const TOLERANCE: f64 = 0.1;
 
 struct Case {
     model: &'static str,
-    params: &'static str,
+    /// The `[[simulate.truth]]` tables.
+    truth: &'static str,
     alpha: f64,
     seed: u64,
 }
 
 fn experiment(dir: &Path, case: &Case, noise: bool) -> std::path::PathBuf {
-    let name = format!("{}_{}_{}", case.model, case.alpha, noise);
+    let name = format!("{}_{}_{}", case.model.replace(' ', ""), case.alpha, noise);
     let path = dir.join(format!("{name}.toml"));
     let text = format!(
-        "[data]\nfile = \"{name}.csv\"\n\n[simulate]\nsweep = {{ w0 = 3.0, alpha = {a}, t0 = 0.0, t1 = {t1} }}\nrate = 100.0\nnoise = {noise}\nseed = {seed}\n\n[[simulate.truth]]\nname = \"{m}\"\nparams = {{ {p} }}\n\n[[models]]\nname = \"viscous\"\n",
+        "[data]\nfile = \"{name}.csv\"\n\n[simulate]\nsweep = {{ w0 = 3.0, alpha = {a}, t0 = 0.0, t1 = {t1} }}\nrate = 100.0\nnoise = {noise}\nseed = {seed}\n\n{truth}\n\n[[models]]\nname = \"viscous\"\n",
         a = case.alpha,
         t1 = 11.0 / case.alpha,
         seed = case.seed,
-        m = case.model,
-        p = case.params,
+        truth = case.truth,
     );
     std::fs::write(&path, text).unwrap();
     simulate_ok(&path, &dir.join(format!("{name}.csv")));
@@ -156,10 +156,36 @@ fn run_case(case: &Case) -> bool {
 }
 
 const CASES: [(&str, &str); 3] = [
-    ("power_law", "K = 5.0, n = 1.6"),
-    ("jamming_on_off", "K_j = 100.0, v_c = 0.05"),
-    ("wall_impact", "k_w = 3e5, gap = 0.01"),
+    (
+        "power_law",
+        "[[simulate.truth]]\nname = \"power_law\"\nparams = { K = 5.0, n = 1.6 }",
+    ),
+    (
+        "jamming_on_off",
+        "[[simulate.truth]]\nname = \"jamming_on_off\"\nparams = { K_j = 100.0, v_c = 0.05 }",
+    ),
+    (
+        "wall_impact",
+        "[[simulate.truth]]\nname = \"wall_impact\"\nparams = { k_w = 3e5, gap = 0.01 }",
+    ),
 ];
+
+/// Power law + wall contact: between the impacts the power law's force is 0.07–0.10 N, right at
+/// the on-threshold, and the impacts raise the record's noise estimate (third differences of
+/// the spikes) from the sensor's 0.02 N to ≈ 0.029 N, so the on-threshold (0.087 N) cuts through
+/// that background and the measured on-fraction flickers around ½ where the truth's (threshold
+/// 0.06 N) stays near 1. Known not to meet 0.1 rad/s on every seed; kept, unloosened:
+/// `cargo test --release --test regime_boundaries -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn a_force_at_the_on_threshold_between_impacts_is_not_placed_within_a_tenth() {
+    let combo = (
+        "power_law + wall_impact",
+        "[[simulate.truth]]\nname = \"power_law\"\n\n[[simulate.truth]]\nname = \"wall_impact\"",
+    );
+    let failed = run_all(&[combo], &[1, 2, 3, 4]);
+    assert_eq!(failed, 0, "{failed} cases outside {TOLERANCE} rad/s");
+}
 
 fn run_all(cases: &[(&'static str, &'static str)], seeds: &[u64]) -> usize {
     println!(
@@ -167,12 +193,12 @@ fn run_all(cases: &[(&'static str, &'static str)], seeds: &[u64]) -> usize {
     );
     println!("|---|---|---|---|---|---|---|");
     let mut failed = 0;
-    for &(model, params) in cases {
+    for &(model, truth) in cases {
         for alpha in [0.0333, 0.047] {
             for &seed in seeds {
                 let case = Case {
                     model,
-                    params,
+                    truth,
                     alpha,
                     seed,
                 };
@@ -199,8 +225,14 @@ fn boundaries_land_within_a_tenth_of_a_rad_s_of_the_truths_crossings() {
 fn a_shallow_on_off_crossing_is_not_placed_within_a_tenth() {
     let failed = run_all(
         &[
-            ("jamming_on_off", "v_c = 0.065"),
-            ("jamming_on_off", "v_c = 0.07"),
+            (
+                "jamming_on_off v_c 0.065",
+                "[[simulate.truth]]\nname = \"jamming_on_off\"\nparams = { v_c = 0.065 }",
+            ),
+            (
+                "jamming_on_off v_c 0.07",
+                "[[simulate.truth]]\nname = \"jamming_on_off\"\nparams = { v_c = 0.07 }",
+            ),
         ],
         &[1, 2],
     );
