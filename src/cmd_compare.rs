@@ -277,21 +277,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     if let Some(b) = ranking.best_overall() {
         let _ = writeln!(md, "- best overall: **{b}**");
     }
-    for line in crate::compare_loops::ranking_lines(&loop_rankings) {
-        let _ = writeln!(md, "- {line}");
-    }
     let energy = crate::compare_loops::energy_table(&labels, &comparisons);
-    let _ = writeln!(
-        md,
-        "\n{}\n\n{}\n",
-        energy.caption,
-        crate::compare_loops::DUTY_EXPLAINED
-    );
-    let _ = writeln!(md, "| {} |\n|---|---|---|---|", energy.columns.join(" | "));
-    for row in &energy.rows {
-        let _ = writeln!(md, "| {} |", row.join(" | "));
-    }
-    md.push('\n');
+    crate::compare_loops::write_markdown(&mut md, &loop_rankings, &energy);
     // Say what each model misses: a duty error above 0.2 in a regime is an on–off miss.
     for (f, c) in fits.iter().zip(&comparisons) {
         for r in Regime::ALL {

@@ -163,6 +163,22 @@ pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
         .collect()
 }
 
+/// The loop rankings (bullets) and the per-regime energy table, for compare.md.
+pub fn write_markdown(md: &mut String, rankings: &[MetricRanking], energy: &Table) {
+    for line in ranking_lines(rankings) {
+        md.push_str(&format!("- {line}\n"));
+    }
+    md.push_str(&format!("\n{}\n\n{DUTY_EXPLAINED}\n\n", energy.caption));
+    md.push_str(&format!(
+        "| {} |\n|---|---|---|---|\n",
+        energy.columns.join(" | ")
+    ));
+    for row in &energy.rows {
+        md.push_str(&format!("| {} |\n", row.join(" | ")));
+    }
+    md.push('\n');
+}
+
 /// A row of `cycles.csv`.
 #[derive(Serialize)]
 struct CycleRow<'a> {

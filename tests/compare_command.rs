@@ -82,3 +82,29 @@ fn the_truth_ranks_first_and_viscous_misses_the_on_off_force() {
     assert!(table.starts_with("source,cycle,regime,t_mid_s,omega_rad_s,amplitude_m,energy_j,c_eq_ns_m,phase_x_deg,phase_v_deg,duty,peak_force_n"));
     assert!(dir.join("compare.csv").exists());
 }
+
+#[test]
+fn the_amplitude_criterion_remains_as_an_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("experiments/jamming_compare.toml")).unwrap();
+    let record = root().join("experiments/records/jamming_sweep.csv");
+    let text = text.replace(
+        "file = \"records/jamming_sweep.csv\"",
+        &format!("file = {:?}", record.display().to_string()),
+    ) + "\n[regimes]\namplitude_rule = true\n";
+    let exp = dir.path().join("amplitude.toml");
+    std::fs::write(&exp, text).unwrap();
+    let out = dir.path().join("cmp");
+    let _ = run_ok("compare", &exp, &out);
+    let doc = read_json(&out.join("compare.json"));
+    let bounds = &doc["measured"]["boundaries"];
+    for b in ["pre_resonance", "resonance_post"] {
+        assert_eq!(bounds[b]["rule"], "amplitude", "{bounds}");
+    }
+    // The earlier classifier's places: resonance from ≈ 5.5 rad/s, post from ≈ 9.4 rad/s.
+    let post = bounds["resonance_post"]["omega"].as_f64().unwrap();
+    assert!((8.5..10.5).contains(&post), "{bounds}");
+    assert_eq!(doc["thresholds"]["amplitude_rule"], true);
+    let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
+    assert!(md.contains("placed by `amplitude`"), "{md}");
+}
