@@ -109,8 +109,13 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
                     m.measured_peak_force,
                 )
             };
+            let phase = if px.is_finite() {
+                format!("{px:.0}°")
+            } else {
+                "no phase".to_string()
+            };
             format!(
-                "{:.2} mJ · c_eq {ceq:.1} · {px:.0}° · duty {duty:.2} · {peak:.2} N",
+                "{:.2} mJ · c_eq {ceq:.1} · {phase} · duty {duty:.2} · {peak:.2} N",
                 e * 1e3
             )
         })

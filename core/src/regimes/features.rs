@@ -22,7 +22,8 @@
 //! - `f_peak_smooth`, `c_eq`, `phase_x`, `phase_v`: what the field reads from the loop — the
 //!   peak of the lightly smoothed force (the negligible-force test reads it), the equivalent
 //!   viscous damping and the phase of the force's fundamental against x and v
-//!   ([`super::loops`]).
+//!   ([`super::loops`]; NaN where the smoothed force never passes the on-threshold: noise has
+//!   no phase to read).
 
 use serde::Serialize;
 
@@ -210,6 +211,15 @@ pub fn cycle_features(
     let energy: f64 = (s..e)
         .map(|i| 0.5 * (sig.f[i] + sig.f[i + 1]) * (sig.x[i + 1] - sig.x[i]))
         .sum();
+    let f_peak_smooth = smoothed_peak(f, peak_window(f.len()));
+    // A force that is never on (only noise, or none) has no phase to read.
+    let phase = |r: &[f64]| {
+        if f_peak_smooth > on_threshold {
+            phase_deg(&sig.t[s..e], f, r)
+        } else {
+            f64::NAN
+        }
+    };
     let scale = std::f64::consts::PI * f_peak * amplitude;
     let energy_ratio = if scale > 0.0 { energy / scale } else { 0.0 };
     Ok(CycleFeatures {
@@ -224,10 +234,10 @@ pub fn cycle_features(
         corr_x: abs_correlation(f, x),
         corr_v: abs_correlation(f, &sig.v[s..e]),
         corr_a: abs_correlation(f, &sig.a[s..e]),
-        f_peak_smooth: smoothed_peak(f, peak_window(f.len())),
+        f_peak_smooth,
         c_eq: equivalent_damping(energy, cycle.omega, amplitude),
-        phase_x: phase_deg(&sig.t[s..e], f, x),
-        phase_v: phase_deg(&sig.t[s..e], f, &sig.v[s..e]),
+        phase_x: phase(x),
+        phase_v: phase(&sig.v[s..e]),
     })
 }
 
@@ -390,6 +400,24 @@ mod tests {
         let f = cycle_features(&c.sig(), &c.cycle(400, 0, 5.0), 0.06, 0.05).unwrap();
         assert!(f.energy.abs() < 1e-6 * f.f_peak * f.amplitude);
         assert!(f.corr_x > 0.999 && f.corr_a > 0.999 && f.corr_v < -0.9);
+    }
+
+    #[test]
+    fn a_force_that_is_never_on_has_no_phase() {
+        // 0.04 N of damper force stays below the on-threshold 0.06 N: no phase to read; ten
+        // times more has the damper's 90° against x.
+        for (c_visc, on) in [(4.0, false), (40.0, true)] {
+            let c = case(6.0, 0.01 / 6.0, 400, 2, |_, _, v, _| c_visc * v);
+            let f = cycle_features(&c.sig(), &c.cycle(400, 0, 6.0), 0.06, 0.05).unwrap();
+            assert_eq!(f.phase_x.is_finite(), on, "{f:?}");
+            if on {
+                assert!(
+                    (f.phase_x - 90.0).abs() < 0.5 && f.phase_v.abs() < 0.5,
+                    "{f:?}"
+                );
+                assert!((f.c_eq / c_visc - 1.0).abs() < 1e-3, "{f:?}");
+            }
+        }
     }
 
     #[test]
