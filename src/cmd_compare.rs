@@ -203,7 +203,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     write_json(&out.join("compare.json"), &doc)?;
 
     // models × regimes: relative force RMS error and duty error.
-    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement\n");
+    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement,measured_energy_J,model_energy_J,measured_c_eq_Ns_m,model_c_eq_Ns_m,phase_x_error_deg,phase_v_error_deg\n");
     let mut md = String::new();
     let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
     let _ = writeln!(
@@ -238,7 +238,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                     let _ = write!(row, "| {:.3} ({:.2}) ", m.relative_rms_error, m.duty_error);
                     let _ = writeln!(
                         csv,
-                        "{},{},{},{},{},{},{},{},{}",
+                        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                         f.label,
                         r.name(),
                         m.cycles,
@@ -247,7 +247,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                         m.energy_error,
                         m.duty_error,
                         m.peak_force_error,
-                        m.label_agreement
+                        m.label_agreement,
+                        m.measured_energy,
+                        m.model_energy,
+                        m.measured_c_eq,
+                        m.model_c_eq,
+                        m.phase_x_error,
+                        m.phase_v_error
                     );
                 }
                 None => row.push_str("| — "),

@@ -91,9 +91,13 @@ pub struct Classification {
     pub cycles: Vec<Cycle>,
     /// Their features.
     pub features: Vec<CycleFeatures>,
-    /// Labels before smoothing.
+    /// Labels before smoothing: by the definitions, what each cycle's own behaviour says — on:
+    /// resonance; negligible: pre-resonance where labelled so, else post-resonance; on–off:
+    /// post-resonance where labelled so, else resonance (pulses of a force that is starting);
+    /// with `amplitude_rule`, rules 2–4 of the amplitude criterion.
     pub raw_labels: Vec<Regime>,
-    /// Smoothed labels.
+    /// The labels: by the definitions, those the boundaries give; with `amplitude_rule`, the
+    /// median-filtered raw labels.
     pub labels: Vec<Regime>,
     /// Where the smoothed labels change, rad/s.
     pub boundaries: Boundaries,
