@@ -80,6 +80,22 @@ fn the_truth_ranks_first_and_viscous_misses_the_on_off_force() {
     let table = std::fs::read_to_string(dir.join("cycles.csv")).unwrap();
     assert_eq!(table.lines().count(), 1 + 5 * cycles);
     assert!(table.starts_with("source,cycle,regime,t_mid_s,omega_rad_s,amplitude_m,energy_j,c_eq_ns_m,phase_x_deg,phase_v_deg,duty,peak_force_n"));
+    // Its rows are the cycles the per-regime figures average: the measured resonance energy.
+    let header: Vec<&str> = table.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (src, reg, en) = (col("source"), col("regime"), col("energy_j"));
+    let energies: Vec<f64> = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|c| c[src] == "measured" && c[reg] == "resonance")
+        .map(|c| c[en].parse().unwrap())
+        .collect();
+    let mean = energies.iter().sum::<f64>() / energies.len() as f64;
+    assert!(
+        (mean / e_meas - 1.0).abs() < 1e-9,
+        "{mean} against {e_meas}"
+    );
     assert!(dir.join("compare.csv").exists());
 }
 
