@@ -16,7 +16,7 @@ use serde_json::{json, Value};
 use stf_core::analysis::{local_maxima, peak};
 use stf_core::oscillator::Oscillator;
 use stf_core::regimes::{
-    classify, compare, rank_models, Classification, Comparison, Regime, Signals,
+    classify, compare, rank_models, rank_on_loops, Classification, Comparison, Regime, Signals,
 };
 use stf_core::simulate::Simulation;
 
@@ -147,6 +147,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
     let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
     let ranking = rank_models(&pairs);
+    let loop_rankings = rank_on_loops(&measured, &pairs);
 
     let count = |r: Regime| measured.labels.iter().filter(|l| **l == r).count();
     let models: Vec<Value> = fits
@@ -189,17 +190,20 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             "cycles": measured.labels.len(),
             "cycles_per_regime": Regime::ALL.iter().map(|&r| (r.name().to_string(), json!(count(r)))).collect::<serde_json::Map<_, _>>(),
             "boundaries": measured.boundaries,
+            "boundary_notes": crate::compare_loops::boundary_notes(&measured),
             "resonance": { "peak_x_m": measured_peak.amplitude, "peak_omega_rad_s": finite_or_null(measured_peak.omega) },
         },
         "thresholds": exp.regimes,
         "models": models,
         "ranking": ranking,
+        "loop_rankings": loop_rankings,
         "best": best,
+        "cycles_csv": "cycles.csv",
     });
     write_json(&out.join("compare.json"), &doc)?;
 
     // models × regimes: relative force RMS error and duty error.
-    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement\n");
+    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement,measured_energy_J,model_energy_J,measured_c_eq_Ns_m,model_c_eq_Ns_m,phase_x_error_deg,phase_v_error_deg\n");
     let mut md = String::new();
     let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
     let _ = writeln!(
@@ -214,19 +218,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             ""
         }
     );
-    if let Some(b) = measured.boundaries.pre_resonance {
-        let _ = writeln!(
-            md,
-            "- pre-resonance → resonance at ω = {:.2} ± {:.2} rad/s",
-            b.omega, b.uncertainty
-        );
-    }
-    if let Some(b) = measured.boundaries.resonance_post {
-        let _ = writeln!(
-            md,
-            "- resonance → post-resonance at ω = {:.2} ± {:.2} rad/s",
-            b.omega, b.uncertainty
-        );
+    for line in crate::compare_loops::boundary_lines(&measured) {
+        let _ = writeln!(md, "- {line}");
     }
     let _ = writeln!(
         md,
@@ -245,7 +238,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                     let _ = write!(row, "| {:.3} ({:.2}) ", m.relative_rms_error, m.duty_error);
                     let _ = writeln!(
                         csv,
-                        "{},{},{},{},{},{},{},{},{}",
+                        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                         f.label,
                         r.name(),
                         m.cycles,
@@ -254,7 +247,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
                         m.energy_error,
                         m.duty_error,
                         m.peak_force_error,
-                        m.label_agreement
+                        m.label_agreement,
+                        m.measured_energy,
+                        m.model_energy,
+                        m.measured_c_eq,
+                        m.model_c_eq,
+                        m.phase_x_error,
+                        m.phase_v_error
                     );
                 }
                 None => row.push_str("| — "),
@@ -284,6 +283,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     if let Some(b) = ranking.best_overall() {
         let _ = writeln!(md, "- best overall: **{b}**");
     }
+    let energy = crate::compare_loops::energy_table(&labels, &comparisons);
+    crate::compare_loops::write_markdown(&mut md, &loop_rankings, &energy);
     // Say what each model misses: a duty error above 0.2 in a regime is an on–off miss.
     for (f, c) in fits.iter().zip(&comparisons) {
         for r in Regime::ALL {
@@ -314,6 +315,12 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         let _ = writeln!(md, "\n**Warnings**\n\n{}", warned.join("\n"));
     }
     write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
+    crate::compare_loops::write_cycles_csv(
+        &out.join("cycles.csv"),
+        &measured,
+        &labels,
+        &comparisons,
+    )?;
     write_atomic(&out.join("compare.md"), md.as_bytes())?;
     if exp.output.report {
         // The report: regimes table, frequency response, the record and the fits.
@@ -363,6 +370,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             table.rows.push(row);
         }
         regimes.tables.push(table);
+        regimes
+            .paragraphs
+            .push(crate::compare_loops::DUTY_EXPLAINED.into());
+        regimes.tables.push(energy);
         let bars: Vec<(&str, Vec<f64>)> = fits
             .iter()
             .zip(&comparisons)
@@ -407,7 +418,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     print!("{md}");
     println!(
-        "wrote {}/compare.json, compare.md, compare.csv, report.html, report.md and figures/",
+        "wrote {}/compare.json, compare.md, compare.csv, cycles.csv, report.html, report.md and figures/",
         out.display()
     );
     Ok(())

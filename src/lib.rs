@@ -14,6 +14,7 @@ pub mod cmd_discover;
 pub mod cmd_fit;
 pub mod cmd_models;
 pub mod cmd_simulate;
+pub mod compare_loops;
 pub mod data_layout;
 pub mod discovery_curves;
 pub mod experiment;

@@ -6,6 +6,11 @@
 //! sampled at 200 Hz. Noisy records add σ_f = 0.02 N to the force (seeded), the rig's
 //! displacement noise and quantization to x and the 2048-count encoder to φ; v and a stay those
 //! of the simulation (what a good derivative filter would give).
+//!
+//! These tests exercise the amplitude criterion (`amplitude_rule = true`, an option): by the
+//! study's behavioural definitions, the default, this law has no post-resonance — its force
+//! rests at zero for only 0.33–0.40 of each cycle after the resonance, never the half that
+//! makes it on–off (`tests/regime_boundaries.rs` checks the definitions against the truth).
 
 use std::sync::{Arc, OnceLock};
 
@@ -95,8 +100,15 @@ fn classified(run: &Trajectory, noise: &SensorNoise, seed: u64) -> Classified {
         f: &f,
     };
     let cycles = cycles_from_phase(&run.t, &phi).unwrap();
-    let c = classify(&sig, cycles, &RegimeThresholds::default()).unwrap();
+    let c = classify(&sig, cycles, &amplitude_rule()).unwrap();
     Classified { x: rec.x, f, c }
+}
+
+fn amplitude_rule() -> RegimeThresholds {
+    RegimeThresholds {
+        amplitude_rule: true,
+        ..Default::default()
+    }
 }
 
 const FORCE_NOISE: SensorNoise = SensorNoise {
@@ -183,7 +195,7 @@ fn comparison_ranks_the_truth_first_and_shows_a_damper_misses_the_on_off_force()
         a: &run.a,
         f: &noisy.f,
     };
-    let th = RegimeThresholds::default();
+    let th = amplitude_rule();
     let truth: Vec<f64> = run.v.iter().map(|&v| jamming_force(&TRUTH, v)).collect();
     // The best viscous force c·v in the least-squares sense, and a jamming law with the wrong
     // critical speed.

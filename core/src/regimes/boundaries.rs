@@ -1,5 +1,12 @@
 //! Where the regimes change along a sweep, in rad/s, with an uncertainty.
 //!
+//! Each [`Boundary`] carries the [`BoundaryRule`] that placed it: the source study's behavioural
+//! definitions ([`super::rules`]: the force stops being negligible; the force becomes on–off or
+//! falls back to negligible) by default, or the amplitude criterion when
+//! `RegimeThresholds::amplitude_rule` is set. The rest of this page describes how a change of
+//! smoothed labels becomes a boundary ([`find_boundaries`], used by the amplitude criterion; the
+//! definitions place theirs the same way from their own per-cycle behaviour).
+//!
 //! A boundary lies between two neighbouring cycles whose smoothed labels are Pre and Resonance
 //! (for `pre_resonance`) or Resonance and Post (for `resonance_post`), in either order, so
 //! down-sweeps work too; the first such pair counts. Its ω is the mean of the two cycles' ω.
@@ -12,6 +19,50 @@ use serde::Serialize;
 
 use super::classify::Regime;
 
+/// Which rule placed a boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundaryRule {
+    /// Pre → resonance where the force stops being negligible: its peak passes
+    /// max(`negligible_force`, `negligible_k`·σ) and stays above it.
+    ForceOnset,
+    /// Resonance → post where the force, after being on for most of the cycle, becomes
+    /// on–off: zero (at or below the on-threshold) for more than 1 − `resonance_duty` of the
+    /// cycle, in intervals between its pulses.
+    OnOff,
+    /// Resonance → post where the force, after being on for most of the cycle, falls back to
+    /// negligible.
+    ForceGone,
+    /// Resonance → post at the force's onset itself: the force is on–off from its first
+    /// non-negligible cycle and never on for most of a cycle (impact spikes with no damping
+    /// regime); the resonance has no cycles.
+    OnOffFromOnset,
+    /// The amplitude criterion (an option, `amplitude_rule`): resonance cycles also need
+    /// `resonance_amplitude` of the record's largest amplitude.
+    Amplitude,
+}
+
+impl BoundaryRule {
+    /// A sentence saying what placed the boundary, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            BoundaryRule::ForceOnset => {
+                "the force stops being negligible (its peak passes the negligible level)"
+            }
+            BoundaryRule::OnOff => {
+                "the force becomes on–off (zero for at least the stated share of the cycle)"
+            }
+            BoundaryRule::ForceGone => "the force falls back to negligible after the resonance",
+            BoundaryRule::OnOffFromOnset => {
+                "the force is on–off from its onset: no cycle has it on for most of the cycle"
+            }
+            BoundaryRule::Amplitude => {
+                "the amplitude criterion (a fraction of the record's largest amplitude)"
+            }
+        }
+    }
+}
+
 /// One change of regime.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Boundary {
@@ -21,6 +72,8 @@ pub struct Boundary {
     pub uncertainty: f64,
     /// Index of the first cycle after the change.
     pub cycle: usize,
+    /// The rule that placed it.
+    pub rule: BoundaryRule,
 }
 
 /// The changes of regime of a record (`None` where there is no such change).
@@ -62,6 +115,7 @@ pub fn find_boundaries(
             omega: 0.5 * (omega[j - 1] + omega[j]),
             uncertainty: 0.5 * (span.1 - span.0),
             cycle: j,
+            rule: BoundaryRule::Amplitude,
         })
     };
     Boundaries {

@@ -8,18 +8,19 @@
 //!    `negligible_k`·σ). If every cycle's force is negligible the record has no STF effect:
 //!    [`Classification::no_stf`] is set and every cycle is labelled
 //!    [`Regime::PreResonance`] ("force negligible") — no regime is invented from noise.
-//! 3. Otherwise a cycle is [`Regime::Resonance`] when its force is not negligible, is on for at
-//!    least `resonance_duty` (0.5) of the cycle (strong damping: force on most of the cycle)
-//!    and its amplitude is at least `resonance_amplitude` (0.6) of the record's largest.
-//! 4. Any other cycle is [`Regime::PreResonance`] if its ω lies below that of the record's
-//!    largest-amplitude cycle (the resonance peak), [`Regime::PostResonance`] if not: before
-//!    the resonance the force is negligible or merely starting, after it the amplitude is small
-//!    and the force on–off (duty well below 1, zero between spikes) or gone. The comparison
-//!    with ω of the peak makes the rule hold for up- and down-sweeps alike.
-//! 5. The labels are smoothed by a median filter over `smoothing_cycles` (5) cycles, ordered
-//!    Pre < Resonance < Post (the order along a sweep), so single noisy cycles do not flip; the
-//!    window shrinks symmetrically at the ends.
-//! 6. [`find_boundaries`] places the changes of the smoothed labels in ω, with an uncertainty.
+//! 3. Otherwise, by default, the boundaries follow the source study's behavioural definitions
+//!    ([`super::rules`]): pre → resonance where the force stops being negligible; resonance →
+//!    post where the force, after being on for most of the cycle, becomes on–off (zero for more
+//!    than 1 − `resonance_duty` of the cycle) or falls back to negligible. The labels follow the
+//!    boundaries; each [`Boundary`](super::Boundary) names the rule that placed it.
+//! 4. With `amplitude_rule` (an option, off by default) the earlier amplitude criterion runs
+//!    instead ([`label_cycles`]): a cycle is [`Regime::Resonance`] when its force is not
+//!    negligible, on for at least `resonance_duty` of the cycle and its amplitude at least
+//!    `resonance_amplitude` (0.6) of the record's largest; any other cycle is
+//!    [`Regime::PreResonance`] below ω of the largest-amplitude cycle and
+//!    [`Regime::PostResonance`] above it. The labels are smoothed by a median filter over
+//!    `smoothing_cycles` (5) cycles, ordered Pre < Resonance < Post, and [`find_boundaries`]
+//!    places their changes in ω, with an uncertainty.
 
 use serde::{Deserialize, Serialize};
 
@@ -28,6 +29,7 @@ use super::cycles::Cycle;
 use super::error::RegimeError;
 use super::features::{features, CycleFeatures, Signals};
 use super::noise::noise_floor;
+use super::rules::place;
 use super::thresholds::RegimeThresholds;
 
 /// The three behaviours of the STF along a sweep.
@@ -89,9 +91,13 @@ pub struct Classification {
     pub cycles: Vec<Cycle>,
     /// Their features.
     pub features: Vec<CycleFeatures>,
-    /// Labels before smoothing.
+    /// Labels before smoothing: by the definitions, what each cycle's own behaviour says — on:
+    /// resonance; negligible: pre-resonance where labelled so, else post-resonance; on–off:
+    /// post-resonance where labelled so, else resonance (pulses of a force that is starting);
+    /// with `amplitude_rule`, rules 2–4 of the amplitude criterion.
     pub raw_labels: Vec<Regime>,
-    /// Smoothed labels.
+    /// The labels: by the definitions, those the boundaries give; with `amplitude_rule`, the
+    /// median-filtered raw labels.
     pub labels: Vec<Regime>,
     /// Where the smoothed labels change, rad/s.
     pub boundaries: Boundaries,
@@ -167,10 +173,19 @@ pub fn classify(
     };
     let features = features(sig, &cycles, th, noise_sigma)?;
     let negligible_level = th.negligible_level(noise_sigma);
-    let (raw_labels, no_stf, peak_omega) = label_cycles(&features, th, negligible_level);
-    let labels = median_filter(&raw_labels, th.smoothing_cycles);
-    let omega: Vec<f64> = features.iter().map(|f| f.omega).collect();
-    let boundaries = find_boundaries(&omega, &raw_labels, &labels, th.smoothing_cycles);
+    let (amp_raw, no_stf, peak_omega) = label_cycles(&features, th, negligible_level);
+    let (raw_labels, labels, boundaries) = if no_stf {
+        let l = vec![Regime::PreResonance; features.len()];
+        (l.clone(), l, Boundaries::default())
+    } else if th.amplitude_rule {
+        let labels = median_filter(&amp_raw, th.smoothing_cycles);
+        let omega: Vec<f64> = features.iter().map(|f| f.omega).collect();
+        let b = find_boundaries(&omega, &amp_raw, &labels, th.smoothing_cycles);
+        (amp_raw, labels, b)
+    } else {
+        let p = place(&features, th, negligible_level);
+        (p.raw, p.labels, p.boundaries)
+    };
     Ok(Classification {
         noise_sigma,
         on_threshold: th.on_threshold(noise_sigma),
@@ -203,6 +218,10 @@ mod tests {
             corr_x: 0.0,
             corr_v: 0.0,
             corr_a: 0.0,
+            f_peak_smooth: f_peak,
+            c_eq: 0.0,
+            phase_x: f64::NAN,
+            phase_v: f64::NAN,
         }
     }
 

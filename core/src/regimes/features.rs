@@ -18,12 +18,18 @@
 //!   turning points (in phase with the acceleration, as the paper observed post-resonance) have
 //!   `corr_a` and `corr_x` near 1. The correlation is 0 when either signal is constant over the
 //!   cycle (nothing to align). A correlation is used rather than the lag between single peaks
-//!   because it uses every sample and does not jump when two peaks of a cycle are nearly equal.
+//!   because it uses every sample and does not jump when two peaks of a cycle are nearly equal;
+//! - `f_peak_smooth`, `c_eq`, `phase_x`, `phase_v`: what the field reads from the loop — the
+//!   peak of the lightly smoothed force (the negligible-force test reads it), the equivalent
+//!   viscous damping and the phase of the force's fundamental against x and v
+//!   ([`super::loops`]; NaN where the smoothed force never passes the on-threshold: noise has
+//!   no phase to read).
 
 use serde::Serialize;
 
 use super::cycles::Cycle;
 use super::error::{check_finite, check_len, RegimeError};
+use super::loops::{equivalent_damping, peak_window, phase_deg, smoothed_peak};
 use super::thresholds::RegimeThresholds;
 
 /// The signals of a record, sampled together: kinematics and the STF force.
@@ -84,6 +90,14 @@ pub struct CycleFeatures {
     pub corr_v: f64,
     /// Correlation of |F| with |a|.
     pub corr_a: f64,
+    /// Largest |F| of the force smoothed over about 1/25 of the cycle, N.
+    pub f_peak_smooth: f64,
+    /// Equivalent viscous damping ∮F dx / (π·ω·X²), N·s/m.
+    pub c_eq: f64,
+    /// Phase of the force's fundamental against x's, degrees (NaN: no fundamental).
+    pub phase_x: f64,
+    /// Phase of the force's fundamental against v's, degrees (NaN: no fundamental).
+    pub phase_v: f64,
 }
 
 /// Fraction of a cycle in which the force `f` (the cycle's samples) is on.
@@ -197,6 +211,15 @@ pub fn cycle_features(
     let energy: f64 = (s..e)
         .map(|i| 0.5 * (sig.f[i] + sig.f[i + 1]) * (sig.x[i + 1] - sig.x[i]))
         .sum();
+    let f_peak_smooth = smoothed_peak(f, peak_window(f.len()));
+    // A force that is never on (only noise, or none) has no phase to read.
+    let phase = |r: &[f64]| {
+        if f_peak_smooth > on_threshold {
+            phase_deg(&sig.t[s..e], f, r)
+        } else {
+            f64::NAN
+        }
+    };
     let scale = std::f64::consts::PI * f_peak * amplitude;
     let energy_ratio = if scale > 0.0 { energy / scale } else { 0.0 };
     Ok(CycleFeatures {
@@ -211,6 +234,10 @@ pub fn cycle_features(
         corr_x: abs_correlation(f, x),
         corr_v: abs_correlation(f, &sig.v[s..e]),
         corr_a: abs_correlation(f, &sig.a[s..e]),
+        f_peak_smooth,
+        c_eq: equivalent_damping(energy, cycle.omega, amplitude),
+        phase_x: phase(x),
+        phase_v: phase(&sig.v[s..e]),
     })
 }
 
@@ -373,6 +400,24 @@ mod tests {
         let f = cycle_features(&c.sig(), &c.cycle(400, 0, 5.0), 0.06, 0.05).unwrap();
         assert!(f.energy.abs() < 1e-6 * f.f_peak * f.amplitude);
         assert!(f.corr_x > 0.999 && f.corr_a > 0.999 && f.corr_v < -0.9);
+    }
+
+    #[test]
+    fn a_force_that_is_never_on_has_no_phase() {
+        // 0.04 N of damper force stays below the on-threshold 0.06 N: no phase to read; ten
+        // times more has the damper's 90° against x.
+        for (c_visc, on) in [(4.0, false), (40.0, true)] {
+            let c = case(6.0, 0.01 / 6.0, 400, 2, |_, _, v, _| c_visc * v);
+            let f = cycle_features(&c.sig(), &c.cycle(400, 0, 6.0), 0.06, 0.05).unwrap();
+            assert_eq!(f.phase_x.is_finite(), on, "{f:?}");
+            if on {
+                assert!(
+                    (f.phase_x - 90.0).abs() < 0.5 && f.phase_v.abs() < 0.5,
+                    "{f:?}"
+                );
+                assert!((f.c_eq / c_visc - 1.0).abs() < 1e-3, "{f:?}");
+            }
+        }
     }
 
     #[test]

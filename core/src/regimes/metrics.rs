@@ -12,6 +12,12 @@
 //! - `duty_error`: mean over cycles of |duty_model − duty_measured| (with the means of both, so a
 //!   model that misses the on–off behaviour shows as duty ≈ 1 against a measured 0.5);
 //! - `peak_force_error`: mean over cycles of |peak_model − peak_measured|, N;
+//! - the loop metrics the field reads ([`super::loops`]), as the measured and the model's mean
+//!   per cycle and the mean |difference| per cycle: `measured_energy`/`model_energy`/
+//!   `energy_error` (∮F dx, J), `measured_c_eq`/`model_c_eq`/`c_eq_error` (equivalent viscous
+//!   damping, N·s/m), `measured_phase_x`/`model_phase_x`/`phase_x_error` and the same against v
+//!   (phase of the force's fundamental, degrees; circular means; differences wrapped to ±180°,
+//!   over the cycles where both have a fundamental), `measured_peak_force`/`model_peak_force`;
 //! - `label_agreement`: fraction of the cycles whose label from the model's own force (the same
 //!   classifier, the same thresholds and the measurement's noise σ, so both are judged alike)
 //!   equals the measured label.
@@ -24,6 +30,7 @@ use super::boundaries::{Boundaries, Boundary};
 use super::classify::{classify, Classification, Regime};
 use super::error::{check_len, RegimeError};
 use super::features::{CycleFeatures, Signals};
+use super::loops::wrap_deg;
 use super::thresholds::RegimeThresholds;
 
 /// One value per regime (`None`: the measurement has no cycle in that regime).
@@ -92,6 +99,30 @@ pub struct RegimeMetrics {
     pub duty_error: f64,
     /// Mean |Δ peak |F|| per cycle, N.
     pub peak_force_error: f64,
+    /// Mean ∮F dx per cycle of the model's force, J.
+    pub model_energy: f64,
+    /// Mean measured equivalent viscous damping, N·s/m.
+    pub measured_c_eq: f64,
+    /// Mean equivalent viscous damping of the model's force, N·s/m.
+    pub model_c_eq: f64,
+    /// Mean |Δc_eq| per cycle, N·s/m.
+    pub c_eq_error: f64,
+    /// Circular mean of the measured force's phase against x, degrees.
+    pub measured_phase_x: f64,
+    /// Circular mean of the model force's phase against x, degrees.
+    pub model_phase_x: f64,
+    /// Mean |Δphase against x| per cycle, degrees.
+    pub phase_x_error: f64,
+    /// Circular mean of the measured force's phase against v, degrees.
+    pub measured_phase_v: f64,
+    /// Circular mean of the model force's phase against v, degrees.
+    pub model_phase_v: f64,
+    /// Mean |Δphase against v| per cycle, degrees.
+    pub phase_v_error: f64,
+    /// Mean measured peak |F| per cycle, N.
+    pub measured_peak_force: f64,
+    /// Mean peak |F| of the model's force per cycle, N.
+    pub model_peak_force: f64,
     /// Fraction of cycles whose model label equals the measured label.
     pub label_agreement: f64,
 }
@@ -118,6 +149,10 @@ pub struct Comparison {
     pub model_labels: Vec<Regime>,
     /// The model's own boundaries.
     pub model_boundaries: Boundaries,
+    /// The features of the model's force, cycle by cycle (the measured cycles).
+    pub model_features: Vec<CycleFeatures>,
+    /// RMS of the force error in each cycle, N.
+    pub cycle_force_rms_error: Vec<f64>,
 }
 
 fn mean(x: impl Iterator<Item = f64>) -> f64 {
@@ -127,6 +162,64 @@ fn mean(x: impl Iterator<Item = f64>) -> f64 {
     } else {
         0.0
     }
+}
+
+/// Circular mean of angles in degrees (NaN ones skipped; NaN if none).
+fn circular_mean(x: impl Iterator<Item = f64>) -> f64 {
+    let (s, c, n) = x
+        .filter(|a| a.is_finite())
+        .fold((0.0, 0.0, 0usize), |(s, c, n), a| {
+            (s + a.to_radians().sin(), c + a.to_radians().cos(), n + 1)
+        });
+    if n > 0 {
+        s.atan2(c).to_degrees()
+    } else {
+        f64::NAN
+    }
+}
+
+/// Mean of the finite values (NaN if none).
+fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = x
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n > 0 {
+        s / n as f64
+    } else {
+        f64::NAN
+    }
+}
+
+/// |model − measured| of a phase, wrapped to [0°, 180°] (NaN when either is NaN).
+pub fn phase_error(measured: f64, model: f64) -> f64 {
+    wrap_deg(model - measured).abs()
+}
+
+/// Loop metrics of the cycles `idx`: measured and model means and mean |differences|.
+fn loop_metrics(
+    idx: &[usize],
+    meas: &[CycleFeatures],
+    model: &[CycleFeatures],
+    m: &mut RegimeMetrics,
+) {
+    let over = |g: &dyn Fn(&CycleFeatures, &CycleFeatures) -> f64| {
+        finite_mean(idx.iter().map(|&i| g(&meas[i], &model[i])))
+    };
+    let circ = |g: &dyn Fn(&CycleFeatures) -> f64, set: &[CycleFeatures]| {
+        circular_mean(idx.iter().map(|&i| g(&set[i])))
+    };
+    m.model_energy = over(&|_, b| b.energy);
+    m.measured_c_eq = over(&|a, _| a.c_eq);
+    m.model_c_eq = over(&|_, b| b.c_eq);
+    m.c_eq_error = over(&|a, b| (b.c_eq - a.c_eq).abs());
+    m.measured_phase_x = circ(&|f| f.phase_x, meas);
+    m.model_phase_x = circ(&|f| f.phase_x, model);
+    m.phase_x_error = over(&|a, b| phase_error(a.phase_x, b.phase_x));
+    m.measured_phase_v = circ(&|f| f.phase_v, meas);
+    m.model_phase_v = circ(&|f| f.phase_v, model);
+    m.phase_v_error = over(&|a, b| phase_error(a.phase_v, b.phase_v));
+    m.measured_peak_force = over(&|a, _| a.f_peak);
+    m.model_peak_force = over(&|_, b| b.f_peak);
 }
 
 fn metrics_over(
@@ -158,7 +251,7 @@ fn metrics_over(
             g(a, b)
         }))
     };
-    RegimeMetrics {
+    let mut m = RegimeMetrics {
         cycles: idx.len(),
         measured_rms: meas,
         model_rms: rms(p2),
@@ -174,7 +267,36 @@ fn metrics_over(
             idx.iter()
                 .map(|&i| f64::from(u8::from(measured.labels[i] == model.labels[i]))),
         ),
-    }
+        model_energy: 0.0,
+        measured_c_eq: 0.0,
+        model_c_eq: 0.0,
+        c_eq_error: 0.0,
+        measured_phase_x: f64::NAN,
+        model_phase_x: f64::NAN,
+        phase_x_error: f64::NAN,
+        measured_phase_v: f64::NAN,
+        model_phase_v: f64::NAN,
+        phase_v_error: f64::NAN,
+        measured_peak_force: 0.0,
+        model_peak_force: 0.0,
+    };
+    loop_metrics(idx, &measured.features, &model.features, &mut m);
+    m
+}
+
+/// RMS of the force error in each measured cycle, N.
+fn cycle_rms(measured: &Classification, f_meas: &[f64], f_model: &[f64]) -> Vec<f64> {
+    measured
+        .cycles
+        .iter()
+        .map(|c| {
+            let n = c.len().max(1) as f64;
+            let s: f64 = (c.start..c.end)
+                .map(|k| (f_model[k] - f_meas[k]).powi(2))
+                .sum();
+            (s / n).sqrt()
+        })
+        .collect()
 }
 
 fn boundary_error(a: Option<Boundary>, b: Option<Boundary>) -> Option<f64> {
@@ -219,6 +341,8 @@ pub fn compare(
         },
         model_labels: model.labels,
         model_boundaries: model.boundaries,
+        model_features: model.features,
+        cycle_force_rms_error: cycle_rms(measured, sig.f, model_force),
     })
 }
 

@@ -9,12 +9,17 @@
 //! 2. [`noise`] estimates the force's noise floor from the record (users may override it);
 //! 3. [`features`](mod@features) computes per-cycle features: ω, displacement amplitude, peak and RMS force,
 //!    duty (fraction of the cycle the force is on), ∮F dx and the alignment of |F| with
-//!    |x|, |v|, |a|;
+//!    |x|, |v|, |a|, the equivalent viscous damping and the phase of the force's fundamental;
 //! 4. [`classify`](mod@classify) labels each cycle [`Regime::PreResonance`], [`Regime::Resonance`] or
-//!    [`Regime::PostResonance`] with the thresholds of [`RegimeThresholds`], smooths the labels
-//!    along the sweep and finds the [`boundaries`] in rad/s with an uncertainty;
+//!    [`Regime::PostResonance`] by the source study's behavioural definitions ([`rules`]; the
+//!    amplitude criterion is an option) and finds the [`boundaries`] in rad/s, each with an
+//!    uncertainty and the rule that placed it;
 //! 5. [`metrics`] compares a model's force on the same kinematics with the measured force,
-//!    per measured regime, and [`ranking`] names the best model per regime and overall;
+//!    per measured regime — force error and what the field reads from loops ([`loops`]:
+//!    energy per cycle, equivalent viscous damping, phase of the force's fundamental against x
+//!    and v, on-fraction, peak force) — and [`ranking`] names the best model per regime and
+//!    overall by the force error, [`loop_ranking`] by each loop metric with the paired test
+//!    behind each ranking;
 //!    [`prediction`] gives any prediction's RMS error per regime (a model scored on a second
 //!    record).
 //!
@@ -41,19 +46,24 @@ pub mod classify;
 pub mod cycles;
 pub mod error;
 pub mod features;
+pub mod loop_ranking;
+pub mod loops;
 pub mod metrics;
 pub mod noise;
 pub mod prediction;
 pub mod ranking;
+pub mod rules;
 pub mod thresholds;
 
-pub use boundaries::{find_boundaries, Boundaries, Boundary};
+pub use boundaries::{find_boundaries, Boundaries, Boundary, BoundaryRule};
 pub use classify::{classify, label_cycles, median_filter, Classification, Regime};
 pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, segments, Cycle};
 pub use error::RegimeError;
 pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
+pub use loop_ranking::{rank_on_loops, LoopMetric, MetricRanking, PairedTest, RegimeRank};
 pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};
 pub use noise::noise_floor;
 pub use prediction::{rms_by_regime, RegimeRms};
 pub use ranking::{rank_models, Ranking, Score};
+pub use rules::{behaviour, place, Behaviour};
 pub use thresholds::RegimeThresholds;

@@ -116,6 +116,18 @@ mod tests {
             duty_error: 0.0,
             peak_force_error: 0.0,
             label_agreement: 1.0,
+            model_energy: 0.0,
+            measured_c_eq: 0.0,
+            model_c_eq: 0.0,
+            c_eq_error: 0.0,
+            measured_phase_x: 0.0,
+            model_phase_x: 0.0,
+            phase_x_error: 0.0,
+            measured_phase_v: 0.0,
+            model_phase_v: 0.0,
+            phase_v_error: 0.0,
+            measured_peak_force: 0.0,
+            model_peak_force: 0.0,
         }
     }
 
@@ -130,6 +142,8 @@ mod tests {
             boundary_errors: BoundaryErrors::default(),
             model_labels: vec![],
             model_boundaries: Boundaries::default(),
+            model_features: vec![],
+            cycle_force_rms_error: vec![],
         }
     }
 

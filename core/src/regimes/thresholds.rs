@@ -7,14 +7,19 @@
 //! | `on_k` | 3 | the force is *on* where \|F\| > max(`on_k`·σ, `on_min`) |
 //! | `on_min` | 0.05 N | floor of the on-threshold (noise-free records have σ ≈ 0) |
 //! | `min_off_fraction` | 0.05 | an *off* stretch shorter than this fraction of the cycle is bridged: a force that only passes through zero stays on |
-//! | `negligible_force` | 0.2 N | a cycle whose peak \|F\| ≤ max(`negligible_force`, `negligible_k`·σ) has negligible force (the paper's pre-resonance: F_STF ≤ 0.2 N) |
+//! | `negligible_force` | 0.2 N | a cycle whose peak \|F\| (lightly smoothed, see [`super::features`]) ≤ max(`negligible_force`, `negligible_k`·σ) has negligible force (the paper's pre-resonance: F_STF ≤ 0.2 N) |
 //! | `negligible_k` | 5 | see above; the largest of a cycle's noise samples reaches ≈ 3–4 σ |
-//! | `resonance_duty` | 0.5 | a resonance cycle has its force on for at least this fraction of the cycle (strong damping: on most of the cycle) … |
-//! | `resonance_amplitude` | 0.6 | … and a displacement amplitude of at least this fraction of the record's largest (within the resonance peak) |
+//! | `resonance_duty` | 0.5 | a cycle's force is *on* (a damper: on most of the cycle) when it is on for at least this fraction of the cycle, and *on–off* when it is zero for more than 1 − this (the stated share: half the cycle) |
+//! | `amplitude_rule` | false | the amplitude criterion, an option: resonance cycles also need … |
+//! | `resonance_amplitude` | 0.6 | … a displacement amplitude of at least this fraction of the record's largest (used only with `amplitude_rule`) |
 //! | `smoothing_cycles` | 5 | width of the median filter over the labels (odd; 1: none) |
 //!
-//! How the defaults reproduce docs/ARCHITECTURE.md §1: pre-resonance is "F_STF ≤ 0.2 N", hence
-//! `negligible_force`. The amplitude ratio 0.6 is a little below the half-power ratio 1/√2 of a
+//! By default the boundaries follow the source study's behavioural definitions
+//! ([`super::rules`]): pre-resonance is "F_STF ≤ 0.2 N", hence `negligible_force`;
+//! post-resonance is the on–off force, zero between impact-like pulses, hence the zero-force
+//! share 1 − `resonance_duty`.
+//!
+//! With `amplitude_rule = true` the earlier classifier runs instead. Its amplitude ratio 0.6 is a little below the half-power ratio 1/√2 of a
 //! linear resonance, because the measured boundary to post-resonance (9.22 rad/s) lies lower on
 //! the peak's flank than the half-power point: on a simulated 0.0333 rad/s² sweep with the
 //! on–off jamming law of `jamming_on_off` (K = 100, v_c = 0.05 m/s), whose amplitudes resemble
@@ -55,7 +60,11 @@ pub struct RegimeThresholds {
     pub negligible_k: f64,
     /// Least duty of a resonance cycle.
     pub resonance_duty: f64,
-    /// Least amplitude of a resonance cycle, as a fraction of the record's largest amplitude.
+    /// Use the amplitude criterion (resonance cycles need `resonance_amplitude` of the largest
+    /// amplitude) instead of the study's behavioural definitions.
+    pub amplitude_rule: bool,
+    /// Least amplitude of a resonance cycle, as a fraction of the record's largest amplitude
+    /// (with `amplitude_rule` only).
     pub resonance_amplitude: f64,
     /// Width of the median filter over the labels, cycles.
     pub smoothing_cycles: usize,
@@ -71,6 +80,7 @@ impl Default for RegimeThresholds {
             negligible_force: 0.2,
             negligible_k: 5.0,
             resonance_duty: 0.5,
+            amplitude_rule: false,
             resonance_amplitude: 0.6,
             smoothing_cycles: 5,
         }

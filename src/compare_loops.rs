@@ -1,0 +1,255 @@
+//! What `compare` says about regime boundaries and hysteresis loops, beside the force errors:
+//! which rule placed each boundary, the per-regime energy and loop metrics of the measurement
+//! and of every model, the rankings on those metrics with the test behind each, and the
+//! per-cycle table `cycles.csv` (one row per cycle and source: the measurement, then each
+//! model's force on the measured kinematics).
+//!
+//! The on-fraction (duty) is explained where it is shown: the share of the cycle in which the
+//! force is *on*, |F| above the on-threshold (3 σ of the force noise, at least 0.05 N), with lone
+//! noise samples ignored and gaps shorter than 5 % of the cycle bridged — 1 for a damper, small
+//! for impact spikes with zero force between them.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use stf_core::regimes::{
+    Boundary, Classification, Comparison, CycleFeatures, MetricRanking, Regime,
+};
+
+use crate::output::write_atomic;
+use crate::report::Table;
+
+/// The on-fraction in words, for reports.
+pub const DUTY_EXPLAINED: &str = "On-fraction (duty): the share of each cycle in which the force is on, |F| above the on-threshold (3 σ of the force noise, at least 0.05 N), lone noise samples ignored and gaps under 5 % of the cycle bridged; 1 for a damper, small for spikes with zero force between them.";
+
+/// A boundary as reports show it.
+#[derive(Clone, Debug, Serialize)]
+pub struct BoundaryNote {
+    /// `pre_resonance` (pre → resonance) or `resonance_post`.
+    pub boundary: &'static str,
+    /// ω, rad/s.
+    pub omega: f64,
+    /// Half-width of its uncertainty, rad/s.
+    pub uncertainty: f64,
+    /// The rule that placed it (`force_onset`, `on_off`, `force_gone`, `on_off_from_onset`,
+    /// `amplitude`).
+    pub rule: stf_core::regimes::BoundaryRule,
+    /// The rule in words.
+    pub explanation: &'static str,
+}
+
+/// The measured boundaries, with the rule that placed each.
+pub fn boundary_notes(c: &Classification) -> Vec<BoundaryNote> {
+    let note = |name, b: Option<Boundary>| {
+        b.map(|b| BoundaryNote {
+            boundary: name,
+            omega: b.omega,
+            uncertainty: b.uncertainty,
+            rule: b.rule,
+            explanation: b.rule.describe(),
+        })
+    };
+    [
+        note("pre_resonance", c.boundaries.pre_resonance),
+        note("resonance_post", c.boundaries.resonance_post),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// One line per boundary for compare.md and the report (and one saying a boundary is absent).
+pub fn boundary_lines(c: &Classification) -> Vec<String> {
+    let mut lines: Vec<String> = boundary_notes(c)
+        .iter()
+        .map(|n| {
+            let what = if n.boundary == "pre_resonance" {
+                "pre-resonance → resonance"
+            } else {
+                "resonance → post-resonance"
+            };
+            format!(
+                "{what} at ω = {:.2} ± {:.2} rad/s, placed by `{}`: {}",
+                n.omega,
+                n.uncertainty,
+                serde_json::to_value(n.rule)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default(),
+                n.explanation
+            )
+        })
+        .collect();
+    if !c.no_stf && c.boundaries.resonance_post.is_none() {
+        lines.push("no resonance → post-resonance boundary: after the resonance the force never becomes on–off (zero for at least the stated share of a cycle) nor falls back to negligible".into());
+    }
+    lines
+}
+
+/// Per-regime energy and loop metrics: measured, then each model (`labels` with `comparisons`).
+pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
+    let mut rows = Vec::new();
+    let cell = |c: &Comparison, r: Regime, model: bool| {
+        c.per_regime.get(r).map_or("—".to_string(), |m| {
+            let (e, ceq, px, duty, peak) = if model {
+                (
+                    m.model_energy,
+                    m.model_c_eq,
+                    m.model_phase_x,
+                    m.model_duty,
+                    m.model_peak_force,
+                )
+            } else {
+                (
+                    m.measured_energy,
+                    m.measured_c_eq,
+                    m.measured_phase_x,
+                    m.measured_duty,
+                    m.measured_peak_force,
+                )
+            };
+            let phase = if px.is_finite() {
+                format!("{px:.0}°")
+            } else {
+                "no phase".to_string()
+            };
+            format!(
+                "{:.2} mJ · c_eq {ceq:.1} · {phase} · duty {duty:.2} · {peak:.2} N",
+                e * 1e3
+            )
+        })
+    };
+    if let Some(first) = comparisons.first() {
+        let mut row = vec!["measured".to_string()];
+        row.extend(Regime::ALL.iter().map(|&r| cell(first, r, false)));
+        rows.push(row);
+    }
+    for (label, c) in labels.iter().zip(comparisons) {
+        let mut row = vec![label.to_string()];
+        row.extend(Regime::ALL.iter().map(|&r| cell(c, r, true)));
+        rows.push(row);
+    }
+    Table {
+        caption: "Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area), equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in N·s/m, the phase of the force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak force.".into(),
+        columns: ["source", "pre-resonance", "resonance", "post-resonance"]
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        rows,
+    }
+}
+
+/// One line per loop metric: the best model overall and in each regime, with the test.
+pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
+    rankings
+        .iter()
+        .map(|m| {
+            let mut line = format!(
+                "by {} ({}): best overall {}",
+                m.metric.name(),
+                m.criterion,
+                m.overall.first().map_or("—", |s| s.model.as_str())
+            );
+            for r in Regime::ALL {
+                if let Some(rank) = m.per_regime.get(r) {
+                    let best = rank.scores.first().map_or("—", |s| s.model.as_str());
+                    let test = rank.test.as_ref().map_or(String::new(), |t| {
+                        format!(
+                            ", paired z {:.1} against {} over {} cycles",
+                            t.z, t.runner_up, t.cycles
+                        )
+                    });
+                    line.push_str(&format!("; {} {best}{test}", r.name().replace('_', "-")));
+                }
+            }
+            line
+        })
+        .collect()
+}
+
+/// The loop rankings (bullets) and the per-regime energy table, for compare.md.
+pub fn write_markdown(md: &mut String, rankings: &[MetricRanking], energy: &Table) {
+    for line in ranking_lines(rankings) {
+        md.push_str(&format!("- {line}\n"));
+    }
+    md.push_str(&format!("\n{}\n\n{DUTY_EXPLAINED}\n\n", energy.caption));
+    md.push_str(&format!(
+        "| {} |\n|---|---|---|---|\n",
+        energy.columns.join(" | ")
+    ));
+    for row in &energy.rows {
+        md.push_str(&format!("| {} |\n", row.join(" | ")));
+    }
+    md.push('\n');
+}
+
+/// A row of `cycles.csv`.
+#[derive(Serialize)]
+struct CycleRow<'a> {
+    source: &'a str,
+    cycle: usize,
+    regime: &'static str,
+    t_mid_s: f64,
+    omega_rad_s: f64,
+    amplitude_m: f64,
+    energy_j: f64,
+    c_eq_ns_m: f64,
+    phase_x_deg: f64,
+    phase_v_deg: f64,
+    duty: f64,
+    peak_force_n: f64,
+    rms_force_n: f64,
+    force_rms_error_n: Option<f64>,
+}
+
+fn row<'a>(
+    source: &'a str,
+    i: usize,
+    regime: Regime,
+    f: &CycleFeatures,
+    err: Option<f64>,
+) -> CycleRow<'a> {
+    CycleRow {
+        source,
+        cycle: i,
+        regime: regime.name(),
+        t_mid_s: f.t_mid,
+        omega_rad_s: f.omega,
+        amplitude_m: f.amplitude,
+        energy_j: f.energy,
+        c_eq_ns_m: f.c_eq,
+        phase_x_deg: f.phase_x,
+        phase_v_deg: f.phase_v,
+        duty: f.duty,
+        peak_force_n: f.f_peak,
+        rms_force_n: f.f_rms,
+        force_rms_error_n: err,
+    }
+}
+
+/// Write `cycles.csv` (the measured regime of each cycle on every row) atomically.
+pub fn write_cycles_csv(
+    path: &Path,
+    measured: &Classification,
+    labels: &[&str],
+    comparisons: &[Comparison],
+) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for (i, f) in measured.features.iter().enumerate() {
+        w.serialize(row("measured", i, measured.labels[i], f, None))?;
+    }
+    for (label, c) in labels.iter().zip(comparisons) {
+        for (i, f) in c.model_features.iter().enumerate() {
+            w.serialize(row(
+                label,
+                i,
+                measured.labels[i],
+                f,
+                c.cycle_force_rms_error.get(i).copied(),
+            ))?;
+        }
+    }
+    let bytes = w.into_inner().context("cannot build cycles.csv")?;
+    write_atomic(path, &bytes)
+}
