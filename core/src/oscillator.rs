@@ -138,9 +138,9 @@ impl Oscillator {
                     z: &y[2..],
                 };
                 let wrap = |source| SimError::Model { time: t, source };
-                let m_a = model.added_mass(&self.model_params, &s).map_err(wrap)?;
-                let f = model.force(&self.model_params, &s, dz).map_err(wrap)?;
-                (m_a, f)
+                model
+                    .mass_and_force(&self.model_params, &s, dz)
+                    .map_err(wrap)?
             }
         };
         let mass = p.m + m_a;

@@ -10,15 +10,18 @@
 //! record's fit starts: every score, held-out residual and verdict is still the whole
 //! record's.
 //!
-//! A piece starts from the current model's simulated state, not from the candidate's own
-//! (which would need the whole run): the first quarter of each piece, where that start's
-//! error dies away, is simulated but not fitted. Pieces spread over the record see every part
-//! of a sweep. The pieces are simulated one after the other; the candidates already run in
-//! parallel.
+//! A piece starts from the measured state: x and v of a quadratic fitted by least squares to
+//! the measured x over a quarter cycle either side of its first sample. Not from the current
+//! model's simulated state: where the current model lacks an effect that state is off by the
+//! very gap sought (3 mm on a trolley that misses a cubic spring), and a candidate that damps
+//! the start's transient away faster (any extra damping) would then look best. The first
+//! quarter of each piece, where the start's error dies away, is simulated but not fitted.
+//! Pieces spread over the record see every part of a sweep. The pieces are simulated one
+//! after the other; the candidates already run in parallel.
 
 use std::sync::Arc;
 
-use super::trajectory_fit::{Rig, Run, Track};
+use super::trajectory_fit::{Rig, Track};
 use crate::force_model::ForceModel;
 use crate::regimes::Cycle;
 
@@ -49,27 +52,20 @@ pub(super) struct Scout<'a> {
 }
 
 impl<'a> Scout<'a> {
-    /// The scout of `rig`'s record, its pieces starting from the state of `run` (the current
-    /// model's whole-record run, with its displacement offset `offset`), or `None` when the
-    /// record is too short for pieces of [`PIECE_CYCLES`] of `cycles` to make a scout of at
-    /// least [`MIN_PIECES`] at one sample in [`SHARE`]. `train` are the record's training
-    /// samples (increasing).
-    pub fn new(
-        rig: &Rig<'a>,
-        run: &Run,
-        offset: f64,
-        cycles: &[Cycle],
-        train: &[usize],
-    ) -> Option<Self> {
+    /// The scout of `rig`'s record, or `None` when the record is too short for pieces of
+    /// [`PIECE_CYCLES`] of `cycles` to make a scout of at least [`MIN_PIECES`] at one sample
+    /// in [`SHARE`]. `train` are the record's training samples (increasing).
+    pub fn new(rig: &Rig<'a>, cycles: &[Cycle], train: &[usize]) -> Option<Self> {
         let n = rig.t.len();
         let mut lengths: Vec<usize> = cycles.iter().map(|c| c.end - c.start).collect();
         lengths.sort_unstable();
         let cycle = lengths.get(lengths.len() / 2).copied().unwrap_or(n);
         let length = (n / (PIECES * SHARE)).max(PIECE_CYCLES * cycle);
         let count = (n / SHARE / length.max(1)).min(PIECES);
-        if count < MIN_PIECES || run.sim.x.len() != n || run.sim.v.len() != n {
+        if count < MIN_PIECES || rig.x.len() != n {
             return None;
         }
+        let half = (cycle / 4).max(2);
         let mut is_train = vec![false; n];
         for &i in train {
             if let Some(slot) = is_train.get_mut(i) {
@@ -90,7 +86,7 @@ impl<'a> Scout<'a> {
             );
             joined += end - start;
             pieces.push(Rig {
-                initial: Some((run.sim.x[start] + offset, run.sim.v[start])),
+                initial: Some(measured_state(rig.t, rig.x, start, half)?),
                 fixed_start: true,
                 t: &rig.t[start..end],
                 x: &rig.x[start..end],
@@ -125,5 +121,39 @@ impl Track for Scout<'_> {
     }
     fn fixes_start(&self) -> bool {
         true
+    }
+}
+
+/// x and v at sample `i` of a quadratic fitted by least squares to the measured `x` over
+/// `half` samples either side (fewer at the record's ends); `None` if that fit is singular.
+fn measured_state(t: &[f64], x: &[f64], i: usize, half: usize) -> Option<(f64, f64)> {
+    let lo = i.saturating_sub(half);
+    let hi = (i + half + 1).min(x.len());
+    // Normal equations of x ≈ a + b·τ + c·τ², τ = t − t_i.
+    let mut m = nalgebra::Matrix3::<f64>::zeros();
+    let mut r = nalgebra::Vector3::<f64>::zeros();
+    for j in lo..hi {
+        let tau = t[j] - t[i];
+        let basis = nalgebra::Vector3::new(1.0, tau, tau * tau);
+        m += basis * basis.transpose();
+        r += basis * x[j];
+    }
+    let coef = m.lu().solve(&r)?;
+    (coef[0].is_finite() && coef[1].is_finite()).then_some((coef[0], coef[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_measured_state_is_the_local_quadratic_s_value_and_slope() {
+        let t: Vec<f64> = (0..40).map(|i| i as f64 * 0.01).collect();
+        let x: Vec<f64> = t.iter().map(|&t| 0.3 + 2.0 * t - 4.0 * t * t).collect();
+        let (x0, v0) = measured_state(&t, &x, 20, 5).unwrap();
+        assert!((x0 - x[20]).abs() < 1e-12);
+        assert!((v0 - (2.0 - 8.0 * t[20])).abs() < 1e-9);
+        let (_, v_end) = measured_state(&t, &x, 0, 5).unwrap();
+        assert!((v_end - 2.0).abs() < 1e-9);
     }
 }

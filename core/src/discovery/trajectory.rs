@@ -516,6 +516,10 @@ const TRIAL_ITERS: u64 = 60;
 /// scout (see [`super::scout`]).
 const SCOUTED_TRIAL_ITERS: u64 = 15;
 
+/// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
+/// out by their fits on the scout (see [`Trials::step`]).
+const SCOUT_KEEP: usize = 3;
+
 /// What every candidate trial of a run shares.
 struct Trials<'a, 'r> {
     rig: &'a Rig<'r>,
@@ -532,12 +536,10 @@ struct Trials<'a, 'r> {
     scout: Option<&'a Scout<'r>>,
 }
 
-/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples, its pieces
-/// starting from `current`'s whole-record run; `None` for a shorter record, or when the record
-/// makes no scout.
+/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples; `None` for a
+/// shorter record, or when the record makes no scout.
 fn scout_of<'r>(
     rig: &Rig<'r>,
-    current: &Stage,
     cycles: &[Cycle],
     train: &[usize],
     settings: &DiscoverySettings,
@@ -545,13 +547,7 @@ fn scout_of<'r>(
     if settings.scout_from == 0 || rig.t.len() < settings.scout_from {
         return None;
     }
-    let run = current.run(rig).ok()?;
-    let offset = if rig.fit_offset {
-        current.values.last().copied().unwrap_or(0.0)
-    } else {
-        0.0
-    };
-    Scout::new(rig, &run, offset, cycles, train)
+    Scout::new(rig, cycles, train)
 }
 
 impl Trials<'_, '_> {
@@ -564,7 +560,9 @@ impl Trials<'_, '_> {
     /// current model's mean square, only the best [`SCREEN_KEEP`] are fitted at trajectory
     /// level (starts, short fits, the trial; in parallel) and the others are reported as not
     /// fitted, with their gain and rank; otherwise all are fitted. A trajectory fit costs
-    /// hundreds of simulations.
+    /// hundreds of simulations. On a scouted record each candidate's values are searched on
+    /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
+    /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
     fn step(
         &self,
         step: usize,
@@ -579,6 +577,65 @@ impl Trials<'_, '_> {
                 current.stage.with(&c.model, &defaults, n_osc)
             })
             .collect();
+        let (hinted, gains, rank, screened) = self.force_screen(&withs, current);
+        let searched: Vec<Option<(Stage, f64)>> = (0..tried.len())
+            .into_par_iter()
+            .map(|i| {
+                if screened && rank[i] >= SCREEN_KEEP {
+                    return None;
+                }
+                self.settings
+                    .observer
+                    .candidate(step, i, tried.len(), &tried[i].name);
+                let h = hinted[i].as_ref().map(|(s, _)| s);
+                Some(self.searched(withs[i].clone(), h))
+            })
+            .collect();
+        let scout_rank = self.scout_ranks(&searched, current);
+        (0..tried.len())
+            .into_par_iter()
+            .map(|i| {
+                let c = &tried[i];
+                let Some((stage, _)) = &searched[i] else {
+                    let why = format!(
+                        "not fitted at trajectory level: the force-level screen ranks it {} of \
+                         {} (it lowers the recovered force's mean square by {:.3e} N²)",
+                        rank[i] + 1,
+                        tried.len(),
+                        gains[i].unwrap_or(f64::NAN)
+                    );
+                    return (choice::failed(&c.name, why), None);
+                };
+                if let Some((r, of, gain)) = scout_rank[i].filter(|(r, _, _)| *r >= SCOUT_KEEP) {
+                    let why = format!(
+                        "not fitted on the whole record: the scout ranks it {} of {of} (it \
+                         lowers the scout's mean square by {:.3e} mm²)",
+                        r + 1,
+                        gain * 1e6
+                    );
+                    return (choice::failed(&c.name, why), None);
+                }
+                let s = self.scored(c, stage.clone(), current);
+                emit_scored(self.settings, step, Some(&s));
+                s
+            })
+            .collect()
+    }
+
+    /// The force-level screen of the candidates `withs` (each added to `current`): each one's
+    /// force-level start and its RMS, its gain over `current` (N²), its rank by the gain, and
+    /// whether the screen ranks out all but [`SCREEN_KEEP`].
+    #[allow(clippy::type_complexity)]
+    fn force_screen(
+        &self,
+        withs: &[Stage],
+        current: &Trial,
+    ) -> (
+        Vec<Option<(Stage, f64)>>,
+        Vec<Option<f64>>,
+        Vec<usize>,
+        bool,
+    ) {
         let train = &self.split.train;
         let hint = self.setup.force_hint.as_ref();
         let hinted: Vec<Option<(Stage, f64)>> = withs
@@ -592,12 +649,12 @@ impl Trials<'_, '_> {
             .iter()
             .map(|h| Some(reference? * reference? - h.as_ref()?.1.powi(2)))
             .collect();
-        let mut order: Vec<usize> = (0..tried.len()).collect();
+        let mut order: Vec<usize> = (0..withs.len()).collect();
         order.sort_by(|&a, &b| {
             let g = |i: usize| gains[i].unwrap_or(f64::INFINITY);
             g(b).total_cmp(&g(a))
         });
-        let mut rank = vec![0; tried.len()];
+        let mut rank = vec![0; withs.len()];
         for (r, &i) in order.iter().enumerate() {
             rank[i] = r;
         }
@@ -610,53 +667,65 @@ impl Trials<'_, '_> {
             .flatten()
             .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
         let screened = self.screen
-            && tried.len() > SCREEN_KEEP
+            && withs.len() > SCREEN_KEEP
             && reference.is_some_and(|r| best_gain > SCREEN_MIN_GAIN * r * r);
-        (0..tried.len())
-            .into_par_iter()
-            .map(|i| {
-                let c = &tried[i];
-                if screened && rank[i] >= SCREEN_KEEP {
-                    let why = format!(
-                        "not fitted at trajectory level: the force-level screen ranks it {} of \
-                         {} (it lowers the recovered force's mean square by {:.3e} N²)",
-                        rank[i] + 1,
-                        tried.len(),
-                        gains[i].unwrap_or(f64::NAN)
-                    );
-                    return (choice::failed(&c.name, why), None);
-                }
-                self.settings
-                    .observer
-                    .candidate(step, i, tried.len(), &c.name);
-                let h = hinted[i].as_ref().map(|(s, _)| s);
-                let s = self.scored(c, withs[i].clone(), h, current);
-                emit_scored(self.settings, step, Some(&s));
-                s
-            })
-            .collect()
+        (hinted, gains, rank, screened)
     }
 
-    /// The trial of candidate `c` (`with`: the current model with it added at its defaults;
-    /// `hinted`: its force-level start) from the best of its starts, scored against
-    /// `current`.
-    fn scored(
+    /// Each searched candidate's rank among them by the gain of its scout fit over the
+    /// current model on the scout, their number and the gain (mean square, m²); all `None`
+    /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
+    fn scout_ranks(
         &self,
-        c: &Candidate,
-        with: Stage,
-        hinted: Option<&Stage>,
+        searched: &[Option<(Stage, f64)>],
         current: &Trial,
-    ) -> (CandidateScore, Option<Trial>) {
+    ) -> Vec<Option<(usize, usize, f64)>> {
+        let mut out = vec![None; searched.len()];
+        let of = searched.iter().flatten().count();
+        let Some(scout) = self.scout.filter(|_| of > SCOUT_KEEP) else {
+            return out;
+        };
+        let Ok(model) = current.stage.model() else {
+            return out;
+        };
+        let Ok(r) = scout.residual(&model, &current.stage.values) else {
+            return out;
+        };
+        let reference = rms_over(&r, &scout.train).powi(2);
+        let mut order: Vec<(usize, f64)> = searched
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|(_, ms)| (i, reference - ms)))
+            .collect();
+        order.sort_by(|a, b| b.1.total_cmp(&a.1));
+        for (r, (i, gain)) in order.into_iter().enumerate() {
+            out[i] = Some((r, of, gain));
+        }
+        out
+    }
+
+    /// Where candidate `with`'s trial starts (`with`: the current model with it added at its
+    /// defaults; `hinted`: its force-level start): the best of its starts, fitted on the
+    /// scout when there is one; and its mean square on the scout's training samples (m²;
+    /// infinite without a scout).
+    fn searched(&self, with: Stage, hinted: Option<&Stage>) -> (Stage, f64) {
         let (track, train): (&dyn Track, &[usize]) = match self.scout {
             Some(scout) => (scout, &scout.train),
             None => (self.rig, &self.split.train),
         };
         let starts = with.starts(track, train, self.osc_start, hinted);
         let stage = Stage::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
-        // Levenberg–Marquardt alone, from the best start, at most `TRIAL_ITERS` iterations: a
-        // candidate whose fit does not settle by then (a stiff relaxation wandering through
-        // thousands of simulations) is scored where it stopped, not chased by Nelder–Mead.
-        let settings = DiscoverySettings {
+        match self.scout {
+            Some(scout) => self.scouted(stage, scout, &self.trial_settings()),
+            None => (stage, f64::INFINITY),
+        }
+    }
+
+    /// Levenberg–Marquardt alone, at most `TRIAL_ITERS` iterations: a candidate whose fit
+    /// does not settle by then (a stiff relaxation wandering through thousands of
+    /// simulations) is scored where it stopped, not chased by Nelder–Mead.
+    fn trial_settings(&self) -> DiscoverySettings {
+        DiscoverySettings {
             fit: self
                 .settings
                 .fit
@@ -664,19 +733,24 @@ impl Trials<'_, '_> {
                 .solver(Solver::LevenbergMarquardt)
                 .max_iters(self.settings.fit.max_iters.min(TRIAL_ITERS)),
             ..self.settings.clone()
-        };
-        // Scouted, the search is done: the whole record's trial polishes, at most
-        // `SCOUTED_TRIAL_ITERS` iterations (a candidate still wandering then is scored where it
-        // stopped, as one wandering on the whole record is after `TRIAL_ITERS`).
-        let (stage, settings) = match self.scout {
-            Some(scout) => {
-                let stage = self.scouted(stage, scout, &settings);
-                let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
-                let fit = settings.fit.clone().max_iters(iters);
-                (stage, DiscoverySettings { fit, ..settings })
-            }
-            None => (stage, settings),
-        };
+        }
+    }
+
+    /// The trial of candidate `c` from `stage` on the whole record, scored against
+    /// `current`. Scouted, the search is done: the trial polishes, at most
+    /// `SCOUTED_TRIAL_ITERS` iterations (a candidate still wandering then is scored where it
+    /// stopped, as one wandering on the whole record is after `TRIAL_ITERS`).
+    fn scored(
+        &self,
+        c: &Candidate,
+        stage: Stage,
+        current: &Trial,
+    ) -> (CandidateScore, Option<Trial>) {
+        let mut settings = self.trial_settings();
+        if self.scout.is_some() {
+            let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
+            settings.fit = settings.fit.max_iters(iters);
+        }
         choice::scored(
             &c.name,
             c.model.params().len(),
@@ -690,19 +764,29 @@ impl Trials<'_, '_> {
 
 impl Trials<'_, '_> {
     /// `stage` fitted on `scout`, if that lowers the whole record's training RMS (one
-    /// simulation of each): where the trial on the whole record starts.
-    fn scouted(&self, stage: Stage, scout: &Scout, settings: &DiscoverySettings) -> Stage {
-        let Ok((fitted, _)) = stage.fit_simulated(scout, self.setup, &scout.train, settings) else {
-            return stage;
+    /// simulation of each): where the trial on the whole record starts; and its mean square
+    /// on the scout's training samples (m²).
+    fn scouted(&self, stage: Stage, scout: &Scout, settings: &DiscoverySettings) -> (Stage, f64) {
+        let on_scout = |s: &Stage| {
+            s.model()
+                .ok()
+                .and_then(|m| scout.residual(&m, &s.values).ok())
+                .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
+        };
+        let Ok((fitted, fit)) = stage.fit_simulated(scout, self.setup, &scout.train, settings)
+        else {
+            let ms = on_scout(&stage);
+            return (stage, ms);
         };
         let train_rms = |s: &Stage| {
             s.residual(self.rig)
                 .map_or(f64::INFINITY, |r| rms_over(&r, &self.split.train))
         };
         if train_rms(&fitted) < train_rms(&stage) {
-            fitted
+            (fitted, fit.rms * fit.rms)
         } else {
-            stage
+            let ms = on_scout(&stage);
+            (stage, ms)
         }
     }
 }
@@ -831,16 +915,16 @@ pub fn discover_trajectory(
              fitted at trajectory level"
         ));
     }
-    for step in 1..=settings.max_effects {
-        let scout = scout_of(&rig, &current.stage, cycles, &split.train, settings);
-        if let (Some(s), 1) = (&scout, step) {
-            notes.push(format!(
-                "scouted: each candidate's values are searched on {} pieces of the record \
+    let scout = scout_of(&rig, cycles, &split.train, settings);
+    if let Some(s) = &scout {
+        notes.push(format!(
+            "scouted: each candidate's values are searched on {} pieces of the record \
                  ({} samples of {n}), then fitted on the whole record from there",
-                s.pieces(),
-                s.samples
-            ));
-        }
+            s.pieces(),
+            s.samples
+        ));
+    }
+    for step in 1..=settings.max_effects {
         let trials = Trials {
             rig: &rig,
             setup,
@@ -1078,6 +1162,15 @@ mod tests {
         Arc::new(Term("quadratic_damping", spec, |s| s.v * s.v.abs()))
     }
 
+    fn stiffening() -> Arc<dyn ForceModel> {
+        let spec = vec![ParamSpec::new("k2", "N/m²", 1e3, 0.0, 1e7, "")];
+        Arc::new(Term("quadratic_stiffness", spec, |s| s.x * s.x.abs()))
+    }
+    fn cubic_damping() -> Arc<dyn ForceModel> {
+        let spec = vec![ParamSpec::new("c3", "N·s³/m³", 1.0, 0.0, 1e4, "")];
+        Arc::new(Term("cubic_damping", spec, |s| s.v.powi(3)))
+    }
+
     /// The trolley without friction, driven by a chirp force 0.5 → 1.5 Hz over 20 s at
     /// 200 Hz through the rig's displacement sensor; STF = 1.0·v (+ k3·x³).
     fn record(k3: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams) {
@@ -1123,7 +1216,19 @@ mod tests {
     }
 
     fn discover_on(
+        record: (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
+        settings: &DiscoverySettings,
+    ) -> TrajectoryDiscovery {
+        let candidates = [
+            Candidate::new("cubic_stiffness", cubic()),
+            Candidate::new("quadratic_damping", quadratic()),
+        ];
+        discover_among(record, &candidates, settings)
+    }
+
+    fn discover_among(
         (t, x, u, system): (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
+        candidates: &[Candidate],
         settings: &DiscoverySettings,
     ) -> TrajectoryDiscovery {
         let cycles = cycles_from_x(&t, &x, 1.5e-4).unwrap();
@@ -1139,13 +1244,9 @@ mod tests {
         .refit(start("m"))
         .refit(start("k"))
         .refit(start("c"));
-        let candidates = [
-            Candidate::new("cubic_stiffness", cubic()),
-            Candidate::new("quadratic_damping", quadratic()),
-        ];
         discover_trajectory(
             viscous(),
-            &candidates,
+            candidates,
             &TrajectoryData { t: &t, x: &x },
             &cycles,
             &setup,
@@ -1179,6 +1280,40 @@ mod tests {
         assert!((ks / 1e4 - 1.0).abs() < 0.2, "k3 = {ks}");
         assert!((ks / kw - 1.0).abs() < 0.01, "k3 {ks} scouted, {kw} whole");
         assert!(scouted.s_after_mm2 < 1.01 * whole.s_after_mm2);
+    }
+
+    #[test]
+    fn the_scout_ranks_out_all_but_three_candidates_and_keeps_the_true_one() {
+        let candidates = [
+            Candidate::new("quadratic_damping", quadratic()),
+            Candidate::new("cubic_damping", cubic_damping()),
+            Candidate::new("quadratic_stiffness", stiffening()),
+            Candidate::new("cubic_stiffness", cubic()),
+        ];
+        let rec = record_of(1e4, 200.0, 50.0);
+        let found = discover_among(
+            rec,
+            &candidates,
+            &DiscoverySettings::default().scout_from(1),
+        );
+        let d = &found.discovery;
+        let first = &d.steps[0];
+        let ranked_out: Vec<&str> = first
+            .candidates
+            .iter()
+            .filter(|c| {
+                c.failure
+                    .as_deref()
+                    .is_some_and(|f| f.contains("the scout ranks it"))
+            })
+            .map(|c| c.name.as_str())
+            .collect();
+        eprintln!("{:?}; ranked out {ranked_out:?}", d.effects);
+        assert_eq!(ranked_out.len(), 1, "{:?}", first.candidates);
+        assert_ne!(ranked_out[0], "cubic_stiffness");
+        assert_eq!(d.effects[0], "cubic_stiffness");
+        let k3 = d.value("k3").unwrap();
+        assert!((k3 / 1e4 - 1.0).abs() < 0.2, "k3 = {k3}");
     }
 
     #[test]
