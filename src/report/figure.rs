@@ -1,5 +1,5 @@
-//! Rendering a figure to its three files: the same drawing code runs on the SVG and the PNG
-//! backend, and the CSV holds the columns the drawing used. Also the text styles shared by all
+//! Rendering a figure to its three files: the drawing code runs on the SVG backend, the PNG is
+//! that SVG rasterised ([`super::raster`]), and the CSV holds the columns the drawing used. Also the text styles shared by all
 //! figures, so they look alike.
 
 use std::path::{Path, PathBuf};
@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::atomic::{commit, ensure_dir, temporary_sibling, write_atomic};
+use super::atomic::{ensure_dir, write_atomic};
 use super::font::{ensure_registered, FAMILY};
+use super::raster::svg_to_png;
 use super::series_csv::{write_csv, Column};
 use super::ReportError;
 
@@ -94,15 +95,11 @@ pub fn render(
     })?;
     write_atomic(&files.svg, svg.as_bytes())?;
 
-    let tmp = temporary_sibling(&files.png);
-    if let Err(message) = draw_on(BitMapBackend::new(&tmp, size), plot) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(ReportError::Plot {
-            path: files.png.clone(),
-            message,
-        });
-    }
-    commit(&tmp, &files.png)?;
+    let png = svg_to_png(&svg).map_err(|message| ReportError::Plot {
+        path: files.png.clone(),
+        message,
+    })?;
+    write_atomic(&files.png, &png)?;
 
     write_csv(&files.csv, columns)?;
     Ok(files)

@@ -39,6 +39,7 @@ mod hysteresis;
 mod markdown;
 mod measured_vs_fitted;
 mod plot_range;
+mod raster;
 mod regime_errors;
 mod series_csv;
 mod smoothing;
@@ -59,6 +60,7 @@ pub use measured_vs_fitted::{
     measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
+pub use raster::svg_to_png;
 pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};
