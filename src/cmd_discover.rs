@@ -358,25 +358,12 @@ fn force_report(
         minus(f, &found.residual_after),
     );
     let mut s = Section::new("Discovery");
-    s.paragraphs.push(format!(
-        "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
-        base_of(exp, found),
-        found.gap_before,
-        found.noise_floor,
-        found.where_before.summary
-    ));
-    for step in &found.steps {
-        s.paragraphs.push(step.verdict.clone());
-    }
-    s.paragraphs.push(format!(
-        "Final `{}`: gap {:.4} N. {}",
-        found.final_model_name, found.gap_after, found.where_after.summary
-    ));
+    // The notes are the base's gap, each step's verdict and the final gap, in order.
+    s.paragraphs.extend(found.notes.iter().cloned());
     s.paragraphs.push(format!(
         "{}.",
         held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
     ));
-    s.paragraphs.extend(found.notes.iter().cloned());
     s.tables.extend(
         found
             .steps

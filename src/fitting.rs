@@ -180,11 +180,47 @@ pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
     Ok(match (&k.phi, &k.omega) {
         (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
         (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
-        _ => match cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)? {
-            few if few.len() < MIN_CYCLES => segments(&k.t, MIN_CYCLES),
-            cycles => cycles,
-        },
+        _ => {
+            let of_x = cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?;
+            let mut cycles = if of_x.len() < MIN_CYCLES {
+                segments(&k.t, MIN_CYCLES)
+            } else {
+                of_x.clone()
+            };
+            let speeds = match &k.u {
+                Some(u) => {
+                    let rms = (u.iter().map(|v| v * v).sum::<f64>() / u.len().max(1) as f64).sqrt();
+                    cycles_from_x(&k.t, u, 0.1 * rms)?
+                }
+                None => of_x,
+            };
+            drive_omega(&k.t, &speeds, &mut cycles);
+            cycles
+        }
     })
+}
+
+/// Give each cycle the ω of the `speeds` cycle (of the measured drive `u`, else of x) around
+/// its middle, or the nearest one: equal stretches stand in for too few cycles and x's own
+/// crossings beat near resonance, and their 2π/duration read as speeds the drive never
+/// reached (ω 10.05 rad/s on a chirp ending at 9.42).
+fn drive_omega(
+    t: &[f64],
+    speeds: &[stf_core::regimes::Cycle],
+    cycles: &mut [stf_core::regimes::Cycle],
+) {
+    for c in cycles.iter_mut() {
+        let nearest = speeds.iter().min_by(|a, b| {
+            let d = |s: &stf_core::regimes::Cycle| {
+                let (lo, hi) = (t[s.start], t[s.end.min(t.len() - 1)]);
+                (lo - c.t_mid).max(c.t_mid - hi).max(0.0)
+            };
+            d(a).total_cmp(&d(b))
+        });
+        if let Some(s) = nearest {
+            c.omega = s.omega;
+        }
+    }
 }
 
 /// The fewest cycles of x a record is scored by; fewer, and equal stretches stand in.

@@ -126,3 +126,36 @@ pub fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .map(|(a, b)| (*a, *b))
         .collect()
 }
+
+/// A tick label for `v` on an axis spanning `span`: as many decimals as ticks 1/200 of
+/// the span apart need, trailing zeros dropped, and never `-0` (a tick at zero computed as
+/// −1e-17 read "-0.0").
+pub fn tick_label(v: f64, span: f64) -> String {
+    let step = (span.abs() / 200.0).max(f64::MIN_POSITIVE);
+    let decimals = (-step.log10().floor()).clamp(0.0, 12.0) as usize;
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_label;
+
+    #[test]
+    fn tick_labels_have_the_digits_the_axis_needs_and_no_negative_zero() {
+        assert_eq!(tick_label(-1e-17, 0.8), "0");
+        assert_eq!(tick_label(-0.0, 60.0), "0");
+        assert_eq!(tick_label(0.30000000000000004, 0.8), "0.3");
+        assert_eq!(tick_label(0.25, 0.8), "0.25");
+        assert_eq!(tick_label(-30.0, 66.0), "-30");
+        assert_eq!(tick_label(12.5, 66.0), "12.5");
+        assert_eq!(tick_label(150.0, 300.0), "150");
+        assert_eq!(tick_label(0.0015, 0.01), "0.0015");
+    }
+}

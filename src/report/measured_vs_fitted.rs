@@ -11,7 +11,7 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_style, title_style, Draw, FigureFiles, SIZE,
+    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -111,12 +111,15 @@ impl Draw for MeasuredVsFittedPlot {
             .margin_right(30)
             .x_label_area_size(50)
             .y_label_area_size(90)
-            .build_cartesian_2d(t_range, f_range)
+            .build_cartesian_2d(t_range.clone(), f_range.clone())
             .map_err(msg)?;
+        let (ts, fs) = (t_range.end - t_range.start, f_range.end - f_range.start);
         chart
             .configure_mesh()
             .x_desc("time t, s")
             .y_desc(self.quantity.label)
+            .x_label_formatter(&|v| tick_label(*v, ts))
+            .y_label_formatter(&|v| tick_label(*v, fs))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0))

@@ -52,7 +52,7 @@ pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;
 pub use extrema::{extrema, Extremum, ExtremumKind};
 pub use figure::FigureFiles;
-pub use frequency_response::{frequency_response, FrfCurve};
+pub use frequency_response::{frequency_response, FrfCurve, FrfRole, RegimeChange};
 pub use html::write_html;
 pub use hysteresis::hysteresis;
 pub use markdown::write_markdown;

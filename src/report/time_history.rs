@@ -12,7 +12,7 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
+    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -57,11 +57,20 @@ impl TimeHistoryPlot {
             .x_label_area_size(if index == 2 { 48 } else { 28 })
             .y_label_area_size(90)
             .right_y_label_area_size(80)
-            .build_cartesian_2d(t_range.clone(), y_range)
+            .build_cartesian_2d(t_range.clone(), y_range.clone())
             .map_err(msg)?
-            .set_secondary_coord(t_range, f_range);
+            .set_secondary_coord(t_range.clone(), f_range.clone());
+        let (ts, ys, fs) = (
+            t_range.end - t_range.start,
+            y_range.end - y_range.start,
+            f_range.end - f_range.start,
+        );
+        let x_fmt = |v: &f64| tick_label(*v, ts);
+        let y_fmt = |v: &f64| tick_label(*v, ys);
         let mut mesh = chart.configure_mesh();
         mesh.y_desc(*label)
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt)
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0));
@@ -72,6 +81,7 @@ impl TimeHistoryPlot {
         chart
             .configure_secondary_axes()
             .y_desc(F_LABEL)
+            .y_label_formatter(&|v| tick_label(*v, fs))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .draw()
@@ -129,8 +139,8 @@ impl Draw for TimeHistoryPlot {
     }
 }
 
-/// Draw x, v and a against F_STF over time (three panels, F_STF on the right axis, its
-/// extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
+/// Draw x (in mm), v (mm/s) and a (m/s²) against F_STF over time (three panels, F_STF on
+/// the right axis, its extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
 /// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
 pub fn time_history(
     out_dir: &Path,
@@ -160,8 +170,8 @@ pub fn time_history(
     let plot = TimeHistoryPlot {
         t: pick(t, &keep),
         panels: [
-            ("displacement x, m", pick(x, &keep)),
-            ("velocity v, m/s", pick(v, &keep)),
+            ("displacement x, mm", milli(&pick(x, &keep))),
+            ("velocity v, mm/s", milli(&pick(v, &keep))),
             ("acceleration a, m/s²", pick(a, &keep)),
         ],
         f: pick(f_stf, &keep),
@@ -176,8 +186,8 @@ pub fn time_history(
     };
     let columns = vec![
         Column::new("t, s", plot.t.clone()),
-        Column::new("x, m", plot.panels[0].1.clone()),
-        Column::new("v, m/s", plot.panels[1].1.clone()),
+        Column::new("x, mm", plot.panels[0].1.clone()),
+        Column::new("v, mm/s", plot.panels[1].1.clone()),
         Column::new("a, m/s²", plot.panels[2].1.clone()),
         Column::new(F_LABEL, plot.f.clone()),
         Column::new(
@@ -194,6 +204,11 @@ pub fn time_history(
         ),
     ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
+}
+
+/// Metres (per second) in millimetres (per second), the unit the rig's motion is read in.
+fn milli(values: &[f64]) -> Vec<f64> {
+    values.iter().map(|v| v * 1e3).collect()
 }
 
 #[cfg(test)]
@@ -215,7 +230,7 @@ mod tests {
         let files = time_history(dir.path(), "history", &motion, &s.f).unwrap();
         let cols = assert_rendered(&files, SIZE_TALL);
         let t = column(&cols, "t, s");
-        let x = column(&cols, "x, m");
+        let x = column(&cols, "x, mm");
         let f = column(&cols, "F_STF, N");
         assert!(t.len() < s.t.len() && t.len() <= MAX_POINTS_PER_LINE + 100);
         // Every plotted row is a sample of the record (the grid is uniform: index = t / dt).
@@ -223,11 +238,11 @@ mod tests {
         for (k, tk) in t.iter().enumerate() {
             let i = (tk / dt).round() as usize;
             assert_eq!(s.t[i], *tk);
-            assert_eq!(s.x[i], x[k]);
+            assert_eq!(s.x[i] * 1e3, x[k]);
             assert_eq!(s.f[i], f[k]);
         }
         let max = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
-        assert_eq!(max(x), max(&s.x));
+        assert_eq!(max(x), max(&s.x) * 1e3);
         assert_eq!(max(f), max(&s.f));
         // Two force peaks and two troughs per period of 0.5 s over 10 s, less the damped tail
         // lost in the noise: many extrema, alternating, and no more than the true count.
