@@ -422,12 +422,15 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         sections.extend(record_sections(&data, &fits, out)?);
         write_report(
             &format!("Comparison: {}", exp.path.display()),
-            vec![format!(
-                "{} cycles of {}; noise floor σ = {:.4} N.",
-                measured.labels.len(),
-                data.record.source,
-                measured.noise_sigma
-            )],
+            vec![
+                crate::verdict::compare_verdict(&ranking),
+                format!(
+                    "{} cycles of {}; noise floor σ = {:.4} N.",
+                    measured.labels.len(),
+                    data.record.source,
+                    measured.noise_sigma
+                ),
+            ],
             sections,
             out,
         )?;

@@ -396,12 +396,12 @@ fn force_report(
     ));
     let mut sections = vec![s];
     sections.extend(record_sections(data, &[], out)?);
-    let mut intro = vec![format!(
-        "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-        named(&found.effects),
+    let mut intro = vec![crate::verdict::discover_verdict(
+        &found.effects,
         found.gap_before,
         found.gap_after,
-        found.noise_floor
+        found.noise_floor,
+        "N",
     )];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("N", 1.0))));
     write_report(
@@ -689,13 +689,16 @@ fn trajectory_report(
     let mut sections = vec![s];
     sections.extend(record_sections(data, &[], out)?);
     let mut intro = vec![format!(
-        "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor {:.4} mm).",
-        named(&found.effects),
+        "{} S(μ) {:.4} → {:.4} mm².",
+        crate::verdict::discover_verdict(
+            &found.effects,
+            found.gap_before * 1e3,
+            found.gap_after * 1e3,
+            found.noise_floor * 1e3,
+            "mm",
+        ),
         tf.s_before_mm2,
         tf.s_after_mm2,
-        found.gap_before * 1e3,
-        found.gap_after * 1e3,
-        found.noise_floor * 1e3
     )];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("mm", 1e3))));
     write_report(

@@ -24,7 +24,9 @@ use crate::fitting::{
     estimate_line, finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData,
     ModelFit,
 };
+use crate::identify_report::{system_line, write_identification_report, StageOutcome};
 use crate::output::{prepare_dir, write_columns, write_json};
+use crate::param_table::{rows_of, rows_of_fits, write_params_csv};
 use crate::progress::{fit_message, Progress};
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
@@ -65,6 +67,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
     });
     write_json(&out.join("fit.json"), &doc)?;
+    write_params_csv(&out.join("params.csv"), &rows_of_fits(&fits))?;
 
     let measured_name = match level {
         FitLevel::Force => "f_stf",
@@ -89,12 +92,15 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             sections.push(crate::reporting::validation_section(rec, &fits, out)?);
         }
         sections.extend(crate::reporting::record_sections(&data, &fits, out)?);
-        let mut intro = vec![format!(
-            "stf-lab fitted {} model(s) of {} to {}.",
-            fits.len(),
-            exp.path.display(),
-            data.record.source
-        )];
+        let mut intro = vec![
+            crate::verdict::fit_verdict(&fits, level),
+            format!(
+                "stf-lab fitted {} model(s) of {} to {}.",
+                fits.len(),
+                exp.path.display(),
+                data.record.source
+            ),
+        ];
         if let Some(rec) = &validation {
             intro.push(crate::reporting::validation_intro(rec, &fits));
         }
@@ -113,7 +119,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         )?;
     }
     println!(
-        "wrote {0}/fit.json, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
+        "wrote {0}/fit.json, {0}/params.csv, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
         out.display()
     );
     Ok(())
@@ -275,6 +281,8 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
     let mut stages = Vec::new();
     let mut all_warnings = Vec::new();
+    let mut rows = Vec::new();
+    let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         if let Some(preset) = stage.preset {
             // A preset replaces only the parameters not found by earlier stages.
@@ -344,6 +352,22 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             all_warnings.push(entry);
         }
         stages.push(stage_json(stage, &result, &floor, &warnings));
+        let label = format!("stage {}", i + 1);
+        rows.extend(rows_of(&label, &result, None, &warnings));
+        let data = TrajectoryData {
+            t: &record.t,
+            x: &record.x,
+        };
+        let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
+        outcomes.push(StageOutcome {
+            record: stage.data.display().to_string(),
+            simulated: fit.predict(&data, &values).unwrap_or_default(),
+            t: record.t.clone(),
+            x: record.x.clone(),
+            result,
+            floor,
+            warnings,
+        });
     }
     let doc = json!({
         "experiment": exp.path.display().to_string(),
@@ -358,7 +382,14 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         }],
     });
     write_json(&out.join("fit.json"), &doc)?;
-    println!("identified system: {}", serde_json::to_string(&system)?);
-    println!("wrote {}/fit.json", out.display());
+    write_params_csv(&out.join("params.csv"), &rows)?;
+    println!("identified system: {}", system_line(&system));
+    if exp.output.report {
+        write_identification_report(&exp.path, &outcomes, &system, out)?;
+    }
+    println!(
+        "wrote {0}/fit.json, {0}/params.csv, {0}/report.html, {0}/report.md and {0}/figures/",
+        out.display()
+    );
     Ok(())
 }
