@@ -60,7 +60,7 @@ pub use measured_vs_fitted::{
     measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
-pub use raster::svg_to_png;
+pub use raster::{stray_coloured_pixels, svg_to_png};
 pub use regime_errors::regime_errors;
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};

@@ -56,15 +56,14 @@ pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
 /// How many strongly coloured pixels of `png` lie more than `margin` pixels outside every
 /// coloured shape of `svg` (each shape's stroked bounding box): stray marks such as the
 /// spikes the bitmap backend drew at sharp joins. Text and axes are black or grey, so they
-/// are not counted.
-#[cfg(test)]
-pub(crate) fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> usize {
-    let tree = usvg::Tree::from_str(svg, options()).expect("the SVG parses");
+/// are not counted. A check for tests (a figure's PNG against its SVG).
+pub fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> Result<usize, String> {
+    let tree = usvg::Tree::from_str(svg, options()).map_err(|e| format!("SVG: {e}"))?;
     let mut boxes = Vec::new();
     collect_coloured_boxes(tree.root(), &mut boxes);
-    let image = tiny_skia::Pixmap::decode_png(png).expect("the PNG decodes");
+    let image = tiny_skia::Pixmap::decode_png(png).map_err(|e| format!("PNG: {e}"))?;
     let width = image.width() as usize;
-    image
+    Ok(image
         .pixels()
         .iter()
         .enumerate()
@@ -85,10 +84,9 @@ pub(crate) fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> usize
                     && y <= b.bottom() + margin
             })
         })
-        .count()
+        .count())
 }
 
-#[cfg(test)]
 fn collect_coloured_boxes(group: &usvg::Group, boxes: &mut Vec<tiny_skia::Rect>) {
     let coloured = |paint: &usvg::Paint| match paint {
         usvg::Paint::Color(c) => {
@@ -133,6 +131,6 @@ mod tests {
             super::super::hysteresis(dir.path(), "zigzag", ("x, m", &s.x), &zigzag, &s.t).unwrap();
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         let png = std::fs::read(&files.png).unwrap();
-        assert_eq!(stray_coloured_pixels(&svg, &png, 3.0), 0);
+        assert_eq!(stray_coloured_pixels(&svg, &png, 3.0), Ok(0));
     }
 }

@@ -73,7 +73,7 @@ pub fn assert_rendered(
     let stray = super::raster::stray_coloured_pixels(&svg, &png, 3.0);
     assert_eq!(
         stray,
-        0,
+        Ok(0),
         "{} has coloured marks outside its shapes",
         files.png.display()
     );
