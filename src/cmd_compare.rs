@@ -420,6 +420,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         let frequency = frequency_section(&curves, changes, out)?;
         let mut sections = vec![regimes, frequency];
         sections.extend(record_sections(&data, &fits, out)?);
+        let forces: Vec<(&str, &[f64])> = fits
+            .iter()
+            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+            .collect();
+        sections.extend(crate::regime_figures::regime_section(
+            &exp, &data, &forces, out,
+        )?);
         write_report(
             &format!("Comparison: {}", exp.path.display()),
             vec![

@@ -395,6 +395,10 @@ fn force_report(
         "Residual (measured − model) of the base (grey band) and of the final model.",
     ));
     let mut sections = vec![s];
+    let curves = [("base", before.as_slice()), ("final", after.as_slice())];
+    sections.extend(crate::regime_figures::regime_section(
+        exp, data, &curves, out,
+    )?);
     sections.extend(record_sections(data, &[], out)?);
     let mut intro = vec![crate::verdict::discover_verdict(
         &found.effects,

@@ -92,6 +92,16 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             sections.push(crate::reporting::validation_section(rec, &fits, out)?);
         }
         sections.extend(crate::reporting::record_sections(&data, &fits, out)?);
+        let forces: Vec<(&str, &[f64])> = match level {
+            FitLevel::Force => fits
+                .iter()
+                .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+                .collect(),
+            FitLevel::Trajectory => Vec::new(),
+        };
+        sections.extend(crate::regime_figures::regime_section(
+            &exp, &data, &forces, out,
+        )?);
         let mut intro = vec![
             crate::verdict::fit_verdict(&fits, level),
             format!(

@@ -25,6 +25,7 @@ pub mod model_config;
 pub mod output;
 pub mod param_table;
 pub mod progress;
+pub mod regime_figures;
 pub mod report;
 pub mod reporting;
 pub mod validation;

@@ -38,9 +38,11 @@ mod html;
 mod hysteresis;
 mod markdown;
 mod measured_vs_fitted;
+mod parity;
 mod plot_range;
 mod raster;
 mod regime_errors;
+mod regime_windows;
 mod series_csv;
 mod smoothing;
 pub mod test_signals;
@@ -60,8 +62,10 @@ pub use measured_vs_fitted::{
     measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
+pub use parity::{parity, ParityQuantity, SampleGroup};
 pub use raster::{stray_coloured_pixels, svg_to_png};
 pub use regime_errors::regime_errors;
+pub use regime_windows::{regime_windows, RegimeWindow, WindowSeries};
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};
 pub use time_history::{time_history, Motion};
