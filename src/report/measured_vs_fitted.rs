@@ -4,11 +4,13 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::envelope::{band, dense, envelope, BUCKETS};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
     tick_label, tick_style, title_style, Draw, FigureFiles, SIZE,
@@ -93,6 +95,46 @@ struct MeasuredVsFittedPlot {
     fitted: Vec<(String, Vec<f64>)>,
 }
 
+impl MeasuredVsFittedPlot {
+    /// A record of hundreds of cycles: the measured envelope as a grey band, each model's as
+    /// its upper and lower edge (the cycles themselves are in the regime windows).
+    fn draw_envelopes<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> Result<(), String> {
+        let measured = envelope(&self.t, &self.measured, BUCKETS);
+        chart
+            .draw_series([Polygon::new(band(&measured), MEASURED_GREY.filled())])
+            .map_err(msg)?
+            .label(format!("{} (envelope)", self.quantity.band))
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
+            });
+        for (i, (label, f)) in self.fitted.iter().enumerate() {
+            let colour = series_colour(i);
+            let edges = envelope(&self.t, f, BUCKETS);
+            let upper = edges.iter().map(|&(t, _, hi)| (t, hi));
+            let lower = edges.iter().map(|&(t, lo, _)| (t, lo));
+            chart
+                .draw_series(LineSeries::new(upper, colour.stroke_width(2)))
+                .map_err(msg)?
+                .label(format!("{label} (envelope)"))
+                .legend(legend_line(colour));
+            chart
+                .draw_series(LineSeries::new(lower, colour.stroke_width(2)))
+                .map_err(msg)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(legend_style())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(msg)
+    }
+}
+
 impl Draw for MeasuredVsFittedPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let no_data = || "measured vs fitted: no finite value".to_string();
@@ -125,6 +167,9 @@ impl Draw for MeasuredVsFittedPlot {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(msg)?;
+        if dense(&self.measured) {
+            return self.draw_envelopes(&mut chart);
+        }
         chart
             .draw_series(LineSeries::new(
                 finite_points(&self.t, &self.measured),

@@ -29,6 +29,7 @@ mod base64;
 mod colour;
 mod decimate;
 mod document;
+mod envelope;
 mod error;
 mod extrema;
 mod figure;

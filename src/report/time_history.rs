@@ -4,11 +4,13 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::envelope::{band, dense, envelope, BUCKETS};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
@@ -89,22 +91,41 @@ impl TimeHistoryPlot {
 
         let c_motion = series_colour(0);
         let c_force = series_colour(1);
-        chart
-            .draw_series(LineSeries::new(
-                finite_points(&self.t, y),
-                c_motion.stroke_width(2),
-            ))
-            .map_err(msg)?
-            .label(*label)
-            .legend(legend_line(c_motion));
-        chart
-            .draw_secondary_series(LineSeries::new(
-                finite_points(&self.t, &self.f),
-                c_force.stroke_width(1),
-            ))
-            .map_err(msg)?
-            .label(F_LABEL)
-            .legend(legend_line(c_force));
+        if dense(y) || dense(&self.f) {
+            // Hundreds of cycles: each signal's envelope, the cycles are in the windows.
+            let y_band = band(&envelope(&self.t, y, BUCKETS));
+            chart
+                .draw_series([Polygon::new(y_band, c_motion.mix(0.45).filled())])
+                .map_err(msg)?
+                .label(format!("{label} (envelope)"))
+                .legend(legend_line(c_motion));
+            let f_band = band(&envelope(&self.t, &self.f, BUCKETS));
+            chart
+                .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
+                .map_err(msg)?
+                .label(format!("{F_LABEL} (envelope)"))
+                .legend(legend_line(c_force));
+        } else {
+            chart
+                .draw_series(LineSeries::new(
+                    finite_points(&self.t, y),
+                    c_motion.stroke_width(2),
+                ))
+                .map_err(msg)?
+                .label(*label)
+                .legend(legend_line(c_motion));
+            chart
+                .draw_secondary_series(LineSeries::new(
+                    finite_points(&self.t, &self.f),
+                    c_force.stroke_width(1),
+                ))
+                .map_err(msg)?
+                .label(F_LABEL)
+                .legend(legend_line(c_force));
+        }
+        if self.marks.len() > MAX_MARKS {
+            return self.legend(&mut chart);
+        }
         chart
             .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
                 let style = match kind {
@@ -116,6 +137,13 @@ impl TimeHistoryPlot {
             .map_err(msg)?
             .label("F_STF maxima (●) and minima (○)")
             .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
+        self.legend(&mut chart)
+    }
+
+    fn legend<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> Result<(), String> {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
@@ -126,6 +154,9 @@ impl TimeHistoryPlot {
             .map_err(msg)
     }
 }
+
+/// More extrema than this and they are not marked: they would cover the plot.
+const MAX_MARKS: usize = 80;
 
 impl Draw for TimeHistoryPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
