@@ -68,7 +68,7 @@ mod tests {
         let t: Vec<f64> = (0..20_000).map(|i| i as f64 * 0.01).collect();
         let y: Vec<f64> = t
             .iter()
-            .map(|t| (1.0 + 0.01 * t) * (2.0 * t).sin())
+            .map(|t| (1.0 + 0.01 * t) * (5.0 * t).sin())
             .collect();
         assert!(dense(&y));
         assert!(!dense(&y[..1_000]));
