@@ -328,8 +328,8 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         for p in &free {
             fit = fit.free(p.clone());
         }
-        let bar = progress.job(&format!("stage {}", i + 1));
-        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));
+        let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
+        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
         let result = fit
             .fit(
                 &TrajectoryData {

@@ -400,7 +400,12 @@ pub fn fit_model(
     configured: Option<&ConfiguredModel>,
     progress: &indicatif::ProgressBar,
 ) -> Result<ModelFit> {
-    let observer = |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p));
+    let (unit, scale) = match data.level {
+        FitLevel::Force => ("N", 1.0),
+        FitLevel::Trajectory => ("mm", 1e3),
+    };
+    let observer =
+        |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     match data.level {
         FitLevel::Force => fit_force(exp, data, configured, label, &observer),
@@ -550,6 +555,12 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             })
             .collect::<Result<_>>()?
     };
+    let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
+    overall.set_message(crate::progress::jobs_message(0, configured.len(), 0.0));
+    let (started, done) = (
+        std::time::Instant::now(),
+        std::sync::atomic::AtomicUsize::new(0),
+    );
     let bars: Vec<_> = configured
         .iter()
         .map(|c| progress.job(c.as_ref().map_or("oscillator", |c| c.model.name())))
@@ -560,6 +571,9 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .map(|(c, bar)| {
             let r = fit_model(exp, data, c.as_ref(), bar);
             bar.finish_and_clear();
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            let elapsed = started.elapsed().as_secs_f64();
+            overall.set_message(crate::progress::jobs_message(n, configured.len(), elapsed));
             if r.is_ok() {
                 let name = c.as_ref().map_or("the oscillator", |c| c.model.name());
                 crate::interrupt::finished_step(format!("the fit of `{name}`"));
@@ -567,6 +581,7 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             r
         })
         .collect::<Result<_>>()?;
+    overall.finish_and_clear();
     let names: Vec<String> = fits.iter().map(|f| f.label.replace(' ', "")).collect();
     for (i, f) in fits.iter_mut().enumerate() {
         let same = names[..i].iter().filter(|n| **n == names[i]).count();
