@@ -26,10 +26,11 @@ use crate::fitting::{
 };
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
 use crate::output::{prepare_dir, write_columns, write_json};
-use crate::param_table::{rows_of, rows_of_fits, write_params_csv};
+use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
+use stf_core::system::OscillatorParams;
 
 /// Run `stf-lab fit`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
@@ -379,23 +380,36 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             warnings,
         });
     }
+    finish_identification(exp, out, &system, stages, all_warnings, &rows, &outcomes)
+}
+
+/// Write the identification's fit.json, params.csv and report, and say where they went.
+fn finish_identification(
+    exp: &Experiment,
+    out: &Path,
+    system: &OscillatorParams,
+    stages: Vec<serde_json::Value>,
+    all_warnings: Vec<serde_json::Value>,
+    rows: &[ParamRow],
+    outcomes: &[StageOutcome],
+) -> Result<()> {
     let doc = json!({
         "experiment": exp.path.display().to_string(),
         "level": "trajectory",
         "stages": stages,
-        "system": system,
+        "system": *system,
         "models": [{
             "name": "none",
-            "params": serde_json::to_value(system)?,
+            "params": serde_json::to_value(*system)?,
             "rms": stages.last().and_then(|s| s["rms"].as_f64()),
             "warnings": all_warnings,
         }],
     });
     write_json(&out.join("fit.json"), &doc)?;
-    write_params_csv(&out.join("params.csv"), &rows)?;
-    println!("identified system: {}", system_line(&system));
+    write_params_csv(&out.join("params.csv"), rows)?;
+    println!("identified system: {}", system_line(system));
     if exp.output.report {
-        write_identification_report(&exp.path, &outcomes, &system, out)?;
+        write_identification_report(&exp.path, outcomes, system, out)?;
     }
     println!(
         "wrote {0}/fit.json, {0}/params.csv, {0}/report.html, {0}/report.md and {0}/figures/",

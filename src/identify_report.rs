@@ -93,7 +93,7 @@ fn verdict(stages: &[StageOutcome], system: &OscillatorParams) -> String {
 }
 
 fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
-    let mut section = Section::new(&format!("Stage {}: {}", i + 1, s.record));
+    let mut section = Section::new(format!("Stage {}: {}", i + 1, s.record));
     section.tables.push(Table {
         caption: format!(
             "Stage {} values (± standard error); S(μ) = {:.4} mm², {} evaluations, {}.",

@@ -73,27 +73,6 @@ pub fn jobs_message(done: usize, of: usize, elapsed_s: f64) -> String {
     format!("{done} of {of} done{}", left.unwrap_or_default())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn messages_speak_of_the_work_not_the_solver() {
-        let p = FitProgress {
-            stage: Stage::LevenbergMarquardt,
-            evaluations: 42,
-            best_cost: 4e-4,
-        };
-        assert_eq!(
-            fit_message(&p, "N", 1.0),
-            "refining the best point · 42 evaluations · best RMS 0.0200 N"
-        );
-        assert_eq!(jobs_message(0, 4, 1.0), "0 of 4 done");
-        assert_eq!(jobs_message(2, 4, 6.0), "2 of 4 done · ~6 s left");
-        assert_eq!(jobs_message(4, 4, 9.0), "4 of 4 done");
-    }
-}
-
 /// The live display of a discovery run on `bar`: the step, the candidate being fitted (i of
 /// n), the best held-out score so far in the step (residuals in `unit`, scaled by `scale`
 /// from SI) and the time left in the step, from the mean time of its candidates so far.
@@ -163,4 +142,25 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
             }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_speak_of_the_work_not_the_solver() {
+        let p = FitProgress {
+            stage: Stage::LevenbergMarquardt,
+            evaluations: 42,
+            best_cost: 4e-4,
+        };
+        assert_eq!(
+            fit_message(&p, "N", 1.0),
+            "refining the best point · 42 evaluations · best RMS 0.0200 N"
+        );
+        assert_eq!(jobs_message(0, 4, 1.0), "0 of 4 done");
+        assert_eq!(jobs_message(2, 4, 6.0), "2 of 4 done · ~6 s left");
+        assert_eq!(jobs_message(4, 4, 9.0), "4 of 4 done");
+    }
 }

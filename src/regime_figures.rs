@@ -90,6 +90,37 @@ fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Opti
     Ok((cycles, labels))
 }
 
+/// [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch, named with their ω.
+fn windows_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<RegimeWindow> {
+    found
+        .iter()
+        .map(|s| {
+            let n = CYCLES_PER_WINDOW.min(s.count);
+            let first = s.first + (s.count - n) / 2;
+            let (a, b) = (&cycles[first], &cycles[first + n - 1]);
+            RegimeWindow {
+                name: format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega),
+                start: a.start,
+                end: b.end,
+            }
+        })
+        .collect()
+}
+
+/// Every sample of each stretch's cycles.
+fn groups_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<SampleGroup> {
+    found
+        .iter()
+        .map(|s| SampleGroup {
+            name: s.name.clone(),
+            samples: cycles[s.first..s.first + s.count]
+                .iter()
+                .flat_map(|c| c.start..c.end)
+                .collect(),
+        })
+        .collect()
+}
+
 /// The section of regime windows and parity plots for `models` (`(label, fitted STF force)`,
 /// N; none: the measured force alone), or `None` when the record has no STF force or too
 /// few cycles.
@@ -111,19 +142,7 @@ pub fn regime_section(
     let k = &data.kinematics;
     let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
     let (x_mm, v_mm) = (mm(&k.x), mm(&k.v));
-    let windows: Vec<RegimeWindow> = found
-        .iter()
-        .map(|s| {
-            let n = CYCLES_PER_WINDOW.min(s.count);
-            let first = s.first + (s.count - n) / 2;
-            let (a, b) = (&cycles[first], &cycles[first + n - 1]);
-            RegimeWindow {
-                name: format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega),
-                start: a.start,
-                end: b.end,
-            }
-        })
-        .collect();
+    let windows = windows_of(&found, &cycles);
     let series = WindowSeries {
         t: &k.t,
         x_mm: &x_mm,
@@ -154,16 +173,7 @@ pub fn regime_section(
          each model's force over the measured one (grey).",
     ));
     if !models.is_empty() {
-        let groups: Vec<SampleGroup> = found
-            .iter()
-            .map(|s| SampleGroup {
-                name: s.name.clone(),
-                samples: cycles[s.first..s.first + s.count]
-                    .iter()
-                    .flat_map(|c| c.start..c.end)
-                    .collect(),
-            })
-            .collect();
+        let groups = groups_of(&found, &cycles);
         let quantity = ParityQuantity {
             label: "F_STF, N".into(),
             noise_sigma: Some(stf_core::derivative::noise_estimate(f).sigma),

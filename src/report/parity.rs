@@ -85,6 +85,26 @@ fn density(r: &[f64], range: &Range<f64>) -> Vec<f64> {
     h
 }
 
+/// measured − fitted, the finite values, for each model.
+fn residuals_of(measured: &[f64], fitted: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    fitted
+        .iter()
+        .map(|f| {
+            measured
+                .iter()
+                .zip(f)
+                .map(|(m, f)| m - f)
+                .filter(|r| r.is_finite())
+                .collect()
+        })
+        .collect()
+}
+
+/// The normal density with σ `s` at `x`.
+fn bell(x: f64, s: f64) -> f64 {
+    (-0.5 * (x / s).powi(2)).exp() / (s * (2.0 * std::f64::consts::PI).sqrt())
+}
+
 /// Every `step`-th index, so a scatter has at most `max` points.
 fn thin(n: usize, max: usize) -> impl Iterator<Item = usize> {
     (0..n).step_by(n.div_ceil(max.max(1)).max(1))
@@ -145,25 +165,12 @@ impl ParityPlot {
         (name, measured, fitted): &(String, Vec<f64>, Vec<Vec<f64>>),
         legend: bool,
     ) -> Result<(), String> {
-        let residuals: Vec<Vec<f64>> = fitted
-            .iter()
-            .map(|f| {
-                measured
-                    .iter()
-                    .zip(f)
-                    .map(|(m, f)| m - f)
-                    .filter(|r| r.is_finite())
-                    .collect()
-            })
-            .collect();
+        let residuals = residuals_of(measured, fitted);
         let range = histogram_range(&residuals, self.quantity.noise_sigma)
             .ok_or_else(|| format!("{name}: no finite residual"))?;
         let width = (range.end - range.start) / BINS as f64;
         let histograms: Vec<Vec<f64>> = residuals.iter().map(|r| density(r, &range)).collect();
         let sigma = self.quantity.noise_sigma.filter(|s| *s > 0.0);
-        let bell = |x: f64, s: f64| {
-            (-0.5 * (x / s).powi(2)).exp() / (s * (2.0 * std::f64::consts::PI).sqrt())
-        };
         let top = histograms
             .iter()
             .flatten()

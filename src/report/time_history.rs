@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use plotters::chart::DualCoordChartContext;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -89,6 +90,37 @@ impl TimeHistoryPlot {
             .draw()
             .map_err(msg)?;
 
+        self.draw_signals(&mut chart, label, y)?;
+        if self.marks.len() > MAX_MARKS {
+            return self.legend(&mut chart);
+        }
+        chart
+            .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
+                let style = match kind {
+                    ExtremumKind::Max => BLACK.filled(),
+                    ExtremumKind::Min => BLACK.stroke_width(2),
+                };
+                Circle::new((t, f), 4, style)
+            }))
+            .map_err(msg)?
+            .label("F_STF maxima (●) and minima (○)")
+            .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
+        self.legend(&mut chart)
+    }
+
+    /// The motion `y` (primary axis) and the force (secondary): lines, or for hundreds of
+    /// cycles each signal's envelope (the cycles are in the regime windows).
+    fn draw_signals<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut DualCoordChartContext<
+            'a,
+            DB,
+            Cartesian2d<RangedCoordf64, RangedCoordf64>,
+            Cartesian2d<RangedCoordf64, RangedCoordf64>,
+        >,
+        label: &str,
+        y: &[f64],
+    ) -> Result<(), String> {
         let c_motion = series_colour(0);
         let c_force = series_colour(1);
         if dense(y) || dense(&self.f) {
@@ -112,7 +144,7 @@ impl TimeHistoryPlot {
                     c_motion.stroke_width(2),
                 ))
                 .map_err(msg)?
-                .label(*label)
+                .label(label)
                 .legend(legend_line(c_motion));
             chart
                 .draw_secondary_series(LineSeries::new(
@@ -123,21 +155,7 @@ impl TimeHistoryPlot {
                 .label(F_LABEL)
                 .legend(legend_line(c_force));
         }
-        if self.marks.len() > MAX_MARKS {
-            return self.legend(&mut chart);
-        }
-        chart
-            .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
-                let style = match kind {
-                    ExtremumKind::Max => BLACK.filled(),
-                    ExtremumKind::Min => BLACK.stroke_width(2),
-                };
-                Circle::new((t, f), 4, style)
-            }))
-            .map_err(msg)?
-            .label("F_STF maxima (●) and minima (○)")
-            .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
-        self.legend(&mut chart)
+        Ok(())
     }
 
     fn legend<'a, DB: DrawingBackend + 'a>(
