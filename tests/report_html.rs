@@ -1,4 +1,5 @@
 //! `report.html` in a real browser: a small report with two figures and a table is written,
+//! and every bundled example's report as its command writes it;
 //! then opened in headless Chromium, which must load it with no script error and lay out every
 //! figure with a non-zero size. Chromium comes from Debian's `chromium` package (`.ci/run`
 //! installs it and sets `STF_LAB_REQUIRE_BROWSER=1`, so there a missing browser fails the
@@ -95,6 +96,38 @@ fn run_chromium(chromium: &Path, page: &Path, args: &[String]) -> String {
     std::fs::read_to_string(&stdout_path).unwrap()
 }
 
+/// The page's own layout check (written by its script into `#layout-check`): no script
+/// error, `figures` figures, each laid out with a non-zero size.
+fn check_layout(dom: &str, figures: usize) {
+    let check = dom
+        .split("<pre id=\"layout-check\" hidden=\"\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
+    assert!(!check.contains("error:"), "page errors:\n{check}");
+    assert!(
+        check.contains(&format!("figures {figures}")),
+        "layout check:\n{check}"
+    );
+    let lines: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
+    assert_eq!(lines.len(), figures, "{check}");
+    for line in lines {
+        // "figure 0 img 1000x1000 natural 1000x1000"
+        let sizes: Vec<(u32, u32)> = line
+            .split_whitespace()
+            .filter(|w| w.contains('x') && w.chars().next().is_some_and(|c| c.is_ascii_digit()))
+            .map(|w| {
+                let (a, b) = w.split_once('x').unwrap();
+                (a.parse().unwrap(), b.parse().unwrap())
+            })
+            .collect();
+        assert_eq!(sizes.len(), 2, "{line}");
+        for (w, h) in sizes {
+            assert!(w > 0 && h > 0, "a figure has zero size: {line}");
+        }
+    }
+}
+
 fn build_report(dir: &Path) -> PathBuf {
     let s = damped_sine(5_000, 5.0);
     let motion = Motion {
@@ -171,30 +204,7 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     };
 
     let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
-    let check = dom
-        .split("<pre id=\"layout-check\" hidden=\"\">")
-        .nth(1)
-        .and_then(|rest| rest.split("</pre>").next())
-        .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
-    assert!(!check.contains("error:"), "page errors:\n{check}");
-    assert!(check.contains("figures 2"), "layout check:\n{check}");
-    let figures: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
-    assert_eq!(figures.len(), 2, "{check}");
-    for line in figures {
-        // "figure 0 img 1000x1000 natural 1000x1000"
-        let sizes: Vec<(u32, u32)> = line
-            .split_whitespace()
-            .filter(|w| w.contains('x') && w.chars().next().is_some_and(|c| c.is_ascii_digit()))
-            .map(|w| {
-                let (a, b) = w.split_once('x').unwrap();
-                (a.parse().unwrap(), b.parse().unwrap())
-            })
-            .collect();
-        assert_eq!(sizes.len(), 2, "{line}");
-        for (w, h) in sizes {
-            assert!(w > 0 && h > 0, "a figure has zero size: {line}");
-        }
-    }
+    check_layout(&dom, 2);
 
     let shot = dir.join("screenshot.png");
     run_chromium(
@@ -204,4 +214,51 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     );
     let png = std::fs::read(&shot).unwrap();
     assert!(png.len() > 10_000, "screenshot is {} bytes", png.len());
+}
+
+/// Every bundled example's report, as its command writes it, loads in the browser with every
+/// figure laid out; with `STF_REPORT_TEST_OUT=DIR` each page's screenshot is kept in DIR.
+#[test]
+fn every_bundled_report_lays_out_every_figure_in_headless_chromium() {
+    let kept = std::env::var_os("STF_REPORT_TEST_OUT").map(PathBuf::from);
+    let Some(chromium) = browser_or_skip() else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (command, example) in [
+        ("fit", "power_law_fit"),
+        ("fit", "paper_identification"),
+        ("compare", "jamming_compare"),
+        ("discover", "discovery"),
+        ("discover", "trajectory_discovery"),
+    ] {
+        let out = tmp.path().join(example);
+        let run = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
+            .args([command, "--quiet", "--out"])
+            .arg(&out)
+            .arg(root.join("experiments").join(format!("{example}.toml")))
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let page = out.join("report.html").canonicalize().unwrap();
+        let html = std::fs::read_to_string(&page).unwrap();
+        let figures = html.matches("<img src=\"data:image/png;base64,").count();
+        assert!(figures >= 2, "{example}: {figures} figures");
+        let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
+        check_layout(&dom, figures);
+        if let Some(dir) = &kept {
+            std::fs::create_dir_all(dir).unwrap();
+            let shot = dir.join(format!("{example}.png"));
+            run_chromium(
+                &chromium,
+                &page,
+                &[format!("--screenshot={}", shot.display())],
+            );
+        }
+    }
 }
