@@ -11,16 +11,44 @@ const DENSE_CROSSINGS: usize = 150;
 /// Whether `y` oscillates too often to be drawn as a line across one plot: it crosses the
 /// middle of its range more than [`DENSE_CROSSINGS`] times.
 pub fn dense(y: &[f64]) -> bool {
+    crossings(y) > DENSE_CROSSINGS
+}
+
+/// How many times `y` crosses the middle of its range (with a margin).
+fn crossings(y: &[f64]) -> usize {
     let finite = || y.iter().filter(|v| v.is_finite());
     let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
         (a.min(v), b.max(v))
     });
     if !(lo < hi) {
-        return false;
+        return 0;
     }
-    let mid = 0.5 * (lo + hi);
-    let above: Vec<bool> = finite().map(|&v| v > mid).collect();
-    above.windows(2).filter(|w| w[0] != w[1]).count() > DENSE_CROSSINGS
+    // A crossing counts once the value is a tenth of the half-range past the middle, so noise
+    // about the middle of a quiet stretch is not counted.
+    let (mid, band) = (0.5 * (lo + hi), 0.05 * (hi - lo));
+    let mut side = 0;
+    let mut count = 0;
+    for &v in finite() {
+        let now = if v > mid + band {
+            1
+        } else if v < mid - band {
+            -1
+        } else {
+            side
+        };
+        if side != 0 && now != side {
+            count += 1;
+        }
+        side = now;
+    }
+    count
+}
+
+/// The buckets an envelope of `y` takes: about two cycles each (a bucket shorter than a cycle
+/// misses its peak, and the edge then swings with the beat of bucket and cycle), at most
+/// [`BUCKETS`].
+pub fn buckets_for(y: &[f64]) -> usize {
+    (crossings(y) / 4).clamp(20, BUCKETS)
 }
 
 /// The lower and upper edge of `y` over `buckets` equal stretches of `t`: `(t_mid, min, max)`
@@ -79,5 +107,14 @@ mod tests {
         assert!(e.iter().all(|(_, lo, hi)| lo <= hi));
         assert_eq!(band(&e).len(), 200);
         assert!(envelope(&[], &[], 10).is_empty());
+        // 200 s of 5 rad/s: 318 crossings, an envelope of 79 buckets, about two cycles each.
+        assert_eq!(buckets_for(&y), 79);
+        // Noise about a flat line is not a crossing.
+        let quiet: Vec<f64> = (0..5_000)
+            .map(|i| if i % 2 == 0 { 1e-3 } else { -1e-3 })
+            .collect();
+        let mut quiet_then_sine = quiet.clone();
+        quiet_then_sine.extend(&y[..1_000]);
+        assert!(!dense(&quiet_then_sine));
     }
 }

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
-use super::envelope::{band, dense, envelope, BUCKETS};
+use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
     tick_label, tick_style, title_style, Draw, FigureFiles, SIZE,
@@ -102,7 +102,8 @@ impl MeasuredVsFittedPlot {
         &self,
         chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     ) -> Result<(), String> {
-        let measured = envelope(&self.t, &self.measured, BUCKETS);
+        let buckets = buckets_for(&self.measured);
+        let measured = envelope(&self.t, &self.measured, buckets);
         chart
             .draw_series([Polygon::new(band(&measured), MEASURED_GREY.filled())])
             .map_err(msg)?
@@ -112,7 +113,7 @@ impl MeasuredVsFittedPlot {
             });
         for (i, (label, f)) in self.fitted.iter().enumerate() {
             let colour = series_colour(i);
-            let edges = envelope(&self.t, f, BUCKETS);
+            let edges = envelope(&self.t, f, buckets);
             let upper = edges.iter().map(|&(t, _, hi)| (t, hi));
             let lower = edges.iter().map(|&(t, lo, _)| (t, lo));
             chart

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
-use super::envelope::{band, dense, envelope, BUCKETS};
+use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
@@ -125,13 +125,14 @@ impl TimeHistoryPlot {
         let c_force = series_colour(1);
         if dense(y) || dense(&self.f) {
             // Hundreds of cycles: each signal's envelope, the cycles are in the windows.
-            let y_band = band(&envelope(&self.t, y, BUCKETS));
+            let buckets = buckets_for(y).min(buckets_for(&self.f));
+            let y_band = band(&envelope(&self.t, y, buckets));
             chart
                 .draw_series([Polygon::new(y_band, c_motion.mix(0.45).filled())])
                 .map_err(msg)?
                 .label(format!("{label} (envelope)"))
                 .legend(legend_line(c_motion));
-            let f_band = band(&envelope(&self.t, &self.f, BUCKETS));
+            let f_band = band(&envelope(&self.t, &self.f, buckets));
             chart
                 .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
                 .map_err(msg)?
