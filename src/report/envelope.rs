@@ -23,9 +23,9 @@ fn crossings(y: &[f64]) -> usize {
     if !(lo < hi) {
         return 0;
     }
-    // A crossing counts once the value is a tenth of the half-range past the middle, so noise
+    // A crossing counts once the value is a fifth of the half-range past the middle, so noise
     // about the middle of a quiet stretch is not counted.
-    let (mid, band) = (0.5 * (lo + hi), 0.05 * (hi - lo));
+    let (mid, band) = (0.5 * (lo + hi), 0.1 * (hi - lo));
     let mut side = 0;
     let mut count = 0;
     for &v in finite() {
