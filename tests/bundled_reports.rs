@@ -181,4 +181,17 @@ fn compare_and_discover_reports_open_with_their_verdicts() {
         let text = std::fs::read_to_string(out.join("discovery.json")).unwrap();
         assert_eq!(noisy_numbers(&text), Vec::<String>::new(), "{example}");
     }
+    // The shaker's chirp runs 0.5 → 1.5 Hz (3.14 → 9.42 rad/s): the residual is located at
+    // speeds the drive reached (the x cycles' own 2π/duration had said 10.05 rad/s).
+    let md = std::fs::read_to_string(
+        tmp.path()
+            .join("experiments_trajectory_discovery.toml")
+            .join("report.md"),
+    )
+    .unwrap();
+    let located = md.split("largest at ω ").nth(1).unwrap();
+    let (lo, rest) = located.split_once('–').unwrap();
+    let hi = rest.split_once(' ').unwrap().0;
+    let (lo, hi): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
+    assert!(3.1 <= lo && hi <= 9.43, "ω {lo}–{hi} rad/s");
 }
