@@ -430,7 +430,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         write_report(
             &format!("Comparison: {}", exp.path.display()),
             vec![
-                crate::verdict::compare_verdict(&ranking),
+                crate::verdict::compare_verdict(
+                    &ranking,
+                    &measured.cycles,
+                    &measured.labels,
+                    data.record.f_stf.as_deref().unwrap_or(&[]),
+                    &forces,
+                ),
                 format!(
                     "{} cycles of {}; noise floor σ = {:.4} N.",
                     measured.labels.len(),

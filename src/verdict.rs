@@ -1,9 +1,10 @@
 //! The paragraph each report opens with: the judgement, not only the numbers. For `fit`,
 //! which model fits best and by how much, and every reason not to trust it; for `compare`,
-//! the ranking in each regime and the measure behind it.
+//! the ranking in each regime, the measure behind it and a paired test of the first two over
+//! the regime's cycles; for `discover`, what was named and its share of the excess.
 
 use stf_core::fit::FitWarning;
-use stf_core::regimes::{Ranking, Regime};
+use stf_core::regimes::{Cycle, Ranking, Regime};
 
 use crate::experiment::FitLevel;
 use crate::fitting::ModelFit;
@@ -97,8 +98,17 @@ fn trust(best: &ModelFit, fits: &[ModelFit]) -> String {
 }
 
 /// The verdict of a comparison: the models in order in each regime the record has, by the
-/// relative force RMS error over the regime's cycles, and the best overall.
-pub fn compare_verdict(ranking: &Ranking) -> String {
+/// relative force RMS error over the regime's cycles, and whether the first is ahead of the
+/// second cycle by cycle: a paired z of their per-cycle mean squared errors (`models`' fitted
+/// forces against `measured` over each `cycles[i]` labelled `labels[i]`), cycles being the
+/// independent units.
+pub fn compare_verdict(
+    ranking: &Ranking,
+    cycles: &[Cycle],
+    labels: &[Regime],
+    measured: &[f64],
+    models: &[(&str, &[f64])],
+) -> String {
     let mut parts = Vec::new();
     for r in Regime::ALL {
         let Some(scores) = ranking.per_regime.get(r) else {
@@ -108,8 +118,27 @@ pub fn compare_verdict(ranking: &Ranking) -> String {
             .iter()
             .map(|s| format!("`{}` {:.3}", s.model, s.score))
             .collect();
+        let test = match scores.as_slice() {
+            [first, second, ..] => {
+                let in_regime: Vec<&Cycle> = cycles
+                    .iter()
+                    .zip(labels)
+                    .filter(|(_, l)| **l == r)
+                    .map(|(c, _)| c)
+                    .collect();
+                let errors = |name: &str| {
+                    let f = models.iter().find(|(l, _)| *l == name)?.1;
+                    Some(cycle_errors(&in_regime, measured, f))
+                };
+                match (errors(&first.model), errors(&second.model)) {
+                    (Some(a), Some(b)) => paired_test(&a, &b, &first.model, &second.model),
+                    _ => String::new(),
+                }
+            }
+            _ => String::new(),
+        };
         parts.push(format!(
-            "{}: {}",
+            "{}: {}{test}",
             r.name().replace('_', "-"),
             order.join(" < ")
         ));
@@ -130,9 +159,48 @@ pub fn compare_verdict(ranking: &Ranking) -> String {
     format!(
         "Models ranked in each regime by their relative force RMS error over the regime's cycles \
          (the RMS of model − measured force over the measured force's RMS; 0 is perfect, 1 is \
-         no better than no force): {}.{overall}",
+         no better than no force), the first two compared cycle by cycle: {}.{overall}",
         parts.join("; ")
     )
+}
+
+/// The mean squared error of `fitted` against `measured` over each cycle.
+fn cycle_errors(cycles: &[&Cycle], measured: &[f64], fitted: &[f64]) -> Vec<f64> {
+    cycles
+        .iter()
+        .filter(|c| c.end <= measured.len() && c.end <= fitted.len() && c.start < c.end)
+        .map(|c| {
+            let n = (c.end - c.start) as f64;
+            (c.start..c.end)
+                .map(|i| (fitted[i] - measured[i]).powi(2))
+                .sum::<f64>()
+                / n
+        })
+        .collect()
+}
+
+/// ` (paired over N cycles: z Z, ahead in K)` for the per-cycle errors `a` (the first) and `b`.
+fn paired_test(a: &[f64], b: &[f64], first: &str, second: &str) -> String {
+    let d: Vec<f64> = b
+        .iter()
+        .zip(a)
+        .map(|(b, a)| b - a)
+        .filter(|d| d.is_finite())
+        .collect();
+    let n = d.len();
+    if n < 3 {
+        return format!(" (too few cycles, {n}, to tell `{first}` from `{second}`)");
+    }
+    let mean = d.iter().sum::<f64>() / n as f64;
+    let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+    let ahead = d.iter().filter(|x| **x > 0.0).count();
+    let z = if sd > 0.0 {
+        mean / (sd / (n as f64).sqrt())
+    } else {
+        f64::INFINITY
+    };
+    let call = if z > 3.0 { "ahead" } else { "not told apart" };
+    format!(" (`{first}` {call} of `{second}`: paired z {z:.1} over {n} cycles, smaller error in {ahead})")
 }
 
 /// The verdict of a discovery: the effects named and how much of the base's excess over the
@@ -182,6 +250,21 @@ pub fn discover_verdict(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_paired_test_tells_a_consistent_lead_from_a_coin_toss() {
+        let a = [1.0, 1.1, 0.9, 1.0, 1.05, 0.95];
+        let better: Vec<f64> = a.iter().map(|x| x + 0.5).collect();
+        let said = paired_test(&a, &better, "p", "q");
+        assert!(
+            said.contains("`p` ahead of `q`") && said.contains("smaller error in 6"),
+            "{said}"
+        );
+        let mixed = [1.2, 0.8, 1.1, 0.9, 1.0, 1.0];
+        let said = paired_test(&a, &mixed, "p", "q");
+        assert!(said.contains("not told apart"), "{said}");
+        assert!(paired_test(&a[..2], &mixed[..2], "p", "q").contains("too few cycles"));
+    }
 
     #[test]
     fn a_discovery_verdict_says_what_was_named_and_its_share() {
