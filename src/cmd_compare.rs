@@ -24,7 +24,7 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
 use crate::output::{prepare_dir, write_atomic, write_json};
 use crate::progress::Progress;
-use crate::report::{regime_errors, FigureRef, FrfCurve, Section, Table};
+use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
 use crate::reporting::{frequency_section, record_sections, write_report};
 
 /// The measured record's regimes.
@@ -96,7 +96,22 @@ fn frf(label: &str, t: &[f64], x: &[f64], omega: Option<&[f64]>) -> FrfCurve {
         label: label.to_string(),
         omega: maxima.iter().map(|m| m.omega).collect(),
         x_peak: maxima.iter().map(|m| m.x).collect(),
+        role: match label {
+            "measured" => FrfRole::Measured,
+            "without STF" => FrfRole::Reference,
+            _ => FrfRole::Model,
+        },
     }
+}
+
+/// What the duty and its error are, with the record's on-threshold.
+fn duty_meaning(on_threshold: f64) -> String {
+    format!(
+        "The duty of a cycle is the fraction of it in which the STF force is on (|F_STF| above \
+         {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
+         zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
+         a regime's cycles of |model duty − measured duty|."
+    )
 }
 
 fn regime_json(c: &Comparison) -> Value {
@@ -223,7 +238,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     }
     let _ = writeln!(
         md,
-        "\nRelative force RMS error (duty error) per regime; lower is better.\n"
+        "\nRelative force RMS error (duty error) per regime; lower is better. {}\n",
+        duty_meaning(measured.on_threshold)
     );
     let _ = writeln!(
         md,
@@ -369,6 +385,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             ));
             table.rows.push(row);
         }
+        regimes.paragraphs.push(duty_meaning(measured.on_threshold));
         regimes.tables.push(table);
         regimes
             .paragraphs
@@ -401,17 +418,43 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             fig,
             "Relative force RMS error of each model in each regime of the record (lower is better).",
         ));
-        let frequency = frequency_section(&curves, out)?;
+        let change = |b: Option<stf_core::regimes::Boundary>| {
+            b.map(|b| RegimeChange {
+                omega: b.omega,
+                uncertainty: b.uncertainty,
+            })
+        };
+        let changes = [
+            change(measured.boundaries.pre_resonance),
+            change(measured.boundaries.resonance_post),
+        ];
+        let frequency = frequency_section(&curves, changes, out)?;
         let mut sections = vec![regimes, frequency];
         sections.extend(record_sections(&data, &fits, out)?);
+        let forces: Vec<(&str, &[f64])> = fits
+            .iter()
+            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+            .collect();
+        sections.extend(crate::regime_figures::regime_section(
+            &exp, &data, &forces, out,
+        )?);
         write_report(
             &format!("Comparison: {}", exp.path.display()),
-            vec![format!(
-                "{} cycles of {}; noise floor σ = {:.4} N.",
-                measured.labels.len(),
-                data.record.source,
-                measured.noise_sigma
-            )],
+            vec![
+                crate::verdict::compare_verdict(
+                    &ranking,
+                    &measured.cycles,
+                    &measured.labels,
+                    data.record.f_stf.as_deref().unwrap_or(&[]),
+                    &forces,
+                ),
+                format!(
+                    "{} cycles of {}; noise floor σ = {:.4} N.",
+                    measured.labels.len(),
+                    data.record.source,
+                    measured.noise_sigma
+                ),
+            ],
             sections,
             out,
         )?;

@@ -361,25 +361,12 @@ fn force_report(
         minus(f, &found.residual_after),
     );
     let mut s = Section::new("Discovery");
-    s.paragraphs.push(format!(
-        "Base `{}`: gap {:.4} N (noise floor {:.4} N). {}",
-        base_of(exp, found),
-        found.gap_before,
-        found.noise_floor,
-        found.where_before.summary
-    ));
-    for step in &found.steps {
-        s.paragraphs.push(step.verdict.clone());
-    }
-    s.paragraphs.push(format!(
-        "Final `{}`: gap {:.4} N. {}",
-        found.final_model_name, found.gap_after, found.where_after.summary
-    ));
+    // The notes are the base's gap, each step's verdict and the final gap, in order.
+    s.paragraphs.extend(found.notes.iter().cloned());
     s.paragraphs.push(format!(
         "{}.",
         held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
     ));
-    s.paragraphs.extend(found.notes.iter().cloned());
     s.tables.extend(
         found
             .steps
@@ -411,13 +398,17 @@ fn force_report(
         "Residual (measured − model) of the base (grey band) and of the final model.",
     ));
     let mut sections = vec![s];
+    let curves = [("base", before.as_slice()), ("final", after.as_slice())];
+    sections.extend(crate::regime_figures::regime_section(
+        exp, data, &curves, out,
+    )?);
     sections.extend(record_sections(data, &[], out)?);
-    let mut intro = vec![format!(
-        "Effects named: {}. Gap {:.4} N → {:.4} N (noise floor {:.4} N).",
-        named(&found.effects),
+    let mut intro = vec![crate::verdict::discover_verdict(
+        &found.effects,
         found.gap_before,
         found.gap_after,
-        found.noise_floor
+        found.noise_floor,
+        "N",
     )];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("N", 1.0))));
     write_report(
@@ -705,13 +696,16 @@ fn trajectory_report(
     let mut sections = vec![s];
     sections.extend(record_sections(data, &[], out)?);
     let mut intro = vec![format!(
-        "Effects named: {}. S {:.4} → {:.4} mm² (x gap {:.4} → {:.4} mm, noise floor {:.4} mm).",
-        named(&found.effects),
+        "{} S(μ) {:.4} → {:.4} mm².",
+        crate::verdict::discover_verdict(
+            &found.effects,
+            found.gap_before * 1e3,
+            found.gap_after * 1e3,
+            found.noise_floor * 1e3,
+            "mm",
+        ),
         tf.s_before_mm2,
         tf.s_after_mm2,
-        found.gap_before * 1e3,
-        found.gap_after * 1e3,
-        found.noise_floor * 1e3
     )];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("mm", 1e3))));
     write_report(

@@ -24,10 +24,13 @@ use crate::fitting::{
     estimate_line, finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData,
     ModelFit,
 };
+use crate::identify_report::{system_line, write_identification_report, StageOutcome};
 use crate::output::{prepare_dir, write_columns, write_json};
+use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
+use stf_core::system::OscillatorParams;
 
 /// Run `stf-lab fit`.
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
@@ -65,6 +68,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
     });
     write_json(&out.join("fit.json"), &doc)?;
+    write_params_csv(&out.join("params.csv"), &rows_of_fits(&fits))?;
 
     let measured_name = match level {
         FitLevel::Force => "f_stf",
@@ -89,12 +93,25 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             sections.push(crate::reporting::validation_section(rec, &fits, out)?);
         }
         sections.extend(crate::reporting::record_sections(&data, &fits, out)?);
-        let mut intro = vec![format!(
-            "stf-lab fitted {} model(s) of {} to {}.",
-            fits.len(),
-            exp.path.display(),
-            data.record.source
-        )];
+        let forces: Vec<(&str, &[f64])> = match level {
+            FitLevel::Force => fits
+                .iter()
+                .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+                .collect(),
+            FitLevel::Trajectory => Vec::new(),
+        };
+        sections.extend(crate::regime_figures::regime_section(
+            &exp, &data, &forces, out,
+        )?);
+        let mut intro = vec![
+            crate::verdict::fit_verdict(&fits, level),
+            format!(
+                "stf-lab fitted {} model(s) of {} to {}.",
+                fits.len(),
+                exp.path.display(),
+                data.record.source
+            ),
+        ];
         if let Some(rec) = &validation {
             intro.push(crate::reporting::validation_intro(rec, &fits));
         }
@@ -113,7 +130,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         )?;
     }
     println!(
-        "wrote {0}/fit.json, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
+        "wrote {0}/fit.json, {0}/params.csv, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
         out.display()
     );
     Ok(())
@@ -275,6 +292,8 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
     let mut stages = Vec::new();
     let mut all_warnings = Vec::new();
+    let mut rows = Vec::new();
+    let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         if let Some(preset) = stage.preset {
             // A preset replaces only the parameters not found by earlier stages.
@@ -310,8 +329,8 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         for p in &free {
             fit = fit.free(p.clone());
         }
-        let bar = progress.job(&format!("stage {}", i + 1));
-        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p));
+        let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
+        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
         let result = fit
             .fit(
                 &TrajectoryData {
@@ -344,21 +363,57 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             all_warnings.push(entry);
         }
         stages.push(stage_json(stage, &result, &floor, &warnings));
+        let label = format!("stage {}", i + 1);
+        rows.extend(rows_of(&label, &result, None, &warnings));
+        let data = TrajectoryData {
+            t: &record.t,
+            x: &record.x,
+        };
+        let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
+        outcomes.push(StageOutcome {
+            record: stage.data.display().to_string(),
+            simulated: fit.predict(&data, &values).unwrap_or_default(),
+            t: record.t.clone(),
+            x: record.x.clone(),
+            result,
+            floor,
+            warnings,
+        });
     }
+    finish_identification(exp, out, &system, stages, all_warnings, &rows, &outcomes)
+}
+
+/// Write the identification's fit.json, params.csv and report, and say where they went.
+fn finish_identification(
+    exp: &Experiment,
+    out: &Path,
+    system: &OscillatorParams,
+    stages: Vec<serde_json::Value>,
+    all_warnings: Vec<serde_json::Value>,
+    rows: &[ParamRow],
+    outcomes: &[StageOutcome],
+) -> Result<()> {
     let doc = json!({
         "experiment": exp.path.display().to_string(),
         "level": "trajectory",
         "stages": stages,
-        "system": system,
+        "system": *system,
         "models": [{
             "name": "none",
-            "params": serde_json::to_value(system)?,
+            "params": serde_json::to_value(*system)?,
             "rms": stages.last().and_then(|s| s["rms"].as_f64()),
             "warnings": all_warnings,
         }],
     });
     write_json(&out.join("fit.json"), &doc)?;
-    println!("identified system: {}", serde_json::to_string(&system)?);
-    println!("wrote {}/fit.json", out.display());
+    write_params_csv(&out.join("params.csv"), rows)?;
+    println!("identified system: {}", system_line(system));
+    if exp.output.report {
+        write_identification_report(&exp.path, outcomes, system, out)?;
+    }
+    println!(
+        "wrote {0}/fit.json, {0}/params.csv, {0}/report.html, {0}/report.md and {0}/figures/",
+        out.display()
+    );
     Ok(())
 }

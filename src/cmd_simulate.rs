@@ -20,7 +20,7 @@ use stf_core::synthetic::{sample_record, SensorNoise};
 
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;
-use crate::output::{check_overwrite, ensure_parent, write_atomic};
+use crate::output::{check_overwrite, ensure_parent, write_json};
 
 /// Run the `[simulate]` section of `exp_path` and write the record to `out`.
 pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
@@ -120,8 +120,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         "record": out.display().to_string(),
         "summary": summary,
     });
-    let text = serde_json::to_string_pretty(&meta)? + "\n";
-    write_atomic(&sidecar, text.as_bytes())?;
+    write_json(&sidecar, &meta)?;
 
     println!(
         "simulated {:.1} s ({} samples) in {:.0} ms, {} right-hand-side calls",

@@ -180,11 +180,47 @@ pub fn cycles_of(data: &FitData) -> Result<Vec<stf_core::regimes::Cycle>> {
     Ok(match (&k.phi, &k.omega) {
         (Some(phi), _) => cycles_from_phase(&k.t, phi)?,
         (None, Some(w)) => cycles_from_phase(&k.t, &phase_from_omega(&k.t, w)?)?,
-        _ => match cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)? {
-            few if few.len() < MIN_CYCLES => segments(&k.t, MIN_CYCLES),
-            cycles => cycles,
-        },
+        _ => {
+            let of_x = cycles_from_x(&k.t, &k.x, 3.0 * k.sigma_x)?;
+            let mut cycles = if of_x.len() < MIN_CYCLES {
+                segments(&k.t, MIN_CYCLES)
+            } else {
+                of_x.clone()
+            };
+            let speeds = match &k.u {
+                Some(u) => {
+                    let rms = (u.iter().map(|v| v * v).sum::<f64>() / u.len().max(1) as f64).sqrt();
+                    cycles_from_x(&k.t, u, 0.1 * rms)?
+                }
+                None => of_x,
+            };
+            drive_omega(&k.t, &speeds, &mut cycles);
+            cycles
+        }
     })
+}
+
+/// Give each cycle the ω of the `speeds` cycle (of the measured drive `u`, else of x) around
+/// its middle, or the nearest one: equal stretches stand in for too few cycles and x's own
+/// crossings beat near resonance, and their 2π/duration read as speeds the drive never
+/// reached (ω 10.05 rad/s on a chirp ending at 9.42).
+fn drive_omega(
+    t: &[f64],
+    speeds: &[stf_core::regimes::Cycle],
+    cycles: &mut [stf_core::regimes::Cycle],
+) {
+    for c in cycles.iter_mut() {
+        let nearest = speeds.iter().min_by(|a, b| {
+            let d = |s: &stf_core::regimes::Cycle| {
+                let (lo, hi) = (t[s.start], t[s.end.min(t.len() - 1)]);
+                (lo - c.t_mid).max(c.t_mid - hi).max(0.0)
+            };
+            d(a).total_cmp(&d(b))
+        });
+        if let Some(s) = nearest {
+            c.omega = s.omega;
+        }
+    }
 }
 
 /// The fewest cycles of x a record is scored by; fewer, and equal stretches stand in.
@@ -364,7 +400,12 @@ pub fn fit_model(
     configured: Option<&ConfiguredModel>,
     progress: &indicatif::ProgressBar,
 ) -> Result<ModelFit> {
-    let observer = |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p));
+    let (unit, scale) = match data.level {
+        FitLevel::Force => ("N", 1.0),
+        FitLevel::Trajectory => ("mm", 1e3),
+    };
+    let observer =
+        |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     match data.level {
         FitLevel::Force => fit_force(exp, data, configured, label, &observer),
@@ -514,6 +555,12 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             })
             .collect::<Result<_>>()?
     };
+    let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
+    overall.set_message(crate::progress::jobs_message(0, configured.len(), 0.0));
+    let (started, done) = (
+        std::time::Instant::now(),
+        std::sync::atomic::AtomicUsize::new(0),
+    );
     let bars: Vec<_> = configured
         .iter()
         .map(|c| progress.job(c.as_ref().map_or("oscillator", |c| c.model.name())))
@@ -524,6 +571,9 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .map(|(c, bar)| {
             let r = fit_model(exp, data, c.as_ref(), bar);
             bar.finish_and_clear();
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            let elapsed = started.elapsed().as_secs_f64();
+            overall.set_message(crate::progress::jobs_message(n, configured.len(), elapsed));
             if r.is_ok() {
                 let name = c.as_ref().map_or("the oscillator", |c| c.model.name());
                 crate::interrupt::finished_step(format!("the fit of `{name}`"));
@@ -531,6 +581,7 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             r
         })
         .collect::<Result<_>>()?;
+    overall.finish_and_clear();
     let names: Vec<String> = fits.iter().map(|f| f.label.replace(' ', "")).collect();
     for (i, f) in fits.iter_mut().enumerate() {
         let same = names[..i].iter().filter(|n| **n == names[i]).count();

@@ -43,9 +43,12 @@ pub fn prepare_dir(dir: &Path, force: bool) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
 }
 
-/// Serialize `value` as pretty JSON into `path`, atomically.
+/// Serialize `value` as pretty JSON into `path`, atomically, numbers with the digits they
+/// carry ([`crate::digits`]).
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)? + "\n";
+    let mut value = value.clone();
+    crate::digits::tidy_json(&mut value);
+    let text = serde_json::to_string_pretty(&value)? + "\n";
     write_atomic(path, text.as_bytes())
 }
 
@@ -55,7 +58,10 @@ pub fn write_columns(path: &Path, names: &[&str], columns: &[&[f64]]) -> Result<
     let mut text = names.join(",");
     text.push('\n');
     for i in 0..n {
-        let row: Vec<String> = columns.iter().map(|c| format!("{}", c[i])).collect();
+        let row: Vec<String> = columns
+            .iter()
+            .map(|c| crate::digits::carried(c[i]).to_string())
+            .collect();
         text.push_str(&row.join(","));
         text.push('\n');
     }

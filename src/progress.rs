@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stf_core::discovery::{DiscoveryEvent, Observer};
-use stf_core::fit::FitProgress;
+use stf_core::fit::{FitProgress, Stage};
 
 /// A set of spinners, one per running job.
 pub struct Progress {
@@ -43,12 +43,34 @@ impl Progress {
     }
 }
 
-/// The message a fit's progress shows.
-pub fn fit_message(p: &FitProgress) -> String {
-    format!(
-        "{:?}: {} evaluations, best cost {:.4e}",
-        p.stage, p.evaluations, p.best_cost
-    )
+/// The message a fit's progress shows: what it is doing, in words, how many times the model
+/// was evaluated (simulated, at trajectory level) and the best RMS residual so far, in `unit`
+/// (`scale` from SI: the cost is a mean square in N² or m²).
+pub fn fit_message(p: &FitProgress, unit: &str, scale: f64) -> String {
+    let doing = match p.stage {
+        Stage::ParticleSwarm => "searching the parameter box",
+        Stage::NelderMead | Stage::LevenbergMarquardt => "refining the best point",
+        Stage::Errors => "estimating the standard errors",
+    };
+    let rms = p.best_cost.sqrt() * scale;
+    if rms.is_finite() {
+        format!(
+            "{doing} · {} evaluations · best RMS {rms:.4} {unit}",
+            p.evaluations
+        )
+    } else {
+        format!("{doing} · {} evaluations", p.evaluations)
+    }
+}
+
+/// The overall line of several jobs running together: how many are done, and the time left
+/// from the mean time of those done so far (`None` before the first is done).
+pub fn jobs_message(done: usize, of: usize, elapsed_s: f64) -> String {
+    let left = (done > 0 && done < of).then(|| {
+        let each = elapsed_s / done as f64;
+        format!(" · ~{:.0} s left", each * (of - done) as f64)
+    });
+    format!("{done} of {of} done{}", left.unwrap_or_default())
 }
 
 /// The live display of a discovery run on `bar`: the step, the candidate being fitted (i of
@@ -120,4 +142,25 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
             }
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_speak_of_the_work_not_the_solver() {
+        let p = FitProgress {
+            stage: Stage::LevenbergMarquardt,
+            evaluations: 42,
+            best_cost: 4e-4,
+        };
+        assert_eq!(
+            fit_message(&p, "N", 1.0),
+            "refining the best point · 42 evaluations · best RMS 0.0200 N"
+        );
+        assert_eq!(jobs_message(0, 4, 1.0), "0 of 4 done");
+        assert_eq!(jobs_message(2, 4, 6.0), "2 of 4 done · ~6 s left");
+        assert_eq!(jobs_message(4, 4, 9.0), "4 of 4 done");
+    }
 }

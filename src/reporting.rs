@@ -13,9 +13,9 @@ use stf_core::fit::{CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::report::{
-    frequency_response, hysteresis, measured_vs_fitted, measured_vs_model, time_history,
-    write_html, write_markdown, FigureRef, FrfCurve, Motion, Report, Section, Smoothing, Table,
-    DISPLACEMENT_VALIDATION_MM, STF_FORCE_VALIDATION,
+    frequency_response, hysteresis, measured_vs_model, time_history, write_html, write_markdown,
+    FigureRef, FrfCurve, Motion, RegimeChange, Report, Section, Smoothing, Table, DISPLACEMENT_MM,
+    DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
 };
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
@@ -50,12 +50,13 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
             th,
             "Displacement, velocity and acceleration against the STF force; extrema of F_STF marked.",
         ));
+        let mm = |s: &[f64]| s.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
         for (name, label, series) in [
-            ("hysteresis_x", "displacement x, m", &k.x),
-            ("hysteresis_v", "velocity v, m/s", &k.v),
-            ("hysteresis_a", "acceleration a, m/s²", &k.a),
+            ("hysteresis_x", "displacement x, mm", mm(&k.x)),
+            ("hysteresis_v", "velocity v, mm/s", mm(&k.v)),
+            ("hysteresis_a", "acceleration a, m/s²", k.a.clone()),
         ] {
-            let fig = hysteresis(&dir, name, (label, series), f, &k.t)?;
+            let fig = hysteresis(&dir, name, (label, &series), f, &k.t)?;
             s.figures.push(FigureRef::new(
                 fig,
                 format!("Hysteresis loop of F_STF against {label}, coloured by time."),
@@ -134,16 +135,23 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
             .iter()
             .flat_map(|f| f.warnings.iter().map(move |w| format!("{}: {w}", f.label)))
             .collect();
-        let fitted: Vec<(&str, &[f64])> = fits
+        let scaled = |s: &[f64]| s.iter().map(|v| v * scale).collect::<Vec<f64>>();
+        let fitted: Vec<(&str, Vec<f64>)> = fits
             .iter()
-            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+            .map(|f| (f.label.as_str(), scaled(&f.fitted)))
             .collect();
-        let fig = measured_vs_fitted(
+        let curves: Vec<(&str, &[f64])> = fitted.iter().map(|(l, v)| (*l, v.as_slice())).collect();
+        let quantity = match data.level {
+            FitLevel::Force => STF_FORCE,
+            FitLevel::Trajectory => DISPLACEMENT_MM,
+        };
+        let fig = measured_vs_model(
             &dir,
             "measured_vs_fitted",
+            quantity,
             &data.record.t,
-            data.target(),
-            &fitted,
+            &scaled(data.target()),
+            &curves,
         )?;
         s.figures.push(FigureRef::new(
             fig,
@@ -311,16 +319,30 @@ fn warning_rules(fits: &[ModelFit]) -> String {
 }
 
 /// A section with the frequency response (local maxima of x against ω) of several runs.
-pub fn frequency_section(curves: &[FrfCurve], out: &Path) -> Result<Section> {
+/// `changes` are the record's changes of regime (pre-resonance → resonance, resonance →
+/// post-resonance), shaded with their uncertainty.
+pub fn frequency_section(
+    curves: &[FrfCurve],
+    changes: [Option<RegimeChange>; 2],
+    out: &Path,
+) -> Result<Section> {
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut s = Section::new("Frequency response");
     s.paragraphs.push(
         "Local maxima of the displacement against the rotor speed, with the smoothed trend \
-         (outliers replaced by the mean of their neighbours, then a moving average)."
+         (outliers replaced by the mean of their neighbours, then a moving average). The \
+         resonance regime of the record is shaded, each change of regime's uncertainty darker; \
+         the oscillator without STF is the dashed black line."
             .into(),
     );
-    let fig = frequency_response(&dir, "frequency_response", curves, &Smoothing::default())?;
+    let fig = frequency_response(
+        &dir,
+        "frequency_response",
+        curves,
+        changes,
+        &Smoothing::default(),
+    )?;
     s.figures.push(FigureRef::new(
         fig,
         "Frequency response of the record and of the oscillator with each fitted model.",

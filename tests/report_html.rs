@@ -1,11 +1,15 @@
 //! `report.html` in a real browser: a small report with two figures and a table is written,
+//! and every bundled example's report as its command writes it;
 //! then opened in headless Chromium, which must load it with no script error and lay out every
 //! figure with a non-zero size. Chromium comes from Debian's `chromium` package (`.ci/run`
-//! installs it); when it is missing the test fails, unless `STF_SKIP_BROWSER=1` is set.
+//! installs it and sets `STF_LAB_REQUIRE_BROWSER=1`, so there a missing browser fails the
+//! test); elsewhere, with no browser on PATH, the browser check is skipped and says so, so
+//! the README's test command passes on a fresh machine.
 //!
 //! Set `STF_REPORT_TEST_OUT=DIR` to keep the report, its figures and the browser's screenshot
 //! in DIR for a look.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -19,6 +23,25 @@ fn find_chromium() -> Option<PathBuf> {
     std::env::split_paths(&path)
         .flat_map(|dir| ["chromium", "chromium-browser"].map(|name| dir.join(name)))
         .find(|p| p.is_file())
+}
+
+/// Chromium, or `None` (the browser check skipped, and said on stderr) when there is none on
+/// PATH — a failure instead when `STF_LAB_REQUIRE_BROWSER=1` (CI).
+fn browser_or_skip() -> Option<PathBuf> {
+    let found = find_chromium();
+    if found.is_none() {
+        let how = "install Debian's package (apt-get install -y chromium), as .ci/run does";
+        if std::env::var("STF_LAB_REQUIRE_BROWSER").as_deref() == Ok("1") {
+            panic!("chromium not found on PATH and STF_LAB_REQUIRE_BROWSER=1: {how}");
+        }
+        // Straight to stderr, past the test harness's capture, so `cargo test` shows it.
+        let _ = writeln!(
+            std::io::stderr(),
+            "chromium not found on PATH: the report's browser check is SKIPPED ({how}; \
+             STF_LAB_REQUIRE_BROWSER=1 makes a missing browser a failure)"
+        );
+    }
+    found
 }
 
 /// Run Chromium headless on `page` with the extra `args`; returns stdout. Output goes to files
@@ -71,6 +94,38 @@ fn run_chromium(chromium: &Path, page: &Path, args: &[String]) -> String {
         std::fs::read_to_string(&stderr_path).unwrap_or_default()
     );
     std::fs::read_to_string(&stdout_path).unwrap()
+}
+
+/// The page's own layout check (written by its script into `#layout-check`): no script
+/// error, `figures` figures, each laid out with a non-zero size.
+fn check_layout(dom: &str, figures: usize) {
+    let check = dom
+        .split("<pre id=\"layout-check\" hidden=\"\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
+    assert!(!check.contains("error:"), "page errors:\n{check}");
+    assert!(
+        check.contains(&format!("figures {figures}")),
+        "layout check:\n{check}"
+    );
+    let lines: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
+    assert_eq!(lines.len(), figures, "{check}");
+    for line in lines {
+        // "figure 0 img 1000x1000 natural 1000x1000"
+        let sizes: Vec<(u32, u32)> = line
+            .split_whitespace()
+            .filter(|w| w.contains('x') && w.chars().next().is_some_and(|c| c.is_ascii_digit()))
+            .map(|w| {
+                let (a, b) = w.split_once('x').unwrap();
+                (a.parse().unwrap(), b.parse().unwrap())
+            })
+            .collect();
+        assert_eq!(sizes.len(), 2, "{line}");
+        for (w, h) in sizes {
+            assert!(w > 0 && h > 0, "a figure has zero size: {line}");
+        }
+    }
 }
 
 fn build_report(dir: &Path) -> PathBuf {
@@ -144,42 +199,12 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("](figures/time_history.png)"), "{md}");
 
-    let Some(chromium) = find_chromium() else {
-        if std::env::var("STF_SKIP_BROWSER").as_deref() == Ok("1") {
-            eprintln!("chromium not found; browser check skipped (STF_SKIP_BROWSER=1)");
-            return;
-        }
-        panic!(
-            "chromium not found on PATH: install Debian's package \
-             (apt-get install -y chromium), or set STF_SKIP_BROWSER=1 to skip this check"
-        );
+    let Some(chromium) = browser_or_skip() else {
+        return;
     };
 
     let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
-    let check = dom
-        .split("<pre id=\"layout-check\" hidden=\"\">")
-        .nth(1)
-        .and_then(|rest| rest.split("</pre>").next())
-        .unwrap_or_else(|| panic!("no layout-check in the DOM:\n{dom}"));
-    assert!(!check.contains("error:"), "page errors:\n{check}");
-    assert!(check.contains("figures 2"), "layout check:\n{check}");
-    let figures: Vec<&str> = check.lines().filter(|l| l.starts_with("figure ")).collect();
-    assert_eq!(figures.len(), 2, "{check}");
-    for line in figures {
-        // "figure 0 img 1000x1000 natural 1000x1000"
-        let sizes: Vec<(u32, u32)> = line
-            .split_whitespace()
-            .filter(|w| w.contains('x') && w.chars().next().is_some_and(|c| c.is_ascii_digit()))
-            .map(|w| {
-                let (a, b) = w.split_once('x').unwrap();
-                (a.parse().unwrap(), b.parse().unwrap())
-            })
-            .collect();
-        assert_eq!(sizes.len(), 2, "{line}");
-        for (w, h) in sizes {
-            assert!(w > 0 && h > 0, "a figure has zero size: {line}");
-        }
-    }
+    check_layout(&dom, 2);
 
     let shot = dir.join("screenshot.png");
     run_chromium(
@@ -189,4 +214,51 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     );
     let png = std::fs::read(&shot).unwrap();
     assert!(png.len() > 10_000, "screenshot is {} bytes", png.len());
+}
+
+/// Every bundled example's report, as its command writes it, loads in the browser with every
+/// figure laid out; with `STF_REPORT_TEST_OUT=DIR` each page's screenshot is kept in DIR.
+#[test]
+fn every_bundled_report_lays_out_every_figure_in_headless_chromium() {
+    let kept = std::env::var_os("STF_REPORT_TEST_OUT").map(PathBuf::from);
+    let Some(chromium) = browser_or_skip() else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (command, example) in [
+        ("fit", "power_law_fit"),
+        ("fit", "paper_identification"),
+        ("compare", "jamming_compare"),
+        ("discover", "discovery"),
+        ("discover", "trajectory_discovery"),
+    ] {
+        let out = tmp.path().join(example);
+        let run = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
+            .args([command, "--quiet", "--out"])
+            .arg(&out)
+            .arg(root.join("experiments").join(format!("{example}.toml")))
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let page = out.join("report.html").canonicalize().unwrap();
+        let html = std::fs::read_to_string(&page).unwrap();
+        let figures = html.matches("<img src=\"data:image/png;base64,").count();
+        assert!(figures >= 2, "{example}: {figures} figures");
+        let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
+        check_layout(&dom, figures);
+        if let Some(dir) = &kept {
+            std::fs::create_dir_all(dir).unwrap();
+            let shot = dir.join(format!("{example}.png"));
+            run_chromium(
+                &chromium,
+                &page,
+                &[format!("--screenshot={}", shot.display())],
+            );
+        }
+    }
 }

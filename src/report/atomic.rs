@@ -42,17 +42,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
     })
 }
 
-/// Move a finished temporary file into place.
-pub fn commit(tmp: &Path, path: &Path) -> Result<(), ReportError> {
-    std::fs::rename(tmp, path).map_err(|source| {
-        let _ = std::fs::remove_file(tmp);
-        ReportError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
-}
-
 /// Create `dir` (and its parents) if missing.
 pub fn ensure_dir(dir: &Path) -> Result<(), ReportError> {
     if dir.as_os_str().is_empty() {

@@ -1,5 +1,5 @@
-//! Rendering a figure to its three files: the same drawing code runs on the SVG and the PNG
-//! backend, and the CSV holds the columns the drawing used. Also the text styles shared by all
+//! Rendering a figure to its three files: the drawing code runs on the SVG backend, the PNG is
+//! that SVG rasterised ([`super::raster`]), and the CSV holds the columns the drawing used. Also the text styles shared by all
 //! figures, so they look alike.
 
 use std::path::{Path, PathBuf};
@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::atomic::{commit, ensure_dir, temporary_sibling, write_atomic};
+use super::atomic::{ensure_dir, write_atomic};
 use super::font::{ensure_registered, FAMILY};
+use super::raster::svg_to_png;
 use super::series_csv::{write_csv, Column};
 use super::ReportError;
 
@@ -94,15 +95,11 @@ pub fn render(
     })?;
     write_atomic(&files.svg, svg.as_bytes())?;
 
-    let tmp = temporary_sibling(&files.png);
-    if let Err(message) = draw_on(BitMapBackend::new(&tmp, size), plot) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(ReportError::Plot {
-            path: files.png.clone(),
-            message,
-        });
-    }
-    commit(&tmp, &files.png)?;
+    let png = svg_to_png(&svg).map_err(|message| ReportError::Plot {
+        path: files.png.clone(),
+        message,
+    })?;
+    write_atomic(&files.png, &png)?;
 
     write_csv(&files.csv, columns)?;
     Ok(files)
@@ -128,4 +125,37 @@ pub fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
         .filter(|(a, b)| a.is_finite() && b.is_finite())
         .map(|(a, b)| (*a, *b))
         .collect()
+}
+
+/// A tick label for `v` on an axis spanning `span`: as many decimals as ticks 1/200 of
+/// the span apart need, trailing zeros dropped, and never `-0` (a tick at zero computed as
+/// −1e-17 read "-0.0").
+pub fn tick_label(v: f64, span: f64) -> String {
+    let step = (span.abs() / 200.0).max(f64::MIN_POSITIVE);
+    let decimals = (-step.log10().floor()).clamp(0.0, 12.0) as usize;
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_label;
+
+    #[test]
+    fn tick_labels_have_the_digits_the_axis_needs_and_no_negative_zero() {
+        assert_eq!(tick_label(-1e-17, 0.8), "0");
+        assert_eq!(tick_label(-0.0, 60.0), "0");
+        assert_eq!(tick_label(0.30000000000000004, 0.8), "0.3");
+        assert_eq!(tick_label(0.25, 0.8), "0.25");
+        assert_eq!(tick_label(-30.0, 66.0), "-30");
+        assert_eq!(tick_label(12.5, 66.0), "12.5");
+        assert_eq!(tick_label(150.0, 300.0), "150");
+        assert_eq!(tick_label(0.0015, 0.01), "0.0015");
+    }
 }

@@ -11,7 +11,7 @@ use super::ReportError;
 /// The family name figures use for all text.
 pub const FAMILY: &str = "sans-serif";
 
-static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+pub(super) static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 static REGISTERED: OnceLock<bool> = OnceLock::new();
 
 /// Register the embedded font (once per process); every figure calls this before drawing.

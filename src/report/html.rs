@@ -72,6 +72,26 @@ pub fn escape(text: &str) -> String {
     out
 }
 
+/// A paragraph's text as HTML: escaped, with `code` spans (backticks, as in the Markdown
+/// report) set in `<code>`; an unpaired backtick stays as it is.
+pub fn inline(text: &str) -> String {
+    let parts: Vec<&str> = text.split('`').collect();
+    if parts.len() % 2 == 0 {
+        return escape(text);
+    }
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                format!("<code>{}</code>", escape(part))
+            } else {
+                escape(part)
+            }
+        })
+        .collect()
+}
+
 /// Width and height from a PNG's header, if it is one.
 fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
     if bytes.len() < 24 || &bytes[..8] != b"\x89PNG\r\n\x1a\n" {
@@ -181,13 +201,13 @@ pub fn to_html(report: &Report) -> Result<String, ReportError> {
     );
     let _ = writeln!(out, "<h1>{}</h1>", escape(&report.title));
     for p in &report.intro {
-        let _ = writeln!(out, "<p>{}</p>", escape(p));
+        let _ = writeln!(out, "<p>{}</p>", inline(p));
     }
     let mut number = 0;
     for section in &report.sections {
         let _ = writeln!(out, "<section>\n<h2>{}</h2>", escape(&section.heading));
         for p in &section.paragraphs {
-            let _ = writeln!(out, "<p>{}</p>", escape(p));
+            let _ = writeln!(out, "<p>{}</p>", inline(p));
         }
         warnings_html(&mut out, &section.warnings);
         for table in &section.tables {
@@ -221,6 +241,12 @@ pub fn write_html(report: &Report, path: &Path) -> Result<(), ReportError> {
 mod tests {
     use super::*;
     use crate::report::Section;
+
+    #[test]
+    fn backticks_become_code_and_the_rest_is_escaped() {
+        assert_eq!(inline("a `b<c` d"), "a <code>b&lt;c</code> d");
+        assert_eq!(inline("odd ` tick"), "odd ` tick");
+    }
 
     #[test]
     fn escapes_markup_and_right_aligns_numbers() {

@@ -9,7 +9,8 @@ use plotters::prelude::*;
 use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, msg, render, same_length, tick_style, title_style, Draw, FigureFiles, SIZE,
+    axis_desc_style, msg, render, same_length, tick_label, tick_style, title_style, Draw,
+    FigureFiles, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -69,12 +70,15 @@ impl Draw for HysteresisPlot {
             .margin(10)
             .x_label_area_size(50)
             .y_label_area_size(90)
-            .build_cartesian_2d(x_range, f_range)
+            .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
+        let (xs, fs) = (x_range.end - x_range.start, f_range.end - f_range.start);
         chart
             .configure_mesh()
             .x_desc(self.label.as_str())
             .y_desc(F_LABEL)
+            .x_label_formatter(&|v| tick_label(*v, xs))
+            .y_label_formatter(&|v| tick_label(*v, fs))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0))
@@ -90,6 +94,7 @@ impl Draw for HysteresisPlot {
 
         // The colour bar: a narrow strip with the time axis on its right, aligned with the
         // plotting area of the main chart (same top margin and bottom label area).
+        let t_span = t_range.end - t_range.start;
         let mut colour_bar = ChartBuilder::on(&bar)
             .margin(10)
             .margin_left(15)
@@ -104,6 +109,7 @@ impl Draw for HysteresisPlot {
             .disable_y_mesh()
             .disable_x_axis()
             .y_desc(T_LABEL)
+            .y_label_formatter(&|v| tick_label(*v, t_span))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .draw()

@@ -4,14 +4,16 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_style, title_style, Draw, FigureFiles, SIZE,
+    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -93,6 +95,47 @@ struct MeasuredVsFittedPlot {
     fitted: Vec<(String, Vec<f64>)>,
 }
 
+impl MeasuredVsFittedPlot {
+    /// A record of hundreds of cycles: the measured envelope as a grey band, each model's as
+    /// its upper and lower edge (the cycles themselves are in the regime windows).
+    fn draw_envelopes<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> Result<(), String> {
+        let buckets = buckets_for(&self.measured);
+        let measured = envelope(&self.t, &self.measured, buckets);
+        chart
+            .draw_series([Polygon::new(band(&measured), MEASURED_GREY.filled())])
+            .map_err(msg)?
+            .label(format!("{} (envelope)", self.quantity.band))
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
+            });
+        for (i, (label, f)) in self.fitted.iter().enumerate() {
+            let colour = series_colour(i);
+            let edges = envelope(&self.t, f, buckets);
+            let upper = edges.iter().map(|&(t, _, hi)| (t, hi));
+            let lower = edges.iter().map(|&(t, lo, _)| (t, lo));
+            chart
+                .draw_series(LineSeries::new(upper, colour.stroke_width(2)))
+                .map_err(msg)?
+                .label(format!("{label} (envelope)"))
+                .legend(legend_line(colour));
+            chart
+                .draw_series(LineSeries::new(lower, colour.stroke_width(2)))
+                .map_err(msg)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(legend_style())
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(msg)
+    }
+}
+
 impl Draw for MeasuredVsFittedPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let no_data = || "measured vs fitted: no finite value".to_string();
@@ -111,17 +154,23 @@ impl Draw for MeasuredVsFittedPlot {
             .margin_right(30)
             .x_label_area_size(50)
             .y_label_area_size(90)
-            .build_cartesian_2d(t_range, f_range)
+            .build_cartesian_2d(t_range.clone(), f_range.clone())
             .map_err(msg)?;
+        let (ts, fs) = (t_range.end - t_range.start, f_range.end - f_range.start);
         chart
             .configure_mesh()
             .x_desc("time t, s")
             .y_desc(self.quantity.label)
+            .x_label_formatter(&|v| tick_label(*v, ts))
+            .y_label_formatter(&|v| tick_label(*v, fs))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(msg)?;
+        if dense(&self.measured) {
+            return self.draw_envelopes(&mut chart);
+        }
         chart
             .draw_series(LineSeries::new(
                 finite_points(&self.t, &self.measured),

@@ -8,7 +8,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, legend_style, msg, render, tick_style, title_style, Draw, FigureFiles, SIZE,
+    axis_desc_style, legend_style, msg, render, tick_label, tick_style, title_style, Draw,
+    FigureFiles, SIZE,
 };
 use super::series_csv::Column;
 use super::ReportError;
@@ -54,6 +55,7 @@ impl Draw for RegimeErrorPlot {
             })
             .disable_x_mesh()
             .y_desc(self.y_label.as_str())
+            .y_label_formatter(&|v| tick_label(*v, top))
             .x_desc("regime")
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())

@@ -51,8 +51,8 @@ pub fn damped_sine(n: usize, duration: f64) -> Signals {
     Signals { t, x, v, a, f }
 }
 
-/// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works) and the
-/// PNG has the expected size; returns the CSV's columns.
+/// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works), the
+/// PNG has the expected size and no coloured mark outside the SVG's coloured shapes; returns the CSV's columns.
 #[cfg(test)]
 pub fn assert_rendered(
     files: &super::FigureFiles,
@@ -70,6 +70,13 @@ pub fn assert_rendered(
     let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
     let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
     assert_eq!((w, h), size);
+    let stray = super::raster::stray_coloured_pixels(&svg, &png, 3.0);
+    assert_eq!(
+        stray,
+        Ok(0),
+        "{} has coloured marks outside its shapes",
+        files.png.display()
+    );
     let dir = files.png.parent().unwrap();
     let leftovers: Vec<_> = std::fs::read_dir(dir)
         .unwrap()

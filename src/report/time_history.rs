@@ -4,15 +4,18 @@
 
 use std::path::Path;
 
+use plotters::chart::DualCoordChartContext;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
+use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
+    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -57,11 +60,20 @@ impl TimeHistoryPlot {
             .x_label_area_size(if index == 2 { 48 } else { 28 })
             .y_label_area_size(90)
             .right_y_label_area_size(80)
-            .build_cartesian_2d(t_range.clone(), y_range)
+            .build_cartesian_2d(t_range.clone(), y_range.clone())
             .map_err(msg)?
-            .set_secondary_coord(t_range, f_range);
+            .set_secondary_coord(t_range.clone(), f_range.clone());
+        let (ts, ys, fs) = (
+            t_range.end - t_range.start,
+            y_range.end - y_range.start,
+            f_range.end - f_range.start,
+        );
+        let x_fmt = |v: &f64| tick_label(*v, ts);
+        let y_fmt = |v: &f64| tick_label(*v, ys);
         let mut mesh = chart.configure_mesh();
         mesh.y_desc(*label)
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt)
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .light_line_style(WHITE.mix(0.0));
@@ -72,29 +84,16 @@ impl TimeHistoryPlot {
         chart
             .configure_secondary_axes()
             .y_desc(F_LABEL)
+            .y_label_formatter(&|v| tick_label(*v, fs))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
             .draw()
             .map_err(msg)?;
 
-        let c_motion = series_colour(0);
-        let c_force = series_colour(1);
-        chart
-            .draw_series(LineSeries::new(
-                finite_points(&self.t, y),
-                c_motion.stroke_width(2),
-            ))
-            .map_err(msg)?
-            .label(*label)
-            .legend(legend_line(c_motion));
-        chart
-            .draw_secondary_series(LineSeries::new(
-                finite_points(&self.t, &self.f),
-                c_force.stroke_width(1),
-            ))
-            .map_err(msg)?
-            .label(F_LABEL)
-            .legend(legend_line(c_force));
+        self.draw_signals(&mut chart, label, y)?;
+        if self.marks.len() > MAX_MARKS {
+            return self.legend(&mut chart);
+        }
         chart
             .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
                 let style = match kind {
@@ -106,6 +105,64 @@ impl TimeHistoryPlot {
             .map_err(msg)?
             .label("F_STF maxima (●) and minima (○)")
             .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
+        self.legend(&mut chart)
+    }
+
+    /// The motion `y` (primary axis) and the force (secondary): lines, or for hundreds of
+    /// cycles each signal's envelope (the cycles are in the regime windows).
+    fn draw_signals<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut DualCoordChartContext<
+            'a,
+            DB,
+            Cartesian2d<RangedCoordf64, RangedCoordf64>,
+            Cartesian2d<RangedCoordf64, RangedCoordf64>,
+        >,
+        label: &str,
+        y: &[f64],
+    ) -> Result<(), String> {
+        let c_motion = series_colour(0);
+        let c_force = series_colour(1);
+        if dense(y) || dense(&self.f) {
+            // Hundreds of cycles: each signal's envelope, the cycles are in the windows.
+            let buckets = buckets_for(y).min(buckets_for(&self.f));
+            let y_band = band(&envelope(&self.t, y, buckets));
+            chart
+                .draw_series([Polygon::new(y_band, c_motion.mix(0.45).filled())])
+                .map_err(msg)?
+                .label(format!("{label} (envelope)"))
+                .legend(legend_line(c_motion));
+            let f_band = band(&envelope(&self.t, &self.f, buckets));
+            chart
+                .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
+                .map_err(msg)?
+                .label(format!("{F_LABEL} (envelope)"))
+                .legend(legend_line(c_force));
+        } else {
+            chart
+                .draw_series(LineSeries::new(
+                    finite_points(&self.t, y),
+                    c_motion.stroke_width(2),
+                ))
+                .map_err(msg)?
+                .label(label)
+                .legend(legend_line(c_motion));
+            chart
+                .draw_secondary_series(LineSeries::new(
+                    finite_points(&self.t, &self.f),
+                    c_force.stroke_width(1),
+                ))
+                .map_err(msg)?
+                .label(F_LABEL)
+                .legend(legend_line(c_force));
+        }
+        Ok(())
+    }
+
+    fn legend<'a, DB: DrawingBackend + 'a>(
+        &self,
+        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> Result<(), String> {
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
@@ -116,6 +173,9 @@ impl TimeHistoryPlot {
             .map_err(msg)
     }
 }
+
+/// More extrema than this and they are not marked: they would cover the plot.
+const MAX_MARKS: usize = 80;
 
 impl Draw for TimeHistoryPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
@@ -129,8 +189,8 @@ impl Draw for TimeHistoryPlot {
     }
 }
 
-/// Draw x, v and a against F_STF over time (three panels, F_STF on the right axis, its
-/// extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
+/// Draw x (in mm), v (mm/s) and a (m/s²) against F_STF over time (three panels, F_STF on
+/// the right axis, its extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
 /// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
 pub fn time_history(
     out_dir: &Path,
@@ -160,8 +220,8 @@ pub fn time_history(
     let plot = TimeHistoryPlot {
         t: pick(t, &keep),
         panels: [
-            ("displacement x, m", pick(x, &keep)),
-            ("velocity v, m/s", pick(v, &keep)),
+            ("displacement x, mm", milli(&pick(x, &keep))),
+            ("velocity v, mm/s", milli(&pick(v, &keep))),
             ("acceleration a, m/s²", pick(a, &keep)),
         ],
         f: pick(f_stf, &keep),
@@ -176,8 +236,8 @@ pub fn time_history(
     };
     let columns = vec![
         Column::new("t, s", plot.t.clone()),
-        Column::new("x, m", plot.panels[0].1.clone()),
-        Column::new("v, m/s", plot.panels[1].1.clone()),
+        Column::new("x, mm", plot.panels[0].1.clone()),
+        Column::new("v, mm/s", plot.panels[1].1.clone()),
         Column::new("a, m/s²", plot.panels[2].1.clone()),
         Column::new(F_LABEL, plot.f.clone()),
         Column::new(
@@ -194,6 +254,11 @@ pub fn time_history(
         ),
     ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
+}
+
+/// Metres (per second) in millimetres (per second), the unit the rig's motion is read in.
+fn milli(values: &[f64]) -> Vec<f64> {
+    values.iter().map(|v| v * 1e3).collect()
 }
 
 #[cfg(test)]
@@ -215,7 +280,7 @@ mod tests {
         let files = time_history(dir.path(), "history", &motion, &s.f).unwrap();
         let cols = assert_rendered(&files, SIZE_TALL);
         let t = column(&cols, "t, s");
-        let x = column(&cols, "x, m");
+        let x = column(&cols, "x, mm");
         let f = column(&cols, "F_STF, N");
         assert!(t.len() < s.t.len() && t.len() <= MAX_POINTS_PER_LINE + 100);
         // Every plotted row is a sample of the record (the grid is uniform: index = t / dt).
@@ -223,11 +288,11 @@ mod tests {
         for (k, tk) in t.iter().enumerate() {
             let i = (tk / dt).round() as usize;
             assert_eq!(s.t[i], *tk);
-            assert_eq!(s.x[i], x[k]);
+            assert_eq!(s.x[i] * 1e3, x[k]);
             assert_eq!(s.f[i], f[k]);
         }
         let max = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
-        assert_eq!(max(x), max(&s.x));
+        assert_eq!(max(x), max(&s.x) * 1e3);
         assert_eq!(max(f), max(&s.f));
         // Two force peaks and two troughs per period of 0.5 s over 10 s, less the damped tail
         // lost in the noise: many extrema, alternating, and no more than the true count.

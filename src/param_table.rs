@@ -1,0 +1,112 @@
+//! The parameter table a paper's methods section quotes, written as `params.csv` beside
+//! `fit.json`: one row per fitted (or held) parameter with its model, value, standard error,
+//! unit and whether it ended on a bound. Rows are [`ParamRow`]s serialized by the csv crate;
+//! numbers carry their own digits ([`crate::digits`]).
+//!
+//! ```text
+//! model,parameter,value,std_error,unit,fixed,at_bound
+//! power_law,K,4.07392,0.0469,N·(s/m)^n,false,false
+//! ```
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use stf_core::fit::{FitResult, FitWarning};
+use stf_core::force_model::ForceModel;
+
+use crate::digits::carried;
+use crate::fitting::ModelFit;
+use crate::output::write_atomic;
+
+/// One row of the table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ParamRow {
+    /// The model's label (unique in the experiment), or the identification stage.
+    pub model: String,
+    /// The parameter's name as in `fit.json`.
+    pub parameter: String,
+    /// Fitted value (SI units).
+    pub value: f64,
+    /// Standard error; empty when the data do not determine it (or when held).
+    pub std_error: Option<f64>,
+    /// SI unit; empty for a dimensionless parameter.
+    pub unit: String,
+    /// Held at its value, not fitted.
+    pub fixed: bool,
+    /// The fit ended on one of its bounds (a `on_bound` warning).
+    pub at_bound: bool,
+}
+
+/// The unit of an oscillator parameter, an offset or an initial state.
+fn system_unit(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "m" => "kg",
+        "k" => "N/m",
+        "c" => "N·s/m",
+        "T" | "delta_T" | "f_off" | "u_off" => "N",
+        "F0" => "kg·m",
+        "eta" => "s/m",
+        "phi_off" => "rad",
+        "x_off" | "x0" => "m",
+        "v0" => "m/s",
+        _ => return None,
+    })
+}
+
+/// The rows of one fit: `result`'s parameters, units from `model`'s specs or the oscillator's.
+pub fn rows_of(
+    label: &str,
+    result: &FitResult,
+    model: Option<&dyn ForceModel>,
+    warnings: &[FitWarning],
+) -> Vec<ParamRow> {
+    result
+        .params
+        .iter()
+        .map(|p| {
+            let spec_unit = model
+                .and_then(|m| m.params().iter().find(|s| s.name == p.name))
+                .map(|s| s.unit.clone());
+            let unit = spec_unit
+                .or_else(|| system_unit(&p.name).map(str::to_string))
+                .unwrap_or_default();
+            let at_bound = warnings
+                .iter()
+                .any(|w| matches!(w, FitWarning::OnBound { param, .. } if *param == p.name));
+            ParamRow {
+                model: label.to_string(),
+                parameter: p.name.clone(),
+                value: carried(p.value),
+                std_error: (!p.fixed && p.std_error.is_finite()).then(|| carried(p.std_error)),
+                unit,
+                fixed: p.fixed,
+                at_bound,
+            }
+        })
+        .collect()
+}
+
+/// The rows of every model fit, in order.
+pub fn rows_of_fits(fits: &[ModelFit]) -> Vec<ParamRow> {
+    fits.iter()
+        .flat_map(|f| {
+            let model = f.configured.as_ref().map(|c| c.model.as_ref());
+            rows_of(&f.label, &f.result, model, &f.warnings)
+        })
+        .collect()
+}
+
+/// Write `rows` as CSV to `path`, atomically.
+pub fn write_params_csv(path: &Path, rows: &[ParamRow]) -> Result<()> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        writer
+            .serialize(row)
+            .with_context(|| format!("cannot write a row of {}", path.display()))?;
+    }
+    let bytes = writer
+        .into_inner()
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    write_atomic(path, &bytes)
+}

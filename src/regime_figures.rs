@@ -1,0 +1,189 @@
+//! The figures of a record regime by regime: a window of a few cycles in each regime
+//! (pre-resonance, resonance, post-resonance) with the loops F–x, F–v, F–a of every model over
+//! the measured ones ([`crate::report::regime_windows`]), and measured against fitted with the
+//! residual's distribution per regime ([`crate::report::parity`]). The regimes are the
+//! record's own (classified on its STF force, as `compare` does); a record without them (no
+//! rotor, no STF force to speak of) gets windows at its start, middle and end instead.
+
+use std::path::Path;
+
+use anyhow::Result;
+use stf_core::regimes::{classify, Cycle, Regime, Signals};
+
+use crate::experiment::Experiment;
+use crate::fitting::FitData;
+use crate::report::{
+    parity, regime_windows, FigureRef, ParityQuantity, RegimeWindow, SampleGroup, Section,
+    WindowSeries,
+};
+
+/// How many whole cycles a window shows.
+const CYCLES_PER_WINDOW: usize = 3;
+
+/// A named stretch of consecutive cycles `cycles[first..first + count]`.
+struct Stretch {
+    name: String,
+    first: usize,
+    count: usize,
+}
+
+/// The longest run of consecutive cycles labelled with each regime the record has; or, with
+/// no regimes, the whole record's start, middle and end thirds.
+fn stretches(cycles: &[Cycle], labels: Option<&[Regime]>) -> Vec<Stretch> {
+    let Some(labels) = labels else {
+        let third = cycles.len() / 3;
+        return ["start", "middle", "end"]
+            .iter()
+            .enumerate()
+            .filter(|_| third > 0)
+            .map(|(k, name)| Stretch {
+                name: name.to_string(),
+                first: k * third,
+                count: third,
+            })
+            .collect();
+    };
+    Regime::ALL
+        .iter()
+        .filter_map(|&r| {
+            let mut best: Option<(usize, usize)> = None;
+            let mut i = 0;
+            while i < labels.len() {
+                let j = (i..labels.len())
+                    .find(|&j| labels[j] != labels[i])
+                    .unwrap_or(labels.len());
+                if labels[i] == r && best.is_none_or(|(_, n)| j - i > n) {
+                    best = Some((i, j - i));
+                }
+                i = j;
+            }
+            best.map(|(first, count)| Stretch {
+                name: r.name().replace('_', "-"),
+                first,
+                count,
+            })
+        })
+        .collect()
+}
+
+/// The record's cycles and, when it has an STF force and a rotor, their regime labels.
+fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Option<Vec<Regime>>)> {
+    let k = &data.kinematics;
+    let cycles = crate::fitting::cycles_of(data)?;
+    let rotor = k.phi.is_some() || k.omega.is_some();
+    let labels = match (data.record.f_stf.as_deref(), rotor) {
+        (Some(f), true) => {
+            let sig = Signals {
+                t: &k.t,
+                x: &k.x,
+                v: &k.v,
+                a: &k.a,
+                f,
+            };
+            classify(&sig, cycles.clone(), &exp.regimes)
+                .ok()
+                .filter(|c| !c.no_stf)
+                .map(|c| c.labels)
+        }
+        _ => None,
+    };
+    Ok((cycles, labels))
+}
+
+/// [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch, named with their ω.
+fn windows_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<RegimeWindow> {
+    found
+        .iter()
+        .map(|s| {
+            let n = CYCLES_PER_WINDOW.min(s.count);
+            let first = s.first + (s.count - n) / 2;
+            let (a, b) = (&cycles[first], &cycles[first + n - 1]);
+            RegimeWindow {
+                name: format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega),
+                start: a.start,
+                end: b.end,
+            }
+        })
+        .collect()
+}
+
+/// Every sample of each stretch's cycles.
+fn groups_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<SampleGroup> {
+    found
+        .iter()
+        .map(|s| SampleGroup {
+            name: s.name.clone(),
+            samples: cycles[s.first..s.first + s.count]
+                .iter()
+                .flat_map(|c| c.start..c.end)
+                .collect(),
+        })
+        .collect()
+}
+
+/// The section of regime windows and parity plots for `models` (`(label, fitted STF force)`,
+/// N; none: the measured force alone), or `None` when the record has no STF force or too
+/// few cycles.
+pub fn regime_section(
+    exp: &Experiment,
+    data: &FitData,
+    models: &[(&str, &[f64])],
+    out: &Path,
+) -> Result<Option<Section>> {
+    let Some(f) = data.record.f_stf.as_deref() else {
+        return Ok(None);
+    };
+    let (cycles, labels) = labelled_cycles(exp, data)?;
+    let found = stretches(&cycles, labels.as_deref());
+    if found.is_empty() {
+        return Ok(None);
+    }
+    let dir = out.join("figures");
+    let k = &data.kinematics;
+    let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
+    let (x_mm, v_mm) = (mm(&k.x), mm(&k.v));
+    let windows = windows_of(&found, &cycles);
+    let series = WindowSeries {
+        t: &k.t,
+        x_mm: &x_mm,
+        v_mm: &v_mm,
+        a: &k.a,
+        f,
+        models,
+    };
+    let mut s = Section::new(if labels.is_some() {
+        "Regime by regime"
+    } else {
+        "Start, middle and end"
+    });
+    s.paragraphs.push(format!(
+        "{} whole cycles from the middle of the longest stretch of each {}, and every sample of \
+         it for measured against fitted.",
+        CYCLES_PER_WINDOW,
+        if labels.is_some() {
+            "regime of the record (classified on its STF force, as `compare` does)"
+        } else {
+            "third of the record (it has no regimes to classify: no rotor, or no STF force)"
+        }
+    ));
+    let fig = regime_windows(&dir, "regime_windows", &series, &windows)?;
+    s.figures.push(FigureRef::new(
+        fig,
+        "A few cycles of each regime: the STF force over time, and its loops against x, v and a; \
+         each model's force over the measured one (grey).",
+    ));
+    if !models.is_empty() {
+        let groups = groups_of(&found, &cycles);
+        let quantity = ParityQuantity {
+            label: "F_STF, N".into(),
+            noise_sigma: Some(stf_core::derivative::noise_estimate(f).sigma),
+        };
+        let fig = parity(&dir, "parity", &quantity, f, models, &groups)?;
+        s.figures.push(FigureRef::new(
+            fig,
+            "Measured against fitted STF force in each regime (on y = x where they agree), and \
+             the residual's distribution against the normal curve of the force noise.",
+        ));
+    }
+    Ok(Some(s))
+}

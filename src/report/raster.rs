@@ -1,0 +1,136 @@
+//! The PNG of a figure is its SVG rasterised by resvg, so the two files are one picture.
+//!
+//! plotters' bitmap backend joins the segments of a thick polyline with unlimited miters: where
+//! a loop or a noisy trace turns back on itself the join's offset lines meet far away, and the
+//! PNG showed long straight spikes across the plot (the SVG, stroked by the browser, was
+//! clean). resvg strokes with a miter limit and anti-aliases, and reads the same embedded font
+//! ([`super::font`]) the SVG names, so no system font is needed.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), String> {
+//! let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>"#;
+//! let png: Vec<u8> = stf_lab::report::svg_to_png(svg)?;
+//! # Ok(()) }
+//! ```
+
+use std::sync::{Arc, OnceLock};
+
+use resvg::{tiny_skia, usvg};
+
+use super::font::{DEJAVU_SANS, FAMILY};
+
+fn options() -> &'static usvg::Options<'static> {
+    static OPTIONS: OnceLock<usvg::Options<'static>> = OnceLock::new();
+    OPTIONS.get_or_init(|| {
+        let mut fonts = usvg::fontdb::Database::new();
+        fonts.load_font_data(DEJAVU_SANS.to_vec());
+        let family = fonts
+            .faces()
+            .next()
+            .and_then(|face| face.families.first().map(|(name, _)| name.clone()))
+            .unwrap_or_else(|| FAMILY.to_string());
+        fonts.set_sans_serif_family(family.clone());
+        usvg::Options {
+            font_family: family,
+            fontdb: Arc::new(fonts),
+            ..usvg::Options::default()
+        }
+    })
+}
+
+/// Rasterise an SVG document (at its own size, white where it draws nothing) to PNG bytes.
+pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
+    let tree = usvg::Tree::from_str(svg, options()).map_err(|e| e.to_string())?;
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or_else(|| format!("an empty image ({}×{})", size.width(), size.height()))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::identity(),
+        &mut pixmap.as_mut(),
+    );
+    pixmap.encode_png().map_err(|e| e.to_string())
+}
+
+/// How many strongly coloured pixels of `png` lie more than `margin` pixels outside every
+/// coloured shape of `svg` (each shape's stroked bounding box): stray marks such as the
+/// spikes the bitmap backend drew at sharp joins. Text and axes are black or grey, so they
+/// are not counted. A check for tests (a figure's PNG against its SVG).
+pub fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> Result<usize, String> {
+    let tree = usvg::Tree::from_str(svg, options()).map_err(|e| format!("SVG: {e}"))?;
+    let mut boxes = Vec::new();
+    collect_coloured_boxes(tree.root(), &mut boxes);
+    let image = tiny_skia::Pixmap::decode_png(png).map_err(|e| format!("PNG: {e}"))?;
+    let width = image.width() as usize;
+    Ok(image
+        .pixels()
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| {
+            let c = p.demultiply();
+            let (hi, lo) = (
+                c.red().max(c.green()).max(c.blue()),
+                c.red().min(c.green()).min(c.blue()),
+            );
+            hi - lo > 80
+        })
+        .filter(|(i, _)| {
+            let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
+            !boxes.iter().any(|b: &tiny_skia::Rect| {
+                x >= b.left() - margin
+                    && x <= b.right() + margin
+                    && y >= b.top() - margin
+                    && y <= b.bottom() + margin
+            })
+        })
+        .count())
+}
+
+fn collect_coloured_boxes(group: &usvg::Group, boxes: &mut Vec<tiny_skia::Rect>) {
+    let coloured = |paint: &usvg::Paint| match paint {
+        usvg::Paint::Color(c) => {
+            let (hi, lo) = (
+                c.red.max(c.green).max(c.blue),
+                c.red.min(c.green).min(c.blue),
+            );
+            hi - lo > 40
+        }
+        _ => true,
+    };
+    for node in group.children() {
+        match node {
+            usvg::Node::Group(g) => collect_coloured_boxes(g, boxes),
+            usvg::Node::Path(p) => {
+                let stroked = p.stroke().is_some_and(|s| coloured(s.paint()));
+                let filled = p.fill().is_some_and(|f| coloured(f.paint()));
+                if stroked || filled {
+                    boxes.push(p.abs_stroke_bounding_box());
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_noisy_thick_loop_leaves_no_marks_outside_its_shapes() {
+        // Sharp reversals with thick lines: where the bitmap backend drew its spikes.
+        let s = super::super::test_signals::damped_sine(6_000, 3.0);
+        let zigzag: Vec<f64> =
+            s.f.iter()
+                .enumerate()
+                .map(|(i, f)| f + if i % 2 == 0 { 0.05 } else { -0.05 })
+                .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files =
+            super::super::hysteresis(dir.path(), "zigzag", ("x, m", &s.x), &zigzag, &s.t).unwrap();
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        let png = std::fs::read(&files.png).unwrap();
+        assert_eq!(stray_coloured_pixels(&svg, &png, 3.0), Ok(0));
+    }
+}

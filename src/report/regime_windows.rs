@@ -1,0 +1,274 @@
+//! A few cycles of each regime side by side, as the source study shows them: one column per
+//! window (pre-resonance, resonance, post-resonance), the STF force over time on top and the
+//! hysteresis loops F–x, F–v, F–a under it, each fitted model's force drawn over the measured
+//! one (a wide grey line). A long record squeezed into one plot is a solid band; a window of
+//! a few cycles shows the loops' shapes.
+
+use std::ops::Range;
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::series_colour;
+use super::figure::{
+    finite_points, legend_line, legend_style, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles,
+};
+use super::plot_range::{exact_range, padded_range};
+use super::series_csv::Column;
+use super::ReportError;
+
+/// A window of the record: a name (the regime) and its samples `start..end`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RegimeWindow {
+    /// What the window shows, e.g. `resonance, ω 6.1–6.4 rad/s`.
+    pub name: String,
+    /// First sample.
+    pub start: usize,
+    /// One past the last sample.
+    pub end: usize,
+}
+
+/// The series the windows are cut from, all of one length: motion in the units people read
+/// (x in mm, v in mm/s, a in m/s²), the measured STF force and each model's (N).
+#[derive(Clone, Copy, Debug)]
+pub struct WindowSeries<'a> {
+    /// Time, s.
+    pub t: &'a [f64],
+    /// Displacement, mm.
+    pub x_mm: &'a [f64],
+    /// Velocity, mm/s.
+    pub v_mm: &'a [f64],
+    /// Acceleration, m/s².
+    pub a: &'a [f64],
+    /// Measured STF force, N.
+    pub f: &'a [f64],
+    /// Each model's fitted force, N: `(label, force)`.
+    pub models: &'a [(&'a str, &'a [f64])],
+}
+
+const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
+const F_LABEL: &str = "F_STF, N";
+
+struct WindowsPlot<'a> {
+    series: WindowSeries<'a>,
+    windows: Vec<RegimeWindow>,
+}
+
+impl WindowsPlot<'_> {
+    /// One panel: the measured force and each model's against `x` over `w`'s samples.
+    fn panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        w: &RegimeWindow,
+        (x_label, x): (&str, &[f64]),
+        caption: Option<&str>,
+        legend: bool,
+    ) -> Result<(), String> {
+        let r = w.start..w.end;
+        let s = &self.series;
+        let all_f = s.f[r.clone()]
+            .iter()
+            .chain(s.models.iter().flat_map(|(_, m)| &m[r.clone()]));
+        let no_data = || format!("{}: no finite value", w.name);
+        let f_range = padded_range(all_f).ok_or_else(no_data)?;
+        let x_range = if x_label.starts_with("time") {
+            exact_range(&x[r.clone()])
+        } else {
+            padded_range(&x[r.clone()])
+        }
+        .ok_or_else(no_data)?;
+        let mut builder = ChartBuilder::on(area);
+        builder
+            .margin(8)
+            .x_label_area_size(42)
+            .y_label_area_size(62);
+        if let Some(c) = caption {
+            builder.caption(c, legend_style());
+        }
+        let mut chart = builder
+            .build_cartesian_2d(x_range.clone(), f_range.clone())
+            .map_err(msg)?;
+        let span = |r: &Range<f64>| r.end - r.start;
+        let (xs, fs) = (span(&x_range), span(&f_range));
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(F_LABEL)
+            .x_labels(5)
+            .y_labels(6)
+            .x_label_formatter(&|v| tick_label(*v, xs))
+            .y_label_formatter(&|v| tick_label(*v, fs))
+            .axis_desc_style(tick_style())
+            .label_style(tick_style())
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(msg)?;
+        let x = &x[r.clone()];
+        chart
+            .draw_series(LineSeries::new(
+                finite_points(x, &s.f[r.clone()]),
+                MEASURED_GREY.stroke_width(5),
+            ))
+            .map_err(msg)?
+            .label("measured")
+            .legend(|(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(5))
+            });
+        for (i, (label, m)) in s.models.iter().enumerate() {
+            let colour = series_colour(i);
+            chart
+                .draw_series(LineSeries::new(
+                    finite_points(x, &m[r.clone()]),
+                    colour.stroke_width(2),
+                ))
+                .map_err(msg)?
+                .label(*label)
+                .legend(legend_line(colour));
+        }
+        if legend {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font(legend_style())
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(msg)?;
+        }
+        Ok(())
+    }
+}
+
+impl Draw for WindowsPlot<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let root = root
+            .titled(
+                "A few cycles of each regime: the STF force over time and against x, v, a",
+                title_style(),
+            )
+            .map_err(msg)?;
+        let s = &self.series;
+        let rows: [(&str, &[f64]); 4] = [
+            ("time t, s", s.t),
+            ("displacement x, mm", s.x_mm),
+            ("velocity v, mm/s", s.v_mm),
+            ("acceleration a, m/s²", s.a),
+        ];
+        let cells = root.split_evenly((rows.len(), self.windows.len()));
+        for (k, cell) in cells.iter().enumerate() {
+            let (row, col) = (k / self.windows.len(), k % self.windows.len());
+            let w = &self.windows[col];
+            let caption = (row == 0).then_some(w.name.as_str());
+            let legend = row == 1 && col == 0;
+            self.panel(cell, w, rows[row], caption, legend)?;
+        }
+        Ok(())
+    }
+}
+
+/// Draw each window of `series` (a column each: F_STF over time, then against x, v and a,
+/// every model over the measured force) to `out_dir/name.{svg,png,csv}`. The CSV holds the
+/// window's number with the samples drawn.
+pub fn regime_windows(
+    out_dir: &Path,
+    name: &str,
+    series: &WindowSeries,
+    windows: &[RegimeWindow],
+) -> Result<FigureFiles, ReportError> {
+    let s = series;
+    for (what, v) in [("x", s.x_mm), ("v", s.v_mm), ("a", s.a), ("F_STF", s.f)] {
+        same_length(&format!("regime windows: t and {what}"), s.t, v)?;
+    }
+    for (label, m) in s.models {
+        same_length(&format!("regime windows: t and {label}"), s.t, m)?;
+    }
+    let windows: Vec<RegimeWindow> = windows
+        .iter()
+        .filter(|w| w.start + 2 <= w.end && w.end <= s.t.len())
+        .cloned()
+        .collect();
+    if windows.is_empty() {
+        return Err(ReportError::NoData {
+            what: "regime windows: no window of at least two samples".into(),
+        });
+    }
+    let rows: Vec<usize> = windows.iter().flat_map(|w| w.start..w.end).collect();
+    let pick = |v: &[f64]| rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+    let number: Vec<f64> = windows
+        .iter()
+        .enumerate()
+        .flat_map(|(k, w)| std::iter::repeat_n((k + 1) as f64, w.end - w.start))
+        .collect();
+    let mut columns = vec![
+        Column::new("window", number),
+        Column::new("t, s", pick(s.t)),
+        Column::new("x, mm", pick(s.x_mm)),
+        Column::new("v, mm/s", pick(s.v_mm)),
+        Column::new("a, m/s²", pick(s.a)),
+        Column::new("F_STF measured, N", pick(s.f)),
+    ];
+    columns.extend(
+        s.models
+            .iter()
+            .map(|(label, m)| Column::new(format!("F_STF {label}, N"), pick(m))),
+    );
+    let size = (500 * windows.len() as u32 + 20, 1500);
+    let plot = WindowsPlot {
+        series: *s,
+        windows,
+    };
+    render(out_dir, name, size, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+
+    #[test]
+    fn draws_each_window_with_the_models_and_writes_the_samples_drawn() {
+        let s = damped_sine(3_000, 6.0);
+        let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
+        let (x, v) = (mm(&s.x), mm(&s.v));
+        let model: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
+        let models = [("power law", model.as_slice())];
+        let series = WindowSeries {
+            t: &s.t,
+            x_mm: &x,
+            v_mm: &v,
+            a: &s.a,
+            f: &s.f,
+            models: &models,
+        };
+        let windows = [
+            RegimeWindow {
+                name: "early".into(),
+                start: 0,
+                end: 500,
+            },
+            RegimeWindow {
+                name: "late".into(),
+                start: 2_000,
+                end: 2_750,
+            },
+            RegimeWindow {
+                name: "empty".into(),
+                start: 10,
+                end: 10,
+            },
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        let files = regime_windows(dir.path(), "windows", &series, &windows).unwrap();
+        let cols = assert_rendered(&files, (1020, 1500));
+        let t = column(&cols, "t, s");
+        assert_eq!(t.len(), 1_250);
+        assert_eq!(t[500], s.t[2_000]);
+        assert_eq!(column(&cols, "window")[500], 2.0);
+        assert_eq!(column(&cols, "F_STF power law, N")[0], model[0]);
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(svg.contains("\nearly\n") && svg.contains("\nlate\n"));
+        assert!(!svg.contains("\nempty\n"));
+    }
+}
