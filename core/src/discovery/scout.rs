@@ -1,16 +1,16 @@
 //! The scout of a long record: a few short pieces of it, spread evenly over its length, each
-//! simulated from the state the current model's whole-record run reaches there.
+//! simulated from the measured state at its start.
 //!
 //! A trajectory fit simulates the whole record at every evaluation, and a candidate's trial
 //! (its starts, their short fits, then up to [`super::trajectory`]'s iteration limit) costs
 //! hundreds of evaluations. On a long record the search for a candidate's values runs on the
 //! scout instead — an eighth of the samples, so each evaluation costs about an eighth — and
 //! the trial on the whole record continues from where the scout ended, a few
-//! Levenberg–Marquardt iterations from its optimum. The scout only chooses where the whole
-//! record's fit starts: every score, held-out residual and verdict is still the whole
-//! record's.
+//! Levenberg–Marquardt iterations from its optimum. The scout only chooses which candidates
+//! are tried on the whole record and where their fits start: every score, held-out residual
+//! and verdict is still the whole record's.
 //!
-//! A piece starts from the measured state: x and v of a quadratic fitted by least squares to
+//! A piece starts from the measured state: x and v of a cubic fitted by least squares to
 //! the measured x over a quarter cycle either side of its first sample. Not from the current
 //! model's simulated state: where the current model lacks an effect that state is off by the
 //! very gap sought (3 mm on a trolley that misses a cubic spring), and a candidate that damps
@@ -124,22 +124,26 @@ impl Track for Scout<'_> {
     }
 }
 
-/// x and v at sample `i` of a quadratic fitted by least squares to the measured `x` over
-/// `half` samples either side (fewer at the record's ends); `None` if that fit is singular.
+/// x and v at sample `i` of a cubic fitted by least squares to the measured `x` over `half`
+/// samples either side (fewer at the record's ends); `None` if that fit is singular. A cubic,
+/// not a quadratic: over a quarter cycle either side a quadratic's slope of a sine is 23 %
+/// low, a cubic's within 2 %.
 fn measured_state(t: &[f64], x: &[f64], i: usize, half: usize) -> Option<(f64, f64)> {
     let lo = i.saturating_sub(half);
     let hi = (i + half + 1).min(x.len());
-    // Normal equations of x ≈ a + b·τ + c·τ², τ = t − t_i.
-    let mut m = nalgebra::Matrix3::<f64>::zeros();
-    let mut r = nalgebra::Vector3::<f64>::zeros();
+    // Normal equations of x ≈ a + b·τ + c·τ² + d·τ³, τ = (t − t_i)/h (scaled for conditioning).
+    let h = (t[hi - 1] - t[lo]).abs().max(f64::MIN_POSITIVE);
+    let mut m = nalgebra::Matrix4::<f64>::zeros();
+    let mut r = nalgebra::Vector4::<f64>::zeros();
     for j in lo..hi {
-        let tau = t[j] - t[i];
-        let basis = nalgebra::Vector3::new(1.0, tau, tau * tau);
+        let tau = (t[j] - t[i]) / h;
+        let basis = nalgebra::Vector4::new(1.0, tau, tau * tau, tau * tau * tau);
         m += basis * basis.transpose();
         r += basis * x[j];
     }
     let coef = m.lu().solve(&r)?;
-    (coef[0].is_finite() && coef[1].is_finite()).then_some((coef[0], coef[1]))
+    let (x0, v0) = (coef[0], coef[1] / h);
+    (x0.is_finite() && v0.is_finite()).then_some((x0, v0))
 }
 
 #[cfg(test)]
@@ -147,7 +151,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_measured_state_is_the_local_quadratic_s_value_and_slope() {
+    fn the_measured_state_is_the_local_cubic_s_value_and_slope() {
         let t: Vec<f64> = (0..40).map(|i| i as f64 * 0.01).collect();
         let x: Vec<f64> = t.iter().map(|&t| 0.3 + 2.0 * t - 4.0 * t * t).collect();
         let (x0, v0) = measured_state(&t, &x, 20, 5).unwrap();
@@ -155,5 +159,21 @@ mod tests {
         assert!((v0 - (2.0 - 8.0 * t[20])).abs() < 1e-9);
         let (_, v_end) = measured_state(&t, &x, 0, 5).unwrap();
         assert!((v_end - 2.0).abs() < 1e-9);
+    }
+
+    /// A sine at 9 and at 1000 samples a period, a quarter period either side: the slope
+    /// within 2 % of the amplitude's rate.
+    #[test]
+    fn the_measured_slope_of_a_sine_holds_at_few_and_many_samples_a_period() {
+        for per in [9usize, 1000] {
+            let w = std::f64::consts::TAU;
+            let t: Vec<f64> = (0..5 * per).map(|i| i as f64 / per as f64).collect();
+            let x: Vec<f64> = t.iter().map(|&t| (w * t + 0.4).sin()).collect();
+            for i in [2 * per, 2 * per + per / 3] {
+                let (_, v) = measured_state(&t, &x, i, (per / 4).max(2)).unwrap();
+                let truth = w * (w * t[i] + 0.4).cos();
+                assert!((v - truth).abs() < 0.02 * w, "{per} a period: {v} vs {truth}");
+            }
+        }
     }
 }
