@@ -172,7 +172,10 @@ mod tests {
             for i in [2 * per, 2 * per + per / 3] {
                 let (_, v) = measured_state(&t, &x, i, (per / 4).max(2)).unwrap();
                 let truth = w * (w * t[i] + 0.4).cos();
-                assert!((v - truth).abs() < 0.02 * w, "{per} a period: {v} vs {truth}");
+                assert!(
+                    (v - truth).abs() < 0.02 * w,
+                    "{per} a period: {v} vs {truth}"
+                );
             }
         }
     }
