@@ -578,7 +578,7 @@ impl Trials<'_, '_> {
             })
             .collect();
         let (hinted, gains, rank, screened) = self.force_screen(&withs, current);
-        let searched: Vec<Option<(Stage, f64)>> = (0..tried.len())
+        let searched: Vec<Option<(Stage, f64, f64)>> = (0..tried.len())
             .into_par_iter()
             .map(|i| {
                 if screened && rank[i] >= SCREEN_KEEP {
@@ -596,7 +596,7 @@ impl Trials<'_, '_> {
             .into_par_iter()
             .map(|i| {
                 let c = &tried[i];
-                let Some((stage, _)) = &searched[i] else {
+                let Some((stage, _, start_rms)) = &searched[i] else {
                     let why = format!(
                         "not fitted at trajectory level: the force-level screen ranks it {} of \
                          {} (it lowers the recovered force's mean square by {:.3e} N²)",
@@ -612,6 +612,17 @@ impl Trials<'_, '_> {
                          lowers the scout's mean square by {:.3e} mm²)",
                         r + 1,
                         gain * 1e6
+                    );
+                    return (choice::failed(&c.name, why), None);
+                }
+                // Scouted, a start no better than the current model on the whole record is
+                // where the search failed: a short polish does not climb out of it.
+                if *start_rms >= current.train.rms {
+                    let why = format!(
+                        "not fitted on the whole record: its scout fit leaves the training RMS \
+                         at {:.4} mm, not below the current model's {:.4} mm",
+                        start_rms * 1e3,
+                        current.train.rms * 1e3
                     );
                     return (choice::failed(&c.name, why), None);
                 }
@@ -677,7 +688,7 @@ impl Trials<'_, '_> {
     /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
     fn scout_ranks(
         &self,
-        searched: &[Option<(Stage, f64)>],
+        searched: &[Option<(Stage, f64, f64)>],
         current: &Trial,
     ) -> Vec<Option<(usize, usize, f64)>> {
         let mut out = vec![None; searched.len()];
@@ -695,7 +706,7 @@ impl Trials<'_, '_> {
         let mut order: Vec<(usize, f64)> = searched
             .iter()
             .enumerate()
-            .filter_map(|(i, s)| s.as_ref().map(|(_, ms)| (i, reference - ms)))
+            .filter_map(|(i, s)| s.as_ref().map(|(_, ms, _)| (i, reference - ms)))
             .collect();
         order.sort_by(|a, b| b.1.total_cmp(&a.1));
         for (r, (i, gain)) in order.into_iter().enumerate() {
@@ -706,9 +717,10 @@ impl Trials<'_, '_> {
 
     /// Where candidate `with`'s trial starts (`with`: the current model with it added at its
     /// defaults; `hinted`: its force-level start): the best of its starts, fitted on the
-    /// scout when there is one; and its mean square on the scout's training samples (m²;
-    /// infinite without a scout).
-    fn searched(&self, with: Stage, hinted: Option<&Stage>) -> (Stage, f64) {
+    /// scout when there is one; its mean square on the scout's training samples (m²;
+    /// infinite without a scout) and its RMS on the whole record's training samples (m; NaN
+    /// without a scout).
+    fn searched(&self, with: Stage, hinted: Option<&Stage>) -> (Stage, f64, f64) {
         let (track, train): (&dyn Track, &[usize]) = match self.scout {
             Some(scout) => (scout, &scout.train),
             None => (self.rig, &self.split.train),
@@ -716,8 +728,11 @@ impl Trials<'_, '_> {
         let starts = with.starts(track, train, self.osc_start, hinted);
         let stage = Stage::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
         match self.scout {
-            Some(scout) => self.scouted(stage, scout, &self.trial_settings()),
-            None => (stage, f64::INFINITY),
+            Some(scout) => {
+                let on = (self.rig, self.setup, self.split.train.as_slice());
+                scouted(stage, scout, on, &self.trial_settings())
+            }
+            None => (stage, f64::INFINITY, f64::NAN),
         }
     }
 
@@ -762,32 +777,37 @@ impl Trials<'_, '_> {
     }
 }
 
-impl Trials<'_, '_> {
-    /// `stage` fitted on `scout`, if that lowers the whole record's training RMS (one
-    /// simulation of each): where the trial on the whole record starts; and its mean square
-    /// on the scout's training samples (m²).
-    fn scouted(&self, stage: Stage, scout: &Scout, settings: &DiscoverySettings) -> (Stage, f64) {
-        let on_scout = |s: &Stage| {
-            s.model()
-                .ok()
-                .and_then(|m| scout.residual(&m, &s.values).ok())
-                .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
-        };
-        let Ok((fitted, fit)) = stage.fit_simulated(scout, self.setup, &scout.train, settings)
-        else {
-            let ms = on_scout(&stage);
-            return (stage, ms);
-        };
-        let train_rms = |s: &Stage| {
-            s.residual(self.rig)
-                .map_or(f64::INFINITY, |r| rms_over(&r, &self.split.train))
-        };
-        if train_rms(&fitted) < train_rms(&stage) {
-            (fitted, fit.rms * fit.rms)
-        } else {
-            let ms = on_scout(&stage);
-            (stage, ms)
-        }
+/// Where a fit scouted on `scout` continues on the whole record: `stage` fitted on the scout
+/// if that lowers the whole record's RMS at the samples `train`, else `stage` (one
+/// simulation of each); with its mean square on the scout's training samples (m²) and its RMS
+/// at `train` (m).
+fn scouted(
+    stage: Stage,
+    scout: &Scout,
+    (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),
+    settings: &DiscoverySettings,
+) -> (Stage, f64, f64) {
+    let on_scout = |s: &Stage| {
+        s.model()
+            .ok()
+            .and_then(|m| scout.residual(&m, &s.values).ok())
+            .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
+    };
+    let train_rms = |s: &Stage| {
+        s.residual(rig)
+            .map_or(f64::INFINITY, |r| rms_over(&r, train))
+    };
+    let before = train_rms(&stage);
+    let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) else {
+        let ms = on_scout(&stage);
+        return (stage, ms, before);
+    };
+    let after = train_rms(&fitted);
+    if after < before {
+        (fitted, fit.rms * fit.rms, after)
+    } else {
+        let ms = on_scout(&stage);
+        (stage, ms, before)
     }
 }
 
@@ -865,6 +885,17 @@ pub fn discover_trajectory(
         Some(h) => start.force_started(&rig, h, &all).map_or(start, |(s, _)| s),
         None => start,
     };
+    let scout = scout_of(&rig, cycles, &split.train, settings);
+    let start = match &scout {
+        Some(s) => {
+            let lm = DiscoverySettings {
+                fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
+                ..settings.clone()
+            };
+            scouted(start, s, (&rig, setup, &all), &lm).0
+        }
+        None => start,
+    };
     let (base_full, base_result) = start.fit_simulated(&rig, setup, &all, settings)?;
     let run_before = base_full.run(&rig)?;
     let gap_before = rms(&run_before.residual);
@@ -915,7 +946,6 @@ pub fn discover_trajectory(
              fitted at trajectory level"
         ));
     }
-    let scout = scout_of(&rig, cycles, &split.train, settings);
     if let Some(s) = &scout {
         notes.push(format!(
             "scouted: each candidate's values are searched on {} pieces of the record \
