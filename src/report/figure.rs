@@ -51,6 +51,26 @@ pub fn legend_line(colour: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32,
     move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
 }
 
+/// Draw `chart`'s legend at `position` in the house style (legend text, a white box with a
+/// black border).
+pub fn draw_legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: plotters::coord::CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(legend_style())
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(msg)
+}
+
 /// Turn any plotting error into its message.
 pub fn msg<E: std::fmt::Display>(e: E) -> String {
     e.to_string()

@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, finite_points, legend_style, msg, render, same_length, tick_label, tick_style,
+    axis_desc_style, draw_legend, finite_points, msg, render, same_length, tick_label, tick_style,
     title_style, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::padded_range;
@@ -223,14 +223,7 @@ impl Draw for FrequencyResponsePlot {
             }
             Self::draw_curve(&mut chart, c, colour)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(legend_style())
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 

@@ -12,8 +12,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE,
+    axis_desc_style, draw_legend, finite_points, legend_line, msg, render, same_length, tick_label,
+    tick_style, title_style, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -125,14 +125,7 @@ impl MeasuredVsFittedPlot {
                 .draw_series(LineSeries::new(lower, colour.stroke_width(2)))
                 .map_err(msg)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(legend_style())
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(msg)
+        draw_legend(chart, SeriesLabelPosition::UpperRight)
     }
 }
 
@@ -192,14 +185,7 @@ impl Draw for MeasuredVsFittedPlot {
                 .label(label.as_str())
                 .legend(legend_line(colour));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(legend_style())
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 

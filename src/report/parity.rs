@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    legend_line, legend_style, msg, render, same_length, tick_label, tick_style, title_style, Draw,
-    FigureFiles,
+    draw_legend, legend_line, legend_style, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -227,14 +227,7 @@ impl ParityPlot {
                 .legend(legend_line(GREY));
         }
         if legend {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font(legend_style())
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(msg)?;
+            draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
         Ok(())
     }

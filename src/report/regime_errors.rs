@@ -8,7 +8,7 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, legend_style, msg, render, tick_label, tick_style, title_style, Draw,
+    axis_desc_style, draw_legend, msg, render, tick_label, tick_style, title_style, Draw,
     FigureFiles, SIZE,
 };
 use super::series_csv::Column;
@@ -81,14 +81,7 @@ impl Draw for RegimeErrorPlot {
                     Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.filled())
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(legend_style())
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(msg)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }
 }
 

@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    finite_points, legend_line, legend_style, msg, render, same_length, tick_label, tick_style,
-    title_style, Draw, FigureFiles,
+    draw_legend, finite_points, legend_line, legend_style, msg, render, same_length, tick_label,
+    tick_style, title_style, Draw, FigureFiles,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -128,14 +128,7 @@ impl WindowsPlot<'_> {
                 .legend(legend_line(colour));
         }
         if legend {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .label_font(legend_style())
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(msg)?;
+            draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         }
         Ok(())
     }

@@ -14,8 +14,8 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, finite_points, legend_line, legend_style, msg, render, same_length,
-    tick_label, tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
+    axis_desc_style, draw_legend, finite_points, legend_line, msg, render, same_length, tick_label,
+    tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -163,14 +163,7 @@ impl TimeHistoryPlot {
         &self,
         chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     ) -> Result<(), String> {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(legend_style())
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(msg)
+        draw_legend(chart, SeriesLabelPosition::UpperRight)
     }
 }
 
