@@ -443,7 +443,7 @@ fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
                     format!("{:.5}", c.holdout_rms),
                     format!("{:.1}", c.delta_bic),
                     format!("{:.1} ({})", c.gain_z, c.effective_n),
-                    format!("{:.0} %", 100.0 * c.explained_share),
+                    format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),
                     if c.significant {
                         "yes".into()
                     } else {

@@ -17,6 +17,7 @@ use stf_core::regimes::{
     Boundary, Classification, Comparison, CycleFeatures, MetricRanking, Regime,
 };
 
+use crate::digits::fixed;
 use crate::output::write_atomic;
 use crate::report::Table;
 
@@ -115,8 +116,11 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
                 "no phase".to_string()
             };
             format!(
-                "{:.2} mJ · c_eq {ceq:.1} · {phase} · duty {duty:.2} · {peak:.2} N",
-                e * 1e3
+                "{} mJ · c_eq {} · {phase} · duty {} · {} N",
+                fixed(e * 1e3, 2),
+                fixed(ceq, 1),
+                fixed(duty, 2),
+                fixed(peak, 2)
             )
         })
     };

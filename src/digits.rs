@@ -8,6 +8,8 @@
 //! use stf_lab::digits::carried;
 //! assert_eq!(carried(2.35 + 0.047 * 82.0).to_string(), "6.204");
 //! assert_eq!(carried(0.1 + 0.2).to_string(), "0.3");
+//! assert_eq!(stf_lab::digits::fixed(-0.04, 1), "0.0");
+//! assert_eq!(stf_lab::digits::fixed(-0.06, 1), "-0.1");
 //! ```
 
 use serde_json::Value;
@@ -18,6 +20,16 @@ pub fn carried(x: f64) -> f64 {
         return x;
     }
     format!("{x:.14e}").parse().unwrap_or(x)
+}
+
+/// `x` with `decimals` decimals for a person to read, never as a negative zero ("-0.0" for
+/// -0.04 at one decimal reads as a sign the value does not have).
+pub fn fixed(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.decimals$}");
+    if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') {
+        return s[1..].to_string();
+    }
+    s
 }
 
 /// Every floating-point number of `value`, recursively, rounded by [`carried`]; integers
