@@ -1033,6 +1033,7 @@ params = { K = 2.0, n = { value = 1.2, min = 1.0, max = 4.0 } }
 
 [discover]
 base = "power_law"
+scout_from = 0
 
 [simulate]
 sweep = { w0 = 2.35, alpha = 0.047, t0 = 50.0, t1 = 200.0 }
@@ -1052,6 +1053,7 @@ params = { K = 4.0, n = 1.5 }
         let s = e.simulate.unwrap();
         assert_eq!((s.t0, s.t1), (50.0, 200.0));
         assert_eq!(s.truth[0].key, "simulate.truth[0]");
+        assert_eq!(e.discover.unwrap().scout_from, Some(0));
     }
 
     #[test]
