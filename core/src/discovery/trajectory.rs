@@ -520,6 +520,18 @@ const SCOUTED_TRIAL_ITERS: u64 = 15;
 /// out by their fits on the scout (see [`Trials::step`]).
 const SCOUT_KEEP: usize = 3;
 
+/// The force-level screen of a step's candidates ([`Trials::force_screen`]).
+struct ForceScreen {
+    /// Each candidate's force-level start and that fit's RMS (N).
+    hinted: Vec<Option<(Stage, f64)>>,
+    /// Each one's gain over the current model's mean square (N²).
+    gains: Vec<Option<f64>>,
+    /// Each one's rank by its gain (0 the best).
+    rank: Vec<usize>,
+    /// Whether the screen ranks out all but [`SCREEN_KEEP`].
+    screened: bool,
+}
+
 /// What every candidate trial of a run shares.
 struct Trials<'a, 'r> {
     rig: &'a Rig<'r>,
@@ -577,7 +589,12 @@ impl Trials<'_, '_> {
                 current.stage.with(&c.model, &defaults, n_osc)
             })
             .collect();
-        let (hinted, gains, rank, screened) = self.force_screen(&withs, current);
+        let ForceScreen {
+            hinted,
+            gains,
+            rank,
+            screened,
+        } = self.force_screen(&withs, current);
         let searched: Vec<Option<(Stage, f64, f64)>> = (0..tried.len())
             .into_par_iter()
             .map(|i| {
@@ -636,17 +653,7 @@ impl Trials<'_, '_> {
     /// The force-level screen of the candidates `withs` (each added to `current`): each one's
     /// force-level start and its RMS, its gain over `current` (N²), its rank by the gain, and
     /// whether the screen ranks out all but [`SCREEN_KEEP`].
-    #[allow(clippy::type_complexity)]
-    fn force_screen(
-        &self,
-        withs: &[Stage],
-        current: &Trial,
-    ) -> (
-        Vec<Option<(Stage, f64)>>,
-        Vec<Option<f64>>,
-        Vec<usize>,
-        bool,
-    ) {
+    fn force_screen(&self, withs: &[Stage], current: &Trial) -> ForceScreen {
         let train = &self.split.train;
         let hint = self.setup.force_hint.as_ref();
         let hinted: Vec<Option<(Stage, f64)>> = withs
@@ -680,7 +687,12 @@ impl Trials<'_, '_> {
         let screened = self.screen
             && withs.len() > SCREEN_KEEP
             && reference.is_some_and(|r| best_gain > SCREEN_MIN_GAIN * r * r);
-        (hinted, gains, rank, screened)
+        ForceScreen {
+            hinted,
+            gains,
+            rank,
+            screened,
+        }
     }
 
     /// Each searched candidate's rank among them by the gain of its scout fit over the
