@@ -450,7 +450,7 @@ fn jacobian(
             }
         })
         .collect();
-    let noise = residual_noise(x, r0, &probe, &mut |point, out| {
+    let noise = residual_noise(x, r0, &probe, &|point, out| {
         obj.residuals_user(point, out).is_some()
     })
     .unwrap_or(0.0);
@@ -472,7 +472,7 @@ fn jacobian(
         &mut steps,
         &floor,
         &|j, v| !(v > free[j].min && v < free[j].max),
-        &mut |point, out| obj.residuals_user(point, out).is_some(),
+        &|point, out| obj.residuals_user(point, out).is_some(),
         &exact,
         &mut jac,
     );

@@ -11,8 +11,15 @@
 //! and Levenberg–Marquardt stopped at S four times the optimum's. So the noise is measured
 //! ([`residual_noise`]) and each column's step is lengthened until the change it makes stands
 //! [`SIGNAL_TO_NOISE`] times above that noise (up to a largest step).
+//!
+//! The columns are independent, so they are computed in parallel (rayon): a fit along a
+//! simulated record spends nearly all its time here, one simulation a column, and a fit that
+//! runs alone (a base, a polish, the last candidate of a step) would otherwise leave all
+//! cores but one idle. Each column's value depends on its own evaluations only, so the
+//! Jacobian is the same whatever the order the columns finish in.
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 
 /// Change a difference step must make in the residuals, in multiples of their noise
 /// (rms over the samples): the noise then contributes about `√2 / SIGNAL_TO_NOISE` (5 %)
@@ -22,24 +29,24 @@ pub const SIGNAL_TO_NOISE: f64 = 30.0;
 /// Tries at lengthening one column's step before the column is taken as it is.
 const LENGTHEN_TRIES: usize = 3;
 
+/// An evaluation of the residuals: `eval(x, out)` writes them to `out`, false on failure.
+/// Shared across threads: the columns of a Jacobian are evaluated in parallel.
+pub type Eval<'a> = &'a (dyn Fn(&[f64], &mut [f64]) -> bool + Sync);
+
 /// The noise of the residuals at `x` (rms per residual), from a second difference along all
 /// parameters at once: `r(x + e) + r(x − e) − 2·r(x)` with `e_j = probe[j]` cancels the
 /// residuals' slope and leaves their noise (variance 6σ²) plus a curvature term of order
-/// `probe²`, negligible for probes of 1e-6 of a scale. `None` if an evaluation fails.
-pub fn residual_noise(
-    x: &[f64],
-    r0: &[f64],
-    probe: &[f64],
-    eval: &mut dyn FnMut(&[f64], &mut [f64]) -> bool,
-) -> Option<f64> {
+/// `probe²`, negligible for probes of 1e-6 of a scale. `None` if an evaluation fails. The two
+/// evaluations run in parallel.
+pub fn residual_noise(x: &[f64], r0: &[f64], probe: &[f64], eval: Eval) -> Option<f64> {
     let n = r0.len();
-    let mut plus = vec![0.0; n];
-    let mut minus = vec![0.0; n];
-    let up: Vec<f64> = x.iter().zip(probe).map(|(x, e)| x + e).collect();
-    let down: Vec<f64> = x.iter().zip(probe).map(|(x, e)| x - e).collect();
-    if !(eval(&up, &mut plus) && eval(&down, &mut minus)) {
-        return None;
-    }
+    let side = |sign: f64| {
+        let point: Vec<f64> = x.iter().zip(probe).map(|(x, e)| x + sign * e).collect();
+        let mut out = vec![0.0; n];
+        eval(&point, &mut out).then_some(out)
+    };
+    let (plus, minus) = rayon::join(|| side(1.0), || side(-1.0));
+    let (plus, minus) = (plus?, minus?);
     let ss: f64 = plus
         .iter()
         .zip(&minus)
@@ -65,60 +72,83 @@ pub struct StepFloor {
 /// A column whose rms change is below `SIGNAL_TO_NOISE × floor.noise` is recomputed with a
 /// longer step (up to `floor.max[j]`); the steps used are written back to `steps`, so a
 /// caller that keeps them starts the next Jacobian from there. Columns marked in `exact` are
-/// left as they are (known exactly).
+/// left as they are (known exactly). The columns are computed in parallel.
 #[allow(clippy::too_many_arguments)]
 pub fn forward_difference(
     x: &[f64],
     r0: &[f64],
     steps: &mut [f64],
     floor: &StepFloor,
-    flip: &dyn Fn(usize, f64) -> bool,
-    eval: &mut dyn FnMut(&[f64], &mut [f64]) -> bool,
+    flip: &(dyn Fn(usize, f64) -> bool + Sync),
+    eval: Eval,
     exact: &[bool],
     jac: &mut DMatrix<f64>,
 ) {
-    let n = r0.len().max(1) as f64;
-    let wanted = SIGNAL_TO_NOISE * floor.noise;
-    let mut point = x.to_vec();
-    for j in 0..steps.len() {
-        if exact.get(j).copied().unwrap_or(false) {
-            continue;
-        }
-        let longest = floor.max.get(j).copied().unwrap_or(0.0);
-        let mut h0 = steps[j].abs();
-        let mut column = jac.column_mut(j);
-        let col = column.as_mut_slice();
-        let mut ok = false;
-        for attempt in 0..=LENGTHEN_TRIES {
-            let mut h = if flip(j, x[j] + h0) { -h0 } else { h0 };
-            ok = false;
-            for _ in 0..2 {
-                point[j] = x[j] + h;
-                let dx = point[j] - x[j];
-                if dx != 0.0 && eval(&point, col) {
-                    for (c, r) in col.iter_mut().zip(r0) {
-                        *c = (*c - r) / dx;
-                    }
-                    ok = true;
-                    break;
-                }
-                h = -h;
-            }
-            point[j] = x[j];
-            if !ok || attempt == LENGTHEN_TRIES || h0 >= longest {
-                break;
-            }
-            // The rms change this step made, against the noise it must stand above.
-            let change = h0 * (col.iter().map(|c| c * c).sum::<f64>() / n).sqrt();
-            if !(change < wanted) {
-                break;
-            }
-            let grow = if change > 0.0 { wanted / change } else { 10.0 };
-            h0 = (h0 * grow.clamp(2.0, 10.0)).min(longest);
-        }
-        steps[j] = h0;
-        if !ok {
-            col.fill(f64::NAN);
-        }
+    let todo: Vec<usize> = (0..steps.len())
+        .filter(|&j| !exact.get(j).copied().unwrap_or(false))
+        .collect();
+    let columns: Vec<(usize, f64, Vec<f64>)> = todo
+        .par_iter()
+        .map(|&j| {
+            let longest = floor.max.get(j).copied().unwrap_or(0.0);
+            let (h, col) = column(x, r0, j, steps[j].abs(), longest, floor.noise, flip, eval);
+            (j, h, col)
+        })
+        .collect();
+    for (j, h, col) in columns {
+        steps[j] = h;
+        jac.column_mut(j).copy_from_slice(&col);
     }
+}
+
+/// Column `j` of the forward-difference Jacobian from a step of `h0`, lengthened (up to
+/// `longest`) while its change stays below [`SIGNAL_TO_NOISE`] × `noise`: the step used and
+/// the column (NaN throughout when no step could be evaluated).
+#[allow(clippy::too_many_arguments)]
+fn column(
+    x: &[f64],
+    r0: &[f64],
+    j: usize,
+    mut h0: f64,
+    longest: f64,
+    noise: f64,
+    flip: &(dyn Fn(usize, f64) -> bool + Sync),
+    eval: Eval,
+) -> (f64, Vec<f64>) {
+    let n = r0.len().max(1) as f64;
+    let wanted = SIGNAL_TO_NOISE * noise;
+    let mut point = x.to_vec();
+    let mut col = vec![0.0; r0.len()];
+    let mut ok = false;
+    for attempt in 0..=LENGTHEN_TRIES {
+        let mut h = if flip(j, x[j] + h0) { -h0 } else { h0 };
+        ok = false;
+        for _ in 0..2 {
+            point[j] = x[j] + h;
+            let dx = point[j] - x[j];
+            if dx != 0.0 && eval(&point, &mut col) {
+                for (c, r) in col.iter_mut().zip(r0) {
+                    *c = (*c - r) / dx;
+                }
+                ok = true;
+                break;
+            }
+            h = -h;
+        }
+        point[j] = x[j];
+        if !ok || attempt == LENGTHEN_TRIES || h0 >= longest {
+            break;
+        }
+        // The rms change this step made, against the noise it must stand above.
+        let change = h0 * (col.iter().map(|c| c * c).sum::<f64>() / n).sqrt();
+        if !(change < wanted) {
+            break;
+        }
+        let grow = if change > 0.0 { wanted / change } else { 10.0 };
+        h0 = (h0 * grow.clamp(2.0, 10.0)).min(longest);
+    }
+    if !ok {
+        col.fill(f64::NAN);
+    }
+    (h0, col)
 }

@@ -118,7 +118,7 @@ pub fn refine(
         let all_exact = exact.iter().all(|&e| e);
         if !all_exact {
             let floor = floor.get_or_insert_with(|| StepFloor {
-                noise: residual_noise(&u, &r, &vec![NOISE_PROBE; p], &mut |point, out| {
+                noise: residual_noise(&u, &r, &vec![NOISE_PROBE; p], &|point, out| {
                     obj.residuals_user(&obj.to_user(point), out).is_some()
                 })
                 .unwrap_or(0.0),
@@ -130,7 +130,7 @@ pub fn refine(
                 &mut steps,
                 floor,
                 &|_, _| false,
-                &mut |point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
+                &|point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
                 &exact,
                 &mut jac,
             );
