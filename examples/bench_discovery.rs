@@ -3,6 +3,7 @@
 //! ```text
 //! cargo run --release --example bench_discovery                 # force level
 //! cargo run --release --example bench_discovery -- --trajectory # and trajectory level
+//! cargo run --release --example bench_discovery -- --shaker     # a 10⁵-sample shaker record
 //! ```
 //!
 //! Records: the source study's 0.047 rad/s² sweep, ω 2.35 → 9.4 rad/s over t 50 → 200 s at
@@ -11,7 +12,11 @@
 //! everything else default. Each case runs `stf-lab simulate` and `stf-lab discover` as the
 //! command line does (experiment files and records under `target/bench_discovery/`) and
 //! prints the discovery's wall time and verdict. Trajectory level discovers from t, φ and x
-//! only (`[discover] level = "trajectory"`). Timings depend on what else runs on the machine.
+//! only (`[discover] level = "trajectory"`). `--shaker` runs trajectory-level discovery alone
+//! on a shaker rig's record of 100 001 samples (the bundled `trajectory_discovery` rig: a
+//! measured drive force `u`, a 0.5 → 1.5 Hz chirp over 500 s at 200 Hz, truth `viscous` with
+//! a `cubic_stiffness` hidden, base `viscous`, every default candidate). Timings depend on
+//! what else runs on the machine.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,6 +28,24 @@ struct Case {
     label: &'static str,
     hidden: Option<&'static str>,
     trajectory: bool,
+}
+
+/// The shaker case (`--shaker`): trajectory level on 100 001 samples with a measured drive.
+const SHAKER: Case = Case {
+    label: "trajectory, shaker u, 100 001 samples, cubic_stiffness hidden",
+    hidden: Some("cubic_stiffness"),
+    trajectory: true,
+};
+
+/// The shaker case's experiment file: the bundled `trajectory_discovery` rig, 500 s long.
+fn shaker_experiment(record: &str) -> String {
+    format!(
+        "[data]\nfile = \"{record}\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
+         [simulate]\nchirp = {{ f0 = 0.5, f1 = 1.5, amplitude = 2.0, t1 = 500.0 }}\n\
+         rate = 200.0\nnoise = true\nseed = 7\n\n[[simulate.truth]]\nname = \"viscous\"\n\
+         plus = [\"cubic_stiffness\"]\nparams = {{ c_s = 1.0, k3 = 1e4 }}\n\n\
+         [discover]\nbase = \"viscous\"\nlevel = \"trajectory\"\n"
+    )
 }
 
 const CASES: [Case; 4] = [
@@ -50,6 +73,9 @@ const CASES: [Case; 4] = [
 
 /// The experiment file of `case`.
 fn experiment(case: &Case, record: &str) -> String {
+    if case.hidden == Some("cubic_stiffness") {
+        return shaker_experiment(record);
+    }
     let (plus, extra) = match case.hidden {
         Some("added_mass") => ("plus = [\"added_mass\"]\n", ", m_a = 1.5"),
         _ => ("", ""),
@@ -117,11 +143,20 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, String)> {
 
 fn main() -> Result<()> {
     let trajectory = std::env::args().any(|a| a == "--trajectory");
+    let shaker = std::env::args().any(|a| a == "--shaker");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/bench_discovery");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     // The commands print their own summaries as they go; the table comes last.
     let mut rows = Vec::new();
-    for case in CASES.iter().filter(|c| trajectory || !c.trajectory) {
+    let cases: Vec<&Case> = if shaker {
+        vec![&SHAKER]
+    } else {
+        CASES
+            .iter()
+            .filter(|c| trajectory || !c.trajectory)
+            .collect()
+    };
+    for case in cases {
         let (wall, verdict) = run(case, &dir).with_context(|| case.label)?;
         rows.push(format!("| {} | {wall:.1} s | {verdict} |", case.label));
     }

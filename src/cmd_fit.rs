@@ -17,7 +17,6 @@ use stf_core::fit::{
     fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
-use stf_core::record::Record;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{
@@ -310,7 +309,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         for (name, value) in &stage.set {
             system.set(name, *value);
         }
-        let record = Record::read(&stage.data)?;
+        let record = crate::fitting::read_record(exp, &stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
         let (x0, v0) = k.initial_state();

@@ -21,7 +21,8 @@ use crate::experiment::{Ctx, RawDrive};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawData {
-    file: String,
+    /// The record; absent, `[data]` gives only the layout (of the `[[identify]]` records).
+    file: Option<String>,
     /// Time window to use, s.
     window: Option<[f64; 2]>,
     /// Where each signal is: a column (variable) name or a CSV column number from 1.
@@ -80,7 +81,7 @@ pub(crate) fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Re
     }
     let layout = layout(cx, &span, raw)?;
     Ok(DataSection {
-        file: Some(dir.join(&raw.file)),
+        file: raw.file.as_ref().map(|f| dir.join(f)),
         line: cx.line(span.start),
         window,
         layout,
@@ -129,9 +130,11 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
 /// `separator`, `decimal`, `skip` and `header` (CSV only).
 fn text_settings(cx: &Ctx, raw: &RawData) -> Result<ReadOptions> {
     let mut opts = ReadOptions::default();
-    let is_mat = Path::new(&raw.file)
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mat"));
+    let is_mat = raw.file.as_ref().is_some_and(|f| {
+        Path::new(f)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mat"))
+    });
     let text_spans = [
         ("separator", raw.separator.as_ref().map(Spanned::span)),
         ("decimal", raw.decimal.as_ref().map(Spanned::span)),

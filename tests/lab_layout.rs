@@ -121,3 +121,55 @@ fn a_lab_layout_record_fits_to_the_truth() {
         "{stderr}"
     );
 }
+
+/// Identification stages of the free-vibration record, read with `[data]`'s layout (`{layout}`).
+fn identification(record: &str, layout: &str) -> String {
+    format!(
+        "[data]\n{layout}\n[output]\nreport = false\n\n[system]\nm = 7.65\nk = 294.7\nc = 4.81\n\
+         T = 0.461\ndelta_T = 0.0\nF0 = 0.0\neta = 1000.0\n\n[[identify]]\ndata = {record:?}\n\
+         free = [\"k\", \"c\", \"T\"]\n"
+    )
+}
+
+#[test]
+fn identification_stages_read_their_records_with_the_data_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let si = common::root().join("experiments/records/free_vibration.csv");
+    let text = std::fs::read_to_string(&si).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,x,f_stf,u"));
+    let mut lab = String::from("Zeit [ms];Weg [mm];Antrieb [mN]\n");
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        let (t, x, u) = (v[0] * 1e3, v[1] * 1e3, v[3] * 1e3);
+        lab += &format!("{};{};{}\n", comma(t, 3), comma(x, 6), comma(u, 3));
+    }
+    std::fs::write(dir.path().join("lab.csv"), lab).unwrap();
+
+    let stage_values = |name: &str, record: &str, layout: &str| {
+        let exp = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&exp, identification(record, layout)).unwrap();
+        let out = dir.path().join(name);
+        let _ = run_ok("fit", &exp, &out);
+        let fit = read_json(&out.join("fit.json"));
+        ["k", "c", "T"].map(|p| fit["stages"][0]["params"][p].as_f64().unwrap())
+    };
+    let layout = "decimal = \",\"\n\
+                  columns = { t = \"Zeit [ms]\", x = \"Weg [mm]\", u = \"Antrieb [mN]\" }\n\
+                  units = { t = \"ms\", x = \"mm\", u = \"mN\" }\n";
+    let from_lab = stage_values("lab", "lab.csv", layout);
+    let from_si = stage_values("si", si.to_str().unwrap(), "");
+    eprintln!("k, c, T: lab layout {from_lab:?}, SI {from_si:?}");
+    for (a, b) in from_lab.iter().zip(&from_si) {
+        assert!(
+            (a / b - 1.0).abs() < 1e-4,
+            "lab {from_lab:?} vs SI {from_si:?}"
+        );
+    }
+
+    // Without the layout the same file is not read as a record at all.
+    let exp = dir.path().join("plain.toml");
+    std::fs::write(&exp, identification("lab.csv", "")).unwrap();
+    let failed = common::run("fit", &exp, &dir.path().join("plain"));
+    assert!(!failed.status.success());
+}
