@@ -231,7 +231,7 @@ fn column(cx: &Ctx, signal: Signal, value: &Value, at: Range<usize>) -> Result<C
 
 /// How a unit is written (for messages).
 const UNIT_FORMS: &str = "a unit is a name (\"mm\") or a table: { unit = \"V\", gain = 2.5 } \
-                          (N per V) or { unit = \"counts\", per_rev = 2048 }";
+                          (N or m per V) or { unit = \"counts\", per_rev = 2048 }";
 
 /// A `units` value: `"mm"`, or `{ unit = "V", gain = 2.5 }`, `{ unit = "counts",
 /// per_rev = 2048 }`.
@@ -260,7 +260,7 @@ fn unit_table(table: &toml::Table) -> Result<(Option<&str>, Option<f64>, Option<
                 )
             }
             "gain" => {
-                gain = Some(number(v).ok_or(format!("`gain` = {v} is not a number, N per V"))?)
+                gain = Some(number(v).ok_or(format!("`gain` = {v} is not a number, N or m per V"))?)
             }
             "per_rev" => {
                 per_rev =

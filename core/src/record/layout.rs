@@ -69,7 +69,7 @@ impl Signal {
     pub fn unit_list(self) -> &'static str {
         match self {
             Signal::T => "s, ms, us (or µs)",
-            Signal::X => "m, mm, um (or µm)",
+            Signal::X => "m, mm, um (or µm), V (with `gain`, metres per volt)",
             Signal::Phi => "rad, deg, counts (with `per_rev`, encoder counts per revolution)",
             Signal::Omega => "rad/s, rpm, Hz",
             Signal::FStf | Signal::U => "N, mN, V (with `gain`, newtons per volt)",
@@ -121,9 +121,10 @@ pub enum Unit {
     Newton,
     /// mN.
     Millinewton,
-    /// Volts of a force sensor with `gain` newtons per volt.
+    /// Volts of a sensor with `gain` SI units per volt: newtons for a force, metres for a
+    /// displacement.
     Volt {
-        /// N per V.
+        /// N per V, or m per V.
         gain: f64,
     },
 }
@@ -141,7 +142,7 @@ impl Unit {
     }
 
     /// The unit called `name` for `signal`. `counts` needs `per_rev` (counts per revolution)
-    /// and `V` needs `gain` (N per V); neither is taken by another unit.
+    /// and `V` needs `gain` (N or m per V); neither is taken by another unit.
     pub fn parse(
         signal: Signal,
         name: &str,
@@ -166,7 +167,7 @@ impl Unit {
             (S::Omega, "Hz") => Unit::Hertz,
             (S::FStf | S::U, "N") => Unit::Newton,
             (S::FStf | S::U, "mN") => Unit::Millinewton,
-            (S::FStf | S::U, "V") => Unit::Volt {
+            (S::X | S::FStf | S::U, "V") => Unit::Volt {
                 gain: parameter(name, "gain", gain)?,
             },
             _ => {
@@ -199,7 +200,7 @@ impl Unit {
             Unit::RadianPerSecond | Unit::Rpm | Unit::Hertz => signal == S::Omega,
             Unit::Newton | Unit::Millinewton => matches!(signal, S::FStf | S::U),
             Unit::Volt { gain } => {
-                matches!(signal, S::FStf | S::U) && gain.is_finite() && gain != 0.0
+                matches!(signal, S::X | S::FStf | S::U) && gain.is_finite() && gain != 0.0
             }
         }
     }
@@ -768,6 +769,10 @@ mod tests {
         let volts = Unit::parse(Signal::U, "V", Some(2.5), None).unwrap();
         assert_eq!(volts, Unit::Volt { gain: 2.5 });
         assert_eq!(volts.scale(), 2.5);
+        // A displacement sensor in volts: 2 mm per V.
+        let lvdt = Unit::parse(Signal::X, "V", Some(0.002), None).unwrap();
+        assert!(lvdt.fits(Signal::X) && !lvdt.fits(Signal::Phi));
+        assert_eq!(lvdt.scale(), 0.002);
     }
 
     #[test]
@@ -775,7 +780,8 @@ mod tests {
         let e = Unit::parse(Signal::X, "furlong", None, None).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown unit `furlong` for `x`; known: m, mm, um (or µm)"
+            "unknown unit `furlong` for `x`; known: m, mm, um (or µm), V (with `gain`, metres \
+             per volt)"
         );
         let e = Unit::parse(Signal::T, "mm", None, None).unwrap_err();
         assert!(e.to_string().contains("known: s, ms, us"), "{e}");
@@ -790,7 +796,8 @@ mod tests {
         );
         let e = Unit::parse(Signal::Phi, "counts", None, Some(-5.0)).unwrap_err();
         assert_eq!(e.setting(), "units");
-        assert!(Unit::parse(Signal::X, "V", Some(2.0), None).is_err());
+        assert!(Unit::parse(Signal::T, "V", Some(2.0), None).is_err());
+        assert!(Unit::parse(Signal::Phi, "V", Some(2.0), None).is_err());
     }
 
     #[test]
