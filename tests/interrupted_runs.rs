@@ -47,7 +47,16 @@ fn a_killed_fit_leaves_whole_results() {
         std::thread::sleep(Duration::from_millis(delay));
         let _ = child.kill();
         let _ = child.wait();
+        // A kill between the two renames of the folder swap leaves the old results beside
+        // the folder's place; the next run puts them back first, as here.
+        stf_lab::results_dir::repair(&dir).unwrap();
         assert_whole(&dir, rows);
+        let strays: Vec<_> = std::fs::read_dir(out.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "fit" && n != ".fit.lock")
+            .collect();
+        assert!(strays.is_empty(), "{strays:?}");
     }
 }
 

@@ -76,14 +76,21 @@ fn a_fifo_or_a_link_to_one_is_never_replaced_by_an_output() {
             .output()
             .unwrap();
         assert!(!run.status.success());
-        assert!(stderr(&run).contains("is not a regular file"), "{}", stderr(&run));
+        assert!(
+            stderr(&run).contains("is not a regular file"),
+            "{}",
+            stderr(&run)
+        );
     }
     let exp = fit_experiment(tmp.path(), "exp.toml", false);
     let run = fit(&exp, &fifo, true);
     assert!(!run.status.success());
     assert!(stderr(&run).contains("is not a folder"), "{}", stderr(&run));
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
-    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
     assert_eq!(entries(tmp.path()), ["exp.toml", "link.csv", "pipe"]);
 }
 
@@ -121,7 +128,10 @@ fn a_forced_rerun_replaces_the_whole_folder_and_says_only_what_it_wrote() {
     assert_eq!(entries(&out), ["fit.json", "fitted.csv", "params.csv"]);
     let wrote = stdout(&again);
     let wrote = wrote.lines().last().unwrap();
-    assert!(wrote.starts_with("wrote ") && !wrote.contains("report"), "{wrote}");
+    assert!(
+        wrote.starts_with("wrote ") && !wrote.contains("report"),
+        "{wrote}"
+    );
     let doc = common::read_json(&out.join("fit.json"));
     assert!(doc["experiment"].as_str().unwrap().ends_with("b.toml"));
     // Nothing is left beside the folder but its lock file.
@@ -167,9 +177,15 @@ fn what_a_killed_run_left_is_repaired_and_strangers_are_kept() {
     let run = fit(&exp, &out, false);
     let msg = stderr(&run);
     assert!(msg.contains("the previous results were put back"), "{msg}");
-    assert!(msg.contains("removed") && msg.contains(".fit.new-999999"), "{msg}");
+    assert!(
+        msg.contains("removed") && msg.contains(".fit.new-999999"),
+        "{msg}"
+    );
     // Put back, the old results are there to be replaced only with --force.
-    assert!(!run.status.success() && msg.contains("pass --force"), "{msg}");
+    assert!(
+        !run.status.success() && msg.contains("pass --force"),
+        "{msg}"
+    );
     assert_eq!(
         std::fs::read_to_string(out.join("fit.json")).unwrap(),
         "{\"old\": true}"
@@ -207,7 +223,10 @@ fn control_characters_from_files_reach_the_terminal_escaped() {
     let run = fit(&exp, &tmp.path().join("fit"), false);
     assert!(!run.status.success());
     let msg = stderr(&run);
-    assert!(!run.stderr.contains(&0x1b) && !run.stderr.contains(&0x07), "{msg:?}");
+    assert!(
+        !run.stderr.contains(&0x1b) && !run.stderr.contains(&0x07),
+        "{msg:?}"
+    );
     assert!(msg.contains("rec\\u{1b}]0;pwned\\u{7}.csv"), "{msg}");
     assert!(msg.contains("not a number: `\\u{1b}[2Jboom`"), "{msg}");
 }
@@ -221,7 +240,10 @@ fn report_md_escapes_html_from_file_names() {
     assert!(run.status.success(), "{}", stderr(&run));
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(!md.contains("<img"), "{md}");
-    assert!(md.contains("&lt;img src=x onerror=alert(1)&gt;.toml"), "{md}");
+    assert!(
+        md.contains("&lt;img src=x onerror=alert(1)&gt;.toml"),
+        "{md}"
+    );
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(!html.contains("<img src=x"));
 }
@@ -283,7 +305,13 @@ fn script_text_in_the_model_list_reaches_the_terminal_escaped() {
         .unwrap();
     assert!(run.status.success(), "{}", stderr(&run));
     let text = stdout(&run);
-    assert!(!run.stdout.contains(&0x1b) && !run.stdout.contains(&0x07), "{text:?}");
-    assert!(text.contains("Evil \\u{1b}[31mred\\u{1b}[0m model."), "{text}");
+    assert!(
+        !run.stdout.contains(&0x1b) && !run.stdout.contains(&0x07),
+        "{text:?}"
+    );
+    assert!(
+        text.contains("Evil \\u{1b}[31mred\\u{1b}[0m model."),
+        "{text}"
+    );
     assert!(text.contains("doc \\u{1b}]0;title\\u{7} here"), "{text}");
 }
