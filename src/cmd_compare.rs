@@ -22,10 +22,12 @@ use stf_core::simulate::Simulation;
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
-use crate::output::{prepare_dir, write_atomic, write_json};
+use crate::output::{write_atomic, write_json};
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
 use crate::reporting::{frequency_section, record_sections, write_report};
+use crate::results_dir::{wrote_line, ResultsDir};
+use crate::say;
 
 /// The measured record's regimes.
 pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {
@@ -125,8 +127,9 @@ fn regime_json(c: &Comparison) -> Value {
     Value::Object(m)
 }
 
-/// Run `stf-lab compare`.
-pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
+/// Run `stf-lab compare`: the results are built in a staging folder and swapped in as a
+/// whole ([`ResultsDir`]).
+pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let mut exp = Experiment::load(exp_path)?;
     let data = load_data(&mut exp)?;
     if data.level != FitLevel::Force {
@@ -136,7 +139,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         );
     }
     let validation = crate::validation::load(&exp, &data)?;
-    prepare_dir(out, force)?;
+    let results = ResultsDir::begin(out_arg, force)?;
+    let out = results.path();
     let measured = measured_regimes(&exp, &data)?;
     let mut fits = fit_all(&exp, &data, &Progress::new(quiet))?;
     if let Some(rec) = &validation {
@@ -337,7 +341,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         &labels,
         &comparisons,
     )?;
-    write_atomic(&out.join("compare.md"), md.as_bytes())?;
+    write_atomic(
+        &out.join("compare.md"),
+        crate::report::md_text(&md).as_bytes(),
+    )?;
     if exp.output.report {
         // The report: regimes table, frequency response, the record and the fits.
         let mut curves = vec![frf(
@@ -459,10 +466,15 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             out,
         )?;
     }
-    print!("{md}");
-    println!(
-        "wrote {}/compare.json, compare.md, compare.csv, cycles.csv, report.html, report.md and figures/",
-        out.display()
+    results.commit()?;
+    say!("{}", md.strip_suffix('\n').unwrap_or(&md));
+    say!(
+        "{}",
+        wrote_line(
+            out_arg,
+            &["compare.json", "compare.md", "compare.csv", "cycles.csv"],
+            exp.output.report
+        )
     );
     Ok(())
 }

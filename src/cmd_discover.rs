@@ -27,14 +27,16 @@ use stf_core::model_sum::ModelSum;
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, std_errors_json, system_param, FitData};
 use crate::model_config::resolve;
-use crate::output::{prepare_dir, write_json};
+use crate::output::write_json;
 use crate::progress::{discovery_observer, Progress};
 use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
 };
 use crate::reporting::{record_sections, write_report};
+use crate::results_dir::{wrote_line, ResultsDir};
 use crate::validation::{DiscoveryScore, ValidationRecord};
+use crate::{say, tell};
 
 /// The effects of docs/ARCHITECTURE.md §5, the default candidates.
 pub const EFFECTS: [&str; 8] = [
@@ -79,10 +81,10 @@ fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -
 /// `held_out` line (the held-out cycles and the validation record).
 fn print_steps(found: &Discovery, summary: &str, held_out: &str) {
     for step in &found.steps {
-        println!("  {}", step.verdict);
+        say!("  {}", step.verdict);
     }
-    println!("{summary}");
-    println!("  {held_out}");
+    say!("{summary}");
+    say!("  {held_out}");
 }
 
 /// The effects named, or `none`.
@@ -110,7 +112,8 @@ fn force_fit_settings(from: &FitSettings) -> FitSettings {
 }
 
 /// Run `stf-lab discover`.
-pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
+/// The results are built in a staging folder and swapped in as a whole ([`ResultsDir`]).
+pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let mut exp = Experiment::load(exp_path)?;
     let Some(spec) = exp.discover.clone() else {
         bail!(
@@ -124,10 +127,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     })?;
     let spec = &spec;
     if let Some(line) = estimate_line(&data) {
-        println!("{line}");
+        say!("{line}");
     }
     let validation = crate::validation::load(&exp, &data)?;
-    prepare_dir(out, force)?;
+    let results = ResultsDir::begin(out_arg, force)?;
+    let out = results.path();
     let (base, candidates) = models_of(&exp, spec, &data)?;
     let cycles = crate::fitting::cycles_of(&data)?;
     let mut settings = settings_of(&exp, spec, data.level);
@@ -140,7 +144,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     };
     settings.observer = discovery_observer(bar.clone(), unit, scale);
     if data.level == FitLevel::Trajectory {
-        return run_trajectory(
+        run_trajectory(
             &exp,
             &data,
             base,
@@ -149,10 +153,20 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             &settings,
             (out, validation.as_ref()),
             (quiet, &bar),
+        )?;
+        results.commit()?;
+        say!(
+            "{}",
+            wrote_line(
+                out_arg,
+                &["discovery.json", "discovered.csv"],
+                exp.output.report
+            )
         );
+        return Ok(());
     }
     if !quiet {
-        eprintln!(
+        tell!(
             "discovering from `{}` over {} candidates on {} cycles…",
             spec.base,
             candidates.len(),
@@ -177,7 +191,16 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
         force_report(&exp, &data, &found, score.as_ref(), out)?;
     }
 
-    print_force(spec, &found, score.as_ref(), (&toml_entry, wall), out);
+    results.commit()?;
+    print_force(spec, &found, score.as_ref(), (&toml_entry, wall));
+    say!(
+        "{}",
+        wrote_line(
+            out_arg,
+            &["discovery.json", "discovered.csv"],
+            exp.output.report
+        )
+    );
     Ok(())
 }
 
@@ -236,11 +259,12 @@ fn print_force(
     found: &Discovery,
     score: Option<&DiscoveryScore>,
     (toml_entry, wall): (&str, f64),
-    out: &Path,
 ) {
-    println!(
+    say!(
         "base `{}`: gap {:.4} N; {}",
-        spec.base, found.gap_before, found.where_before.summary
+        spec.base,
+        found.gap_before,
+        found.where_before.summary
     );
     let summary = format!(
         "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
@@ -256,14 +280,9 @@ fn print_force(
         &held_out_and_validation(found.holdout_cycles, score, "N", 1.0),
     );
     for note in &found.notes {
-        println!("  note: {note}");
+        say!("  note: {note}");
     }
-    println!("final model, as an experiment entry:\n{toml_entry}");
-    println!(
-        "wrote {0}/discovery.json, {0}/discovered.csv, {0}/report.html, {0}/report.md and \
-         {0}/figures/",
-        out.display()
-    );
+    say!("final model, as an experiment entry:\n{toml_entry}");
 }
 
 /// The held-out cycles every step was scored on and, with `[validate]`, the base's and the
@@ -478,7 +497,7 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
     let mut kept = Vec::new();
     for name in names {
         match repeated.iter().find(|(_, o)| o == name) {
-            Some((p, _)) if !quiet => eprintln!(
+            Some((p, _)) if !quiet => tell!(
                 "`{name}` is not refitted: the base's `{p}` is the same term (give `[fit] system` \
                  to choose)"
             ),
@@ -509,7 +528,7 @@ fn run_trajectory(
     let settings = settings.clone();
     let started = Instant::now();
     if !quiet {
-        eprintln!(
+        tell!(
             "discovering from `{}` at trajectory level (refitting {}) over {} candidates on {} \
              cycles…",
             spec.base,
@@ -543,11 +562,7 @@ fn run_trajectory(
     );
     let held_out = held_out_and_validation(found.holdout_cycles, score.as_ref(), "mm", 1e3);
     print_steps(found, &summary, &held_out);
-    println!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
-    println!(
-        "wrote {0}/discovery.json and {0}/discovered.csv",
-        out.display()
-    );
+    say!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
     Ok(())
 }
 

@@ -24,14 +24,17 @@ use crate::fitting::{
     ModelFit,
 };
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
-use crate::output::{prepare_dir, write_columns, write_json};
+use crate::output::{write_columns, write_json};
 use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
+use crate::results_dir::{wrote_line, ResultsDir};
+use crate::say;
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
 use stf_core::system::OscillatorParams;
 
-/// Run `stf-lab fit`.
+/// Run `stf-lab fit`: the results are built in a staging folder and swapped in as a whole
+/// ([`ResultsDir`]).
 pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let mut exp = Experiment::load(exp_path)?;
     let progress = Progress::new(quiet);
@@ -40,17 +43,44 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
             let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
             return Err(spec.error("validate", msg));
         }
-        prepare_dir(out, force)?;
-        return identify(&exp, out, &progress);
+        let results = ResultsDir::begin(out, force)?;
+        identify(&exp, results.path(), &progress)?;
+        results.commit()?;
+        say!(
+            "{}",
+            wrote_line(out, &["fit.json", "params.csv"], exp.output.report)
+        );
+        return Ok(());
     }
     let data = load_data(&mut exp)?;
     let validation = crate::validation::load(&exp, &data)?;
-    prepare_dir(out, force)?;
-    if let Some(line) = estimate_line(&data) {
-        println!("{line}");
+    let results = ResultsDir::begin(out, force)?;
+    write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+    results.commit()?;
+    say!(
+        "{}",
+        wrote_line(
+            out,
+            &["fit.json", "params.csv", "fitted.csv"],
+            exp.output.report
+        )
+    );
+    Ok(())
+}
+
+/// Fit every model of `exp` to `data`, print the summary and write the results into `out`.
+fn write_fits(
+    exp: &Experiment,
+    data: &FitData,
+    validation: Option<&ValidationRecord>,
+    out: &Path,
+    progress: &Progress,
+) -> Result<()> {
+    if let Some(line) = estimate_line(data) {
+        say!("{line}");
     }
-    let mut fits = fit_all(&exp, &data, &progress)?;
-    if let Some(rec) = &validation {
+    let mut fits = fit_all(exp, data, progress)?;
+    if let Some(rec) = validation {
         crate::validation::score_fits(&mut fits, rec);
     }
 
@@ -82,56 +112,65 @@ pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> 
     let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
     write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
 
-    print_summary(&data, &fits);
-    if let Some(rec) = &validation {
+    print_summary(data, &fits);
+    if let Some(rec) = validation {
         print_validation(rec, &fits);
     }
     if exp.output.report {
-        let mut sections = Vec::new();
-        if let Some(rec) = &validation {
-            sections.push(crate::reporting::validation_section(rec, &fits, out)?);
-        }
-        sections.extend(crate::reporting::record_sections(&data, &fits, out)?);
-        let forces: Vec<(&str, &[f64])> = match level {
-            FitLevel::Force => fits
-                .iter()
-                .map(|f| (f.label.as_str(), f.fitted.as_slice()))
-                .collect(),
-            FitLevel::Trajectory => Vec::new(),
-        };
-        sections.extend(crate::regime_figures::regime_section(
-            &exp, &data, &forces, out,
-        )?);
-        let mut intro = vec![
-            crate::verdict::fit_verdict(&fits, level),
-            format!(
-                "stf-lab fitted {} model(s) of {} to {}.",
-                fits.len(),
-                exp.path.display(),
-                data.record.source
-            ),
-        ];
-        if let Some(rec) = &validation {
-            intro.push(crate::reporting::validation_intro(rec, &fits));
-        }
-        let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
-        if warned > 0 {
-            intro.push(format!(
-                "⚠ {warned} of the {} fits carry warnings: see the box under Fits.",
-                fits.len()
-            ));
-        }
-        crate::reporting::write_report(
-            &format!("Fit: {}", exp.path.display()),
-            intro,
-            sections,
-            out,
-        )?;
+        write_fit_report(exp, data, validation, &fits, out)?;
     }
-    println!(
-        "wrote {0}/fit.json, {0}/params.csv, {0}/fitted.csv, {0}/report.html, {0}/report.md and {0}/figures/",
-        out.display()
-    );
+    Ok(())
+}
+
+/// The fit's report (report.html, report.md, figures/) in `out`.
+fn write_fit_report(
+    exp: &Experiment,
+    data: &FitData,
+    validation: Option<&ValidationRecord>,
+    fits: &[ModelFit],
+    out: &Path,
+) -> Result<()> {
+    let level = data.level;
+    let mut sections = Vec::new();
+    if let Some(rec) = validation {
+        sections.push(crate::reporting::validation_section(rec, fits, out)?);
+    }
+    sections.extend(crate::reporting::record_sections(data, fits, out)?);
+    let forces: Vec<(&str, &[f64])> = match level {
+        FitLevel::Force => fits
+            .iter()
+            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+            .collect(),
+        FitLevel::Trajectory => Vec::new(),
+    };
+    sections.extend(crate::regime_figures::regime_section(
+        exp, data, &forces, out,
+    )?);
+    let mut intro = vec![
+        crate::verdict::fit_verdict(fits, level),
+        format!(
+            "stf-lab fitted {} model(s) of {} to {}.",
+            fits.len(),
+            exp.path.display(),
+            data.record.source
+        ),
+    ];
+    if let Some(rec) = validation {
+        intro.push(crate::reporting::validation_intro(rec, fits));
+    }
+    let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
+    if warned > 0 {
+        intro.push(format!(
+            "⚠ {warned} of the {} fits carry warnings: see the box under Fits.",
+            fits.len()
+        ));
+    }
+    crate::reporting::write_report(
+        &format!("Fit: {}", exp.path.display()),
+        intro,
+        sections,
+        out,
+    )?;
     Ok(())
 }
 
@@ -146,7 +185,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
     } else {
         1e3
     };
-    println!(
+    say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
         if data.level == FitLevel::Force {
@@ -158,7 +197,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
         data.record.source
     );
     if let Some(drive) = &data.kinematics.drive {
-        println!("  {drive}");
+        say!("  {drive}");
     }
     for f in fits {
         let params: Vec<String> = f
@@ -168,7 +207,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
             .filter(|p| !p.fixed)
             .map(|p| format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error))
             .collect();
-        println!(
+        say!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
             f.label,
             f.result.rms * scale,
@@ -191,7 +230,7 @@ fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
         FitLevel::Force => ("N", 1.0),
         FitLevel::Trajectory => ("mm", 1e3),
     };
-    println!(
+    say!(
         "validation on {} ({} samples), fitted parameters held{}:",
         rec.spec.given,
         rec.data.record.len(),
@@ -204,7 +243,7 @@ fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
     for f in fits {
         let Some(v) = &f.validation else { continue };
         let Some(score) = &v.score else {
-            println!(
+            say!(
                 "  {:<24} not scored: {}",
                 f.label,
                 v.error.as_deref().unwrap_or("?")
@@ -218,7 +257,7 @@ fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
             .flatten()
             .map(|(r, rms)| format!("{} {:.4}", r.name(), rms * scale))
             .collect();
-        println!(
+        say!(
             "  {:<24} rms {:.4} {unit} ({:.3} of the measured RMS){}",
             f.label,
             score.rms * scale,
@@ -235,13 +274,13 @@ fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
 /// Each warning on its own line, indented under the model's line.
 fn print_warnings(warnings: &[FitWarning]) {
     for w in warnings {
-        println!("      warning: {w}");
+        say!("      warning: {w}");
     }
 }
 
 /// The terminal line of identification stage `i`, its warnings under it.
 fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitWarning]) {
-    println!(
+    say!(
         "stage {} ({}): S(μ) = {:.4} mm², {}{}",
         i + 1,
         stage.data.display(),
@@ -382,7 +421,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     finish_identification(exp, out, &system, stages, all_warnings, &rows, &outcomes)
 }
 
-/// Write the identification's fit.json, params.csv and report, and say where they went.
+/// Write the identification's fit.json, params.csv and report into `out`.
 fn finish_identification(
     exp: &Experiment,
     out: &Path,
@@ -406,13 +445,9 @@ fn finish_identification(
     });
     write_json(&out.join("fit.json"), &doc)?;
     write_params_csv(&out.join("params.csv"), rows)?;
-    println!("identified system: {}", system_line(system));
+    say!("identified system: {}", system_line(system));
     if exp.output.report {
         write_identification_report(&exp.path, outcomes, system, out)?;
     }
-    println!(
-        "wrote {0}/fit.json, {0}/params.csv, {0}/report.html, {0}/report.md and {0}/figures/",
-        out.display()
-    );
     Ok(())
 }

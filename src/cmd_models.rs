@@ -11,9 +11,14 @@ use stf_plugins::ScriptModel;
 
 fn print_params(params: &[ParamSpec]) {
     for p in params {
-        println!(
+        crate::say!(
             "    {:<10} {:>10} [{}, {}] {:<14} {}",
-            p.name, p.default, p.min, p.max, p.unit, p.doc
+            p.name,
+            p.default,
+            p.min,
+            p.max,
+            p.unit,
+            p.doc
         );
     }
 }
@@ -28,7 +33,7 @@ pub fn list(script_dir: Option<&Path>) -> Result<()> {
         None => Registry::new(),
     };
     for entry in registry.list() {
-        println!(
+        crate::say!(
             "{}{}  —  {}",
             entry.name,
             if entry.is_script { " (script)" } else { "" },
@@ -48,7 +53,7 @@ pub fn check(path: &Path) -> Result<()> {
     } else {
         "runs on the rhai VM (uses constructs outside the compiled subset)"
     };
-    println!(
+    crate::say!(
         "{}: ok, {} parameter(s); {path_taken}",
         path.display(),
         params.len()

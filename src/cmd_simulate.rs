@@ -5,6 +5,10 @@
 //! drives the oscillator linearly interpolated, as a measured force does when a record is
 //! replayed; it is written exact (the rig's sensor model has no drive-force sensor, only the
 //! displacement, STF-force and encoder noise of `SensorNoise::RIG`).
+//!
+//! The record and its sidecar are refused if they would be one file (`--out rec.json`) or
+//! replace something that is not a regular file; they are staged beside their targets and
+//! renamed into place together, the record locked for the run ([`crate::staged_files`]).
 
 use std::path::Path;
 use std::time::Instant;
@@ -20,7 +24,10 @@ use stf_core::synthetic::{sample_record, SensorNoise};
 
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;
-use crate::output::{check_overwrite, ensure_parent, write_json};
+use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
+use crate::output_lock::OutputLock;
+use crate::say;
+use crate::staged_files::{clean_stale, StagedFiles};
 
 /// Run the `[simulate]` section of `exp_path` and write the record to `out`.
 pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
@@ -32,8 +39,25 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         );
     };
     let sidecar = out.with_extension("json");
+    if check_distinct(&[("the record", out), ("its JSON sidecar", &sidecar)]).is_err() {
+        bail!(
+            "{}: the JSON sidecar is written to the record's path with the extension .json, \
+             which is the record itself; give the record another extension (e.g. .csv)",
+            out.display()
+        );
+    }
     check_overwrite(out, force)?;
     check_overwrite(&sidecar, force)?;
+    ensure_parent(out)?;
+    let _lock = OutputLock::acquire(out)?;
+    for target in [out, sidecar.as_path()] {
+        for name in clean_stale(target)? {
+            crate::tell!(
+                "note: removed {name}, left beside {} by an interrupted run",
+                target.display()
+            );
+        }
+    }
 
     // The sample times, as `Simulation::run` makes them.
     let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
@@ -82,9 +106,9 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let mut record = sample_record(&run, &noise, spec.seed, rotor);
     record.source = out.display().to_string();
 
-    ensure_parent(out)?;
+    let mut staged = StagedFiles::new();
     record
-        .write_csv(out)
+        .write_csv(&staged.stage(out))
         .with_context(|| format!("cannot write {}", out.display()))?;
 
     let omega = run.omega.as_deref();
@@ -120,9 +144,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         "record": out.display().to_string(),
         "summary": summary,
     });
-    write_json(&sidecar, &meta)?;
+    write_json(&staged.stage(&sidecar), &meta)
+        .with_context(|| format!("cannot write {}", sidecar.display()))?;
+    staged.commit()?;
 
-    println!(
+    say!(
         "simulated {:.1} s ({} samples) in {:.0} ms, {} right-hand-side calls",
         spec.t1 - spec.t0,
         run.t.len(),
@@ -131,35 +157,35 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     );
     if let Some(p) = pk {
         if p.omega.is_finite() {
-            println!(
+            say!(
                 "peak |x| = {:.2} mm at ω = {:.2} rad/s (t = {:.1} s)",
                 p.amplitude * 1e3,
                 p.omega,
                 p.t
             );
         } else {
-            println!("peak |x| = {:.2} mm at t = {:.2} s", p.amplitude * 1e3, p.t);
+            say!("peak |x| = {:.2} mm at t = {:.2} s", p.amplitude * 1e3, p.t);
         }
     }
     match (brk, omega) {
-        (Some(i), Some(w)) => println!(
+        (Some(i), Some(w)) => say!(
             "breakaway (|x| first above {:.1} mm) at ω = {:.2} rad/s (t = {:.1} s)",
             BREAKAWAY_DISPLACEMENT * 1e3,
             w[i],
             run.t[i]
         ),
-        (None, Some(_)) => println!("the trolley never broke away from sticking"),
+        (None, Some(_)) => say!("the trolley never broke away from sticking"),
         _ => {}
     }
     if free {
         if let Some(i) = stop(&run.v, MOVING_SPEED) {
-            println!(
+            say!(
                 "motion stops at t = {:.2} s, {:.2} mm from zero",
                 run.t[i],
                 run.x[i].abs() * 1e3
             );
         }
     }
-    println!("wrote {} and {}", out.display(), sidecar.display());
+    say!("wrote {} and {}", out.display(), sidecar.display());
     Ok(())
 }

@@ -7,6 +7,8 @@
 //! stf-lab compare EXP.toml --out DIR      fit, then compare models on the regime metrics
 //! stf-lab discover EXP.toml --out DIR     find, name and add the missing effect
 //! ```
+//!
+//! Every command takes `-q`/`--quiet`; `-o` is `--out` and `-f` is `--force`.
 
 #![deny(clippy::unwrap_used)]
 
@@ -14,12 +16,15 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use stf_lab::{cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt};
+use stf_lab::{cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt, tell};
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.
 #[derive(Parser)]
 #[command(name = "stf-lab", version, about)]
 struct Cli {
+    /// No progress display (before or after the command; `simulate` and `models` show none).
+    #[arg(short, long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -40,59 +45,52 @@ enum Command {
         /// The experiment file.
         experiment: PathBuf,
         /// The record to write (CSV); a JSON sidecar is written beside it.
-        #[arg(long)]
+        #[arg(short, long)]
         out: PathBuf,
         /// Replace existing output files.
-        #[arg(long)]
+        #[arg(short, long)]
         force: bool,
     },
     /// Calibrate every model of the experiment against its record.
     Fit {
         /// The experiment file.
         experiment: PathBuf,
-        /// Folder for fit.json and fitted.csv.
-        #[arg(long)]
+        /// Folder for fit.json and fitted.csv (replaced as a whole).
+        #[arg(short, long)]
         out: PathBuf,
-        /// Replace results in an existing folder.
-        #[arg(long)]
+        /// Replace the results of an existing folder.
+        #[arg(short, long)]
         force: bool,
-        /// No progress display.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Fit every model, then compare them regime by regime.
     Compare {
         /// The experiment file.
         experiment: PathBuf,
-        /// Folder for compare.json, compare.md, compare.csv and the fit results.
-        #[arg(long)]
+        /// Folder for compare.json, compare.md, compare.csv and the fit results (replaced as
+        /// a whole).
+        #[arg(short, long)]
         out: PathBuf,
-        /// Replace results in an existing folder.
-        #[arg(long)]
+        /// Replace the results of an existing folder.
+        #[arg(short, long)]
         force: bool,
-        /// No progress display.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Find, name and add the effect the base model misses; show the gap shrink.
     Discover {
         /// The experiment file (with a [discover] section).
         experiment: PathBuf,
-        /// Folder for discovery.json, the report and figures.
-        #[arg(long)]
+        /// Folder for discovery.json, the report and figures (replaced as a whole).
+        #[arg(short, long)]
         out: PathBuf,
-        /// Replace results in an existing folder.
-        #[arg(long)]
+        /// Replace the results of an existing folder.
+        #[arg(short, long)]
         force: bool,
-        /// No progress messages.
-        #[arg(long)]
-        quiet: bool,
     },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     interrupt::install();
+    let quiet = cli.quiet;
     let result = match cli.command {
         Command::Models { check, scripts } => match check {
             Some(path) => cmd_models::check(&path),
@@ -107,25 +105,22 @@ fn main() -> ExitCode {
             experiment,
             out,
             force,
-            quiet,
         } => cmd_fit::run(&experiment, &out, force, quiet),
         Command::Compare {
             experiment,
             out,
             force,
-            quiet,
         } => cmd_compare::run(&experiment, &out, force, quiet),
         Command::Discover {
             experiment,
             out,
             force,
-            quiet,
         } => cmd_discover::run(&experiment, &out, force, quiet),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            tell!("error: {e:#}");
             ExitCode::FAILURE
         }
     }

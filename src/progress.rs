@@ -1,11 +1,13 @@
 //! Progress of long work on a terminal (indicatif), silent in CI, with `--quiet`, or when
-//! standard error is not a terminal.
+//! standard error is not a terminal. Job names and messages quote model names, which may come
+//! from script files: their control characters are escaped ([`crate::terminal`]).
 
 use std::io::IsTerminal;
 
 use std::sync::Mutex;
 use std::time::Instant;
 
+use crate::terminal::escape_controls;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stf_core::discovery::{DiscoveryEvent, Observer};
 use stf_core::fit::{FitProgress, Stage};
@@ -35,7 +37,7 @@ impl Progress {
                 {
                     bar.set_style(style);
                 }
-                bar.set_prefix(name.to_string());
+                bar.set_prefix(escape_controls(name).into_owned());
                 bar.enable_steady_tick(std::time::Duration::from_millis(120));
                 bar
             }
@@ -122,12 +124,13 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
                         rms * scale
                     )
                 });
-                bar.set_message(format!(
+                let text = format!(
                     "step {step} · candidate {}/{of} `{name}`{}{}",
                     index + 1,
                     best.unwrap_or_default(),
                     left.unwrap_or_default()
-                ));
+                );
+                bar.set_message(escape_controls(&text).into_owned());
             }
             DiscoveryEvent::Scored {
                 name,

@@ -47,7 +47,16 @@ fn a_killed_fit_leaves_whole_results() {
         std::thread::sleep(Duration::from_millis(delay));
         let _ = child.kill();
         let _ = child.wait();
+        // A kill between the two renames of the folder swap leaves the old results beside
+        // the folder's place; the next run puts them back first, as here.
+        stf_lab::results_dir::repair(&dir).unwrap();
         assert_whole(&dir, rows);
+        let strays: Vec<_> = std::fs::read_dir(out.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "fit" && n != ".fit.lock")
+            .collect();
+        assert!(strays.is_empty(), "{strays:?}");
     }
 }
 
@@ -76,4 +85,42 @@ fn ctrl_c_says_what_had_finished_and_writes_nothing() {
     assert_eq!(result.status.code(), Some(130), "{msg}");
     assert!(msg.contains("interrupted"), "{msg}");
     assert!(!dir.join("fit.json").exists());
+}
+
+#[test]
+fn sigterm_removes_the_staged_folder_and_keeps_the_old_results() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("fit");
+    let first = fit(&dir, "experiments/power_law_fit.toml")
+        .output()
+        .unwrap();
+    assert!(first.status.success());
+    let before = std::fs::read(dir.join("fit.json")).unwrap();
+    let child = fit(&dir, "experiments/paper_identification.toml")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The identification's second stage takes seconds: the signal lands while it works.
+    std::thread::sleep(Duration::from_millis(1500));
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let result = child.wait_with_output().unwrap();
+    let msg = String::from_utf8_lossy(&result.stderr);
+    if result.status.success() {
+        // The machine was fast enough to finish first: nothing to check.
+        return;
+    }
+    assert_eq!(result.status.code(), Some(130), "{msg}");
+    assert!(msg.contains("no results were written"), "{msg}");
+    assert_eq!(std::fs::read(dir.join("fit.json")).unwrap(), before);
+    let mut left: Vec<_> = std::fs::read_dir(out.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, [".fit.lock", "fit"]);
 }

@@ -1,6 +1,8 @@
 //! Atomic file writes: the content goes to a temporary file beside the target (same folder,
 //! same extension, so format-sniffing writers such as the PNG encoder still work), which is then
-//! renamed over the target. A crash never leaves a half-written file under the final name.
+//! renamed over the target. A crash never leaves a half-written file under the final name. A
+//! target that exists and is not a regular file (a device, FIFO, socket or folder, or a link to
+//! one) is refused: the rename would put a file in its place.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -26,6 +28,11 @@ pub fn temporary_sibling(path: &Path) -> PathBuf {
 
 /// Write `bytes` to `path` atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Err(ReportError::NotRegularFile {
+            path: path.to_path_buf(),
+        });
+    }
     let tmp = temporary_sibling(path);
     let result = (|| -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
@@ -65,6 +72,16 @@ mod tests {
         write_atomic(&p, b"two").unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"two");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn refuses_to_replace_what_is_not_a_regular_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        let e = write_atomic(&sub, b"x").unwrap_err();
+        assert!(matches!(e, ReportError::NotRegularFile { .. }), "{e}");
+        assert!(sub.is_dir());
     }
 
     #[test]

@@ -30,6 +30,13 @@ pub enum ReportError {
         /// The cause.
         source: std::io::Error,
     },
+    /// The output path exists and is not a regular file: a rename would replace a device, a
+    /// FIFO, a socket or a folder.
+    #[error("{} is not a regular file (a device, FIFO, socket or folder); outputs go only to regular files or new paths", path.display())]
+    NotRegularFile {
+        /// The output path.
+        path: PathBuf,
+    },
     /// A file could not be read (a figure to inline in a report).
     #[error("cannot read {}: {source}", path.display())]
     Read {

@@ -1,5 +1,7 @@
 //! `report.md`: the same report for a terminal or a lab notebook — headings, pipe tables, and
-//! figures linked by their path relative to the Markdown file.
+//! figures linked by their path relative to the Markdown file. Markdown viewers render HTML
+//! found in the text, and the text quotes file names, column names and model names: `<`, `>`
+//! and `&` are written as entities outside code spans, as `report.html` escapes them.
 
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
@@ -8,13 +10,34 @@ use super::atomic::{ensure_dir, write_atomic};
 use super::document::{Report, Table};
 use super::ReportError;
 
+/// Text for the Markdown report: HTML's `&`, `<`, `>` as entities, except inside backtick
+/// code spans (shown literally there); an unpaired backtick leaves the whole text escaped.
+pub fn md_text(text: &str) -> String {
+    let parts: Vec<&str> = text.split('`').collect();
+    let paired = parts.len() % 2 == 1;
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, part)| {
+            if paired && i % 2 == 1 {
+                part.to_string()
+            } else {
+                part.replace('&', "&amp;")
+                    .replace('<', "&lt;")
+                    .replace('>', "&gt;")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("`")
+}
+
 fn cell(text: &str) -> String {
-    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+    md_text(text).replace('|', "\\|").replace(['\n', '\r'], " ")
 }
 
 fn table_md(out: &mut String, table: &Table) {
     if !table.caption.is_empty() {
-        let _ = writeln!(out, "**{}**\n", table.caption);
+        let _ = writeln!(out, "**{}**\n", md_text(&table.caption));
     }
     let width = table
         .rows
@@ -57,20 +80,20 @@ pub fn relative_link(target: &Path, base: &Path) -> String {
 /// The Markdown text of `report`, figure links relative to folder `base`.
 pub fn to_markdown(report: &Report, base: &Path) -> String {
     let mut out = String::new();
-    let _ = writeln!(out, "# {}\n", report.title);
+    let _ = writeln!(out, "# {}\n", md_text(&report.title));
     for p in &report.intro {
-        let _ = writeln!(out, "{p}\n");
+        let _ = writeln!(out, "{}\n", md_text(p));
     }
     let mut number = 0;
     for section in &report.sections {
-        let _ = writeln!(out, "## {}\n", section.heading);
+        let _ = writeln!(out, "## {}\n", md_text(&section.heading));
         for p in &section.paragraphs {
-            let _ = writeln!(out, "{p}\n");
+            let _ = writeln!(out, "{}\n", md_text(p));
         }
         if !section.warnings.is_empty() {
             let _ = writeln!(out, "> **⚠ Warnings: not to be trusted as it stands**\n>");
             for w in &section.warnings {
-                let _ = writeln!(out, "> - {}", w.replace(['\n', '\r'], " "));
+                let _ = writeln!(out, "> - {}", md_text(w).replace(['\n', '\r'], " "));
             }
             out.push('\n');
         }
@@ -84,7 +107,7 @@ pub fn to_markdown(report: &Report, base: &Path) -> String {
                 "![Figure {number}: {}]({})\n\n*Figure {number}.* {} (vector: [{}]({}), data: [{}]({}))\n",
                 cell(&figure.caption),
                 relative_link(&figure.files.png, base),
-                figure.caption,
+                md_text(&figure.caption),
                 relative_link(&figure.files.svg, base),
                 relative_link(&figure.files.svg, base),
                 relative_link(&figure.files.csv, base),
@@ -106,6 +129,26 @@ pub fn write_markdown(report: &Report, path: &Path) -> Result<(), ReportError> {
 mod tests {
     use super::*;
     use crate::report::{FigureFiles, FigureRef, Section};
+
+    #[test]
+    fn html_from_names_is_escaped_outside_code_spans() {
+        assert_eq!(
+            md_text("Fit: <script>alert(1)</script>.toml & `a<b`"),
+            "Fit: &lt;script&gt;alert(1)&lt;/script&gt;.toml &amp; `a<b`"
+        );
+        assert_eq!(md_text("odd ` <b>"), "odd ` &lt;b&gt;");
+        let mut report = Report::new("Fit: <img src=x onerror=alert(1)>.toml");
+        let mut s = Section::new("Fits");
+        s.tables.push(Table {
+            caption: "<b>".into(),
+            columns: vec!["<i>".into()],
+            rows: vec![vec!["<u>|".into()]],
+        });
+        report.sections.push(s);
+        let md = to_markdown(&report, Path::new("/out"));
+        assert!(!md.contains('<'), "{md}");
+        assert!(md.contains("| &lt;u&gt;\\| |"), "{md}");
+    }
 
     #[test]
     fn links_are_relative_to_the_markdown_file() {

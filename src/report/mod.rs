@@ -58,7 +58,7 @@ pub use figure::FigureFiles;
 pub use frequency_response::{frequency_response, FrfCurve, FrfRole, RegimeChange};
 pub use html::write_html;
 pub use hysteresis::hysteresis;
-pub use markdown::write_markdown;
+pub use markdown::{md_text, write_markdown};
 pub use measured_vs_fitted::{
     measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,

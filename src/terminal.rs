@@ -1,0 +1,110 @@
+//! What reaches the terminal. Messages quote text from outside — a record's column names and
+//! cells, a script's source and names, file names — and a terminal obeys the control
+//! characters in what it prints (ESC sequences move the cursor, recolour, retitle, or write
+//! over a line with CR). Every line the program prints therefore goes through
+//! [`escape_controls`]: control characters other than line feed and tab, and the bidirectional
+//! overrides that reorder a line as displayed, are shown as escapes (`\u{1b}`, `\r`).
+//!
+//! `println!` panics when standard output is a closed pipe (`stf-lab models | head -1`), so the
+//! program prints through [`say!`](crate::say) and [`tell!`](crate::tell): a closed or failed
+//! stream ends printing to it quietly while the run goes on (its results are still written).
+
+use std::borrow::Cow;
+use std::fmt;
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+static STDERR_CLOSED: AtomicBool = AtomicBool::new(false);
+
+/// Whether `c` must not reach a terminal raw: a control character other than `\n` and `\t`
+/// (C0, DEL, C1), or a bidirectional embedding, override or isolate.
+fn unsafe_char(c: char) -> bool {
+    (c.is_control() && c != '\n' && c != '\t')
+        || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
+/// `text` with its unsafe characters written as escapes: `\r`, `\u{1b}` … (a backslash is
+/// kept as it is). Text without any is returned as it is.
+pub fn escape_controls(text: &str) -> Cow<'_, str> {
+    if !text.chars().any(unsafe_char) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        match c {
+            '\r' => out.push_str("\\r"),
+            c if unsafe_char(c) => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// Write one line to `stream`, escaped, unless it is known closed; a failed write marks it
+/// closed.
+fn line(mut stream: impl Write, closed: &AtomicBool, args: fmt::Arguments) {
+    if closed.load(Ordering::Relaxed) {
+        return;
+    }
+    let text = args.to_string();
+    if writeln!(stream, "{}", escape_controls(&text)).is_err() {
+        closed.store(true, Ordering::Relaxed);
+    }
+}
+
+/// One line on standard output (use [`say!`](crate::say)).
+pub fn say_line(args: fmt::Arguments) {
+    line(std::io::stdout().lock(), &STDOUT_CLOSED, args);
+}
+
+/// One line on standard error (use [`tell!`](crate::tell)).
+pub fn tell_line(args: fmt::Arguments) {
+    line(std::io::stderr().lock(), &STDERR_CLOSED, args);
+}
+
+/// `println!` for the program: escaped, and quiet on a closed pipe.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => { $crate::terminal::say_line(format_args!($($arg)*)) };
+}
+
+/// `eprintln!` for the program: escaped, and quiet on a closed pipe.
+#[macro_export]
+macro_rules! tell {
+    ($($arg:tt)*) => { $crate::terminal::tell_line(format_args!($($arg)*)) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_controls_and_keeps_plain_text() {
+        assert!(matches!(escape_controls("t,x,f_stf"), Cow::Borrowed(_)));
+        assert_eq!(escape_controls("a\tb\nc"), "a\tb\nc");
+        assert_eq!(escape_controls("x\u{1b}[2J"), "x\\u{1b}[2J");
+        assert_eq!(escape_controls("ok\rfake"), "ok\\rfake");
+        assert_eq!(escape_controls("\u{7}\u{7f}\u{9b}"), "\\u{7}\\u{7f}\\u{9b}");
+        assert_eq!(escape_controls("a\u{202e}b"), "a\\u{202e}b");
+    }
+
+    #[test]
+    fn a_failed_stream_is_marked_closed_and_skipped() {
+        struct Broken;
+        impl Write for Broken {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::ErrorKind::BrokenPipe.into())
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let closed = AtomicBool::new(false);
+        line(Broken, &closed, format_args!("one"));
+        assert!(closed.load(Ordering::Relaxed));
+        let mut sink = Vec::new();
+        line(&mut sink, &closed, format_args!("two"));
+        assert!(sink.is_empty());
+    }
+}
