@@ -1,7 +1,8 @@
 //! End to end: a record written in a lab's own layout — two lines before the header,
 //! semicolons, decimal commas, time in ms, displacement in mm, angle in degrees, the force
 //! as a voltage with a gain, sensor offsets — is read as it is through `[data]` and fits to
-//! the truth it was made with.
+//! the truth it was made with, and scores at the sensor noise on a second record in the same
+//! layout (`[validate]`).
 
 mod common;
 
@@ -82,13 +83,24 @@ fn a_lab_layout_record_fits_to_the_truth() {
     simulate_ok(&sim, &si);
     let lab = to_lab_layout(&std::fs::read_to_string(&si).unwrap());
     std::fs::write(dir.path().join("lab.csv"), &lab).unwrap();
+    // A separate measurement in the same layout: another run of the rig (seed 6).
+    std::fs::write(&sim, SIMULATE.replace("seed = 5", "seed = 6")).unwrap();
+    let si_val = dir.path().join("si_val.csv");
+    simulate_ok(&sim, &si_val);
+    let lab_val = to_lab_layout(&std::fs::read_to_string(&si_val).unwrap());
+    std::fs::write(dir.path().join("lab_val.csv"), &lab_val).unwrap();
     let exp = dir.path().join("fit.toml");
-    std::fs::write(&exp, FIT).unwrap();
+    let validated = format!("{FIT}\n[validate]\nfile = \"lab_val.csv\"\nwindow = [2.0, 22.5]\n");
+    std::fs::write(&exp, &validated).unwrap();
 
     let out = dir.path().join("fit");
     let _ = run_ok("fit", &exp, &out);
     let fit = read_json(&out.join("fit.json"));
     let power = &fit["models"][0];
+    // Scored on the second measurement, read with the same layout and offsets: the noise.
+    let validation = power["validation_rms"].as_f64().unwrap();
+    eprintln!("validation rms {validation} N");
+    assert!(validation < 0.03, "validation rms {validation}");
     let k = power["params"]["K"].as_f64().unwrap();
     let n = power["params"]["n"].as_f64().unwrap();
     assert!((k / 4.0 - 1.0).abs() < 0.03, "K = {k}");
