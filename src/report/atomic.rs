@@ -1,8 +1,11 @@
 //! Atomic file writes: the content goes to a temporary file beside the target (same folder,
-//! same extension, so format-sniffing writers such as the PNG encoder still work), which is then
-//! renamed over the target. A crash never leaves a half-written file under the final name. A
-//! target that exists and is not a regular file (a device, FIFO, socket or folder, or a link to
-//! one) is refused: the rename would put a file in its place.
+//! same extension, so format-sniffing writers such as the PNG encoder still work), synced, then
+//! renamed over the target — `tempfile`'s `NamedTempFile::persist`, which also removes the
+//! temporary when a write fails. A crash never leaves a half-written file under the final
+//! name; the temporary's name (`.name.<pid>-<n>.tmp.ext`) is one that a later run recognises
+//! as stale ([`crate::output::is_temporary_name`]). A target that exists and is not a regular
+//! file (a device, FIFO, socket or folder, or a link to one) is refused: the rename would put a
+//! file in its place.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -34,19 +37,27 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ReportError> {
         });
     }
     let tmp = temporary_sibling(path);
-    let result = (|| -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        ReportError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
+    let io = |source| ReportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = tmp
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    let mut file = tempfile::Builder::new()
+        .prefix(&name)
+        .rand_bytes(0)
+        .tempfile_in(dir)
+        .map_err(io)?;
+    file.write_all(bytes).map_err(io)?;
+    file.as_file().sync_all().map_err(io)?;
+    file.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
 }
 
 /// Create `dir` (and its parents) if missing.

@@ -7,9 +7,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::atomic::write_atomic;
-use super::base64;
 use super::document::{FigureRef, Report, Table};
 use super::ReportError;
+use base64::Engine;
 
 const STYLE: &str = r#"
 body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; color: #222;
@@ -175,7 +175,7 @@ fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<()
     let _ = writeln!(
         out,
         "<figure id=\"figure-{number}\">\n<img src=\"data:image/png;base64,{}\" alt=\"{}\"{size}>",
-        base64::encode(&png),
+        base64::engine::general_purpose::STANDARD.encode(&png),
         escape(&figure.caption)
     );
     let _ = writeln!(

@@ -25,7 +25,6 @@
 //! ```
 
 mod atomic;
-mod base64;
 mod colour;
 mod decimate;
 mod document;

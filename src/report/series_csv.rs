@@ -26,55 +26,30 @@ impl Column {
     }
 }
 
-fn quote(field: &str) -> String {
-    if field.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", field.replace('"', "\"\""))
-    } else {
-        field.to_string()
-    }
-}
-
-/// The CSV text of `columns` (numbers in Rust's shortest exact form).
+/// The CSV text of `columns` (numbers in Rust's shortest exact form; quoting by `csv`).
 pub fn to_csv(columns: &[Column]) -> String {
-    let mut out = String::new();
-    let header: Vec<String> = columns.iter().map(|c| quote(&c.name)).collect();
-    out.push_str(&header.join(","));
-    out.push('\n');
+    let mut w = csv::Writer::from_writer(Vec::new());
     let rows = columns.iter().map(|c| c.values.len()).max().unwrap_or(0);
-    for r in 0..rows {
-        let cells: Vec<String> = columns
-            .iter()
-            .map(|c| c.values.get(r).map(|v| v.to_string()).unwrap_or_default())
-            .collect();
-        out.push_str(&cells.join(","));
-        out.push('\n');
-    }
-    out
+    let written = w
+        .write_record(columns.iter().map(|c| c.name.as_str()))
+        .and_then(|()| {
+            (0..rows).try_for_each(|r| {
+                w.write_record(
+                    columns
+                        .iter()
+                        .map(|c| c.values.get(r).map(|v| v.to_string()).unwrap_or_default()),
+                )
+            })
+        });
+    // Writing into memory cannot fail.
+    debug_assert!(written.is_ok());
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
 }
 
 /// Write `columns` to `path` atomically.
 pub fn write_csv(path: &Path, columns: &[Column]) -> Result<(), ReportError> {
     write_atomic(path, to_csv(columns).as_bytes())
-}
-
-fn split_record(line: &str) -> Vec<String> {
-    let mut fields = Vec::new();
-    let mut field = String::new();
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                field.push('"');
-                chars.next();
-            }
-            ('"', _) => quoted = !quoted,
-            (',', false) => fields.push(std::mem::take(&mut field)),
-            _ => field.push(c),
-        }
-    }
-    fields.push(field);
-    fields
 }
 
 /// Read a figure CSV back into columns (empty cells end a column). For tests and for users
@@ -84,16 +59,22 @@ pub fn read_csv_columns(path: &Path) -> Result<Vec<Column>, ReportError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let mut lines = text.lines();
-    let mut columns: Vec<Column> = lines
-        .next()
-        .map(split_record)
-        .unwrap_or_default()
-        .into_iter()
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_reader(text.as_bytes());
+    let unreadable = |e: csv::Error| ReportError::Read {
+        path: path.to_path_buf(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string()),
+    };
+    let mut columns: Vec<Column> = reader
+        .headers()
+        .map_err(unreadable)?
+        .iter()
         .map(|name| Column::new(name, Vec::new()))
         .collect();
-    for line in lines {
-        for (col, cell) in columns.iter_mut().zip(split_record(line)) {
+    for row in reader.records() {
+        let row = row.map_err(unreadable)?;
+        for (col, cell) in columns.iter_mut().zip(row.iter()) {
             if !cell.is_empty() {
                 col.values.push(cell.parse().unwrap_or(f64::NAN));
             }
