@@ -38,18 +38,6 @@ use crate::results_dir::{wrote_line, ResultsDir};
 use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::{say, tell};
 
-/// The effects of docs/ARCHITECTURE.md §5, the default candidates.
-pub const EFFECTS: [&str; 8] = [
-    "viscous",
-    "power_law",
-    "added_mass",
-    "yield",
-    "wall_impact",
-    "cubic_stiffness",
-    "maxwell",
-    "jamming_on_off",
-];
-
 /// A model from `a + b + …` (names or script paths).
 fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
     let parts = spec
@@ -219,7 +207,8 @@ fn models_of(
     let mut candidates = Vec::new();
     let names: Vec<String> = match &spec.candidates {
         Some(list) => list.clone(),
-        None => EFFECTS.iter().map(|s| s.to_string()).collect(),
+        // Every built-in model is a default candidate (docs/ARCHITECTURE.md §5).
+        None => stf_models::names().into_iter().map(String::from).collect(),
     };
     for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
         let model = resolve(name, &exp.dir)
