@@ -25,6 +25,7 @@ pub mod interrupt;
 pub mod model_config;
 pub mod output;
 pub mod param_table;
+pub mod plausibility;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;
