@@ -520,18 +520,20 @@ impl Experiment {
 
     /// Validate the text of an experiment file that lives at `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Experiment> {
-        let raw: RawExperiment = toml::from_str(text).map_err(|e| {
-            let line = e.span().map_or(0, |s| line_of(text, s.start));
-            anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message().trim_end())
-        })?;
+        // Before deserialising, which refuses a number beyond a double's range without its key.
         if let Some((key, at)) = finite::first_non_finite(text) {
             return Err(error_at(
                 path,
                 line_of(text, at),
                 &key,
-                "NaN and infinity are not accepted: give a finite number",
+                "NaN, infinity and numbers beyond a double's range (±1.8e308) are not \
+                 accepted: give a finite number",
             ));
         }
+        let raw: RawExperiment = toml::from_str(text).map_err(|e| {
+            let line = e.span().map_or(0, |s| line_of(text, s.start));
+            anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message().trim_end())
+        })?;
         let cx = Ctx { file: path, text };
         let dir = path
             .parent()
@@ -1019,6 +1021,33 @@ mod tests {
 
     fn parse(text: &str) -> Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn tolerances_that_would_run_for_minutes_are_refused_with_the_range() {
+        for (text, key, range) in [
+            ("rtol = 1e-300", "integrator.rtol", "[1e-13, 1e-1]"),
+            ("atol = 1e-300", "integrator.atol", "[1e-15, 1e-2]"),
+            (
+                "h_max = 1e-300",
+                "integrator.h_max",
+                "[1e-5, 1e3] s, or 0 (no limit)",
+            ),
+            ("rtol = 0.5", "integrator.rtol", "[1e-13, 1e-1]"),
+            ("h_max = -1.0", "integrator.h_max", "or 0"),
+        ] {
+            let msg = format!(
+                "{:#}",
+                parse(&format!("[integrator]\n{text}\n")).unwrap_err()
+            );
+            assert!(
+                msg.starts_with(&format!("exp.toml:1: `{key}`:"))
+                    && msg.contains("outside the accepted range")
+                    && msg.contains(range),
+                "{msg}"
+            );
+        }
+        assert!(parse("[integrator]\nrtol = 1e-11\natol = 1e-12\nh_max = 0.0\n").is_ok());
     }
 
     #[test]

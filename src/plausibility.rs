@@ -57,7 +57,11 @@ pub fn check(exp: &Experiment, file: &std::path::Path, record: &Record) -> Resul
                 "{name}: {rate:.4} samples per second is below twice the {what} frequency \
                  ({f:.4} Hz): no record of this rig can be that coarse; is its time in ms or µs \
                  read as s? set {t_key} {off}",
-                what = if record.omega.is_some() { "rotor's" } else { "oscillator's natural" },
+                what = if record.omega.is_some() {
+                    "rotor's"
+                } else {
+                    "oscillator's natural"
+                },
             );
         }
         if span > LONG_DURATION {
@@ -100,12 +104,7 @@ fn rotor(record: &Record) -> bool {
 
 /// x (read in metres) on the rotor rig: beyond [`MAX_X`] refused, beyond [`LARGE_X`] a
 /// warning.
-fn check_x(
-    record: &Record,
-    name: &str,
-    off: &str,
-    warnings: &mut Vec<String>,
-) -> Result<()> {
+fn check_x(record: &Record, name: &str, off: &str, warnings: &mut Vec<String>) -> Result<()> {
     if !rotor(record) {
         return Ok(());
     }
@@ -135,7 +134,11 @@ fn check_x(
 
 /// With `[data] rate`, the record's own `t` column (if it has one) read as seconds: a warning
 /// when its step disagrees with the rate by more than [`RATE_TOLERANCE`].
-fn rate_against_column(exp: &Experiment, file: &std::path::Path, record: &Record) -> Option<String> {
+fn rate_against_column(
+    exp: &Experiment,
+    file: &std::path::Path,
+    record: &Record,
+) -> Option<String> {
     let TimeBase::Rate { rate, .. } = exp.data_layout.time else {
         return None;
     };

@@ -77,7 +77,10 @@ fn time_a_trillion_times_too_long_is_refused_naming_the_units_key() {
         msg.contains("exp.toml:1") && msg.contains("rec.csv") && msg.contains("days"),
         "{msg}"
     );
-    assert!(msg.contains("units = { t = \"ms\" }") && msg.contains("plausibility = false"), "{msg}");
+    assert!(
+        msg.contains("units = { t = \"ms\" }") && msg.contains("plausibility = false"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -102,18 +105,27 @@ fn x_in_mm_read_as_m_is_refused_and_a_large_one_flagged() {
         "{msg}"
     );
     // With the unit declared it is a 20 mm motion again.
-    assert_eq!(load(dir.path(), &rec, "units = { x = \"mm\" }", ""), Ok(vec![]));
+    assert_eq!(
+        load(dir.path(), &rec, "units = { x = \"mm\" }", ""),
+        Ok(vec![])
+    );
     // 0.4 m is possible, but suspicious.
     let rec = rotor_csv(dir.path(), 1.0, 20.0);
     let warnings = load(dir.path(), &rec, "", "").unwrap();
-    assert!(warnings.len() == 1 && warnings[0].contains("mm read as m"), "{warnings:?}");
+    assert!(
+        warnings.len() == 1 && warnings[0].contains("mm read as m"),
+        "{warnings:?}"
+    );
 }
 
 #[test]
 fn every_check_is_switched_off_by_the_plausibility_key() {
     let dir = tempfile::tempdir().unwrap();
     let rec = rotor_csv(dir.path(), 1.0, 1000.0);
-    assert_eq!(load(dir.path(), &rec, "plausibility = false", ""), Ok(vec![]));
+    assert_eq!(
+        load(dir.path(), &rec, "plausibility = false", ""),
+        Ok(vec![])
+    );
 }
 
 #[test]

@@ -60,8 +60,14 @@ mod tests {
             first_non_finite(text).map(|(k, _)| k).as_deref(),
             Some("models[1].params.K.value")
         );
-        assert_eq!(first_non_finite("x = 1e400\n").map(|(k, _)| k).as_deref(), Some("x"));
-        assert_eq!(first_non_finite("x = 1.5\ny = [1, 2.0]\ns = \"inf\"\n"), None);
+        assert_eq!(
+            first_non_finite("x = 1e400\n").map(|(k, _)| k).as_deref(),
+            Some("x")
+        );
+        assert_eq!(
+            first_non_finite("x = 1.5\ny = [1, 2.0]\ns = \"inf\"\n"),
+            None
+        );
     }
 }
 
@@ -101,29 +107,5 @@ mod refused_at_parse {
                 "{key}: {msg}"
             );
         }
-    }
-
-    #[test]
-    fn tolerances_that_would_run_for_minutes_are_refused_with_the_range() {
-        for (text, key, range) in [
-            ("rtol = 1e-300", "integrator.rtol", "[1e-13, 1e-1]"),
-            ("atol = 1e-300", "integrator.atol", "[1e-15, 1e-2]"),
-            ("h_max = 1e-300", "integrator.h_max", "[1e-5, 1e3] s, or 0 (no limit)"),
-            ("rtol = 0.5", "integrator.rtol", "[1e-13, 1e-1]"),
-            ("h_max = -1.0", "integrator.h_max", "or 0"),
-        ] {
-            let msg = error(&format!("[integrator]\n{text}\n"));
-            assert!(
-                msg.starts_with(&format!("exp.toml:1: `{key}`:"))
-                    && msg.contains("outside the accepted range")
-                    && msg.contains(range),
-                "{msg}"
-            );
-        }
-        let ok = Experiment::parse(
-            Path::new("exp.toml"),
-            "[integrator]\nrtol = 1e-11\natol = 1e-12\nh_max = 0.0\n",
-        );
-        assert!(ok.is_ok());
     }
 }

@@ -48,18 +48,34 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
     for (key, value, slot) in counts {
         if let Some(v) = value {
             if v == 0 {
-                return Err(cx.at(span.clone(), &format!("scripts.{key}"), "must be at least 1"));
+                return Err(cx.at(
+                    span.clone(),
+                    &format!("scripts.{key}"),
+                    "must be at least 1",
+                ));
             }
             *slot = v;
         }
     }
     for (key, value, slot) in [
-        ("call_operations", r.call_operations, &mut limits.call_operations),
-        ("run_operations", r.run_operations, &mut limits.run_operations),
+        (
+            "call_operations",
+            r.call_operations,
+            &mut limits.call_operations,
+        ),
+        (
+            "run_operations",
+            r.run_operations,
+            &mut limits.run_operations,
+        ),
     ] {
         if let Some(v) = value {
             if v == 0 {
-                return Err(cx.at(span.clone(), &format!("scripts.{key}"), "must be at least 1"));
+                return Err(cx.at(
+                    span.clone(),
+                    &format!("scripts.{key}"),
+                    "must be at least 1",
+                ));
             }
             *slot = v;
         }
@@ -75,4 +91,57 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
         limits.call_seconds = s;
     }
     Ok(ScriptRun::new(limits))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use stf_plugins::ScriptLimits;
+
+    use crate::experiment::Experiment;
+
+    fn parse(text: &str) -> anyhow::Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn the_keys_set_the_limits_and_the_rest_keep_their_defaults() {
+        let e = parse("[scripts]\nrun_operations = 5000\nmax_functions = 3\ncall_seconds = 2.5\n")
+            .unwrap();
+        assert_eq!(
+            e.scripts.limits(),
+            &ScriptLimits {
+                run_operations: 5000,
+                max_functions: 3,
+                call_seconds: 2.5,
+                ..ScriptLimits::default()
+            }
+        );
+        assert_eq!(
+            parse("").unwrap().scripts.limits(),
+            &ScriptLimits::default()
+        );
+    }
+
+    #[test]
+    fn zero_or_negative_limits_and_unknown_keys_are_refused_with_the_key() {
+        for (text, key) in [
+            (
+                "[scripts]\ncall_operations = 0\n",
+                "scripts.call_operations",
+            ),
+            ("[scripts]\nmax_bytes = 0\n", "scripts.max_bytes"),
+            ("[scripts]\ncall_seconds = -1.0\n", "scripts.call_seconds"),
+            // Not a count: TOML's own message, at the key's line.
+            ("[scripts]\nrun_operations = -5\n", "exp.toml:2:"),
+            ("[scripts]\ndeadline = 1.0\n", "deadline"),
+        ] {
+            let msg = format!("{:#}", parse(text).unwrap_err());
+            assert!(
+                msg.starts_with("exp.toml:") && msg.contains(key),
+                "{text}: {msg}"
+            );
+        }
+    }
 }
