@@ -23,6 +23,7 @@ use stf_core::discovery::{
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
+use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, std_errors_json, system_param, FitData};
@@ -39,12 +40,12 @@ use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::{say, tell};
 
 /// A model from `a + b + …` (names or script paths).
-fn model_from(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
+fn model_from(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
     let parts = spec
         .split('+')
         .map(str::trim)
         .filter(|s| *s != "none")
-        .map(|s| resolve(s, dir))
+        .map(|s| resolve(s, dir, run))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
 }
@@ -200,7 +201,7 @@ fn models_of(
     data: &FitData,
 ) -> Result<(Arc<dyn ForceModel>, Vec<Candidate>)> {
     let scales = data.scales(&exp.system);
-    let base = model_from(&spec.base, &exp.dir)
+    let base = model_from(&spec.base, &exp.dir, &exp.scripts)
         .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
     let base = widened(base, &scales);
     let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
@@ -211,7 +212,7 @@ fn models_of(
         None => stf_models::names().into_iter().map(String::from).collect(),
     };
     for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
-        let model = resolve(name, &exp.dir)
+        let model = resolve(name, &exp.dir, &exp.scripts)
             .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
         candidates.push(Candidate::new(
             model.name().to_string(),
@@ -327,7 +328,7 @@ fn write_force_results(
             "experiment_entry": toml_entry,
         },
         "fitted": crate::discovery_curves::force_curves(found, exp.system),
-        "notes": found.notes,
+        "notes": data.record_warnings.iter().chain(&found.notes).collect::<Vec<_>>(),
     });
     if let Some(score) = score {
         doc["validation"] = serde_json::to_value(score)?;
@@ -641,7 +642,7 @@ fn write_trajectory_results(
         },
         "fitted": crate::discovery_curves::trajectory_curves(tf),
         "wall_seconds": wall,
-        "notes": found.notes,
+        "notes": data.record_warnings.iter().chain(&found.notes).collect::<Vec<_>>(),
     });
     if let Some(score) = score {
         doc["validation"] = serde_json::to_value(score)?;

@@ -58,6 +58,14 @@ pub fn check(path: &Path) -> Result<()> {
         path.display(),
         params.len()
     );
+    let limits = model.limits();
+    println!(
+        "  one force() call at the defaults: {} operations on rhai's VM (budget {} a call, {} \
+         for all calls in a run; the compiled path counts none)",
+        model.force_operations(),
+        limits.call_operations,
+        limits.run_operations
+    );
     print_params(params);
     Ok(())
 }

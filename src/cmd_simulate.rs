@@ -79,7 +79,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
     if !spec.truth.is_empty() {
-        let truth = configure(&spec.truth, &exp.path, &exp.dir)?;
+        let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
         truth_json.push(json!({
             "model": truth.model.name(),
             "params": truth.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),

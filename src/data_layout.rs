@@ -45,6 +45,8 @@ pub(crate) struct RawData {
     calibration: Option<Spanned<RawCalibration>>,
     /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
     pub drive: Option<RawDrive>,
+    /// Refuse or flag implausible records (`crate::plausibility`); default true.
+    plausibility: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -65,12 +67,17 @@ pub struct DataSection {
     pub window: Option<(f64, f64)>,
     /// How to read the record.
     pub layout: ReadOptions,
+    /// Whether records are checked for plausibility (`[data] plausibility`, default true).
+    pub plausibility: bool,
 }
 
 /// Validate `[data]` (absent: no record, the default layout).
 pub(crate) fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Result<DataSection> {
     let Some(d) = data else {
-        return Ok(DataSection::default());
+        return Ok(DataSection {
+            plausibility: true,
+            ..DataSection::default()
+        });
     };
     let (span, raw) = (d.span(), d.get_ref());
     let window = raw.window.map(|[a, b]| (a, b));
@@ -85,6 +92,7 @@ pub(crate) fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Re
         line: cx.line(span.start),
         window,
         layout,
+        plausibility: raw.plausibility.unwrap_or(true),
     })
 }
 

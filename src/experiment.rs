@@ -23,6 +23,8 @@ use toml::Spanned;
 
 use crate::data_layout::{self, RawData};
 
+mod finite;
+mod scripts;
 mod validate;
 pub use validate::ValidateSpec;
 
@@ -287,6 +289,7 @@ struct RawExperiment {
     regimes: Option<Spanned<toml::Value>>,
     output: Option<RawOutput>,
     validate: Option<Spanned<validate::RawValidate>>,
+    scripts: Option<Spanned<scripts::RawScripts>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -445,6 +448,8 @@ pub struct Experiment {
     pub data_window: Option<(f64, f64)>,
     /// How to read the record: its layout (`[data]` columns, units, offsets, …).
     pub data_layout: ReadOptions,
+    /// Whether records are checked for plausibility (`[data] plausibility`).
+    pub data_plausibility: bool,
     /// `[fit]`.
     pub fit: FitSpec,
     /// `[filter]`.
@@ -459,7 +464,18 @@ pub struct Experiment {
     pub discover: Option<DiscoverSpec>,
     /// `[validate]`: the second record every fitted model is scored on.
     pub validate: Option<ValidateSpec>,
+    /// `[scripts]`: the limits script models run under, and this run's operation counters.
+    pub scripts: stf_plugins::ScriptRun,
 }
+
+/// Accepted `[integrator]` tolerances: key, least, most, and what else is accepted. Beyond
+/// them a run takes minutes to hours (`rtol = 1e-300` asks for more digits than a double
+/// holds; `h_max = 1e-300` for more steps than the integrator's limit) or means nothing.
+const TOLERANCE_RANGES: [(&str, f64, f64, &str); 3] = [
+    ("rtol", 1e-13, 0.1, ""),
+    ("atol", 1e-15, 1e-2, ""),
+    ("h_max", 1e-5, 1e3, " s, or 0 (no limit)"),
+];
 
 /// 1-based line of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
@@ -504,6 +520,16 @@ impl Experiment {
 
     /// Validate the text of an experiment file that lives at `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Experiment> {
+        // Before deserialising, which refuses a number beyond a double's range without its key.
+        if let Some((key, at)) = finite::first_non_finite(text) {
+            return Err(error_at(
+                path,
+                line_of(text, at),
+                &key,
+                "NaN, infinity and numbers beyond a double's range (±1.8e308) are not \
+                 accepted: give a finite number",
+            ));
+        }
         let raw: RawExperiment = toml::from_str(text).map_err(|e| {
             let line = e.span().map_or(0, |s| line_of(text, s.start));
             anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message().trim_end())
@@ -573,11 +599,17 @@ impl Experiment {
                 ("h_max", i.h_max, &mut integrator.h_max),
             ] {
                 if let Some(v) = value {
-                    if !(v.is_finite() && v >= 0.0) || (name != "h_max" && v == 0.0) {
+                    let (lo, hi, what) = TOLERANCE_RANGES
+                        .iter()
+                        .find(|(n, ..)| *n == name)
+                        .map(|&(_, lo, hi, what)| (lo, hi, what))
+                        .unwrap_or((0.0, f64::MAX, ""));
+                    let off = name == "h_max" && v == 0.0;
+                    if !off && !(lo..=hi).contains(&v) {
                         return Err(cx.at(
                             span.clone(),
                             &format!("integrator.{name}"),
-                            format!("{v} must be positive"),
+                            format!("{v} is outside the accepted range [{lo:e}, {hi:e}]{what}"),
                         ));
                     }
                     *slot = v;
@@ -936,9 +968,11 @@ impl Experiment {
         }
         Ok(Experiment {
             validate: validate::spec(raw.validate.as_ref(), &cx, &dir)?,
+            scripts: scripts::run(raw.scripts.as_ref(), &cx)?,
             path: path.to_path_buf(),
             data_window: data.window,
             data_layout: data.layout,
+            data_plausibility: data.plausibility,
             fit,
             kinematics,
             identify,
@@ -987,6 +1021,33 @@ mod tests {
 
     fn parse(text: &str) -> Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn tolerances_that_would_run_for_minutes_are_refused_with_the_range() {
+        for (text, key, range) in [
+            ("rtol = 1e-300", "integrator.rtol", "[1e-13, 1e-1]"),
+            ("atol = 1e-300", "integrator.atol", "[1e-15, 1e-2]"),
+            (
+                "h_max = 1e-300",
+                "integrator.h_max",
+                "[1e-5, 1e3] s, or 0 (no limit)",
+            ),
+            ("rtol = 0.5", "integrator.rtol", "[1e-13, 1e-1]"),
+            ("h_max = -1.0", "integrator.h_max", "or 0"),
+        ] {
+            let msg = format!(
+                "{:#}",
+                parse(&format!("[integrator]\n{text}\n")).unwrap_err()
+            );
+            assert!(
+                msg.starts_with(&format!("exp.toml:1: `{key}`:"))
+                    && msg.contains("outside the accepted range")
+                    && msg.contains(range),
+                "{msg}"
+            );
+        }
+        assert!(parse("[integrator]\nrtol = 1e-11\natol = 1e-12\nh_max = 0.0\n").is_ok());
     }
 
     #[test]

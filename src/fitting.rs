@@ -37,6 +37,8 @@ pub struct FitData {
     /// The linear oscillator the record shows, where the experiment's oscillator was taken
     /// from it (a trajectory-level fit of a rig driven by `u` with no `[system]`).
     pub system_estimate: Option<LinearEstimate>,
+    /// What looks suspicious about the record ([`crate::plausibility`]), already printed.
+    pub record_warnings: Vec<String>,
 }
 
 impl FitData {
@@ -104,6 +106,11 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         );
     }
     let mut record = read_record(exp, file)?;
+    let record_warnings = crate::plausibility::check(exp, file, &record)
+        .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
+    for w in &record_warnings {
+        eprintln!("warning: {w}");
+    }
     if let Some((t0, t1)) = exp.data_window {
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
@@ -154,6 +161,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         kinematics,
         level,
         system_estimate,
+        record_warnings,
     })
 }
 
@@ -551,7 +559,14 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         exp.models
             .iter()
             .map(|m| {
-                configure_for(std::slice::from_ref(m), &exp.path, &exp.dir, Some(&scales)).map(Some)
+                configure_for(
+                    std::slice::from_ref(m),
+                    &exp.path,
+                    &exp.dir,
+                    &exp.scripts,
+                    Some(&scales),
+                )
+                .map(Some)
             })
             .collect::<Result<_>>()?
     };

@@ -26,6 +26,7 @@ pub mod model_config;
 pub mod output;
 pub mod output_lock;
 pub mod param_table;
+pub mod plausibility;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;

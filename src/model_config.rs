@@ -9,6 +9,8 @@ use stf_core::data_bounds::{widened, DataScales};
 use stf_core::force_model::ForceModel;
 use stf_core::model_sum::ModelSum;
 
+use stf_plugins::ScriptRun;
+
 use crate::experiment::{ModelEntry, RawParam};
 
 /// A parameter's setting for a fit: value, bounds and whether it is held fixed.
@@ -42,16 +44,22 @@ impl ConfiguredModel {
     }
 }
 
-/// Resolve a model name or script path (relative to `dir`) to a model, through the registry.
-pub fn resolve(spec: &str, dir: &Path) -> Result<Arc<dyn ForceModel>> {
-    Ok(stf_plugins::registry::Registry::new().resolve(spec, dir)?)
+/// Resolve a model name or script path (relative to `dir`) to a model, through the registry;
+/// scripts load in `run` (the experiment's `[scripts]` limits and operation counters).
+pub fn resolve(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
+    Ok(stf_plugins::registry::Registry::in_run(run.clone()).resolve(spec, dir)?)
 }
 
 /// Build one model from experiment entries: the parts of every entry are summed (one entry
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
-/// are applied. `file` is the experiment file, `dir` its folder.
-pub fn configure(entries: &[ModelEntry], file: &Path, dir: &Path) -> Result<ConfiguredModel> {
-    configure_for(entries, file, dir, None)
+/// are applied. `file` is the experiment file, `dir` its folder, `run` where scripts load.
+pub fn configure(
+    entries: &[ModelEntry],
+    file: &Path,
+    dir: &Path,
+    run: &ScriptRun,
+) -> Result<ConfiguredModel> {
+    configure_for(entries, file, dir, run, None)
 }
 
 /// [`configure`] for a record of sizes `scales`: each model's bounds are widened where the
@@ -60,6 +68,7 @@ pub fn configure_for(
     entries: &[ModelEntry],
     file: &Path,
     dir: &Path,
+    run: &ScriptRun,
     scales: Option<&DataScales>,
 ) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
@@ -80,7 +89,7 @@ pub fn configure_for(
             .or(raw.script.as_deref())
             .ok_or_else(|| at("a model needs `name` or `script`".into()))?;
         for spec in std::iter::once(first).chain(raw.plus.iter().map(String::as_str)) {
-            let model = resolve(spec, dir).map_err(|e| at(format!("{e:#}")))?;
+            let model = resolve(spec, dir, run).map_err(|e| at(format!("{e:#}")))?;
             parts.push(match scales {
                 Some(s) => widened(model, s),
                 None => model,
@@ -154,7 +163,7 @@ mod tests {
 
     fn models_of(text: &str) -> Result<ConfiguredModel> {
         let exp = Experiment::parse(Path::new("exp.toml"), text)?;
-        configure(&exp.models, &exp.path, &exp.dir)
+        configure(&exp.models, &exp.path, &exp.dir, &exp.scripts)
     }
 
     #[test]

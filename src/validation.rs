@@ -90,6 +90,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         kinematics,
         level: estimation.level,
         system_estimate: None,
+        record_warnings: Vec::new(),
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),

@@ -170,3 +170,29 @@ fn a_script_that_reads_a_file_is_refused_at_load() {
     let msg = fit_fails(&script);
     assert_names_script_and_line(&msg, 2);
 }
+
+#[test]
+fn the_run_budget_stops_a_fit_with_a_clear_message() {
+    // A script on rhai's VM (its loop is outside the compiled subset) whose every call is
+    // well within its own budget; all its calls together exceed a small run budget.
+    let script = format!(
+        "{PARAMS}fn force(p, t, x, v, z) {{\n  let s = 0.0;\n  for i in 0..10 {{ s += p.K * v; }}\n  s / 10.0\n}}\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let exp = experiment(
+        dir.path(),
+        &script,
+        "[scripts]\nrun_operations = 200000\n\n[[models]]\nscript = \"hostile.rhai\"\n",
+    );
+    let out = run("fit", &exp, &dir.path().join("out"));
+    assert!(!out.status.success());
+    assert!(!dir.path().join("out/fit.json").exists());
+    let msg = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        msg.contains("hostile.rhai")
+            && msg.contains("run budget")
+            && msg.contains("more than 200000 operations")
+            && msg.contains("`[scripts] run_operations`"),
+        "{msg}"
+    );
+}

@@ -34,6 +34,14 @@ pub enum ScriptError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The script exceeds a size limit ([`crate::ScriptLimits`]); checked before it is compiled.
+    #[error("{path}: the script is too large to load: {message}")]
+    TooLarge {
+        /// The script's path.
+        path: String,
+        /// Which limit, with the script's size and the limit.
+        message: String,
+    },
     /// rhai could not parse the script (syntax, undefined variable, disabled `import`, …).
     #[error("{at}: syntax error: {message}")]
     Syntax {

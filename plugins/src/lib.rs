@@ -12,11 +12,14 @@
 #![deny(clippy::unwrap_used)]
 
 pub mod error;
+pub mod limits;
 pub mod registry;
 pub mod sandbox;
 mod script_compiled;
 pub mod script_model;
 mod script_params;
+mod script_size;
 
 pub use error::{ScriptError, ScriptLocation};
+pub use limits::{ScriptLimits, ScriptRun};
 pub use script_model::ScriptModel;

@@ -11,6 +11,7 @@ use stf_core::force_model::ForceModel;
 use stf_core::params::ParamSpec;
 
 use crate::error::ScriptError;
+use crate::limits::ScriptRun;
 use crate::script_model::ScriptModel;
 
 /// One model a user can pick.
@@ -30,18 +31,28 @@ pub struct ModelEntry {
 #[derive(Clone, Debug, Default)]
 pub struct Registry {
     script_dir: Option<PathBuf>,
+    run: ScriptRun,
 }
 
 impl Registry {
     /// The built-in models only (scripts are still resolved by path).
     pub fn new() -> Self {
-        Registry { script_dir: None }
+        Registry::default()
+    }
+
+    /// The built-in models; scripts load in `run` (its limits and operation budgets).
+    pub fn in_run(run: ScriptRun) -> Self {
+        Registry {
+            script_dir: None,
+            run,
+        }
     }
 
     /// The built-ins plus the `*.rhai` scripts of `dir` in listings.
     pub fn with_script_dir(dir: impl Into<PathBuf>) -> Self {
         Registry {
             script_dir: Some(dir.into()),
+            run: ScriptRun::default(),
         }
     }
 
@@ -56,7 +67,7 @@ impl Registry {
             } else {
                 base_dir.join(path)
             };
-            return Ok(Arc::new(ScriptModel::load(path)?));
+            return Ok(Arc::new(ScriptModel::load_in(path, &self.run)?));
         }
         stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
             name: spec.to_string(),

@@ -3,11 +3,13 @@
 //! One engine, built once, serves all scripts: rhai's standard packages (arithmetic, math,
 //! strings, arrays, maps: no file, network or process access exist in rhai), `import` and
 //! `eval` disabled with a module resolver that resolves nothing, `print`/`debug` discarded,
-//! strict variables (an undefined name is a compile error), and limits on call depth, string,
-//! array and map sizes. Each call to a script function gets a budget of
-//! [`MAX_OPERATIONS`] operations and [`MAX_CALL_SECONDS`] of wall-clock time (checked every
-//! [`DEADLINE_CHECK_EVERY`] operations), so a script that loops forever, or one whose every
-//! operation is slow (large strings and arrays under the size limits), is stopped with an error.
+//! strict variables (an undefined name is a compile error), and limits on call depth,
+//! expression depth, string, array and map sizes. Each call to a script function runs under a
+//! [`CallBudget`]: a number of operations — the call's own budget, or what is left of its
+//! script's budget for the run, whichever is smaller — that decides deterministically whether a
+//! call may finish, and a wall-clock deadline (checked every [`DEADLINE_CHECK_EVERY`]
+//! operations) as the last resort for a call whose single operations are slow (large strings
+//! and arrays under the size limits). See [`crate::limits`].
 //!
 //! Calls run on rhai's `grain` bytecode VM. A VM is reused per thread (it keeps its function
 //! resolution cache), so no lock is taken on the hot path and models stay `Send + Sync`.
@@ -20,10 +22,10 @@ use rhai::grain::Vm;
 use rhai::module_resolvers::DummyModuleResolver;
 use rhai::{Dynamic, Engine};
 
-/// Operations one call of a script function may perform before it is stopped.
-pub const MAX_OPERATIONS: u64 = 1_000_000;
-/// Wall-clock seconds one call of a script function may take before it is stopped.
-pub const MAX_CALL_SECONDS: f64 = 1.0;
+/// Operations one call of a script function may perform by default.
+pub const MAX_OPERATIONS: u64 = crate::limits::CALL_OPERATIONS;
+/// Wall-clock seconds one call of a script function may take by default (the last resort).
+pub const MAX_CALL_SECONDS: f64 = crate::limits::CALL_SECONDS;
 /// Operations between two looks at the clock. One look (≈ 20 ns) costs about as much as a
 /// simple operation, so this adds ≈ 1 % to a call; one operation on data at the size limits
 /// (`contains` or `sort` on a 10 000-element array) takes up to a few milliseconds, so the
@@ -31,6 +33,8 @@ pub const MAX_CALL_SECONDS: f64 = 1.0;
 pub const DEADLINE_CHECK_EVERY: u64 = 16;
 /// Deepest nesting of script function calls.
 pub const MAX_CALL_LEVELS: usize = 32;
+/// Deepest nesting of expressions at a script's top level and inside its functions.
+pub const MAX_EXPR_DEPTHS: (usize, usize) = (64, 32);
 /// Longest string a script may build, in bytes.
 pub const MAX_STRING_SIZE: usize = 10_000;
 /// Largest array a script may build.
@@ -40,6 +44,9 @@ pub const MAX_MAP_SIZE: usize = 1_000;
 
 /// The token of the error raised when a call exceeds its operation budget.
 pub(crate) const BUDGET_TOKEN: &str = "operation budget exceeded";
+/// The token of the error raised when a call exceeds what is left of its script's budget
+/// for the run.
+pub(crate) const RUN_BUDGET_TOKEN: &str = "run operation budget exceeded";
 /// The token of the error raised when a call exceeds its wall-clock deadline.
 pub(crate) const DEADLINE_TOKEN: &str = "call deadline exceeded";
 
@@ -50,6 +57,8 @@ thread_local! {
     static OPS_LAST: Cell<u64> = const { Cell::new(0) };
     /// Operation count at which the current call looks at the clock next.
     static NEXT_CLOCK_CHECK: Cell<u64> = const { Cell::new(0) };
+    /// Operations the current call may perform, and whether that is the run's remainder.
+    static LIMIT: Cell<(u64, bool)> = const { Cell::new((u64::MAX, false)) };
     /// When the current call must be finished.
     static DEADLINE: Cell<Option<Instant>> = const { Cell::new(None) };
     /// This thread's VM, reused from call to call.
@@ -70,6 +79,7 @@ fn build_engine() -> Engine {
         .disable_symbol("eval")
         .set_strict_variables(true)
         .set_max_call_levels(MAX_CALL_LEVELS)
+        .set_max_expr_depths(MAX_EXPR_DEPTHS.0, MAX_EXPR_DEPTHS.1)
         .set_max_string_size(MAX_STRING_SIZE)
         .set_max_array_size(MAX_ARRAY_SIZE)
         .set_max_map_size(MAX_MAP_SIZE)
@@ -79,8 +89,14 @@ fn build_engine() -> Engine {
         .on_progress(|count| {
             OPS_LAST.with(|last| last.set(count));
             let used = count.saturating_sub(OPS_BASE.with(Cell::get));
-            if used > MAX_OPERATIONS {
-                return Some(Dynamic::from(BUDGET_TOKEN));
+            let (limit, from_run) = LIMIT.with(Cell::get);
+            if used > limit {
+                let token = if from_run {
+                    RUN_BUDGET_TOKEN
+                } else {
+                    BUDGET_TOKEN
+                };
+                return Some(Dynamic::from(token));
             }
             past_deadline(count).then(|| Dynamic::from(DEADLINE_TOKEN))
         })
@@ -101,11 +117,26 @@ fn past_deadline(count: u64) -> bool {
         .is_some_and(|deadline| Instant::now() > deadline)
 }
 
-/// Run `f` with this thread's VM, a fresh operation budget and a fresh deadline.
+/// What one call may use.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CallBudget {
+    /// Operations.
+    pub operations: u64,
+    /// Whether `operations` is what is left of the script's run budget (else the call's own).
+    pub from_run: bool,
+    /// Wall-clock seconds, the last resort.
+    pub seconds: f64,
+}
+
+/// Run `f` with this thread's VM under `budget`; returns its result and the operations the
+/// call used.
 ///
 /// Returns `None` if the VM is already in use on this thread (a script model called from
 /// inside a script call, which the host never does).
-pub(crate) fn with_vm<R>(f: impl FnOnce(&mut Vm<'static>) -> R) -> Option<R> {
+pub(crate) fn with_vm<R>(
+    budget: CallBudget,
+    f: impl FnOnce(&mut Vm<'static>) -> R,
+) -> Option<(R, u64)> {
     VM.with(|cell| {
         let mut slot = cell.try_borrow_mut().ok()?;
         let vm = slot.get_or_insert_with(|| {
@@ -114,9 +145,14 @@ pub(crate) fn with_vm<R>(f: impl FnOnce(&mut Vm<'static>) -> R) -> Option<R> {
         });
         let base = OPS_LAST.with(Cell::get);
         OPS_BASE.with(|b| b.set(base));
+        LIMIT.with(|l| l.set((budget.operations, budget.from_run)));
         NEXT_CLOCK_CHECK.with(|next| next.set(base.saturating_add(DEADLINE_CHECK_EVERY)));
-        let deadline = Instant::now().checked_add(Duration::from_secs_f64(MAX_CALL_SECONDS));
+        let deadline = Duration::try_from_secs_f64(budget.seconds)
+            .ok()
+            .and_then(|d| Instant::now().checked_add(d));
         DEADLINE.with(|d| d.set(deadline));
-        Some(f(vm))
+        let result = f(vm);
+        let used = OPS_LAST.with(Cell::get).saturating_sub(base);
+        Some((result, used))
     })
 }

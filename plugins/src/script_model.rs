@@ -33,7 +33,10 @@
 //!   re-run on the VM, so errors and their messages are rhai's own. A power-law force call
 //!   costs tens of ns instead of ≈ 2 µs on the VM;
 //! - **VM**: anything else (loops, strings, maps, helper functions, …) runs on rhai's bytecode
-//!   VM in the sandbox of [`crate::sandbox`], with its operation budget.
+//!   VM in the sandbox of [`crate::sandbox`], with its operation budgets ([`crate::limits`]).
+//!
+//! A script larger than its [`ScriptLimits`] (bytes, functions, AST nodes, constants) is
+//! refused before rhai's bytecode compiler sees it, with the limit named.
 //!
 //! Why a translation of our own: rhai has no JIT, and its fastest engine (the `grain` bytecode
 //! VM) still pays ≈ 0.5 µs per call plus dynamic dispatch per operator, so a paper sweep with a
@@ -52,6 +55,7 @@
 use std::cell::RefCell;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 use rhai::grain::{Compiler, SharedProgram};
 use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
@@ -59,11 +63,13 @@ use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::{defaults, ParamSpec};
 
 use crate::error::{ScriptError, ScriptLocation};
+use crate::limits::{ScriptLimits, ScriptRun};
 use crate::sandbox::{
-    self, BUDGET_TOKEN, DEADLINE_TOKEN, MAX_CALL_LEVELS, MAX_CALL_SECONDS, MAX_OPERATIONS,
+    self, CallBudget, BUDGET_TOKEN, DEADLINE_TOKEN, MAX_CALL_LEVELS, RUN_BUDGET_TOKEN,
 };
 use crate::script_compiled::{self, CompiledFn};
 use crate::script_params::{param_docs, parse_params, to_f64};
+use crate::script_size;
 
 /// Most internal states a script may declare.
 pub const MAX_INTERNAL: usize = 64;
@@ -102,6 +108,12 @@ pub struct ScriptModel {
     fn_lines: Vec<(&'static str, usize)>,
     /// The compiled fast path, when the script is inside its subset.
     compiled: Option<Compiled>,
+    /// The limits its calls run under.
+    limits: ScriptLimits,
+    /// Operations its calls have used in this run (shared by every load of the script).
+    run_used: Arc<AtomicU64>,
+    /// Operations of one `force` call at the defaults, from rest, on the VM.
+    force_operations: u64,
 }
 
 /// The hot functions translated to closures ([`crate::script_compiled`]).
@@ -129,8 +141,15 @@ impl std::fmt::Debug for ScriptModel {
 }
 
 impl ScriptModel {
-    /// Load, compile and check the script at `path`; the model's name is the file stem.
+    /// Load, compile and check the script at `path`, in a run of its own with the default
+    /// limits; the model's name is the file stem.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ScriptError> {
+        Self::load_in(path, &ScriptRun::default())
+    }
+
+    /// [`ScriptModel::load`] in `run`: its limits, and its operation budget shared with every
+    /// other load of the same path in it.
+    pub fn load_in(path: impl AsRef<Path>, run: &ScriptRun) -> Result<Self, ScriptError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
         let source = std::fs::read_to_string(path).map_err(|source| ScriptError::Read {
@@ -140,12 +159,28 @@ impl ScriptModel {
         let name = path
             .file_stem()
             .map_or_else(|| shown.clone(), |s| s.to_string_lossy().into_owned());
-        Self::compile(name, shown, &source)
+        Self::compile(name, shown, &source, run)
     }
 
     /// Compile and check a script given as text; `name` is used as its name and path.
     pub fn from_source(name: &str, source: &str) -> Result<Self, ScriptError> {
-        Self::compile(name.to_string(), name.to_string(), source)
+        Self::from_source_in(name, source, &ScriptRun::default())
+    }
+
+    /// [`ScriptModel::from_source`] in `run`.
+    pub fn from_source_in(name: &str, source: &str, run: &ScriptRun) -> Result<Self, ScriptError> {
+        Self::compile(name.to_string(), name.to_string(), source, run)
+    }
+
+    /// The limits its calls run under.
+    pub fn limits(&self) -> &ScriptLimits {
+        &self.limits
+    }
+
+    /// Operations of one `force` call at the defaults, from rest, on rhai's VM (what the
+    /// load-time check measured; deterministic).
+    pub fn force_operations(&self) -> u64 {
+        self.force_operations
     }
 
     /// The script's path (or the name given to [`ScriptModel::from_source`]).
@@ -165,17 +200,29 @@ impl ScriptModel {
         self
     }
 
-    fn compile(name: String, path: String, source: &str) -> Result<Self, ScriptError> {
+    fn compile(
+        name: String,
+        path: String,
+        source: &str,
+        run: &ScriptRun,
+    ) -> Result<Self, ScriptError> {
         let at = |line: Option<usize>| ScriptLocation {
             path: path.clone(),
             line,
         };
+        let limits = run.limits();
+        let too_large = |message: String| ScriptError::TooLarge {
+            path: path.clone(),
+            message,
+        };
+        script_size::check_bytes(source, limits).map_err(too_large)?;
         let mut ast = sandbox::engine()
             .compile(source)
             .map_err(|e| ScriptError::Syntax {
                 at: at(e.1.line()),
                 message: e.0.to_string(),
             })?;
+        script_size::check_ast(&ast, limits).map_err(too_large)?;
         ast.set_source(path.as_str());
 
         let defined: Vec<(String, usize)> = ast
@@ -225,6 +272,9 @@ impl ScriptModel {
                 .filter_map(|(fname, ..)| Some((*fname, fn_line(source, fname)?)))
                 .collect(),
             compiled: None,
+            limits: limits.clone(),
+            run_used: run.counter(&path),
+            force_operations: 0,
         };
         let runtime = |e: CallError| ScriptError::Runtime {
             at: at(e.line),
@@ -265,7 +315,7 @@ impl ScriptModel {
             });
         }
         model.compiled = model.translate(&ast);
-        model
+        model.force_operations = model
             .check_at_defaults()
             .map_err(|e| ScriptError::Runtime {
                 at: at(e.line),
@@ -300,8 +350,9 @@ impl ScriptModel {
         })
     }
 
-    /// Call every function once at the defaults, from rest, so errors show at load time.
-    fn check_at_defaults(&self) -> Result<(), CallError> {
+    /// Call every function once at the defaults, from rest, so errors show at load time;
+    /// returns the operations of one `force` call on the VM.
+    fn check_at_defaults(&self) -> Result<u64, CallError> {
         let p = defaults(&self.specs);
         let mut z = vec![0.0; self.n_internal];
         if self.has_initial {
@@ -314,17 +365,34 @@ impl ScriptModel {
             z: &z,
         };
         let mut dz = vec![0.0; self.n_internal];
+        let before = self.run_used.load(Ordering::Relaxed);
+        let _ = self.call("force", self.args(&p, &s))?;
+        let force_operations = self.run_used.load(Ordering::Relaxed).saturating_sub(before);
         self.eval_force(&p, &s, &mut dz)?;
         if self.has_added_mass {
             self.eval_number("added_mass", &p, &s)?;
         }
-        Ok(())
+        Ok(force_operations)
     }
 
-    /// Call script function `fname` on this thread's VM.
+    /// What the next call may use: its own budget, or what is left of the run's.
+    fn budget(&self) -> CallBudget {
+        let left = self
+            .limits
+            .run_operations
+            .saturating_sub(self.run_used.load(Ordering::Relaxed));
+        CallBudget {
+            operations: left.min(self.limits.call_operations),
+            from_run: left < self.limits.call_operations,
+            seconds: self.limits.call_seconds,
+        }
+    }
+
+    /// Call script function `fname` on this thread's VM, under [`ScriptModel::budget`].
     fn call(&self, fname: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, CallError> {
         let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
-        sandbox::with_vm(|vm| {
+        let budget = self.budget();
+        let (result, used) = sandbox::with_vm(budget, |vm| {
             vm.call_fn_with_options::<Dynamic>(
                 options,
                 &mut Scope::new(),
@@ -336,16 +404,32 @@ impl ScriptModel {
         .ok_or_else(|| CallError {
             line: None,
             message: format!("fn {fname} called re-entrantly on one thread"),
-        })?
-        .map_err(|e| describe(*e, fname))
-        .map_err(|e| CallError {
-            line: e.line.or_else(|| {
-                self.fn_lines
-                    .iter()
-                    .find_map(|(name, line)| (*name == fname).then_some(*line))
-            }),
-            message: e.message,
-        })
+        })?;
+        let total = self
+            .run_used
+            .fetch_add(used, Ordering::Relaxed)
+            .saturating_add(used);
+        let fn_line = || {
+            self.fn_lines
+                .iter()
+                .find_map(|(name, line)| (*name == fname).then_some(*line))
+        };
+        let value = result
+            .map_err(|e| describe(*e, fname, &self.limits, used))
+            .map_err(|e| CallError {
+                line: e.line.or_else(fn_line),
+                message: e.message,
+            })?;
+        // Calls running in parallel each stay within what was left when they started; the
+        // one that carries the total past the budget fails too, so a run fails exactly when
+        // its calls need more than the budget.
+        if total > self.limits.run_operations {
+            return Err(CallError {
+                line: fn_line(),
+                message: format!("{} (in fn {fname})", run_budget_message(&self.limits)),
+            });
+        }
+        Ok(value)
     }
 
     /// The parameter map for `p`, cached per thread.
@@ -512,8 +596,18 @@ fn fn_line(source: &str, name: &str) -> Option<usize> {
         .map(|i| i + 1)
 }
 
-/// A runtime error as line + message, from the innermost function call that failed.
-fn describe(err: EvalAltResult, fname: &str) -> CallError {
+/// Why a script was stopped by its run budget.
+fn run_budget_message(limits: &ScriptLimits) -> String {
+    format!(
+        "stopped by its run budget: this script's calls in this run used more than {} \
+         operations (`[scripts] run_operations`); it is too slow for this run",
+        limits.run_operations
+    )
+}
+
+/// A runtime error as line + message, from the innermost function call that failed; `used`
+/// is the operations the call performed.
+fn describe(err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
     let mut err = err;
     let mut line = err.position().line();
     let mut callee = fname.to_string();
@@ -524,21 +618,21 @@ fn describe(err: EvalAltResult, fname: &str) -> CallError {
     }
     line = err.position().line().or(line);
     let message = match &err {
-        EvalAltResult::ErrorTerminated(token, _)
-            if token.clone().into_string().is_ok_and(|t| t == BUDGET_TOKEN) =>
-        {
-            format!("stopped after {MAX_OPERATIONS} operations in one call (an endless loop?)")
+        EvalAltResult::ErrorTerminated(token, _) if is_token(token, BUDGET_TOKEN) => format!(
+            "stopped by its operation budget: more than {} operations in one call (an endless \
+             loop?; `[scripts] call_operations`)",
+            limits.call_operations
+        ),
+        EvalAltResult::ErrorTerminated(token, _) if is_token(token, RUN_BUDGET_TOKEN) => {
+            run_budget_message(limits)
         }
-        EvalAltResult::ErrorTerminated(token, _)
-            if token
-                .clone()
-                .into_string()
-                .is_ok_and(|t| t == DEADLINE_TOKEN) =>
-        {
-            format!(
-                "stopped after {MAX_CALL_SECONDS} s in one call (an endless loop, or too slow?)"
-            )
-        }
+        EvalAltResult::ErrorTerminated(token, _) if is_token(token, DEADLINE_TOKEN) => format!(
+            "stopped by the wall-clock safety limit of {} s in one call, after {used} \
+             operations, within its operation budget of {}: its single operations are slow \
+             (work on large arrays or strings?); unlike the operation budget, this limit \
+             depends on the machine's speed and load (`[scripts] call_seconds`)",
+            limits.call_seconds, limits.call_operations
+        ),
         EvalAltResult::ErrorStackOverflow(_) => {
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")
         }
@@ -552,6 +646,11 @@ fn describe(err: EvalAltResult, fname: &str) -> CallError {
         line,
         message: format!("{message} (in fn {callee})"),
     }
+}
+
+/// Whether a termination token is `expected`.
+fn is_token(token: &Dynamic, expected: &str) -> bool {
+    token.clone().into_string().is_ok_and(|t| t == expected)
 }
 
 #[cfg(test)]

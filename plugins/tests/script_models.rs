@@ -12,7 +12,7 @@ use stf_core::params::{defaults, ParamSpec};
 use stf_core::simulate::{Simulation, Trajectory};
 use stf_core::system::OscillatorParams;
 use stf_plugins::registry::{check_script, Registry};
-use stf_plugins::{ScriptError, ScriptModel};
+use stf_plugins::{ScriptError, ScriptLimits, ScriptModel, ScriptRun};
 
 fn scripts_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts")
@@ -222,17 +222,30 @@ fn sandbox_cannot_write_files_or_spawn_processes() {
 }
 
 #[test]
-fn sandbox_stops_a_call_past_its_deadline_even_under_the_operation_budget() {
+fn sandbox_stops_a_call_past_its_wall_clock_limit_as_a_last_resort() {
     // Each `contains` on a 10 000-element array is one operation of ~10 µs or more: the
-    // operation budget alone would let this run for many seconds.
+    // operation budget alone would let this run for many seconds. The wall-clock limit (here
+    // 0.05 s) stops it, and says that this verdict depends on the machine.
     let src = format!(
         "{PARAMS}fn force(p, t, x, v, z) {{\n  let a = [];\n  a.pad(10000, 1.0);\n  loop {{ a.contains(2.0); }}\n}}"
     );
+    let run = ScriptRun::new(ScriptLimits {
+        call_seconds: 0.05,
+        ..ScriptLimits::default()
+    });
+    let err = ScriptModel::from_source_in("slow.rhai", &src, &run)
+        .err()
+        .unwrap()
+        .to_string();
     assert_names(
-        &load_err("slow.rhai", &src),
+        &err,
         "slow.rhai",
         Some(2),
-        &format!("stopped after {} s", stf_plugins::sandbox::MAX_CALL_SECONDS),
+        "wall-clock safety limit of 0.05 s",
+    );
+    assert!(
+        err.contains("call_seconds") && err.contains("machine"),
+        "{err}"
     );
 }
 

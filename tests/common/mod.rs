@@ -83,7 +83,7 @@ pub fn fitted_model(
         .as_str()
         .unwrap()
         .split(" + ")
-        .map(|p| stf_lab::model_config::resolve(p, root()).unwrap())
+        .map(|p| stf_lab::model_config::resolve(p, root(), &Default::default()).unwrap())
         .collect();
     let model: std::sync::Arc<dyn stf_core::force_model::ForceModel> =
         std::sync::Arc::new(stf_core::model_sum::ModelSum::new(parts).unwrap());

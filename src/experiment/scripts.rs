@@ -1,0 +1,147 @@
+//! The `[scripts]` section of an experiment file: the limits script models run under in this
+//! run ([`stf_plugins::ScriptLimits`]), each key optional.
+//!
+//! ```toml
+//! [scripts]
+//! call_operations = 1_000_000        # operations one call may perform
+//! run_operations = 10_000_000_000    # operations all calls of one script may perform in this run
+//! call_seconds = 10.0                # wall-clock last resort per call
+//! max_bytes = 65536                  # size limits, checked before a script is compiled
+//! max_functions = 256
+//! max_nodes = 10_000
+//! max_constants = 1_000
+//! ```
+
+use anyhow::Result;
+use serde::Deserialize;
+use stf_plugins::{ScriptLimits, ScriptRun};
+use toml::Spanned;
+
+use super::Ctx;
+
+/// `[scripts]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScripts {
+    max_bytes: Option<usize>,
+    max_functions: Option<usize>,
+    max_nodes: Option<usize>,
+    max_constants: Option<usize>,
+    call_operations: Option<u64>,
+    run_operations: Option<u64>,
+    call_seconds: Option<f64>,
+}
+
+/// The run scripts load in: the defaults, with the keys of `[scripts]` (if present).
+pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptRun> {
+    let mut limits = ScriptLimits::default();
+    let Some(raw) = raw else {
+        return Ok(ScriptRun::new(limits));
+    };
+    let (span, r) = (raw.span(), raw.get_ref());
+    let counts = [
+        ("max_bytes", r.max_bytes, &mut limits.max_bytes),
+        ("max_functions", r.max_functions, &mut limits.max_functions),
+        ("max_nodes", r.max_nodes, &mut limits.max_nodes),
+        ("max_constants", r.max_constants, &mut limits.max_constants),
+    ];
+    for (key, value, slot) in counts {
+        if let Some(v) = value {
+            if v == 0 {
+                return Err(cx.at(
+                    span.clone(),
+                    &format!("scripts.{key}"),
+                    "must be at least 1",
+                ));
+            }
+            *slot = v;
+        }
+    }
+    for (key, value, slot) in [
+        (
+            "call_operations",
+            r.call_operations,
+            &mut limits.call_operations,
+        ),
+        (
+            "run_operations",
+            r.run_operations,
+            &mut limits.run_operations,
+        ),
+    ] {
+        if let Some(v) = value {
+            if v == 0 {
+                return Err(cx.at(
+                    span.clone(),
+                    &format!("scripts.{key}"),
+                    "must be at least 1",
+                ));
+            }
+            *slot = v;
+        }
+    }
+    if let Some(s) = r.call_seconds {
+        if !(s > 0.0) {
+            return Err(cx.at(
+                span,
+                "scripts.call_seconds",
+                format!("{s} must be a positive number of seconds"),
+            ));
+        }
+        limits.call_seconds = s;
+    }
+    Ok(ScriptRun::new(limits))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use stf_plugins::ScriptLimits;
+
+    use crate::experiment::Experiment;
+
+    fn parse(text: &str) -> anyhow::Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn the_keys_set_the_limits_and_the_rest_keep_their_defaults() {
+        let e = parse("[scripts]\nrun_operations = 5000\nmax_functions = 3\ncall_seconds = 2.5\n")
+            .unwrap();
+        assert_eq!(
+            e.scripts.limits(),
+            &ScriptLimits {
+                run_operations: 5000,
+                max_functions: 3,
+                call_seconds: 2.5,
+                ..ScriptLimits::default()
+            }
+        );
+        assert_eq!(
+            parse("").unwrap().scripts.limits(),
+            &ScriptLimits::default()
+        );
+    }
+
+    #[test]
+    fn zero_or_negative_limits_and_unknown_keys_are_refused_with_the_key() {
+        for (text, key) in [
+            (
+                "[scripts]\ncall_operations = 0\n",
+                "scripts.call_operations",
+            ),
+            ("[scripts]\nmax_bytes = 0\n", "scripts.max_bytes"),
+            ("[scripts]\ncall_seconds = -1.0\n", "scripts.call_seconds"),
+            // Not a count: TOML's own message, at the key's line.
+            ("[scripts]\nrun_operations = -5\n", "exp.toml:2:"),
+            ("[scripts]\ndeadline = 1.0\n", "deadline"),
+        ] {
+            let msg = format!("{:#}", parse(text).unwrap_err());
+            assert!(
+                msg.starts_with("exp.toml:") && msg.contains(key),
+                "{text}: {msg}"
+            );
+        }
+    }
+}
