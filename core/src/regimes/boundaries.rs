@@ -17,7 +17,7 @@
 
 use serde::Serialize;
 
-use super::classify::Regime;
+use super::regime::Regime;
 
 /// Which rule placed a boundary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]

@@ -22,57 +22,16 @@
 //!    `smoothing_cycles` (5) cycles, ordered Pre < Resonance < Post, and [`find_boundaries`]
 //!    places their changes in ω, with an uncertainty.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::boundaries::{find_boundaries, Boundaries};
 use super::cycles::Cycle;
 use super::error::RegimeError;
 use super::features::{features, CycleFeatures, Signals};
 use super::noise::noise_floor;
+pub use super::regime::Regime;
 use super::rules::place;
 use super::thresholds::RegimeThresholds;
-
-/// The three behaviours of the STF along a sweep.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Regime {
-    /// Below resonance: force negligible (or only starting).
-    PreResonance,
-    /// Through resonance: large amplitude, force on most of the cycle, strong damping.
-    Resonance,
-    /// Above resonance: small amplitude, on–off force (or none).
-    PostResonance,
-}
-
-impl Regime {
-    /// The three regimes in sweep order.
-    pub const ALL: [Regime; 3] = [
-        Regime::PreResonance,
-        Regime::Resonance,
-        Regime::PostResonance,
-    ];
-
-    /// The name used in results (`pre_resonance`, `resonance`, `post_resonance`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Regime::PreResonance => "pre_resonance",
-            Regime::Resonance => "resonance",
-            Regime::PostResonance => "post_resonance",
-        }
-    }
-
-    fn rank(self) -> u8 {
-        self as u8
-    }
-
-    fn from_rank(r: u8) -> Regime {
-        match r {
-            0 => Regime::PreResonance,
-            1 => Regime::Resonance,
-            _ => Regime::PostResonance,
-        }
-    }
-}
 
 /// A record's cycles, their features and labels.
 #[derive(Clone, Debug, PartialEq, Serialize)]

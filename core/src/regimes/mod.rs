@@ -52,11 +52,12 @@ pub mod metrics;
 pub mod noise;
 pub mod prediction;
 pub mod ranking;
+pub mod regime;
 pub mod rules;
 pub mod thresholds;
 
 pub use boundaries::{find_boundaries, Boundaries, Boundary, BoundaryRule};
-pub use classify::{classify, label_cycles, median_filter, Classification, Regime};
+pub use classify::{classify, label_cycles, median_filter, Classification};
 pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, segments, Cycle};
 pub use error::RegimeError;
 pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
@@ -65,5 +66,6 @@ pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics}
 pub use noise::noise_floor;
 pub use prediction::{rms_by_regime, RegimeRms};
 pub use ranking::{rank_models, Ranking, Score};
+pub use regime::Regime;
 pub use rules::{behaviour, place, Behaviour};
 pub use thresholds::RegimeThresholds;
