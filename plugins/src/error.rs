@@ -34,6 +34,14 @@ pub enum ScriptError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The file is larger than a script may be.
+    #[error("{path}: the script {source}")]
+    TooLarge {
+        /// The script's path.
+        path: String,
+        /// Its size and the limit.
+        source: stf_core::bounded::BoundedError,
+    },
     /// rhai could not parse the script (syntax, undefined variable, disabled `import`, …).
     #[error("{at}: syntax error: {message}")]
     Syntax {

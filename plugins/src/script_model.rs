@@ -55,6 +55,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use rhai::grain::{Compiler, SharedProgram};
 use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
+use stf_core::bounded::{read_file_to_string, BoundedError};
 use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::{defaults, ParamSpec};
 
@@ -128,14 +129,30 @@ impl std::fmt::Debug for ScriptModel {
     }
 }
 
+/// The most bytes a script may hold: 1 MiB, hundreds of times a force model's script, so
+/// that a wrong path (`/dev/zero`) is refused instead of filling memory.
+pub const MAX_SCRIPT_BYTES: u64 = 1 << 20;
+
 impl ScriptModel {
-    /// Load, compile and check the script at `path`; the model's name is the file stem.
+    /// Load, compile and check the script at `path`; the model's name is the file stem. A
+    /// script over [`MAX_SCRIPT_BYTES`] is refused unread.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ScriptError> {
+        Self::load_capped(path, MAX_SCRIPT_BYTES)
+    }
+
+    /// [`ScriptModel::load`], refusing a script of more than `limit` bytes.
+    pub fn load_capped(path: impl AsRef<Path>, limit: u64) -> Result<Self, ScriptError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|source| ScriptError::Read {
-            path: shown.clone(),
-            source,
+        let source = read_file_to_string(path, limit).map_err(|e| match e {
+            BoundedError::Io(source) => ScriptError::Read {
+                path: shown.clone(),
+                source,
+            },
+            too_large => ScriptError::TooLarge {
+                path: shown.clone(),
+                source: too_large,
+            },
         })?;
         let name = path
             .file_stem()

@@ -383,6 +383,32 @@ fn unreadable_script_is_a_read_error() {
     assert!(e.to_string().contains("/nonexistent/dir/model.rhai"), "{e}");
 }
 
+#[test]
+fn a_script_over_the_cap_is_refused_with_its_size_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.rhai");
+    let text = "// padding\n".repeat(100);
+    std::fs::write(&path, &text).unwrap();
+    let e = ScriptModel::load_capped(&path, 999).unwrap_err();
+    assert!(matches!(e, ScriptError::TooLarge { .. }), "{e}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: the script is {} bytes, over the limit of 999 bytes",
+            path.display(),
+            text.len()
+        )
+    );
+    #[cfg(unix)]
+    {
+        let e = ScriptModel::load("/dev/zero").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "/dev/zero: the script holds more than the limit of 1048576 bytes (1.0 MB)"
+        );
+    }
+}
+
 // ---- the VM is shared per thread by all scripts ----
 
 #[test]
