@@ -809,6 +809,48 @@ mod tests {
     }
 
     #[test]
+    fn awkward_floats_round_trip_through_a_file_bit_for_bit() {
+        let awkward = [
+            -0.0,
+            0.0,
+            0.1,
+            5e-324,
+            -2.225073858507201e-308,
+            f64::MIN_POSITIVE,
+            1e300,
+            -f64::MAX,
+            1.0 / 3.0,
+            9.999999999999998e15,
+            -97135501438217.625,
+            1e-5,
+        ];
+        let n = awkward.len();
+        let rec = Record {
+            source: MEMORY_SOURCE.into(),
+            t: (0..n).map(|i| i as f64).collect(),
+            x: awkward.to_vec(),
+            phi: Some(awkward.iter().rev().copied().collect()),
+            f_stf: Some(awkward.iter().map(|v| -v).collect()),
+            omega: None,
+            u: None,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("awkward.csv");
+        rec.write_csv(&path).unwrap();
+        let back = Record::read_csv(&path).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back.x), bits(&rec.x));
+        assert_eq!(
+            bits(back.phi.as_deref().unwrap()),
+            bits(rec.phi.as_deref().unwrap())
+        );
+        assert_eq!(
+            bits(back.f_stf.as_deref().unwrap()),
+            bits(rec.f_stf.as_deref().unwrap())
+        );
+    }
+
+    #[test]
     fn write_refuses_an_invalid_record_and_leaves_no_file() {
         let rec = Record {
             source: MEMORY_SOURCE.into(),
@@ -921,7 +963,14 @@ mod tests {
                     "u" => rec.u.as_ref(),
                     _ => None,
                 };
-                assert_eq!(read, Some(&values), "{} column {name}", path.display());
+                // Bit for bit: `-0` stays `-0`.
+                let bits = |v: &Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    read.map(bits),
+                    Some(bits(&values)),
+                    "{} column {name}",
+                    path.display()
+                );
             }
             let copy = dir.path().join("copy.csv");
             rec.write_csv(&copy).unwrap();

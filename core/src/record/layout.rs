@@ -715,9 +715,13 @@ pub(crate) fn apply(
             (Signal::FStf, Some(c)) => c,
             _ => Calibration { a: 1.0, b: 0.0 },
         };
-        values
-            .iter_mut()
-            .for_each(|v| *v = cal.a * (k * (*v - offset)) + cal.b);
+        // SI values with no offset or calibration are kept as read: `+ 0.0` would turn a
+        // recorded `-0` into `0`, and a record must read back to the very numbers written.
+        if (offset, k, cal.a, cal.b) != (0.0, 1.0, 1.0, 0.0) {
+            values
+                .iter_mut()
+                .for_each(|v| *v = cal.a * (k * (*v - offset)) + cal.b);
+        }
     }
     raw[Signal::T.index()] = Some(t);
     Ok(raw)
