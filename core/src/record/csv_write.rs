@@ -226,7 +226,7 @@ mod tests {
     #[test]
     fn a_tie_between_two_shortest_texts_goes_to_the_even_digit() {
         // −97135501438217.625 exactly: `.62` and `.63` are both 16 digits and equally near.
-        let v = -97135501438217.625;
+        let v = -(97_135_501_438_217.0 + 0.625); // exact: the sum is a double
         assert_eq!(format_f64(v), "-97135501438217.62");
         assert_eq!(fmt_reference(v), "-97135501438217.63");
         check_against_fmt(v, &format_f64(v));
