@@ -114,7 +114,9 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let omega = run.omega.as_deref();
     let pk = peak(&run.t, &run.x, omega);
     let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
-    let experiment_text = std::fs::read_to_string(exp_path).unwrap_or_default();
+    let experiment_text =
+        crate::experiment::read_text(exp_path, crate::experiment::MAX_EXPERIMENT_BYTES)
+            .unwrap_or_default();
     let summary = json!({
         "peak_x_m": pk.map(|p| p.amplitude),
         "peak_t_s": pk.map(|p| p.t),

@@ -2,9 +2,10 @@
 //! layout a lab wrote it in — `columns` (by name or by number from 1), `units` (with a
 //! `gain` for volts and `per_rev` for encoder counts), `offsets` (a number in the column's
 //! own units, or `"rest"`: the mean over the `rest` stretch), a sample `rate` (and `t0`)
-//! instead of a time column, `separator`, `decimal`, `skip`, `header` and the force
-//! `calibration`. The keys become the core's typed [`ReadOptions`], which the readers apply;
-//! every error names the file, the line and the key, and lists what is accepted.
+//! instead of a time column, `separator`, `decimal`, `skip`, `header`, the force
+//! `calibration` and `max_bytes`, the cap on what is read. The keys become the core's typed
+//! [`ReadOptions`], which the readers apply; every error names the file, the line and the key,
+//! and lists what is accepted.
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -41,6 +42,8 @@ pub(crate) struct RawData {
     decimal: Option<Spanned<String>>,
     skip: Option<Spanned<usize>>,
     header: Option<Spanned<bool>>,
+    /// The most bytes the record file may hold (a `.mat` file: inflate to).
+    max_bytes: Option<Spanned<f64>>,
     /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
     calibration: Option<Spanned<RawCalibration>>,
     /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
@@ -123,6 +126,17 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
     }
     if let Some(c) = &raw.calibration {
         opts = opts.calibration(c.get_ref().a, c.get_ref().b);
+    }
+    if let Some(m) = &raw.max_bytes {
+        let v = *m.get_ref();
+        if !(v >= 1.0 && v <= u64::MAX as f64) {
+            return Err(cx.at(
+                m.span(),
+                "data.max_bytes",
+                format!("{v} is not a size in bytes (at least 1)"),
+            ));
+        }
+        opts = opts.max_bytes(v as u64);
     }
     opts.check().map_err(|e| {
         let setting = e.setting();
@@ -348,6 +362,21 @@ mod tests {
             "{msg}"
         );
         assert!(msg.contains(words), "{msg}");
+    }
+
+    #[test]
+    fn max_bytes_caps_the_record_and_names_its_line_when_bad() {
+        let e = parse("max_bytes = 1e9\n").unwrap();
+        assert_eq!(e.data_layout.max_bytes, 1_000_000_000);
+        assert_eq!(
+            parse("").unwrap().data_layout.max_bytes,
+            stf_core::record::DEFAULT_MAX_BYTES
+        );
+        let msg = parse("\nmax_bytes = 0\n").unwrap_err().to_string();
+        assert_eq!(
+            msg,
+            "exp.toml:5: `data.max_bytes`: 0 is not a size in bytes (at least 1)"
+        );
     }
 
     #[test]

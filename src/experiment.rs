@@ -8,8 +8,9 @@ use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
+use stf_core::bounded::{read_file_to_string, BoundedError};
 use stf_core::derivative::{Boundary, PolyFilter};
 use stf_core::excitation::RotorAngle;
 use stf_core::fit::{FitSettings, Solver};
@@ -18,6 +19,7 @@ use stf_core::kinematics::KinematicsSettings;
 use stf_core::reconstruct::DriveSmoothing;
 use stf_core::record::ReadOptions;
 use stf_core::regimes::RegimeThresholds;
+use stf_core::simulate::{count_text, sample_count, DEFAULT_MAX_SAMPLES};
 use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
@@ -156,6 +158,8 @@ struct RawSimulate {
     v0: f64,
     #[serde(default)]
     truth: Vec<Spanned<RawModel>>,
+    /// The most samples the run may make (default `DEFAULT_MAX_SAMPLES`).
+    max_samples: Option<Spanned<f64>>,
 }
 
 fn default_rate() -> f64 {
@@ -408,6 +412,8 @@ pub struct SimulateSpec {
     pub t1: f64,
     /// Samples per second.
     pub rate: f64,
+    /// The most samples the run may make (`max_samples`).
+    pub max_samples: u64,
     /// Sensor noise on or off.
     pub noise: bool,
     /// Random seed.
@@ -477,9 +483,58 @@ const TOLERANCE_RANGES: [(&str, f64, f64, &str); 3] = [
     ("h_max", 1e-5, 1e3, " s, or 0 (no limit)"),
 ];
 
+/// The most bytes an experiment file may hold: 16 MiB, thousands of times a real one (a
+/// long `profile` included), so that a wrong path (`/dev/zero`) is an error, not a full memory.
+pub const MAX_EXPERIMENT_BYTES: u64 = 16 << 20;
+
+/// `[simulate] max_samples` (default [`DEFAULT_MAX_SAMPLES`]), and the run's sample count
+/// checked against it before anything is allocated.
+fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64) -> Result<u64> {
+    let limit = match &s.max_samples {
+        None => DEFAULT_MAX_SAMPLES,
+        Some(m) => {
+            let v = *m.get_ref();
+            if !(v >= 2.0 && v <= u64::MAX as f64) {
+                return Err(cx.at(
+                    m.span(),
+                    "simulate.max_samples",
+                    format!("{v} is not a sample count (at least 2)"),
+                ));
+            }
+            v as u64
+        }
+    };
+    let count = sample_count(t0, t1, s.rate);
+    if !(count <= limit as f64) {
+        return Err(cx.at(
+            span.clone(),
+            "simulate.rate",
+            format!(
+                "{} samples/s from t0 = {t0} to t1 = {t1} s asks for {} samples, over the limit \
+                 of {limit} (`simulate.max_samples`; a run holds about 140 bytes a sample)",
+                s.rate,
+                count_text(count)
+            ),
+        ));
+    }
+    Ok(limit)
+}
+
 /// 1-based line of a byte offset.
 pub fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// The text of the experiment file at `path`, at most `limit` bytes.
+pub fn read_text(path: &Path, limit: u64) -> Result<String> {
+    read_file_to_string(path, limit).map_err(|e| match e {
+        BoundedError::TooLarge { .. } => {
+            anyhow::anyhow!("{}: the experiment file {e}", path.display())
+        }
+        BoundedError::Io(e) => {
+            anyhow::anyhow!("cannot read experiment file {}: {e}", path.display())
+        }
+    })
 }
 
 /// `FILE:LINE: `KEY`: MSG`, the form of every error about a value in an experiment file.
@@ -513,8 +568,12 @@ impl Ctx<'_> {
 impl Experiment {
     /// Read and validate an experiment file.
     pub fn load(path: &Path) -> Result<Experiment> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read experiment file {}", path.display()))?;
+        Self::load_capped(path, MAX_EXPERIMENT_BYTES)
+    }
+
+    /// [`Experiment::load`], refusing a file of more than `limit` bytes.
+    pub fn load_capped(path: &Path, limit: u64) -> Result<Experiment> {
+        let text = read_text(path, limit)?;
         Self::parse(path, &text)
     }
 
@@ -771,6 +830,7 @@ impl Experiment {
                 if !(s.rate > 0.0 && s.rate.is_finite()) {
                     return Err(cx.at(span, "simulate.rate", "must be a positive number"));
                 }
+                let max_samples = sample_limit(&cx, &span, s, t0, t1)?;
                 let mut as_json = as_json;
                 as_json["rate"] = s.rate.into();
                 as_json["noise"] = s.noise.into();
@@ -782,6 +842,7 @@ impl Experiment {
                     t0,
                     t1,
                     rate: s.rate,
+                    max_samples,
                     noise: s.noise,
                     seed: s.seed,
                     x0: s.x0,
@@ -1115,6 +1176,71 @@ params = { K = 4.0, n = 1.5 }
         assert_eq!((s.t0, s.t1), (50.0, 200.0));
         assert_eq!(s.truth[0].key, "simulate.truth[0]");
         assert_eq!(e.discover.unwrap().scout_from, Some(0));
+    }
+
+    #[test]
+    fn a_run_too_long_for_memory_names_the_key_the_samples_and_the_limit() {
+        // The issue's case: 10⁹ s at 1 MHz, 10¹⁵ samples. Parsing allocates nothing.
+        let msg = parse("[simulate]\nconstant = { omega = 6.0, t1 = 1e9 }\nrate = 1e6\n")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            msg,
+            "exp.toml:1: `simulate.rate`: 1000000 samples/s from t0 = 0 to t1 = 1000000000 s \
+             asks for 1.00e15 samples, over the limit of 10000000 (`simulate.max_samples`; a \
+             run holds about 140 bytes a sample)"
+        );
+        let msg = parse("[simulate]\nconstant = { omega = 6.0, t1 = 1.0 }\nrate = 1e300\n")
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("asks for 1.00e300 samples"), "{msg}");
+        // The limit is a setting: raised, the same run parses; lowered, a short one is refused.
+        let e = parse(
+            "[simulate]\nconstant = { omega = 6.0, t1 = 1e9 }\nrate = 1e6\nmax_samples = 2e15\n",
+        )
+        .unwrap();
+        assert_eq!(e.simulate.unwrap().max_samples, 2_000_000_000_000_000);
+        let msg = parse("[simulate]\nfree = { t1 = 1.0 }\nrate = 100.0\nmax_samples = 100\n")
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("101 samples, over the limit of 100"), "{msg}");
+        let msg = parse("[simulate]\nfree = { t1 = 1.0 }\nmax_samples = -3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.starts_with("exp.toml:3: `simulate.max_samples`: -3 is not"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn an_experiment_file_over_the_cap_is_refused_with_its_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.toml");
+        let text = "# padding\n".repeat(120);
+        std::fs::write(&path, &text).unwrap();
+        let msg = Experiment::load_capped(&path, 1000)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            msg,
+            format!(
+                "{}: the experiment file is {} bytes, over the limit of 1000 bytes",
+                path.display(),
+                text.len()
+            )
+        );
+        assert!(Experiment::load_capped(&path, text.len() as u64).is_ok());
+        #[cfg(unix)]
+        {
+            let msg = Experiment::load_capped(Path::new("/dev/zero"), 4096)
+                .unwrap_err()
+                .to_string();
+            assert_eq!(
+                msg,
+                "/dev/zero: the experiment file holds more than the limit of 4096 bytes"
+            );
+        }
     }
 
     #[test]

@@ -136,6 +136,36 @@ fn the_readme_example_prints_the_reference_figures() {
 }
 
 #[test]
+fn a_run_too_long_for_memory_is_refused_before_it_starts() {
+    // The case: 10⁹ s at 1 MHz aborted with a failed 8 PB allocation.
+    let dir = tempfile::tempdir().unwrap();
+    let exp = write(
+        dir.path(),
+        "huge.toml",
+        "[simulate]\nconstant = { omega = 6.0, t1 = 1e9 }\nrate = 1e6\n",
+    );
+    let out = dir.path().join("rec.csv");
+    let run = stf_lab()
+        .args([
+            "simulate",
+            exp.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("huge.toml:1: `simulate.rate`")
+            && stderr.contains("asks for 1.00e15 samples, over the limit of 10000000")
+            && stderr.contains("`simulate.max_samples`"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+#[test]
 fn bundled_records_regenerate_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let mut stale = Vec::new();

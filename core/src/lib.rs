@@ -27,6 +27,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod bounded;
 pub mod data_bounds;
 pub mod derivative;
 pub mod discovery;

@@ -4,5 +4,8 @@ use libfuzzer_sys::fuzz_target;
 use stf_core::record::ReadOptions;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = ReadOptions::default().read_mat_bytes(data, "fuzz.mat");
+    // A cap well under the fuzzer's memory limit: a small input may inflate to it.
+    let _ = ReadOptions::default()
+        .max_bytes(64 << 20)
+        .read_mat_bytes(data, "fuzz.mat");
 });

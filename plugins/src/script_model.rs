@@ -59,6 +59,7 @@ use std::sync::Arc;
 
 use rhai::grain::{Compiler, SharedProgram};
 use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
+use stf_core::bounded::{read_file_to_string, BoundedError};
 use stf_core::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::params::{defaults, ParamSpec};
 
@@ -152,9 +153,18 @@ impl ScriptModel {
     pub fn load_in(path: impl AsRef<Path>, run: &ScriptRun) -> Result<Self, ScriptError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|source| ScriptError::Read {
-            path: shown.clone(),
-            source,
+        // Read no more than the size limit (a wrong path such as `/dev/zero` is refused, not
+        // read into memory).
+        let limit = run.limits().max_bytes as u64;
+        let source = read_file_to_string(path, limit).map_err(|e| match e {
+            BoundedError::Io(source) => ScriptError::Read {
+                path: shown.clone(),
+                source,
+            },
+            too_large => ScriptError::TooLarge {
+                path: shown.clone(),
+                message: format!("it {too_large} (`[scripts] max_bytes`)"),
+            },
         })?;
         let name = path
             .file_stem()

@@ -396,6 +396,38 @@ fn unreadable_script_is_a_read_error() {
     assert!(e.to_string().contains("/nonexistent/dir/model.rhai"), "{e}");
 }
 
+#[test]
+fn a_script_over_the_cap_is_refused_with_its_size_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.rhai");
+    let text = "// padding\n".repeat(100);
+    std::fs::write(&path, &text).unwrap();
+    let run = ScriptRun::new(ScriptLimits {
+        max_bytes: 999,
+        ..ScriptLimits::default()
+    });
+    let e = ScriptModel::load_in(&path, &run).unwrap_err();
+    assert!(matches!(e, ScriptError::TooLarge { .. }), "{e}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: the script is too large to load: it is {} bytes, over the limit of 999 bytes \
+             (`[scripts] max_bytes`)",
+            path.display(),
+            text.len()
+        )
+    );
+    #[cfg(unix)]
+    {
+        let e = ScriptModel::load("/dev/zero").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "/dev/zero: the script is too large to load: it holds more than the limit of 65536 \
+             bytes (`[scripts] max_bytes`)"
+        );
+    }
+}
+
 // ---- the VM is shared per thread by all scripts ----
 
 #[test]

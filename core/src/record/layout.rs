@@ -410,7 +410,16 @@ pub struct ReadOptions {
     pub rest: Option<(f64, f64)>,
     /// Calibration of `f_stf`.
     pub calibration: Option<Calibration>,
+    /// The most bytes read from a record file, and the most a `.mat` file's compressed
+    /// variables may inflate to ([`DEFAULT_MAX_BYTES`] unless set).
+    pub max_bytes: u64,
 }
+
+/// The default cap on a record's bytes, 1 GiB: a CSV record of about 2·10⁷ rows of four
+/// columns (a 10⁷-row one is 0.4–0.7 GB), or 1.3·10⁸ doubles in a `.mat` file, while a
+/// wrong path (`/dev/zero`) or a `.mat` file that inflates without end stops there instead of
+/// at the machine's memory.
+pub const DEFAULT_MAX_BYTES: u64 = 1 << 30;
 
 impl Default for ReadOptions {
     fn default() -> Self {
@@ -429,6 +438,7 @@ impl Default for ReadOptions {
             time: TimeBase::Column,
             rest: None,
             calibration: None,
+            max_bytes: DEFAULT_MAX_BYTES,
         }
     }
 }
@@ -509,6 +519,12 @@ impl ReadOptions {
     /// Calibrate `f_stf`: `F = a·signal + b`.
     pub fn calibration(mut self, a: f64, b: f64) -> Self {
         self.calibration = Some(Calibration { a, b });
+        self
+    }
+
+    /// Refuse a record file over `bytes` (a `.mat` file: whose variables inflate past it).
+    pub fn max_bytes(mut self, bytes: u64) -> Self {
+        self.max_bytes = bytes;
         self
     }
 
@@ -700,9 +716,13 @@ pub(crate) fn apply(
             (Signal::FStf, Some(c)) => c,
             _ => Calibration { a: 1.0, b: 0.0 },
         };
-        values
-            .iter_mut()
-            .for_each(|v| *v = cal.a * (k * (*v - offset)) + cal.b);
+        // SI values with no offset or calibration are kept as read: `+ 0.0` would turn a
+        // recorded `-0` into `0`, and a record must read back to the very numbers written.
+        if (offset, k, cal.a, cal.b) != (0.0, 1.0, 1.0, 0.0) {
+            values
+                .iter_mut()
+                .for_each(|v| *v = cal.a * (k * (*v - offset)) + cal.b);
+        }
     }
     raw[Signal::T.index()] = Some(t);
     Ok(raw)

@@ -6,7 +6,9 @@
 //! `int32` variable anywhere in the file makes the whole file unreadable; `char`, `struct` and
 //! `cell` variables are invisible. Rows in errors are the 1-based element of the vector.
 //! The layout's names, units, offsets, rest stretch, rate and calibration apply as to a CSV
-//! file; its text settings (separator, decimal mark, skipped lines, header) do not.
+//! file; its text settings (separator, decimal mark, skipped lines, header) do not. The file
+//! is read up to `max_bytes`, and its compressed variables inflated up to the same cap
+//! (`mat_inflate`).
 
 use super::layout::{self, Raw};
 use super::{Column, Columns, ReadOptions, Record, RecordError, Signal};
@@ -17,8 +19,12 @@ const SAVE_HINT: &str = "save the signals as double vectors with `save(file, ...
 /// Read a record from a `.mat` file.
 pub(super) fn read(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
     let source = path.display().to_string();
-    let bytes =
-        std::fs::read(path).map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
+    let bytes = crate::bounded::read_file(path, opts.max_bytes).map_err(|e| match e {
+        crate::bounded::BoundedError::Io(e) => {
+            RecordError::new(&source, format!("cannot open: {e}"))
+        }
+        too_large => RecordError::new(&source, format!("{too_large} for a record (`max_bytes`)")),
+    })?;
     read_bytes(&bytes, &source, opts)
 }
 
@@ -30,7 +36,8 @@ pub(super) fn read_bytes(
 ) -> Result<Record, RecordError> {
     let source = source.to_string();
     check_header(&source, bytes)?;
-    let file = matfile::MatFile::parse(bytes).map_err(|e| {
+    let bytes = super::mat_inflate::inflate(bytes, &source, opts.max_bytes)?;
+    let file = matfile::MatFile::parse(&bytes[..]).map_err(|e| {
         RecordError::new(
             &source,
             format!(
@@ -338,6 +345,88 @@ mod tests {
         let csv = Record::read(&data.join("small_record.csv")).unwrap();
         assert_eq!(mat.len(), csv.len());
         assert_eq!((mat.t, mat.x, mat.phi), (csv.t, csv.x, csv.phi));
+    }
+
+    /// `bytes` (a file from [`mat_v5`]) with every variable zlib-compressed, as `-v7` saves.
+    fn compressed(bytes: &[u8]) -> Vec<u8> {
+        use std::io::Write;
+        let mut out = bytes[..128].to_vec();
+        let mut at = 128;
+        while at < bytes.len() {
+            let size = u32::from_le_bytes(bytes[at + 4..at + 8].try_into().unwrap()) as usize;
+            let element = &bytes[at..at + 8 + size];
+            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+            z.write_all(element).unwrap();
+            let z = z.finish().unwrap();
+            out.extend_from_slice(&15u32.to_le_bytes());
+            out.extend_from_slice(&(z.len() as u32).to_le_bytes());
+            out.extend_from_slice(&z);
+            at += 8 + size;
+        }
+        out
+    }
+
+    #[test]
+    fn compressed_variables_read_as_the_plain_ones() {
+        let plain = mat_v5(&[
+            col("t", &T, true),
+            col("x", &X, false),
+            col("phi", &PHI, true),
+            col("f_stf", &F, false),
+        ]);
+        let packed = compressed(&plain);
+        assert!(packed[128..].starts_with(&15u32.to_le_bytes()));
+        let opts = ReadOptions::default();
+        let from_plain = opts.read_mat_bytes(&plain, "p.mat").unwrap();
+        let from_packed = opts.read_mat_bytes(&packed, "z.mat").unwrap();
+        assert_eq!(
+            (from_plain.t, from_plain.x, from_plain.phi, from_plain.f_stf),
+            (
+                from_packed.t,
+                from_packed.x,
+                from_packed.phi,
+                from_packed.f_stf
+            )
+        );
+    }
+
+    #[test]
+    fn a_zlib_bomb_is_refused_at_the_inflation_cap() {
+        // Three vectors of 10⁶ zeros: 24 MB once inflated, some 70 kB compressed.
+        let zeros = vec![0.0; 1_000_000];
+        let bomb = compressed(&mat_v5(&[
+            col("t", &zeros, true),
+            col("x", &zeros, true),
+            col("phi", &zeros, true),
+        ]));
+        assert!(bomb.len() < 100_000, "{}", bomb.len());
+        let capped = ReadOptions::default().max_bytes(4_000_000);
+        let e = capped.read_mat_bytes(&bomb, "bomb.mat").unwrap_err();
+        assert_eq!(e.file, "bomb.mat");
+        assert!(
+            e.message.starts_with(
+                "its compressed variables inflate to more than the limit of 4000000 bytes (4.0 MB) \
+                 for a record (`max_bytes`; the file itself is "
+            ),
+            "{e}"
+        );
+        // Under a cap it fits in, the file is inflated and read (its time does not increase).
+        let e = ReadOptions::default()
+            .read_mat_bytes(&bomb, "bomb.mat")
+            .unwrap_err();
+        assert!(e.message.contains("not strictly increasing"), "{e}");
+        // And from disk, the file's own size is capped too.
+        let dir = tempfile::tempdir().unwrap();
+        let path = write(dir.path(), "bomb.mat", &bomb);
+        let e = ReadOptions::default()
+            .max_bytes(1000)
+            .read(&path)
+            .unwrap_err();
+        assert!(
+            e.message
+                .contains("over the limit of 1000 bytes for a record"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -28,14 +28,17 @@
 //! ```
 
 mod csv;
+mod csv_rows;
+mod csv_write;
 mod error;
 mod layout;
 mod mat;
+mod mat_inflate;
 
 pub use error::RecordError;
 pub use layout::{
     Calibration, Channel, Column, DecimalMark, LayoutError, Offset, ReadOptions, Separator, Signal,
-    TimeBase, Unit,
+    TimeBase, Unit, DEFAULT_MAX_BYTES,
 };
 
 use std::path::Path;
@@ -117,9 +120,11 @@ impl ReadOptions {
     pub fn read_csv(&self, path: &Path) -> Result<Record, RecordError> {
         let source = path.display().to_string();
         self.checked(&source)?;
+        crate::bounded::check_len(path, self.max_bytes)
+            .map_err(|e| RecordError::new(&source, format!("{e} for a record (`max_bytes`)")))?;
         let file = std::fs::File::open(path)
             .map_err(|e| RecordError::new(&source, format!("cannot open: {e}")))?;
-        csv::read(std::io::BufReader::new(file), &source, self)
+        csv::read(file, &source, self)
     }
 
     /// Read CSV text from `reader`; `source` names it in errors.
@@ -279,7 +284,7 @@ impl Record {
     /// half a file. The record is validated first.
     pub fn write_csv(&self, path: &Path) -> Result<(), RecordError> {
         self.validate()?;
-        csv::write(self, path)
+        csv_write::write(self, path)
     }
 
     /// Number of samples.
