@@ -205,7 +205,13 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
             .params
             .iter()
             .filter(|p| !p.fixed)
-            .map(|p| format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error))
+            .map(|p| {
+                format!(
+                    "{} = {}",
+                    p.name,
+                    crate::digits::with_error(p.value, p.std_error)
+                )
+            })
             .collect();
         say!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
@@ -288,7 +294,11 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
         result
             .params
             .iter()
-            .map(|p| format!("{} = {:.4} ± {:.1e}", p.name, p.value, p.std_error))
+            .map(|p| format!(
+                "{} = {}",
+                p.name,
+                crate::digits::with_error(p.value, p.std_error)
+            ))
             .collect::<Vec<_>>()
             .join(", "),
         if result.convergence.converged() {

@@ -10,6 +10,8 @@
 //! assert_eq!(carried(0.1 + 0.2).to_string(), "0.3");
 //! assert_eq!(stf_lab::digits::fixed(-0.04, 1), "0.0");
 //! assert_eq!(stf_lab::digits::fixed(-0.06, 1), "-0.1");
+//! assert_eq!(stf_lab::digits::with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
+//! assert_eq!(stf_lab::digits::with_error(3.02331, 0.313), "3.02 ± 0.31");
 //! ```
 
 use serde_json::Value;
@@ -30,6 +32,40 @@ pub fn fixed(x: f64, decimals: usize) -> String {
         return s[1..].to_string();
     }
     s
+}
+
+/// `value ± error` for a person to read: the value to the error's second significant digit,
+/// the error to two digits, each in plain notation between 10⁻³ and 10⁶ and in exponent form
+/// outside it (`5.336e-6 ± 2.6e-8`, not `0.00001 ± 2.57e-8`). Without a usable error (zero,
+/// NaN, infinite) the value gets six significant digits and the error is shown as it is.
+pub fn with_error(value: f64, error: f64) -> String {
+    let plain = |x: f64| x == 0.0 || (1e-3..1e6).contains(&x.abs());
+    let show = |x: f64, last: i32| -> String {
+        if !x.is_finite() {
+            return x.to_string();
+        }
+        let lead = if x == 0.0 {
+            last
+        } else {
+            x.abs().log10().floor() as i32
+        };
+        if plain(x) {
+            fixed(x, (-last).clamp(0, 12) as usize)
+        } else {
+            let digits = (lead - last).clamp(0, 12) as usize;
+            format!("{x:.digits$e}")
+        }
+    };
+    if !(error.is_finite() && error > 0.0) {
+        let lead = if value == 0.0 || !value.is_finite() {
+            0
+        } else {
+            value.abs().log10().floor() as i32
+        };
+        return format!("{} ± {error}", show(value, lead - 5));
+    }
+    let last = error.log10().floor() as i32 - 1;
+    format!("{} ± {}", show(value, last), show(error, last))
 }
 
 /// Every floating-point number of `value`, recursively, rounded by [`carried`]; integers
@@ -53,6 +89,19 @@ pub fn tidy_json(value: &mut Value) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_value_shows_the_digits_its_error_allows() {
+        assert_eq!(with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
+        assert_eq!(with_error(-51.13313, 8.44), "-51.1 ± 8.4");
+        assert_eq!(with_error(0.97819, 9.92e-3), "0.9782 ± 0.0099");
+        assert_eq!(with_error(1.0000432e4, 0.45), "10000.43 ± 0.45");
+        // A value far below its error keeps one digit; no error: six significant digits.
+        assert_eq!(with_error(2e-5, 5e-3), "2e-5 ± 0.0050");
+        assert_eq!(with_error(1234.5678, 0.0), "1234.57 ± 0");
+        assert_eq!(with_error(1234.5678, f64::NAN), "1234.57 ± NaN");
+        assert_eq!(with_error(-0.0001, 1e-9), "-1.000000e-4 ± 1.0e-9");
+    }
 
     #[test]
     fn arithmetic_residue_goes_and_measured_digits_stay() {

@@ -109,7 +109,11 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
                     if p.fixed {
                         format!("{} = {:.5} (fixed)", p.name, p.value)
                     } else {
-                        format!("{} = {:.5} ± {:.2e}", p.name, p.value, p.std_error)
+                        format!(
+                            "{} = {}",
+                            p.name,
+                            crate::digits::with_error(p.value, p.std_error)
+                        )
                     }
                 })
                 .collect();
