@@ -84,7 +84,9 @@ fn ctrl_c_says_what_had_finished_and_writes_nothing() {
     }
     assert_eq!(result.status.code(), Some(130), "{msg}");
     assert!(msg.contains("interrupted"), "{msg}");
-    assert!(!dir.join("fit.json").exists());
+    // Unless the signal came after the results were put in place, nothing is there.
+    let written = msg.contains("the results were already written");
+    assert_eq!(dir.join("fit.json").exists(), written, "{msg}");
 }
 
 #[test]
