@@ -86,14 +86,19 @@ fn an_unknown_model_is_named_with_file_line_and_the_known_models() {
         "[simulate]\nconstant = { omega = 5.0, t1 = 1.0 }\n\n[[simulate.truth]]\nname = \"viscuos\"\n",
     );
     let out = stf_lab()
-        .args(["simulate", exp.to_str().unwrap(), "--out", "unused.csv"])
+        .args([
+            "simulate",
+            exp.to_str().unwrap(),
+            "--out",
+            dir.path().join("unused.csv").to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(!out.status.success());
     let msg = String::from_utf8_lossy(&out.stderr);
     assert!(msg.contains("bad.toml:4"), "{msg}");
     assert!(msg.contains("viscuos") && msg.contains("viscous"), "{msg}");
-    assert!(!Path::new("unused.csv").exists());
+    assert!(!dir.path().join("unused.csv").exists());
 }
 
 #[test]
