@@ -14,7 +14,6 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use serde_json::json;
 use stf_core::analysis::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_SPEED};
 use stf_core::excitation::Excitation;
 use stf_core::interpolate::Linear;
@@ -25,6 +24,7 @@ use stf_core::synthetic::{sample_record, SensorNoise};
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;
 use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
+use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::output_lock::OutputLock;
 use crate::say;
 use crate::staged_files::{clean_stale, StagedFiles};
@@ -80,10 +80,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let mut truth_json = Vec::new();
     if !spec.truth.is_empty() {
         let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
-        truth_json.push(json!({
-            "model": truth.model.name(),
-            "params": truth.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-        }));
+        truth_json.push(Truth {
+            model: truth.model.name().to_string(),
+            params: truth.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
+        });
         let values = truth.values();
         osc = osc
             .with_model(truth.model, values)
@@ -115,35 +115,34 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let pk = peak(&run.t, &run.x, omega);
     let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
     let experiment_text = std::fs::read_to_string(exp_path).unwrap_or_default();
-    let summary = json!({
-        "peak_x_m": pk.map(|p| p.amplitude),
-        "peak_t_s": pk.map(|p| p.t),
-        "peak_omega_rad_s": pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
-        "breakaway_omega_rad_s": brk.and_then(|i| omega.map(|w| w[i])),
-        "motion_stops_t_s": if !free { None } else { stop(&run.v, MOVING_SPEED).map(|i| run.t[i]) },
-        "samples": run.t.len(),
-        "rhs_calls": run.stats.rhs_calls,
-        "steps": run.stats.accepted,
-    });
-    let meta = json!({
-        "generator": "stf-lab simulate",
-        "version": env!("CARGO_PKG_VERSION"),
-        "experiment_file": exp_path.display().to_string(),
-        "experiment": experiment_text,
-        "simulate": spec.as_json,
-        "system": exp.system,
-        "integrator": {
-            "method": exp.integrator.method.name(),
-            "rtol": exp.integrator.rtol,
-            "atol": exp.integrator.atol,
-            "h_max": exp.integrator.h_max,
+    let summary = Summary {
+        peak_x_m: pk.map(|p| p.amplitude),
+        peak_t_s: pk.map(|p| p.t),
+        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
+        breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
+        motion_stops_t_s: if free {
+            stop(&run.v, MOVING_SPEED).map(|i| run.t[i])
+        } else {
+            None
         },
-        "truth": truth_json,
-        "noise": noise,
-        "seed": spec.seed,
-        "record": out.display().to_string(),
-        "summary": summary,
-    });
+        samples: run.t.len(),
+        rhs_calls: run.stats.rhs_calls,
+        steps: run.stats.accepted,
+    };
+    let meta = SimulateJson {
+        generator: "stf-lab simulate",
+        version: env!("CARGO_PKG_VERSION"),
+        experiment_file: exp_path.display().to_string(),
+        experiment: experiment_text,
+        simulate: &spec.as_json,
+        system: exp.system,
+        integrator: (&exp.integrator).into(),
+        truth: truth_json,
+        noise,
+        seed: spec.seed,
+        record: out.display().to_string(),
+        summary,
+    };
     write_json(&staged.stage(&sidecar), &meta)
         .with_context(|| format!("cannot write {}", sidecar.display()))?;
     staged.commit()?;
