@@ -200,7 +200,10 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
         crate::validation::score_fits(&mut fits, rec);
     }
     let c = compare_fits(&exp, &data, measured, fits)?;
-    write_json(&out.join("compare.json"), &CompareJson::new(&exp, &data, &c))?;
+    write_json(
+        &out.join("compare.json"),
+        &CompareJson::new(&exp, &data, &c),
+    )?;
     let labels = c.labels();
     let rows = compare_csv::rows(&labels, &c.comparisons);
     compare_csv::write(&out.join("compare.csv"), &rows)?;
@@ -300,7 +303,9 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         .filter(|l| l.starts_with("- "))
         .map(|l| l.trim_start_matches("- ").replace("**", ""))
         .collect();
-    regimes.paragraphs.push(duty_meaning(c.measured.on_threshold));
+    regimes
+        .paragraphs
+        .push(duty_meaning(c.measured.on_threshold));
     regimes.tables.push(errors_table(c));
     regimes
         .paragraphs

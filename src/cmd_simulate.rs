@@ -24,8 +24,8 @@ use stf_core::synthetic::{sample_record, SensorNoise};
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;
 use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
-use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::output_lock::OutputLock;
+use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::say;
 use crate::staged_files::{clean_stale, StagedFiles};
 
@@ -82,7 +82,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
         truth_json.push(Truth {
             model: truth.model.name().to_string(),
-            params: truth.params.iter().map(|p| (p.name.clone(), p.value)).collect(),
+            params: truth
+                .params
+                .iter()
+                .map(|p| (p.name.clone(), p.value))
+                .collect(),
         });
         let values = truth.values();
         osc = osc

@@ -13,8 +13,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use stf_core::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::fit::{
-    fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor,
-    TrajectoryData, TrajectoryFit,
+    fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
+    TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;

@@ -43,7 +43,7 @@ impl<'a> Columns<'a> {
         for i in 0..self.rows() {
             w.write_record(self.values.iter().map(|c| carried(c[i]).to_string()))?;
         }
-        Ok(w.into_inner().context("cannot build a CSV table")?)
+        w.into_inner().context("cannot build a CSV table")
     }
 
     /// Write the table to `path`, atomically.
@@ -63,8 +63,15 @@ mod tests {
     fn rows_stop_at_the_shortest_column_and_digits_are_carried() {
         let t = [0.0, 0.005, 0.01];
         let f = [0.1 + 0.2, -1.5];
-        let text = Columns::new().with("t", &t).with("f_stf", &f).to_csv().unwrap();
-        assert_eq!(String::from_utf8(text).unwrap(), "t,f_stf\n0,0.3\n0.005,-1.5\n");
+        let text = Columns::new()
+            .with("t", &t)
+            .with("f_stf", &f)
+            .to_csv()
+            .unwrap();
+        assert_eq!(
+            String::from_utf8(text).unwrap(),
+            "t,f_stf\n0,0.3\n0.005,-1.5\n"
+        );
     }
 
     #[test]

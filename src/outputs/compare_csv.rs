@@ -121,7 +121,48 @@ pub fn write(path: &Path, rows: &[CompareRow]) -> Result<()> {
 fn header() -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.serialize(CompareRow::default())?;
-    let text = w.into_inner().context("cannot build the header of compare.csv")?;
-    let end = text.iter().position(|b| *b == b'\n').map_or(text.len(), |i| i + 1);
+    let text = w
+        .into_inner()
+        .context("cannot build the header of compare.csv")?;
+    let end = text
+        .iter()
+        .position(|b| *b == b'\n')
+        .map_or(text.len(), |i| i + 1);
     Ok(text[..end].to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_keep_their_shortest_form_and_no_rows_still_give_the_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("compare.csv");
+        let row = CompareRow {
+            model: "power_law",
+            regime: "resonance",
+            cycles: 3,
+            label_agreement: 1.0,
+            energy_error: 0.000025,
+            ..CompareRow::default()
+        };
+        write(&path, &[row]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines = text.lines();
+        let header = lines.next().unwrap();
+        assert!(
+            header.starts_with("model,regime,cycles,force_rms_error_N,"),
+            "{header}"
+        );
+        assert_eq!(
+            lines.next().unwrap(),
+            "power_law,resonance,3,0,0,0.000025,0,0,1,0,0,0,0,0,0"
+        );
+        write(&path, &[]).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            format!("{header}\n")
+        );
+    }
 }

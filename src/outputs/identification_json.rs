@@ -27,7 +27,11 @@ pub struct IdentificationJson<'a> {
 
 impl<'a> IdentificationJson<'a> {
     /// The document of `stages` that ended with `system`.
-    pub fn new(experiment: &std::path::Path, stages: &'a [StageJson], system: OscillatorParams) -> Self {
+    pub fn new(
+        experiment: &std::path::Path,
+        stages: &'a [StageJson],
+        system: OscillatorParams,
+    ) -> Self {
         let warnings = stages
             .iter()
             .enumerate()

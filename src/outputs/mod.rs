@@ -37,8 +37,13 @@ pub fn finite(v: f64) -> Option<f64> {
 }
 
 /// Parameters by name: each one's value.
-pub fn values_by_name<'a>(params: impl IntoIterator<Item = &'a FittedParam>) -> BTreeMap<String, f64> {
-    params.into_iter().map(|p| (p.name.clone(), p.value)).collect()
+pub fn values_by_name<'a>(
+    params: impl IntoIterator<Item = &'a FittedParam>,
+) -> BTreeMap<String, f64> {
+    params
+        .into_iter()
+        .map(|p| (p.name.clone(), p.value))
+        .collect()
 }
 
 /// Parameters by name: each one's standard error (`null` where the data do not give it).

@@ -110,7 +110,11 @@ mod tests {
         let path = "scripts/my \"best\" model\\v2.rhai";
         let e = ModelsEntry::new(
             path,
-            &[param("we\"ird key", 1e25), param("tiny", 1e-7), param("k", f64::NAN)],
+            &[
+                param("we\"ird key", 1e25),
+                param("tiny", 1e-7),
+                param("k", f64::NAN),
+            ],
         );
         let text = e.to_toml().unwrap();
         let back: toml::Table = toml::from_str(&text).unwrap();
