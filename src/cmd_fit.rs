@@ -290,6 +290,23 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
     print_warnings(warnings);
 }
 
+/// The oscillator stage `i` of `exp` starts from: `system` as the earlier stages left it,
+/// its preset's values for the parameters no earlier stage found, then its `set` values.
+fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
+    let stage = &exp.identify[i];
+    if let Some(preset) = stage.preset {
+        let found: Vec<&String> = exp.identify[..i].iter().flat_map(|s| &s.free).collect();
+        for name in OscillatorParams::NAMES {
+            if !found.iter().any(|f| *f == name) {
+                system.set(name, preset.get(name).unwrap_or(0.0));
+            }
+        }
+    }
+    for (name, value) in &stage.set {
+        system.set(name, *value);
+    }
+}
+
 /// The source study's identification: each stage fits the oscillator's parameters against a
 /// record's displacement, starting from the previous stage's values.
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
@@ -298,21 +315,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut rows = Vec::new();
     let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
-        if let Some(preset) = stage.preset {
-            // A preset replaces only the parameters not found by earlier stages.
-            let found: Vec<String> = exp.identify[..i]
-                .iter()
-                .flat_map(|s| s.free.clone())
-                .collect();
-            for name in stf_core::system::OscillatorParams::NAMES {
-                if !found.iter().any(|f| f == name) {
-                    system.set(name, preset.get(name).unwrap_or(0.0));
-                }
-            }
-        }
-        for (name, value) in &stage.set {
-            system.set(name, *value);
-        }
+        stage_start(exp, i, &mut system);
         let record = crate::fitting::read_record(exp, &stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;

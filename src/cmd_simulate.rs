@@ -18,7 +18,7 @@ use stf_core::analysis::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_S
 use stf_core::excitation::Excitation;
 use stf_core::interpolate::Linear;
 use stf_core::oscillator::Oscillator;
-use stf_core::simulate::Simulation;
+use stf_core::simulate::{Simulation, Trajectory as SimRun};
 use stf_core::synthetic::{sample_record, SensorNoise};
 
 use crate::experiment::{Drive, Experiment};
@@ -39,42 +39,12 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         );
     };
     let sidecar = out.with_extension("json");
-    if check_distinct(&[("the record", out), ("its JSON sidecar", &sidecar)]).is_err() {
-        bail!(
-            "{}: the JSON sidecar is written to the record's path with the extension .json, \
-             which is the record itself; give the record another extension (e.g. .csv)",
-            out.display()
-        );
-    }
-    check_overwrite(out, force)?;
-    check_overwrite(&sidecar, force)?;
-    ensure_parent(out)?;
-    let _lock = OutputLock::acquire(out)?;
-    for target in [out, sidecar.as_path()] {
-        for name in clean_stale(target)? {
-            crate::tell!(
-                "note: removed {name}, left beside {} by an interrupted run",
-                target.display()
-            );
-        }
-    }
+    let _lock = claim_outputs(out, &sidecar, force)?;
 
     // The sample times, as `Simulation::run` makes them.
     let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
     let times: Vec<f64> = (0..n).map(|i| spec.t0 + i as f64 / spec.rate).collect();
-    let (excitation, rotor) = match &spec.drive {
-        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
-        Drive::Free => (Excitation::None, false),
-        Drive::Force(chirp) => {
-            let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held {
-                Linear::held(times.clone(), u)
-            } else {
-                Linear::new(times.clone(), u)
-            };
-            (Excitation::Force(held), false)
-        }
-    };
+    let (excitation, rotor) = excitation_of(&spec.drive, &times);
     let free = matches!(spec.drive, Drive::Free);
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
@@ -114,30 +84,11 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     record
         .write_csv(&staged.stage(out))
         .with_context(|| format!("cannot write {}", out.display()))?;
-
-    let omega = run.omega.as_deref();
-    let pk = peak(&run.t, &run.x, omega);
-    let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
-    let experiment_text = std::fs::read_to_string(exp_path).unwrap_or_default();
-    let summary = Summary {
-        peak_x_m: pk.map(|p| p.amplitude),
-        peak_t_s: pk.map(|p| p.t),
-        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
-        breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
-        motion_stops_t_s: if free {
-            stop(&run.v, MOVING_SPEED).map(|i| run.t[i])
-        } else {
-            None
-        },
-        samples: run.t.len(),
-        rhs_calls: run.stats.rhs_calls,
-        steps: run.stats.accepted,
-    };
     let meta = SimulateJson {
         generator: "stf-lab simulate",
         version: env!("CARGO_PKG_VERSION"),
         experiment_file: exp_path.display().to_string(),
-        experiment: experiment_text,
+        experiment: std::fs::read_to_string(exp_path).unwrap_or_default(),
         simulate: &spec.as_json,
         system: exp.system,
         integrator: (&exp.integrator).into(),
@@ -145,7 +96,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         noise,
         seed: spec.seed,
         record: out.display().to_string(),
-        summary,
+        summary: summary(&run, free),
     };
     write_json(&staged.stage(&sidecar), &meta)
         .with_context(|| format!("cannot write {}", sidecar.display()))?;
@@ -158,7 +109,79 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         wall.as_secs_f64() * 1e3,
         run.stats.rhs_calls
     );
-    if let Some(p) = pk {
+    print_outcome(&run, free);
+    say!("wrote {} and {}", out.display(), sidecar.display());
+    Ok(())
+}
+
+/// Check that the record `out` and its `sidecar` may be written (distinct, regular or new,
+/// replaced only with `force`), lock the record and clear what an interrupted run left.
+fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> {
+    if check_distinct(&[("the record", out), ("its JSON sidecar", sidecar)]).is_err() {
+        bail!(
+            "{}: the JSON sidecar is written to the record's path with the extension .json, \
+             which is the record itself; give the record another extension (e.g. .csv)",
+            out.display()
+        );
+    }
+    check_overwrite(out, force)?;
+    check_overwrite(sidecar, force)?;
+    ensure_parent(out)?;
+    let lock = OutputLock::acquire(out)?;
+    for target in [out, sidecar] {
+        for name in clean_stale(target)? {
+            crate::tell!(
+                "note: removed {name}, left beside {} by an interrupted run",
+                target.display()
+            );
+        }
+    }
+    Ok(lock)
+}
+
+/// The excitation of `drive` at the sample `times`, and whether it is a rotor. A force is
+/// tabulated at the sample times (held, or interpolated linearly).
+fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
+    match drive {
+        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
+        Drive::Free => (Excitation::None, false),
+        Drive::Force(chirp) => {
+            let u = times.iter().map(|&t| chirp.at(t)).collect();
+            let held = if chirp.held {
+                Linear::held(times.to_vec(), u)
+            } else {
+                Linear::new(times.to_vec(), u)
+            };
+            (Excitation::Force(held), false)
+        }
+    }
+}
+
+/// What the run shows, for the sidecar (`free`: free vibration, where motion stops).
+fn summary(run: &SimRun, free: bool) -> Summary {
+    let omega = run.omega.as_deref();
+    let pk = peak(&run.t, &run.x, omega);
+    let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
+    Summary {
+        peak_x_m: pk.map(|p| p.amplitude),
+        peak_t_s: pk.map(|p| p.t),
+        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
+        breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
+        motion_stops_t_s: if free {
+            stop(&run.v, MOVING_SPEED).map(|i| run.t[i])
+        } else {
+            None
+        },
+        samples: run.t.len(),
+        rhs_calls: run.stats.rhs_calls,
+        steps: run.stats.accepted,
+    }
+}
+
+/// The terminal lines of the run: its peak, the breakaway and where free motion stops.
+fn print_outcome(run: &SimRun, free: bool) {
+    let omega = run.omega.as_deref();
+    if let Some(p) = peak(&run.t, &run.x, omega) {
         if p.omega.is_finite() {
             say!(
                 "peak |x| = {:.2} mm at ω = {:.2} rad/s (t = {:.1} s)",
@@ -170,7 +193,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
             say!("peak |x| = {:.2} mm at t = {:.2} s", p.amplitude * 1e3, p.t);
         }
     }
-    match (brk, omega) {
+    match (breakaway(&run.x, BREAKAWAY_DISPLACEMENT), omega) {
         (Some(i), Some(w)) => say!(
             "breakaway (|x| first above {:.1} mm) at ω = {:.2} rad/s (t = {:.1} s)",
             BREAKAWAY_DISPLACEMENT * 1e3,
@@ -189,6 +212,4 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
             );
         }
     }
-    say!("wrote {} and {}", out.display(), sidecar.display());
-    Ok(())
 }
