@@ -5,24 +5,27 @@
 //! kinematics, is scored per regime (force RMS error, energy per cycle, on–off duty, peak
 //! force, label agreement, boundary error), and the oscillator with the model plugged in is
 //! simulated against the record for the resonance peak. Writes `compare.json`, `compare.md`
-//! and `compare.csv` (models × regimes). With `[validate]`, each model's `fit` in
-//! compare.json carries its error on the second record, as in fit.json.
+//! and `compare.csv` (models × regimes; [`crate::outputs::compare_json`],
+//! [`crate::outputs::compare_csv`], [`crate::compare_markdown`]). With `[validate]`, each
+//! model's `fit` in compare.json carries its error on the second record, as in fit.json.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use serde_json::{json, Value};
-use stf_core::analysis::{local_maxima, peak};
+use stf_core::analysis::{local_maxima, peak, Peak};
 use stf_core::oscillator::Oscillator;
 use stf_core::regimes::{
-    classify, compare, rank_models, rank_on_loops, Classification, Comparison, Regime, Signals,
+    classify, compare, rank_models, rank_on_loops, Classification, Comparison, MetricRanking,
+    Ranking, Regime, Signals,
 };
 use stf_core::simulate::Simulation;
 
+use crate::compare_markdown::{compare_markdown, duty_meaning};
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{finite_or_null, fit_all, load_data, FitData, ModelFit};
+use crate::fitting::{fit_all, load_data, FitData, ModelFit};
 use crate::output::{write_atomic, write_json};
+use crate::outputs::compare_csv;
+use crate::outputs::compare_json::CompareJson;
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
 use crate::reporting::{frequency_section, record_sections, write_report};
@@ -106,25 +109,75 @@ fn frf(label: &str, t: &[f64], x: &[f64], omega: Option<&[f64]>) -> FrfCurve {
     }
 }
 
-/// What the duty and its error are, with the record's on-threshold.
-fn duty_meaning(on_threshold: f64) -> String {
-    format!(
-        "The duty of a cycle is the fraction of it in which the STF force is on (|F_STF| above \
-         {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
-         zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
-         a regime's cycles of |model duty − measured duty|."
-    )
+/// Everything a comparison found: the measured record's regimes and peak, each model's fit,
+/// its comparison and its simulated response, and the rankings.
+pub struct Compared {
+    /// The measured record's cycles, labels and boundaries.
+    pub measured: Classification,
+    /// Each model's fit, in the experiment's order.
+    pub fits: Vec<ModelFit>,
+    /// Each model's comparison with the record, in the same order.
+    pub comparisons: Vec<Comparison>,
+    /// The record's resonance peak.
+    pub measured_peak: Peak,
+    /// Each model's simulated response and its peak (|x| m, ω rad/s); none if it failed.
+    pub responses: Vec<Option<(FrfCurve, (f64, f64))>>,
+    /// The models in order of relative force RMS error.
+    pub ranking: Ranking,
+    /// The models in order on each loop metric.
+    pub loop_rankings: Vec<MetricRanking>,
 }
 
-fn regime_json(c: &Comparison) -> Value {
-    let mut m = serde_json::Map::new();
-    for r in Regime::ALL {
-        m.insert(
-            r.name().into(),
-            serde_json::to_value(c.per_regime.get(r)).unwrap_or(Value::Null),
-        );
+impl Compared {
+    /// The models' labels, in order.
+    pub fn labels(&self) -> Vec<&str> {
+        self.fits.iter().map(|f| f.label.as_str()).collect()
     }
-    Value::Object(m)
+
+    /// Each model's simulated peak (|x| m, ω rad/s), none where the simulation failed.
+    pub fn peaks(&self) -> Vec<Option<(f64, f64)>> {
+        self.responses
+            .iter()
+            .map(|r| r.as_ref().map(|r| r.1))
+            .collect()
+    }
+}
+
+/// Compare every fit in `fits` with the record `data` regime by regime.
+fn compare_fits(
+    exp: &Experiment,
+    data: &FitData,
+    measured: Classification,
+    fits: Vec<ModelFit>,
+) -> Result<Compared> {
+    let sig = signals(data);
+    let comparisons: Vec<Comparison> = fits
+        .iter()
+        .map(|f| compare(&measured, &sig, &f.fitted, &exp.regimes))
+        .collect::<std::result::Result<_, _>>()?;
+    let measured_peak = peak(
+        &data.record.t,
+        &data.record.x,
+        data.kinematics.omega.as_deref(),
+    )
+    .context("empty record")?;
+    let responses = fits
+        .iter()
+        .map(|f| simulated_response(exp, data, Some(f)).ok())
+        .collect();
+    let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
+    let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
+    let ranking = rank_models(&pairs);
+    let loop_rankings = rank_on_loops(&measured, &pairs);
+    Ok(Compared {
+        measured,
+        fits,
+        comparisons,
+        measured_peak,
+        responses,
+        ranking,
+        loop_rankings,
+    })
 }
 
 /// Run `stf-lab compare`: the results are built in a staging folder and swapped in as a
@@ -146,325 +199,27 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
     if let Some(rec) = &validation {
         crate::validation::score_fits(&mut fits, rec);
     }
-    let sig = signals(&data);
-    let comparisons: Vec<Comparison> = fits
-        .iter()
-        .map(|f| compare(&measured, &sig, &f.fitted, &exp.regimes))
-        .collect::<std::result::Result<_, _>>()?;
-    let measured_peak = peak(
-        &data.record.t,
-        &data.record.x,
-        data.kinematics.omega.as_deref(),
-    )
-    .context("empty record")?;
-    let responses: Vec<Option<(FrfCurve, (f64, f64))>> = fits
-        .iter()
-        .map(|f| simulated_response(&exp, &data, Some(f)).ok())
-        .collect();
-    let peaks: Vec<Option<(f64, f64)>> =
-        responses.iter().map(|r| r.as_ref().map(|r| r.1)).collect();
-    let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
-    let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
-    let ranking = rank_models(&pairs);
-    let loop_rankings = rank_on_loops(&measured, &pairs);
-
-    let count = |r: Regime| measured.labels.iter().filter(|l| **l == r).count();
-    let models: Vec<Value> = fits
-        .iter()
-        .zip(&comparisons)
-        .zip(&peaks)
-        .map(|((f, c), p)| {
-            json!({
-                "name": f.name(),
-                "label": f.label,
-                "fit": f.to_json(data.level),
-                "regimes": regime_json(c),
-                "overall": c.overall,
-                "boundary_errors": c.boundary_errors,
-                "model_boundaries": c.model_boundaries,
-                "resonance": p.map(|(x, w)| json!({
-                    "peak_x_m": x,
-                    "peak_omega_rad_s": finite_or_null(w),
-                    "peak_x_error_m": x - measured_peak.amplitude,
-                    "peak_omega_error_rad_s": finite_or_null(w - measured_peak.omega),
-                })),
-            })
-        })
-        .collect();
-    let best: serde_json::Map<String, Value> = Regime::ALL
-        .iter()
-        .map(|&r| (r.name().to_string(), json!(ranking.best_in(r))))
-        .chain(std::iter::once((
-            "overall".to_string(),
-            json!(ranking.best_overall()),
-        )))
-        .collect();
-    let doc = json!({
-        "experiment": exp.path.display().to_string(),
-        "record": data.record.source,
-        "measured": {
-            "noise_sigma": measured.noise_sigma,
-            "on_threshold": measured.on_threshold,
-            "no_stf": measured.no_stf,
-            "cycles": measured.labels.len(),
-            "cycles_per_regime": Regime::ALL.iter().map(|&r| (r.name().to_string(), json!(count(r)))).collect::<serde_json::Map<_, _>>(),
-            "boundaries": measured.boundaries,
-            "boundary_notes": crate::compare_loops::boundary_notes(&measured),
-            "resonance": { "peak_x_m": measured_peak.amplitude, "peak_omega_rad_s": finite_or_null(measured_peak.omega) },
-        },
-        "thresholds": exp.regimes,
-        "models": models,
-        "ranking": ranking,
-        "loop_rankings": loop_rankings,
-        "best": best,
-        "cycles_csv": "cycles.csv",
-    });
-    write_json(&out.join("compare.json"), &doc)?;
-
-    // models × regimes: relative force RMS error and duty error.
-    let mut csv = String::from("model,regime,cycles,force_rms_error_N,relative_rms_error,energy_error_J,duty_error,peak_force_error_N,label_agreement,measured_energy_J,model_energy_J,measured_c_eq_Ns_m,model_c_eq_Ns_m,phase_x_error_deg,phase_v_error_deg\n");
-    let mut md = String::new();
-    let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
-    let _ = writeln!(
-        md,
-        "Record `{}`: {} cycles; noise floor σ = {:.4} N{}.\n",
-        data.record.source,
-        measured.labels.len(),
-        measured.noise_sigma,
-        if measured.no_stf {
-            "; the STF force is negligible everywhere (no regimes)"
-        } else {
-            ""
-        }
-    );
-    for line in crate::compare_loops::boundary_lines(&measured) {
-        let _ = writeln!(md, "- {line}");
-    }
-    let _ = writeln!(
-        md,
-        "\nRelative force RMS error (duty error) per regime; lower is better. {}\n",
-        duty_meaning(measured.on_threshold)
-    );
-    let _ = writeln!(
-        md,
-        "| model | pre-resonance | resonance | post-resonance | overall | peak x (mm) at ω |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|---|");
-    for ((f, c), p) in fits.iter().zip(&comparisons).zip(&peaks) {
-        let mut row = format!("| {} ", f.label);
-        for r in Regime::ALL {
-            match c.per_regime.get(r) {
-                Some(m) => {
-                    let _ = write!(row, "| {:.3} ({:.2}) ", m.relative_rms_error, m.duty_error);
-                    let _ = writeln!(
-                        csv,
-                        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                        f.label,
-                        r.name(),
-                        m.cycles,
-                        m.force_rms_error,
-                        m.relative_rms_error,
-                        m.energy_error,
-                        m.duty_error,
-                        m.peak_force_error,
-                        m.label_agreement,
-                        m.measured_energy,
-                        m.model_energy,
-                        m.measured_c_eq,
-                        m.model_c_eq,
-                        m.phase_x_error,
-                        m.phase_v_error
-                    );
-                }
-                None => row.push_str("| — "),
-            }
-        }
-        let o = &c.overall;
-        let _ = write!(row, "| {:.3} ({:.2}) ", o.relative_rms_error, o.duty_error);
-        match p {
-            Some((x, w)) => {
-                let _ = write!(row, "| {:.2} at {:.2} |", x * 1e3, w);
-            }
-            None => row.push_str("| simulation failed |"),
-        }
-        let _ = writeln!(md, "{row}");
-    }
-    let _ = writeln!(
-        md,
-        "| *measured* | | | | | {:.2} at {:.2} |\n",
-        measured_peak.amplitude * 1e3,
-        measured_peak.omega
-    );
-    for r in Regime::ALL {
-        if let Some(b) = ranking.best_in(r) {
-            let _ = writeln!(md, "- best in {}: **{b}**", r.name().replace('_', "-"));
-        }
-    }
-    if let Some(b) = ranking.best_overall() {
-        let _ = writeln!(md, "- best overall: **{b}**");
-    }
-    let energy = crate::compare_loops::energy_table(&labels, &comparisons);
-    crate::compare_loops::write_markdown(&mut md, &loop_rankings, &energy);
-    // Say what each model misses: a duty error above 0.2 in a regime is an on–off miss.
-    for (f, c) in fits.iter().zip(&comparisons) {
-        for r in Regime::ALL {
-            if let Some(m) = c.per_regime.get(r) {
-                if m.duty_error > 0.2 {
-                    let _ = writeln!(
-                        md,
-                        "- {} misses the on–off behaviour in {}: duty {:.2} against the measured {:.2}",
-                        f.label,
-                        r.name().replace('_', "-"),
-                        m.model_duty,
-                        m.measured_duty
-                    );
-                }
-            }
-        }
-    }
-    // Fits not to be trusted as they stand (`*` bullets: the report shows them in its own box).
-    let warned: Vec<String> = fits
-        .iter()
-        .flat_map(|f| {
-            f.warnings
-                .iter()
-                .map(move |w| format!("* {}: {w}", f.label))
-        })
-        .collect();
-    if !warned.is_empty() {
-        let _ = writeln!(md, "\n**Warnings**\n\n{}", warned.join("\n"));
-    }
-    write_atomic(&out.join("compare.csv"), csv.as_bytes())?;
+    let c = compare_fits(&exp, &data, measured, fits)?;
+    write_json(
+        &out.join("compare.json"),
+        &CompareJson::new(&exp, &data, &c),
+    )?;
+    let labels = c.labels();
+    let rows = compare_csv::rows(&labels, &c.comparisons);
+    compare_csv::write(&out.join("compare.csv"), &rows)?;
     crate::compare_loops::write_cycles_csv(
         &out.join("cycles.csv"),
-        &measured,
+        &c.measured,
         &labels,
-        &comparisons,
+        &c.comparisons,
     )?;
+    let md = compare_markdown(&exp, &data, &c);
     write_atomic(
         &out.join("compare.md"),
         crate::report::md_text(&md).as_bytes(),
     )?;
     if exp.output.report {
-        // The report: regimes table, frequency response, the record and the fits.
-        let mut curves = vec![frf(
-            "measured",
-            &data.record.t,
-            &data.record.x,
-            data.kinematics.omega.as_deref(),
-        )];
-        if let Ok((c, _)) = simulated_response(&exp, &data, None) {
-            curves.push(c);
-        }
-        curves.extend(responses.into_iter().flatten().map(|r| r.0));
-        let mut regimes = Section::new("Models regime by regime");
-        regimes.paragraphs = md
-            .lines()
-            .filter(|l| l.starts_with("- "))
-            .map(|l| l.trim_start_matches("- ").replace("**", ""))
-            .collect();
-        let mut table = Table {
-            caption:
-                "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
-                    .into(),
-            columns: [
-                "model",
-                "pre-resonance",
-                "resonance",
-                "post-resonance",
-                "overall",
-            ]
-            .iter()
-            .map(|c| c.to_string())
-            .collect(),
-            rows: Vec::new(),
-        };
-        for (f, c) in fits.iter().zip(&comparisons) {
-            let mut row = vec![f.label.clone()];
-            for r in Regime::ALL {
-                row.push(c.per_regime.get(r).map_or("—".to_string(), |m| {
-                    format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
-                }));
-            }
-            row.push(format!(
-                "{:.3} ({:.2})",
-                c.overall.relative_rms_error, c.overall.duty_error
-            ));
-            table.rows.push(row);
-        }
-        regimes.paragraphs.push(duty_meaning(measured.on_threshold));
-        regimes.tables.push(table);
-        regimes
-            .paragraphs
-            .push(crate::compare_loops::DUTY_EXPLAINED.into());
-        regimes.tables.push(energy);
-        let bars: Vec<(&str, Vec<f64>)> = fits
-            .iter()
-            .zip(&comparisons)
-            .map(|(f, c)| {
-                let mut v: Vec<f64> = Regime::ALL
-                    .iter()
-                    .map(|&r| {
-                        c.per_regime
-                            .get(r)
-                            .map_or(f64::NAN, |m| m.relative_rms_error)
-                    })
-                    .collect();
-                v.push(c.overall.relative_rms_error);
-                (f.label.as_str(), v)
-            })
-            .collect();
-        let fig = regime_errors(
-            &out.join("figures"),
-            "regime_errors",
-            &["pre-resonance", "resonance", "post-resonance", "overall"],
-            &bars,
-            "relative force RMS error",
-        )?;
-        regimes.figures.push(FigureRef::new(
-            fig,
-            "Relative force RMS error of each model in each regime of the record (lower is better).",
-        ));
-        let change = |b: Option<stf_core::regimes::Boundary>| {
-            b.map(|b| RegimeChange {
-                omega: b.omega,
-                uncertainty: b.uncertainty,
-            })
-        };
-        let changes = [
-            change(measured.boundaries.pre_resonance),
-            change(measured.boundaries.resonance_post),
-        ];
-        let frequency = frequency_section(&curves, changes, out)?;
-        let mut sections = vec![regimes, frequency];
-        sections.extend(record_sections(&data, &fits, out)?);
-        let forces: Vec<(&str, &[f64])> = fits
-            .iter()
-            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
-            .collect();
-        sections.extend(crate::regime_figures::regime_section(
-            &exp, &data, &forces, out,
-        )?);
-        write_report(
-            &format!("Comparison: {}", exp.path.display()),
-            vec![
-                crate::verdict::compare_verdict(
-                    &ranking,
-                    &measured.cycles,
-                    &measured.labels,
-                    data.record.f_stf.as_deref().unwrap_or(&[]),
-                    &forces,
-                ),
-                format!(
-                    "{} cycles of {}; noise floor σ = {:.4} N.",
-                    measured.labels.len(),
-                    data.record.source,
-                    measured.noise_sigma
-                ),
-            ],
-            sections,
-            out,
-        )?;
+        write_compare_report(&exp, &data, &c, &md, out)?;
     }
     results.commit()?;
     say!("{}", md.strip_suffix('\n').unwrap_or(&md));
@@ -477,4 +232,150 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
         )
     );
     Ok(())
+}
+
+/// The report: regimes table, frequency response, the record and the fits.
+fn write_compare_report(
+    exp: &Experiment,
+    data: &FitData,
+    c: &Compared,
+    md: &str,
+    out: &Path,
+) -> Result<()> {
+    let mut curves = vec![frf(
+        "measured",
+        &data.record.t,
+        &data.record.x,
+        data.kinematics.omega.as_deref(),
+    )];
+    if let Ok((curve, _)) = simulated_response(exp, data, None) {
+        curves.push(curve);
+    }
+    curves.extend(c.responses.iter().flatten().map(|r| r.0.clone()));
+    let change = |b: Option<stf_core::regimes::Boundary>| {
+        b.map(|b| RegimeChange {
+            omega: b.omega,
+            uncertainty: b.uncertainty,
+        })
+    };
+    let changes = [
+        change(c.measured.boundaries.pre_resonance),
+        change(c.measured.boundaries.resonance_post),
+    ];
+    let frequency = frequency_section(&curves, changes, out)?;
+    let mut sections = vec![regimes_section(c, md, out)?, frequency];
+    sections.extend(record_sections(data, &c.fits, out)?);
+    let forces: Vec<(&str, &[f64])> = c
+        .fits
+        .iter()
+        .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+        .collect();
+    sections.extend(crate::regime_figures::regime_section(
+        exp, data, &forces, out,
+    )?);
+    let verdict = crate::verdict::compare_verdict(
+        &c.ranking,
+        &c.measured.cycles,
+        &c.measured.labels,
+        data.record.f_stf.as_deref().unwrap_or(&[]),
+        &forces,
+    );
+    let record = format!(
+        "{} cycles of {}; noise floor σ = {:.4} N.",
+        c.measured.labels.len(),
+        data.record.source,
+        c.measured.noise_sigma
+    );
+    write_report(
+        &format!("Comparison: {}", exp.path.display()),
+        vec![verdict, record],
+        sections,
+        out,
+    )
+}
+
+/// The report's "Models regime by regime": compare.md's bullets, the error and energy
+/// tables and the error of each model in each regime as bars.
+fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
+    let mut regimes = Section::new("Models regime by regime");
+    regimes.paragraphs = md
+        .lines()
+        .filter(|l| l.starts_with("- "))
+        .map(|l| l.trim_start_matches("- ").replace("**", ""))
+        .collect();
+    regimes
+        .paragraphs
+        .push(duty_meaning(c.measured.on_threshold));
+    regimes.tables.push(errors_table(c));
+    regimes
+        .paragraphs
+        .push(crate::compare_loops::DUTY_EXPLAINED.into());
+    regimes.tables.push(crate::compare_loops::energy_table(
+        &c.labels(),
+        &c.comparisons,
+    ));
+    let bars: Vec<(&str, Vec<f64>)> = c
+        .fits
+        .iter()
+        .zip(&c.comparisons)
+        .map(|(f, cmp)| {
+            let mut v: Vec<f64> = Regime::ALL
+                .iter()
+                .map(|&r| {
+                    cmp.per_regime
+                        .get(r)
+                        .map_or(f64::NAN, |m| m.relative_rms_error)
+                })
+                .collect();
+            v.push(cmp.overall.relative_rms_error);
+            (f.label.as_str(), v)
+        })
+        .collect();
+    let fig = regime_errors(
+        &out.join("figures"),
+        "regime_errors",
+        &["pre-resonance", "resonance", "post-resonance", "overall"],
+        &bars,
+        "relative force RMS error",
+    )?;
+    regimes.figures.push(FigureRef::new(
+        fig,
+        "Relative force RMS error of each model in each regime of the record (lower is better).",
+    ));
+    Ok(regimes)
+}
+
+/// The relative force RMS error (duty error) of each model per regime and overall.
+fn errors_table(c: &Compared) -> Table {
+    let cell = |m: &stf_core::regimes::RegimeMetrics| {
+        format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
+    };
+    Table {
+        caption:
+            "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
+                .into(),
+        columns: [
+            "model",
+            "pre-resonance",
+            "resonance",
+            "post-resonance",
+            "overall",
+        ]
+        .iter()
+        .map(|c| c.to_string())
+        .collect(),
+        rows: c
+            .fits
+            .iter()
+            .zip(&c.comparisons)
+            .map(|(f, cmp)| {
+                let mut row = vec![f.label.clone()];
+                for r in Regime::ALL {
+                    row.push(cmp.per_regime.get(r).map_or("—".to_string(), cell));
+                }
+                row.push(cell(&cmp.overall));
+                row
+            })
+            .collect(),
+    }
 }

@@ -14,7 +14,6 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use serde_json::json;
 use stf_core::data_bounds::widened;
 use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
@@ -26,9 +25,11 @@ use stf_core::model_sum::ModelSum;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
-use crate::fitting::{estimate_line, load_data_at, std_errors_json, system_param, FitData};
+use crate::fitting::{estimate_line, load_data_at, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::write_json;
+use crate::outputs::discovery_json::{Common, DiscoveryJson};
+use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::progress::{discovery_observer, Progress};
 use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
@@ -51,19 +52,11 @@ fn model_from(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceMo
 }
 
 /// The final model `name` (`a + b + …`) with the values of `params` as an experiment's
-/// `[[models]]` entry that `fit` and `compare` accept as it is.
-fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -> String {
-    let parts: Vec<&str> = name.split(" + ").collect();
-    let mut entry = format!("[[models]]\nname = \"{}\"\n", parts[0]);
-    if parts.len() > 1 {
-        let plus: Vec<String> = parts[1..].iter().map(|p| format!("\"{p}\"")).collect();
-        entry.push_str(&format!("plus = [{}]\n", plus.join(", ")));
-    }
-    let values: Vec<String> = params
-        .map(|p| format!("\"{}\" = {}", p.name, p.value))
-        .collect();
-    entry.push_str(&format!("params = {{ {} }}\n", values.join(", ")));
-    entry
+/// `[[models]]` entry that `fit` and `compare` accept as it is (TOML).
+fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -> Result<String> {
+    ModelsEntry::new(name, params)
+        .to_toml()
+        .context("cannot write the final model as an experiment entry")
 }
 
 /// The terminal's account of a discovery: each step's verdict, the `summary` line and the
@@ -174,7 +167,7 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
     let toml_entry = models_entry(
         &found.final_model_name,
         found.final_params.iter().filter(|p| p.name != "f_off"),
-    );
+    )?;
     write_force_results(&exp, &data, &found, score.as_ref(), &toml_entry, out)?;
     if exp.output.report {
         force_report(&exp, &data, &found, score.as_ref(), out)?;
@@ -300,39 +293,18 @@ fn write_force_results(
     toml_entry: &str,
     out: &Path,
 ) -> Result<()> {
-    let params: serde_json::Map<String, serde_json::Value> = found
-        .final_params
-        .iter()
-        .map(|p| (p.name.clone(), json!(p.value)))
-        .collect();
-    let mut doc = json!({
-        "experiment": exp.path.display().to_string(),
-        "record": data.record.source,
-        "drive": data.kinematics.drive,
-        "noise_estimate": data.noise_estimate(),
-        "base": base_of(exp, found),
-        "effects": found.effects,
-        "gap_before": found.gap_before,
-        "gap_after": found.gap_after,
-        "noise_floor": found.noise_floor,
-        "noise_floor_parts": found.noise_floor_parts,
-        "gap_unit": "N",
-        "holdout_cycles": found.holdout_cycles,
-        "where_before": found.where_before,
-        "where_after": found.where_after,
-        "steps": found.steps,
-        "final_model": {
-            "name": found.final_model_name,
-            "params": params,
-            "std_errors": std_errors_json(&found.final_params),
-            "experiment_entry": toml_entry,
+    let all: Vec<&FittedParam> = found.final_params.iter().collect();
+    let doc = DiscoveryJson::new(
+        Common {
+            exp,
+            data,
+            found,
+            score,
         },
-        "fitted": crate::discovery_curves::force_curves(found, exp.system),
-        "notes": data.record_warnings.iter().chain(&found.notes).collect::<Vec<_>>(),
-    });
-    if let Some(score) = score {
-        doc["validation"] = serde_json::to_value(score)?;
-    }
+        &all,
+        toml_entry.to_string(),
+        crate::discovery_curves::force_curves(found, exp.system),
+    );
     write_json(&out.join("discovery.json"), &doc)?;
     let f = data.record.f_stf.as_deref().unwrap_or(&[]);
     let (before, after) = (
@@ -340,13 +312,6 @@ fn write_force_results(
         minus(f, &found.residual_after),
     );
     crate::discovery_curves::write_curves(out, "f_stf", &data.record.t, f, (&before, &after))
-}
-
-/// The base model as `[discover] base` names it.
-fn base_of<'a>(exp: &'a Experiment, found: &'a Discovery) -> &'a str {
-    exp.discover
-        .as_ref()
-        .map_or(found.base.as_str(), |d| d.base.as_str())
 }
 
 /// `measured − residual`, sample by sample: the modelled curve.
@@ -601,52 +566,27 @@ fn write_trajectory_results(
                 && !stf_core::fit::INITIAL_STATE.contains(&p.name.as_str())
         })
         .collect();
-    let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied());
-    let system_entry: String = std::iter::once("[system]\n".to_string())
-        .chain(
-            names
-                .iter()
-                .filter_map(|n| tf.system_after.get(n).map(|v| format!("{n} = {v}\n"))),
-        )
-        .collect();
-    let mut doc = json!({
-        "experiment": exp.path.display().to_string(),
-        "record": data.record.source,
-        "drive": data.kinematics.drive,
-        "noise_estimate": data.noise_estimate(),
-        "system_estimate": data.system_estimate,
-        "level": "trajectory",
-        "base": base_of(exp, found),
-        "effects": found.effects,
-        "gap_before": found.gap_before,
-        "gap_after": found.gap_after,
-        "noise_floor": found.noise_floor,
-        "noise_floor_parts": found.noise_floor_parts,
-        "gap_unit": "m",
-        "s_before_mm2": tf.s_before_mm2,
-        "s_after_mm2": tf.s_after_mm2,
-        "holdout_cycles": found.holdout_cycles,
-        "where_before": found.where_before,
-        "where_after": found.where_after,
-        "steps": found.steps,
-        "refitted": names,
-        "system_before": tf.system_before,
-        "system": tf.system_after,
-        "final_model": {
-            "name": found.final_model_name,
-            "params": model_params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-            "std_errors": std_errors_json(&found.final_params),
-            "system": names.iter().filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), json!(v)))).collect::<serde_json::Map<_, _>>(),
-            "experiment_entry": toml_entry,
-            "system_entry": system_entry,
-        },
-        "fitted": crate::discovery_curves::trajectory_curves(tf),
-        "wall_seconds": wall,
-        "notes": data.record_warnings.iter().chain(&found.notes).collect::<Vec<_>>(),
-    });
-    if let Some(score) = score {
-        doc["validation"] = serde_json::to_value(score)?;
+    let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied())?;
+    let system_entry = SystemEntry {
+        system: names
+            .iter()
+            .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
+            .collect(),
     }
+    .to_toml()
+    .context("cannot write the refitted oscillator as a [system] entry")?;
+    let doc = DiscoveryJson::new(
+        Common {
+            exp,
+            data,
+            found,
+            score,
+        },
+        &model_params,
+        toml_entry.clone(),
+        crate::discovery_curves::trajectory_curves(tf),
+    )
+    .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
     write_json(&out.join("discovery.json"), &doc)?;
     let x = &data.record.x;
     let curves = (tf.x_before.as_slice(), tf.x_after.as_slice());

@@ -12,19 +12,18 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
-use serde_json::json;
 use stf_core::fit::{
     fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
-use crate::fitting::{
-    estimate_line, finite_or_null, fit_all, load_data, std_errors_json, system_param, FitData,
-    ModelFit,
-};
+use crate::fitting::{estimate_line, fit_all, load_data, system_param, FitData, ModelFit};
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
-use crate::output::{write_columns, write_json};
+use crate::output::write_json;
+use crate::outputs::columns_csv::Columns;
+use crate::outputs::fit_json::FitJson;
+use crate::outputs::identification_json::{IdentificationJson, StageJson};
 use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
@@ -84,33 +83,9 @@ fn write_fits(
         crate::validation::score_fits(&mut fits, rec);
     }
 
-    let level = data.level;
-    let doc = json!({
-        "experiment": exp.path.display().to_string(),
-        "record": data.record.source,
-        "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
-        "samples": data.record.len(),
-        "motion_filter": { "order": data.kinematics.motion_filter.order(), "window": data.kinematics.motion_filter.window() },
-        "drive": data.kinematics.drive,
-        "noise_estimate": data.noise_estimate(),
-        "system_estimate": data.system_estimate,
-        "models": fits.iter().map(|f| f.to_json(level)).collect::<Vec<_>>(),
-    });
-    write_json(&out.join("fit.json"), &doc)?;
+    write_json(&out.join("fit.json"), &FitJson::new(&exp.path, data, &fits))?;
     write_params_csv(&out.join("params.csv"), &rows_of_fits(&fits))?;
-
-    let measured_name = match level {
-        FitLevel::Force => "f_stf",
-        FitLevel::Trajectory => "x",
-    };
-    let names: Vec<String> = std::iter::once("t".to_string())
-        .chain(std::iter::once(measured_name.to_string()))
-        .chain(fits.iter().map(|f| format!("{measured_name}_{}", f.label)))
-        .collect();
-    let mut columns: Vec<&[f64]> = vec![&data.record.t, data.target()];
-    columns.extend(fits.iter().map(|f| f.fitted.as_slice()));
-    let name_refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    write_columns(&out.join("fitted.csv"), &name_refs, &columns)?;
+    fitted_columns(data, &fits).write(&out.join("fitted.csv"))?;
 
     print_summary(data, &fits);
     if let Some(rec) = validation {
@@ -120,6 +95,21 @@ fn write_fits(
         write_fit_report(exp, data, validation, &fits, out)?;
     }
     Ok(())
+}
+
+/// `fitted.csv`: t, the measured signal (`f_stf` or `x`) and each model's fit of it
+/// (`f_stf_<label>` or `x_<label>`).
+fn fitted_columns<'a>(data: &'a FitData, fits: &'a [ModelFit]) -> Columns<'a> {
+    let measured = match data.level {
+        FitLevel::Force => "f_stf",
+        FitLevel::Trajectory => "x",
+    };
+    let columns = Columns::new()
+        .with("t", &data.record.t)
+        .with(measured, data.target());
+    fits.iter().fold(columns, |c, f| {
+        c.with(format!("{measured}_{}", f.label), &f.fitted)
+    })
 }
 
 /// The fit's report (report.html, report.md, figures/) in `out`.
@@ -310,28 +300,21 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
     print_warnings(warnings);
 }
 
-/// The record of one identification stage in fit.json.
-fn stage_json(
-    stage: &StageSpec,
-    result: &FitResult,
-    floor: &NoiseFloor,
-    warnings: &[FitWarning],
-) -> serde_json::Value {
-    json!({
-        "record": stage.data.display().to_string(),
-        "free": stage.free,
-        "params": result.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-        "std_errors": std_errors_json(&result.params),
-        "s_mm2": result.s_mm2,
-        "rms": result.rms,
-        "aic": finite_or_null(result.aic),
-        "bic": finite_or_null(result.bic),
-        "evaluations": result.evaluations,
-        "converged": result.convergence.converged(),
-        "convergence": result.convergence,
-        "noise_floor": floor,
-        "warnings": warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
-    })
+/// The oscillator stage `i` of `exp` starts from: `system` as the earlier stages left it,
+/// its preset's values for the parameters no earlier stage found, then its `set` values.
+fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
+    let stage = &exp.identify[i];
+    if let Some(preset) = stage.preset {
+        let found: Vec<&String> = exp.identify[..i].iter().flat_map(|s| &s.free).collect();
+        for name in OscillatorParams::NAMES {
+            if !found.iter().any(|f| *f == name) {
+                system.set(name, preset.get(name).unwrap_or(0.0));
+            }
+        }
+    }
+    for (name, value) in &stage.set {
+        system.set(name, *value);
+    }
 }
 
 /// The source study's identification: each stage fits the oscillator's parameters against a
@@ -339,25 +322,10 @@ fn stage_json(
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
     let mut stages = Vec::new();
-    let mut all_warnings = Vec::new();
     let mut rows = Vec::new();
     let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
-        if let Some(preset) = stage.preset {
-            // A preset replaces only the parameters not found by earlier stages.
-            let found: Vec<String> = exp.identify[..i]
-                .iter()
-                .flat_map(|s| s.free.clone())
-                .collect();
-            for name in stf_core::system::OscillatorParams::NAMES {
-                if !found.iter().any(|f| f == name) {
-                    system.set(name, preset.get(name).unwrap_or(0.0));
-                }
-            }
-        }
-        for (name, value) in &stage.set {
-            system.set(name, *value);
-        }
+        stage_start(exp, i, &mut system);
         let record = crate::fitting::read_record(exp, &stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
@@ -405,14 +373,15 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let floor = NoiseFloor::displacement(k.sigma_x);
         let warnings = fit_warnings(&result, &free, Some(&floor));
         print_stage(i, stage, &result, &warnings);
-        for w in &warnings {
-            let mut entry = serde_json::to_value(w.stated())?;
-            entry["stage"] = json!(i + 1);
-            all_warnings.push(entry);
-        }
-        stages.push(stage_json(stage, &result, &floor, &warnings));
         let label = format!("stage {}", i + 1);
         rows.extend(rows_of(&label, &result, None, &warnings));
+        stages.push(StageJson::new(
+            stage.data.display().to_string(),
+            stage.free.clone(),
+            &result,
+            floor,
+            warnings.clone(),
+        ));
         let data = TrajectoryData {
             t: &record.t,
             x: &record.x,
@@ -428,7 +397,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             warnings,
         });
     }
-    finish_identification(exp, out, &system, stages, all_warnings, &rows, &outcomes)
+    finish_identification(exp, out, &system, &stages, &rows, &outcomes)
 }
 
 /// Write the identification's fit.json, params.csv and report into `out`.
@@ -436,23 +405,11 @@ fn finish_identification(
     exp: &Experiment,
     out: &Path,
     system: &OscillatorParams,
-    stages: Vec<serde_json::Value>,
-    all_warnings: Vec<serde_json::Value>,
+    stages: &[StageJson],
     rows: &[ParamRow],
     outcomes: &[StageOutcome],
 ) -> Result<()> {
-    let doc = json!({
-        "experiment": exp.path.display().to_string(),
-        "level": "trajectory",
-        "stages": stages,
-        "system": *system,
-        "models": [{
-            "name": "none",
-            "params": serde_json::to_value(*system)?,
-            "rms": stages.last().and_then(|s| s["rms"].as_f64()),
-            "warnings": all_warnings,
-        }],
-    });
+    let doc = IdentificationJson::new(&exp.path, stages, *system);
     write_json(&out.join("fit.json"), &doc)?;
     write_params_csv(&out.join("params.csv"), rows)?;
     say!("identified system: {}", system_line(system));

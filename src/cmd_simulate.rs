@@ -14,18 +14,18 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use serde_json::json;
 use stf_core::analysis::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_SPEED};
 use stf_core::excitation::Excitation;
 use stf_core::interpolate::Linear;
 use stf_core::oscillator::Oscillator;
-use stf_core::simulate::Simulation;
+use stf_core::simulate::{Simulation, Trajectory as SimRun};
 use stf_core::synthetic::{sample_record, SensorNoise};
 
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;
 use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
 use crate::output_lock::OutputLock;
+use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::say;
 use crate::staged_files::{clean_stale, StagedFiles};
 
@@ -39,51 +39,25 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         );
     };
     let sidecar = out.with_extension("json");
-    if check_distinct(&[("the record", out), ("its JSON sidecar", &sidecar)]).is_err() {
-        bail!(
-            "{}: the JSON sidecar is written to the record's path with the extension .json, \
-             which is the record itself; give the record another extension (e.g. .csv)",
-            out.display()
-        );
-    }
-    check_overwrite(out, force)?;
-    check_overwrite(&sidecar, force)?;
-    ensure_parent(out)?;
-    let _lock = OutputLock::acquire(out)?;
-    for target in [out, sidecar.as_path()] {
-        for name in clean_stale(target)? {
-            crate::tell!(
-                "note: removed {name}, left beside {} by an interrupted run",
-                target.display()
-            );
-        }
-    }
+    let _lock = claim_outputs(out, &sidecar, force)?;
 
     // The sample times, as `Simulation::run` makes them.
     let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
     let times: Vec<f64> = (0..n).map(|i| spec.t0 + i as f64 / spec.rate).collect();
-    let (excitation, rotor) = match &spec.drive {
-        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
-        Drive::Free => (Excitation::None, false),
-        Drive::Force(chirp) => {
-            let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held {
-                Linear::held(times.clone(), u)
-            } else {
-                Linear::new(times.clone(), u)
-            };
-            (Excitation::Force(held), false)
-        }
-    };
+    let (excitation, rotor) = excitation_of(&spec.drive, &times);
     let free = matches!(spec.drive, Drive::Free);
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
     if !spec.truth.is_empty() {
         let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
-        truth_json.push(json!({
-            "model": truth.model.name(),
-            "params": truth.params.iter().map(|p| (p.name.clone(), json!(p.value))).collect::<serde_json::Map<_, _>>(),
-        }));
+        truth_json.push(Truth {
+            model: truth.model.name().to_string(),
+            params: truth
+                .params
+                .iter()
+                .map(|p| (p.name.clone(), p.value))
+                .collect(),
+        });
         let values = truth.values();
         osc = osc
             .with_model(truth.model, values)
@@ -110,42 +84,21 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     record
         .write_csv(&staged.stage(out))
         .with_context(|| format!("cannot write {}", out.display()))?;
-
-    let omega = run.omega.as_deref();
-    let pk = peak(&run.t, &run.x, omega);
-    let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
-    let experiment_text =
-        crate::experiment::read_text(exp_path, crate::experiment::MAX_EXPERIMENT_BYTES)
-            .unwrap_or_default();
-    let summary = json!({
-        "peak_x_m": pk.map(|p| p.amplitude),
-        "peak_t_s": pk.map(|p| p.t),
-        "peak_omega_rad_s": pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
-        "breakaway_omega_rad_s": brk.and_then(|i| omega.map(|w| w[i])),
-        "motion_stops_t_s": if !free { None } else { stop(&run.v, MOVING_SPEED).map(|i| run.t[i]) },
-        "samples": run.t.len(),
-        "rhs_calls": run.stats.rhs_calls,
-        "steps": run.stats.accepted,
-    });
-    let meta = json!({
-        "generator": "stf-lab simulate",
-        "version": env!("CARGO_PKG_VERSION"),
-        "experiment_file": exp_path.display().to_string(),
-        "experiment": experiment_text,
-        "simulate": spec.as_json,
-        "system": exp.system,
-        "integrator": {
-            "method": exp.integrator.method.name(),
-            "rtol": exp.integrator.rtol,
-            "atol": exp.integrator.atol,
-            "h_max": exp.integrator.h_max,
-        },
-        "truth": truth_json,
-        "noise": noise,
-        "seed": spec.seed,
-        "record": out.display().to_string(),
-        "summary": summary,
-    });
+    let meta = SimulateJson {
+        generator: "stf-lab simulate",
+        version: env!("CARGO_PKG_VERSION"),
+        experiment_file: exp_path.display().to_string(),
+        experiment: crate::experiment::read_text(exp_path, crate::experiment::MAX_EXPERIMENT_BYTES)
+            .unwrap_or_default(),
+        simulate: &spec.as_json,
+        system: exp.system,
+        integrator: (&exp.integrator).into(),
+        truth: truth_json,
+        noise,
+        seed: spec.seed,
+        record: out.display().to_string(),
+        summary: summary(&run, free),
+    };
     write_json(&staged.stage(&sidecar), &meta)
         .with_context(|| format!("cannot write {}", sidecar.display()))?;
     staged.commit()?;
@@ -157,7 +110,79 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         wall.as_secs_f64() * 1e3,
         run.stats.rhs_calls
     );
-    if let Some(p) = pk {
+    print_outcome(&run, free);
+    say!("wrote {} and {}", out.display(), sidecar.display());
+    Ok(())
+}
+
+/// Check that the record `out` and its `sidecar` may be written (distinct, regular or new,
+/// replaced only with `force`), lock the record and clear what an interrupted run left.
+fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> {
+    if check_distinct(&[("the record", out), ("its JSON sidecar", sidecar)]).is_err() {
+        bail!(
+            "{}: the JSON sidecar is written to the record's path with the extension .json, \
+             which is the record itself; give the record another extension (e.g. .csv)",
+            out.display()
+        );
+    }
+    check_overwrite(out, force)?;
+    check_overwrite(sidecar, force)?;
+    ensure_parent(out)?;
+    let lock = OutputLock::acquire(out)?;
+    for target in [out, sidecar] {
+        for name in clean_stale(target)? {
+            crate::tell!(
+                "note: removed {name}, left beside {} by an interrupted run",
+                target.display()
+            );
+        }
+    }
+    Ok(lock)
+}
+
+/// The excitation of `drive` at the sample `times`, and whether it is a rotor. A force is
+/// tabulated at the sample times (held, or interpolated linearly).
+fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
+    match drive {
+        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
+        Drive::Free => (Excitation::None, false),
+        Drive::Force(chirp) => {
+            let u = times.iter().map(|&t| chirp.at(t)).collect();
+            let held = if chirp.held {
+                Linear::held(times.to_vec(), u)
+            } else {
+                Linear::new(times.to_vec(), u)
+            };
+            (Excitation::Force(held), false)
+        }
+    }
+}
+
+/// What the run shows, for the sidecar (`free`: free vibration, where motion stops).
+fn summary(run: &SimRun, free: bool) -> Summary {
+    let omega = run.omega.as_deref();
+    let pk = peak(&run.t, &run.x, omega);
+    let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
+    Summary {
+        peak_x_m: pk.map(|p| p.amplitude),
+        peak_t_s: pk.map(|p| p.t),
+        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
+        breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
+        motion_stops_t_s: if free {
+            stop(&run.v, MOVING_SPEED).map(|i| run.t[i])
+        } else {
+            None
+        },
+        samples: run.t.len(),
+        rhs_calls: run.stats.rhs_calls,
+        steps: run.stats.accepted,
+    }
+}
+
+/// The terminal lines of the run: its peak, the breakaway and where free motion stops.
+fn print_outcome(run: &SimRun, free: bool) {
+    let omega = run.omega.as_deref();
+    if let Some(p) = peak(&run.t, &run.x, omega) {
         if p.omega.is_finite() {
             say!(
                 "peak |x| = {:.2} mm at ω = {:.2} rad/s (t = {:.1} s)",
@@ -169,7 +194,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
             say!("peak |x| = {:.2} mm at t = {:.2} s", p.amplitude * 1e3, p.t);
         }
     }
-    match (brk, omega) {
+    match (breakaway(&run.x, BREAKAWAY_DISPLACEMENT), omega) {
         (Some(i), Some(w)) => say!(
             "breakaway (|x| first above {:.1} mm) at ω = {:.2} rad/s (t = {:.1} s)",
             BREAKAWAY_DISPLACEMENT * 1e3,
@@ -188,6 +213,4 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
             );
         }
     }
-    say!("wrote {} and {}", out.display(), sidecar.display());
-    Ok(())
 }

@@ -20,7 +20,7 @@ use stf_core::fit::{FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STAT
 use stf_core::force_model::ForceModel;
 use stf_core::system::OscillatorParams;
 
-use crate::output::write_columns;
+use crate::outputs::columns_csv::Columns;
 
 /// The fitted values behind one curve.
 #[derive(Clone, Debug, Serialize)]
@@ -150,10 +150,10 @@ pub fn write_curves(
     measured: &[f64],
     (base, final_curve): (&[f64], &[f64]),
 ) -> Result<()> {
-    let (b, f) = (format!("{signal}_base"), format!("{signal}_final"));
-    write_columns(
-        &out.join("discovered.csv"),
-        &["t", signal, &b, &f],
-        &[t, measured, base, final_curve],
-    )
+    Columns::new()
+        .with("t", t)
+        .with(signal, measured)
+        .with(format!("{signal}_base"), base)
+        .with(format!("{signal}_final"), final_curve)
+        .write(&out.join("discovered.csv"))
 }

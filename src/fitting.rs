@@ -11,11 +11,10 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
-use serde_json::{json, Value};
 use stf_core::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::fit::{
-    fit_warnings, FitParam, FitResult, FitWarning, FittedParam, ForceData, ForceFit, NoiseFloor,
-    TrajectoryData, TrajectoryFit,
+    fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
+    TrajectoryFit,
 };
 use stf_core::kinematics::Kinematics;
 use stf_core::record::Record;
@@ -284,84 +283,6 @@ impl ModelFit {
                 .map(|p| self.result.value(&p.name).unwrap_or(p.value))
                 .collect()
         })
-    }
-
-    /// The fit as the JSON of docs/ARCHITECTURE.md §6 (`name`, `params`, `rms`) and more;
-    /// with a validation record, `validation_rms` and `validation`.
-    pub fn to_json(&self, level: FitLevel) -> Value {
-        let mut doc = self.fit_json(level);
-        if let Some(v) = &self.validation {
-            doc["validation_rms"] = v.rms().map_or(Value::Null, |r| json!(r));
-            doc["validation"] = serde_json::to_value(v).unwrap_or(Value::Null);
-        }
-        doc
-    }
-
-    /// The fit's own part of [`ModelFit::to_json`].
-    fn fit_json(&self, level: FitLevel) -> Value {
-        let params: serde_json::Map<String, Value> = self
-            .result
-            .params
-            .iter()
-            .map(|p| (p.name.clone(), json!(p.value)))
-            .collect();
-        let fixed: Vec<&str> = self
-            .result
-            .params
-            .iter()
-            .filter(|p| p.fixed)
-            .map(|p| p.name.as_str())
-            .collect();
-        json!({
-            "name": self.name(),
-            "label": self.label,
-            "level": match level { FitLevel::Force => "force", FitLevel::Trajectory => "trajectory" },
-            "params": params,
-            "std_errors": std_errors_json(&self.result.params),
-            "naive_std_errors": Value::Object(
-                self.result
-                    .params
-                    .iter()
-                    .map(|p| (p.name.clone(), finite_or_null(p.naive_std_error)))
-                    .collect(),
-            ),
-            "error_blocks": self.result.error_blocks,
-            "fixed": fixed,
-            "rms": self.result.rms,
-            "rms_unit": match level { FitLevel::Force => "N", FitLevel::Trajectory => "m" },
-            "s_mm2": self.result.s_mm2,
-            "aic": finite_or_null(self.result.aic),
-            "bic": finite_or_null(self.result.bic),
-            "n_points": self.result.n_points,
-            "n_free": self.result.n_free,
-            "evaluations": self.result.evaluations,
-            "failures": self.result.failures,
-            "converged": self.result.convergence.converged(),
-            "convergence": self.result.convergence,
-            "system": (level == FitLevel::Trajectory).then_some(self.system),
-            "correlation": self.result.correlation.iter().map(|row| row.iter().map(|&c| finite_or_null(c)).collect::<Vec<_>>()).collect::<Vec<_>>(),
-            "noise_floor": self.floor,
-            "warnings": self.warnings.iter().map(FitWarning::stated).collect::<Vec<_>>(),
-        })
-    }
-}
-
-/// The standard errors of fitted parameters as a JSON object by name (null where unknown).
-pub fn std_errors_json(params: &[FittedParam]) -> Value {
-    Value::Object(
-        params
-            .iter()
-            .map(|p| (p.name.clone(), finite_or_null(p.std_error)))
-            .collect(),
-    )
-}
-
-/// JSON has no NaN or infinity: those become null.
-pub fn finite_or_null(v: f64) -> Value {
-    if v.is_finite() {
-        json!(v)
-    } else {
-        Value::Null
     }
 }
 

@@ -1,7 +1,8 @@
 //! `stf_lab`: the library behind the `stf-lab` program of the shear-thickening fluid lab. It
 //! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
 //! compare, discover, models), scores fitted models on a second record ([`validation`]), and
-//! writes results, figures and reports ([`output`], [`report`], [`reporting`],
+//! writes results ([`outputs`]: one `Serialize` type a file, written by [`output`]), figures
+//! and reports ([`report`], [`reporting`],
 //! [`discovery_curves`]). The binary (`src/main.rs`) only parses the command line and
 //! calls one `cmd_*::run`; integration tests and fuzz targets use the same functions.
 
@@ -15,6 +16,7 @@ pub mod cmd_fit;
 pub mod cmd_models;
 pub mod cmd_simulate;
 pub mod compare_loops;
+pub mod compare_markdown;
 pub mod data_layout;
 pub mod digits;
 pub mod discovery_curves;
@@ -25,6 +27,7 @@ pub mod interrupt;
 pub mod model_config;
 pub mod output;
 pub mod output_lock;
+pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
 pub mod progress;

@@ -115,27 +115,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Serialize `value` as pretty JSON into `path`, atomically, numbers with the digits they
-/// carry ([`crate::digits`]).
-pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
-    let mut value = value.clone();
+/// carry ([`crate::digits`]); object keys in sorted order.
+pub fn write_json<T: serde::Serialize + ?Sized>(path: &Path, value: &T) -> Result<()> {
+    let mut value = serde_json::to_value(value)
+        .with_context(|| format!("cannot serialize {}", path.display()))?;
     crate::digits::tidy_json(&mut value);
     let text = serde_json::to_string_pretty(&value)? + "\n";
-    write_atomic(path, text.as_bytes())
-}
-
-/// Write columns of numbers as CSV (header `names`) into `path`, atomically.
-pub fn write_columns(path: &Path, names: &[&str], columns: &[&[f64]]) -> Result<()> {
-    let n = columns.iter().map(|c| c.len()).min().unwrap_or(0);
-    let mut text = names.join(",");
-    text.push('\n');
-    for i in 0..n {
-        let row: Vec<String> = columns
-            .iter()
-            .map(|c| crate::digits::carried(c[i]).to_string())
-            .collect();
-        text.push_str(&row.join(","));
-        text.push('\n');
-    }
     write_atomic(path, text.as_bytes())
 }
 

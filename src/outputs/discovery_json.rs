@@ -1,0 +1,199 @@
+//! `discovery.json` of `stf-lab discover`: the effects named, the gap before and after, every
+//! step's evidence, the final model (with its experiment entry) and the values that redraw
+//! `discovered.csv`; at trajectory level also the oscillator refitted with the models.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use stf_core::derivative::NoiseEstimate;
+use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryDiscovery};
+use stf_core::estimate::LinearEstimate;
+use stf_core::fit::{FittedParam, NoiseFloor};
+use stf_core::reconstruct::DriveReport;
+use stf_core::system::OscillatorParams;
+
+use super::{std_errors_by_name, values_by_name};
+use crate::discovery_curves::FittedCurves;
+use crate::experiment::Experiment;
+use crate::fitting::FitData;
+use crate::validation::DiscoveryScore;
+
+/// The whole of `discovery.json`.
+#[derive(Serialize)]
+pub struct DiscoveryJson<'a> {
+    /// The experiment file, as given.
+    pub experiment: String,
+    /// The record discovered on (its path).
+    pub record: &'a str,
+    /// How the measured drive was rebuilt (null for free vibration).
+    pub drive: &'a Option<DriveReport>,
+    /// The noise of the signal fitted (N or m) and how it was estimated.
+    pub noise_estimate: NoiseEstimate,
+    /// The base model as `[discover] base` names it.
+    pub base: &'a str,
+    /// The effects named, in the order added (docs/ARCHITECTURE.md §5).
+    pub effects: &'a [String],
+    /// The base's held-out RMS error, in `gap_unit`.
+    pub gap_before: f64,
+    /// The final model's held-out RMS error, in `gap_unit`.
+    pub gap_after: f64,
+    /// The RMS error noise alone leaves, in `gap_unit`.
+    pub noise_floor: f64,
+    /// The floor's parts: `measured`, `propagated`, `sigma`.
+    pub noise_floor_parts: &'a NoiseFloor,
+    /// `N` (force level) or `m` (trajectory level).
+    pub gap_unit: &'static str,
+    /// Held-out cycles every step was scored on.
+    pub holdout_cycles: usize,
+    /// Where the base's error lies (regimes, parts of the cycle).
+    pub where_before: &'a GapLocation,
+    /// Where the final model's error lies.
+    pub where_after: &'a GapLocation,
+    /// Each step: every candidate's scores and the verdict.
+    pub steps: &'a [Step],
+    /// The final model, its values and its experiment entry.
+    pub final_model: FinalModelJson<'a>,
+    /// The values that redraw `discovered.csv`.
+    pub fitted: FittedCurves,
+    /// The record's plausibility warnings, then discovery's notes.
+    pub notes: Vec<&'a String>,
+    /// The oscillator side of a trajectory-level discovery (absent at force level).
+    #[serde(flatten)]
+    pub trajectory: Option<TrajectoryJson<'a>>,
+    /// The base and final model on the `[validate]` record (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation: Option<&'a DiscoveryScore>,
+}
+
+/// The keys only a trajectory-level discovery has.
+#[derive(Serialize)]
+pub struct TrajectoryJson<'a> {
+    /// The linear oscillator taken from the record, when no `[system]` was given.
+    pub system_estimate: Option<LinearEstimate>,
+    /// Always `trajectory`.
+    pub level: &'static str,
+    /// The base's mean squared displacement error S, mm².
+    pub s_before_mm2: f64,
+    /// The final model's S, mm².
+    pub s_after_mm2: f64,
+    /// The oscillator parameters refitted with every model.
+    pub refitted: &'a [String],
+    /// The oscillator fitted with the base.
+    pub system_before: OscillatorParams,
+    /// The oscillator fitted with the final model.
+    pub system: OscillatorParams,
+    /// Wall time of the discovery, s.
+    pub wall_seconds: f64,
+}
+
+/// The final model.
+#[derive(Serialize)]
+pub struct FinalModelJson<'a> {
+    /// `a + b + …`.
+    pub name: &'a str,
+    /// The model's fitted values by name (SI units; no offsets or initial state).
+    pub params: BTreeMap<String, f64>,
+    /// Standard errors of every fitted value by name; null where not determined.
+    pub std_errors: BTreeMap<String, Option<f64>>,
+    /// The model as a `[[models]]` entry (TOML).
+    pub experiment_entry: String,
+    /// The refitted oscillator (trajectory level; absent at force level).
+    #[serde(flatten)]
+    pub system: Option<FinalSystemJson>,
+}
+
+/// The refitted oscillator of the final model.
+#[derive(Serialize)]
+pub struct FinalSystemJson {
+    /// The refitted parameters by name, SI units.
+    pub system: BTreeMap<String, f64>,
+    /// The same as a `[system]` table (TOML).
+    pub system_entry: String,
+}
+
+/// What both levels share, from the experiment, the record and the discovery.
+pub struct Common<'a> {
+    /// The experiment.
+    pub exp: &'a Experiment,
+    /// The record and its kinematics.
+    pub data: &'a FitData,
+    /// The discovery.
+    pub found: &'a Discovery,
+    /// The score on the `[validate]` record.
+    pub score: Option<&'a DiscoveryScore>,
+}
+
+impl<'a> DiscoveryJson<'a> {
+    /// The document of a discovery: `model_params` are the final model's own values,
+    /// `experiment_entry` their `[[models]]` entry, `fitted` the curves' values.
+    pub fn new(
+        c: Common<'a>,
+        model_params: &[&FittedParam],
+        experiment_entry: String,
+        fitted: FittedCurves,
+    ) -> Self {
+        let (exp, data, found) = (c.exp, c.data, c.found);
+        DiscoveryJson {
+            experiment: exp.path.display().to_string(),
+            record: &data.record.source,
+            drive: &data.kinematics.drive,
+            noise_estimate: data.noise_estimate(),
+            base: exp
+                .discover
+                .as_ref()
+                .map_or(found.base.as_str(), |d| d.base.as_str()),
+            effects: &found.effects,
+            gap_before: found.gap_before,
+            gap_after: found.gap_after,
+            noise_floor: found.noise_floor,
+            noise_floor_parts: &found.noise_floor_parts,
+            gap_unit: "N",
+            holdout_cycles: found.holdout_cycles,
+            where_before: &found.where_before,
+            where_after: &found.where_after,
+            steps: &found.steps,
+            final_model: FinalModelJson {
+                name: &found.final_model_name,
+                params: values_by_name(model_params.iter().copied()),
+                std_errors: std_errors_by_name(&found.final_params),
+                experiment_entry,
+                system: None,
+            },
+            fitted,
+            notes: data.record_warnings.iter().chain(&found.notes).collect(),
+            trajectory: None,
+            validation: c.score,
+        }
+    }
+
+    /// The same at trajectory level: `tf` refitted `names` of the oscillator (the `[system]`
+    /// entry `system_entry`) in `wall` seconds.
+    pub fn with_trajectory(
+        mut self,
+        tf: &'a TrajectoryDiscovery,
+        names: &'a [String],
+        system_entry: String,
+        wall: f64,
+        system_estimate: Option<LinearEstimate>,
+    ) -> Self {
+        self.gap_unit = "m";
+        self.final_model.system = Some(FinalSystemJson {
+            system: names
+                .iter()
+                .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
+                .collect(),
+            system_entry,
+        });
+        self.trajectory = Some(TrajectoryJson {
+            system_estimate,
+            level: "trajectory",
+            s_before_mm2: tf.s_before_mm2,
+            s_after_mm2: tf.s_after_mm2,
+            refitted: names,
+            system_before: tf.system_before,
+            system: tf.system_after,
+            wall_seconds: wall,
+        });
+        self
+    }
+}

@@ -1,0 +1,187 @@
+//! `fit.json` of `stf-lab fit` (models fitted to one record), and the per-model fit that
+//! `compare.json` repeats under each model's `fit` (docs/ARCHITECTURE.md §6).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use stf_core::derivative::NoiseEstimate;
+use stf_core::estimate::LinearEstimate;
+use stf_core::fit::{Convergence, ErrorBlocks, FitWarning, NoiseFloor, StatedWarning};
+use stf_core::reconstruct::DriveReport;
+use stf_core::system::OscillatorParams;
+
+use super::{finite, level_name, std_errors_by_name, values_by_name};
+use crate::experiment::FitLevel;
+use crate::fitting::{FitData, ModelFit};
+use crate::validation::ModelValidation;
+
+/// The whole of `fit.json`.
+#[derive(Serialize)]
+pub struct FitJson<'a> {
+    /// The experiment file, as given.
+    pub experiment: String,
+    /// The record fitted (its path).
+    pub record: &'a str,
+    /// `force` (against `f_stf`) or `trajectory` (against `x`).
+    pub level: &'static str,
+    /// Samples fitted (after the time window).
+    pub samples: usize,
+    /// The polynomial filter v and a were derived with.
+    pub motion_filter: MotionFilter,
+    /// How the measured drive was rebuilt (null for free vibration).
+    pub drive: &'a Option<DriveReport>,
+    /// The noise of the fitted signal (N or m) and how it was estimated.
+    pub noise_estimate: NoiseEstimate,
+    /// The linear oscillator taken from the record, when no `[system]` was given.
+    pub system_estimate: Option<LinearEstimate>,
+    /// One entry per model, in the experiment's order.
+    pub models: Vec<ModelFitJson<'a>>,
+}
+
+impl<'a> FitJson<'a> {
+    /// `fit.json` of `fits` on `data`.
+    pub fn new(experiment: &std::path::Path, data: &'a FitData, fits: &'a [ModelFit]) -> Self {
+        let filter = &data.kinematics.motion_filter;
+        FitJson {
+            experiment: experiment.display().to_string(),
+            record: &data.record.source,
+            level: level_name(data.level),
+            samples: data.record.len(),
+            motion_filter: MotionFilter {
+                order: filter.order(),
+                window: filter.window(),
+            },
+            drive: &data.kinematics.drive,
+            noise_estimate: data.noise_estimate(),
+            system_estimate: data.system_estimate,
+            models: fits
+                .iter()
+                .map(|f| ModelFitJson::new(f, data.level))
+                .collect(),
+        }
+    }
+}
+
+/// The sliding polynomial filter of the kinematics.
+#[derive(Serialize)]
+pub struct MotionFilter {
+    /// Polynomial order.
+    pub order: usize,
+    /// Window, samples.
+    pub window: usize,
+}
+
+/// One fitted model.
+#[derive(Serialize)]
+pub struct ModelFitJson<'a> {
+    /// The model's name (`none` for the bare oscillator).
+    pub name: String,
+    /// Its label, unique in the experiment.
+    pub label: &'a str,
+    /// `force` or `trajectory`.
+    pub level: &'static str,
+    /// Fitted (or held) values by parameter name, SI units.
+    pub params: BTreeMap<String, f64>,
+    /// Block-robust standard errors by name, SI units; null where not determined.
+    pub std_errors: BTreeMap<String, Option<f64>>,
+    /// Standard errors as if the residuals were independent, by name; null where unknown.
+    pub naive_std_errors: BTreeMap<String, Option<f64>>,
+    /// The blocks the robust errors were computed over.
+    pub error_blocks: Option<ErrorBlocks>,
+    /// Names of the parameters held at their values.
+    pub fixed: Vec<&'a str>,
+    /// RMS residual, in `rms_unit`.
+    pub rms: f64,
+    /// `N` (force level) or `m` (trajectory level).
+    pub rms_unit: &'static str,
+    /// Mean squared displacement error, mm² (trajectory level).
+    pub s_mm2: Option<f64>,
+    /// Akaike information criterion; null if not finite.
+    pub aic: Option<f64>,
+    /// Bayesian information criterion; null if not finite.
+    pub bic: Option<f64>,
+    /// Samples fitted.
+    pub n_points: usize,
+    /// Free parameters.
+    pub n_free: usize,
+    /// Model evaluations.
+    pub evaluations: u64,
+    /// Evaluations that failed (a simulation that did not finish).
+    pub failures: u64,
+    /// Whether the optimiser converged.
+    pub converged: bool,
+    /// How it ended.
+    pub convergence: &'a Convergence,
+    /// The oscillator after the fit (trajectory level; null at force level).
+    pub system: Option<OscillatorParams>,
+    /// Correlation matrix of the free parameters; null where not finite.
+    pub correlation: Vec<Vec<Option<f64>>>,
+    /// The record's noise floor for this fit (same unit as `rms`).
+    pub noise_floor: Option<NoiseFloor>,
+    /// Why the fit is not to be trusted as it stands (`kind`, `message`, data).
+    pub warnings: Vec<StatedWarning<'a>>,
+    /// The error on the `[validate]` record (absent without one).
+    #[serde(flatten)]
+    pub validation: Option<ValidationJson<'a>>,
+}
+
+/// A model's error on the `[validate]` record, beside its fit.
+#[derive(Serialize)]
+pub struct ValidationJson<'a> {
+    /// The RMS error on the second record (unit of `validation.unit`); null if not scored.
+    pub validation_rms: Option<f64>,
+    /// The whole score: `file`, `unit`, `rms`, `measured_rms`, `normalised`, … .
+    pub validation: &'a ModelValidation,
+}
+
+impl<'a> ModelFitJson<'a> {
+    /// The JSON of `fit` at `level`.
+    pub fn new(fit: &'a ModelFit, level: FitLevel) -> Self {
+        let r = &fit.result;
+        ModelFitJson {
+            name: fit.name(),
+            label: &fit.label,
+            level: level_name(level),
+            params: values_by_name(&r.params),
+            std_errors: std_errors_by_name(&r.params),
+            naive_std_errors: r
+                .params
+                .iter()
+                .map(|p| (p.name.clone(), finite(p.naive_std_error)))
+                .collect(),
+            error_blocks: r.error_blocks,
+            fixed: r
+                .params
+                .iter()
+                .filter(|p| p.fixed)
+                .map(|p| p.name.as_str())
+                .collect(),
+            rms: r.rms,
+            rms_unit: match level {
+                FitLevel::Force => "N",
+                FitLevel::Trajectory => "m",
+            },
+            s_mm2: r.s_mm2,
+            aic: finite(r.aic),
+            bic: finite(r.bic),
+            n_points: r.n_points,
+            n_free: r.n_free,
+            evaluations: r.evaluations,
+            failures: r.failures,
+            converged: r.convergence.converged(),
+            convergence: &r.convergence,
+            system: (level == FitLevel::Trajectory).then_some(fit.system),
+            correlation: r
+                .correlation
+                .iter()
+                .map(|row| row.iter().map(|&c| finite(c)).collect())
+                .collect(),
+            noise_floor: fit.floor,
+            warnings: fit.warnings.iter().map(FitWarning::stated).collect(),
+            validation: fit.validation.as_ref().map(|v| ValidationJson {
+                validation_rms: v.rms(),
+                validation: v,
+            }),
+        }
+    }
+}
