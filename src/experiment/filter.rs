@@ -197,7 +197,7 @@ mod tests {
         );
         let msg = format!(
             "{:#}",
-            parse("[filter]\nmotion = { order = 3, window = 4 }\n").unwrap_err()
+            parse("[filter]\nmotion = { order = 3, window = 3 }\n").unwrap_err()
         );
         assert!(msg.starts_with("exp.toml:1: `filter.motion`: "), "{msg}");
     }
