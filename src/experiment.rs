@@ -313,7 +313,10 @@ params = { K = 4.0, n = 1.5 }
         assert_eq!(folder_of(Path::new("exp.toml")), Path::new("."));
         assert_eq!(folder_of(Path::new("a/b/exp.toml")), Path::new("a/b"));
         let e = parse("[data]\nfile = \"r.csv\"\n").unwrap();
-        assert_eq!((e.dir.as_path(), e.data_file.unwrap()), (Path::new("."), "./r.csv".into()));
+        assert_eq!(
+            (e.dir.as_path(), e.data_file.unwrap()),
+            (Path::new("."), "./r.csv".into())
+        );
     }
 
     const VALID: &str = r#"

@@ -179,8 +179,8 @@ mod tests {
 
     #[test]
     fn the_boundary_applies_to_every_filter_and_an_unknown_one_lists_both() {
-        let e = parse("[filter]\nboundary = \"zero\"\nmotion = { order = 3, window = 21 }\n")
-            .unwrap();
+        let e =
+            parse("[filter]\nboundary = \"zero\"\nmotion = { order = 3, window = 21 }\n").unwrap();
         assert_eq!(e.kinematics.boundary, Boundary::Zero);
         let motion = e.kinematics.motion.unwrap();
         assert_eq!(motion.boundary_handling(), Boundary::Zero);
@@ -189,7 +189,10 @@ mod tests {
         if let DriveSmoothing::Samples(f) = e.kinematics.drive {
             assert_eq!(f.boundary_handling(), Boundary::Zero);
         }
-        let msg = format!("{:#}", parse("[filter]\nboundary = \"edge\"\n").unwrap_err());
+        let msg = format!(
+            "{:#}",
+            parse("[filter]\nboundary = \"edge\"\n").unwrap_err()
+        );
         assert!(
             msg.starts_with("exp.toml:2: `filter.boundary`: unknown variant `edge`")
                 && msg.contains("`shifted` or `zero`"),

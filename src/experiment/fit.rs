@@ -81,7 +81,11 @@ pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> 
         return Ok(fit);
     };
     let (span, f) = (f.span(), f.get_ref());
-    if let Some(name) = f.system.iter().find(|n| OscillatorParams::FORCED.get(n).is_none()) {
+    if let Some(name) = f
+        .system
+        .iter()
+        .find(|n| OscillatorParams::FORCED.get(n).is_none())
+    {
         return Err(cx.at(
             span,
             "fit.system",
@@ -152,9 +156,14 @@ mod tests {
                 "{msg}"
             );
         }
-        let msg = format!("{:#}", parse("[fit]\nsystem = [\"k\", \"q\"]\n").unwrap_err());
+        let msg = format!(
+            "{:#}",
+            parse("[fit]\nsystem = [\"k\", \"q\"]\n").unwrap_err()
+        );
         assert!(
-            msg.starts_with("exp.toml:1: `fit.system`: `q` is not an oscillator parameter; known: m, k"),
+            msg.starts_with(
+                "exp.toml:1: `fit.system`: `q` is not an oscillator parameter; known: m, k"
+            ),
             "{msg}"
         );
     }

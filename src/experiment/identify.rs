@@ -48,7 +48,10 @@ pub(super) fn check(stages: &[Spanned<RawStage>], cx: &Ctx, dir: &Path) -> Resul
         .map(|(i, st)| {
             let (span, r) = (st.span(), st.get_ref());
             let names = r.free.iter().chain(r.set.keys());
-            if let Some(name) = names.into_iter().find(|n| OscillatorParams::FORCED.get(n).is_none()) {
+            if let Some(name) = names
+                .into_iter()
+                .find(|n| OscillatorParams::FORCED.get(n).is_none())
+            {
                 return Err(cx.at(
                     span,
                     &format!("identify[{i}]"),
@@ -90,9 +93,15 @@ mod tests {
         };
         assert_eq!(a.data, Path::new("dir/free.csv"));
         assert_eq!(a.preset, Some(OscillatorParams::FREE));
-        assert_eq!((a.free.as_slice(), a.line), (&["k".to_string(), "c".into()][..], 1));
+        assert_eq!(
+            (a.free.as_slice(), a.line),
+            (&["k".to_string(), "c".into()][..], 1)
+        );
         assert_eq!(b.preset, None);
-        assert_eq!((b.set.as_slice(), b.line), (&[("T".to_string(), 0.5)][..], 6));
+        assert_eq!(
+            (b.set.as_slice(), b.line),
+            (&[("T".to_string(), 0.5)][..], 6)
+        );
     }
 
     #[test]
@@ -103,7 +112,9 @@ mod tests {
             parse(&format!("{stage}{stage}set = {{ q = 1.0 }}\n")).unwrap_err()
         );
         assert!(
-            msg.starts_with("dir/exp.toml:4: `identify[1]`: `q` is not an oscillator parameter; known: m, k"),
+            msg.starts_with(
+                "dir/exp.toml:4: `identify[1]`: `q` is not an oscillator parameter; known: m, k"
+            ),
             "{msg}"
         );
         let msg = format!(

@@ -198,13 +198,19 @@ mod tests {
             ("K", Some(2.0))
         );
         assert_eq!(e.models[1].source, ModelSource::Script("m.rhai".into()));
-        assert_eq!((e.models[1].line, e.models[1].key.as_str()), (5, "models[1]"));
+        assert_eq!(
+            (e.models[1].line, e.models[1].key.as_str()),
+            (5, "models[1]")
+        );
     }
 
     #[test]
     fn an_entry_with_both_or_neither_source_names_its_line_and_key() {
         for (text, says) in [
-            ("[[models]]\nname = \"viscous\"\nscript = \"m.rhai\"\n", "not both"),
+            (
+                "[[models]]\nname = \"viscous\"\nscript = \"m.rhai\"\n",
+                "not both",
+            ),
             ("[[models]]\nplus = [\"viscous\"]\n", "needs `name`"),
         ] {
             let msg = format!("{:#}", parse(&format!("\n{text}")).unwrap_err());
@@ -218,7 +224,10 @@ mod tests {
             parse("[simulate]\nfree = { t1 = 1.0 }\n[[simulate.truth]]\nscript = \"a\"\nname = \"b\"\n")
                 .unwrap_err()
         );
-        assert!(msg.starts_with("exp.toml:3: `simulate.truth[0]`: "), "{msg}");
+        assert!(
+            msg.starts_with("exp.toml:3: `simulate.truth[0]`: "),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -89,11 +89,7 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
         mut as_json,
     } = the_drive(s, cx, span.clone())?;
     if !(t1 > t0) {
-        return Err(cx.at(
-            span,
-            "simulate",
-            format!("t1 = {t1} must exceed t0 = {t0}"),
-        ));
+        return Err(cx.at(span, "simulate", format!("t1 = {t1} must exceed t0 = {t0}")));
     }
     if !(s.rate > 0.0 && s.rate.is_finite()) {
         return Err(cx.at(span, "simulate.rate", "must be a positive number"));
@@ -229,10 +225,12 @@ mod tests {
 
     #[test]
     fn each_drive_gives_its_span_and_the_sidecar_its_table() {
-        let s = parse("[simulate]\nprofile = { t = [1.0, 2.0, 4.0], omega = [1.0, 2.0, 3.0] }\nseed = 7\n")
-            .unwrap()
-            .simulate
-            .unwrap();
+        let s = parse(
+            "[simulate]\nprofile = { t = [1.0, 2.0, 4.0], omega = [1.0, 2.0, 3.0] }\nseed = 7\n",
+        )
+        .unwrap()
+        .simulate
+        .unwrap();
         assert_eq!((s.t0, s.t1, s.seed, s.rate), (1.0, 4.0, 7, 1000.0));
         assert!(matches!(s.drive, Drive::Rotor(_)));
         assert_eq!(s.as_json["profile"]["t"][2], 4.0);
@@ -245,8 +243,16 @@ mod tests {
         assert_eq!((s.t0, s.t1), (0.0, 3.0));
         for (profile, key, says) in [
             ("t = [1.0], omega = [1.0]", "simulate.profile", "at least 2"),
-            ("t = [1.0, 2.0], omega = [1.0]", "simulate.profile", "same length"),
-            ("t = [2.0, 1.0], omega = [1.0, 1.0]", "simulate.profile.t", "increase"),
+            (
+                "t = [1.0, 2.0], omega = [1.0]",
+                "simulate.profile",
+                "same length",
+            ),
+            (
+                "t = [2.0, 1.0], omega = [1.0, 1.0]",
+                "simulate.profile.t",
+                "increase",
+            ),
         ] {
             let msg = format!(
                 "{:#}",
@@ -261,7 +267,10 @@ mod tests {
             "{:#}",
             parse("[simulate]\nfree = { t1 = 1.0 }\nrate = -5.0\n").unwrap_err()
         );
-        assert!(msg.starts_with("exp.toml:1: `simulate.rate`: must be"), "{msg}");
+        assert!(
+            msg.starts_with("exp.toml:1: `simulate.rate`: must be"),
+            "{msg}"
+        );
     }
 
     #[test]

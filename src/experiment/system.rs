@@ -88,8 +88,8 @@ pub(super) fn check(raw: Option<&Spanned<RawSystem>>, cx: &Ctx) -> Result<Oscill
 #[cfg(test)]
 mod tests {
     use super::super::Experiment;
-    use stf_core::system::OscillatorParams;
     use std::path::Path;
+    use stf_core::system::OscillatorParams;
 
     fn parse(text: &str) -> anyhow::Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)
@@ -112,8 +112,7 @@ mod tests {
     fn an_unknown_preset_or_a_bad_value_names_file_line_key_and_what_is_accepted() {
         let msg = format!("{:#}", parse("[system]\npreset = \"forcd\"\n").unwrap_err());
         assert!(
-            msg.starts_with("exp.toml:2: `system.preset`:")
-                && msg.contains("`forced` or `free`"),
+            msg.starts_with("exp.toml:2: `system.preset`:") && msg.contains("`forced` or `free`"),
             "{msg}"
         );
         for (text, key) in [
