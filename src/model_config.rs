@@ -1,5 +1,8 @@
 //! Force models as an experiment file names them: built-ins or scripts, summed, with their
-//! parameter values, bounds and fixed/free switches resolved once.
+//! parameter values, bounds and fixed/free switches resolved once. The entries come checked
+//! from the experiment file (`crate::experiment::ModelEntry`); what needs the registry —
+//! whether a name or script resolves, whether a parameter is the model's and within its
+//! bounds — is checked here.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -11,7 +14,7 @@ use stf_core::model_sum::ModelSum;
 
 use stf_plugins::ScriptRun;
 
-use crate::experiment::{ModelEntry, RawParam};
+use crate::experiment::{ModelEntry, ParamGiven};
 
 /// A parameter's setting for a fit: value, bounds and whether it is held fixed.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -82,13 +85,7 @@ pub fn configure_for(
                 msg
             )
         };
-        let raw = &entry.raw;
-        let first = raw
-            .name
-            .as_deref()
-            .or(raw.script.as_deref())
-            .ok_or_else(|| at("a model needs `name` or `script`".into()))?;
-        for spec in std::iter::once(first).chain(raw.plus.iter().map(String::as_str)) {
+        for spec in entry.specs() {
             let model = resolve(spec, dir, run).map_err(|e| at(format!("{e:#}")))?;
             parts.push(match scales {
                 Some(s) => widened(model, s),
@@ -112,48 +109,56 @@ pub fn configure_for(
         })
         .collect();
     for entry in entries {
-        for (name, value) in &entry.raw.params {
-            let line = entry.param_lines.get(name).copied().unwrap_or(entry.line);
-            let at = |msg: String| {
-                anyhow!(
-                    "{}:{}: `{}.params.{}`: {}",
-                    file.display(),
-                    line,
-                    entry.key,
-                    name,
-                    msg
-                )
-            };
-            let i = sum.param_index(name).ok_or_else(|| {
-                let known: Vec<&str> = sum.params().iter().map(|s| s.name.as_str()).collect();
-                at(format!(
-                    "`{}` has no parameter `{name}`; its parameters: {}",
-                    sum.name(),
-                    known.join(", ")
-                ))
-            })?;
-            let p = &mut params[i];
-            match value.get_ref() {
-                RawParam::Value(v) => p.value = *v,
-                RawParam::Table(t) => {
-                    p.value = t.value.unwrap_or(p.value);
-                    p.min = t.min.unwrap_or(p.min);
-                    p.max = t.max.unwrap_or(p.max);
-                    p.fixed = t.fixed.unwrap_or(p.fixed);
-                }
-            }
-            if !(p.value.is_finite() && p.min <= p.value && p.value <= p.max) {
-                return Err(at(format!(
-                    "{} lies outside its bounds [{}, {}]",
-                    p.value, p.min, p.max
-                )));
-            }
+        for given in &entry.params {
+            apply(&mut params, &sum, entry, given, file)?;
         }
     }
     Ok(ConfiguredModel {
         model: Arc::new(sum),
         params,
     })
+}
+
+/// Set the parameter `given` of `entry` in `params` (the settings of `sum`): it must be one
+/// of the sum's parameters, and its value within its bounds.
+fn apply(
+    params: &mut [ParamSetting],
+    sum: &ModelSum,
+    entry: &ModelEntry,
+    given: &ParamGiven,
+    file: &Path,
+) -> Result<()> {
+    let name = &given.name;
+    let at = |msg: String| {
+        anyhow!(
+            "{}:{}: `{}.params.{}`: {}",
+            file.display(),
+            given.line,
+            entry.key,
+            name,
+            msg
+        )
+    };
+    let i = sum.param_index(name).ok_or_else(|| {
+        let known: Vec<&str> = sum.params().iter().map(|s| s.name.as_str()).collect();
+        at(format!(
+            "`{}` has no parameter `{name}`; its parameters: {}",
+            sum.name(),
+            known.join(", ")
+        ))
+    })?;
+    let p = &mut params[i];
+    p.value = given.value.unwrap_or(p.value);
+    p.min = given.min.unwrap_or(p.min);
+    p.max = given.max.unwrap_or(p.max);
+    p.fixed = given.fixed.unwrap_or(p.fixed);
+    if !(p.value.is_finite() && p.min <= p.value && p.value <= p.max) {
+        return Err(at(format!(
+            "{} lies outside its bounds [{}, {}]",
+            p.value, p.min, p.max
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -1,0 +1,99 @@
+//! Where an experiment file's errors point: [`Ctx`] holds the file and its text, and every
+//! error about a value reads `FILE:LINE: `KEY`: MSG` ([`error_at`]). Errors from serde (an
+//! unknown key, a wrong type, an unknown variant of a serde enum, which lists the accepted
+//! ones) take the same form through [`deserialize_error`], with the key path `toml` records.
+
+use std::ops::Range;
+use std::path::Path;
+
+/// 1-based line of a byte offset.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// `FILE:LINE: `KEY`: MSG`, the form of every error about a value in an experiment file.
+pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{}:{}: `{}`: {}", file.display(), line, key, msg)
+}
+
+/// Where errors point: the experiment file and its text.
+pub(crate) struct Ctx<'a> {
+    pub(super) file: &'a Path,
+    pub(super) text: &'a str,
+}
+
+impl Ctx<'_> {
+    /// The 1-based line of a byte offset.
+    pub(crate) fn line(&self, offset: usize) -> usize {
+        line_of(self.text, offset)
+    }
+
+    /// An error at `span`'s line, about `key`.
+    pub(crate) fn at(
+        &self,
+        span: Range<usize>,
+        key: &str,
+        msg: impl std::fmt::Display,
+    ) -> anyhow::Error {
+        error_at(self.file, line_of(self.text, span.start), key, msg)
+    }
+
+    /// A deserialisation error of the file's text: its line, the key path of the value it is
+    /// about (none for a key unknown at the top level) and serde's message.
+    pub(crate) fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {
+        let line = e.span().map_or(0, |s| line_of(self.text, s.start));
+        let msg = e.message().trim_end();
+        match key_path(e) {
+            Some(key) => error_at(self.file, line, &key, msg),
+            None => anyhow::anyhow!("{}:{}: {}", self.file.display(), line, msg),
+        }
+    }
+}
+
+/// The dotted key path `toml` records on a deserialisation error (`fit.level`; a table's
+/// path for a key unknown in it). `toml` shows it, and has no getter for it, only in its
+/// message without the input's excerpt: `MESSAGE\nin `PATH``.
+fn key_path(e: &toml::de::Error) -> Option<String> {
+    let mut bare = e.clone();
+    bare.set_input(None);
+    let shown = bare.to_string();
+    let rest = shown.strip_prefix(e.message())?.trim();
+    let path = rest.strip_prefix("in `")?.strip_suffix('`')?;
+    (!path.is_empty()).then(|| path.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Experiment;
+    use std::path::Path;
+
+    fn message(text: &str) -> String {
+        format!(
+            "{:#}",
+            Experiment::parse(Path::new("exp.toml"), text).unwrap_err()
+        )
+    }
+
+    #[test]
+    fn a_serde_error_names_the_line_and_the_key_path() {
+        assert_eq!(
+            message("[fit]\n\nlevel = \"forc\"\n"),
+            "exp.toml:3: `fit.level`: unknown variant `forc`, expected `force` or `trajectory`"
+        );
+        assert_eq!(
+            message("[system]\nm = 7.65\nk = \"stiff\"\n"),
+            "exp.toml:3: `system.k`: invalid type: string \"stiff\", expected f64"
+        );
+        // A key unknown in a table names the table; at the top level, no key.
+        let msg = message("[system]\nm = 7.65\nstifnes = 3.0\n");
+        assert!(
+            msg.starts_with("exp.toml:3: `system`: unknown field `stifnes`, expected one of"),
+            "{msg}"
+        );
+        let msg = message("\nsystm = 3.0\n");
+        assert!(
+            msg.starts_with("exp.toml:2: unknown field `systm`, expected one of"),
+            "{msg}"
+        );
+    }
+}

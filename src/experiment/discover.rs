@@ -1,0 +1,89 @@
+//! The `[discover]` section of an experiment file: the base model, the candidate effects,
+//! how many may be added, the held-out cycles, the scouting threshold and the fit level.
+//! Every key's shape is its serde type, so the checked section is a plain conversion.
+
+use serde::Deserialize;
+
+use super::FitLevel;
+
+/// `[discover]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawDiscover {
+    base: String,
+    candidates: Option<Vec<String>>,
+    max_effects: Option<usize>,
+    holdout_every: Option<usize>,
+    level: Option<FitLevel>,
+    scout_from: Option<usize>,
+}
+
+/// A validated `[discover]` section.
+#[derive(Clone, Debug)]
+pub struct DiscoverSpec {
+    /// The base model: a name, a script path, or `a + b`.
+    pub base: String,
+    /// Candidate effects (default: the vocabulary of docs/ARCHITECTURE.md §5).
+    pub candidates: Option<Vec<String>>,
+    /// At most this many effects are added.
+    pub max_effects: Option<usize>,
+    /// Every k-th cycle is held out for scoring.
+    pub holdout_every: Option<usize>,
+    /// Records of at least this many samples are scouted at trajectory level (0: never).
+    pub scout_from: Option<usize>,
+    /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
+    /// `f_stf`.
+    pub level: Option<FitLevel>,
+}
+
+impl From<RawDiscover> for DiscoverSpec {
+    fn from(d: RawDiscover) -> DiscoverSpec {
+        DiscoverSpec {
+            base: d.base,
+            candidates: d.candidates,
+            max_effects: d.max_effects,
+            holdout_every: d.holdout_every,
+            scout_from: d.scout_from,
+            level: d.level,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Experiment;
+    use super::*;
+    use std::path::Path;
+
+    fn parse(text: &str) -> anyhow::Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn the_section_parses_and_an_unknown_level_lists_the_levels() {
+        let d = parse(
+            "[discover]\nbase = \"viscous\"\ncandidates = [\"yield\"]\nmax_effects = 2\n\
+             holdout_every = 4\nlevel = \"trajectory\"\nscout_from = 0\n",
+        )
+        .unwrap()
+        .discover
+        .unwrap();
+        assert_eq!(d.base, "viscous");
+        assert_eq!(d.candidates, Some(vec!["yield".to_string()]));
+        assert_eq!(
+            (d.max_effects, d.holdout_every, d.scout_from),
+            (Some(2), Some(4), Some(0))
+        );
+        assert_eq!(d.level, Some(FitLevel::Trajectory));
+        assert!(parse("").unwrap().discover.is_none());
+        let msg = format!(
+            "{:#}",
+            parse("\n[discover]\nbase = \"viscous\"\nlevel = \"forces\"\n").unwrap_err()
+        );
+        assert!(
+            msg.starts_with("exp.toml:4: `discover.level`: unknown variant `forces`")
+                && msg.contains("`force` or `trajectory`"),
+            "{msg}"
+        );
+    }
+}

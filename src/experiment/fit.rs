@@ -1,0 +1,170 @@
+//! The `[fit]` section of an experiment file: the fit `level` (`force`, `trajectory`), the
+//! `solver` (a serde enum of core's, [`Solver`]), `max_iters` and `seed`, oscillator
+//! parameters fitted along (`system`), a constant `offset`, and whether a trajectory fit
+//! fits its `initial` state or takes the record's.
+
+use anyhow::Result;
+use serde::Deserialize;
+use stf_core::fit::{FitSettings, Solver};
+use stf_core::system::OscillatorParams;
+use toml::Spanned;
+
+use super::Ctx;
+
+/// Whether models are fitted to the measured force or to the measured motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitLevel {
+    /// Against `f_stf`, along the record's kinematics.
+    Force,
+    /// Against `x`, by simulating the oscillator driven as in the record.
+    Trajectory,
+}
+
+/// Where a trajectory fit's initial state comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum Initial {
+    /// Fitted with the other parameters (the default).
+    Fit,
+    /// The record's estimated state.
+    Record,
+}
+
+/// `[fit]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFit {
+    level: Option<FitLevel>,
+    solver: Option<Solver>,
+    max_iters: Option<u64>,
+    seed: Option<u64>,
+    #[serde(default)]
+    system: Vec<String>,
+    #[serde(default)]
+    offset: bool,
+    initial: Option<Initial>,
+}
+
+/// A validated `[fit]` section.
+#[derive(Clone, Debug)]
+pub struct FitSpec {
+    /// Force or trajectory level; `None`: force when the record has `f_stf`.
+    pub level: Option<FitLevel>,
+    /// Optimiser settings.
+    pub settings: FitSettings,
+    /// Oscillator parameters fitted along with a model (trajectory level).
+    pub system_free: Vec<String>,
+    /// Fit a constant offset (force: `f_off`, trajectory: `x_off`).
+    pub offset: bool,
+    /// Trajectory level: fit the initial state `x0`, `v0` (the default, `initial = "fit"`)
+    /// or take it from the record (`initial = "record"`).
+    pub fit_initial: bool,
+}
+
+impl Default for FitSpec {
+    fn default() -> FitSpec {
+        FitSpec {
+            level: None,
+            settings: FitSettings::default(),
+            system_free: Vec::new(),
+            offset: false,
+            fit_initial: true,
+        }
+    }
+}
+
+/// Check `[fit]` (absent: the defaults): every name in `system` is an oscillator parameter.
+pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> {
+    let mut fit = FitSpec::default();
+    let Some(f) = raw else {
+        return Ok(fit);
+    };
+    let (span, f) = (f.span(), f.get_ref());
+    if let Some(name) = f
+        .system
+        .iter()
+        .find(|n| OscillatorParams::FORCED.get(n).is_none())
+    {
+        return Err(cx.at(
+            span,
+            "fit.system",
+            format!(
+                "`{name}` is not an oscillator parameter; known: {}",
+                OscillatorParams::NAMES.join(", ")
+            ),
+        ));
+    }
+    fit.level = f.level;
+    if let Some(solver) = f.solver {
+        fit.settings.solver = solver;
+    }
+    if let Some(n) = f.max_iters {
+        fit.settings.max_iters = n;
+    }
+    if let Some(seed) = f.seed {
+        fit.settings.seed = seed;
+    }
+    fit.system_free = f.system.clone();
+    fit.offset = f.offset;
+    fit.fit_initial = f.initial != Some(Initial::Record);
+    Ok(fit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Experiment;
+    use super::*;
+    use std::path::Path;
+
+    fn parse(text: &str) -> anyhow::Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn the_section_s_keys_set_the_fit() {
+        let e = parse(
+            "[fit]\nlevel = \"trajectory\"\nsolver = \"nelder_mead\"\nmax_iters = 50\nseed = 9\n\
+             system = [\"k\", \"c\"]\noffset = true\ninitial = \"record\"\n",
+        )
+        .unwrap();
+        let f = &e.fit;
+        assert_eq!(f.level, Some(FitLevel::Trajectory));
+        assert_eq!(f.settings.solver, Solver::NelderMead);
+        assert_eq!((f.settings.max_iters, f.settings.seed), (50, 9));
+        assert_eq!(f.system_free, ["k", "c"]);
+        assert!(f.offset && !f.fit_initial);
+        let e = parse("[fit]\nlevel = \"force\"\ninitial = \"fit\"\n").unwrap();
+        assert_eq!(e.fit.level, Some(FitLevel::Force));
+        assert!(e.fit.fit_initial);
+        let e = parse("").unwrap();
+        assert_eq!(e.fit.level, None);
+        assert!(e.fit.fit_initial && !e.fit.offset);
+    }
+
+    #[test]
+    fn an_unknown_name_names_file_line_key_and_the_known_ones() {
+        for (text, key, known) in [
+            ("level = \"forc\"", "fit.level", "`force` or `trajectory`"),
+            ("initial = \"guess\"", "fit.initial", "`fit` or `record`"),
+            ("solver = \"newton\"", "fit.solver", "`nelder_mead`"),
+        ] {
+            let msg = format!("{:#}", parse(&format!("\n[fit]\n{text}\n")).unwrap_err());
+            assert!(
+                msg.starts_with(&format!("exp.toml:3: `{key}`: unknown variant"))
+                    && msg.contains(known),
+                "{msg}"
+            );
+        }
+        let msg = format!(
+            "{:#}",
+            parse("[fit]\nsystem = [\"k\", \"q\"]\n").unwrap_err()
+        );
+        assert!(
+            msg.starts_with(
+                "exp.toml:1: `fit.system`: `q` is not an oscillator parameter; known: m, k"
+            ),
+            "{msg}"
+        );
+    }
+}

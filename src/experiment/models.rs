@@ -1,0 +1,244 @@
+//! `[[models]]` and `[[simulate.truth]]` entries of an experiment file: a built-in `name` or
+//! a `script` (exactly one), further models summed with it (`plus`), and `params` — a value,
+//! or a table of `value`, `min`, `max`, `fixed` — each with its line. Whether the names
+//! resolve and the values lie within the model's bounds needs the registry (scripts), so
+//! `crate::model_config` checks that, from these typed entries.
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::Ctx;
+
+/// A parameter value as written: a number, or a table with value / min / max / fixed.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+enum RawParam {
+    /// Just the value.
+    Value(f64),
+    /// Value with bounds and a fixed/free switch.
+    Table(RawParamTable),
+}
+
+/// The table form of a parameter.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawParamTable {
+    value: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+    fixed: Option<bool>,
+}
+
+/// One `[[models]]` (or `[[simulate.truth]]`) entry as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawModel {
+    name: Option<String>,
+    script: Option<String>,
+    #[serde(default)]
+    plus: Vec<String>,
+    #[serde(default)]
+    params: BTreeMap<String, Spanned<RawParam>>,
+}
+
+/// Where an entry's first model comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ModelSource {
+    /// A built-in model's name (`name = "power_law"`), or a sum `a + b`.
+    Name(String),
+    /// A script model's path, relative to the experiment file (`script = "m.rhai"`).
+    Script(String),
+}
+
+impl ModelSource {
+    /// The name or path, as the registry resolves it.
+    pub fn spec(&self) -> &str {
+        match self {
+            ModelSource::Name(s) | ModelSource::Script(s) => s,
+        }
+    }
+}
+
+/// A parameter's value and bounds as an entry gives them; what is not given keeps the
+/// model's default.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamGiven {
+    /// The parameter's name in the (summed) model.
+    pub name: String,
+    /// Initial or fixed value.
+    pub value: Option<f64>,
+    /// Lower bound.
+    pub min: Option<f64>,
+    /// Upper bound.
+    pub max: Option<f64>,
+    /// Held at its value in fits.
+    pub fixed: Option<bool>,
+    /// Line of the parameter in the file (1-based).
+    pub line: usize,
+}
+
+/// A checked model entry, with where it stands in the file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelEntry {
+    /// The entry's first model.
+    pub source: ModelSource,
+    /// Further models added to it (`plus = ["added_mass"]`).
+    pub plus: Vec<String>,
+    /// The parameters given, by name.
+    pub params: Vec<ParamGiven>,
+    /// Line of the entry in the file (1-based).
+    pub line: usize,
+    /// Key path (`models[0]`, `simulate.truth[1]`).
+    pub key: String,
+}
+
+impl ModelEntry {
+    /// The names and paths of the entry's models, in order: its source, then `plus`.
+    pub fn specs(&self) -> impl Iterator<Item = &str> {
+        std::iter::once(self.source.spec()).chain(self.plus.iter().map(String::as_str))
+    }
+}
+
+/// Check a list of entries whose key is `prefix` (`models`, `simulate.truth`).
+pub(super) fn check(list: &[Spanned<RawModel>], prefix: &str, cx: &Ctx) -> Result<Vec<ModelEntry>> {
+    list.iter()
+        .enumerate()
+        .map(|(i, m)| entry(m, format!("{prefix}[{i}]"), cx))
+        .collect()
+}
+
+/// One entry: exactly one of `name` and `script`.
+fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
+    let r = m.get_ref();
+    let source = match (&r.name, &r.script) {
+        (Some(_), Some(_)) => {
+            return Err(cx.at(m.span(), &key, "give either `name` or `script`, not both"))
+        }
+        (None, None) => {
+            return Err(cx.at(
+                m.span(),
+                &key,
+                "a model needs `name` (a built-in) or `script` (a .rhai file)",
+            ))
+        }
+        (Some(name), None) => ModelSource::Name(name.clone()),
+        (None, Some(script)) => ModelSource::Script(script.clone()),
+    };
+    let params = r
+        .params
+        .iter()
+        .map(|(name, v)| {
+            let line = cx.line(v.span().start);
+            let name = name.clone();
+            match v.get_ref() {
+                RawParam::Value(value) => ParamGiven {
+                    name,
+                    value: Some(*value),
+                    min: None,
+                    max: None,
+                    fixed: None,
+                    line,
+                },
+                RawParam::Table(t) => ParamGiven {
+                    name,
+                    value: t.value,
+                    min: t.min,
+                    max: t.max,
+                    fixed: t.fixed,
+                    line,
+                },
+            }
+        })
+        .collect();
+    Ok(ModelEntry {
+        source,
+        plus: r.plus.clone(),
+        params,
+        line: cx.line(m.span().start),
+        key,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Experiment;
+    use super::*;
+    use std::path::Path;
+
+    fn parse(text: &str) -> anyhow::Result<Experiment> {
+        Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn an_entry_is_checked_into_its_source_sum_and_parameters_with_their_lines() {
+        let e = parse(
+            "[[models]]\nname = \"power_law\"\nplus = [\"added_mass\"]\n\
+             params = { K = 2.0, n = { value = 1.2, min = 1.0, fixed = true } }\n\
+             [[models]]\nscript = \"m.rhai\"\n",
+        )
+        .unwrap();
+        let m = &e.models[0];
+        assert_eq!(m.source, ModelSource::Name("power_law".into()));
+        assert_eq!(m.specs().collect::<Vec<_>>(), ["power_law", "added_mass"]);
+        assert_eq!((m.line, m.key.as_str()), (1, "models[0]"));
+        let n = ParamGiven {
+            name: "n".into(),
+            value: Some(1.2),
+            min: Some(1.0),
+            max: None,
+            fixed: Some(true),
+            line: 4,
+        };
+        assert_eq!(m.params[1], n);
+        assert_eq!(
+            (m.params[0].name.as_str(), m.params[0].value),
+            ("K", Some(2.0))
+        );
+        assert_eq!(e.models[1].source, ModelSource::Script("m.rhai".into()));
+        assert_eq!(
+            (e.models[1].line, e.models[1].key.as_str()),
+            (5, "models[1]")
+        );
+    }
+
+    #[test]
+    fn an_entry_with_both_or_neither_source_names_its_line_and_key() {
+        for (text, says) in [
+            (
+                "[[models]]\nname = \"viscous\"\nscript = \"m.rhai\"\n",
+                "not both",
+            ),
+            ("[[models]]\nplus = [\"viscous\"]\n", "needs `name`"),
+        ] {
+            let msg = format!("{:#}", parse(&format!("\n{text}")).unwrap_err());
+            assert!(
+                msg.starts_with("exp.toml:2: `models[0]`: ") && msg.contains(says),
+                "{msg}"
+            );
+        }
+        let msg = format!(
+            "{:#}",
+            parse("[simulate]\nfree = { t1 = 1.0 }\n[[simulate.truth]]\nscript = \"a\"\nname = \"b\"\n")
+                .unwrap_err()
+        );
+        assert!(
+            msg.starts_with("exp.toml:3: `simulate.truth[0]`: "),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn a_misspelled_key_inside_a_model_names_its_line() {
+        let msg = format!(
+            "{:#}",
+            parse("[[models]]\nname = \"viscous\"\nparmas = { c_s = 1.0 }\n").unwrap_err()
+        );
+        assert!(
+            msg.contains("exp.toml:3") && msg.contains("parmas"),
+            "{msg}"
+        );
+    }
+}
