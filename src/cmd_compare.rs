@@ -13,8 +13,8 @@ use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use serde_json::{json, Value};
-use stf_core::analysis::{local_maxima, peak};
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{local_maxima, peak};
+use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare, rank_models, rank_on_loops, Classification, Comparison, Regime, Signals,
 };

@@ -13,10 +13,10 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde_json::json;
+use stf_core::data::kinematics::Kinematics;
 use stf_core::fit::{
     fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
 };
-use stf_core::kinematics::Kinematics;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{
@@ -30,8 +30,8 @@ use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::regimes::Regime;
-use stf_core::system::OscillatorParams;
 
 /// Run `stf-lab fit`: the results are built in a staging folder and swapped in as a whole
 /// ([`ResultsDir`]).
@@ -339,7 +339,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
                 .iter()
                 .flat_map(|s| s.free.clone())
                 .collect();
-            for name in stf_core::system::OscillatorParams::NAMES {
+            for name in stf_core::physics::oscillator_params::OscillatorParams::NAMES {
                 if !found.iter().any(|f| f == name) {
                     system.set(name, preset.get(name).unwrap_or(0.0));
                 }

@@ -10,17 +10,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
-use stf_core::bounded::{read_file_to_string, BoundedError};
-use stf_core::derivative::{Boundary, PolyFilter};
-use stf_core::excitation::RotorAngle;
+use stf_core::data::bounded::{read_file_to_string, BoundedError};
+use stf_core::data::kinematics::KinematicsSettings;
+use stf_core::data::record::ReadOptions;
 use stf_core::fit::{FitSettings, Solver};
-use stf_core::integrate::{Method, Settings};
-use stf_core::kinematics::KinematicsSettings;
-use stf_core::reconstruct::DriveSmoothing;
-use stf_core::record::ReadOptions;
+use stf_core::numerics::derivative::{Boundary, PolyFilter};
+use stf_core::numerics::integrate::{Method, Settings};
+use stf_core::numerics::reconstruct::DriveSmoothing;
+use stf_core::physics::excitation::RotorAngle;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::regimes::RegimeThresholds;
 use stf_core::simulate::{count_text, sample_count, DEFAULT_MAX_SAMPLES};
-use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
 use crate::data_layout::{self, RawData};
@@ -1113,7 +1113,7 @@ mod tests {
 
     #[test]
     fn the_drive_reconstruction_and_initial_state_are_settings() {
-        use stf_core::reconstruct::DriveSmoothing;
+        use stf_core::numerics::reconstruct::DriveSmoothing;
         let e = parse("[data]\nfile = \"r.csv\"\ndrive = \"samples\"\n").unwrap();
         assert!(matches!(e.kinematics.drive, DriveSmoothing::Samples(_)));
         let e = parse("[data]\nfile = \"r.csv\"\ndrive = { order = 2, window = 101 }\n").unwrap();
