@@ -12,8 +12,8 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use stf_core::analysis::{local_maxima, peak, Peak};
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{local_maxima, peak, Peak};
+use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare, rank_models, rank_on_loops, Classification, Comparison, MetricRanking,
     Ranking, Regime, Signals,

@@ -14,14 +14,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use stf_core::data_bounds::widened;
+use stf_core::data::record_bounds::widened;
 use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
     TrajectoryDiscovery, TrajectorySetup,
 };
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
-use stf_core::force_model::ForceModel;
-use stf_core::model_sum::ModelSum;
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::model_sum::ModelSum;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};

@@ -12,10 +12,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use stf_core::data::kinematics::Kinematics;
 use stf_core::fit::{
     fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
 };
-use stf_core::kinematics::Kinematics;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{estimate_line, fit_all, load_data, system_param, FitData, ModelFit};
@@ -29,8 +29,8 @@ use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::regimes::Regime;
-use stf_core::system::OscillatorParams;
 
 /// Run `stf-lab fit`: the results are built in a staging folder and swapped in as a whole
 /// ([`ResultsDir`]).

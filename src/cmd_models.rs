@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use stf_core::force_model::ForceModel;
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_plugins::registry::Registry;
 use stf_plugins::ScriptModel;
 

@@ -14,12 +14,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use stf_core::analysis::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_SPEED};
-use stf_core::excitation::Excitation;
-use stf_core::interpolate::Linear;
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_SPEED};
+use stf_core::numerics::interpolate::Linear;
+use stf_core::physics::excitation::Excitation;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory as SimRun};
-use stf_core::synthetic::{sample_record, SensorNoise};
 
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure;

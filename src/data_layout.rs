@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::record::{Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit};
+use stf_core::data::record::{Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit};
 use toml::{Spanned, Value};
 
 use crate::experiment::{Ctx, RawDrive};
@@ -345,7 +345,7 @@ fn setting_span(raw: &RawData, setting: &str, data: &Range<usize>) -> Range<usiz
 mod tests {
     use super::*;
     use crate::experiment::Experiment;
-    use stf_core::record::{Calibration, TimeBase};
+    use stf_core::data::record::{Calibration, TimeBase};
 
     fn parse(data: &str) -> Result<Experiment> {
         Experiment::parse(
@@ -370,7 +370,7 @@ mod tests {
         assert_eq!(e.data_layout.max_bytes, 1_000_000_000);
         assert_eq!(
             parse("").unwrap().data_layout.max_bytes,
-            stf_core::record::DEFAULT_MAX_BYTES
+            stf_core::data::record::DEFAULT_MAX_BYTES
         );
         let msg = parse("\nmax_bytes = 0\n").unwrap_err().to_string();
         assert_eq!(

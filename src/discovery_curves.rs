@@ -17,8 +17,8 @@ use anyhow::Result;
 use serde::Serialize;
 use stf_core::discovery::{Discovery, TrajectoryDiscovery};
 use stf_core::fit::{FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
-use stf_core::force_model::ForceModel;
-use stf_core::system::OscillatorParams;
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use crate::outputs::columns_csv::Columns;
 

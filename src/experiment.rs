@@ -11,12 +11,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::bounded::{read_file_to_string, BoundedError};
-use stf_core::integrate::Settings;
-use stf_core::kinematics::KinematicsSettings;
-use stf_core::record::ReadOptions;
+use stf_core::data::bounded::{read_file_to_string, BoundedError};
+use stf_core::data::kinematics::KinematicsSettings;
+use stf_core::data::record::ReadOptions;
+use stf_core::numerics::integrate::Settings;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::regimes::RegimeThresholds;
-use stf_core::system::OscillatorParams;
 use toml::Spanned;
 
 use crate::data_layout::{self, RawData};

@@ -11,19 +11,19 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
-use stf_core::estimate::{linear_oscillator, LinearEstimate};
+use stf_core::data::estimate::{linear_oscillator, LinearEstimate};
+use stf_core::data::kinematics::Kinematics;
+use stf_core::data::record::Record;
 use stf_core::fit::{
     fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
     TrajectoryFit,
 };
-use stf_core::kinematics::Kinematics;
-use stf_core::record::Record;
-use stf_core::system::OscillatorParams;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
 use crate::progress::{fit_message, Progress};
-use stf_core::data_bounds::DataScales;
+use stf_core::data::record_bounds::DataScales;
 
 /// A record with its kinematics, ready to fit.
 pub struct FitData {
@@ -41,7 +41,7 @@ pub struct FitData {
 }
 
 impl FitData {
-    /// The sizes the models' bounds are widened to ([`stf_core::data_bounds`]): the measured
+    /// The sizes the models' bounds are widened to ([`stf_core::data::record_bounds`]): the measured
     /// force at force level, the force recovered with the oscillator `system` at trajectory
     /// level, along the record's motion.
     pub fn scales(&self, system: &OscillatorParams) -> DataScales {
@@ -54,9 +54,9 @@ impl FitData {
     }
 
     /// How the noise of the signal fits aim at was estimated (both estimates and the one
-    /// taken: [`stf_core::derivative::noise_estimate`]).
-    pub fn noise_estimate(&self) -> stf_core::derivative::NoiseEstimate {
-        stf_core::derivative::noise_estimate(self.target())
+    /// taken: [`stf_core::numerics::derivative::noise_estimate`]).
+    pub fn noise_estimate(&self) -> stf_core::numerics::derivative::NoiseEstimate {
+        stf_core::numerics::derivative::noise_estimate(self.target())
     }
 
     /// The measured signal fits aim at: `f_stf` (force level) or `x` (trajectory level).

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use stf_core::fit::{FitResult, FitWarning, NoiseFloor};
-use stf_core::system::OscillatorParams;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use crate::report::{measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM};
 use crate::reporting::write_report;

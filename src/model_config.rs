@@ -8,9 +8,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{anyhow, Result};
-use stf_core::data_bounds::{widened, DataScales};
-use stf_core::force_model::ForceModel;
-use stf_core::model_sum::ModelSum;
+use stf_core::data::record_bounds::{widened, DataScales};
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::model_sum::ModelSum;
 
 use stf_plugins::ScriptRun;
 

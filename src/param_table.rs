@@ -13,7 +13,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use stf_core::fit::{FitResult, FitWarning};
-use stf_core::force_model::ForceModel;
+use stf_core::physics::force_model::ForceModel;
 
 use crate::digits::carried;
 use crate::fitting::ModelFit;

@@ -13,7 +13,7 @@
 //! by `[data] plausibility = false`.
 
 use anyhow::{bail, Result};
-use stf_core::record::{ReadOptions, Record, TimeBase};
+use stf_core::data::record::{ReadOptions, Record, TimeBase};
 
 use crate::experiment::Experiment;
 

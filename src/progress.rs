@@ -10,7 +10,7 @@ use std::time::Instant;
 use crate::terminal::escape_controls;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use stf_core::discovery::{DiscoveryEvent, Observer};
-use stf_core::fit::{FitProgress, Stage};
+use stf_core::fit::{FitProgress, SolverStage};
 
 /// A set of spinners, one per running job.
 pub struct Progress {
@@ -50,9 +50,9 @@ impl Progress {
 /// (`scale` from SI: the cost is a mean square in N² or m²).
 pub fn fit_message(p: &FitProgress, unit: &str, scale: f64) -> String {
     let doing = match p.stage {
-        Stage::ParticleSwarm => "searching the parameter box",
-        Stage::NelderMead | Stage::LevenbergMarquardt => "refining the best point",
-        Stage::Errors => "estimating the standard errors",
+        SolverStage::ParticleSwarm => "searching the parameter box",
+        SolverStage::NelderMead | SolverStage::LevenbergMarquardt => "refining the best point",
+        SolverStage::Errors => "estimating the standard errors",
     };
     let rms = p.best_cost.sqrt() * scale;
     if rms.is_finite() {
@@ -154,7 +154,7 @@ mod tests {
     #[test]
     fn messages_speak_of_the_work_not_the_solver() {
         let p = FitProgress {
-            stage: Stage::LevenbergMarquardt,
+            stage: SolverStage::LevenbergMarquardt,
             evaluations: 42,
             best_cost: 4e-4,
         };

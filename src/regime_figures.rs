@@ -176,7 +176,7 @@ pub fn regime_section(
         let groups = groups_of(&found, &cycles);
         let quantity = ParityQuantity {
             label: "F_STF, N".into(),
-            noise_sigma: Some(stf_core::derivative::noise_estimate(f).sigma),
+            noise_sigma: Some(stf_core::numerics::derivative::noise_estimate(f).sigma),
         };
         let fig = parity(&dir, "parity", &quantity, f, models, &groups)?;
         s.figures.push(FigureRef::new(

@@ -16,10 +16,10 @@ use std::sync::Arc;
 use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
+use stf_core::data::kinematics::Kinematics;
 use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectoryDiscovery, TrajectorySetup};
-use stf_core::excitation::Excitation;
 use stf_core::fit::{TrajectoryData, Validation};
-use stf_core::kinematics::Kinematics;
+use stf_core::physics::excitation::Excitation;
 use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms, Signals};
 
 use crate::experiment::{Experiment, FitLevel, ValidateSpec};
@@ -105,17 +105,17 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
 fn check_columns(
     exp: &Experiment,
     spec: &ValidateSpec,
-    record: &stf_core::record::Record,
+    record: &stf_core::data::record::Record,
     estimation: &FitData,
 ) -> Result<()> {
     let column = |signal: &str| {
-        let channel = stf_core::record::Signal::from_name(signal)
+        let channel = stf_core::data::record::Signal::from_name(signal)
             .map(|s| exp.data_layout.channel(s).column.clone());
         match channel {
-            Some(stf_core::record::Column::Name(n)) if n != signal => {
+            Some(stf_core::data::record::Column::Name(n)) if n != signal => {
                 format!("`{signal}` (`{n}`)")
             }
-            Some(stf_core::record::Column::Number(i)) => format!("`{signal}` (column {i})"),
+            Some(stf_core::data::record::Column::Number(i)) => format!("`{signal}` (column {i})"),
             _ => format!("`{signal}`"),
         }
     };

@@ -207,11 +207,14 @@ fn trajectory_discovery_is_validated_on_a_second_record_and_its_json_redraws_its
     for (which, column) in [("base", "x_base"), ("final", "x_final")] {
         let entry = &doc["fitted"][which];
         let (model, values) = common::fitted_model(entry);
-        let system: stf_core::system::OscillatorParams =
+        let system: stf_core::physics::oscillator_params::OscillatorParams =
             serde_json::from_value(entry["system"].clone()).unwrap();
-        let osc = stf_core::oscillator::Oscillator::with_shared_excitation(system, drive.clone())
-            .with_model(model, values)
-            .unwrap();
+        let osc = stf_core::physics::oscillator::Oscillator::with_shared_excitation(
+            system,
+            drive.clone(),
+        )
+        .with_model(model, values)
+        .unwrap();
         let initial = &entry["initial"];
         let run = stf_core::simulate::Simulation::new(&osc)
             .settings(experiment.integrator.clone())

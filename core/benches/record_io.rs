@@ -8,7 +8,7 @@
 //! rate well enough, and it needs no benchmarking crate beyond what the tests use.
 
 use std::time::Instant;
-use stf_core::record::{Record, MEMORY_SOURCE};
+use stf_core::data::record::{Record, MEMORY_SOURCE};
 
 /// A record that looks like a simulated sweep: 1 kHz, smooth signals with noise-like digits.
 fn record(rows: usize) -> Record {

@@ -16,13 +16,13 @@ use std::time::Instant;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use stf_core::excitation::{Excitation, RotorAngle};
 use stf_core::fit::{FitParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 struct PowerLaw(Vec<ParamSpec>);
 

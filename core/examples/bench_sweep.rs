@@ -14,13 +14,13 @@
 
 use std::time::Instant;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::integrate::{integrate, Method, Settings, Solution};
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::oscillator::Oscillator;
-use stf_core::record::Record;
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
+use stf_core::data::record::Record;
+use stf_core::numerics::integrate::{integrate, Method, Settings, Solution};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 /// CPU time of this process (user + system), s, from /proc (Linux; 0 elsewhere). On a
 /// machine shared with other jobs it is a steadier figure than wall time.

@@ -27,15 +27,15 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use stf_core::excitation::{Excitation, RotorAngle};
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
 use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
 
 struct PowerLaw(Vec<ParamSpec>);
 

@@ -2,10 +2,10 @@
 //! (default 3), and print the best wall time.
 //!
 //! `cargo run --release -p stf-core --example profile_sweep [repeats]`
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::oscillator::Oscillator;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 fn main() {
     let repeats: usize = std::env::args()

@@ -10,12 +10,12 @@
 
 use std::path::Path;
 
-use stf_core::integrate::{integrate, Method, OdeSystem, Settings, SimError, Solution};
-use stf_core::interpolate::Linear;
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::oscillator::Oscillator;
-use stf_core::record::Record;
-use stf_core::system::OscillatorParams;
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
+use stf_core::data::record::Record;
+use stf_core::numerics::integrate::{integrate, Method, OdeSystem, Settings, SimError, Solution};
+use stf_core::numerics::interpolate::Linear;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 /// `y' = u(t)`, `u` linear between uneven knots.
 struct Integral {

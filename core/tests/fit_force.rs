@@ -10,9 +10,9 @@ use rand_distr::{Distribution, Normal};
 use stf_core::fit::{
     Convergence, FitError, FitParam, FitProgress, FitSettings, ForceData, ForceFit, Solver,
 };
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::model_sum::ModelSum;
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::param_spec::ParamSpec;
 
 /// `K·|v|ⁿ·sign v`; errs for n above `fail_above`; may carry an ignored parameter.
 struct PowerLaw {

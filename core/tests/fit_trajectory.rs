@@ -5,13 +5,13 @@ use std::sync::Arc;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use stf_core::excitation::Excitation;
 use stf_core::fit::{FitError, FitParam, FitSettings, Solver, TrajectoryData, TrajectoryFit};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::physics::excitation::Excitation;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 fn record(
     osc: &Oscillator,
@@ -165,7 +165,7 @@ fn names_are_resolved_or_refused() {
 
 #[test]
 fn forced_sweep_identification_from_ten_percent_off_reaches_the_noise() {
-    use stf_core::excitation::RotorAngle;
+    use stf_core::physics::excitation::RotorAngle;
     let truth = OscillatorParams::FORCED;
     let excitation = Arc::new(Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0)));
     let osc = Oscillator::with_shared_excitation(truth, excitation.clone());
@@ -205,9 +205,14 @@ fn forced_sweep_identification_from_ten_percent_off_reaches_the_noise() {
 }
 
 /// A forced sweep record sampled through the rig's sensors (ω = w0 + alpha·t from t = 0).
-fn rig_sweep_record(w0: f64, alpha: f64, duration: f64, rate: f64) -> stf_core::record::Record {
-    use stf_core::excitation::RotorAngle;
-    use stf_core::synthetic::{sample_record, SensorNoise};
+fn rig_sweep_record(
+    w0: f64,
+    alpha: f64,
+    duration: f64,
+    rate: f64,
+) -> stf_core::data::record::Record {
+    use stf_core::physics::excitation::RotorAngle;
+    use stf_core::simulate::synthetic::{sample_record, SensorNoise};
     let drive = Excitation::Rotor(RotorAngle::sweep(w0, alpha, 0.0));
     let osc = Oscillator::new(OscillatorParams::FORCED, drive);
     let run = Simulation::new(&osc).rate(rate).run(0.0, duration).unwrap();
@@ -221,10 +226,10 @@ fn rig_sweep_record(w0: f64, alpha: f64, duration: f64, rate: f64) -> stf_core::
 /// step, and Levenberg–Marquardt stopped up the valley. Returns S at the truth (the forced
 /// preset) and the 5-parameter fit from `factors` × the truth.
 fn fit_like_the_cli(
-    rec: &stf_core::record::Record,
+    rec: &stf_core::data::record::Record,
     factors: [f64; 5],
 ) -> (f64, stf_core::fit::FitResult) {
-    use stf_core::kinematics::{Kinematics, KinematicsSettings};
+    use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
     let truth = OscillatorParams::FORCED;
     let k = Kinematics::from_record(rec, &KinematicsSettings::default()).unwrap();
     let excitation = Arc::new(k.excitation());
@@ -269,7 +274,7 @@ fn a_measured_drive_sweep_fit_from_ten_percent_low_is_not_stopped_by_integrator_
 fn bundled_forced_sweep_from_three_ten_percent_off_starts_reaches_the_optimum() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../experiments/records/forced_sweep.csv");
-    let rec = stf_core::record::ReadOptions::default()
+    let rec = stf_core::data::record::ReadOptions::default()
         .read(&path)
         .unwrap();
     for factors in [[1.1; 5], [0.9; 5], [1.1, 0.9, 1.1, 0.9, 1.1]] {

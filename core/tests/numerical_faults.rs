@@ -4,14 +4,14 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
 use stf_core::fit::{FitParam, ForceData, ForceFit};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::integrate::{integrate, OdeSystem, Settings, SimError};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::numerics::integrate::{integrate, OdeSystem, Settings, SimError};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 /// A model whose force turns bad after `t_bad`: NaN, or an error, or a negative added mass.
 struct Faulty {

@@ -1,10 +1,10 @@
 //! Free vibration from x0 = 30 mm against an independent implementation's curve.
 
-use stf_core::analysis::{stop, MOVING_SPEED};
-use stf_core::excitation::Excitation;
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{stop, MOVING_SPEED};
+use stf_core::physics::excitation::Excitation;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 fn reference() -> Vec<(f64, f64, f64)> {
     let text = include_str!("data/free_vibration_x0_30mm.csv");

@@ -1,11 +1,11 @@
 //! The frequency response of the no-STF forced model on the 0.047 rad/s² sweep against an
 //! independent implementation (local maxima of x), and the reference figures of docs/ARCHITECTURE.md §1.
 
-use stf_core::analysis::{breakaway, local_maxima, peak, BREAKAWAY_DISPLACEMENT};
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{breakaway, local_maxima, peak, BREAKAWAY_DISPLACEMENT};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 #[test]
 fn sweep_0p047_matches_the_reference_response() {

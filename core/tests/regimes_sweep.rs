@@ -14,17 +14,17 @@
 
 use std::sync::{Arc, OnceLock};
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_core::regimes::{
     classify, compare, cycles_from_phase, rank_models, Classification, Regime, RegimeThresholds,
     Signals,
 };
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
 
 const ALPHA: f64 = 0.0333;
 const RATE: f64 = 200.0;

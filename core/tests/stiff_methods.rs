@@ -1,7 +1,9 @@
 //! The stiff-capable methods (`Method::Auto`, the default, and `Method::Rodas4`) against known
 //! solutions, a tight Dormand–Prince reference on stiff problems, and their failure modes.
 
-use stf_core::integrate::{integrate, Method, OdeSystem, Settings, SimError, Solution, Stats};
+use stf_core::numerics::integrate::{
+    integrate, Method, OdeSystem, Settings, SimError, Solution, Stats,
+};
 
 const STIFF: [Method; 2] = [Method::Auto, Method::Rodas4];
 

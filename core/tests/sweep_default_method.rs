@@ -2,12 +2,12 @@
 //! ignored test, because the reference takes seconds — its agreement with a tight
 //! Dormand–Prince run.
 
-use stf_core::analysis::{breakaway, peak, BREAKAWAY_DISPLACEMENT};
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::integrate::{Method, Settings};
-use stf_core::oscillator::Oscillator;
+use stf_core::data::response::{breakaway, peak, BREAKAWAY_DISPLACEMENT};
+use stf_core::numerics::integrate::{Method, Settings};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::system::OscillatorParams;
 
 fn sweep(settings: Settings) -> Trajectory {
     let osc = Oscillator::new(

@@ -2,7 +2,7 @@
 //! error; never a panic or a hang (the sandbox bounds operations, depth and sizes).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use stf_core::force_model::{ForceModel, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_plugins::ScriptModel;
 
 fuzz_target!(|data: &[u8]| {

@@ -12,8 +12,8 @@
 //! |---|---|---|---|---|
 //! | `m_a` | kg | 0.5 | [0, 20] | mass of fluid moving with the blade |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 
@@ -85,9 +85,9 @@ impl ForceModel for AddedMass {
 mod tests {
     use super::*;
     use std::sync::Arc;
-    use stf_core::excitation::{Excitation, RotorAngle};
-    use stf_core::oscillator::Oscillator;
-    use stf_core::system::OscillatorParams;
+    use stf_core::physics::excitation::{Excitation, RotorAngle};
+    use stf_core::physics::oscillator::Oscillator;
+    use stf_core::physics::oscillator_params::OscillatorParams;
 
     #[test]
     fn added_mass_is_the_parameter_and_the_rest_of_the_force_is_zero() {

@@ -10,8 +10,8 @@
 //! |---|---|---|---|---|
 //! | `k3` | N/m³ | 1e5 | [0, 1e9] | cubic stiffness (0.1 N at 1 cm, 7.4 N at 42 mm) |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

@@ -44,8 +44,8 @@
 //! | `v_c` | m/s | 0.05 | [0, 1] | critical speed of jamming onset |
 //! | `w` | m/s | 0.002 | [1e-4, 0.1] | width of the onset gate |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::power_law::{power_law_force, power_law_gradient};
 use crate::values::take;

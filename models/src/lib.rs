@@ -1,7 +1,7 @@
 //! stf-models: the built-in shear-thickening fluid force models of stf-lab.
 //!
-//! Each model implements [`stf_core::force_model::ForceModel`] and is listed in [`BUILTINS`],
-//! the one static table the registry reads. Models add: a [`stf_core::model_sum::ModelSum`] of
+//! Each model implements [`stf_core::physics::force_model::ForceModel`] and is listed in [`BUILTINS`],
+//! the one static table the registry reads. Models add: a [`stf_core::physics::model_sum::ModelSum`] of
 //! built-ins is a model too.
 //!
 //! | name | law | parameters |
@@ -26,7 +26,7 @@
 
 use std::sync::Arc;
 
-use stf_core::force_model::ForceModel;
+use stf_core::physics::force_model::ForceModel;
 
 pub mod added_mass;
 pub mod cubic_stiffness;

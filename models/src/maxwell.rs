@@ -20,8 +20,8 @@
 //! | `c_m` | N·s/m | 5 | [0, 1e4] | viscosity of the dashpot (the long-time damping) |
 //! | `tau` | s | 0.05 | [1e-4, 10] | relaxation time; spring stiffness is c_m/τ |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

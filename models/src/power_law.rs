@@ -12,8 +12,8 @@
 //! | `K` | N·(s/m)ⁿ | 5 | [0, 1e4] | consistency: the force at 1 m/s |
 //! | `n` | — | 1.6 | [1, 4] | flow index; n > 1 thickens |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

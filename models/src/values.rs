@@ -3,7 +3,7 @@
 //! The values arrive as a plain `&[f64]` in the order of the model's specs; a caller that
 //! passes too few is told so by a [`ModelError`] instead of a panic.
 
-use stf_core::force_model::ModelError;
+use stf_core::physics::force_model::ModelError;
 
 /// The first `N` values of `p`, or an error naming `model` when there are fewer.
 #[inline]

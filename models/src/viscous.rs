@@ -6,8 +6,8 @@
 //! |---|---|---|---|---|
 //! | `c_s` | N·s/m | 2 | [0, 1e4] | damping coefficient of the fluid |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

@@ -22,8 +22,8 @@
 //! | `p` | — | 1.5 | [1, 3] | contact exponent (Hertz: 1.5) |
 //! | `c_r` | s/m | 0.5 | [0, 10] | Hunt–Crossley damping factor α |
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

@@ -16,8 +16,8 @@
 //! The file is `yield_stress.rs` because `yield` is a reserved word in Rust; the model's
 //! name is `yield`.
 
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::values::take;
 

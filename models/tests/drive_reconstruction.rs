@@ -1,6 +1,6 @@
 //! With the truth fixed, a simulation driven by a record's own rotor angle reaches the
 //! record's x noise, whatever the sweep rate and encoder: the drive is rebuilt from the encoder
-//! samples as the smooth signal it is (`stf_core::reconstruct`).
+//! samples as the smooth signal it is (`stf_core::numerics::reconstruct`).
 //!
 //! Records: the forced reference oscillator with a power law (K 20, n 1.5) through a sweep
 //! from ω 2.35 to 9.4 rad/s at the paper's 1 kHz, sampled through the rig's sensors (x noise
@@ -14,13 +14,13 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::oscillator::Oscillator;
-use stf_core::reconstruct::DriveSmoothing;
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
+use stf_core::numerics::reconstruct::DriveSmoothing;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::Simulation;
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
 use stf_models::find;
 
 /// Truth x residual against the x noise, both RMS in m, and the smoothing window (samples).
@@ -92,7 +92,7 @@ fn samples_as_recorded_put_the_encoder_steps_into_x() {
         0.047,
         2048,
         1,
-        DriveSmoothing::Samples(stf_core::derivative::PolyFilter::paper_omega()),
+        DriveSmoothing::Samples(stf_core::numerics::derivative::PolyFilter::paper_omega()),
     );
     println!(
         "x residual: smoothed {:.4} mm, samples {:.4} mm, noise {:.4} mm",

@@ -7,8 +7,8 @@
 use std::sync::Arc;
 
 use proptest::prelude::*;
-use stf_core::force_model::{ForceModel, ModelState};
-use stf_core::model_sum::ModelSum;
+use stf_core::physics::force_model::{ForceModel, ModelState};
+use stf_core::physics::model_sum::ModelSum;
 use stf_models::{find, BUILTINS};
 
 /// The whole force `m_a·a + f` at parameters `p`.

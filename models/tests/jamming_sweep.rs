@@ -8,11 +8,11 @@
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::defaults;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::defaults;
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::system::OscillatorParams;
 use stf_models::jamming_on_off::JammingOnOff;
 
 /// Force below which the fluid counts as at rest, N.
@@ -20,7 +20,9 @@ const NIL: f64 = 0.05;
 
 fn simulate(angle: RotorAngle, t1: f64) -> Trajectory {
     let model = Arc::new(JammingOnOff::new());
-    let values = defaults(stf_core::force_model::ForceModel::params(model.as_ref()));
+    let values = defaults(stf_core::physics::force_model::ForceModel::params(
+        model.as_ref(),
+    ));
     let osc = Oscillator::new(OscillatorParams::FORCED, Excitation::Rotor(angle))
         .with_model(model, values)
         .unwrap();

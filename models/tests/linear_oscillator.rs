@@ -2,11 +2,11 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::integrate::Settings;
-use stf_core::oscillator::Oscillator;
+use stf_core::numerics::integrate::Settings;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 
 #[test]
 fn steady_state_amplitude_matches_the_analytic_one() {

@@ -2,7 +2,7 @@
 //! never add energy (F·v ≥ 0), odd laws satisfy F(−x, −v) = −F(x, v), contacts never pull.
 
 use proptest::prelude::*;
-use stf_core::force_model::{ForceModel, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_models::find;
 
 /// Parameter values of `model` placed at the fractions `u` (in [0, 1]) of their bounds.

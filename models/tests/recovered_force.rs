@@ -2,12 +2,12 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::oscillator::Oscillator;
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::Simulation;
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
 
 fn rms(a: &[f64]) -> f64 {
     (a.iter().map(|v| v * v).sum::<f64>() / a.len() as f64).sqrt()

@@ -2,7 +2,7 @@
 //! spring, a gate open at every speed the record reaches is its power law, a power law of
 //! exponent 1 is viscous; values that use the model's own freedom are not reduced.
 
-use stf_core::force_model::{ForceModel, Reach};
+use stf_core::physics::force_model::{ForceModel, Reach};
 use stf_models::{jamming_on_off::JammingOnOff, power_law::PowerLaw, wall_impact::WallImpact};
 
 const REACH: Reach = Reach { x: 0.03, v: 0.2 };

@@ -15,13 +15,13 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::force_model::ForceModel;
-use stf_core::integrate::{Method, Settings, SimError};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::defaults;
+use stf_core::numerics::integrate::{Method, Settings, SimError};
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::defaults;
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::system::OscillatorParams;
 use stf_models::jamming_on_off::JammingOnOff;
 use stf_models::wall_impact::WallImpact;
 

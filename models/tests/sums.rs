@@ -3,12 +3,12 @@
 use std::sync::Arc;
 
 use approx::assert_relative_eq;
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::force_model::{ForceModel, ModelState};
-use stf_core::model_sum::ModelSum;
-use stf_core::oscillator::Oscillator;
-use stf_core::params::defaults;
-use stf_core::system::OscillatorParams;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelState};
+use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::defaults;
 use stf_models::find;
 
 fn sum(names: &[&str]) -> ModelSum {

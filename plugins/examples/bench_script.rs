@@ -9,12 +9,12 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::oscillator::Oscillator;
-use stf_core::params::ParamSpec;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::system::OscillatorParams;
 use stf_plugins::ScriptModel;
 
 /// The native twin of `models/scripts/power_law.rhai`.

@@ -1,5 +1,5 @@
 //! stf-plugins: force models written as rhai scripts, and the registry that maps a model name
-//! or a script path to a [`stf_core::force_model::ForceModel`].
+//! or a script path to a [`stf_core::physics::force_model::ForceModel`].
 //!
 //! ```
 //! use stf_plugins::registry::Registry;

@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use stf_core::force_model::ForceModel;
-use stf_core::params::ParamSpec;
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::param_spec::ParamSpec;
 
 use crate::error::ScriptError;
 use crate::limits::ScriptRun;

@@ -45,7 +45,7 @@
 //!
 //! ```
 //! use stf_plugins::ScriptModel;
-//! use stf_core::force_model::{ForceModel, ModelState};
+//! use stf_core::physics::force_model::{ForceModel, ModelState};
 //! let m = ScriptModel::from_source("lin", "fn params() { #{ c: [2.0, 0.0, 10.0, \"N s/m\"] } }\n\
 //!                                          fn force(p, t, x, v, z) { p.c * v }").unwrap();
 //! let s = ModelState { t: 0.0, x: 0.0, v: 0.5, z: &[] };
@@ -59,9 +59,9 @@ use std::sync::Arc;
 
 use rhai::grain::{Compiler, SharedProgram};
 use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
-use stf_core::bounded::{read_file_to_string, BoundedError};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::params::{defaults, ParamSpec};
+use stf_core::data::bounded::{read_file_to_string, BoundedError};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::param_spec::{defaults, ParamSpec};
 
 use crate::error::{ScriptError, ScriptLocation};
 use crate::limits::{ScriptLimits, ScriptRun};

@@ -8,7 +8,7 @@
 use std::collections::HashMap;
 
 use rhai::Dynamic;
-use stf_core::params::ParamSpec;
+use stf_core::physics::param_spec::ParamSpec;
 
 /// Convert a script number (float or integer) to `f64`.
 pub(crate) fn to_f64(value: &Dynamic) -> Option<f64> {

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use stf_core::force_model::{ForceModel, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_plugins::ScriptModel;
 
 /// Both paths of one script: (compiled, VM only).

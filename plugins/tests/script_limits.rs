@@ -4,10 +4,10 @@
 
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::oscillator::Oscillator;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::simulate::Simulation;
-use stf_core::system::OscillatorParams;
 use stf_plugins::{ScriptError, ScriptLimits, ScriptModel, ScriptRun};
 
 const PARAMS: &str = "fn params() { #{ c: [1.0, 0.0, 10.0, \"N s/m\"] } }\n";

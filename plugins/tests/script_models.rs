@@ -4,13 +4,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use stf_core::excitation::{Excitation, RotorAngle};
-use stf_core::force_model::{ForceModel, ModelError, ModelState};
-use stf_core::integrate::SimError;
-use stf_core::oscillator::Oscillator;
-use stf_core::params::{defaults, ParamSpec};
+use stf_core::numerics::integrate::SimError;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::{defaults, ParamSpec};
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_core::system::OscillatorParams;
 use stf_plugins::registry::{check_script, Registry};
 use stf_plugins::{ScriptError, ScriptLimits, ScriptModel, ScriptRun};
 

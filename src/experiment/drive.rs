@@ -8,7 +8,7 @@ use std::ops::Range;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
-use stf_core::excitation::RotorAngle;
+use stf_core::physics::excitation::RotorAngle;
 use toml::Spanned;
 
 use super::Ctx;

@@ -9,9 +9,9 @@
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::derivative::{Boundary, PolyFilter};
-use stf_core::kinematics::KinematicsSettings;
-use stf_core::reconstruct::DriveSmoothing;
+use stf_core::data::kinematics::KinematicsSettings;
+use stf_core::numerics::derivative::{Boundary, PolyFilter};
+use stf_core::numerics::reconstruct::DriveSmoothing;
 use toml::Spanned;
 
 use super::Ctx;

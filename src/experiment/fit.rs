@@ -6,7 +6,7 @@
 use anyhow::Result;
 use serde::Deserialize;
 use stf_core::fit::{FitSettings, Solver};
-use stf_core::system::OscillatorParams;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use toml::Spanned;
 
 use super::Ctx;

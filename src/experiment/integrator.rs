@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::integrate::{Method, Settings};
+use stf_core::numerics::integrate::{Method, Settings};
 use toml::Spanned;
 
 use super::Ctx;
@@ -65,7 +65,7 @@ pub(super) fn check(raw: Option<&Spanned<RawIntegrator>>, cx: &Ctx) -> Result<Se
 mod tests {
     use super::super::Experiment;
     use std::path::Path;
-    use stf_core::integrate::Method;
+    use stf_core::numerics::integrate::Method;
 
     fn parse(text: &str) -> anyhow::Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)

@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::system::OscillatorParams;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use toml::Spanned;
 
 use super::Ctx;
@@ -89,7 +89,7 @@ pub(super) fn check(raw: Option<&Spanned<RawSystem>>, cx: &Ctx) -> Result<Oscill
 mod tests {
     use super::super::Experiment;
     use std::path::Path;
-    use stf_core::system::OscillatorParams;
+    use stf_core::physics::oscillator_params::OscillatorParams;
 
     fn parse(text: &str) -> anyhow::Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)

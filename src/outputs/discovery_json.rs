@@ -5,12 +5,12 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use stf_core::derivative::NoiseEstimate;
+use stf_core::data::estimate::LinearEstimate;
 use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryDiscovery};
-use stf_core::estimate::LinearEstimate;
 use stf_core::fit::{FittedParam, NoiseFloor};
-use stf_core::reconstruct::DriveReport;
-use stf_core::system::OscillatorParams;
+use stf_core::numerics::derivative::NoiseEstimate;
+use stf_core::numerics::reconstruct::DriveReport;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use super::{std_errors_by_name, values_by_name};
 use crate::discovery_curves::FittedCurves;

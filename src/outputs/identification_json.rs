@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 use stf_core::fit::{Convergence, FitResult, FitWarning, NoiseFloor, StatedWarning};
-use stf_core::system::OscillatorParams;
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use super::{finite, std_errors_by_name, values_by_name};
 

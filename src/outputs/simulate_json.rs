@@ -5,9 +5,9 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use stf_core::integrate::Settings as IntegratorSettings;
-use stf_core::synthetic::SensorNoise;
-use stf_core::system::OscillatorParams;
+use stf_core::numerics::integrate::Settings as IntegratorSettings;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::simulate::synthetic::SensorNoise;
 
 /// The whole sidecar.
 #[derive(Serialize)]

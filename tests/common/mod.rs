@@ -76,7 +76,7 @@ pub fn csv_column(path: &Path, name: &str) -> Vec<f64> {
 pub fn fitted_model(
     entry: &serde_json::Value,
 ) -> (
-    std::sync::Arc<dyn stf_core::force_model::ForceModel>,
+    std::sync::Arc<dyn stf_core::physics::force_model::ForceModel>,
     Vec<f64>,
 ) {
     let parts = entry["name"]
@@ -85,8 +85,8 @@ pub fn fitted_model(
         .split(" + ")
         .map(|p| stf_lab::model_config::resolve(p, root(), &Default::default()).unwrap())
         .collect();
-    let model: std::sync::Arc<dyn stf_core::force_model::ForceModel> =
-        std::sync::Arc::new(stf_core::model_sum::ModelSum::new(parts).unwrap());
+    let model: std::sync::Arc<dyn stf_core::physics::force_model::ForceModel> =
+        std::sync::Arc::new(stf_core::physics::model_sum::ModelSum::new(parts).unwrap());
     let values = model
         .params()
         .iter()

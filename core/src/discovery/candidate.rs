@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use super::error::DiscoveryError;
-use crate::force_model::ForceModel;
+use crate::physics::force_model::ForceModel;
 
 /// An effect the discovery may add, by name (e.g. a name of docs/ARCHITECTURE.md §5, or a script's).
 ///

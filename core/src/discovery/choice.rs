@@ -11,15 +11,15 @@
 use super::acceptance;
 use super::error::DiscoveryError;
 use super::score::{CandidateScore, Step};
+use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
-use super::stage::Stage;
 use crate::fit::{Convergence, FitResult, NoiseFloor};
-use crate::force_model::Reach;
+use crate::physics::force_model::Reach;
 
 /// A model fitted on the training samples and scored on the held-out ones.
 pub(super) struct Trial {
     /// The model with its fitted values.
-    pub stage: Stage,
+    pub stage: SearchModel,
     /// The fit on the training samples.
     pub train: FitResult,
     /// What the paired test reads: the residual at the held-out samples (force level, cut
@@ -80,7 +80,7 @@ pub(super) struct Yardstick<'a> {
     /// The length of the test's blocks, samples (`None`: whole cycles).
     pub block_samples: Option<usize>,
     /// How far the record goes, to judge whether a fitted gap or threshold is nothing
-    /// ([`crate::force_model::ForceModel::reduces_to`]).
+    /// ([`crate::physics::force_model::ForceModel::reduces_to`]).
     pub reach: Reach,
 }
 
@@ -269,7 +269,7 @@ pub(super) fn decide(
 }
 
 /// The simpler candidate that the trial of `winner` is in effect (its model's
-/// [`crate::force_model::ForceModel::reduces_to`] at its fitted values), if that candidate was fitted in this step
+/// [`crate::physics::force_model::ForceModel::reduces_to`] at its fitted values), if that candidate was fitted in this step
 /// too, with a sentence saying so: the step names it instead. Without a fit of it, the
 /// sentence alone says what the winner amounts to.
 fn reduced(

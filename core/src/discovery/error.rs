@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 use crate::fit::FitError;
-use crate::force_model::ModelError;
+use crate::physics::force_model::ModelError;
 use crate::regimes::RegimeError;
 
 /// A discovery request was invalid, or a fit it needs could not run.

@@ -5,9 +5,9 @@
 //! [`discover_force`] runs the workflow:
 //!
 //! 1. fit the base model on the whole record;
-//! 2. locate its residual against the noise floor ([`gap`]: by regime, ω band, |x|, |v|, |a|
+//! 2. locate its residual against the noise floor ([`force_gap`]: by regime, ω band, |x|, |v|, |a|
 //!    and direction of motion, in words);
-//! 3. add each [`Candidate`] not yet in the model to it ([`crate::model_sum::ModelSum`]),
+//! 3. add each [`Candidate`] not yet in the model to it ([`crate::physics::model_sum::ModelSum`]),
 //!    refit the sum from the current values (the new parameters from their defaults) on the
 //!    training cycles and score it on the held-out ones ([`holdout`]) and by AIC/BIC; accept
 //!    the best only if the data demand it ([`acceptance`]), naming ties;
@@ -16,9 +16,9 @@
 //!
 //! At trajectory level (records with a measured displacement only), [`discover_trajectory`]
 //! runs the same workflow on the simulated oscillator against the measured x, refitting the
-//! oscillator's own parameters with every model ([`trajectory`]).
+//! oscillator's own parameters with every model ([`trajectory_level`]).
 //!
-//! Either result scores its base and final models on another record ([`validation`]).
+//! Either result scores its base and final models on another record ([`before_after_validation`]).
 //!
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
 //! docs/ARCHITECTURE.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
@@ -26,33 +26,33 @@
 //! [`ForceData`]: crate::fit::ForceData
 
 pub mod acceptance;
+pub mod before_after_validation;
 pub mod blocks;
 pub mod candidate;
 mod choice;
-pub mod engine;
 pub mod error;
-pub mod gap;
+pub mod findings;
+pub mod force_gap;
+pub mod force_level;
+mod force_subset_fit;
 pub mod holdout;
 pub mod progress;
-pub mod report;
 pub mod score;
 mod scout;
+mod search_model;
 pub mod settings;
-mod stage;
-mod subset_fit;
-pub mod trajectory;
-mod trajectory_fit;
 mod trajectory_gap;
-pub mod validation;
+pub mod trajectory_level;
+mod trajectory_subset_fit;
 
+pub use before_after_validation::DiscoveryValidation;
 pub use candidate::Candidate;
-pub use engine::discover_force;
 pub use error::DiscoveryError;
-pub use gap::{locate_gap, GapBreakdown, GapGroup, GapLocation};
+pub use findings::Discovery;
+pub use force_gap::{locate_gap, GapBreakdown, GapGroup, GapLocation};
+pub use force_level::discover_force;
 pub use holdout::HoldoutSplit;
 pub use progress::{DiscoveryEvent, Observer};
-pub use report::Discovery;
 pub use score::{CandidateScore, Step};
 pub use settings::DiscoverySettings;
-pub use trajectory::{discover_trajectory, ForceHint, TrajectoryDiscovery, TrajectorySetup};
-pub use validation::DiscoveryValidation;
+pub use trajectory_level::{discover_trajectory, ForceHint, TrajectoryDiscovery, TrajectorySetup};

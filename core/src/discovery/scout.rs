@@ -2,7 +2,7 @@
 //! simulated from the measured state at its start.
 //!
 //! A trajectory fit simulates the whole record at every evaluation, and a candidate's trial
-//! (its starts, their short fits, then up to [`super::trajectory`]'s iteration limit) costs
+//! (its starts, their short fits, then up to [`super::trajectory_level`]'s iteration limit) costs
 //! hundreds of evaluations. On a long record the search for a candidate's values runs on the
 //! scout instead — an eighth of the samples and at most a few thousand, so each evaluation
 //! costs an eighth or less — and
@@ -22,8 +22,8 @@
 
 use std::sync::Arc;
 
-use super::trajectory_fit::{Rig, Track};
-use crate::force_model::ForceModel;
+use super::trajectory_subset_fit::{Rig, Track};
+use crate::physics::force_model::ForceModel;
 use crate::regimes::Cycle;
 
 /// Fewest samples for a record to be scouted (see [`Scout::new`]).
@@ -178,13 +178,13 @@ mod tests {
     }
 
     fn rig<'a>(t: &'a [f64], x: &'a [f64]) -> Rig<'a> {
-        let u = crate::interpolate::Linear::new(t.to_vec(), vec![0.0; t.len()]);
+        let u = crate::numerics::interpolate::Linear::new(t.to_vec(), vec![0.0; t.len()]);
         Rig {
-            system: crate::system::OscillatorParams::FORCED,
-            excitation: Arc::new(crate::excitation::Excitation::Force(u)),
+            system: crate::physics::oscillator_params::OscillatorParams::FORCED,
+            excitation: Arc::new(crate::physics::excitation::Excitation::Force(u)),
             oscillator: vec![],
             initial: None,
-            sim: crate::integrate::Settings::default(),
+            sim: crate::numerics::integrate::Settings::default(),
             fit_offset: false,
             fixed_start: false,
             t,

@@ -4,8 +4,9 @@ use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
 use super::progress::Observer;
-use crate::fit::{FitSettings, MotionNoise};
-use crate::kinematics::Kinematics;
+use crate::data::kinematics::Kinematics;
+use crate::data::kinematics::MotionNoise;
+use crate::fit::FitSettings;
 
 /// How discovery fits, holds out data and decides that an effect is significant.
 ///

@@ -7,8 +7,8 @@
 //! measured STF force, which a trajectory-level record does not have (ω bands stand in for
 //! them on a sweep).
 
-use super::gap::{locate_gap, summary, GapBreakdown, GapLocation};
-use super::trajectory_fit::Run;
+use super::force_gap::{locate_gap, summary, GapBreakdown, GapLocation};
+use super::trajectory_subset_fit::Run;
 use crate::fit::ForceData;
 use crate::regimes::Cycle;
 

@@ -13,14 +13,14 @@
 //! Steps are shortened to at most two scales of any parameter. The Jacobian is exact where the
 //! problem gives one ([`super::objective::Residuals::jacobian`]: force fits of built-ins
 //! without state); else its difference steps start at `fd_step` and grow above the residuals'
-//! noise, measured once (see [`super::jacobian`]): a column that is mostly integrator noise
+//! noise, measured once (see [`super::residual_jacobian`]): a column that is mostly integrator noise
 //! gives a step that raises the cost at every damping, and the refinement stopped far from
 //! the optimum.
 
 use nalgebra::{DMatrix, DVector};
 
-use super::jacobian::{forward_difference, residual_noise, StepFloor};
 use super::objective::Objective;
+use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
 use super::result::Convergence;
 
 /// What the refinement did.
@@ -37,7 +37,7 @@ pub struct Refined {
 const MAX_STEP: f64 = 2.0;
 
 /// Longest finite-difference step, in scales, that a column may grow to when the residuals
-/// are noisy (see [`super::jacobian`]).
+/// are noisy (see [`super::residual_jacobian`]).
 pub const MAX_FD_STEP: f64 = 0.1;
 
 /// Probe of the residuals' noise, in scales: far below any step, far above rounding.

@@ -27,31 +27,31 @@
 //! [`TrajectoryFit::validate`].
 
 mod covariance;
-mod engine;
+mod driver;
 mod error;
-mod force;
-mod jacobian;
+mod fit_param;
+mod force_fit;
 mod levenberg_marquardt;
 mod noise_floor;
 mod objective;
-mod param;
+mod residual_jacobian;
 mod result;
 mod same_term;
-mod settings;
-mod trajectory;
+mod solver;
+mod trajectory_fit;
 mod transform;
 mod validation;
 mod warning;
 
 pub use error::FitError;
-pub use force::{ForceData, ForceFit, FORCE_OFFSET};
-pub use noise_floor::{MotionNoise, NoiseFloor, Quantity};
+pub use fit_param::{full_values, FitParam};
+pub use force_fit::{ForceData, ForceFit, FORCE_OFFSET};
+pub use noise_floor::{NoiseFloor, Quantity};
 pub use objective::Residuals;
-pub use param::{full_values, FitParam};
-pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, Stage};
+pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
 pub use same_term::check_same_terms;
-pub use settings::{FitSettings, Solver};
-pub use trajectory::{
+pub use solver::{FitSettings, Solver};
+pub use trajectory_fit::{
     initial_state_params, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, INITIAL_STATE,
 };
 pub use transform::BoundTransform;
@@ -70,5 +70,5 @@ pub fn fit_residuals(
     settings: &FitSettings,
     observer: Option<&(dyn Fn(FitProgress) + Sync)>,
 ) -> Result<FitResult, FitError> {
-    engine::run(problem, params, settings, observer, false)
+    driver::run(problem, params, settings, observer, false)
 }

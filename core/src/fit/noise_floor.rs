@@ -13,7 +13,8 @@
 use serde::Serialize;
 
 use super::error::FitError;
-use super::force::{ForceData, ForceFit};
+use super::force_fit::{ForceData, ForceFit};
+use crate::data::kinematics::MotionNoise;
 
 /// The quantity a fit's residuals measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -41,17 +42,6 @@ impl Quantity {
             Quantity::Displacement => format!("{:.4} mm", value * 1e3),
         }
     }
-}
-
-/// Noise σ of the measured kinematics, SI units.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct MotionNoise {
-    /// Position noise, m.
-    pub x: f64,
-    /// Velocity noise left by the derivative filter, m/s.
-    pub v: f64,
-    /// Acceleration noise left by the derivative filter, m/s².
-    pub a: f64,
 }
 
 /// The RMS residual that measurement noise alone leaves.
@@ -139,8 +129,8 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::force_model::{ForceModel, ModelError, ModelState};
-    use crate::params::ParamSpec;
+    use crate::physics::force_model::{ForceModel, ModelError, ModelState};
+    use crate::physics::param_spec::ParamSpec;
 
     /// F = c·v + m_a·a.
     struct Damper(Vec<ParamSpec>);

@@ -12,7 +12,7 @@ use std::sync::{Mutex, MutexGuard};
 use argmin::core::{CostFunction, Error as ArgminError};
 use nalgebra::DMatrix;
 
-use super::result::{FitProgress, Stage};
+use super::result::{FitProgress, SolverStage};
 use super::transform::BoundTransform;
 
 /// A least-squares problem: residuals as a function of the free parameters' user values.
@@ -53,7 +53,7 @@ pub struct Objective<'a> {
     failures: AtomicU64,
     last_failure: Mutex<Option<String>>,
     best: Mutex<f64>,
-    stage: Mutex<Stage>,
+    stage: Mutex<SolverStage>,
 }
 
 impl<'a> Objective<'a> {
@@ -71,7 +71,7 @@ impl<'a> Objective<'a> {
             failures: AtomicU64::new(0),
             last_failure: Mutex::new(None),
             best: Mutex::new(f64::INFINITY),
-            stage: Mutex::new(Stage::NelderMead),
+            stage: Mutex::new(SolverStage::NelderMead),
         }
     }
 
@@ -91,7 +91,7 @@ impl<'a> Objective<'a> {
     }
 
     /// Report progress as this stage from now on.
-    pub fn set_stage(&self, stage: Stage) {
+    pub fn set_stage(&self, stage: SolverStage) {
         *lock(&self.stage) = stage;
     }
 

@@ -35,10 +35,10 @@ impl Convergence {
     }
 }
 
-/// A stage of a fit, for progress reports.
+/// The solver stage a fit is in, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Stage {
+pub enum SolverStage {
     /// Particle swarm.
     ParticleSwarm,
     /// Nelder–Mead.
@@ -53,7 +53,7 @@ pub enum Stage {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitProgress {
     /// The stage running.
-    pub stage: Stage,
+    pub stage: SolverStage,
     /// Evaluations of the model so far (simulations, for trajectory fits).
     pub evaluations: u64,
     /// Lowest cost so far: mean squared residual (N² or m²).

@@ -2,7 +2,7 @@
 //!
 //! The oscillator `m·ẍ + c·ẋ + k·x + F_R + F_STF + f_off = drive` shares terms with some force
 //! models: a fluid's linear damping `viscous.c_s` adds to `c`, an added mass `m_a` to `m`
-//! ([`crate::params::ParamSpec::same_as`] says which). On a shaker rig the drive offset `u_off`
+//! ([`crate::physics::param_spec::ParamSpec::same_as`] says which). On a shaker rig the drive offset `u_off`
 //! and the force offset `f_off` enter as one constant. Freeing both of such a pair leaves the
 //! fit a valley of equal residuals: the optimiser wanders along it and the standard errors
 //! blow up (±43 on c = 20.5 and on c_s = 0.98 on a measured record). So a fit refuses the
@@ -11,8 +11,8 @@
 //! effect and could not be determined.
 
 use super::error::FitError;
-use crate::excitation::Excitation;
-use crate::params::ParamSpec;
+use crate::physics::excitation::Excitation;
+use crate::physics::param_spec::ParamSpec;
 
 /// Refuse free parameters that duplicate each other or do nothing: `model` are the model's
 /// parameter specs with whether each is free, `oscillator` the freed oscillator parameters.
@@ -58,7 +58,7 @@ pub fn check_same_terms(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::interpolate::Linear;
+    use crate::numerics::interpolate::Linear;
 
     fn shaker() -> Excitation {
         Excitation::Force(Linear::new(vec![0.0, 1.0], vec![0.0, 1.0]))

@@ -13,8 +13,8 @@
 //! ```
 //! use std::sync::Arc;
 //! use stf_core::fit::{ForceData, ForceFit};
-//! use stf_core::force_model::{ForceModel, ModelError, ModelState};
-//! use stf_core::params::ParamSpec;
+//! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+//! use stf_core::physics::param_spec::ParamSpec;
 //! struct Lin(Vec<ParamSpec>);
 //! impl ForceModel for Lin {
 //!     fn name(&self) -> &str { "lin" }
@@ -37,8 +37,8 @@
 use serde::Serialize;
 
 use super::error::FitError;
-use super::force::{ForceData, ForceFit};
-use super::trajectory::{initial_state_params, TrajectoryData, TrajectoryFit, INITIAL_STATE};
+use super::force_fit::{ForceData, ForceFit};
+use super::trajectory_fit::{initial_state_params, TrajectoryData, TrajectoryFit, INITIAL_STATE};
 
 /// A fitted model's error on a record it was not fitted to.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -160,11 +160,11 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::excitation::{Excitation, RotorAngle};
     use crate::fit::FitParam;
-    use crate::oscillator::Oscillator;
+    use crate::physics::excitation::{Excitation, RotorAngle};
+    use crate::physics::oscillator::Oscillator;
+    use crate::physics::oscillator_params::OscillatorParams;
     use crate::simulate::Simulation;
-    use crate::system::OscillatorParams;
 
     /// x of the forced trolley on a constant-speed rotor from (x0, v0), at 100 Hz for 10 s.
     fn run(system: OscillatorParams, omega: f64, x0: f64, v0: f64) -> (Vec<f64>, Vec<f64>) {

@@ -18,8 +18,8 @@ use std::fmt;
 
 use serde::Serialize;
 
+use super::fit_param::FitParam;
 use super::noise_floor::{NoiseFloor, Quantity};
-use super::param::FitParam;
 use super::result::{Convergence, FitResult};
 
 /// Parameters whose value is near zero by nature (offsets, the initial state): their error

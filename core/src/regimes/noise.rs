@@ -10,12 +10,12 @@
 //! Third differences keep the signal itself where a period spans few samples (a record of an
 //! electronic oscillator at 9 samples a period read 4.7 mV of "noise" below 0.1 mV of real
 //! noise), so where this estimate reads more than twice the floor of the spectrum's upper half
-//! ([`crate::derivative::spectral_floor_sigma`]) that floor is taken ([`crate::derivative::noise_sigma`]'s rule).
+//! ([`crate::numerics::derivative::spectral_floor_sigma`]) that floor is taken ([`crate::numerics::derivative::noise_sigma`]'s rule).
 //!
 //! Caveat: noise that is not white — a force recovered from kinematics through a derivative
 //! filter is low-pass — has less power at the highest frequencies, so this underestimates its
 //! σ. Such records should override the floor ([`RegimeThresholds::noise_sigma`], e.g. from
-//! [`crate::recover::recovery_noise`]).
+//! [`crate::data::recover::recovery_noise`]).
 //!
 //! [`RegimeThresholds::noise_sigma`]: super::RegimeThresholds::noise_sigma
 
@@ -42,8 +42,8 @@ pub fn noise_floor(f: &[f64]) -> Result<f64, RegimeError> {
     let med = median(&mut d);
     let mut dev: Vec<f64> = d.iter().map(|x| (x - med).abs()).collect();
     let third = MAD_TO_SIGMA * median(&mut dev) / 20f64.sqrt();
-    Ok(match crate::derivative::spectral_floor_sigma(f) {
-        Some(floor) if third > crate::derivative::SIGNAL_IN_DIFFERENCES * floor => floor,
+    Ok(match crate::numerics::derivative::spectral_floor_sigma(f) {
+        Some(floor) if third > crate::numerics::derivative::SIGNAL_IN_DIFFERENCES * floor => floor,
         _ => third,
     })
 }

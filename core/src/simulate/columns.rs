@@ -5,10 +5,10 @@
 //! a long run fills them on two threads ([`PARALLEL_SAMPLES`]); the drive depends on time alone
 //! and is evaluated while the integration runs.
 
-use crate::excitation::Excitation;
-use crate::integrate::SimError;
-use crate::oscillator::Oscillator;
-use crate::system::OscillatorParams;
+use crate::numerics::integrate::SimError;
+use crate::physics::excitation::Excitation;
+use crate::physics::oscillator::Oscillator;
+use crate::physics::oscillator_params::OscillatorParams;
 
 /// Sampled states with their times and driving forces (a window of a run's samples).
 #[derive(Clone, Copy)]

@@ -5,17 +5,19 @@
 //! of the samples' forces (after it), which leaves the integration as the run's critical path.
 //!
 //! ```
-//! use stf_core::{excitation::{Excitation, RotorAngle}, oscillator::Oscillator,
-//!                simulate::Simulation, system::OscillatorParams};
+//! use stf_core::physics::{excitation::{Excitation, RotorAngle}, oscillator::Oscillator,
+//!                         oscillator_params::OscillatorParams};
+//! use stf_core::simulate::Simulation;
 //! let osc = Oscillator::new(OscillatorParams::FORCED, Excitation::Rotor(RotorAngle::constant(3.0)));
 //! let run = Simulation::new(&osc).rate(50.0).run(0.0, 1.0).unwrap();
 //! assert_eq!(run.x.len(), 51);
 //! ```
 
-use crate::integrate::{integrate_states, Method, Settings, SimError, Stats};
-use crate::oscillator::Oscillator;
+use crate::numerics::integrate::{integrate_states, Method, Settings, SimError, Stats};
+use crate::physics::oscillator::Oscillator;
 
 mod columns;
+pub mod synthetic;
 
 use columns::{Columns, DriveColumns, Rows, PARALLEL_SAMPLES};
 
@@ -222,8 +224,8 @@ pub fn count_text(count: f64) -> String {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use crate::excitation::{Excitation, RotorAngle};
-    use crate::system::OscillatorParams;
+    use crate::physics::excitation::{Excitation, RotorAngle};
+    use crate::physics::oscillator_params::OscillatorParams;
 
     #[test]
     fn a_run_too_long_for_memory_is_refused_before_anything_is_allocated() {

@@ -11,17 +11,17 @@
 
 use std::sync::Arc;
 
+use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
 use stf_core::discovery::{discover_force, Candidate, Discovery, DiscoverySettings};
-use stf_core::excitation::{Excitation, RotorAngle};
 use stf_core::fit::ForceData;
-use stf_core::force_model::ForceModel;
-use stf_core::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::model_sum::ModelSum;
-use stf_core::oscillator::Oscillator;
+use stf_core::physics::excitation::{Excitation, RotorAngle};
+use stf_core::physics::force_model::ForceModel;
+use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::regimes::cycles_from_phase;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::Simulation;
-use stf_core::synthetic::{sample_record, SensorNoise};
-use stf_core::system::OscillatorParams;
 use stf_models::{find, BUILTINS};
 
 /// A part of a truth model: a built-in's name and its parameter values.
@@ -109,7 +109,7 @@ fn record_swept(
         let f: Vec<f64> = (0..run.t.len())
             .map(|i| {
                 let z: Vec<f64> = (z_off..z_off + nz).map(|j| run.z[j][i]).collect();
-                let s = stf_core::force_model::ModelState {
+                let s = stf_core::physics::force_model::ModelState {
                     t: run.t[i],
                     x: run.x[i],
                     v: run.v[i],

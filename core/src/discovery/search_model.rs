@@ -1,0 +1,77 @@
+//! A model as it stands in the search, at either level: its parts (the base, then the
+//! effects added) and the values of every parameter of its fit.
+//!
+//! The values are laid out as the level's fit lists its parameters: at trajectory level the
+//! refitted oscillator parameters first, then the model's (part by part), then the offset if
+//! fitted; at force level the same without the oscillator's. How a stage is fitted and
+//! scored is the level's own (force fits in [`super::force_level`], simulations in
+//! [`super::trajectory_level`]).
+
+use std::sync::Arc;
+
+use super::candidate::Candidate;
+use super::error::DiscoveryError;
+use crate::physics::force_model::ForceModel;
+use crate::physics::model_sum::ModelSum;
+
+/// A model as it stands: its parts and the values of every parameter of its fit.
+#[derive(Clone)]
+pub(super) struct SearchModel {
+    /// The base, then the effects added, in order.
+    pub parts: Vec<Arc<dyn ForceModel>>,
+    /// Start (or fitted) values of every parameter of the fit: the level's own first (the
+    /// oscillator's at trajectory level), then the sum's, then the offset if fitted.
+    pub values: Vec<f64>,
+}
+
+impl SearchModel {
+    /// The model: the one part, or the sum of the parts.
+    pub fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
+        Ok(match self.parts.as_slice() {
+            [one] => one.clone(),
+            _ => Arc::new(ModelSum::new(self.parts.clone())?),
+        })
+    }
+
+    /// The parts' names joined by ` + ` (`power_law + viscous`; the zero force `none` drops out
+    /// once another part joins it).
+    pub fn name(&self) -> String {
+        let names: Vec<&str> = self.parts.iter().map(|p| p.name()).collect();
+        let real: Vec<&str> = names.iter().copied().filter(|n| *n != "none").collect();
+        if real.is_empty() { names } else { real }.join(" + ")
+    }
+
+    /// The candidates a step tries: those this stage does not already hold ([`SearchModel::holds`]).
+    pub fn to_try<'a>(
+        &self,
+        candidates: &'a [Candidate],
+        in_base: &[String],
+        effects: &[String],
+    ) -> Vec<&'a Candidate> {
+        candidates
+            .iter()
+            .filter(|c| !self.holds(c, in_base, effects))
+            .collect()
+    }
+
+    /// Whether candidate `c` is already in the model: its model is a part of the base (whose
+    /// parts are named `in_base`) or of this stage, or its name is one of `effects`.
+    pub fn holds(&self, c: &Candidate, in_base: &[String], effects: &[String]) -> bool {
+        in_base.iter().any(|b| b == c.model.name())
+            || self.parts.iter().any(|p| p.name() == c.model.name())
+            || effects.contains(&c.name)
+    }
+
+    /// This stage with `extra` added last, its parameters at `start`, after the sum's
+    /// parameters (which follow the level's `n_before` own) and before the offset.
+    pub fn with(&self, extra: &Arc<dyn ForceModel>, start: &[f64], n_before: usize) -> SearchModel {
+        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
+        let cut = (n_before + n_model).min(self.values.len());
+        let mut values = self.values[..cut].to_vec();
+        values.extend_from_slice(start);
+        values.extend_from_slice(&self.values[cut..]);
+        let mut parts = self.parts.clone();
+        parts.push(extra.clone());
+        SearchModel { parts, values }
+    }
+}

@@ -1,0 +1,575 @@
+//! The driver shared by every kind of fit: validated parameters in, [`FitResult`] out.
+//!
+//! It runs the stages of the chosen [`Solver`] on an [`Objective`], then computes the residuals
+//! and a forward-difference Jacobian at the best point in the user's parameter space (so the
+//! standard errors are those of the values reported, whatever the transforms; robust to
+//! residuals correlated over blocks of samples, which are chosen from the residuals), and the
+//! statistics of the result.
+
+use std::time::Instant;
+
+use argmin::core::{Executor, State, TerminationReason};
+use argmin::solver::neldermead::NelderMead;
+use argmin::solver::particleswarm::ParticleSwarm;
+use nalgebra::DMatrix;
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+
+use super::covariance::{self, MIN_BLOCKS};
+use super::error::FitError;
+use super::fit_param::FitParam;
+use super::levenberg_marquardt::{self, BoundStop, MAX_FD_STEP, NOISE_PROBE};
+use super::objective::{LnCost, Objective, Residuals};
+use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
+use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
+use super::solver::{FitSettings, Solver};
+
+/// Fit the free members of `params` (all of them, in order) of `problem`, whose
+/// [`Residuals::residuals`] receives the user values of the free parameters only.
+/// `trajectory`: report S(μ) in mm² (the residuals are displacements in m).
+pub fn run(
+    problem: &dyn Residuals,
+    params: &[FitParam],
+    settings: &FitSettings,
+    observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    trajectory: bool,
+) -> Result<FitResult, FitError> {
+    let clock = Instant::now();
+    settings.validate()?;
+    for (i, p) in params.iter().enumerate() {
+        p.validate()?;
+        if params[..i].iter().any(|q| q.name == p.name) {
+            return Err(FitError::DuplicateParam(p.name.clone()));
+        }
+    }
+    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
+    let n = problem.len();
+    if n <= free.len() {
+        return Err(FitError::BadData(format!(
+            "{n} samples cannot determine {} free parameters",
+            free.len()
+        )));
+    }
+    let obj = Objective::new(
+        problem,
+        free.iter().map(|p| p.transform()).collect(),
+        observer,
+    );
+    let p = obj.dim();
+    let u0 = vec![0.0; p];
+    if obj.cost(&u0).is_none() {
+        return Err(FitError::StartFails(
+            obj.last_failure().unwrap_or_else(|| "unknown".into()),
+        ));
+    }
+    let mut log = Vec::new();
+    let mut iterations = 0;
+    let (u, convergence) = if p == 0 {
+        log.push("no free parameters: evaluated only".to_string());
+        (
+            u0.clone(),
+            Convergence::Converged {
+                reason: "nothing to fit".into(),
+            },
+        )
+    } else {
+        // In a trajectory fit a refinement that pins a parameter on a bound stops there; the
+        // parameter is then released (see `release_pinned`).
+        let at_bound = |u: &[f64]| !pinned(&obj, &free, u).is_empty();
+        let stop_at_bound: BoundStop = trajectory.then_some(&at_bound);
+        let lm = |start: &[f64], iterations: &mut u64, log: &mut Vec<String>| {
+            obj.set_stage(SolverStage::LevenbergMarquardt);
+            let out = levenberg_marquardt::refine(
+                &obj,
+                start,
+                settings.max_iters,
+                settings.tol,
+                settings.fd_step,
+                stop_at_bound,
+            );
+            *iterations += out.iterations;
+            log.push(format!(
+                "levenberg_marquardt: {} iterations, {:?}",
+                out.iterations, out.convergence
+            ));
+            (out.u, out.convergence)
+        };
+        match settings.solver {
+            Solver::NelderMead => {
+                let (u, it, conv) = nelder_mead(&obj, &u0, settings.simplex_tol, settings)?;
+                iterations += it;
+                log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
+                (u, conv)
+            }
+            Solver::Auto => {
+                let (u, conv) = lm(&u0, &mut iterations, &mut log);
+                if conv.converged() {
+                    (u, conv)
+                } else {
+                    // From where Levenberg–Marquardt got to, not from the start: restarting
+                    // from the start threw its progress away, and a simplex from there was
+                    // seen to end far worse.
+                    log.push(
+                        "levenberg_marquardt did not converge: Nelder–Mead from its best \
+                         point, then again"
+                            .into(),
+                    );
+                    let tol = settings.simplex_tol.max(settings.presearch_tol);
+                    let (u, it, conv) = nelder_mead(&obj, &u, tol, settings)?;
+                    iterations += it;
+                    log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
+                    lm(&u, &mut iterations, &mut log)
+                }
+            }
+            Solver::LevenbergMarquardt => lm(&u0, &mut iterations, &mut log),
+            Solver::ParticleSwarm => {
+                let (u, it) = particle_swarm(&obj, &u0, settings)?;
+                iterations += it;
+                log.push(format!("particle_swarm: {it} iterations"));
+                lm(&u, &mut iterations, &mut log)
+            }
+        }
+    };
+    let (u, convergence) = if trajectory && p > 0 {
+        release_pinned(
+            &obj,
+            &free,
+            u,
+            convergence,
+            settings,
+            &mut iterations,
+            &mut log,
+        )
+    } else {
+        (u, convergence)
+    };
+    // A fit never ends worse than its start: whatever the chain did, the start is kept if
+    // it is better.
+    let start_cost = obj.cost(&u0).unwrap_or(f64::INFINITY);
+    let (u, convergence) = match obj.cost(&u) {
+        Some(c) if c <= start_cost => (u, convergence),
+        end => {
+            log.push(format!(
+                "the solvers ended worse than the start (mean square {} > {start_cost:e}): \
+                 the start is kept",
+                end.map_or("failed".to_string(), |c| format!("{c:e}"))
+            ));
+            (
+                u0,
+                Convergence::Failed {
+                    reason: "no solver improved on the start".into(),
+                },
+            )
+        }
+    };
+    finish(
+        &obj,
+        params,
+        &u,
+        settings,
+        convergence,
+        iterations,
+        log,
+        trajectory,
+        clock,
+    )
+}
+
+/// Closest a parameter may end to a bound, as a fraction of its typical size (its scale: the
+/// start value's magnitude, or a tenth of the box), before it counts as pinned there. A
+/// fraction of the box's width would not do: in a wide box ([0, 1e9] for a cubic stiffness)
+/// it pinned any value below 1000, where the map, exponential near its lower bound, is far
+/// from flat (a volt-unit record's k3 ≈ 4 stopped the fit at once, 3× the residual).
+const PINNED: f64 = 1e-6;
+
+/// The free parameters (by index) that `u` puts on one of their bounds, where the bound
+/// transform is flat.
+fn pinned(obj: &Objective, free: &[&FitParam], u: &[f64]) -> Vec<usize> {
+    let x = obj.to_user(u);
+    free.iter()
+        .zip(&x)
+        .enumerate()
+        .filter(|(_, (q, &v))| {
+            let width = q.max - q.min;
+            let span = q.effective_scale().min(width);
+            (v - q.min).abs() <= PINNED * span || (q.max - v).abs() <= PINNED * span
+        })
+        .map(|(j, _)| j)
+        .collect()
+}
+
+/// Trajectory fits: a parameter that the refinement drove onto a bound cannot come back, since
+/// its map is flat there, even when the cost falls away from the bound along a joint move with
+/// the others (from the identification's second stage, started from the free-vibration values,
+/// ΔT went to its bound with S 0.0178 mm², while the optimum inside has 0.0035). So the pinned
+/// parameters are released to their start values, the others kept, and Levenberg–Marquardt
+/// runs again from there; the better end is kept. (Force-level fits, cheap to refine, let the
+/// refinement run on along the bound instead: there a parameter often belongs on its bound.)
+fn release_pinned(
+    obj: &Objective,
+    free: &[&FitParam],
+    u: Vec<f64>,
+    convergence: Convergence,
+    settings: &FitSettings,
+    iterations: &mut u64,
+    log: &mut Vec<String>,
+) -> (Vec<f64>, Convergence) {
+    let stuck = pinned(obj, free, &u);
+    if stuck.is_empty() {
+        return (u, convergence);
+    }
+    let Some(cost) = obj.cost(&u) else {
+        return (u, convergence);
+    };
+    let mut restart = u.clone();
+    for &j in &stuck {
+        restart[j] = 0.0;
+    }
+    obj.set_stage(SolverStage::LevenbergMarquardt);
+    let out = levenberg_marquardt::refine(
+        obj,
+        &restart,
+        settings.max_iters,
+        settings.tol,
+        settings.fd_step,
+        Some(&|u: &[f64]| !pinned(obj, free, u).is_empty()),
+    );
+    *iterations += out.iterations;
+    let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
+    match obj.cost(&out.u) {
+        Some(c) if c < cost => {
+            log.push(format!(
+                "{} ended on a bound: released to the start, levenberg_marquardt again: {} \
+                 iterations, {:?} (mean square {cost:e} → {c:e})",
+                names.join(", "),
+                out.iterations,
+                out.convergence
+            ));
+            (out.u, out.convergence)
+        }
+        end => {
+            log.push(format!(
+                "{} ended on a bound: released to the start, the refinement ended no better \
+                 ({}); the bound is kept",
+                names.join(", "),
+                end.map_or("failed".to_string(), |c| format!("mean square {c:e}"))
+            ));
+            (u, convergence)
+        }
+    }
+}
+
+fn nelder_mead(
+    obj: &Objective,
+    u0: &[f64],
+    tol: f64,
+    settings: &FitSettings,
+) -> Result<(Vec<f64>, u64, Convergence), FitError> {
+    obj.set_stage(SolverStage::NelderMead);
+    let p = u0.len();
+    let mut simplex = vec![u0.to_vec()];
+    for j in 0..p {
+        let mut v = u0.to_vec();
+        v[j] += settings.simplex_step;
+        simplex.push(v);
+    }
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(tol)
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let res = Executor::new(LnCost(obj), solver)
+        .configure(|s| s.max_iters(settings.max_iters))
+        .timer(false)
+        .run()
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let state = res.state();
+    let u = state
+        .get_best_param()
+        .cloned()
+        .unwrap_or_else(|| u0.to_vec());
+    let conv = match state.get_termination_reason() {
+        Some(TerminationReason::SolverConverged) => Convergence::Converged {
+            reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
+        },
+        Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
+        other => Convergence::Failed {
+            reason: format!("Nelder–Mead stopped: {other:?}"),
+        },
+    };
+    Ok((u, state.get_iter(), conv))
+}
+
+fn particle_swarm(
+    obj: &Objective,
+    u0: &[f64],
+    settings: &FitSettings,
+) -> Result<(Vec<f64>, u64), FitError> {
+    obj.set_stage(SolverStage::ParticleSwarm);
+    let (lo, hi): (Vec<f64>, Vec<f64>) = obj.transforms().iter().map(|t| t.search_box()).unzip();
+    let solver = ParticleSwarm::new((lo, hi), settings.particles)
+        .with_rng_generator(StdRng::seed_from_u64(settings.seed));
+    let res = Executor::new(LnCost(obj), solver)
+        .configure(|s| s.max_iters(settings.max_iters))
+        .timer(false)
+        .run()
+        .map_err(|e| FitError::Solver(e.to_string()))?;
+    let state = res.state();
+    let iters = state.get_iter();
+    // Keep the start if the swarm found nothing better.
+    let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
+    let u = match state.get_best_param() {
+        Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
+        _ => u0.to_vec(),
+    };
+    Ok((u, iters))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    obj: &Objective,
+    params: &[FitParam],
+    u: &[f64],
+    settings: &FitSettings,
+    mut convergence: Convergence,
+    iterations: u64,
+    mut log: Vec<String>,
+    trajectory: bool,
+    clock: Instant,
+) -> Result<FitResult, FitError> {
+    obj.set_stage(SolverStage::Errors);
+    let n = obj.len();
+    let x = obj.to_user(u);
+    let mut r0 = vec![0.0; n];
+    let Some(rss) = obj.residuals_user(&x, &mut r0) else {
+        return Err(FitError::Solver(format!(
+            "the best point cannot be re-evaluated: {}",
+            obj.last_failure().unwrap_or_default()
+        )));
+    };
+    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
+    let p = free.len();
+    let errors = if p > 0 {
+        let jac = jacobian(obj, &free, &x, &r0, settings);
+        Some(standard_errors(&jac, &r0, rss, &mut log))
+    } else {
+        None
+    };
+    let mut fitted = Vec::with_capacity(params.len());
+    let mut k = 0;
+    for q in params {
+        if q.fixed {
+            fitted.push(FittedParam {
+                name: q.name.clone(),
+                value: q.value,
+                std_error: 0.0,
+                naive_std_error: 0.0,
+                fixed: true,
+            });
+        } else if let Some(e) = &errors {
+            fitted.push(FittedParam {
+                name: q.name.clone(),
+                value: x[k],
+                std_error: e.robust.std_errors[k],
+                naive_std_error: e.naive[k],
+                fixed: false,
+            });
+            k += 1;
+        }
+    }
+    let nf = n as f64;
+    let mean = rss / nf;
+    let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
+    if obj.failures() > 0 {
+        log.push(format!(
+            "{} evaluations failed and were scored as penalties; last: {}",
+            obj.failures(),
+            obj.last_failure().unwrap_or_default()
+        ));
+    }
+    if !x.iter().all(|v| v.is_finite()) {
+        convergence = Convergence::Failed {
+            reason: "a parameter is not finite".into(),
+        };
+    }
+    let (correlation, error_blocks) = match errors {
+        Some(e) => (e.robust.correlation, Some(e.blocks)),
+        None => (vec![], None),
+    };
+    Ok(FitResult {
+        params: fitted,
+        correlation,
+        error_blocks,
+        n_points: n,
+        n_free: p,
+        rss,
+        rms: mean.sqrt(),
+        s_mm2: trajectory.then_some(mean * 1e6),
+        aic: ln_term + 2.0 * p as f64,
+        bic: ln_term + p as f64 * nf.ln(),
+        evaluations: obj.evaluations(),
+        failures: obj.failures(),
+        last_failure: obj.last_failure(),
+        iterations,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+        convergence,
+        log,
+    })
+}
+
+/// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
+/// exact where the problem gives one, else by forward differences.
+fn jacobian(
+    obj: &Objective,
+    free: &[&FitParam],
+    x: &[f64],
+    r0: &[f64],
+    settings: &FitSettings,
+) -> DMatrix<f64> {
+    let (n, p) = (r0.len(), free.len());
+    let mut jac = DMatrix::<f64>::zeros(n, p);
+    let exact = obj
+        .jacobian_user(x, &mut jac)
+        .unwrap_or_else(|| vec![false; p]);
+    if exact.iter().all(|&e| e) {
+        return jac;
+    }
+    let mut steps: Vec<f64> = free
+        .iter()
+        .map(|q| settings.fd_step * q.effective_scale())
+        .collect();
+    // Steps above the residuals' noise (a noisy column would make a noisy standard
+    // error), at most MAX_FD_STEP scales and short enough that one side stays in bounds.
+    let probe: Vec<f64> = free
+        .iter()
+        .zip(x)
+        .map(|(q, v)| {
+            let e = NOISE_PROBE * q.effective_scale();
+            if v + e < q.max && v - e > q.min {
+                e
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let noise = residual_noise(x, r0, &probe, &|point, out| {
+        obj.residuals_user(point, out).is_some()
+    })
+    .unwrap_or(0.0);
+    let floor = StepFloor {
+        noise,
+        max: free
+            .iter()
+            .zip(&steps)
+            .map(|(q, h)| {
+                (MAX_FD_STEP * q.effective_scale())
+                    .min(0.49 * (q.max - q.min))
+                    .max(*h)
+            })
+            .collect(),
+    };
+    forward_difference(
+        x,
+        r0,
+        &mut steps,
+        &floor,
+        &|j, v| !(v > free[j].min && v < free[j].max),
+        &|point, out| obj.residuals_user(point, out).is_some(),
+        &exact,
+        &mut jac,
+    );
+    jac
+}
+
+/// The standard errors of a fit: robust over blocks chosen from the residuals, and naive.
+struct Errors {
+    robust: covariance::Covariance,
+    naive: Vec<f64>,
+    blocks: ErrorBlocks,
+}
+
+/// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`);
+/// a line in `log` when the blocks are too few for the errors to be sure.
+fn standard_errors(jac: &DMatrix<f64>, r: &[f64], rss: f64, log: &mut Vec<String>) -> Errors {
+    let blocks = covariance::blocks(jac, r);
+    if !blocks.settled {
+        log.push(format!(
+            "standard errors: the residuals are correlated over about the whole record (even \
+             {} blocks of {} samples are not long enough): the errors may still be too small",
+            blocks.count, blocks.length
+        ));
+    } else if blocks.count < MIN_BLOCKS {
+        log.push(format!(
+            "standard errors: the residuals are correlated over {} samples, only {} blocks: \
+             the errors are themselves uncertain",
+            blocks.length, blocks.count
+        ));
+    }
+    Errors {
+        robust: covariance::sandwich(jac, r, blocks.length),
+        naive: covariance::from_jacobian(jac, rss).std_errors,
+        blocks,
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// r_i = y_i − k·x_i.
+    struct Line {
+        x: Vec<f64>,
+        y: Vec<f64>,
+    }
+
+    impl Residuals for Line {
+        fn len(&self) -> usize {
+            self.x.len()
+        }
+        fn residuals(&self, k: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+            for (i, (x, y)) in self.x.iter().zip(&self.y).enumerate() {
+                sink(i, y - k[0] * x);
+            }
+            Ok(())
+        }
+    }
+
+    fn rss_at(line: &Line, k: f64) -> f64 {
+        line.x
+            .iter()
+            .zip(&line.y)
+            .map(|(x, y)| (y - k * x).powi(2))
+            .sum()
+    }
+
+    /// A stiffness of 554 with wide bounds [0, 1e9] (those of `wall_impact.k_w`), started at
+    /// its least-squares value: no solver, however few its iterations, may end worse. (The
+    /// bound transform used to move this start to 1e6, "1e-3 of the width inside", and a
+    /// short refit then ended 1e5 times worse than it started.)
+    #[test]
+    fn a_fit_started_at_the_optimum_never_ends_worse() {
+        let x: Vec<f64> = (0..200).map(|i| (i as f64 * 0.1).sin() * 0.01).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, x)| 554.0 * x + 1e-3 * ((i * 7919 % 13) as f64 - 6.0))
+            .collect();
+        let line = Line { x, y };
+        let best = line.x.iter().zip(&line.y).map(|(x, y)| x * y).sum::<f64>()
+            / line.x.iter().map(|x| x * x).sum::<f64>();
+        let start_rss = rss_at(&line, best);
+        for solver in Solver::ALL {
+            for iters in [1, 2, 200] {
+                let params = [FitParam::new("k", best).bounds(0.0, 1e9)];
+                let settings = FitSettings::default().solver(solver).max_iters(iters);
+                let fit = run(&line, &params, &settings, None, false).unwrap();
+                assert!(
+                    fit.rss <= start_rss * (1.0 + 1e-12),
+                    "{solver:?}, {iters} iterations: rss {} > start {start_rss}, k = {}",
+                    fit.rss,
+                    fit.params[0].value
+                );
+                assert!((fit.params[0].value / best - 1.0).abs() < 1e-6);
+            }
+        }
+    }
+}

@@ -1,0 +1,411 @@
+//! Force-level calibration: an STF model's force against a measured F_STF.
+//!
+//! Residual of sample i: `F_meas,i − (m_a·a_i + f(t_i, x_i, v_i, z_i) + f_off)`, with the
+//! kinematics (x, v, a) given — typically from the derivative filter. A model with internal
+//! state is integrated along the measured kinematics with one classical Runge–Kutta (RK4)
+//! step per sample interval, x and v interpolated linearly between the samples (the midpoint
+//! stages use their means); z starts from the model's own initial state at the first sample.
+//! Memoryless models cost one call per sample, models with state four. Nothing is allocated
+//! per sample; an evaluation allocates only the model's few state variables.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use stf_core::fit::{ForceData, ForceFit};
+//! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+//! use stf_core::physics::param_spec::ParamSpec;
+//! struct Lin(Vec<ParamSpec>);
+//! impl ForceModel for Lin {
+//!     fn name(&self) -> &str { "lin" }
+//!     fn params(&self) -> &[ParamSpec] { &self.0 }
+//!     fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+//!         Ok(p[0] * s.v)
+//!     }
+//! }
+//! let model = Arc::new(Lin(vec![ParamSpec::new("c", "N·s/m", 1.0, 0.0, 100.0, "")]));
+//! let t: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
+//! let v: Vec<f64> = t.iter().map(|t| (5.0 * t).cos()).collect();
+//! let f: Vec<f64> = v.iter().map(|v| 3.0 * v).collect();
+//! let zeros = vec![0.0; t.len()];
+//! let data = ForceData { t: &t, x: &zeros, v: &v, a: &zeros, f: &f };
+//! let result = ForceFit::new(model).fit(&data, None).unwrap();
+//! assert!((result.value("c").unwrap() - 3.0).abs() < 1e-6);
+//! ```
+
+use std::sync::Arc;
+
+use nalgebra::DMatrix;
+
+use super::driver;
+use super::error::FitError;
+use super::fit_param::{full_values, FitParam};
+use super::objective::Residuals;
+use super::result::{FitProgress, FitResult};
+use super::solver::FitSettings;
+use crate::physics::force_model::{ForceModel, ModelState};
+
+/// Measured kinematics and force, sample by sample (SI units, equal lengths).
+#[derive(Clone, Copy, Debug)]
+pub struct ForceData<'a> {
+    /// Time, s (strictly increasing).
+    pub t: &'a [f64],
+    /// Displacement, m.
+    pub x: &'a [f64],
+    /// Velocity, m/s.
+    pub v: &'a [f64],
+    /// Acceleration, m/s².
+    pub a: &'a [f64],
+    /// Measured STF force, N.
+    pub f: &'a [f64],
+}
+
+impl ForceData<'_> {
+    fn validate(&self) -> Result<(), FitError> {
+        let n = self.t.len();
+        let lens = [self.x.len(), self.v.len(), self.a.len(), self.f.len()];
+        if lens.iter().any(|&l| l != n) {
+            return Err(FitError::BadData(format!(
+                "t, x, v, a, f must have equal lengths (got {n}, {lens:?})"
+            )));
+        }
+        for (name, col) in [
+            ("t", self.t),
+            ("x", self.x),
+            ("v", self.v),
+            ("a", self.a),
+            ("f", self.f),
+        ] {
+            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
+                return Err(FitError::BadData(format!(
+                    "{name}[{i}] = {} is not finite",
+                    col[i]
+                )));
+            }
+        }
+        if let Some(i) = self
+            .t
+            .windows(2)
+            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+        {
+            return Err(FitError::BadData(format!(
+                "time must increase strictly (t[{i}] = {}, t[{}] = {})",
+                self.t[i],
+                i + 1,
+                self.t[i + 1]
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A force-level calibration of one STF model (a [`crate::physics::model_sum::ModelSum`] is one model).
+#[derive(Clone)]
+pub struct ForceFit {
+    model: Arc<dyn ForceModel>,
+    params: Vec<FitParam>,
+    unknown: Vec<String>,
+    offset: Option<FitParam>,
+    settings: FitSettings,
+}
+
+/// Name of the constant force offset parameter, N.
+pub const FORCE_OFFSET: &str = "f_off";
+
+impl ForceFit {
+    /// Fit every parameter of `model` from its defaults within its bounds; no offset.
+    pub fn new(model: Arc<dyn ForceModel>) -> Self {
+        let params = model.params().iter().map(FitParam::from_spec).collect();
+        ForceFit {
+            model,
+            params,
+            unknown: Vec::new(),
+            offset: None,
+            settings: FitSettings::default(),
+        }
+    }
+
+    /// Start value, bounds or fixing of one of the model's parameters (by its name).
+    pub fn param(mut self, p: FitParam) -> Self {
+        match self.params.iter_mut().find(|q| q.name == p.name) {
+            Some(slot) => *slot = p,
+            None => self.unknown.push(p.name),
+        }
+        self
+    }
+
+    /// Add a constant force offset `f_off` (N) to the model's force; fit it unless `fixed`.
+    /// Its name is replaced by [`FORCE_OFFSET`].
+    pub fn offset(mut self, p: FitParam) -> Self {
+        let mut p = p;
+        p.name = FORCE_OFFSET.to_string();
+        if p.scale.is_none() && p.value == 0.0 {
+            p.scale = Some(0.1);
+        }
+        self.offset = Some(p);
+        self
+    }
+
+    /// Settings of the optimiser.
+    pub fn settings(mut self, settings: FitSettings) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    /// The parameters as they stand (model's, then the offset).
+    pub fn params(&self) -> Vec<FitParam> {
+        let mut all = self.params.clone();
+        all.extend(self.offset.clone());
+        all
+    }
+
+    /// Run the fit; `observer` is called after every evaluation.
+    pub fn fit(
+        &self,
+        data: &ForceData,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
+        self.fit_rows(data, None, &self.settings, observer)
+    }
+
+    /// Fit on the samples `rows` only (strictly increasing; `None`: all) with `settings`
+    /// instead of the fit's own; statistics (RMS, AIC, BIC, standard errors) are those of
+    /// the rows. The model is still evaluated along the whole record where it has internal
+    /// state, so the state evolves through the samples left out as it would in reality.
+    pub fn fit_rows(
+        &self,
+        data: &ForceData,
+        rows: Option<&[usize]>,
+        settings: &FitSettings,
+        observer: Option<&(dyn Fn(FitProgress) + Sync)>,
+    ) -> Result<FitResult, FitError> {
+        if let Some(name) = self.unknown.first() {
+            return Err(FitError::UnknownParam {
+                name: name.clone(),
+                known: self
+                    .model
+                    .params()
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        data.validate()?;
+        if let Some(rows) = rows {
+            let n = data.t.len();
+            if rows.windows(2).any(|w| w[0] >= w[1]) || rows.last().is_some_and(|&l| l >= n) {
+                return Err(FitError::BadData(format!(
+                    "the samples to fit must increase strictly and lie within the {n} samples"
+                )));
+            }
+        }
+        let all = self.params();
+        let problem = ForceResiduals {
+            model: self.model.as_ref(),
+            data: *data,
+            all: &all,
+            rows,
+        };
+        driver::run(&problem, &all, settings, observer, false)
+    }
+}
+
+impl ForceFit {
+    /// The modelled force (with the offset, if any) at every sample for the full parameter
+    /// vector `values` (the model's parameters, then the offset), along the kinematics.
+    pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        data.validate()?;
+        let mut all = self.params();
+        if values.len() != all.len() {
+            return Err(FitError::BadData(format!(
+                "{} values given for {} parameters",
+                values.len(),
+                all.len()
+            )));
+        }
+        for (p, &v) in all.iter_mut().zip(values) {
+            p.value = v;
+            p.fixed = true;
+        }
+        let problem = ForceResiduals {
+            model: self.model.as_ref(),
+            data: *data,
+            all: &all,
+            rows: None,
+        };
+        let mut out = data.f.to_vec();
+        problem
+            .residuals(&[], &mut |i, r| out[i] -= r)
+            .map_err(FitError::BadData)?;
+        Ok(out)
+    }
+}
+
+/// The residuals of a force-level fit, at every sample or at the samples `rows` only.
+struct ForceResiduals<'a> {
+    model: &'a dyn ForceModel,
+    data: ForceData<'a>,
+    /// Model parameters, then the offset if any.
+    all: &'a [FitParam],
+    /// The samples whose residuals count (strictly increasing), or `None` for all. A model
+    /// with internal state is still integrated along every sample.
+    rows: Option<&'a [usize]>,
+}
+
+impl ForceResiduals<'_> {
+    /// The sample behind residual `k`.
+    fn row(&self, k: usize) -> usize {
+        self.rows.map_or(k, |r| r[k])
+    }
+}
+
+impl Residuals for ForceResiduals<'_> {
+    fn len(&self) -> usize {
+        self.rows.map_or(self.data.t.len(), <[usize]>::len)
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        let n_model = self.model.params().len();
+        let full = full_values(self.all, x)?;
+        let p = &full[..n_model];
+        let offset = full.get(n_model).copied().unwrap_or(0.0);
+        let d = &self.data;
+        let m = self.model;
+        let err = |e: crate::physics::force_model::ModelError| e.to_string();
+        if m.n_internal() == 0 {
+            for k in 0..self.len() {
+                let i = self.row(k);
+                let s = ModelState {
+                    t: d.t[i],
+                    x: d.x[i],
+                    v: d.v[i],
+                    z: &[],
+                };
+                let (ma, f) = m.mass_and_force(p, &s, &mut []).map_err(err)?;
+                sink(k, d.f[i] - (ma * d.a[i] + f + offset));
+            }
+            return Ok(());
+        }
+        integrate_state(m, p, d, self.rows, &mut |k, i, ma, f| {
+            sink(k, d.f[i] - (ma * d.a[i] + f + offset));
+        })
+        .map_err(err)
+    }
+
+    /// Exact for models that give their [`ForceModel::gradient`]: built-ins without state,
+    /// and the memoryless parts of a sum (a part with state leaves NaN columns). A
+    /// memoryless part's gradient needs no state, so nothing is integrated here.
+    fn jacobian(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Result<(), String>> {
+        let m = self.model;
+        let n_model = m.params().len();
+        if self.is_empty() {
+            return None;
+        }
+        let full = match full_values(self.all, x) {
+            Ok(f) => f,
+            Err(e) => return Some(Err(e)),
+        };
+        let p = &full[..n_model];
+        // Column of each free parameter among all (the offset is the last).
+        let free: Vec<usize> = (0..self.all.len())
+            .filter(|&j| !self.all[j].fixed)
+            .collect();
+        let mut grad = vec![0.0; n_model];
+        // A placeholder state: only memoryless parts give their gradient.
+        let state = vec![0.0; m.n_internal()];
+        let d = &self.data;
+        for k in 0..self.len() {
+            let i = self.row(k);
+            let s = ModelState {
+                t: d.t[i],
+                x: d.x[i],
+                v: d.v[i],
+                z: &state,
+            };
+            match m.gradient(p, &s, d.a[i], &mut grad) {
+                Ok(true) => {}
+                Ok(false) => return None,
+                Err(e) => return Some(Err(e.to_string())),
+            }
+            for (c, &j) in free.iter().enumerate() {
+                jac[(k, c)] = -grad.get(j).copied().unwrap_or(1.0);
+            }
+        }
+        Some(Ok(()))
+    }
+}
+
+/// Integrate the internal state of `m` (parameters `p`) along the kinematics of `d` with one
+/// RK4 step per sample interval, calling `each(k, i, m_a, f)` at the `k`-th of the samples
+/// `rows` (strictly increasing; `None`: all), sample `i`, with the added mass and the rest of
+/// the force there; elsewhere only the state's rates are evaluated.
+fn integrate_state(
+    m: &dyn ForceModel,
+    p: &[f64],
+    d: &ForceData,
+    rows: Option<&[usize]>,
+    each: &mut dyn FnMut(usize, usize, f64, f64),
+) -> Result<(), crate::physics::force_model::ModelError> {
+    let nz = m.n_internal();
+    // z, stage rates k1..k4, stage state.
+    let mut buf = vec![0.0; 6 * nz];
+    let (z, rest) = buf.split_at_mut(nz);
+    let (k1, rest) = rest.split_at_mut(nz);
+    let (k2, rest) = rest.split_at_mut(nz);
+    let (k3, rest) = rest.split_at_mut(nz);
+    let (k4, zs) = rest.split_at_mut(nz);
+    m.initial_internal(p, z);
+    let last = d.t.len() - 1;
+    let mut next = 0;
+    for i in 0..=last {
+        let s = ModelState {
+            t: d.t[i],
+            x: d.x[i],
+            v: d.v[i],
+            z,
+        };
+        let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
+        if let Some(k) = k {
+            let (ma, f) = m.mass_and_force(p, &s, k1)?;
+            each(k, i, ma, f);
+            next += 1;
+        } else {
+            m.rates(p, &s, k1)?;
+        }
+        if i == last {
+            break;
+        }
+        let h = d.t[i + 1] - d.t[i];
+        let (tm, xm, vm) = (
+            0.5 * (d.t[i] + d.t[i + 1]),
+            0.5 * (d.x[i] + d.x[i + 1]),
+            0.5 * (d.v[i] + d.v[i + 1]),
+        );
+        // The intermediate stages need only the rates, not the force.
+        for j in 0..nz {
+            zs[j] = z[j] + 0.5 * h * k1[j];
+        }
+        m.rates(p, &midpoint(tm, xm, vm, zs), k2)?;
+        for j in 0..nz {
+            zs[j] = z[j] + 0.5 * h * k2[j];
+        }
+        m.rates(p, &midpoint(tm, xm, vm, zs), k3)?;
+        for j in 0..nz {
+            zs[j] = z[j] + h * k3[j];
+        }
+        let se = ModelState {
+            t: d.t[i + 1],
+            x: d.x[i + 1],
+            v: d.v[i + 1],
+            z: zs,
+        };
+        m.rates(p, &se, k4)?;
+        for j in 0..nz {
+            z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+        }
+    }
+    Ok(())
+}
+
+fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
+    ModelState { t, x, v, z }
+}

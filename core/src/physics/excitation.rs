@@ -1,0 +1,257 @@
+//! What drives the oscillator: the unbalanced rotor or a measured force.
+//!
+//! The rotor's force is `F0·ω²·sin φ` (the source study's form). Its angle φ(t) is either
+//! prescribed — constant ω, a linear sweep, a piecewise-linear ω(t) profile — or measured:
+//! samples of a record (wrapped or unwrapped), interpolated by cubic Hermite polynomials with ω
+//! from the derivative filter. Rigs driven by a shaker use a measured force `u` (N) instead.
+
+use crate::numerics::interpolate::{Hermite, Linear};
+use crate::physics::oscillator_params::OscillatorParams;
+
+/// How the rotor angle φ(t) is given.
+#[derive(Clone, Debug)]
+pub enum RotorAngle {
+    /// Constant speed: φ = φ0 + ω·t.
+    Constant {
+        /// ω, rad/s.
+        omega: f64,
+        /// φ at t = 0, rad.
+        phi0: f64,
+    },
+    /// Linear sweep: ω = w0 + α·(t − t0), φ = φ0 + w0·(t − t0) + α·(t − t0)²/2.
+    Sweep {
+        /// ω at t0, rad/s.
+        w0: f64,
+        /// Sweep rate, rad/s².
+        alpha: f64,
+        /// Start time, s.
+        t0: f64,
+        /// φ at t0, rad.
+        phi0: f64,
+    },
+    /// Piecewise-linear ω(t) through knots; ω is held outside them, φ is its exact integral.
+    Profile {
+        /// Knot times, s (increasing).
+        t: Vec<f64>,
+        /// ω at the knots, rad/s.
+        omega: Vec<f64>,
+        /// φ at the first knot, rad.
+        phi0: f64,
+    },
+    /// Measured φ samples, unwrapped, with ω from the derivative filter.
+    Measured(Hermite),
+}
+
+impl RotorAngle {
+    /// Constant ω from φ = 0 at t = 0.
+    pub fn constant(omega: f64) -> Self {
+        RotorAngle::Constant { omega, phi0: 0.0 }
+    }
+
+    /// A linear sweep ω = w0 + α·(t − t0) whose phase is that of a sweep begun from rest,
+    /// φ(t0) = w0²/(2α) (so ω = 0.047·t gives φ = 0.0235·t²).
+    pub fn sweep(w0: f64, alpha: f64, t0: f64) -> Self {
+        let phi0 = if alpha != 0.0 {
+            w0 * w0 / (2.0 * alpha)
+        } else {
+            0.0
+        };
+        RotorAngle::Sweep {
+            w0,
+            alpha,
+            t0,
+            phi0,
+        }
+    }
+
+    /// Measured samples: unwrapped angle `phi` and speed `omega` at times `t`.
+    pub fn measured(t: Vec<f64>, phi: Vec<f64>, omega: Vec<f64>) -> Self {
+        RotorAngle::Measured(Hermite::new(t, phi, omega))
+    }
+
+    /// φ (rad) and ω (rad/s) at time `t`.
+    #[inline]
+    pub fn at(&self, t: f64) -> (f64, f64) {
+        match self {
+            RotorAngle::Constant { omega, phi0 } => (phi0 + omega * t, *omega),
+            RotorAngle::Sweep {
+                w0,
+                alpha,
+                t0,
+                phi0,
+            } => {
+                let s = t - t0;
+                (phi0 + w0 * s + 0.5 * alpha * s * s, w0 + alpha * s)
+            }
+            _ => self.tabulated_at(t),
+        }
+    }
+
+    /// The first time after `t` at which the angle's second derivative may jump: the next knot
+    /// of a profile or of measured samples; none for the analytic kinds.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match self {
+            RotorAngle::Constant { .. } | RotorAngle::Sweep { .. } => None,
+            RotorAngle::Profile { t: ts, .. } => {
+                crate::numerics::interpolate::next_knot(ts, None, t)
+            }
+            RotorAngle::Measured(h) => h.next_knot(t),
+        }
+    }
+
+    /// [`RotorAngle::at`] for the tabulated kinds (kept out of line so that the analytic ones
+    /// inline into the right-hand side).
+    #[inline(never)]
+    fn tabulated_at(&self, t: f64) -> (f64, f64) {
+        match self {
+            RotorAngle::Profile { t: ts, omega, phi0 } => profile_at(ts, omega, *phi0, t),
+            RotorAngle::Measured(h) => h.at(t),
+            RotorAngle::Constant { .. } | RotorAngle::Sweep { .. } => self.at(t),
+        }
+    }
+}
+
+fn profile_at(ts: &[f64], omega: &[f64], phi0: f64, t: f64) -> (f64, f64) {
+    let n = ts.len();
+    if n == 0 {
+        return (phi0, 0.0);
+    }
+    if t <= ts[0] {
+        return (phi0 + omega[0] * (t - ts[0]), omega[0]);
+    }
+    let mut phi = phi0;
+    for i in 0..n - 1 {
+        let (ta, tb) = (ts[i], ts[i + 1]);
+        let slope = (omega[i + 1] - omega[i]) / (tb - ta);
+        if t < tb {
+            let s = t - ta;
+            return (
+                phi + omega[i] * s + 0.5 * slope * s * s,
+                omega[i] + slope * s,
+            );
+        }
+        phi += 0.5 * (omega[i] + omega[i + 1]) * (tb - ta);
+    }
+    (phi + omega[n - 1] * (t - ts[n - 1]), omega[n - 1])
+}
+
+/// The driving force of the oscillator.
+#[derive(Clone, Debug)]
+pub enum Excitation {
+    /// No drive: free vibration.
+    None,
+    /// The unbalanced rotor, `F0·ω²·sin φ`.
+    Rotor(RotorAngle),
+    /// A measured force `u(t)`, N, linearly interpolated.
+    Force(Linear),
+}
+
+impl Excitation {
+    /// The driving force at time `t`, N, for the oscillator's unbalance `F0` (kg·m) and drive
+    /// offsets: `F0·ω²·sin(φ − phi_off)` for a rotor, `u(t) − u_off` for a measured force.
+    #[inline]
+    pub fn force(&self, t: f64, p: &OscillatorParams) -> f64 {
+        match self {
+            Excitation::None => 0.0,
+            Excitation::Rotor(angle) => {
+                let (phi, omega) = angle.at(t);
+                p.f0 * omega * omega * (phi - p.phi_off).sin()
+            }
+            Excitation::Force(u) => u.at(t) - p.u_off,
+        }
+    }
+
+    /// The driving force at `t` (N, as [`Excitation::force`]) together with the rotor angle
+    /// and speed `(φ, ω)` if a rotor drives the oscillator: one evaluation of the angle for all
+    /// three (the same values as [`Excitation::force`], [`Excitation::phi`],
+    /// [`Excitation::omega`]).
+    #[inline]
+    pub fn force_and_angle(&self, t: f64, p: &OscillatorParams) -> (f64, Option<(f64, f64)>) {
+        match self {
+            Excitation::Rotor(angle) => {
+                let (phi, omega) = angle.at(t);
+                (
+                    p.f0 * omega * omega * (phi - p.phi_off).sin(),
+                    Some((phi, omega)),
+                )
+            }
+            _ => (self.force(t, p), None),
+        }
+    }
+
+    /// The first time after `t` at which the driving force stops being smooth (the next knot of
+    /// a measured or piecewise-defined drive), if any: an integrator ends a step there rather
+    /// than stepping across it.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::None => None,
+            Excitation::Rotor(angle) => angle.next_breakpoint(t),
+            Excitation::Force(u) => u.next_knot(t),
+        }
+    }
+
+    /// Rotor speed ω at `t`, rad/s, if a rotor drives the oscillator.
+    pub fn omega(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::Rotor(angle) => Some(angle.at(t).1),
+            _ => None,
+        }
+    }
+
+    /// Rotor angle φ at `t`, rad, if a rotor drives the oscillator.
+    pub fn phi(&self, t: f64) -> Option<f64> {
+        match self {
+            Excitation::Rotor(angle) => Some(angle.at(t).0),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn sweep_from_rest_matches_the_reference_phase() {
+        let a = RotorAngle::sweep(2.35, 0.047, 50.0);
+        for t in [50.0, 120.0, 200.0] {
+            let (phi, w) = a.at(t);
+            assert_relative_eq!(phi, 0.0235 * t * t, max_relative = 1e-12);
+            assert_relative_eq!(w, 0.047 * t, max_relative = 1e-12);
+        }
+    }
+
+    #[test]
+    fn force_and_angle_agrees_with_the_separate_evaluations() {
+        let rotor = Excitation::Rotor(RotorAngle::sweep(2.35, 0.047, 50.0));
+        for t in [50.0, 77.7, 199.9] {
+            let (drive, angle) = rotor.force_and_angle(t, &OscillatorParams::FORCED);
+            assert_eq!(drive, rotor.force(t, &OscillatorParams::FORCED));
+            assert_eq!(
+                angle,
+                Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap()))
+            );
+        }
+        let free = Excitation::None;
+        assert_eq!(
+            free.force_and_angle(3.0, &OscillatorParams::FORCED),
+            (0.0, None)
+        );
+    }
+
+    #[test]
+    fn profile_integrates_omega_exactly() {
+        let p = RotorAngle::Profile {
+            t: vec![0.0, 10.0, 20.0],
+            omega: vec![1.0, 3.0, 3.0],
+            phi0: 0.5,
+        };
+        let (phi, w) = p.at(5.0);
+        assert_relative_eq!(w, 2.0);
+        assert_relative_eq!(phi, 0.5 + 5.0 + 0.5 * 0.2 * 25.0);
+        let (phi, w) = p.at(25.0);
+        assert_relative_eq!(w, 3.0);
+        assert_relative_eq!(phi, 0.5 + 20.0 + 30.0 + 15.0);
+    }
+}

@@ -1,0 +1,165 @@
+//! The seam through which any STF force model plugs into the oscillator.
+//!
+//! A model has named parameters ([`ParamSpec`]), may carry internal state variables that the
+//! integrator advances together with x and v, and may contribute an acceleration-proportional
+//! part (added mass) that the oscillator moves to the left-hand side:
+//!
+//! ```text
+//! F_STF = m_a(state)·ẍ + f(t, x, v, z),     ż = g(t, x, v, z)
+//! ```
+//!
+//! Only [`ForceModel::name`], [`ForceModel::params`] and [`ForceModel::force`] are required;
+//! a model without internal state or added mass needs nothing else.
+//!
+//! ```
+//! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+//! use stf_core::physics::param_spec::ParamSpec;
+//!
+//! struct Linear { specs: Vec<ParamSpec> }
+//! impl ForceModel for Linear {
+//!     fn name(&self) -> &str { "linear" }
+//!     fn params(&self) -> &[ParamSpec] { &self.specs }
+//!     fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+//!         Ok(p[0] * s.v)
+//!     }
+//! }
+//! let m = Linear { specs: vec![ParamSpec::new("c", "N·s/m", 1.0, 0.0, 100.0, "damping")] };
+//! let f = m.force(&[2.0], &ModelState { t: 0.0, x: 0.0, v: 0.5, z: &[] }, &mut []).unwrap();
+//! assert_eq!(f, 1.0);
+//! ```
+
+use crate::physics::param_spec::ParamSpec;
+use thiserror::Error;
+
+/// The state a force model sees: time, displacement, velocity and its own internal variables.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelState<'a> {
+    /// Time, s.
+    pub t: f64,
+    /// Displacement of the blade, m.
+    pub x: f64,
+    /// Velocity of the blade, m/s.
+    pub v: f64,
+    /// The model's internal state variables (empty for a memoryless model).
+    pub z: &'a [f64],
+}
+
+/// A force model failed to evaluate (a script error, a non-finite result, …).
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("model `{model}`: {message}")]
+pub struct ModelError {
+    /// The model's name, or a script's path.
+    pub model: String,
+    /// What went wrong; for scripts, with the line.
+    pub message: String,
+}
+
+impl ModelError {
+    /// An error of model `model` saying `message`.
+    pub fn new(model: impl Into<String>, message: impl Into<String>) -> Self {
+        ModelError {
+            model: model.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// An STF force model: `F_STF = m_a·ẍ + f(t, x, v, z)`.
+pub trait ForceModel: Send + Sync {
+    /// Short name (`power_law`), or a script's file stem.
+    fn name(&self) -> &str;
+
+    /// One line saying what the model is.
+    fn summary(&self) -> &str {
+        ""
+    }
+
+    /// The parameters, in the order in which their values are passed as `p`.
+    fn params(&self) -> &[ParamSpec];
+
+    /// Number of internal state variables advanced by the integrator.
+    fn n_internal(&self) -> usize {
+        0
+    }
+
+    /// Initial values of the internal state (zeros unless the model says otherwise).
+    fn initial_internal(&self, _p: &[f64], z0: &mut [f64]) {
+        z0.fill(0.0);
+    }
+
+    /// Added mass `m_a` (kg): the part of the force proportional to the acceleration.
+    fn added_mass(&self, _p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
+        Ok(0.0)
+    }
+
+    /// The rest of the force, N, positive when it opposes positive x (it enters the equation
+    /// with a plus sign on the left-hand side). Writes the rates of the internal state to `dz`.
+    fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError>;
+
+    /// The added mass and the rest of the force at once (what a fitter needs at every
+    /// sample): `(added_mass, force)`. The default calls both; a sum visits its parts once.
+    fn mass_and_force(
+        &self,
+        p: &[f64],
+        s: &ModelState,
+        dz: &mut [f64],
+    ) -> Result<(f64, f64), ModelError> {
+        Ok((self.added_mass(p, s)?, self.force(p, s, dz)?))
+    }
+
+    /// Only the rates of the internal state, written to `dz` (the intermediate stages of an
+    /// integration step need no force). The default calls [`ForceModel::force`]; a sum
+    /// evaluates only its parts with state.
+    fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+        self.force(p, s, dz).map(|_| ())
+    }
+
+    /// The gradient of the whole force `m_a·a + f` with respect to the parameters at state
+    /// `s` and acceleration `a`, written to `grad` (one entry per parameter); `Ok(false)` when
+    /// the model does not provide it (the default), and the fitter differences instead. Only
+    /// models without internal state provide it (a state would need its sensitivities); a sum
+    /// gives its memoryless parts' entries and leaves NaN in those of its parts with state,
+    /// which the fitter differences.
+    fn gradient(
+        &self,
+        _p: &[f64],
+        _s: &ModelState,
+        _a: f64,
+        _grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        Ok(false)
+    }
+
+    /// The simpler built-in these fitted values `p` make this model over a record that
+    /// reaches `reach`, with that model's values: a wall with no gap and exponent 3 is a cubic
+    /// spring, a gate that is open at every speed the record reaches is its ungated law.
+    /// `None` (the default) when the model is what its name says. Discovery names the
+    /// simpler effect.
+    fn reduces_to(&self, _p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
+        None
+    }
+}
+
+/// How far a record goes: the largest |x| (m) and |ẋ| (m/s) it reaches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reach {
+    /// Largest |x|, m.
+    pub x: f64,
+    /// Largest |ẋ|, m/s.
+    pub v: f64,
+}
+
+impl Reach {
+    /// The reach of displacement and velocity samples.
+    pub fn of(x: &[f64], v: &[f64]) -> Self {
+        let max = |s: &[f64]| s.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        Reach {
+            x: max(x),
+            v: max(v),
+        }
+    }
+}
+
+/// What share of a record's reach counts as nothing: a gap, a threshold speed or a damping
+/// term below 5 % of it does not change the force where the record goes.
+pub const NEGLIGIBLE_SHARE: f64 = 0.05;
