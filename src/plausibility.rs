@@ -1,6 +1,7 @@
 //! Records that cannot be what the experiment file says they are, caught before anything is
 //! fitted: a time column in the wrong unit, a displacement in mm read as m, a `[data] rate`
-//! that disagrees with the record's own `t` column.
+//! that disagrees with the record's own `t` column. The estimation record and the `[validate]`
+//! record are checked alike.
 //!
 //! Clearly impossible records are refused with what looks wrong and the `[data] units` key
 //! that likely fixes it; merely suspicious ones give warnings (printed, and in

@@ -67,6 +67,11 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         return Err(spec.error(key, msg));
     }
     let mut record = read_record(exp, &spec.file).map_err(|e| spec.error(key, format!("{e:#}")))?;
+    let record_warnings = crate::plausibility::check(exp, &spec.file, &record)
+        .map_err(|e| spec.error(key, format!("{e:#}")))?;
+    for w in &record_warnings {
+        eprintln!("warning: {w}");
+    }
     check_columns(exp, spec, &record, estimation)?;
     if let Some((t0, t1)) = spec.window {
         record = record.slice_time(t0, t1);
@@ -90,7 +95,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         kinematics,
         level: estimation.level,
         system_estimate: None,
-        record_warnings: Vec::new(),
+        record_warnings,
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),

@@ -149,3 +149,33 @@ fn a_rate_at_odds_with_the_t_column_is_flagged() {
     );
     assert_eq!(load(dir.path(), &rec, "rate = 100.0", ""), Ok(vec![]));
 }
+
+#[test]
+fn a_validation_record_is_checked_as_the_estimation_record_is() {
+    // The validation record's time is in ms read as s; the estimation record is plausible.
+    let dir = tempfile::tempdir().unwrap();
+    let other = dir.path().join("other.csv");
+    std::fs::rename(rotor_csv(dir.path(), 1000.0, 1.0), &other).unwrap();
+    let rec = rotor_csv(dir.path(), 1.0, 1.0);
+    let exp_path = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp_path,
+        format!(
+            "[data]\nfile = {:?}\n\n[validate]\nfile = {:?}\n\n[fit]\nlevel = \"trajectory\"\n",
+            rec.display().to_string(),
+            other.display().to_string()
+        ),
+    )
+    .unwrap();
+    let mut exp = Experiment::load(&exp_path).unwrap();
+    let data = load_data(&mut exp).unwrap();
+    let Err(e) = stf_lab::validation::load(&exp, &data) else {
+        panic!("the validation record's time in ms was not caught");
+    };
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("exp.toml:5") && msg.contains("validate.file") && msg.contains("other.csv"),
+        "{msg}"
+    );
+    assert!(msg.contains("below twice"), "{msg}");
+}
