@@ -261,7 +261,7 @@ pub fn reconstruct(
     };
     let counts_per_rev = step
         .filter(|_| signal == DriveSignal::Phi)
-        .map(|q| std::f64::consts::TAU / q);
+        .map(|q| whole_counts(std::f64::consts::TAU / q));
     Ok(Reconstruction {
         value,
         slope: d.d1,
@@ -278,6 +278,17 @@ pub fn reconstruct(
             residual_over_step: step.map(|q| residual_rms / q),
         },
     })
+}
+
+/// Encoder counts per revolution as found from the step: a whole number when the step is one
+/// to rounding (2048, not 2048.00000000097: an encoder's counts are whole), else as found.
+fn whole_counts(counts: f64) -> f64 {
+    let whole = counts.round();
+    if (counts - whole).abs() <= 1e-9 * counts {
+        whole
+    } else {
+        counts
+    }
 }
 
 /// The paper's filter for ω (order 2 over 800 samples), shortened to fit a shorter record.
@@ -414,6 +425,7 @@ mod tests {
             .fold(0.0_f64, f64::max);
         assert!(w_err < 1e-3, "max |ω − ω_true| = {w_err:e}");
         assert_eq!(r.report.method, DriveMethod::Auto);
+        assert_eq!(r.report.counts_per_rev, Some(2048.0));
         let ratio = r.report.residual_over_step.unwrap();
         assert!((ratio - 12f64.sqrt().recip()).abs() < 0.03, "{ratio}");
     }
