@@ -71,6 +71,83 @@ where
         .map_err(msg)
 }
 
+/// The mark beside a legend strip's label.
+#[derive(Clone, Copy, Debug)]
+pub enum Swatch {
+    /// A short line of a colour and width, pixels.
+    Line(RGBColor, u32),
+    /// A filled black dot.
+    Dot,
+    /// A black ring.
+    Ring,
+}
+
+/// Height of one row of a legend strip, pixels.
+const STRIP_ROW: i32 = 26;
+
+/// Draw a legend across the top of `area`, its entries left to right, centred, in as many
+/// rows as the width needs, and return the area below it: for figures whose legend would
+/// cover their data (every line spans the whole time axis) or whose panels share one.
+pub fn legend_strip<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, Swatch)],
+) -> Result<DrawingArea<DB, Shift>, String> {
+    const MARK: i32 = 24;
+    const GAP: i32 = 28;
+    let style = legend_style();
+    let widths: Vec<i32> = entries
+        .iter()
+        .map(|(label, _)| {
+            area.estimate_text_size(label, &style)
+                .map(|(w, _)| MARK + 6 + w as i32)
+        })
+        .collect::<Result<_, _>>()
+        .map_err(msg)?;
+    let width = area.dim_in_pixel().0 as i32 - 40;
+    let mut rows: Vec<Vec<usize>> = vec![Vec::new()];
+    let mut used = 0;
+    for (i, w) in widths.iter().enumerate() {
+        let row = rows.last_mut().expect("one row at least");
+        if !row.is_empty() && used + GAP + w > width {
+            rows.push(vec![i]);
+            used = *w;
+        } else {
+            used += if row.is_empty() { *w } else { GAP + w };
+            row.push(i);
+        }
+    }
+    let height = STRIP_ROW * rows.len() as i32 + 4;
+    let (strip, rest) = area.split_vertically(height);
+    let text = style.pos(plotters::style::text_anchor::Pos::new(
+        plotters::style::text_anchor::HPos::Left,
+        plotters::style::text_anchor::VPos::Center,
+    ));
+    for (r, row) in rows.iter().enumerate() {
+        let total: i32 = row.iter().map(|&i| widths[i]).sum::<i32>() + GAP * (row.len() as i32 - 1);
+        let mut x = ((strip.dim_in_pixel().0 as i32 - total) / 2).max(0);
+        let y = STRIP_ROW * r as i32 + STRIP_ROW / 2 + 2;
+        for &i in row {
+            let (label, swatch) = &entries[i];
+            match *swatch {
+                Swatch::Line(colour, w) => strip.draw(&PathElement::new(
+                    vec![(x, y), (x + MARK, y)],
+                    colour.stroke_width(w),
+                )),
+                Swatch::Dot => strip.draw(&Circle::new((x + MARK / 2, y), 4, BLACK.filled())),
+                Swatch::Ring => {
+                    strip.draw(&Circle::new((x + MARK / 2, y), 4, BLACK.stroke_width(2)))
+                }
+            }
+            .map_err(msg)?;
+            strip
+                .draw(&Text::new(label.clone(), (x + MARK + 6, y), text.clone()))
+                .map_err(msg)?;
+            x += widths[i] + GAP;
+        }
+    }
+    Ok(rest)
+}
+
 /// Turn any plotting error into its message.
 pub fn msg<E: std::fmt::Display>(e: E) -> String {
     e.to_string()

@@ -12,8 +12,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, draw_legend, finite_points, legend_line, msg, render, same_length, tick_label,
-    tick_style, title_style, Draw, FigureFiles, SIZE,
+    axis_desc_style, finite_points, legend_strip, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles, Swatch, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -106,26 +106,41 @@ impl MeasuredVsFittedPlot {
         let measured = envelope(&self.t, &self.measured, buckets);
         chart
             .draw_series([Polygon::new(band(&measured), MEASURED_GREY.filled())])
-            .map_err(msg)?
-            .label(format!("{} (envelope)", self.quantity.band))
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
-            });
-        for (i, (label, f)) in self.fitted.iter().enumerate() {
+            .map_err(msg)?;
+        for (i, (_, f)) in self.fitted.iter().enumerate() {
             let colour = series_colour(i);
             let edges = envelope(&self.t, f, buckets);
             let upper = edges.iter().map(|&(t, _, hi)| (t, hi));
             let lower = edges.iter().map(|&(t, lo, _)| (t, lo));
             chart
                 .draw_series(LineSeries::new(upper, colour.stroke_width(2)))
-                .map_err(msg)?
-                .label(format!("{label} (envelope)"))
-                .legend(legend_line(colour));
+                .map_err(msg)?;
             chart
                 .draw_series(LineSeries::new(lower, colour.stroke_width(2)))
                 .map_err(msg)?;
         }
-        draw_legend(chart, SeriesLabelPosition::UpperRight)
+        Ok(())
+    }
+
+    /// The legend, above the plot: every line spans the whole time axis, so no corner of the
+    /// plot is free of data.
+    fn legend_entries(&self) -> Vec<(String, Swatch)> {
+        let suffix = if dense(&self.measured) {
+            " (envelope)"
+        } else {
+            ""
+        };
+        let mut entries = vec![(
+            format!("{}{suffix}", self.quantity.band),
+            Swatch::Line(MEASURED_GREY, 6),
+        )];
+        for (i, (label, _)) in self.fitted.iter().enumerate() {
+            entries.push((
+                format!("{label}{suffix}"),
+                Swatch::Line(series_colour(i), 3),
+            ));
+        }
+        entries
     }
 }
 
@@ -142,6 +157,7 @@ impl Draw for MeasuredVsFittedPlot {
         let root = root
             .titled(self.quantity.title, title_style())
             .map_err(msg)?;
+        let root = legend_strip(&root, &self.legend_entries())?;
         let mut chart = ChartBuilder::on(&root)
             .margin(10)
             .margin_right(30)
@@ -169,23 +185,17 @@ impl Draw for MeasuredVsFittedPlot {
                 finite_points(&self.t, &self.measured),
                 MEASURED_GREY.stroke_width(6),
             ))
-            .map_err(msg)?
-            .label(self.quantity.band)
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(6))
-            });
-        for (i, (label, f)) in self.fitted.iter().enumerate() {
+            .map_err(msg)?;
+        for (i, (_, f)) in self.fitted.iter().enumerate() {
             let colour = series_colour(i);
             chart
                 .draw_series(LineSeries::new(
                     finite_points(&self.t, f),
                     colour.stroke_width(2),
                 ))
-                .map_err(msg)?
-                .label(label.as_str())
-                .legend(legend_line(colour));
+                .map_err(msg)?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+        Ok(())
     }
 }
 

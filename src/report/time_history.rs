@@ -14,8 +14,8 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_legend, finite_points, legend_line, msg, render, same_length, tick_label,
-    tick_style, title_style, Draw, FigureFiles, SIZE_TALL,
+    axis_desc_style, finite_points, legend_strip, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles, Swatch, SIZE_TALL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -90,9 +90,9 @@ impl TimeHistoryPlot {
             .draw()
             .map_err(msg)?;
 
-        self.draw_signals(&mut chart, label, y)?;
+        self.draw_signals(&mut chart, y)?;
         if self.marks.len() > MAX_MARKS {
-            return self.legend(&mut chart);
+            return Ok(());
         }
         chart
             .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
@@ -102,10 +102,34 @@ impl TimeHistoryPlot {
                 };
                 Circle::new((t, f), 4, style)
             }))
-            .map_err(msg)?
-            .label("F_STF maxima (●) and minima (○)")
-            .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
-        self.legend(&mut chart)
+            .map_err(msg)?;
+        Ok(())
+    }
+
+    /// The legend the three panels share: the motion (left axis), the force (right axis) and
+    /// the marks of its extrema.
+    fn legend_entries(&self) -> Vec<(String, Swatch)> {
+        let suffix = if self.is_dense() { " (envelope)" } else { "" };
+        let mut entries = vec![
+            (
+                format!("motion, left axis{suffix}"),
+                Swatch::Line(series_colour(0), 3),
+            ),
+            (
+                format!("{F_LABEL}, right axis{suffix}"),
+                Swatch::Line(series_colour(1), 3),
+            ),
+        ];
+        if !self.marks.is_empty() && self.marks.len() <= MAX_MARKS {
+            entries.push(("F_STF maxima".into(), Swatch::Dot));
+            entries.push(("minima".into(), Swatch::Ring));
+        }
+        entries
+    }
+
+    /// Hundreds of cycles: each signal is drawn as its envelope.
+    fn is_dense(&self) -> bool {
+        dense(&self.f) || self.panels.iter().any(|(_, y)| dense(y))
     }
 
     /// The motion `y` (primary axis) and the force (secondary): lines, or for hundreds of
@@ -118,52 +142,35 @@ impl TimeHistoryPlot {
             Cartesian2d<RangedCoordf64, RangedCoordf64>,
             Cartesian2d<RangedCoordf64, RangedCoordf64>,
         >,
-        label: &str,
         y: &[f64],
     ) -> Result<(), String> {
         let c_motion = series_colour(0);
         let c_force = series_colour(1);
-        if dense(y) || dense(&self.f) {
-            // Hundreds of cycles: each signal's envelope, the cycles are in the windows.
+        if self.is_dense() {
             let buckets = buckets_for(y).min(buckets_for(&self.f));
             let y_band = band(&envelope(&self.t, y, buckets));
             chart
                 .draw_series([Polygon::new(y_band, c_motion.mix(0.45).filled())])
-                .map_err(msg)?
-                .label(format!("{label} (envelope)"))
-                .legend(legend_line(c_motion));
+                .map_err(msg)?;
             let f_band = band(&envelope(&self.t, &self.f, buckets));
             chart
                 .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
-                .map_err(msg)?
-                .label(format!("{F_LABEL} (envelope)"))
-                .legend(legend_line(c_force));
+                .map_err(msg)?;
         } else {
             chart
                 .draw_series(LineSeries::new(
                     finite_points(&self.t, y),
                     c_motion.stroke_width(2),
                 ))
-                .map_err(msg)?
-                .label(label)
-                .legend(legend_line(c_motion));
+                .map_err(msg)?;
             chart
                 .draw_secondary_series(LineSeries::new(
                     finite_points(&self.t, &self.f),
                     c_force.stroke_width(1),
                 ))
-                .map_err(msg)?
-                .label(F_LABEL)
-                .legend(legend_line(c_force));
+                .map_err(msg)?;
         }
         Ok(())
-    }
-
-    fn legend<'a, DB: DrawingBackend + 'a>(
-        &self,
-        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-    ) -> Result<(), String> {
-        draw_legend(chart, SeriesLabelPosition::UpperRight)
     }
 }
 
@@ -175,6 +182,7 @@ impl Draw for TimeHistoryPlot {
         let root = root
             .titled("Motion against the STF force", title_style())
             .map_err(msg)?;
+        let root = legend_strip(&root, &self.legend_entries())?;
         for (i, area) in root.split_evenly((3, 1)).iter().enumerate() {
             self.panel(area, i)?;
         }
@@ -296,6 +304,16 @@ mod tests {
             kinds.len()
         );
         assert!(kinds.windows(2).all(|w| w[0] == -w[1]));
+        // One legend above the panels, naming the marks too (drawn where it covers no data).
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        for label in [
+            "motion, left axis",
+            "F_STF, N, right axis",
+            "F_STF maxima",
+            "minima",
+        ] {
+            assert_eq!(svg.matches(label).count(), 1, "{label}");
+        }
     }
 
     #[test]
