@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    draw_legend, legend_line, legend_style, msg, render, same_length, tick_label, tick_style,
-    title_style, Draw, FigureFiles,
+    legend_strip, legend_style, msg, render, same_length, tick_label, tick_style, title_style,
+    Draw, FigureFiles, Swatch,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -163,7 +163,6 @@ impl ParityPlot {
         &self,
         area: &DrawingArea<DB, Shift>,
         (name, measured, fitted): &(String, Vec<f64>, Vec<Vec<f64>>),
-        legend: bool,
     ) -> Result<(), String> {
         let residuals = residuals_of(measured, fitted);
         let range = histogram_range(&residuals, self.quantity.noise_sigma)
@@ -211,9 +210,7 @@ impl ParityPlot {
             let colour = series_colour(i);
             chart
                 .draw_series(LineSeries::new(steps, colour.stroke_width(2)))
-                .map_err(msg)?
-                .label(self.models[i].as_str())
-                .legend(legend_line(colour));
+                .map_err(msg)?;
         }
         if let Some(s) = sigma {
             let curve = (0..=200).map(|k| {
@@ -222,14 +219,24 @@ impl ParityPlot {
             });
             chart
                 .draw_series(LineSeries::new(curve, GREY.stroke_width(2)))
-                .map_err(msg)?
-                .label("noise floor")
-                .legend(legend_line(GREY));
-        }
-        if legend {
-            draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+                .map_err(msg)?;
         }
         Ok(())
+    }
+
+    /// The legend the panels share, above them: each model's colour (its scatter and its
+    /// histogram) and the noise floor's curve.
+    fn legend_entries(&self) -> Vec<(String, Swatch)> {
+        let mut entries: Vec<(String, Swatch)> = self
+            .models
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (m.clone(), Swatch::Line(series_colour(i), 3)))
+            .collect();
+        if self.quantity.noise_sigma.is_some_and(|s| s > 0.0) {
+            entries.push(("noise floor".into(), Swatch::Line(GREY, 3)));
+        }
+        entries
     }
 }
 
@@ -241,11 +248,12 @@ impl Draw for ParityPlot {
                 title_style(),
             )
             .map_err(msg)?;
+        let root = legend_strip(&root, &self.legend_entries())?;
         let cells = root.split_evenly((2, self.groups.len()));
         let n = self.groups.len();
         for (k, group) in self.groups.iter().enumerate() {
             self.parity(&cells[k], group)?;
-            self.residuals(&cells[n + k], group, k + 1 == n)?;
+            self.residuals(&cells[n + k], group)?;
         }
         Ok(())
     }
