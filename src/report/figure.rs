@@ -46,11 +46,6 @@ pub fn legend_style() -> TextStyle<'static> {
     TextStyle::from((FAMILY, 16).into_font())
 }
 
-/// A legend sample: a short thick line in `colour`.
-pub fn legend_line(colour: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
-}
-
 /// Draw `chart`'s legend at `position` in the house style (legend text, a white box with a
 /// black border).
 pub fn draw_legend<'a, DB, CT>(

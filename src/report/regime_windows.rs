@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    draw_legend, finite_points, legend_line, legend_style, msg, render, same_length, tick_label,
-    tick_style, title_style, Draw, FigureFiles,
+    finite_points, legend_strip, legend_style, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles, Swatch,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -64,7 +64,6 @@ impl WindowsPlot<'_> {
         w: &RegimeWindow,
         (x_label, x): (&str, &[f64]),
         caption: Option<&str>,
-        legend: bool,
     ) -> Result<(), String> {
         let r = w.start..w.end;
         let s = &self.series;
@@ -111,26 +110,29 @@ impl WindowsPlot<'_> {
                 finite_points(x, &s.f[r.clone()]),
                 MEASURED_GREY.stroke_width(5),
             ))
-            .map_err(msg)?
-            .label("measured")
-            .legend(|(x, y)| {
-                PathElement::new(vec![(x, y), (x + 24, y)], MEASURED_GREY.stroke_width(5))
-            });
-        for (i, (label, m)) in s.models.iter().enumerate() {
+            .map_err(msg)?;
+        for (i, (_, m)) in s.models.iter().enumerate() {
             let colour = series_colour(i);
             chart
                 .draw_series(LineSeries::new(
                     finite_points(x, &m[r.clone()]),
                     colour.stroke_width(2),
                 ))
-                .map_err(msg)?
-                .label(*label)
-                .legend(legend_line(colour));
-        }
-        if legend {
-            draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+                .map_err(msg)?;
         }
         Ok(())
+    }
+
+    /// The legend the panels share, above them: the measured force and each model's.
+    fn legend_entries(&self) -> Vec<(String, Swatch)> {
+        let measured = ("measured".to_string(), Swatch::Line(MEASURED_GREY, 5));
+        let models = self.series.models.iter().enumerate();
+        std::iter::once(measured)
+            .chain(
+                models
+                    .map(|(i, (label, _))| (label.to_string(), Swatch::Line(series_colour(i), 3))),
+            )
+            .collect()
     }
 }
 
@@ -142,6 +144,7 @@ impl Draw for WindowsPlot<'_> {
                 title_style(),
             )
             .map_err(msg)?;
+        let root = legend_strip(&root, &self.legend_entries())?;
         let s = &self.series;
         let rows: [(&str, &[f64]); 4] = [
             ("time t, s", s.t),
@@ -154,8 +157,7 @@ impl Draw for WindowsPlot<'_> {
             let (row, col) = (k / self.windows.len(), k % self.windows.len());
             let w = &self.windows[col];
             let caption = (row == 0).then_some(w.name.as_str());
-            let legend = row == 1 && col == 0;
-            self.panel(cell, w, rows[row], caption, legend)?;
+            self.panel(cell, w, rows[row], caption)?;
         }
         Ok(())
     }
