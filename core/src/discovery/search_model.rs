@@ -74,4 +74,44 @@ impl SearchModel {
         parts.push(extra.clone());
         SearchModel { parts, values }
     }
+
+    /// This stage without its part `index` (its parameters, which follow the level's
+    /// `n_before` own, dropped).
+    pub fn without(&self, index: usize, n_before: usize) -> SearchModel {
+        let sizes: Vec<usize> = self.parts.iter().map(|p| p.params().len()).collect();
+        let from: usize = n_before + sizes[..index.min(sizes.len())].iter().sum::<usize>();
+        let to = from + sizes.get(index).copied().unwrap_or(0);
+        let mut values = self.values.clone();
+        if to <= values.len() {
+            values.drain(from..to);
+        }
+        let mut parts = self.parts.clone();
+        if index < parts.len() {
+            parts.remove(index);
+        }
+        SearchModel { parts, values }
+    }
+
+    /// This stage with `extra` (its parameters at `start`) inserted as part `index`, its
+    /// parameters after the level's `n_before` own and those of the parts before it.
+    pub fn inserting(
+        &self,
+        index: usize,
+        n_before: usize,
+        extra: &Arc<dyn ForceModel>,
+        start: &[f64],
+    ) -> SearchModel {
+        let index = index.min(self.parts.len());
+        let at: usize = n_before
+            + self.parts[..index]
+                .iter()
+                .map(|p| p.params().len())
+                .sum::<usize>();
+        let mut values = self.values.clone();
+        let at = at.min(values.len());
+        values.splice(at..at, start.iter().copied());
+        let mut parts = self.parts.clone();
+        parts.insert(index, extra.clone());
+        SearchModel { parts, values }
+    }
 }
