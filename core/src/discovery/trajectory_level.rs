@@ -1340,14 +1340,20 @@ mod tests {
         (rec.t, rec.x, rec.u.unwrap(), system)
     }
 
-    fn discover(k3: f64) -> TrajectoryDiscovery {
+    /// A trajectory-level discovery and its own part.
+    struct Found {
+        discovery: Discovery,
+        part: TrajectoryPart,
+    }
+
+    fn discover(k3: f64) -> Found {
         discover_on(record(k3), &DiscoverySettings::default())
     }
 
     fn discover_on(
         record: (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
         settings: &DiscoverySettings,
-    ) -> TrajectoryDiscovery {
+    ) -> Found {
         let candidates = [
             Candidate::new("cubic_stiffness", cubic()),
             Candidate::new("quadratic_damping", quadratic()),
@@ -1359,7 +1365,7 @@ mod tests {
         (t, x, u, system): (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
         candidates: &[Candidate],
         settings: &DiscoverySettings,
-    ) -> TrajectoryDiscovery {
+    ) -> Found {
         let cycles = cycles_from_x(&t, &x, 1.5e-4).unwrap();
         // Start the oscillator 2 % off.
         let start = |name: &str| {
@@ -1373,7 +1379,7 @@ mod tests {
         .refit(start("m"))
         .refit(start("k"))
         .refit(start("c"));
-        discover_trajectory(
+        let discovery = discover_trajectory(
             viscous(),
             candidates,
             &TrajectoryData { t: &t, x: &x },
@@ -1381,7 +1387,9 @@ mod tests {
             &setup,
             settings,
         )
-        .unwrap()
+        .unwrap();
+        let part = discovery.trajectory.clone().unwrap();
+        Found { discovery, part }
     }
 
     #[test]
@@ -1395,10 +1403,10 @@ mod tests {
             "whole {:?} k3 {:?} S {}; scouted {:?} k3 {:?} S {}; {:?}",
             w.effects,
             w.value("k3"),
-            whole.s_after_mm2,
+            whole.part.s_after_mm2,
             s.effects,
             s.value("k3"),
-            scouted.s_after_mm2,
+            scouted.part.s_after_mm2,
             s.notes
         );
         assert!(s.notes.iter().any(|n| n.starts_with("scouted")));
@@ -1408,7 +1416,7 @@ mod tests {
         let (kw, ks) = (w.value("k3").unwrap(), s.value("k3").unwrap());
         assert!((ks / 1e4 - 1.0).abs() < 0.2, "k3 = {ks}");
         assert!((ks / kw - 1.0).abs() < 0.01, "k3 {ks} scouted, {kw} whole");
-        assert!(scouted.s_after_mm2 < 1.01 * whole.s_after_mm2);
+        assert!(scouted.part.s_after_mm2 < 1.01 * whole.part.s_after_mm2);
     }
 
     #[test]
@@ -1483,20 +1491,23 @@ mod tests {
         let d = &found.discovery;
         eprintln!(
             "S {} → {} mm²; {:?}",
-            found.s_before_mm2, found.s_after_mm2, d.notes
+            found.part.s_before_mm2, found.part.s_after_mm2, d.notes
         );
         assert_eq!(d.effects, ["cubic_stiffness"]);
-        assert!(found.s_after_mm2 < 0.5 * found.s_before_mm2);
+        assert!(found.part.s_after_mm2 < 0.5 * found.part.s_before_mm2);
         let k3 = d.value("k3").unwrap();
         assert!((k3 / 1e4 - 1.0).abs() < 0.2, "k3 = {k3}");
-        assert!((found.system_after.k / 269.9346 - 1.0).abs() < 0.02);
+        assert!((found.part.system_after.k / 269.9346 - 1.0).abs() < 0.02);
     }
 
     #[test]
     fn without_the_cubic_term_nothing_is_named() {
         let found = discover(0.0);
         let d = &found.discovery;
-        eprintln!("S {} → {} mm²", found.s_before_mm2, found.s_after_mm2);
+        eprintln!(
+            "S {} → {} mm²",
+            found.part.s_before_mm2, found.part.s_after_mm2
+        );
         assert!(d.effects.is_empty(), "{:?}", d.steps);
         assert!(d.gap_before < 2.0 * d.noise_floor);
     }
