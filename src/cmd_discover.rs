@@ -120,10 +120,7 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
     let started = Instant::now();
     let progress = Progress::new(quiet);
     let bar = progress.job("discover");
-    let (unit, scale) = match data.level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    };
+    let (unit, scale) = data.level.shown();
     settings.observer = discovery_observer(bar.clone(), unit, scale);
     if data.level == FitLevel::Trajectory {
         run_trajectory(
