@@ -16,8 +16,8 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use stf_core::data::record_bounds::widened;
 use stf_core::discovery::{
-    discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings,
-    TrajectoryDiscovery, TrajectorySetup,
+    discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings, TrajectoryPart,
+    TrajectorySetup,
 };
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::physics::force_model::ForceModel;
@@ -120,10 +120,7 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
     let started = Instant::now();
     let progress = Progress::new(quiet);
     let bar = progress.job("discover");
-    let (unit, scale) = match data.level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    };
+    let (unit, scale) = data.level.shown();
     settings.observer = discovery_observer(bar.clone(), unit, scale);
     if data.level == FitLevel::Trajectory {
         run_trajectory(
@@ -496,17 +493,22 @@ fn run_trajectory(
         t: &data.record.t,
         x: &data.record.x,
     };
-    let tf = discover_trajectory(base, candidates, &td, cycles, &setup, &settings);
+    let found = discover_trajectory(base, candidates, &td, cycles, &setup, &settings);
     bar.finish_and_clear();
-    let tf = tf?;
+    let found = found?;
+    let tf = found
+        .trajectory
+        .as_ref()
+        .context("a trajectory-level discovery without its oscillator")?;
     let wall = started.elapsed().as_secs_f64();
-    let score = validation.map(|rec| crate::validation::score_trajectory_discovery(exp, &tf, rec));
+    let score =
+        validation.map(|rec| crate::validation::score_trajectory_discovery(exp, &found, rec));
     let (toml_entry, system_entry) =
-        write_trajectory_results(exp, data, &tf, &names, score.as_ref(), (out, wall))?;
+        write_trajectory_results(exp, data, (&found, tf), &names, score.as_ref(), (out, wall))?;
     if exp.output.report {
-        trajectory_report(exp, data, &tf, score.as_ref(), out)?;
+        trajectory_report(exp, data, (&found, tf), score.as_ref(), out)?;
     }
-    let found = &tf.discovery;
+    let found = &found;
     let summary = format!(
         "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
         named(&found.effects),
@@ -551,12 +553,11 @@ fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[String]) -> Traje
 fn write_trajectory_results(
     exp: &Experiment,
     data: &FitData,
-    tf: &TrajectoryDiscovery,
+    (found, tf): (&Discovery, &TrajectoryPart),
     names: &[String],
     score: Option<&DiscoveryScore>,
     (out, wall): (&Path, f64),
 ) -> Result<(String, String)> {
-    let found = &tf.discovery;
     let model_params: Vec<&FittedParam> = found
         .final_params
         .iter()
@@ -584,7 +585,7 @@ fn write_trajectory_results(
         },
         &model_params,
         toml_entry.clone(),
-        crate::discovery_curves::trajectory_curves(tf),
+        crate::discovery_curves::trajectory_curves(found, tf),
     )
     .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
     write_json(&out.join("discovery.json"), &doc)?;
@@ -598,11 +599,10 @@ fn write_trajectory_results(
 fn trajectory_report(
     exp: &Experiment,
     data: &FitData,
-    tf: &TrajectoryDiscovery,
+    (found, tf): (&Discovery, &TrajectoryPart),
     score: Option<&DiscoveryScore>,
     out: &Path,
 ) -> Result<()> {
-    let found = &tf.discovery;
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir)?;
     let mut s = Section::new("Discovery (trajectory level)");

@@ -166,15 +166,7 @@ fn write_fit_report(
 
 /// The terminal summary: one line per model, its warnings under it.
 fn print_summary(data: &FitData, fits: &[ModelFit]) {
-    let unit = match data.level {
-        FitLevel::Force => "N",
-        FitLevel::Trajectory => "mm",
-    };
-    let scale = if data.level == FitLevel::Force {
-        1.0
-    } else {
-        1e3
-    };
+    let (unit, scale) = data.level.shown();
     say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
@@ -222,10 +214,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
 /// The validation block: each model's error on the `[validate]` record, per regime where
 /// the record has them.
 fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
-    let (unit, scale) = match rec.data.level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    };
+    let (unit, scale) = rec.data.level.shown();
     say!(
         "validation on {} ({} samples), fitted parameters held{}:",
         rec.spec.given,

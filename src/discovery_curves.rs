@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use anyhow::Result;
 use serde::Serialize;
-use stf_core::discovery::{Discovery, TrajectoryDiscovery};
+use stf_core::discovery::{Discovery, TrajectoryPart};
 use stf_core::fit::{FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::oscillator_params::OscillatorParams;
@@ -115,8 +115,7 @@ pub fn force_curves(found: &Discovery, system: OscillatorParams) -> FittedCurves
 }
 
 /// The values behind a trajectory-level discovery's curves.
-pub fn trajectory_curves(tf: &TrajectoryDiscovery) -> FittedCurves {
-    let d = &tf.discovery;
+pub fn trajectory_curves(d: &Discovery, tf: &TrajectoryPart) -> FittedCurves {
     let initial = |[x0, v0]: [f64; 2], params: &[FittedParam]| InitialState {
         x0,
         v0,

@@ -329,10 +329,7 @@ pub fn fit_model(
     configured: Option<&ConfiguredModel>,
     progress: &indicatif::ProgressBar,
 ) -> Result<ModelFit> {
-    let (unit, scale) = match data.level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    };
+    let (unit, scale) = data.level.shown();
     let observer =
         |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());

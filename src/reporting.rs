@@ -168,7 +168,7 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
 
 /// The sentence of the report's intro on the validation record: the best model there.
 pub fn validation_intro(rec: &ValidationRecord, fits: &[ModelFit]) -> String {
-    let (unit, scale) = unit_of(rec.data.level);
+    let (unit, scale) = rec.data.level.shown();
     let best = fits
         .iter()
         .filter_map(|f| Some((f, f.validation.as_ref()?.score.as_ref()?)))
@@ -189,14 +189,6 @@ pub fn validation_intro(rec: &ValidationRecord, fits: &[ModelFit]) -> String {
     }
 }
 
-/// The unit errors are shown in at a fit level, and the factor from SI.
-fn unit_of(level: FitLevel) -> (&'static str, f64) {
-    match level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    }
-}
-
 /// The section of the validation record: each model's error there (overall, against the
 /// measured RMS, and per regime) beside its error on the estimation record, and the figure of
 /// the record against each model's prediction.
@@ -207,7 +199,7 @@ pub fn validation_section(
 ) -> Result<Section> {
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let (unit, scale) = unit_of(rec.data.level);
+    let (unit, scale) = rec.data.level.shown();
     let mut s = Section::new("Validation on a second record");
     s.paragraphs.push(format!(
         "Every model scored on {} ({} samples; the estimation record's column mapping, filters \

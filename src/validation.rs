@@ -17,7 +17,7 @@ use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
 use stf_core::data::kinematics::Kinematics;
-use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectoryDiscovery, TrajectorySetup};
+use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectorySetup};
 use stf_core::fit::{TrajectoryData, Validation};
 use stf_core::physics::excitation::Excitation;
 use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms, Signals};
@@ -319,12 +319,12 @@ pub fn score_force_discovery(found: &Discovery, rec: &ValidationRecord) -> Disco
 /// simulated with the experiment's integrator.
 pub fn score_trajectory_discovery(
     exp: &Experiment,
-    found: &TrajectoryDiscovery,
+    found: &Discovery,
     rec: &ValidationRecord,
 ) -> DiscoveryScore {
     let (x0, v0) = rec.data.kinematics.initial_state();
     let setup = TrajectorySetup::new(exp.system, rec.excitation.clone())
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0);
-    DiscoveryScore::of(rec, found.validate(&setup, &rec.trajectory()))
+    DiscoveryScore::of(rec, found.validate_trajectory(&setup, &rec.trajectory()))
 }

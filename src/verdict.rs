@@ -16,10 +16,7 @@ const AIC_TIE: f64 = 2.0;
 /// The verdict of a set of fits: the best by AIC, how far the others are behind (ΔAIC and
 /// RMS), and the warnings that stand against the best and the others.
 pub fn fit_verdict(fits: &[ModelFit], level: FitLevel) -> String {
-    let (unit, scale) = match level {
-        FitLevel::Force => ("N", 1.0),
-        FitLevel::Trajectory => ("mm", 1e3),
-    };
+    let (unit, scale) = level.shown();
     let mut ranked: Vec<&ModelFit> = fits.iter().filter(|f| f.result.aic.is_finite()).collect();
     ranked.sort_by(|a, b| a.result.aic.total_cmp(&b.result.aic));
     let Some(lowest) = ranked.first().map(|f| f.result.aic) else {

@@ -21,6 +21,17 @@ pub enum FitLevel {
     Trajectory,
 }
 
+impl FitLevel {
+    /// The unit errors and gaps are shown in at this level, and the factor from SI: N at
+    /// force level, mm at trajectory level.
+    pub fn shown(self) -> (&'static str, f64) {
+        match self {
+            FitLevel::Force => ("N", 1.0),
+            FitLevel::Trajectory => ("mm", 1e3),
+        }
+    }
+}
+
 /// Where a trajectory fit's initial state comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 use stf_core::data::estimate::LinearEstimate;
-use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryDiscovery};
+use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryPart};
 use stf_core::fit::{FittedParam, NoiseFloor};
 use stf_core::numerics::derivative::NoiseEstimate;
 use stf_core::numerics::reconstruct::DriveReport;
@@ -170,7 +170,7 @@ impl<'a> DiscoveryJson<'a> {
     /// entry `system_entry`) in `wall` seconds.
     pub fn with_trajectory(
         mut self,
-        tf: &'a TrajectoryDiscovery,
+        tf: &'a TrajectoryPart,
         names: &'a [String],
         system_entry: String,
         wall: f64,

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use super::error::DiscoveryError;
 use super::findings::Discovery;
-use super::trajectory_level::{TrajectoryDiscovery, TrajectorySetup};
+use super::trajectory_level::TrajectorySetup;
 use crate::fit::{
     FitParam, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit, Validation,
     DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
@@ -104,25 +104,30 @@ fn trajectory_score(
         })
 }
 
-impl TrajectoryDiscovery {
+impl Discovery {
     /// The base's and the final model's errors on another record's displacement `data`
-    /// (trajectory-level discovery). `setup` gives that record's drive, its initial-state
-    /// estimate and the integrator; its `system` and refitted parameters are not used.
-    pub fn validate(
+    /// (trajectory-level discovery; an error for a force-level one). `setup` gives that
+    /// record's drive, its initial-state estimate and the integrator; its `system` and
+    /// refitted parameters are not used.
+    pub fn validate_trajectory(
         &self,
         setup: &TrajectorySetup,
         data: &TrajectoryData,
     ) -> Result<DiscoveryValidation, DiscoveryError> {
-        let d = &self.discovery;
+        let (d, Some(part)) = (self, &self.trajectory) else {
+            return Err(DiscoveryError::BadSettings(
+                "a force-level discovery has no oscillator to simulate".into(),
+            ));
+        };
         Ok(DiscoveryValidation {
             before: trajectory_score(
-                (&d.base_model, &d.base_values, self.system_before),
+                (&d.base_model, &d.base_values, part.system_before),
                 &d.base_params,
                 setup,
                 data,
             )?,
             after: trajectory_score(
-                (&d.final_model, &d.final_values, self.system_after),
+                (&d.final_model, &d.final_values, part.system_after),
                 &d.final_params,
                 setup,
                 data,

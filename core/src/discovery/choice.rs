@@ -17,6 +17,7 @@ use crate::fit::{Convergence, FitResult, NoiseFloor};
 use crate::physics::force_model::Reach;
 
 /// A model fitted on the training samples and scored on the held-out ones.
+#[derive(Clone)]
 pub(super) struct Trial {
     /// The model with its fitted values.
     pub stage: SearchModel,

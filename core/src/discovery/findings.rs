@@ -9,8 +9,11 @@ use super::force_gap::GapLocation;
 use super::score::Step;
 use crate::fit::{FitResult, FittedParam, NoiseFloor};
 use crate::physics::force_model::ForceModel;
+use crate::physics::oscillator_params::OscillatorParams;
 
-/// The outcome of [`super::discover_force`].
+/// The outcome of a discovery at either level ([`super::discover_force`],
+/// [`super::discover_trajectory`]): gaps, residuals and the floor are in the level's SI unit
+/// (N at force level, m at trajectory level).
 #[derive(Clone, Serialize)]
 pub struct Discovery {
     /// The base model's name.
@@ -65,6 +68,35 @@ pub struct Discovery {
     pub final_fit: FitResult,
     /// Sentences for the report: where the gap lives, what each step found, the ties.
     pub notes: Vec<String>,
+    /// At trajectory level, the oscillator as refitted and the simulated motion (not
+    /// serialized); `None` at force level.
+    #[serde(skip)]
+    pub trajectory: Option<TrajectoryPart>,
+}
+
+/// What a trajectory-level discovery says beyond the shared report: the oscillator as
+/// refitted with the base and the final model, S(μ), and their simulated motion. The final
+/// `final_params` of the shared report hold the refitted oscillator parameters too (and
+/// `x_off` if fitted).
+#[derive(Clone, Debug)]
+pub struct TrajectoryPart {
+    /// The oscillator refitted with the base on the whole record.
+    pub system_before: OscillatorParams,
+    /// The oscillator refitted with the final model on the whole record.
+    pub system_after: OscillatorParams,
+    /// S(μ) of the base on the whole record, mm².
+    pub s_before_mm2: f64,
+    /// S(μ) of the final model on the whole record, mm².
+    pub s_after_mm2: f64,
+    /// The state (x0 m, v0 m/s) the base's simulation starts from: fitted, or the setup's
+    /// estimate less the offset.
+    pub initial_before: [f64; 2],
+    /// The same for the final model.
+    pub initial_after: [f64; 2],
+    /// The base's simulated x (with the offset) at every sample, m.
+    pub x_before: Vec<f64>,
+    /// The final model's simulated x (with the offset) at every sample, m.
+    pub x_after: Vec<f64>,
 }
 
 impl Discovery {

@@ -1,5 +1,8 @@
-//! The discovery loop at force level: fit the base, locate its gap, try every candidate on
-//! held-out cycles, add the one the data demand, repeat.
+//! The force level of discovery ([`ForceLevel`], a [`Level`] for the loop of
+//! [`super::search`]): records with a measured F_STF and kinematics, every model fitted to
+//! the force along them. Its candidates start from a small multi-start ([`candidate_starts`],
+//! [`best_trial`]); earlier effects are re-checked after each acceptance
+//! ([`super::reconsider`]).
 //!
 //! Each step cuts the held-out cycles into blocks at least as long as the residual's
 //! correlation ([`super::blocks`]) and measures the current model's noise floor — the force
@@ -13,15 +16,17 @@ use rayon::prelude::*;
 
 use super::acceptance;
 use super::blocks::{block_length, Blocks};
-use super::candidate::{self, Candidate};
-use super::choice::{self, Trial, Yardstick};
+use super::candidate::Candidate;
+use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
-use super::findings::Discovery;
-use super::force_gap::locate_gap;
-use super::force_subset_fit::{fit_subset, residuals, rms, rms_over};
+use super::findings::{Discovery, TrajectoryPart};
+use super::force_gap::{locate_gap, GapLocation};
+use super::force_subset_fit::{fit_subset, residuals, rms_over};
 use super::holdout::HoldoutSplit;
+use super::level::Level;
 use super::progress::DiscoveryEvent;
-use super::score::{CandidateScore, Step};
+use super::score::CandidateScore;
+use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use crate::fit::{FitParam, FitResult, ForceData, ForceFit, NoiseFloor, FORCE_OFFSET};
@@ -113,34 +118,6 @@ impl SearchModel {
             parts: self.parts.clone(),
             values,
         })
-    }
-
-    /// This stage without its part `index` (its parameters dropped).
-    fn without(&self, index: usize) -> SearchModel {
-        let sizes: Vec<usize> = self.parts.iter().map(|p| p.params().len()).collect();
-        let from: usize = sizes[..index.min(sizes.len())].iter().sum();
-        let to = from + sizes.get(index).copied().unwrap_or(0);
-        let mut values = self.values.clone();
-        if to <= values.len() {
-            values.drain(from..to);
-        }
-        let mut parts = self.parts.clone();
-        if index < parts.len() {
-            parts.remove(index);
-        }
-        SearchModel { parts, values }
-    }
-
-    /// This stage with `extra` (its parameters at `start`) inserted as part `index`.
-    fn inserting(&self, index: usize, extra: &Arc<dyn ForceModel>, start: &[f64]) -> SearchModel {
-        let index = index.min(self.parts.len());
-        let at: usize = self.parts[..index].iter().map(|p| p.params().len()).sum();
-        let mut values = self.values.clone();
-        let at = at.min(values.len());
-        values.splice(at..at, start.iter().copied());
-        let mut parts = self.parts.clone();
-        parts.insert(index, extra.clone());
-        SearchModel { parts, values }
     }
 
     /// The force noise floor of this stage at its values: the sensor's `sensor` (N) with the
@@ -422,196 +399,157 @@ pub fn discover_force(
     settings: &DiscoverySettings,
 ) -> Result<Discovery, DiscoveryError> {
     settings.validate()?;
-    let base_name = base.name().to_string();
-    let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
-    candidate::distinct(candidates)?;
-    let n = data.t.len();
-    let sensor = settings.floor_of(data.f, "force", "N")?;
-    let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
-    let all: Vec<usize> = (0..n).collect();
-    let mut notes = Vec::new();
-
-    settings.observer.emit(DiscoveryEvent::Base);
-    // 1. The base on the whole record: the gap before.
-    let start = SearchModel {
-        values: base
-            .params()
-            .iter()
-            .map(|s| s.default)
-            .chain(settings.fit_offset.then_some(0.0))
-            .collect(),
-        parts: vec![base.clone()],
-    };
-    let (base_full, base_fit, base_result) = start.fit(data, &all, settings)?;
-    let residual_before =
-        residuals(&base_fit, data, &base_full.values).map_err(|source| DiscoveryError::Fit {
-            model: base_name.clone(),
-            source,
-        })?;
-    let gap_before = rms(&residual_before);
-    let base_values = base_full.values[..base.params().len().min(base_full.values.len())].to_vec();
-    let base_params = base_result.params.clone();
-    // 2. Where the gap lives.
-    let floor_before = base_full.noise_floor(data, sensor, settings)?;
-    let where_before = locate_gap(&residual_before, data, cycles, floor_before.sigma);
-    notes.push(format!("base `{base_name}`: {}", where_before.summary));
-
-    // 3–4. Add effects while the held-out evidence demands one.
-    let search = Search {
-        candidates,
-        in_base: &in_base,
-        data,
-        split: &split,
-        sensor,
-        settings,
-    };
-    let mut current = start.trial(data, &split, settings)?;
-    let first_blocks = search.blocks(&current.stage.residuals(data, settings)?);
-    let base_excess = choice::excess(
-        &first_blocks.rms(&current.holdout),
-        current.holdout_mse,
-        floor_before.sigma,
-        settings.floor_band(floor_before.propagated),
-        settings,
-    );
-    let mut effects: Vec<String> = Vec::new();
-    let mut steps = Vec::new();
-    for step in 1..=settings.max_effects {
-        let Some((step, winner)) = search.step(step, &current, &effects, base_excess)? else {
-            break;
-        };
-        notes.push(step.verdict.clone());
-        effects.extend(step.accepted.clone());
-        steps.push(step);
-        // The winner becomes the current model.
-        let Some(trial) = winner else {
-            break;
-        };
-        current = trial;
-        if effects.len() >= 2 {
-            if let Some(step) = search.reconsider(&mut current, &mut effects, base_excess)? {
-                notes.push(step.verdict.clone());
-                steps.push(step);
-            }
-        }
-    }
-
-    // 5. The final model on the whole record: the gap after.
-    let (final_stage, final_fit, final_result) = if effects.is_empty() {
-        (base_full, base_fit, base_result)
-    } else {
-        // From the training fit's values, which are near the optimum: Levenberg–Marquardt
-        // alone, which never leaves the start for a worse point (the fallback of the default
-        // solver was seen to wander off and end far worse).
-        let lm = DiscoverySettings {
-            fit: settings
-                .fit
-                .clone()
-                .solver(crate::fit::Solver::LevenbergMarquardt)
-                .tol(settings.fit.tol.min(1e-9)),
-            ..settings.clone()
-        };
-        current.stage.fit(data, &all, &lm)?
-    };
-    let mut residual_after =
-        residuals(&final_fit, data, &final_stage.values).map_err(|source| DiscoveryError::Fit {
-            model: final_stage.name(),
-            source,
-        })?;
-    // Guard: the whole-record refit must not end worse than the training fit it started from.
-    // (It did, by 135 N against 0.036 N, on a `wall_impact` sum: the bound transform moved the
-    // start k_w = 554 in [0, 1e9] to 1e6 — fixed in `fit::transform`. A fit now never ends
-    // worse than its start; this stays as a check, and says so if it ever fires.)
-    let (final_stage, final_result) = if effects.is_empty() {
-        (final_stage, final_result)
-    } else {
-        let start_fit = current.stage.force_fit(settings)?;
-        let start_r = residuals(&start_fit, data, &current.stage.values).map_err(|source| {
-            DiscoveryError::Fit {
-                model: current.stage.name(),
-                source,
-            }
-        })?;
-        if rms(&start_r) < rms(&residual_after) {
-            notes.push(format!(
-                "the whole-record refit ended worse ({:.4} N) than the training fit it started \
-                 from ({:.4} N); the training fit's values are kept",
-                rms(&residual_after),
-                rms(&start_r)
-            ));
-            residual_after = start_r;
-            (current.stage.clone(), current.train.clone())
-        } else {
-            (final_stage, final_result)
-        }
-    };
-    let final_model = final_stage.model()?;
-    let gap_after = rms(&residual_after);
-    let floor = final_stage.noise_floor(data, sensor, settings)?;
-    let where_after = locate_gap(&residual_after, data, cycles, floor.sigma);
-    notes.push(format!(
-        "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {:.4} N: force sensor {:.4} N, \
-         kinematics through the model {:.4} N); final `{}`: {}",
-        floor.sigma,
-        floor.measured,
-        floor.propagated,
-        final_stage.name(),
-        where_after.summary
-    ));
-    notes.extend(floor_doubts(&floor, gap_after, settings));
-    let n_model = final_model.params().len();
-    Ok(Discovery {
-        base: base_name,
-        effects,
-        steps,
-        noise_floor: floor.sigma,
-        noise_floor_parts: floor,
-        holdout_cycles: split.holdout_cycles,
-        holdout_samples: split.holdout.len(),
-        gap_before,
-        gap_after,
-        where_before,
-        where_after,
-        residual_before,
-        residual_after,
-        base_model: base,
-        base_values,
-        base_params,
-        final_model_name: final_stage.name(),
-        final_model,
-        final_values: final_stage.values[..n_model.min(final_stage.values.len())].to_vec(),
-        final_params: final_result.params.clone(),
-        final_fit: final_result,
-        notes,
-    })
+    let level = ForceLevel::new(data, cycles, settings)?;
+    search::discover(&level, base, candidates, settings)
 }
 
-/// What the search at force level works with: the candidates, the record, the split, the
-/// force sensor's noise and the settings.
-struct Search<'a> {
-    candidates: &'a [Candidate],
-    in_base: &'a [String],
+/// The force level: the measured kinematics and F_STF, their cycles and split, the force
+/// sensor's noise and the settings.
+pub(super) struct ForceLevel<'a> {
     data: &'a ForceData<'a>,
-    split: &'a HoldoutSplit,
+    cycles: &'a [Cycle],
+    split: HoldoutSplit,
     sensor: f64,
     settings: &'a DiscoverySettings,
 }
 
-impl Search<'_> {
-    /// `then` called with the yardstick of a step on a model whose held-out units are
-    /// `blocks` and whose floor is `floor`: the block test ([`acceptance::block_gain_z`]) and
-    /// the floor's uncertainty band.
+impl<'a> ForceLevel<'a> {
+    /// The force level of `data` cut into `cycles`, with the sensor's noise of `settings` or
+    /// estimated from the record.
+    pub(super) fn new(
+        data: &'a ForceData<'a>,
+        cycles: &'a [Cycle],
+        settings: &'a DiscoverySettings,
+    ) -> Result<Self, DiscoveryError> {
+        let sensor = settings.floor_of(data.f, "force", "N")?;
+        let split = HoldoutSplit::new(data.t.len(), cycles, settings.holdout_every)?;
+        Ok(ForceLevel {
+            data,
+            cycles,
+            split,
+            sensor,
+            settings,
+        })
+    }
+
+    /// The blocks of the paired test for a model whose residual is `r` (every sample).
+    fn blocks(&self, r: &[f64]) -> Blocks {
+        Blocks::new(
+            &self.split,
+            block_length(r, &self.split, self.settings.filter_window),
+        )
+    }
+}
+
+impl Level for ForceLevel<'_> {
+    fn said(&self) -> &'static Said {
+        &choice::FORCE
+    }
+
+    fn n_before(&self) -> usize {
+        0
+    }
+
+    fn settings(&self) -> &DiscoverySettings {
+        self.settings
+    }
+
+    fn split(&self) -> &HoldoutSplit {
+        &self.split
+    }
+
+    fn samples(&self) -> usize {
+        self.data.t.len()
+    }
+
+    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
+        (candidates.to_vec(), Vec::new())
+    }
+
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
+        SearchModel {
+            values: base
+                .params()
+                .iter()
+                .map(|s| s.default)
+                .chain(self.settings.fit_offset.then_some(0.0))
+                .collect(),
+            parts: vec![base.clone()],
+        }
+    }
+
+    fn fit(
+        &self,
+        stage: &SearchModel,
+        subset: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Result<(SearchModel, FitResult), DiscoveryError> {
+        let (stage, _, result) = stage.fit(self.data, subset, settings)?;
+        Ok((stage, result))
+    }
+
+    fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError> {
+        stage.residuals(self.data, self.settings)
+    }
+
+    fn trial(
+        &self,
+        stage: &SearchModel,
+        settings: &DiscoverySettings,
+    ) -> Result<Trial, DiscoveryError> {
+        stage.trial(self.data, &self.split, settings)
+    }
+
+    /// From the defaults: the training fit of the base as it stood.
+    fn first_trial(&self, start: &SearchModel, _: &SearchModel) -> Result<Trial, DiscoveryError> {
+        start.trial(self.data, &self.split, self.settings)
+    }
+
+    /// The force sensor's noise with the kinematics' propagated through the model.
+    fn floor(&self, stage: &SearchModel) -> Result<NoiseFloor, DiscoveryError> {
+        stage.noise_floor(self.data, self.sensor, self.settings)
+    }
+
+    fn gap(
+        &self,
+        stage: &SearchModel,
+        floor: &NoiseFloor,
+    ) -> Result<(Vec<f64>, GapLocation), DiscoveryError> {
+        let r = self.residual(stage)?;
+        let location = locate_gap(&r, self.data, self.cycles, floor.sigma);
+        Ok((r, location))
+    }
+
+    /// Over blocks cut for the base's training residual, at least the floor's uncertainty.
+    fn base_excess(&self, current: &Trial, floor: &NoiseFloor) -> Result<f64, DiscoveryError> {
+        let blocks = self.blocks(&self.residual(&current.stage)?);
+        Ok(choice::excess(
+            &blocks.rms(&current.holdout),
+            current.holdout_mse,
+            floor.sigma,
+            self.settings.floor_band(floor.propagated),
+            self.settings,
+        ))
+    }
+
+    fn search_notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Blocks cut for `current`'s residual, its own floor: the block test
+    /// ([`acceptance::block_gain_z`]) and the floor's uncertainty band.
     fn measured<T>(
         &self,
-        blocks: &Blocks,
-        floor: NoiseFloor,
+        current: &Trial,
         base_excess: f64,
         then: impl FnOnce(&Yardstick) -> T,
-    ) -> T {
-        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks);
-        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, blocks).0;
+    ) -> Result<T, DiscoveryError> {
+        let blocks = self.blocks(&self.residual(&current.stage)?);
+        let floor = self.floor(&current.stage)?;
+        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
+        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
         let units = |h: &[f64]| blocks.rms(h);
-        then(&Yardstick {
+        Ok(then(&Yardstick {
             gain_z: &gain_z,
             tie_z: &tie_z,
             units: &units,
@@ -620,274 +558,121 @@ impl Search<'_> {
             floor_band: self.settings.floor_band(floor.propagated),
             block_samples: Some(blocks.length),
             reach: Reach::of(self.data.x, self.data.v),
-        })
+        }))
     }
 
-    /// The blocks of the paired test for a model whose residual is `r` (every sample).
-    fn blocks(&self, r: &[f64]) -> Blocks {
-        Blocks::new(
-            self.split,
-            block_length(r, self.split, self.settings.filter_window),
-        )
-    }
-
-    /// One step: every candidate not in `current` added to it, fitted and scored against it
-    /// on blocks cut for its residual and its floor; the step and the accepted trial, or
-    /// `None` when there is nothing left to try.
-    fn step(
+    /// Each candidate a small multi-start ([`candidate_starts`], [`best_trial`]); the
+    /// candidates are independent trials against the same current model: fitted in
+    /// parallel, scored in their order.
+    fn score_step(
         &self,
         step: usize,
+        tried: &[&Candidate],
         current: &Trial,
-        effects: &[String],
-        base_excess: f64,
-    ) -> Result<Option<(Step, Option<Trial>)>, DiscoveryError> {
-        let (data, split, settings) = (self.data, self.split, self.settings);
-        let current_residual = current.stage.residuals(data, settings)?;
-        let blocks = self.blocks(&current_residual);
-        let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        let tried = current.stage.to_try(self.candidates, self.in_base, effects);
-        if tried.is_empty() {
-            return Ok(None);
-        }
-        // The candidates are independent trials against the same current model: fitted in
-        // parallel, scored in their order.
-        Ok(Some(self.measured(
-            &blocks,
-            floor,
-            base_excess,
-            |yardstick| {
-                let scored: Vec<(CandidateScore, Option<Trial>)> = tried
-                    .par_iter()
-                    .enumerate()
-                    .map(|(index, c)| {
-                        settings
-                            .observer
-                            .candidate(step, index, tried.len(), &c.name);
-                        let starts = candidate_starts(
-                            &c.model,
-                            data,
-                            &split.train,
-                            &current_residual,
-                            settings.extra_starts,
-                        );
-                        let best = best_trial(
-                            &starts,
-                            |start| current.stage.with(&c.model, start, 0),
-                            data,
-                            split,
-                            settings,
-                        );
-                        let n_own = c.model.params().len();
-                        let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
-                        emit_scored(settings, step, Some(&s));
-                        s
-                    })
-                    .collect();
-                choice::decide(current, scored, &choice::FORCE, yardstick, settings)
-            },
-        )))
-    }
-
-    /// After an effect is accepted, the earlier ones are tried again in its light: each is
-    /// replaced in turn by every candidate not in the model (refitted on the training cycles). An
-    /// effect chosen first can have won only because the one found later was missing (an added
-    /// mass hidden under a cubic spring made `wall_impact`, whose gap and exponent bend to mimic
-    /// both, beat `cubic_stiffness`). A replacement is made when the held-out evidence demands it
-    /// (the acceptance rule of [`acceptance`] against the current model), or when the held-out
-    /// evidence cannot separate the two (the current model is not better by the paired test) and
-    /// the replacement has fewer parameters and a lower BIC: the simpler is kept and the tie
-    /// named. At most one replacement per call; it is reported as a step of its own.
-    fn reconsider(
-        &self,
-        current: &mut Trial,
-        effects: &mut [String],
-        base_excess: f64,
-    ) -> Result<Option<Step>, DiscoveryError> {
-        let (data, settings) = (self.data, self.settings);
-        // Blocks cut for the accepted model's residual, and its own floor.
-        let blocks = self.blocks(&current.stage.residuals(data, settings)?);
-        let floor = current.stage.noise_floor(data, self.sensor, settings)?;
-        self.measured(&blocks, floor, base_excess, |yardstick| {
-            self.replace_one(current, effects, yardstick)
-        })
-    }
-
-    /// [`Search::reconsider`] with the step's `yardstick`.
-    fn replace_one(
-        &self,
-        current: &mut Trial,
-        effects: &mut [String],
         yardstick: &Yardstick,
-    ) -> Result<Option<Step>, DiscoveryError> {
-        let (data, settings) = (self.data, self.settings);
-        let n_base = current.stage.parts.len().saturating_sub(effects.len());
-        // (score, trial, effect index, candidate index, a tie rather than a win)
-        let mut tried: Vec<(CandidateScore, Option<Trial>, usize, usize, bool)> = Vec::new();
-        let earlier = effects.len().saturating_sub(1);
-        for (j, effect) in effects.iter().enumerate().take(earlier) {
-            let part = n_base + j;
-            let Some(old) = current.stage.parts.get(part).cloned() else {
-                continue;
-            };
-            let rest = current.stage.without(part);
-            let rest_residual = rest.residuals(data, settings)?;
-            let replaced = Replaced {
-                rest: &rest,
-                residual: &rest_residual,
-                part,
-                old_len: old.params().len(),
-            };
-            let to_try: Vec<usize> = (0..self.candidates.len())
-                .filter(|&k| !current.stage.holds(&self.candidates[k], self.in_base, &[]))
-                .collect();
-            // Independent trials against the same current model: fitted in parallel, kept in
-            // their order.
-            let current = &*current;
-            tried.par_extend(to_try.par_iter().map(|&k| {
-                let c = &self.candidates[k];
-                let label = format!("{} for {effect}", c.name);
-                let (score, trial, tie) =
-                    self.replacement(c, &label, current, &replaced, yardstick);
-                (score, trial, j, k, tie)
-            }));
-        }
-        if tried.is_empty() {
-            return Ok(None);
-        }
-        tried.sort_by(|a, b| a.0.holdout_rms.total_cmp(&b.0.holdout_rms));
-        // A win (lowest held-out RMS) before a tie (lowest BIC).
-        let pick = tried
-            .iter()
-            .position(|t| t.0.significant && !t.4)
-            .or_else(|| {
-                (0..tried.len())
-                    .filter(|&i| tried[i].0.significant)
-                    .min_by(|&a, &b| tried[a].0.bic.total_cmp(&tried[b].0.bic))
-            });
-        let scores = tried.iter().map(|t| t.0.clone()).collect();
-        let mut step = choice::step_on(current, scores, yardstick);
-        let Some(i) = pick else {
-            return Ok(None);
-        };
-        let (score, trial, j, k, tie) = tried.swap_remove(i);
-        let Some(trial) = trial else {
-            return Ok(None);
-        };
-        let old_name = effects[j].clone();
-        let new_name = self.candidates[k].name.clone();
-        let with = effects.last().map_or("", String::as_str);
-        step.verdict = replaced_verdict(&step, [&old_name, &new_name, with], &score, tie, settings);
-        step.accepted = Some(new_name.clone());
-        if tie {
-            step.tie_with = vec![old_name];
-        }
-        effects[j] = new_name;
-        *current = trial;
-        Ok(Some(step))
+    ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
+        let (data, split, settings) = (self.data, &self.split, self.settings);
+        let current_residual = self.residual(&current.stage)?;
+        Ok(tried
+            .par_iter()
+            .enumerate()
+            .map(|(index, c)| {
+                settings
+                    .observer
+                    .candidate(step, index, tried.len(), &c.name);
+                let starts = candidate_starts(
+                    &c.model,
+                    data,
+                    &split.train,
+                    &current_residual,
+                    settings.extra_starts,
+                );
+                let best = best_trial(
+                    &starts,
+                    |start| current.stage.with(&c.model, start, 0),
+                    data,
+                    split,
+                    settings,
+                );
+                let n_own = c.model.params().len();
+                let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
+                emit_scored(settings, step, Some(&s));
+                s
+            })
+            .collect())
     }
-}
 
-/// A model with one of its effects taken out, for a replacement to be inserted in its place.
-struct Replaced<'a> {
-    /// The model without the effect.
-    rest: &'a SearchModel,
-    /// Its residual at every sample.
-    residual: &'a [f64],
-    /// The index of the part taken out.
-    part: usize,
-    /// How many parameters the part taken out had.
-    old_len: usize,
-}
-
-impl Search<'_> {
-    /// The candidate `c` put in the place of `replaced`, fitted and scored against `current`
-    /// as `label`: its score (significant when it wins, or ties with fewer parameters and a
-    /// lower BIC), its trial, and whether it is a tie rather than a win.
-    fn replacement(
+    fn replacement_trial(
         &self,
         c: &Candidate,
-        label: &str,
-        current: &Trial,
-        replaced: &Replaced,
-        yardstick: &Yardstick,
-    ) -> (CandidateScore, Option<Trial>, bool) {
-        let (data, settings, part) = (self.data, self.settings, replaced.part);
+        rest: &SearchModel,
+        part: usize,
+        residual: &[f64],
+    ) -> Result<Trial, DiscoveryError> {
+        let settings = self.settings;
         let starts = candidate_starts(
             &c.model,
-            data,
+            self.data,
             &self.split.train,
-            replaced.residual,
+            residual,
             settings.extra_starts,
         );
-        let rest = replaced.rest;
-        let best = best_trial(
+        best_trial(
             &starts,
-            |start| rest.inserting(part, &c.model, start),
-            data,
-            self.split,
+            |start| rest.inserting(part, 0, &c.model, start),
+            self.data,
+            &self.split,
             settings,
-        );
-        let trial = match best {
-            Ok(trial) => trial,
-            Err(e) => return (choice::failed(label, e.to_string()), None, false),
-        };
-        // Its own parameters are not last here: take them by position.
-        let from: usize = rest.parts[..part.min(rest.parts.len())]
-            .iter()
-            .map(|p| p.params().len())
-            .sum();
-        let n_own = c.model.params().len();
-        let mut score = choice::score(label, 0, &trial, current, yardstick, settings);
-        score.params = trial
-            .train
-            .params
-            .get(from..from + n_own)
-            .map(<[_]>::to_vec)
-            .unwrap_or_default();
-        let wins = score.significant;
-        let tie = !wins
-            && score.failure.is_none()
-            && score.gain_z >= -settings.min_gain_sigma
-            && n_own < replaced.old_len
-            && score.delta_bic < 0.0;
-        score.significant = wins || tie;
-        (score, Some(trial), tie)
+        )
     }
-}
 
-/// The verdict of a replacement step on `step`: `names` are the effect replaced, its
-/// replacement and the effect whose acceptance called for it; `score` the replacement's.
-fn replaced_verdict(
-    step: &Step,
-    names: [&str; 3],
-    score: &CandidateScore,
-    tie: bool,
-    settings: &DiscoverySettings,
-) -> String {
-    let [old_name, new_name, with] = names;
-    let current_h = step.current_holdout_rms;
-    if tie {
-        format!(
-            "replace `{old_name}` by `{new_name}`: with `{with}` in the model they explain the \
-             data equally well (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
-             blocks, not beyond ±{}), and `{new_name}` is simpler (ΔBIC {:.1})",
-            score.holdout_rms,
-            score.gain_z,
-            score.effective_n,
-            settings.min_gain_sigma,
-            score.delta_bic
-        )
-    } else {
-        format!(
-            "replace `{old_name}` by `{new_name}`: with `{with}` in the model the held-out \
-             evidence demands it (held-out RMS {current_h:.4} → {:.4} N, paired z {:.1} over {} \
-             blocks, ΔBIC {:.1}, {:.0} % of the excess over the floor)",
-            score.holdout_rms,
-            score.gain_z,
-            score.effective_n,
-            score.delta_bic,
-            100.0 * score.explained_share
-        )
+    fn reconsiders(&self) -> bool {
+        true
+    }
+
+    fn polishes(&self) -> bool {
+        false
+    }
+
+    fn warns_unresolved(&self) -> bool {
+        false
+    }
+
+    /// From the training fit's values, which are near the optimum: Levenberg–Marquardt
+    /// alone, which never leaves the start for a worse point (the fallback of the default
+    /// solver was seen to wander off and end far worse), at a tolerance of at most 1e-9.
+    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
+        DiscoverySettings {
+            fit: settings
+                .fit
+                .clone()
+                .solver(crate::fit::Solver::LevenbergMarquardt)
+                .tol(settings.fit.tol.min(1e-9)),
+            ..settings.clone()
+        }
+    }
+
+    fn closing_notes(
+        &self,
+        [gap_before, gap_after]: [f64; 2],
+        floor: &NoiseFloor,
+        final_name: &str,
+        where_after: &str,
+    ) -> Vec<String> {
+        let mut notes = vec![format!(
+            "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {:.4} N: force sensor {:.4} \
+             N, kinematics through the model {:.4} N); final `{final_name}`: {where_after}",
+            floor.sigma, floor.measured, floor.propagated,
+        )];
+        notes.extend(floor_doubts(floor, gap_after, self.settings));
+        notes
+    }
+
+    fn part(
+        &self,
+        _: [(&SearchModel, &[f64]); 2],
+    ) -> Result<Option<TrajectoryPart>, DiscoveryError> {
+        Ok(None)
     }
 }
 

@@ -74,4 +74,99 @@ impl SearchModel {
         parts.push(extra.clone());
         SearchModel { parts, values }
     }
+
+    /// This stage without its part `index` (its parameters, which follow the level's
+    /// `n_before` own, dropped).
+    pub fn without(&self, index: usize, n_before: usize) -> SearchModel {
+        let sizes: Vec<usize> = self.parts.iter().map(|p| p.params().len()).collect();
+        let from: usize = n_before + sizes[..index.min(sizes.len())].iter().sum::<usize>();
+        let to = from + sizes.get(index).copied().unwrap_or(0);
+        let mut values = self.values.clone();
+        if to <= values.len() {
+            values.drain(from..to);
+        }
+        let mut parts = self.parts.clone();
+        if index < parts.len() {
+            parts.remove(index);
+        }
+        SearchModel { parts, values }
+    }
+
+    /// This stage with `extra` (its parameters at `start`) inserted as part `index`, its
+    /// parameters after the level's `n_before` own and those of the parts before it.
+    pub fn inserting(
+        &self,
+        index: usize,
+        n_before: usize,
+        extra: &Arc<dyn ForceModel>,
+        start: &[f64],
+    ) -> SearchModel {
+        let index = index.min(self.parts.len());
+        let at: usize = n_before
+            + self.parts[..index]
+                .iter()
+                .map(|p| p.params().len())
+                .sum::<usize>();
+        let mut values = self.values.clone();
+        let at = at.min(values.len());
+        values.splice(at..at, start.iter().copied());
+        let mut parts = self.parts.clone();
+        parts.insert(index, extra.clone());
+        SearchModel { parts, values }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::force_model::{ModelError, ModelState};
+    use crate::physics::param_spec::ParamSpec;
+
+    /// A force with `n` parameters named `name`.
+    struct Params(&'static str, Vec<ParamSpec>);
+    impl ForceModel for Params {
+        fn name(&self) -> &str {
+            self.0
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.1
+        }
+        fn force(&self, _: &[f64], _: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+            Ok(0.0)
+        }
+    }
+
+    fn model(name: &'static str, n: usize) -> Arc<dyn ForceModel> {
+        let spec = (0..n)
+            .map(|_| ParamSpec::new("p", "", 1.0, 0.0, 10.0, ""))
+            .collect();
+        Arc::new(Params(name, spec))
+    }
+
+    #[test]
+    fn a_part_taken_out_and_put_back_keeps_the_level_s_own_values_and_the_offset() {
+        // Two oscillator values, parts of 1, 2 and 1 parameters, an offset.
+        let stage = SearchModel {
+            parts: vec![model("a", 1), model("b", 2), model("c", 1)],
+            values: vec![10.0, 11.0, 1.0, 2.0, 3.0, 4.0, 9.0],
+        };
+        let rest = stage.without(1, 2);
+        assert_eq!(rest.name(), "a + c");
+        assert_eq!(rest.values, [10.0, 11.0, 1.0, 4.0, 9.0]);
+        let back = rest.inserting(1, 2, &model("b", 2), &[2.0, 3.0]);
+        assert_eq!(back.name(), "a + b + c");
+        assert_eq!(back.values, stage.values);
+        // At force level (no values of its own) the first part goes.
+        let force = SearchModel {
+            parts: vec![model("a", 1), model("b", 2)],
+            values: vec![1.0, 2.0, 3.0],
+        };
+        assert_eq!(force.without(0, 0).values, [2.0, 3.0]);
+        // Inserting last is adding: `with`.
+        let with = force.with(&model("c", 1), &[4.0], 0);
+        assert_eq!(
+            force.inserting(2, 0, &model("c", 1), &[4.0]).values,
+            with.values
+        );
+    }
 }

@@ -1,9 +1,10 @@
-//! The discovery loop at trajectory level: for records with a measured displacement only.
+//! The trajectory level of discovery ([`TrajectoryLevel`], a [`Level`] for the loop of
+//! [`super::search`]): for records with a measured displacement only.
 //!
 //! The oscillator is simulated with the current STF model and compared with the measured x,
 //! `S(μ) = mean((x_exp − x_sim − x_off)²)`; the oscillator's own parameters named in the setup
 //! (e.g. `k`, `c`, friction; `m`, `k`, `c` for a rig driven by a measured force `u`) are
-//! refitted with every model. The workflow is that of [`super::discover_force`]:
+//! refitted with every model. The loop is that of [`super::search`]:
 //!
 //! 1. fit the base (and the oscillator) on the whole record: the x gap before;
 //! 2. locate the x residual by ω band of the cycles and by region of the simulated motion
@@ -32,22 +33,24 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::acceptance;
-use super::candidate::{self, Candidate};
-use super::choice::{self, Trial, Yardstick};
+use super::candidate::Candidate;
+use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
-use super::findings::Discovery;
+use super::findings::{Discovery, TrajectoryPart};
+use super::force_gap::GapLocation;
 use super::force_level::{emit_scored, inside};
 use super::force_subset_fit::{fit_subset, rms, rms_over};
 use super::holdout::HoldoutSplit;
-use super::progress::DiscoveryEvent;
+use super::level::Level;
 use super::score::CandidateScore;
 use super::scout::Scout;
+use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_gap::locate_x_gap;
 use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
 use crate::fit::{
-    check_same_terms, FitParam, FitResult, FitSettings, ForceData, ForceFit, Solver,
+    check_same_terms, FitParam, FitResult, FitSettings, ForceData, ForceFit, NoiseFloor, Solver,
     TrajectoryData, DISPLACEMENT_OFFSET,
 };
 use crate::numerics::integrate::Settings;
@@ -134,32 +137,6 @@ impl TrajectorySetup {
         self.force_hint = Some(hint);
         self
     }
-}
-
-/// The outcome of [`discover_trajectory`]: the shared report (gaps and RMS in m) and the
-/// oscillator as refitted.
-#[derive(Clone, Debug)]
-pub struct TrajectoryDiscovery {
-    /// Effects, steps, gaps (RMS of measured − simulated x, m), the final model. Its
-    /// `final_params` hold the refitted oscillator parameters too (and `x_off` if fitted).
-    pub discovery: Discovery,
-    /// The oscillator refitted with the base on the whole record.
-    pub system_before: OscillatorParams,
-    /// The oscillator refitted with the final model on the whole record.
-    pub system_after: OscillatorParams,
-    /// S(μ) of the base on the whole record, mm².
-    pub s_before_mm2: f64,
-    /// S(μ) of the final model on the whole record, mm².
-    pub s_after_mm2: f64,
-    /// The state (x0 m, v0 m/s) the base's simulation starts from: fitted, or the setup's
-    /// estimate less the offset.
-    pub initial_before: [f64; 2],
-    /// The same for the final model.
-    pub initial_after: [f64; 2],
-    /// The base's simulated x (with the offset) at every sample, m.
-    pub x_before: Vec<f64>,
-    /// The final model's simulated x (with the offset) at every sample, m.
-    pub x_after: Vec<f64>,
 }
 
 /// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
@@ -788,24 +765,9 @@ impl Trials<'_, '_> {
         match self.scout {
             Some(scout) => {
                 let on = (self.rig, self.setup, self.split.train.as_slice());
-                scouted(stage, scout, on, &self.trial_settings())
+                scouted(stage, scout, on, &trial_settings(self.settings))
             }
             None => (stage, f64::INFINITY, f64::NAN),
-        }
-    }
-
-    /// Levenberg–Marquardt alone, at most `TRIAL_ITERS` iterations: a candidate whose fit
-    /// does not settle by then (a stiff relaxation wandering through thousands of
-    /// simulations) is scored where it stopped, not chased by Nelder–Mead.
-    fn trial_settings(&self) -> DiscoverySettings {
-        DiscoverySettings {
-            fit: self
-                .settings
-                .fit
-                .clone()
-                .solver(Solver::LevenbergMarquardt)
-                .max_iters(self.settings.fit.max_iters.min(TRIAL_ITERS)),
-            ..self.settings.clone()
         }
     }
 
@@ -819,7 +781,7 @@ impl Trials<'_, '_> {
         stage: SearchModel,
         current: &Trial,
     ) -> (CandidateScore, Option<Trial>) {
-        let mut settings = self.trial_settings();
+        let mut settings = trial_settings(self.settings);
         if self.scout.is_some() {
             let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
             settings.fit = settings.fit.max_iters(iters);
@@ -876,6 +838,7 @@ fn scouted(
 /// is held out. `setup` says how the oscillator is driven and which of its parameters are
 /// refitted with every model. Candidates already in the base (by model name) are skipped; a
 /// candidate whose fit fails is scored as failed; a base that cannot be fitted is an error.
+/// The result's [`Discovery::trajectory`] holds the oscillator as refitted.
 pub fn discover_trajectory(
     base: Arc<dyn ForceModel>,
     candidates: &[Candidate],
@@ -883,266 +846,376 @@ pub fn discover_trajectory(
     cycles: &[Cycle],
     setup: &TrajectorySetup,
     settings: &DiscoverySettings,
-) -> Result<TrajectoryDiscovery, DiscoveryError> {
+) -> Result<Discovery, DiscoveryError> {
     settings.validate()?;
-    let n = data.t.len();
-    if data.x.len() != n || n < 8 {
-        return Err(DiscoveryError::BadData(format!(
-            "t and x must have equal lengths ≥ 8 (got {n} and {})",
-            data.x.len()
-        )));
-    }
-    candidate::distinct(candidates)?;
-    for p in &setup.oscillator {
-        let initial = crate::fit::INITIAL_STATE.contains(&p.name.as_str());
-        if OscillatorParams::FORCED.get(&p.name).is_none() && !initial {
-            return Err(DiscoveryError::BadSettings(format!(
-                "`{}` is not an oscillator parameter or the initial state; known: {}, x0, v0",
-                p.name,
-                OscillatorParams::NAMES.join(", ")
-            )));
-        }
-    }
-    let floor = settings.floor_of(data.x, "displacement", "m")?;
-    let rig = Rig {
-        system: setup.system,
-        excitation: setup.excitation.clone(),
-        oscillator: setup.oscillator.iter().map(|p| p.name.as_str()).collect(),
-        initial: setup.initial,
-        sim: setup.sim.clone(),
-        fit_offset: settings.fit_offset,
-        fixed_start: false,
-        t: data.t,
-        x: data.x,
-    };
-    let n_osc = setup.oscillator.len();
-    let osc_start: Vec<f64> = setup.oscillator.iter().map(|p| p.value).collect();
-    let base_name = base.name().to_string();
-    let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
-    let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
-    let mut notes = Vec::new();
-    let (kept, skipped) =
-        without_refitted_terms(&base, candidates, &rig.oscillator, &setup.excitation)?;
-    let candidates = kept.as_slice();
-    notes.extend(skipped);
-
-    settings.observer.emit(DiscoveryEvent::Base);
-    // 1. The base and the oscillator on the whole record: the gap before.
-    let start = SearchModel {
-        values: setup
-            .oscillator
-            .iter()
-            .map(|p| p.value)
-            .chain(base.params().iter().map(|s| s.default))
-            .chain(settings.fit_offset.then_some(0.0))
-            .collect(),
-        parts: vec![base.clone()],
-    };
-    let all: Vec<usize> = (0..n).collect();
-    let start = match &setup.force_hint {
-        Some(h) => start.force_started(&rig, h, &all).map_or(start, |(s, _)| s),
-        None => start,
-    };
-    let scout = scout_of(&rig, cycles, &split.train, settings);
-    let start = match &scout {
-        Some(s) => {
-            let lm = DiscoverySettings {
-                fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-                ..settings.clone()
-            };
-            scouted(start, s, (&rig, setup, &all), &lm).0
-        }
-        None => start,
-    };
-    let (base_full, base_result) = start.fit_simulated(&rig, setup, &all, settings)?;
-    let run_before = base_full.run(&rig)?;
-    let gap_before = rms(&run_before.residual);
-    let simulated = |run: &Run| -> Vec<f64> {
-        data.x
-            .iter()
-            .zip(&run.residual)
-            .map(|(m, r)| m - r)
-            .collect()
-    };
-    let x_before = simulated(&run_before);
-    let residual_before = run_before.residual.clone();
-    let n_base = base.params().len();
-    let base_values = base_full.values[n_osc..n_osc + n_base].to_vec();
-    let base_params = base_result.params.clone();
-    let initial_before = rig
-        .start(&base, &base_full.values)
-        .map_err(DiscoveryError::BadData)?;
-    // 2. Where the gap lives.
-    let where_before = locate_x_gap(&run_before, cycles, floor);
-    notes.push(format!("base `{base_name}`: {}", where_before.summary));
-
-    // 3–4. Add effects while the held-out evidence demands one.
-    // The base's training fit starts from its whole-record fit: from the defaults it can end
-    // in a basin of its own, and every candidate would then be scored against that.
-    let mut current = base_full.trial_simulated(&rig, setup, &split, settings)?;
-    let resolvable = 3.0 * floor / (split.holdout.len().max(1) as f64).sqrt();
-    let base_excess = (current.holdout_mse - floor * floor).max(2.0 * floor * resolvable);
-    let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
-    let yardstick = Yardstick {
-        gain_z: &test,
-        tie_z: &cycle_gain_z,
-        units: &|h: &[f64]| h.to_vec(),
-        base_excess,
-        floor: crate::fit::NoiseFloor::displacement(floor),
-        floor_band: 0.0,
-        block_samples: None,
-        reach: reach_of(data, setup),
-    };
-    let mut effects: Vec<String> = Vec::new();
-    let mut steps = Vec::new();
-    let per_cycle = n / cycles.len().max(1);
-    let screen = per_cycle >= SCREEN_MIN_SAMPLES;
-    if !screen && setup.force_hint.is_some() {
-        notes.push(format!(
-            "no force-level screen: {per_cycle} samples a cycle leave the recovered force to the \
-             derivative filter's bias (a screen needs {SCREEN_MIN_SAMPLES}); every candidate is \
-             fitted at trajectory level"
-        ));
-    }
-    if let Some(s) = &scout {
-        notes.push(format!(
-            "scouted: each candidate's values are searched on {} pieces of the record \
-                 ({} samples of {n}), then fitted on the whole record from there",
-            s.pieces(),
-            s.samples
-        ));
-    }
-    for step in 1..=settings.max_effects {
-        let trials = Trials {
-            rig: &rig,
-            setup,
-            split: &split,
-            osc_start: &osc_start,
-            yardstick: &yardstick,
-            settings,
-            screen,
-            scout: scout.as_ref(),
-        };
-        let tried = current.stage.to_try(candidates, &in_base, &effects);
-        let scored = trials.step(step, &tried, &current);
-        if scored.is_empty() {
-            break;
-        }
-        let (step, winner) = choice::decide(
-            &current,
-            scored,
-            &choice::DISPLACEMENT,
-            &yardstick,
-            settings,
-        );
-        notes.push(step.verdict.clone());
-        notes.extend(choice::unresolved(&step, &choice::DISPLACEMENT));
-        effects.extend(step.accepted.clone());
-        steps.push(step);
-        let Some(trial) = winner else {
-            break;
-        };
-        // The accepted model, polished from its trial fit at the final fit's tolerance: the
-        // next step's candidates must beat the model at its best on the training cycles, not
-        // a screening fit stopped early (whose leftover misfit a later candidate's extra
-        // parameters would otherwise "explain").
-        let polish = DiscoverySettings {
-            fit: settings
-                .fit
-                .clone()
-                .solver(Solver::LevenbergMarquardt)
-                .tol(settings.fit.tol.min(1e-9)),
-            ..settings.clone()
-        };
-        current = match trial.stage.trial_simulated(&rig, setup, &split, &polish) {
-            Ok(polished) if polished.train.rms <= trial.train.rms => polished,
-            _ => trial,
-        };
-    }
-
-    // 5. The final model and the oscillator on the whole record: the gap after.
-    let (final_stage, final_result, run_after) = if effects.is_empty() {
-        (base_full.clone(), base_result.clone(), run_before)
-    } else {
-        // Levenberg–Marquardt alone, from the training fit (near the optimum).
-        let lm = DiscoverySettings {
-            fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-            ..settings.clone()
-        };
-        let (refit, result) = current.stage.fit_simulated(&rig, setup, &all, &lm)?;
-        let refit_run = refit.run(&rig)?;
-        let start_run = current.stage.run(&rig)?;
-        if rms(&start_run.residual) < rms(&refit_run.residual) {
-            notes.push(format!(
-                "the whole-record refit ended worse ({:.4} mm) than the training fit it \
-                 started from ({:.4} mm); the training fit's values are kept",
-                rms(&refit_run.residual) * 1e3,
-                rms(&start_run.residual) * 1e3
-            ));
-            (current.stage.clone(), current.train.clone(), start_run)
-        } else {
-            (refit, result, refit_run)
-        }
-    };
-    let final_model = final_stage.model()?;
-    let initial_after = rig
-        .start(&final_model, &final_stage.values)
-        .map_err(DiscoveryError::BadData)?;
-    let gap_after = rms(&run_after.residual);
-    let where_after = locate_x_gap(&run_after, cycles, floor);
-    let s_mm2 = |g: f64| g * g * 1e6;
-    notes.push(format!(
-        "x gap {:.4} mm → {:.4} mm RMS, S {:.4} → {:.4} mm² (noise floor {:.4} mm); final \
-         `{}`: {}",
-        gap_before * 1e3,
-        gap_after * 1e3,
-        s_mm2(gap_before),
-        s_mm2(gap_after),
-        floor * 1e3,
-        final_stage.name(),
-        where_after.summary
-    ));
-    let n_model = final_model.params().len();
-    Ok(TrajectoryDiscovery {
-        system_before: rig.system_of(&base_full.values),
-        system_after: rig.system_of(&final_stage.values),
-        s_before_mm2: s_mm2(gap_before),
-        s_after_mm2: s_mm2(gap_after),
-        initial_before,
-        initial_after,
-        x_before,
-        x_after: simulated(&run_after),
-        discovery: Discovery {
-            base: base_name,
-            effects,
-            steps,
-            noise_floor: floor,
-            noise_floor_parts: yardstick.floor,
-            holdout_cycles: split.holdout_cycles,
-            holdout_samples: split.holdout.len(),
-            gap_before,
-            gap_after,
-            where_before,
-            where_after,
-            residual_before,
-            residual_after: run_after.residual.clone(),
-            base_model: base,
-            base_values,
-            base_params,
-            final_model_name: final_stage.name(),
-            final_model,
-            final_values: final_stage
-                .values
-                .get(n_osc..n_osc + n_model)
-                .map(<[_]>::to_vec)
-                .unwrap_or_default(),
-            final_params: final_result.params.clone(),
-            final_fit: final_result,
-            notes,
-        },
-    })
+    let level = TrajectoryLevel::new(data, cycles, setup, settings)?;
+    let base_params: Vec<(&ParamSpec, bool)> = base.params().iter().map(|s| (s, true)).collect();
+    check_same_terms(&base_params, &level.rig.oscillator, &setup.excitation)
+        .map_err(|e| DiscoveryError::BadSettings(format!("the base `{}`: {e}", base.name())))?;
+    search::discover(&level, base, candidates, settings)
 }
 
+/// The trajectory level: the measured displacement, its cycles and split, the oscillator
+/// (the rig) simulated with every model, the displacement noise floor, and the scout and
+/// screen that choose which candidates are fitted in full.
+pub(super) struct TrajectoryLevel<'a> {
+    data: &'a TrajectoryData<'a>,
+    cycles: &'a [Cycle],
+    setup: &'a TrajectorySetup,
+    rig: Rig<'a>,
+    split: HoldoutSplit,
+    /// The displacement noise σ, m.
+    floor: f64,
+    /// The refitted oscillator parameters' start values.
+    osc_start: Vec<f64>,
+    /// Whether the force-level screen may rank candidates.
+    screen: bool,
+    scout: Option<Scout<'a>>,
+    settings: &'a DiscoverySettings,
+}
+
+impl<'a> TrajectoryLevel<'a> {
+    /// The trajectory level of `data` cut into `cycles`, the oscillator as `setup` says.
+    pub(super) fn new(
+        data: &'a TrajectoryData<'a>,
+        cycles: &'a [Cycle],
+        setup: &'a TrajectorySetup,
+        settings: &'a DiscoverySettings,
+    ) -> Result<Self, DiscoveryError> {
+        let n = data.t.len();
+        if data.x.len() != n || n < 8 {
+            return Err(DiscoveryError::BadData(format!(
+                "t and x must have equal lengths ≥ 8 (got {n} and {})",
+                data.x.len()
+            )));
+        }
+        for p in &setup.oscillator {
+            let initial = crate::fit::INITIAL_STATE.contains(&p.name.as_str());
+            if OscillatorParams::FORCED.get(&p.name).is_none() && !initial {
+                return Err(DiscoveryError::BadSettings(format!(
+                    "`{}` is not an oscillator parameter or the initial state; known: {}, x0, v0",
+                    p.name,
+                    OscillatorParams::NAMES.join(", ")
+                )));
+            }
+        }
+        let floor = settings.floor_of(data.x, "displacement", "m")?;
+        let rig = Rig {
+            system: setup.system,
+            excitation: setup.excitation.clone(),
+            oscillator: setup.oscillator.iter().map(|p| p.name.as_str()).collect(),
+            initial: setup.initial,
+            sim: setup.sim.clone(),
+            fit_offset: settings.fit_offset,
+            fixed_start: false,
+            t: data.t,
+            x: data.x,
+        };
+        let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
+        let scout = scout_of(&rig, cycles, &split.train, settings);
+        Ok(TrajectoryLevel {
+            data,
+            cycles,
+            setup,
+            osc_start: setup.oscillator.iter().map(|p| p.value).collect(),
+            screen: n / cycles.len().max(1) >= SCREEN_MIN_SAMPLES,
+            rig,
+            split,
+            floor,
+            scout,
+            settings,
+        })
+    }
+}
+
+impl Level for TrajectoryLevel<'_> {
+    fn said(&self) -> &'static Said {
+        &choice::DISPLACEMENT
+    }
+
+    fn n_before(&self) -> usize {
+        self.setup.oscillator.len()
+    }
+
+    fn settings(&self) -> &DiscoverySettings {
+        self.settings
+    }
+
+    fn split(&self) -> &HoldoutSplit {
+        &self.split
+    }
+
+    fn samples(&self) -> usize {
+        self.data.t.len()
+    }
+
+    /// A candidate with a parameter that is the same term as a refitted one (`viscous`
+    /// while `c` is refitted) would be fitted twice over the same valley: it is left out with
+    /// a note saying why.
+    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
+        let refitted = &self.rig.oscillator;
+        let mut kept = Vec::new();
+        let mut notes = Vec::new();
+        for c in candidates {
+            match c
+                .model
+                .params()
+                .iter()
+                .find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)))
+            {
+                Some((spec, osc)) => notes.push(format!(
+                    "`{}` not tried: its `{}` is the same term as the refitted oscillator's \
+                     `{osc}`",
+                    c.name, spec.name
+                )),
+                None => kept.push(c.clone()),
+            }
+        }
+        (kept, notes)
+    }
+
+    /// The oscillator's start, the base's defaults: fitted at force level to the force hint
+    /// if any, then on the scout if any.
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
+        let settings = self.settings;
+        let start = SearchModel {
+            values: self
+                .osc_start
+                .iter()
+                .copied()
+                .chain(base.params().iter().map(|s| s.default))
+                .chain(settings.fit_offset.then_some(0.0))
+                .collect(),
+            parts: vec![base.clone()],
+        };
+        let all: Vec<usize> = (0..self.samples()).collect();
+        let start = match &self.setup.force_hint {
+            Some(h) => start
+                .force_started(&self.rig, h, &all)
+                .map_or(start, |(s, _)| s),
+            None => start,
+        };
+        match &self.scout {
+            Some(s) => {
+                let lm = DiscoverySettings {
+                    fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
+                    ..settings.clone()
+                };
+                scouted(start, s, (&self.rig, self.setup, &all), &lm).0
+            }
+            None => start,
+        }
+    }
+
+    fn fit(
+        &self,
+        stage: &SearchModel,
+        subset: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Result<(SearchModel, FitResult), DiscoveryError> {
+        stage.fit_simulated(&self.rig, self.setup, subset, settings)
+    }
+
+    fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError> {
+        stage.residual(&self.rig)
+    }
+
+    fn trial(
+        &self,
+        stage: &SearchModel,
+        settings: &DiscoverySettings,
+    ) -> Result<Trial, DiscoveryError> {
+        stage.trial_simulated(&self.rig, self.setup, &self.split, settings)
+    }
+
+    /// From the base's whole-record fit: from the defaults it can end in a basin of its
+    /// own, and every candidate would then be scored against that.
+    fn first_trial(
+        &self,
+        _: &SearchModel,
+        base_full: &SearchModel,
+    ) -> Result<Trial, DiscoveryError> {
+        self.trial(base_full, self.settings)
+    }
+
+    /// The displacement noise, whatever the model.
+    fn floor(&self, _: &SearchModel) -> Result<NoiseFloor, DiscoveryError> {
+        Ok(NoiseFloor::displacement(self.floor))
+    }
+
+    fn gap(
+        &self,
+        stage: &SearchModel,
+        floor: &NoiseFloor,
+    ) -> Result<(Vec<f64>, GapLocation), DiscoveryError> {
+        let run = stage.run(&self.rig)?;
+        let location = locate_x_gap(&run, self.cycles, floor.sigma);
+        Ok((run.residual, location))
+    }
+
+    /// At least twice what `3σ/√N` held-out samples resolve.
+    fn base_excess(&self, current: &Trial, _: &NoiseFloor) -> Result<f64, DiscoveryError> {
+        let floor = self.floor;
+        let resolvable = 3.0 * floor / (self.split.holdout.len().max(1) as f64).sqrt();
+        Ok((current.holdout_mse - floor * floor).max(2.0 * floor * resolvable))
+    }
+
+    /// Whether the force-level screen runs, and the scout.
+    fn search_notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        let n = self.samples();
+        if !self.screen && self.setup.force_hint.is_some() {
+            let per_cycle = n / self.cycles.len().max(1);
+            notes.push(format!(
+                "no force-level screen: {per_cycle} samples a cycle leave the recovered force to \
+                 the derivative filter's bias (a screen needs {SCREEN_MIN_SAMPLES}); every \
+                 candidate is fitted at trajectory level"
+            ));
+        }
+        if let Some(s) = &self.scout {
+            notes.push(format!(
+                "scouted: each candidate's values are searched on {} pieces of the record \
+                 ({} samples of {n}), then fitted on the whole record from there",
+                s.pieces(),
+                s.samples
+            ));
+        }
+        notes
+    }
+
+    /// Whole held-out cycles, paired on the log of their mean squares ([`cycle_gain_z`]).
+    fn measured<T>(
+        &self,
+        _: &Trial,
+        base_excess: f64,
+        then: impl FnOnce(&Yardstick) -> T,
+    ) -> Result<T, DiscoveryError> {
+        let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
+        Ok(then(&Yardstick {
+            gain_z: &test,
+            tie_z: &cycle_gain_z,
+            units: &|h: &[f64]| h.to_vec(),
+            base_excess,
+            floor: NoiseFloor::displacement(self.floor),
+            floor_band: 0.0,
+            block_samples: None,
+            reach: reach_of(self.data, self.setup),
+        }))
+    }
+
+    fn score_step(
+        &self,
+        step: usize,
+        tried: &[&Candidate],
+        current: &Trial,
+        yardstick: &Yardstick,
+    ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
+        let trials = Trials {
+            rig: &self.rig,
+            setup: self.setup,
+            split: &self.split,
+            osc_start: &self.osc_start,
+            yardstick,
+            settings: self.settings,
+            screen: self.screen,
+            scout: self.scout.as_ref(),
+        };
+        Ok(trials.step(step, tried, current))
+    }
+
+    /// From the candidate's defaults, at most `TRIAL_ITERS` iterations.
+    fn replacement_trial(
+        &self,
+        c: &Candidate,
+        rest: &SearchModel,
+        part: usize,
+        _: &[f64],
+    ) -> Result<Trial, DiscoveryError> {
+        let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+        let stage = rest.inserting(part, self.n_before(), &c.model, &defaults);
+        self.trial(&stage, &trial_settings(self.settings))
+    }
+
+    fn reconsiders(&self) -> bool {
+        false
+    }
+
+    fn polishes(&self) -> bool {
+        true
+    }
+
+    fn warns_unresolved(&self) -> bool {
+        true
+    }
+
+    /// Levenberg–Marquardt alone, from the training fit (near the optimum).
+    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
+        DiscoverySettings {
+            fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
+            ..settings.clone()
+        }
+    }
+
+    fn closing_notes(
+        &self,
+        [gap_before, gap_after]: [f64; 2],
+        _: &NoiseFloor,
+        final_name: &str,
+        where_after: &str,
+    ) -> Vec<String> {
+        vec![format!(
+            "x gap {:.4} mm → {:.4} mm RMS, S {:.4} → {:.4} mm² (noise floor {:.4} mm); final \
+             `{final_name}`: {where_after}",
+            gap_before * 1e3,
+            gap_after * 1e3,
+            s_mm2(gap_before),
+            s_mm2(gap_after),
+            self.floor * 1e3,
+        )]
+    }
+
+    fn part(
+        &self,
+        [(before, r_before), (after, r_after)]: [(&SearchModel, &[f64]); 2],
+    ) -> Result<Option<TrajectoryPart>, DiscoveryError> {
+        let initial = |stage: &SearchModel| -> Result<[f64; 2], DiscoveryError> {
+            self.rig
+                .start(&stage.model()?, &stage.values)
+                .map_err(DiscoveryError::BadData)
+        };
+        let simulated =
+            |r: &[f64]| -> Vec<f64> { self.data.x.iter().zip(r).map(|(m, r)| m - r).collect() };
+        Ok(Some(TrajectoryPart {
+            system_before: self.rig.system_of(&before.values),
+            system_after: self.rig.system_of(&after.values),
+            s_before_mm2: s_mm2(rms(r_before)),
+            s_after_mm2: s_mm2(rms(r_after)),
+            initial_before: initial(before)?,
+            initial_after: initial(after)?,
+            x_before: simulated(r_before),
+            x_after: simulated(r_after),
+        }))
+    }
+}
+
+/// A displacement RMS `g` (m) as a mean square S in mm².
+fn s_mm2(g: f64) -> f64 {
+    g * g * 1e6
+}
+
+/// Levenberg–Marquardt alone, at most `TRIAL_ITERS` iterations: a candidate whose fit does
+/// not settle by then (a stiff relaxation wandering through thousands of simulations) is
+/// scored where it stopped, not chased by Nelder–Mead.
+fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
+    DiscoverySettings {
+        fit: settings
+            .fit
+            .clone()
+            .solver(Solver::LevenbergMarquardt)
+            .max_iters(settings.fit.max_iters.min(TRIAL_ITERS)),
+        ..settings.clone()
+    }
+}
 /// How far the record goes: its largest |x|, and the largest |v| of the force hint's
 /// filtered velocity or, without one, of central differences of x.
 fn reach_of(data: &TrajectoryData, setup: &TrajectorySetup) -> Reach {
@@ -1155,38 +1228,6 @@ fn reach_of(data: &TrajectoryData, setup: &TrajectorySetup) -> Reach {
             Reach::of(data.x, &v)
         }
     }
-}
-
-/// The candidates a discovery may try beside the refitted oscillator parameters: a candidate
-/// with a parameter that is the same term as a refitted one (`viscous` while `c` is refitted)
-/// would be fitted twice over the same valley, so it is left out with a note saying why. A
-/// base with such a parameter, or refitted offsets that clash, is an error.
-fn without_refitted_terms(
-    base: &Arc<dyn ForceModel>,
-    candidates: &[Candidate],
-    refitted: &[&str],
-    excitation: &Excitation,
-) -> Result<(Vec<Candidate>, Vec<String>), DiscoveryError> {
-    let base_params: Vec<(&ParamSpec, bool)> = base.params().iter().map(|s| (s, true)).collect();
-    check_same_terms(&base_params, refitted, excitation)
-        .map_err(|e| DiscoveryError::BadSettings(format!("the base `{}`: {e}", base.name())))?;
-    let mut kept = Vec::new();
-    let mut notes = Vec::new();
-    for c in candidates {
-        match c
-            .model
-            .params()
-            .iter()
-            .find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)))
-        {
-            Some((spec, osc)) => notes.push(format!(
-                "`{}` not tried: its `{}` is the same term as the refitted oscillator's `{osc}`",
-                c.name, spec.name
-            )),
-            None => kept.push(c.clone()),
-        }
-    }
-    Ok((kept, notes))
 }
 
 #[cfg(test)]
@@ -1299,14 +1340,20 @@ mod tests {
         (rec.t, rec.x, rec.u.unwrap(), system)
     }
 
-    fn discover(k3: f64) -> TrajectoryDiscovery {
+    /// A trajectory-level discovery and its own part.
+    struct Found {
+        discovery: Discovery,
+        part: TrajectoryPart,
+    }
+
+    fn discover(k3: f64) -> Found {
         discover_on(record(k3), &DiscoverySettings::default())
     }
 
     fn discover_on(
         record: (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
         settings: &DiscoverySettings,
-    ) -> TrajectoryDiscovery {
+    ) -> Found {
         let candidates = [
             Candidate::new("cubic_stiffness", cubic()),
             Candidate::new("quadratic_damping", quadratic()),
@@ -1318,7 +1365,7 @@ mod tests {
         (t, x, u, system): (Vec<f64>, Vec<f64>, Vec<f64>, OscillatorParams),
         candidates: &[Candidate],
         settings: &DiscoverySettings,
-    ) -> TrajectoryDiscovery {
+    ) -> Found {
         let cycles = cycles_from_x(&t, &x, 1.5e-4).unwrap();
         // Start the oscillator 2 % off.
         let start = |name: &str| {
@@ -1332,7 +1379,7 @@ mod tests {
         .refit(start("m"))
         .refit(start("k"))
         .refit(start("c"));
-        discover_trajectory(
+        let discovery = discover_trajectory(
             viscous(),
             candidates,
             &TrajectoryData { t: &t, x: &x },
@@ -1340,7 +1387,9 @@ mod tests {
             &setup,
             settings,
         )
-        .unwrap()
+        .unwrap();
+        let part = discovery.trajectory.clone().unwrap();
+        Found { discovery, part }
     }
 
     #[test]
@@ -1354,10 +1403,10 @@ mod tests {
             "whole {:?} k3 {:?} S {}; scouted {:?} k3 {:?} S {}; {:?}",
             w.effects,
             w.value("k3"),
-            whole.s_after_mm2,
+            whole.part.s_after_mm2,
             s.effects,
             s.value("k3"),
-            scouted.s_after_mm2,
+            scouted.part.s_after_mm2,
             s.notes
         );
         assert!(s.notes.iter().any(|n| n.starts_with("scouted")));
@@ -1367,7 +1416,7 @@ mod tests {
         let (kw, ks) = (w.value("k3").unwrap(), s.value("k3").unwrap());
         assert!((ks / 1e4 - 1.0).abs() < 0.2, "k3 = {ks}");
         assert!((ks / kw - 1.0).abs() < 0.01, "k3 {ks} scouted, {kw} whole");
-        assert!(scouted.s_after_mm2 < 1.01 * whole.s_after_mm2);
+        assert!(scouted.part.s_after_mm2 < 1.01 * whole.part.s_after_mm2);
     }
 
     #[test]
@@ -1442,20 +1491,23 @@ mod tests {
         let d = &found.discovery;
         eprintln!(
             "S {} → {} mm²; {:?}",
-            found.s_before_mm2, found.s_after_mm2, d.notes
+            found.part.s_before_mm2, found.part.s_after_mm2, d.notes
         );
         assert_eq!(d.effects, ["cubic_stiffness"]);
-        assert!(found.s_after_mm2 < 0.5 * found.s_before_mm2);
+        assert!(found.part.s_after_mm2 < 0.5 * found.part.s_before_mm2);
         let k3 = d.value("k3").unwrap();
         assert!((k3 / 1e4 - 1.0).abs() < 0.2, "k3 = {k3}");
-        assert!((found.system_after.k / 269.9346 - 1.0).abs() < 0.02);
+        assert!((found.part.system_after.k / 269.9346 - 1.0).abs() < 0.02);
     }
 
     #[test]
     fn without_the_cubic_term_nothing_is_named() {
         let found = discover(0.0);
         let d = &found.discovery;
-        eprintln!("S {} → {} mm²", found.s_before_mm2, found.s_after_mm2);
+        eprintln!(
+            "S {} → {} mm²",
+            found.part.s_before_mm2, found.part.s_after_mm2
+        );
         assert!(d.effects.is_empty(), "{:?}", d.steps);
         assert!(d.gap_before < 2.0 * d.noise_floor);
     }

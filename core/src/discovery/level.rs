@@ -1,0 +1,153 @@
+//! The fit level a discovery runs at: what differs between fitting forces along the measured
+//! kinematics ([`super::force_level::ForceLevel`]) and simulating the oscillator against the
+//! measured displacement ([`super::trajectory_level::TrajectoryLevel`]).
+//!
+//! A level holds its record and split, and says how a [`SearchModel`] is fitted on a subset
+//! and on the whole record, its residual and where that lives, its noise floor (the evidence
+//! a gain is measured against), the unit its gap is said in, and how the candidates of a step
+//! are started and fitted. The search itself — base fit, steps, acceptance, re-check of
+//! earlier effects, polish, final refit — is written once, in [`super::search`], over this
+//! trait. The steps a level does not run by default are its capabilities
+//! ([`Level::reconsiders`], [`Level::polishes`], [`Level::warns_unresolved`]).
+
+use std::sync::Arc;
+
+use super::candidate::Candidate;
+use super::choice::{Said, Trial, Yardstick};
+use super::error::DiscoveryError;
+use super::findings::TrajectoryPart;
+use super::force_gap::GapLocation;
+use super::holdout::HoldoutSplit;
+use super::score::CandidateScore;
+use super::search_model::SearchModel;
+use super::settings::DiscoverySettings;
+use crate::fit::{FitResult, NoiseFloor};
+use crate::physics::force_model::ForceModel;
+
+/// A fit level: its data, fits, residuals, unit and evidence.
+pub(super) trait Level: Sync {
+    /// How the level's verdicts say its residual (quantity, unit, scale from SI).
+    fn said(&self) -> &'static Said;
+
+    /// The level's own parameters, fitted before the model's (the refitted oscillator's at
+    /// trajectory level; none at force level).
+    fn n_before(&self) -> usize;
+
+    /// The settings of the run.
+    fn settings(&self) -> &DiscoverySettings;
+
+    /// The record's held-out split.
+    fn split(&self) -> &HoldoutSplit;
+
+    /// Samples in the record.
+    fn samples(&self) -> usize;
+
+    /// The candidates the search may try, of those given, and notes on any left out.
+    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>);
+
+    /// Where the base's whole-record fit starts from: the level's own start values, the
+    /// base's defaults and the offset (0) if fitted, improved as far as the level can before
+    /// the fit.
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel;
+
+    /// Fit `stage` on the samples `subset`: the stage with the fitted values, and the fit.
+    fn fit(
+        &self,
+        stage: &SearchModel,
+        subset: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Result<(SearchModel, FitResult), DiscoveryError>;
+
+    /// Measured minus modelled signal at every sample, for `stage` at its values.
+    fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError>;
+
+    /// Fit `stage` on the training samples and score it on the held-out ones.
+    fn trial(
+        &self,
+        stage: &SearchModel,
+        settings: &DiscoverySettings,
+    ) -> Result<Trial, DiscoveryError>;
+
+    /// The trial every candidate of the first step is measured against: of the base from
+    /// its defaults (`start`) or from its whole-record fit (`base_full`).
+    fn first_trial(
+        &self,
+        start: &SearchModel,
+        base_full: &SearchModel,
+    ) -> Result<Trial, DiscoveryError>;
+
+    /// The noise floor of `stage` at its values.
+    fn floor(&self, stage: &SearchModel) -> Result<NoiseFloor, DiscoveryError>;
+
+    /// The residual of `stage` at every sample and where it lives against `floor`.
+    fn gap(
+        &self,
+        stage: &SearchModel,
+        floor: &NoiseFloor,
+    ) -> Result<(Vec<f64>, GapLocation), DiscoveryError>;
+
+    /// The base's held-out mean square above its floor `floor` (at least what is resolved):
+    /// the denominator of every step's explained fraction.
+    fn base_excess(&self, current: &Trial, floor: &NoiseFloor) -> Result<f64, DiscoveryError>;
+
+    /// Notes on how the search runs at this level (said once, before the steps).
+    fn search_notes(&self) -> Vec<String>;
+
+    /// `then` called with the yardstick of a step on `current`.
+    fn measured<T>(
+        &self,
+        current: &Trial,
+        base_excess: f64,
+        then: impl FnOnce(&Yardstick) -> T,
+    ) -> Result<T, DiscoveryError>;
+
+    /// The scores of the candidates `tried`, each added to `current`, in their order, with
+    /// their trials where they ran.
+    fn score_step(
+        &self,
+        step: usize,
+        tried: &[&Candidate],
+        current: &Trial,
+        yardstick: &Yardstick,
+    ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError>;
+
+    /// The trial of candidate `c` put in `rest` as its part `part` (for the re-check of an
+    /// earlier effect); `residual` is `rest`'s at every sample.
+    fn replacement_trial(
+        &self,
+        c: &Candidate,
+        rest: &SearchModel,
+        part: usize,
+        residual: &[f64],
+    ) -> Result<Trial, DiscoveryError>;
+
+    /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`]).
+    fn reconsiders(&self) -> bool;
+
+    /// Whether an accepted trial is polished at the final fit's tolerance before the next
+    /// step ([`super::search`]).
+    fn polishes(&self) -> bool;
+
+    /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted.
+    fn warns_unresolved(&self) -> bool;
+
+    /// The settings of the final whole-record refit, from the training fit.
+    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings;
+
+    /// The notes that close a run: the gap before and after, against the final floor.
+    fn closing_notes(
+        &self,
+        gaps: [f64; 2],
+        floor: &NoiseFloor,
+        final_name: &str,
+        where_after: &str,
+    ) -> Vec<String>;
+
+    /// The level's own part of the result (`None` at force level): what the base's and the
+    /// final model's whole-record fits `fits` (each with its residual) say beyond the shared
+    /// report.
+    fn part(
+        &self,
+        fits: [(&SearchModel, &[f64]); 2],
+    ) -> Result<Option<TrajectoryPart>, DiscoveryError>;
+}
