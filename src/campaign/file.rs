@@ -429,3 +429,92 @@ fn check_experiments(units: &[Unit], place: &Place) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder with a record `r.csv` and an experiment `e.toml`; the campaign's text parsed
+    /// as `c.toml` in it.
+    fn parse(text: &str) -> Result<Campaign> {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(
+            dir.path().join("e.toml"),
+            "[[models]]\nname = \"power_law\"\n",
+        )
+        .unwrap();
+        Campaign::parse(&dir.path().join("c.toml"), text)
+    }
+
+    fn message(text: &str) -> String {
+        let e = format!("{:#}", parse(text).unwrap_err());
+        e.split_once("c.toml")
+            .map_or(e.clone(), |(_, m)| m.to_string())
+    }
+
+    const HEAD: &str =
+        "[campaign]\nexperiment = \"e.toml\"\ncommand = \"fit\"\nconditions = [\"c\"]\n";
+
+    #[test]
+    fn a_record_takes_the_campaign_s_work_and_may_name_its_own() {
+        let c = parse(&format!(
+            "{HEAD}\n[[records]]\nfile = \"r.csv\"\nc = 1\n\n[[records]]\nfile = \"r.csv\"\nc = 2.5\ncommand = \"compare\"\n"
+        ))
+        .unwrap();
+        assert_eq!(c.units.len(), 2);
+        assert_eq!(c.units[0].command, CommandName::Fit);
+        assert_eq!(c.units[1].command, CommandName::Compare);
+        assert_eq!(c.units[1].conditions, vec![("c".to_string(), 2.5)]);
+        assert_eq!((c.units[0].line, c.units[1].line), (6, 10));
+        assert_eq!(c.units[1].folder_name(), "002-r");
+        assert!(c.unit(3).is_err() && c.unit(0).is_err());
+    }
+
+    #[test]
+    fn each_bad_record_is_named_with_line_and_key() {
+        let rec = |body: &str| format!("{HEAD}\n[[records]]\n{body}");
+        assert_eq!(
+            message(&rec("file = \"r.csv\"\n")),
+            ":6: `records[0]`: missing condition `c`: every record gives every condition"
+        );
+        assert!(message(&rec("file = \"r.csv\"\nc = 1\nd = 2\n"))
+            .starts_with(":9: `records[0].d`: not a condition: list it in `campaign.conditions`"));
+        assert_eq!(
+            message(&rec("c = 1\n")),
+            ":6: `records[0]`: missing `file`: the record's path"
+        );
+        assert_eq!(
+            message(&rec("file = \"r.csv\"\nc = nan\n")),
+            ":8: `records[0].c`: a condition is a finite number, found NaN"
+        );
+        assert!(
+            message(&rec("file = \"r.csv\"\nc = 1\ncommand = \"simulate\"\n"))
+                .starts_with(":9: `records[0].command`: unknown variant `simulate`")
+        );
+        let m = message(&rec(
+            "file = \"r.csv\"\nc = 1\nexperiment = \"none.toml\"\n",
+        ));
+        assert!(
+            m.starts_with(":6: `records[0]`: no such experiment: ") && m.ends_with("none.toml"),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn the_header_is_checked_too() {
+        assert_eq!(
+            message("[[records]]\nfile = \"r.csv\"\n"),
+            ":1: `campaign`: missing section [campaign]"
+        );
+        assert!(message(&format!("{HEAD}")).starts_with(":1: `records`: no records"));
+        assert!(message("[campaign]\nconditions = [\"file\"]\n")
+            .starts_with(":2: `campaign.conditions[0]`: `file` is a record key"));
+        assert!(message("[campaign]\nconditions = [\"a\", \"a\"]\n")
+            .starts_with(":2: `campaign.conditions[1]`: `a` is listed twice"));
+        let no_work = "[campaign]\n\n[[records]]\nfile = \"r.csv\"\n";
+        assert!(message(no_work).starts_with(":3: `records[0]`: no experiment"));
+        assert!(message("[campaign]\nexperimnt = \"e.toml\"\n")
+            .starts_with(":2: `campaign`: unknown field `experimnt`"));
+    }
+}
