@@ -65,7 +65,8 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
     table::write_csv(&out.join("campaign.csv"), &table)?;
     report::write(&table, out)?;
     say!(
-        "wrote {0}/campaign.csv, {0}/campaign.json and {0}/report.md ({1} row(s))",
+        "wrote {0}/campaign.csv, {0}/campaign.json ({1} row(s)), {0}/report.html, {0}/report.md \
+         and {0}/figures/",
         out.display(),
         table.rows.len()
     );

@@ -305,3 +305,39 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
     );
     assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
 }
+
+#[test]
+fn the_report_draws_each_parameter_against_each_condition() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for figure in [
+        "power_law_K_vs_concentration",
+        "power_law_n_vs_F0",
+        "viscous_c_s_vs_F0",
+    ] {
+        assert!(md.contains(&format!("figures/{figure}.png")), "{figure}");
+        assert!(
+            out.join(format!("figures/{figure}.png")).is_file(),
+            "{figure}"
+        );
+    }
+    // The figure's data are the table's: the K of each record with its error, by F0.
+    let csv =
+        std::fs::read_to_string(out.join("figures/power_law_K_vs_concentration.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,F0 = 0.035: standard error,"),
+        "{header}"
+    );
+    assert_eq!(csv.lines().count(), 4);
+    assert!(
+        std::fs::read_to_string(out.join("report.html"))
+            .unwrap()
+            .contains("power_law: K against concentration")
+            || md.contains("K (± one standard error) against concentration")
+    );
+}
