@@ -507,7 +507,7 @@ mod tests {
             message("[[records]]\nfile = \"r.csv\"\n"),
             ":1: `campaign`: missing section [campaign]"
         );
-        assert!(message(&format!("{HEAD}")).starts_with(":1: `records`: no records"));
+        assert!(message(HEAD).starts_with(":1: `records`: no records"));
         assert!(message("[campaign]\nconditions = [\"file\"]\n")
             .starts_with(":2: `campaign.conditions[0]`: `file` is a record key"));
         assert!(message("[campaign]\nconditions = [\"a\", \"a\"]\n")
