@@ -183,12 +183,17 @@ fn compare_fits(
 /// Run `stf-lab compare`: the results are built in a staging folder and swapped in as a
 /// whole ([`ResultsDir`]).
 pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
-    let mut exp = Experiment::load(exp_path)?;
+    run_experiment(Experiment::load(exp_path)?, out_arg, force, quiet)
+}
+
+/// [`run`] on an experiment already loaded (a campaign's unit: its record set with
+/// [`Experiment::with_data_file`]).
+pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let data = load_data(&mut exp)?;
     if data.level != FitLevel::Force {
         bail!(
             "{}: compare scores models on the measured STF force; the record needs `f_stf`",
-            exp_path.display()
+            exp.path.display()
         );
     }
     let validation = crate::validation::load(&exp, &data)?;

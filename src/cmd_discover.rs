@@ -96,11 +96,16 @@ fn force_fit_settings(from: &FitSettings) -> FitSettings {
 /// Run `stf-lab discover`.
 /// The results are built in a staging folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
-    let mut exp = Experiment::load(exp_path)?;
+    run_experiment(Experiment::load(exp_path)?, out_arg, force, quiet)
+}
+
+/// [`run`] on an experiment already loaded (a campaign's unit: its record set with
+/// [`Experiment::with_data_file`]).
+pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let Some(spec) = exp.discover.clone() else {
         bail!(
             "{}: has no [discover] section (base = \"…\")",
-            exp_path.display()
+            exp.path.display()
         );
     };
     let data = load_data_at(&mut exp, spec.level).with_context(|| match spec.level {

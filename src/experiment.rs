@@ -141,6 +141,13 @@ fn folder_of(path: &Path) -> PathBuf {
 }
 
 impl Experiment {
+    /// This experiment with its `[data] file` replaced by `record` (a campaign runs one
+    /// experiment on many records): the layout keys of `[data]` stay; the file is untouched.
+    pub fn with_data_file(mut self, record: PathBuf) -> Experiment {
+        self.data_file = Some(record);
+        self
+    }
+
     /// Read and validate an experiment file.
     pub fn load(path: &Path) -> Result<Experiment> {
         Self::load_capped(path, MAX_EXPERIMENT_BYTES)

@@ -1,6 +1,6 @@
 //! `stf_lab`: the library behind the `stf-lab` program of the shear-thickening fluid lab. It
 //! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
-//! compare, discover, models), scores fitted models on a second record ([`validation`]), and
+//! compare, discover, models, and [`campaign`]s of them over many records), scores fitted models on a second record ([`validation`]), and
 //! writes results ([`outputs`]: one `Serialize` type a file, written by [`output`]), figures
 //! and reports ([`report`], [`reporting`],
 //! [`discovery_curves`]). The binary (`src/main.rs`) only parses the command line and
@@ -10,6 +10,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![deny(clippy::unwrap_used)]
 
+pub mod campaign;
+pub mod cmd_campaign;
 pub mod cmd_compare;
 pub mod cmd_discover;
 pub mod cmd_fit;

@@ -6,6 +6,7 @@
 //! stf-lab fit EXP.toml --out DIR          calibrate every model of the experiment
 //! stf-lab compare EXP.toml --out DIR      fit, then compare models on the regime metrics
 //! stf-lab discover EXP.toml --out DIR     find, name and add the missing effect
+//! stf-lab campaign C.toml --out DIR       run fit, compare or discover over many records
 //! ```
 //!
 //! Every command takes `-q`/`--quiet`; `-o` is `--out` and `-f` is `--force`.
@@ -16,7 +17,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use stf_lab::{cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt, tell};
+use stf_lab::{
+    cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt, tell,
+};
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.
 #[derive(Parser)]
@@ -85,6 +88,24 @@ enum Command {
         #[arg(short, long)]
         force: bool,
     },
+    /// Run fit, compare or discover on every record of a campaign file, then tabulate.
+    Campaign {
+        /// The campaign file ([campaign] and [[records]]).
+        campaign: PathBuf,
+        /// Folder for the units' results, campaign.csv, campaign.json and the report (a rerun
+        /// into it resumes: units whose inputs have not changed are skipped).
+        #[arg(short, long)]
+        out: PathBuf,
+        /// Rerun every unit, finished or not.
+        #[arg(short, long)]
+        force: bool,
+        /// Units run at once (default: the number of cores).
+        #[arg(short, long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Run unit N (the N-th record, from 1) alone, in this process, into DIR/units/.
+        #[arg(long, value_name = "N")]
+        unit: Option<usize>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -116,6 +137,22 @@ fn main() -> ExitCode {
             out,
             force,
         } => cmd_discover::run(&experiment, &out, force, quiet),
+        Command::Campaign {
+            campaign,
+            out,
+            force,
+            jobs,
+            unit,
+        } => cmd_campaign::run(
+            &campaign,
+            &out,
+            &cmd_campaign::Settings {
+                force,
+                quiet,
+                jobs,
+                unit,
+            },
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -32,6 +32,7 @@ pub const RESULT_NAMES: &[&str] = &[
     "cycles.csv",
     "discovery.json",
     "discovered.csv",
+    "unit.json",
     "report.html",
     "report.md",
     "figures",

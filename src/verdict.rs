@@ -13,23 +13,35 @@ use crate::fitting::ModelFit;
 /// (Burnham & Anderson's rule of thumb: ΔAIC < 2, substantial support for both).
 const AIC_TIE: f64 = 2.0;
 
+/// The best of fits given as `(AIC, free parameters)`: among those the data do not tell apart
+/// from the lowest finite AIC (within ΔAIC 2), the simplest; its index, `None` if no AIC is
+/// finite. The rule of [`fit_verdict`], shared with the campaign table.
+pub fn best_by_aic(fits: &[(f64, usize)]) -> Option<usize> {
+    let lowest = fits
+        .iter()
+        .map(|f| f.0)
+        .filter(|a| a.is_finite())
+        .min_by(f64::total_cmp)?;
+    let mut near: Vec<usize> = (0..fits.len())
+        .filter(|&i| fits[i].0.is_finite() && fits[i].0 - lowest < AIC_TIE)
+        .collect();
+    // The lowest AIC first among equally simple ones.
+    near.sort_by(|&a, &b| fits[a].0.total_cmp(&fits[b].0));
+    near.into_iter().min_by_key(|&i| fits[i].1)
+}
+
 /// The verdict of a set of fits: the best by AIC, how far the others are behind (ΔAIC and
 /// RMS), and the warnings that stand against the best and the others.
 pub fn fit_verdict(fits: &[ModelFit], level: FitLevel) -> String {
     let (unit, scale) = level.shown();
     let mut ranked: Vec<&ModelFit> = fits.iter().filter(|f| f.result.aic.is_finite()).collect();
     ranked.sort_by(|a, b| a.result.aic.total_cmp(&b.result.aic));
-    let Some(lowest) = ranked.first().map(|f| f.result.aic) else {
+    let free = |f: &ModelFit| f.result.params.iter().filter(|p| !p.fixed).count();
+    let scored: Vec<(f64, usize)> = fits.iter().map(|f| (f.result.aic, free(f))).collect();
+    let Some(best) = best_by_aic(&scored).map(|i| &fits[i]) else {
         return "No model could be fitted: see the warnings below.".into();
     };
-    // Among the fits the data do not tell apart from the lowest AIC, the simplest.
-    let free = |f: &ModelFit| f.result.params.iter().filter(|p| !p.fixed).count();
-    let best = ranked
-        .iter()
-        .filter(|f| f.result.aic - lowest < AIC_TIE)
-        .min_by_key(|f| free(f))
-        .copied()
-        .unwrap_or(ranked[0]);
+    let lowest = ranked[0].result.aic;
     let mut text = format!(
         "Best fit: `{}`, RMS residual {:.4} {unit}, AIC {:.1}{}.",
         best.label,

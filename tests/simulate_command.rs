@@ -174,6 +174,14 @@ fn a_run_too_long_for_memory_is_refused_before_it_starts() {
 fn bundled_records_regenerate_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
     let mut stale = Vec::new();
+    // The bundled campaign's records: `experiments/campaign/records/<name>.toml` makes
+    // `<name>.csv`.
+    let campaign: Vec<(String, String)> = ["a1", "a2", "a3"]
+        .iter()
+        .flat_map(|a| ["c1", "c2", "c3"].map(|c| format!("experiments/campaign/records/{a}_{c}")))
+        .map(|stem| (format!("{stem}.toml"), format!("{stem}.csv")))
+        .collect();
+    let campaign = campaign.iter().map(|(e, r)| (e.as_str(), r.as_str()));
     for (exp, record) in [
         (
             "experiments/discovery.toml",
@@ -199,7 +207,10 @@ fn bundled_records_regenerate_byte_for_byte() {
             "experiments/trajectory_discovery.toml",
             "experiments/records/trajectory_discovery.csv",
         ),
-    ] {
+    ]
+    .into_iter()
+    .chain(campaign)
+    {
         let out = dir.path().join("again.csv");
         let run = stf_lab()
             .arg("simulate")

@@ -22,7 +22,13 @@ pub(crate) struct Ctx<'a> {
     pub(super) text: &'a str,
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
+    /// Errors about `text`, the contents of `file` (another TOML file read the same way, such
+    /// as a campaign file).
+    pub(crate) fn new(file: &'a Path, text: &'a str) -> Self {
+        Ctx { file, text }
+    }
+
     /// The 1-based line of a byte offset.
     pub(crate) fn line(&self, offset: usize) -> usize {
         line_of(self.text, offset)

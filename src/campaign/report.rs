@@ -1,0 +1,221 @@
+//! The campaign's report: `report.md` and `report.html` (the house's report module,
+//! `crate::report`) with, for each model's fitted parameter, a figure of its value against
+//! each condition with ±1 standard error bars — one series per combination of the other
+//! conditions — and the campaign table. Figures go to `figures/` as SVG, PNG and CSV.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::Result;
+
+use super::table::{param_names, CampaignJson, CampaignRow};
+use crate::digits::{carried, with_error};
+use crate::report::{self, ErrorPoint, ErrorSeries, FigureRef, Report, Section, Table};
+
+/// Write `report.md`, `report.html` and `figures/` of `table` into `out`.
+pub fn write(table: &CampaignJson, out: &Path) -> Result<()> {
+    let mut doc = Report::new(format!("Campaign {}", table.campaign));
+    let ok_units = table.units - table.failed;
+    doc.intro.push(format!(
+        "stf-lab ran the {} unit(s) of {}: {ok_units} wrote results, {} failed. A row per \
+         record and model; parameters in SI units, ± one standard error (block-robust).",
+        table.units, table.campaign, table.failed
+    ));
+    let figures = parameter_figures(table, &out.join("figures"))?;
+    if !figures.is_empty() {
+        let mut section = Section::new("Parameters against the conditions");
+        section.paragraphs.push(
+            "Each fitted parameter against each condition, one marker per record with its ± one \
+             standard error bar; one colour per value of the other conditions (markers that \
+             share a condition are set slightly apart)."
+                .into(),
+        );
+        section.figures = figures;
+        doc.sections.push(section);
+    }
+    let mut section = Section::new("Table");
+    section.tables.push(table_of(table));
+    doc.sections.push(section);
+    report::write_markdown(&doc, &out.join("report.md"))?;
+    report::write_html(&doc, &out.join("report.html"))?;
+    Ok(())
+}
+
+/// The rows that carry results.
+fn ok_rows(table: &CampaignJson) -> impl Iterator<Item = &CampaignRow> {
+    table.rows.iter().filter(|r| r.status == "ok")
+}
+
+/// A figure per model, fitted parameter and condition that varies.
+fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>> {
+    let mut models: Vec<&str> = Vec::new();
+    for r in ok_rows(table) {
+        if let Some(m) = r.model.as_deref().filter(|m| !models.contains(m)) {
+            models.push(m);
+        }
+    }
+    let mut figures = Vec::new();
+    for model in models {
+        let rows: Vec<&CampaignRow> = ok_rows(table)
+            .filter(|r| r.model.as_deref() == Some(model))
+            .collect();
+        let owned: Vec<CampaignRow> = rows.iter().map(|r| (*r).clone()).collect();
+        for param in param_names(&owned) {
+            // A parameter held on every record (no standard error anywhere) has nothing to show.
+            let fitted = rows
+                .iter()
+                .any(|r| r.params.get(&param).is_some_and(|p| p.std_error.is_some()));
+            if !fitted {
+                continue;
+            }
+            for condition in &table.conditions {
+                let distinct = distinct_values(&rows, condition);
+                if distinct < 2 {
+                    continue;
+                }
+                let series = series_of(&rows, &param, condition, &table.conditions);
+                let name = file_name(&format!("{model}_{param}_vs_{condition}"));
+                let title = format!("{model}: {param} against {condition}");
+                let files = report::error_bars(dir, &name, &title, (condition, &param), &series)?;
+                figures.push(FigureRef::new(
+                    files,
+                    format!(
+                        "`{model}`'s fitted {param} (± one standard error) against {condition}, \
+                         over {} record(s).",
+                        rows.len()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(figures)
+}
+
+/// How many different values `condition` takes over `rows`.
+fn distinct_values(rows: &[&CampaignRow], condition: &str) -> usize {
+    let mut values: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| r.conditions.get(condition).copied())
+        .collect();
+    values.sort_by(f64::total_cmp);
+    values.dedup();
+    values.len()
+}
+
+/// `param` against `condition`, one series per combination of the other conditions.
+fn series_of(
+    rows: &[&CampaignRow],
+    param: &str,
+    condition: &str,
+    conditions: &[String],
+) -> Vec<ErrorSeries> {
+    let mut groups: BTreeMap<String, Vec<ErrorPoint>> = BTreeMap::new();
+    let mut order: Vec<String> = Vec::new();
+    for r in rows {
+        let (Some(x), Some(p)) = (r.conditions.get(condition), r.params.get(param)) else {
+            continue;
+        };
+        let label: Vec<String> = conditions
+            .iter()
+            .filter(|c| *c != condition)
+            .filter_map(|c| {
+                r.conditions
+                    .get(c)
+                    .map(|v| format!("{c} = {}", carried(*v)))
+            })
+            .collect();
+        let label = if label.is_empty() {
+            "records".to_string()
+        } else {
+            label.join(", ")
+        };
+        if !order.contains(&label) {
+            order.push(label.clone());
+        }
+        groups
+            .entry(label)
+            .or_default()
+            .push((*x, p.value, p.std_error.unwrap_or(f64::NAN)));
+    }
+    order
+        .into_iter()
+        .map(|label| ErrorSeries {
+            points: groups.remove(&label).unwrap_or_default(),
+            label,
+        })
+        .collect()
+}
+
+/// A figure's file name: letters, digits, `-` and `_`.
+fn file_name(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The table for a person: conditions, model, parameters ± errors, RMS, verdicts.
+fn table_of(table: &CampaignJson) -> Table {
+    let mut columns: Vec<String> = vec!["unit".into(), "record".into()];
+    columns.extend(table.conditions.iter().cloned());
+    columns.extend(
+        [
+            "model",
+            "parameters (± standard error)",
+            "RMS",
+            "best",
+            "warnings",
+            "status",
+        ]
+        .map(String::from),
+    );
+    let rows = table
+        .rows
+        .iter()
+        .map(|r| {
+            let mut cells = vec![r.unit.to_string(), r.record.clone()];
+            cells.extend(table.conditions.iter().map(|c| {
+                r.conditions
+                    .get(c)
+                    .map_or(String::new(), |v| carried(*v).to_string())
+            }));
+            let params: Vec<String> = r
+                .params
+                .iter()
+                .map(|(n, p)| match p.std_error {
+                    Some(e) => format!("{n} = {}", with_error(p.value, e)),
+                    None => format!("{n} = {}", carried(p.value)),
+                })
+                .collect();
+            let rms = match (r.rms, &r.rms_unit) {
+                (Some(v), Some(u)) => format!("{v:.4} {u}"),
+                _ => String::new(),
+            };
+            cells.extend([
+                r.model.clone().unwrap_or_default(),
+                params.join(", "),
+                rms,
+                r.best.map_or(
+                    String::new(),
+                    |b| if b { "yes".into() } else { String::new() },
+                ),
+                r.warnings.join(", "),
+                match &r.error {
+                    Some(e) => format!("failed: {e}"),
+                    None => r.status.to_string(),
+                },
+            ]);
+            cells
+        })
+        .collect();
+    Table {
+        caption: String::new(),
+        columns,
+        rows,
+    }
+}

@@ -1,0 +1,243 @@
+//! The campaign table: one row per record × model, built from the units' `unit.json` and
+//! their command's JSON ([`super::unit_results`]), written as `campaign.json`
+//! ([`CampaignJson`]) and `campaign.csv` (the same rows flattened: a column per condition,
+//! and a value and a `_std_error` column per parameter name met in any row). A unit that
+//! failed, or never wrote its `unit.json`, is a row with its error, not a missing row.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use indexmap::IndexMap;
+use serde::Serialize;
+
+use super::file::{Campaign, CommandName};
+use super::unit::{read_unit_json, unit_dir, UnitStatus};
+use super::unit_results::{self, ModelResult, ParamValue};
+use crate::digits::carried;
+
+/// One row: a model fitted to one record (or a failed unit).
+#[derive(Clone, Debug, Serialize)]
+pub struct CampaignRow {
+    /// The unit's number.
+    pub unit: usize,
+    /// The record, as written in the campaign file.
+    pub record: String,
+    /// The command the unit ran.
+    pub command: CommandName,
+    /// The record's conditions, by name, in the campaign's order.
+    pub conditions: IndexMap<String, f64>,
+    /// `ok` or `failed`.
+    pub status: &'static str,
+    /// Why the unit failed.
+    pub error: Option<String>,
+    /// The model's label (null for a failed unit).
+    pub model: Option<String>,
+    /// Each parameter's value and standard error, SI units.
+    pub params: BTreeMap<String, ParamValue>,
+    /// RMS residual in `rms_unit` (`discover`: the final model's held-out gap).
+    pub rms: Option<f64>,
+    /// `N` or `m`.
+    pub rms_unit: Option<String>,
+    /// Akaike information criterion.
+    pub aic: Option<f64>,
+    /// Bayesian information criterion.
+    pub bic: Option<f64>,
+    /// Whether the fit converged.
+    pub converged: Option<bool>,
+    /// The unit's best model (`fit`: by AIC, the simplest within ΔAIC 2; `compare`: overall).
+    pub best: Option<bool>,
+    /// Kinds of the fit's warnings (`not_converged`, `above_noise_floor`, …).
+    pub warnings: Vec<String>,
+    /// The error on the `[validate]` record.
+    pub validation_rms: Option<f64>,
+    /// Effects named (`discover`).
+    pub effects: Option<Vec<String>>,
+    /// The base model's held-out gap (`discover`), unit of `rms`.
+    pub gap_before: Option<f64>,
+    /// Wall time of the unit's command, s.
+    pub wall_seconds: Option<f64>,
+}
+
+/// `campaign.json`.
+#[derive(Debug, Serialize)]
+pub struct CampaignJson {
+    /// The campaign file, as given.
+    pub campaign: String,
+    /// Condition names.
+    pub conditions: Vec<String>,
+    /// Units in the campaign.
+    pub units: usize,
+    /// Units that failed.
+    pub failed: usize,
+    /// The rows.
+    pub rows: Vec<CampaignRow>,
+}
+
+/// The table of `campaign` from its output folder `out`; `errors` holds, by unit number, why
+/// a unit the runner ran has no results (used when its folder says nothing).
+pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> CampaignJson {
+    let mut rows = Vec::new();
+    let mut failed = 0;
+    for unit in &campaign.units {
+        let dir = unit_dir(out, unit);
+        let json = read_unit_json(&dir);
+        let base = CampaignRow {
+            unit: unit.number,
+            record: unit.record_given.clone(),
+            command: unit.command,
+            conditions: unit.conditions.iter().cloned().collect(),
+            status: "ok",
+            error: None,
+            model: None,
+            params: BTreeMap::new(),
+            rms: None,
+            rms_unit: None,
+            aic: None,
+            bic: None,
+            converged: None,
+            best: None,
+            warnings: Vec::new(),
+            validation_rms: None,
+            effects: None,
+            gap_before: None,
+            wall_seconds: json.as_ref().map(|u| u.wall_seconds),
+        };
+        let results = match (&json, errors.get(&unit.number)) {
+            (_, Some(e)) => Err(e.clone()),
+            (None, None) => Err(format!(
+                "no {} in {}",
+                super::unit::UNIT_JSON,
+                dir.display()
+            )),
+            (Some(u), None) if u.status == UnitStatus::Failed => {
+                Err(u.error.clone().unwrap_or_else(|| "failed".into()))
+            }
+            (Some(_), None) => unit_results::read(unit.command, &dir).map_err(|e| format!("{e:#}")),
+        };
+        match results {
+            Ok(models) => rows.extend(models.into_iter().map(|m| with_model(&base, m))),
+            Err(e) => {
+                failed += 1;
+                rows.push(CampaignRow {
+                    status: "failed",
+                    error: Some(e),
+                    ..base
+                });
+            }
+        }
+    }
+    CampaignJson {
+        campaign: campaign.path.display().to_string(),
+        conditions: campaign.conditions.clone(),
+        units: campaign.units.len(),
+        failed,
+        rows,
+    }
+}
+
+/// `base` with a model's results.
+fn with_model(base: &CampaignRow, m: ModelResult) -> CampaignRow {
+    CampaignRow {
+        model: Some(m.model),
+        params: m.params,
+        rms: m.rms,
+        rms_unit: m.rms_unit,
+        aic: m.aic,
+        bic: m.bic,
+        converged: m.converged,
+        best: m.best,
+        warnings: m.warnings,
+        validation_rms: m.validation_rms,
+        effects: m.effects,
+        gap_before: m.gap_before,
+        ..base.clone()
+    }
+}
+
+/// Every parameter name of the table, in order of first appearance.
+pub fn param_names(rows: &[CampaignRow]) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for r in rows {
+        for name in r.params.keys() {
+            if !names.contains(name) {
+                names.push(name.clone());
+            }
+        }
+    }
+    names
+}
+
+/// `campaign.csv`: `unit, record, command, status, <conditions…>, model, <param>,
+/// <param>_std_error …, rms, rms_unit, aic, bic, converged, best, warnings, validation_rms,
+/// effects, gap_before, wall_seconds, error` (lists joined with `;`).
+pub fn write_csv(path: &Path, table: &CampaignJson) -> Result<()> {
+    let names = param_names(&table.rows);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = ["unit", "record", "command", "status"]
+        .map(String::from)
+        .to_vec();
+    header.extend(table.conditions.iter().cloned());
+    header.push("model".into());
+    for n in &names {
+        header.push(n.clone());
+        header.push(format!("{n}_std_error"));
+    }
+    header.extend(
+        [
+            "rms",
+            "rms_unit",
+            "aic",
+            "bic",
+            "converged",
+            "best",
+            "warnings",
+            "validation_rms",
+            "effects",
+            "gap_before",
+            "wall_seconds",
+            "error",
+        ]
+        .map(String::from),
+    );
+    w.write_record(&header)?;
+    for r in &table.rows {
+        w.write_record(csv_row(r, &table.conditions, &names))?;
+    }
+    let bytes = w.into_inner().context("cannot build campaign.csv")?;
+    crate::output::write_atomic(path, &bytes)
+}
+
+/// One row's fields in the order of the header.
+fn csv_row(r: &CampaignRow, conditions: &[String], names: &[String]) -> Vec<String> {
+    let num = |x: Option<f64>| x.map(|x| carried(x).to_string()).unwrap_or_default();
+    let flag = |b: Option<bool>| b.map(|b| b.to_string()).unwrap_or_default();
+    let mut f = vec![
+        r.unit.to_string(),
+        r.record.clone(),
+        r.command.name().to_string(),
+        r.status.to_string(),
+    ];
+    f.extend(conditions.iter().map(|c| num(r.conditions.get(c).copied())));
+    f.push(r.model.clone().unwrap_or_default());
+    for n in names {
+        let p = r.params.get(n);
+        f.push(num(p.map(|p| p.value)));
+        f.push(num(p.and_then(|p| p.std_error)));
+    }
+    f.extend([
+        num(r.rms),
+        r.rms_unit.clone().unwrap_or_default(),
+        num(r.aic),
+        num(r.bic),
+        flag(r.converged),
+        flag(r.best),
+        r.warnings.join(";"),
+        num(r.validation_rms),
+        r.effects.as_ref().map(|e| e.join(";")).unwrap_or_default(),
+        num(r.gap_before),
+        num(r.wall_seconds),
+        r.error.clone().unwrap_or_default(),
+    ]);
+    f
+}

@@ -1,0 +1,189 @@
+//! A fitted value against a condition, with error bars: one marker per record at its
+//! condition's value, a vertical bar of ±1 standard error, one colour per series (the
+//! records that share the other conditions). Series sharing an x are nudged apart by a small
+//! fraction of the x span so their bars do not hide one another; the CSV holds the true x.
+//! The bars are drawn as plain paths (plotters' `ErrorBar` needs a feature this build does
+//! not enable, and two lines are all it is).
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::colour::series_colour;
+use super::figure::{
+    axis_desc_style, draw_legend, msg, render, tick_label, tick_style, title_style, Draw,
+    FigureFiles, SIZE,
+};
+use super::plot_range::{finite_bounds, padded_range};
+use super::series_csv::Column;
+use super::ReportError;
+
+/// One point: condition value, fitted value, its standard error (NaN: no bar).
+pub type ErrorPoint = (f64, f64, f64);
+
+/// A series of points under one legend label.
+#[derive(Clone, Debug)]
+pub struct ErrorSeries {
+    /// Legend label (e.g. `F0 = 0.035`).
+    pub label: String,
+    /// Its points.
+    pub points: Vec<ErrorPoint>,
+}
+
+struct ErrorBarPlot<'a> {
+    title: &'a str,
+    x_label: &'a str,
+    y_label: &'a str,
+    series: &'a [ErrorSeries],
+}
+
+impl ErrorBarPlot<'_> {
+    /// The x and y ranges: every point with its bar.
+    fn ranges(&self) -> Option<(std::ops::Range<f64>, std::ops::Range<f64>)> {
+        let xs: Vec<f64> = self.points().map(|p| p.0).collect();
+        let ys: Vec<f64> = self
+            .points()
+            .flat_map(|(_, y, e)| {
+                let e = if e.is_finite() { e } else { 0.0 };
+                [y - e, y + e]
+            })
+            .collect();
+        Some((padded_range(&xs)?, padded_range(&ys)?))
+    }
+
+    fn points(&self) -> impl Iterator<Item = ErrorPoint> + '_ {
+        self.series.iter().flat_map(|s| s.points.iter().copied())
+    }
+}
+
+impl Draw for ErrorBarPlot<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let (xr, yr) = self.ranges().ok_or("no finite point")?;
+        let (x_span, y_span) = (xr.end - xr.start, yr.end - yr.start);
+        let root = root.titled(self.title, title_style()).map_err(msg)?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .margin_right(30)
+            .x_label_area_size(50)
+            .y_label_area_size(90)
+            .build_cartesian_2d(xr.clone(), yr.clone())
+            .map_err(msg)?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label)
+            .y_desc(self.y_label)
+            .x_label_formatter(&|v| tick_label(*v, x_span))
+            .y_label_formatter(&|v| tick_label(*v, y_span))
+            .axis_desc_style(axis_desc_style())
+            .label_style(tick_style())
+            .draw()
+            .map_err(msg)?;
+        let n = self.series.len();
+        for (i, s) in self.series.iter().enumerate() {
+            let colour = series_colour(i);
+            let nudge = (i as f64 - (n as f64 - 1.0) / 2.0) * 0.012 * x_span;
+            let points: Vec<ErrorPoint> = s
+                .points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .map(|&(x, y, e)| (x + nudge, y, e))
+                .collect();
+            let cap = 0.006 * x_span;
+            let bars = points
+                .iter()
+                .filter(|p| p.2.is_finite())
+                .flat_map(|&(x, y, e)| {
+                    let style = colour.stroke_width(2);
+                    [
+                        PathElement::new(vec![(x, y - e), (x, y + e)], style),
+                        PathElement::new(vec![(x - cap, y - e), (x + cap, y - e)], style),
+                        PathElement::new(vec![(x - cap, y + e), (x + cap, y + e)], style),
+                    ]
+                });
+            chart.draw_series(bars).map_err(msg)?;
+            chart
+                .draw_series(
+                    points
+                        .iter()
+                        .map(|&(x, y, _)| Circle::new((x, y), 5, colour.filled())),
+                )
+                .map_err(msg)?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| Circle::new((x + 12, y), 5, colour.filled()));
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+/// Draw `series` (points with ±1 standard error bars) against the condition `x_label` to
+/// `out_dir/name.{svg,png,csv}`; the CSV has per series its x, value and standard error.
+pub fn error_bars(
+    out_dir: &Path,
+    name: &str,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[ErrorSeries],
+) -> Result<FigureFiles, ReportError> {
+    let all = series.iter().flat_map(|s| s.points.iter());
+    if finite_bounds(all.map(|p| &p.1)).is_none() {
+        return Err(ReportError::NoData {
+            what: format!("{title}: no finite value"),
+        });
+    }
+    let plot = ErrorBarPlot {
+        title,
+        x_label,
+        y_label,
+        series,
+    };
+    let columns: Vec<Column> = series
+        .iter()
+        .flat_map(|s| {
+            let of = |f: fn(&ErrorPoint) -> f64| s.points.iter().map(f).collect::<Vec<f64>>();
+            [
+                Column::new(format!("{}: {x_label}", s.label), of(|p| p.0)),
+                Column::new(format!("{}: {y_label}", s.label), of(|p| p.1)),
+                Column::new(format!("{}: standard error", s.label), of(|p| p.2)),
+            ]
+        })
+        .collect();
+    render(out_dir, name, SIZE, &plot, &columns)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_points_with_bars_and_their_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        let series = vec![
+            ErrorSeries {
+                label: "F0 = 0.035".into(),
+                points: vec![(0.36, 2.5, 0.4), (0.40, 4.2, 0.3), (0.44, 7.2, f64::NAN)],
+            },
+            ErrorSeries {
+                label: "F0 = 0.06".into(),
+                points: vec![(0.36, 2.1, 0.05), (0.40, 4.0, 0.06)],
+            },
+        ];
+        let files = error_bars(
+            dir.path(),
+            "k",
+            "power_law K against concentration",
+            ("concentration", "K"),
+            &series,
+        )
+        .unwrap();
+        assert!(std::fs::metadata(&files.png).unwrap().len() > 1000);
+        let csv = std::fs::read_to_string(&files.csv).unwrap();
+        assert!(
+            csv.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,"),
+            "{csv}"
+        );
+        assert_eq!(csv.lines().count(), 4, "{csv}");
+        let none = error_bars(dir.path(), "n", "t", ("x", "y"), &[]);
+        assert!(none.is_err());
+    }
+}

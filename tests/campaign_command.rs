@@ -1,0 +1,339 @@
+//! End-to-end tests of `stf-lab campaign` on the bundled example (`experiments/campaign/`:
+//! 9 records, 3 forcing amplitudes × 3 concentrations, K = 4·(c/0.40)^6): the table's rows,
+//! the law recovered record by record, resuming, a unit run alone, a failed unit's row and
+//! bad campaign input refused before any unit starts.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use common::{read_json, root, stf_lab};
+
+/// The bundled campaign copied into a temporary folder (records are changed by the tests).
+fn bundled_copy(dir: &Path) -> PathBuf {
+    let from = root().join("experiments/campaign");
+    let to = dir.join("campaign");
+    std::fs::create_dir_all(to.join("records")).unwrap();
+    for sub in ["", "records"] {
+        for entry in std::fs::read_dir(from.join(sub)).unwrap() {
+            let entry = entry.unwrap();
+            if entry.file_type().unwrap().is_file() {
+                std::fs::copy(entry.path(), to.join(sub).join(entry.file_name())).unwrap();
+            }
+        }
+    }
+    to.join("campaign.toml")
+}
+
+/// `stf-lab campaign CAMPAIGN --out OUT ARGS…`.
+fn campaign(file: &Path, out: &Path, args: &[&str]) -> Output {
+    stf_lab()
+        .arg("campaign")
+        .arg(file)
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The law the bundled records were made with.
+fn k_law(concentration: f64) -> f64 {
+    4.0 * (concentration / 0.40).powi(6)
+}
+
+/// The rows of campaign.json.
+fn rows(out: &Path) -> Vec<serde_json::Value> {
+    read_json(&out.join("campaign.json"))["rows"]
+        .as_array()
+        .unwrap()
+        .clone()
+}
+
+#[test]
+fn the_bundled_campaign_tabulates_every_record_and_model_and_resumes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let first = campaign(&file, &out, &["--jobs", "2"]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    assert_eq!(
+        stdout(&first).matches(": ok, ").count(),
+        9,
+        "{}",
+        stdout(&first)
+    );
+
+    // One row per record × model, with conditions, parameters and verdicts.
+    let rows = rows(&out);
+    assert_eq!(rows.len(), 18);
+    let power: Vec<&serde_json::Value> =
+        rows.iter().filter(|r| r["model"] == "power_law").collect();
+    assert_eq!(power.len(), 9);
+    let mut worst: f64 = 0.0;
+    for r in &power {
+        assert_eq!(r["status"], "ok");
+        assert_eq!(r["converged"], true);
+        let c = r["conditions"]["concentration"].as_f64().unwrap();
+        let k = r["params"]["K"]["value"].as_f64().unwrap();
+        let se = r["params"]["K"]["std_error"].as_f64().unwrap();
+        let z = (k - k_law(c)) / se;
+        worst = worst.max(z.abs());
+        assert!(
+            z.abs() < 3.0,
+            "{}: K {k} ± {se} against {}",
+            r["record"],
+            k_law(c)
+        );
+    }
+    println!("largest |K − law| over its standard error: {worst:.2}");
+    // The verdict: one best model per unit.
+    for unit in 1..=9 {
+        let best = rows
+            .iter()
+            .filter(|r| r["unit"] == unit && r["best"] == true)
+            .count();
+        assert_eq!(best, 1, "unit {unit}");
+    }
+    let csv = std::fs::read_to_string(out.join("campaign.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("unit,record,command,status,F0,concentration,model,")
+            && header.contains(",K,K_std_error,n,n_std_error,"),
+        "{header}"
+    );
+    assert_eq!(csv.lines().count(), 19);
+
+    // A second run skips every unit and leaves their results as they were.
+    let unit_json = out.join("units/001-a1_c1/unit.json");
+    let before = std::fs::read(&unit_json).unwrap();
+    let second = campaign(&file, &out, &["--jobs", "2"]);
+    assert!(second.status.success(), "{}", stderr(&second));
+    assert_eq!(
+        stdout(&second).matches("skipped").count(),
+        9,
+        "{}",
+        stdout(&second)
+    );
+    assert!(stdout(&second).contains("9 unit(s), 0 to run"));
+    assert_eq!(std::fs::read(&unit_json).unwrap(), before);
+
+    // A changed record reruns its unit alone; so does a unit whose unit.json is missing (a
+    // unit killed midway writes none).
+    let record = file.parent().unwrap().join("records/a1_c1.csv");
+    let other = file.parent().unwrap().join("records/a1_c2.csv");
+    std::fs::copy(&other, &record).unwrap();
+    std::fs::remove_file(out.join("units/005-a2_c2/unit.json")).unwrap();
+    let third = campaign(&file, &out, &["--jobs", "2"]);
+    assert!(third.status.success(), "{}", stderr(&third));
+    let said = stdout(&third);
+    assert!(
+        said.contains("unit 1 (records/a1_c1.csv): its inputs changed: rerun"),
+        "{said}"
+    );
+    assert!(said.contains("9 unit(s), 2 to run"), "{said}");
+    assert_eq!(said.matches("skipped").count(), 7, "{said}");
+    assert!(said.contains("unit 5 records/a2_c2.csv: ok"), "{said}");
+    let k1 = rows_k(&out, 1);
+    let k2 = rows_k(&out, 2);
+    assert_eq!(k1, k2, "unit 1 now fits unit 2's record");
+}
+
+/// The power law's K in unit `unit`'s row.
+fn rows_k(out: &Path, unit: usize) -> f64 {
+    rows(out)
+        .iter()
+        .find(|r| r["unit"] == unit && r["model"] == "power_law")
+        .unwrap()["params"]["K"]["value"]
+        .as_f64()
+        .unwrap()
+}
+
+#[test]
+fn a_unit_run_alone_writes_what_the_runner_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let text = std::fs::read_to_string(&file).unwrap();
+    // The first two records only.
+    let cut: String = text
+        .split("\n[[records]]")
+        .take(3)
+        .collect::<Vec<_>>()
+        .join("\n[[records]]");
+    std::fs::write(&file, cut).unwrap();
+    let all = tmp.path().join("all");
+    let run = campaign(&file, &all, &["--jobs", "1", "--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let alone = tmp.path().join("alone");
+    let run = campaign(&file, &alone, &["--unit", "2", "--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    for name in ["fit.json", "params.csv", "fitted.csv"] {
+        assert_eq!(
+            std::fs::read(all.join("units/002-a1_c2").join(name)).unwrap(),
+            std::fs::read(alone.join("units/002-a1_c2").join(name)).unwrap(),
+            "{name}"
+        );
+    }
+    let a = read_json(&all.join("units/002-a1_c2/unit.json"));
+    let b = read_json(&alone.join("units/002-a1_c2/unit.json"));
+    assert_eq!(a["inputs_hash"], b["inputs_hash"]);
+    let e = stderr(&campaign(&file, &alone, &["--unit", "3"]));
+    assert!(
+        e.contains("no unit 3: the campaign has units 1 to 2"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_failed_unit_is_a_row_with_its_error_and_the_others_still_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let dir = file.parent().unwrap();
+    std::fs::write(dir.join("records/broken.csv"), "t,phi,x\n0,0,0\n1,zero,0\n").unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    let cut: String = text
+        .split("\n[[records]]")
+        .take(2)
+        .collect::<Vec<_>>()
+        .join("\n[[records]]");
+    let cut =
+        format!("{cut}\n[[records]]\nfile = \"records/broken.csv\"\nF0 = 1\nconcentration = 0.5\n");
+    std::fs::write(&file, cut).unwrap();
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(!run.status.success());
+    assert!(
+        stderr(&run).contains("1 of 2 unit(s) failed"),
+        "{}",
+        stderr(&run)
+    );
+    let rows = rows(&out);
+    assert_eq!(rows.len(), 3);
+    let failed = rows.iter().find(|r| r["unit"] == 2).unwrap();
+    assert_eq!(failed["status"], "failed");
+    assert!(
+        failed["error"].as_str().unwrap().contains("broken.csv"),
+        "{failed}"
+    );
+    assert_eq!(failed["conditions"]["F0"], 1.0);
+    let unit = read_json(&out.join("units/002-broken/unit.json"));
+    assert_eq!(unit["status"], "failed");
+    // A failed unit is tried again on the next run.
+    let again = campaign(&file, &out, &[]);
+    assert!(stdout(&again).contains("unit 2 (records/broken.csv): it failed last time: rerun"));
+}
+
+#[test]
+fn bad_campaign_input_is_refused_before_any_unit_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let dir = file.parent().unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    let line_of = |needle: &str, t: &str| t[..t.find(needle).unwrap()].matches('\n').count() + 1;
+    let cases: Vec<(String, String, String)> = vec![
+        {
+            let t = text.replacen("records/a2_c2.csv", "records/missing.csv", 1);
+            let at = line_of("records/missing.csv", &t);
+            (
+                t,
+                format!(":{at}: `records[4].file`: no such record"),
+                "missing record".into(),
+            )
+        },
+        {
+            let t = text.replacen("concentration = 0.36", "concentration = \"high\"", 1);
+            let at = line_of("\"high\"", &t);
+            (
+                t,
+                format!(":{at}: `records[0].concentration`: a condition is a finite number, found the string \"high\""),
+                "not a number".into(),
+            )
+        },
+        {
+            let t = text.replacen("command = \"fit\"", "command = \"fitt\"", 1);
+            let at = line_of("\"fitt\"", &t);
+            (
+                t,
+                format!(":{at}: `campaign.command`: unknown variant `fitt`"),
+                "unknown command".into(),
+            )
+        },
+        {
+            let t = text.replacen(
+                "experiment = \"power_law.toml\"",
+                "experiment = \"bad.toml\"",
+                1,
+            );
+            std::fs::write(dir.join("bad.toml"), "[system]\nm = 7.65\nstifnes = 3\n").unwrap();
+            (
+                t,
+                "bad.toml:3: `system`: unknown field `stifnes`".into(),
+                "experiment that does not parse".into(),
+            )
+        },
+    ];
+    for (t, expected, what) in cases {
+        std::fs::write(&file, &t).unwrap();
+        let out = tmp.path().join("out");
+        let run = campaign(&file, &out, &[]);
+        assert!(!run.status.success(), "{what}");
+        let e = stderr(&run);
+        assert!(
+            e.contains("campaign.toml") && e.contains(&expected),
+            "{what}: {e}"
+        );
+        assert!(!out.exists(), "{what}: a unit started");
+    }
+    // A folder holding anything a campaign does not write is refused.
+    std::fs::write(&file, &text).unwrap();
+    let out = tmp.path().join("notes");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let e = stderr(&campaign(&file, &out, &[]));
+    assert!(
+        e.contains("holds notes.txt, which a campaign does not write"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+}
+
+#[test]
+fn the_report_draws_each_parameter_against_each_condition() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for figure in [
+        "power_law_K_vs_concentration",
+        "power_law_n_vs_F0",
+        "viscous_c_s_vs_F0",
+    ] {
+        assert!(md.contains(&format!("figures/{figure}.png")), "{figure}");
+        assert!(
+            out.join(format!("figures/{figure}.png")).is_file(),
+            "{figure}"
+        );
+    }
+    // The figure's data are the table's: the K of each record with its error, by F0.
+    let csv =
+        std::fs::read_to_string(out.join("figures/power_law_K_vs_concentration.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,F0 = 0.035: standard error,"),
+        "{header}"
+    );
+    assert_eq!(csv.lines().count(), 4);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert_eq!(html.matches("data:image/png;base64").count(), 6);
+}
