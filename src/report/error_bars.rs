@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, draw_legend, msg, render, tick_label, tick_style, title_style, Draw,
-    FigureFiles, SIZE,
+    axis_desc_style, legend_strip, msg, render, tick_label, tick_style, title_style, Draw,
+    FigureFiles, Swatch, SIZE,
 };
 use super::plot_range::{finite_bounds, padded_range};
 use super::series_csv::Column;
@@ -62,6 +62,13 @@ impl Draw for ErrorBarPlot<'_> {
         let (xr, yr) = self.ranges().ok_or("no finite point")?;
         let (x_span, y_span) = (xr.end - xr.start, yr.end - yr.start);
         let root = root.titled(self.title, title_style()).map_err(msg)?;
+        let legend: Vec<(String, Swatch)> = self
+            .series
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.label.clone(), Swatch::Dot(series_colour(i))))
+            .collect();
+        let root = legend_strip(&root, &legend)?;
         let mut chart = ChartBuilder::on(&root)
             .margin(10)
             .margin_right(30)
@@ -77,6 +84,7 @@ impl Draw for ErrorBarPlot<'_> {
             .y_label_formatter(&|v| tick_label(*v, y_span))
             .axis_desc_style(axis_desc_style())
             .label_style(tick_style())
+            .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(msg)?;
         let n = self.series.len();
@@ -108,11 +116,9 @@ impl Draw for ErrorBarPlot<'_> {
                         .iter()
                         .map(|&(x, y, _)| Circle::new((x, y), 5, colour.filled())),
                 )
-                .map_err(msg)?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| Circle::new((x + 12, y), 5, colour.filled()));
+                .map_err(msg)?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+        Ok(())
     }
 }
 

@@ -71,8 +71,8 @@ where
 pub enum Swatch {
     /// A short line of a colour and width, pixels.
     Line(RGBColor, u32),
-    /// A filled black dot.
-    Dot,
+    /// A filled dot of a colour.
+    Dot(RGBColor),
     /// A black ring.
     Ring,
 }
@@ -128,7 +128,9 @@ pub fn legend_strip<DB: DrawingBackend>(
                     vec![(x, y), (x + MARK, y)],
                     colour.stroke_width(w),
                 )),
-                Swatch::Dot => strip.draw(&Circle::new((x + MARK / 2, y), 4, BLACK.filled())),
+                Swatch::Dot(colour) => {
+                    strip.draw(&Circle::new((x + MARK / 2, y), 4, colour.filled()))
+                }
                 Swatch::Ring => {
                     strip.draw(&Circle::new((x + MARK / 2, y), 4, BLACK.stroke_width(2)))
                 }

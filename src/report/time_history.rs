@@ -121,7 +121,7 @@ impl TimeHistoryPlot {
             ),
         ];
         if !self.marks.is_empty() && self.marks.len() <= MAX_MARKS {
-            entries.push(("F_STF maxima".into(), Swatch::Dot));
+            entries.push(("F_STF maxima".into(), Swatch::Dot(BLACK)));
             entries.push(("minima".into(), Swatch::Ring));
         }
         entries
