@@ -40,21 +40,23 @@ use crate::results_dir::{wrote_line, ResultsDir};
 use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::{say, tell};
 
-/// A model from `a + b + …` (names or script paths).
-fn model_from(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
-    let parts = spec
-        .split('+')
-        .map(str::trim)
+/// The sum of `terms` (names or script paths; `none` is the zero force).
+fn model_from(terms: &[String], dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
+    let parts = terms
+        .iter()
         .filter(|s| *s != "none")
         .map(|s| resolve(s, dir, run))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
 }
 
-/// The final model `name` (`a + b + …`) with the values of `params` as an experiment's
-/// `[[models]]` entry that `fit` and `compare` accept as it is (TOML).
-fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -> Result<String> {
-    ModelsEntry::new(name, params)
+/// The final `model` with the values of `params` as an experiment's `[[models]]` entry that
+/// `fit` and `compare` accept as it is (TOML).
+fn models_entry<'a>(
+    model: &dyn ForceModel,
+    params: impl Iterator<Item = &'a FittedParam>,
+) -> Result<String> {
+    ModelsEntry::new(&model.terms(), params)
         .to_toml()
         .context("cannot write the final model as an experiment entry")
 }
@@ -150,7 +152,7 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
     if !quiet {
         tell!(
             "discovering from `{}` over {} candidates on {} cycles…",
-            spec.base,
+            spec.base_text(),
             candidates.len(),
             cycles.len()
         );
@@ -165,7 +167,7 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
         .as_ref()
         .map(|rec| crate::validation::score_force_discovery(&found, rec));
     let toml_entry = models_entry(
-        &found.final_model_name,
+        found.final_model.as_ref(),
         found.final_params.iter().filter(|p| p.name != "f_off"),
     )?;
     write_force_results(&exp, &data, &found, score.as_ref(), &toml_entry, out)?;
@@ -197,14 +199,13 @@ fn models_of(
     let base = model_from(&spec.base, &exp.dir, &exp.scripts)
         .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
     let base = widened(base, &scales);
-    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
     let mut candidates = Vec::new();
     let names: Vec<String> = match &spec.candidates {
         Some(list) => list.clone(),
         // Every built-in model is a default candidate (docs/ARCHITECTURE.md §5).
         None => stf_models::names().into_iter().map(String::from).collect(),
     };
-    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
+    for name in names.iter().filter(|n| !spec.base.contains(n)) {
         let model = resolve(name, &exp.dir, &exp.scripts)
             .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
         candidates.push(Candidate::new(
@@ -245,7 +246,7 @@ fn print_force(
 ) {
     say!(
         "base `{}`: gap {:.4} N; {}",
-        spec.base,
+        spec.base_text(),
         found.gap_before,
         found.where_before.summary
     );
@@ -486,7 +487,7 @@ fn run_trajectory(
         tell!(
             "discovering from `{}` at trajectory level (refitting {}) over {} candidates on {} \
              cycles…",
-            spec.base,
+            spec.base_text(),
             names.join(", "),
             candidates.len(),
             cycles.len()
@@ -566,7 +567,7 @@ fn write_trajectory_results(
                 && !stf_core::fit::INITIAL_STATE.contains(&p.name.as_str())
         })
         .collect();
-    let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied())?;
+    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
     let system_entry = SystemEntry {
         system: names
             .iter()
