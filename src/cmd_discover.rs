@@ -22,6 +22,7 @@ use stf_core::discovery::{
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::oscillator_params::OscParam;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
@@ -434,16 +435,16 @@ fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
 /// or by default `m`, `k`, `c` for a rig driven by a measured force `u`, `k`, `c`, `T` for the
 /// rotor — less those the base repeats (a `viscous` base carries the linear damping, so `c`
 /// stays as set), said on the terminal.
-fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool) -> Vec<String> {
+fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool) -> Vec<OscParam> {
     if !exp.fit.system_free.is_empty() {
         return exp.fit.system_free.clone();
     }
     let k = &data.kinematics;
     let rotor = k.phi.is_some() || k.omega.is_some();
-    let names: &[&str] = if rotor {
-        &["k", "c", "T"]
+    let names = if rotor {
+        [OscParam::K, OscParam::C, OscParam::T]
     } else {
-        &["m", "k", "c"]
+        [OscParam::M, OscParam::K, OscParam::C]
     };
     let repeated: Vec<(&str, &str)> = base
         .params()
@@ -452,13 +453,13 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
         .collect();
     let mut kept = Vec::new();
     for name in names {
-        match repeated.iter().find(|(_, o)| o == name) {
+        match repeated.iter().find(|(_, o)| *o == name.name()) {
             Some((p, _)) if !quiet => tell!(
                 "`{name}` is not refitted: the base's `{p}` is the same term (give `[fit] system` \
                  to choose)"
             ),
             Some(_) => {}
-            None => kept.push(name.to_string()),
+            None => kept.push(name),
         }
     }
     kept
@@ -479,8 +480,9 @@ fn run_trajectory(
     let Some(spec) = &exp.discover else {
         bail!("{}: has no [discover] section", exp.path.display());
     };
-    let names = refitted(exp, data, base.as_ref(), quiet);
-    let setup = trajectory_setup(exp, data, &names);
+    let params = refitted(exp, data, base.as_ref(), quiet);
+    let names: Vec<String> = params.iter().map(OscParam::to_string).collect();
+    let setup = trajectory_setup(exp, data, &params);
     let settings = settings.clone();
     let started = Instant::now();
     if !quiet {
@@ -525,14 +527,14 @@ fn run_trajectory(
 /// The oscillator side of a trajectory-level discovery: the record's drive and initial
 /// state, the parameters `names` refitted with every model (and `x0`, `v0` unless
 /// `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
-fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[String]) -> TrajectorySetup {
+fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> TrajectorySetup {
     let k = &data.kinematics;
     let (x0, v0) = k.initial_state();
     let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0);
-    for name in names {
-        setup = setup.refit(system_param(name, &exp.system, k));
+    for &param in names {
+        setup = setup.refit(system_param(param, &exp.system, k));
     }
     setup = setup.force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),

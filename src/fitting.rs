@@ -18,7 +18,7 @@ use stf_core::fit::{
     fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
     TrajectoryFit,
 };
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
@@ -301,11 +301,11 @@ fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
 /// start (from 0 when it starts at 0). An offset starts where it is set and may take either
 /// sign: `phi_off` within ±π, `f_off` and `u_off` within ± the record's force scale (the
 /// largest drive plus the spring's force at the largest |x|).
-pub fn system_param(name: &str, system: &OscillatorParams, k: &Kinematics) -> FitParam {
-    let value = system.get(name).unwrap_or(0.0);
-    let (min, max, scale) = match name {
-        "phi_off" => (-PI, PI, 0.01),
-        "f_off" | "u_off" => {
+pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) -> FitParam {
+    let value = system[param];
+    let (min, max, scale) = match param {
+        OscParam::PhiOff => (-PI, PI, 0.01),
+        OscParam::FOff | OscParam::UOff => {
             let x_max = k.x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             let drive_max = k.drive(system).iter().fold(0.0_f64, |m, d| m.max(d.abs()));
             let f = (drive_max + system.k * x_max).max(f64::MIN_POSITIVE);
@@ -314,7 +314,7 @@ pub fn system_param(name: &str, system: &OscillatorParams, k: &Kinematics) -> Fi
         _ if value > 0.0 => (value / 5.0, value * 5.0, 0.0),
         _ => (0.0, 10.0, 0.0),
     };
-    let p = FitParam::new(name, value).bounds(min, max);
+    let p = FitParam::new(param.name(), value).bounds(min, max);
     if scale > 0.0 {
         p.scale(scale)
     } else {
@@ -414,8 +414,8 @@ fn fit_trajectory(
         fit = fit.model(c.model.clone(), c.values());
         free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
     }
-    for name in &exp.fit.system_free {
-        free.push(system_param(name, &exp.system, k));
+    for &param in &exp.fit.system_free {
+        free.push(system_param(param, &exp.system, k));
     }
     if exp.fit.offset {
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
@@ -434,9 +434,9 @@ fn fit_trajectory(
         .fit(&td, Some(observer))
         .with_context(|| format!("fitting `{label}`"))?;
     let mut system = exp.system;
-    for name in &exp.fit.system_free {
-        if let Some(v) = result.value(name) {
-            system.set(name, v);
+    for &param in &exp.fit.system_free {
+        if let Some(v) = result.value(param.name()) {
+            system[param] = v;
         }
     }
     let floor = NoiseFloor::displacement(k.sigma_x);
