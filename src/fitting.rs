@@ -286,17 +286,6 @@ impl ModelFit {
     }
 }
 
-fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
-    c.params
-        .iter()
-        .map(|p| {
-            FitParam::new(p.name.clone(), p.value)
-                .bounds(p.min, p.max)
-                .fixed(p.fixed)
-        })
-        .collect()
-}
-
 /// Bounds for an oscillator parameter freed in a trajectory fit: a factor 5 around its
 /// start (from 0 when it starts at 0). An offset starts where it is set and may take either
 /// sign: `phi_off` within ±π, `f_off` and `u_off` within ± the record's force scale (the
@@ -355,8 +344,8 @@ fn fit_force(
 ) -> Result<ModelFit> {
     let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
     let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-    for p in fit_params(c) {
-        fit = fit.param(p);
+    for p in &c.params {
+        fit = fit.param(p.clone());
     }
     if exp.fit.offset {
         fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
@@ -412,7 +401,7 @@ fn fit_trajectory(
     let mut free: Vec<FitParam> = Vec::new();
     if let Some(c) = configured {
         fit = fit.model(c.model.clone(), c.values());
-        free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
+        free.extend(c.params.iter().filter(|p| !p.fixed).cloned());
     }
     for &param in &exp.fit.system_free {
         free.push(system_param(param, &exp.system, k));
