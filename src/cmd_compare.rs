@@ -28,9 +28,9 @@ use crate::outputs::compare_csv;
 use crate::outputs::compare_json::CompareJson;
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
-use crate::reporting::{frequency_section, record_sections, write_report};
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
+use crate::standard_report::{frequency_section, record_sections, write_report};
 
 /// The measured record's regimes.
 pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {

@@ -36,8 +36,8 @@ use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
 };
-use crate::reporting::{record_sections, write_report};
 use crate::results_dir::{wrote_line, ResultsDir};
+use crate::standard_report::{record_sections, write_report};
 use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::{say, tell};
 

@@ -123,9 +123,9 @@ fn write_fit_report(
     let level = data.level;
     let mut sections = Vec::new();
     if let Some(rec) = validation {
-        sections.push(crate::reporting::validation_section(rec, fits, out)?);
+        sections.push(crate::standard_report::validation_section(rec, fits, out)?);
     }
-    sections.extend(crate::reporting::record_sections(data, fits, out)?);
+    sections.extend(crate::standard_report::record_sections(data, fits, out)?);
     let forces: Vec<(&str, &[f64])> = match level {
         FitLevel::Force => fits
             .iter()
@@ -146,7 +146,7 @@ fn write_fit_report(
         ),
     ];
     if let Some(rec) = validation {
-        intro.push(crate::reporting::validation_intro(rec, fits));
+        intro.push(crate::standard_report::validation_intro(rec, fits));
     }
     let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
     if warned > 0 {
@@ -155,7 +155,7 @@ fn write_fit_report(
             fits.len()
         ));
     }
-    crate::reporting::write_report(
+    crate::standard_report::write_report(
         &format!("Fit: {}", exp.path.display()),
         intro,
         sections,

@@ -10,7 +10,7 @@ use stf_core::fit::{FitResult, FitWarning, NoiseFloor};
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::report::{measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM};
-use crate::reporting::write_report;
+use crate::standard_report::write_report;
 
 /// One identification stage as fitted.
 pub struct StageOutcome {

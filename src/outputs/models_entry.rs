@@ -15,12 +15,12 @@ use toml_edit::Item;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModelsEntry {
     /// The array of tables `[[models]]`, with one entry.
-    pub models: [ModelEntry; 1],
+    pub models: [ModelEntryToml; 1],
 }
 
 /// One model of `[[models]]`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ModelEntry {
+pub struct ModelEntryToml {
     /// The first model of the sum (a built-in's name or a script's path).
     pub name: String,
     /// The models added to it, in order (omitted when none).
@@ -36,7 +36,7 @@ impl ModelsEntry {
     pub fn new<'a>(terms: &[&str], params: impl IntoIterator<Item = &'a FittedParam>) -> Self {
         let (name, plus) = terms.split_first().unwrap_or((&"none", &[]));
         ModelsEntry {
-            models: [ModelEntry {
+            models: [ModelEntryToml {
                 name: name.to_string(),
                 plus: plus.iter().map(|t| t.to_string()).collect(),
                 params: params
