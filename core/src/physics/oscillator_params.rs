@@ -93,18 +93,7 @@ impl OscillatorParams {
 
     /// The values in the order of [`OscillatorParams::NAMES`].
     pub fn to_vec(&self) -> [f64; 10] {
-        [
-            self.m,
-            self.k,
-            self.c,
-            self.t_friction,
-            self.delta_t,
-            self.f0,
-            self.eta,
-            self.f_off,
-            self.phi_off,
-            self.u_off,
-        ]
+        OscParam::ALL.map(|p| self[p])
     }
 
     /// The parameter named `name` (text not yet parsed into an [`OscParam`]); `None` if there
@@ -259,6 +248,21 @@ mod tests {
             assert_eq!(p.to_vec()[i], i as f64 + 0.5);
             assert_eq!(p.get(param.name()), Some(i as f64 + 0.5));
         }
+        // Each name reaches its own field, in the order of NAMES.
+        let by_field = OscillatorParams {
+            m: 0.5,
+            k: 1.5,
+            c: 2.5,
+            t_friction: 3.5,
+            delta_t: 4.5,
+            f0: 5.5,
+            eta: 6.5,
+            f_off: 7.5,
+            phi_off: 8.5,
+            u_off: 9.5,
+        };
+        assert_eq!(p, by_field);
+        assert_eq!(values[3], OscillatorParams::FORCED.t_friction);
         let offsets: Vec<&str> = OscParam::ALL
             .into_iter()
             .filter(|p| p.is_offset())
