@@ -16,7 +16,7 @@ use stf_core::data::response::{local_maxima, peak, Peak};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare, rank_models, rank_on_loops, Classification, Comparison, MetricRanking,
-    Ranking, Regime, Signals,
+    Ranking, Regime,
 };
 use stf_core::simulate::Simulation;
 
@@ -28,38 +28,20 @@ use crate::outputs::compare_csv;
 use crate::outputs::compare_json::CompareJson;
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
-use crate::reporting::{frequency_section, record_sections, write_report};
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
+use crate::standard_report::{frequency_section, record_sections, write_report};
 
 /// The measured record's regimes.
 pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {
-    let k = &data.kinematics;
     let f = data
         .record
         .f_stf
         .as_deref()
         .context("comparing models needs the record's `f_stf` column")?;
-    let sig = Signals {
-        t: &k.t,
-        x: &k.x,
-        v: &k.v,
-        a: &k.a,
-        f,
-    };
+    let sig = data.force_data().with_force(f);
     let cycles = crate::fitting::cycles_of(data)?;
     Ok(classify(&sig, cycles, &exp.regimes)?)
-}
-
-fn signals<'a>(data: &'a FitData) -> Signals<'a> {
-    let k = &data.kinematics;
-    Signals {
-        t: &k.t,
-        x: &k.x,
-        v: &k.v,
-        a: &k.a,
-        f: data.record.f_stf.as_deref().unwrap_or(&[]),
-    }
 }
 
 /// The oscillator with the fitted model (or none), driven as in the record: its local maxima
@@ -150,7 +132,7 @@ fn compare_fits(
     measured: Classification,
     fits: Vec<ModelFit>,
 ) -> Result<Compared> {
-    let sig = signals(data);
+    let sig = data.force_data();
     let comparisons: Vec<Comparison> = fits
         .iter()
         .map(|f| compare(&measured, &sig, &f.fitted, &exp.regimes))

@@ -22,6 +22,7 @@ use stf_core::discovery::{
 use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::oscillator_params::OscParam;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
@@ -35,26 +36,28 @@ use crate::report::{
     measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
 };
-use crate::reporting::{record_sections, write_report};
 use crate::results_dir::{wrote_line, ResultsDir};
+use crate::standard_report::{record_sections, write_report};
 use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::{say, tell};
 
-/// A model from `a + b + …` (names or script paths).
-fn model_from(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
-    let parts = spec
-        .split('+')
-        .map(str::trim)
+/// The sum of `terms` (names or script paths; `none` is the zero force).
+fn model_from(terms: &[String], dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
+    let parts = terms
+        .iter()
         .filter(|s| *s != "none")
         .map(|s| resolve(s, dir, run))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
 }
 
-/// The final model `name` (`a + b + …`) with the values of `params` as an experiment's
-/// `[[models]]` entry that `fit` and `compare` accept as it is (TOML).
-fn models_entry<'a>(name: &str, params: impl Iterator<Item = &'a FittedParam>) -> Result<String> {
-    ModelsEntry::new(name, params)
+/// The final `model` with the values of `params` as an experiment's `[[models]]` entry that
+/// `fit` and `compare` accept as it is (TOML).
+fn models_entry<'a>(
+    model: &dyn ForceModel,
+    params: impl Iterator<Item = &'a FittedParam>,
+) -> Result<String> {
+    ModelsEntry::new(&model.terms(), params)
         .to_toml()
         .context("cannot write the final model as an experiment entry")
 }
@@ -152,7 +155,7 @@ pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: b
     if !quiet {
         tell!(
             "discovering from `{}` over {} candidates on {} cycles…",
-            spec.base,
+            spec.base_text(),
             candidates.len(),
             cycles.len()
         );
@@ -167,7 +170,7 @@ pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: b
         .as_ref()
         .map(|rec| crate::validation::score_force_discovery(&found, rec));
     let toml_entry = models_entry(
-        &found.final_model_name,
+        found.final_model.as_ref(),
         found.final_params.iter().filter(|p| p.name != "f_off"),
     )?;
     write_force_results(&exp, &data, &found, score.as_ref(), &toml_entry, out)?;
@@ -199,14 +202,13 @@ fn models_of(
     let base = model_from(&spec.base, &exp.dir, &exp.scripts)
         .with_context(|| format!("{}: `discover.base`", exp.path.display()))?;
     let base = widened(base, &scales);
-    let in_base: Vec<&str> = spec.base.split('+').map(str::trim).collect();
     let mut candidates = Vec::new();
     let names: Vec<String> = match &spec.candidates {
         Some(list) => list.clone(),
         // Every built-in model is a default candidate (docs/ARCHITECTURE.md §5).
         None => stf_models::names().into_iter().map(String::from).collect(),
     };
-    for name in names.iter().filter(|n| !in_base.contains(&n.as_str())) {
+    for name in names.iter().filter(|n| !spec.base.contains(n)) {
         let model = resolve(name, &exp.dir, &exp.scripts)
             .with_context(|| format!("{}: `discover.candidates`", exp.path.display()))?;
         candidates.push(Candidate::new(
@@ -247,7 +249,7 @@ fn print_force(
 ) {
     say!(
         "base `{}`: gap {:.4} N; {}",
-        spec.base,
+        spec.base_text(),
         found.gap_before,
         found.where_before.summary
     );
@@ -435,16 +437,16 @@ fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
 /// or by default `m`, `k`, `c` for a rig driven by a measured force `u`, `k`, `c`, `T` for the
 /// rotor — less those the base repeats (a `viscous` base carries the linear damping, so `c`
 /// stays as set), said on the terminal.
-fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool) -> Vec<String> {
+fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool) -> Vec<OscParam> {
     if !exp.fit.system_free.is_empty() {
         return exp.fit.system_free.clone();
     }
     let k = &data.kinematics;
     let rotor = k.phi.is_some() || k.omega.is_some();
-    let names: &[&str] = if rotor {
-        &["k", "c", "T"]
+    let names = if rotor {
+        [OscParam::K, OscParam::C, OscParam::T]
     } else {
-        &["m", "k", "c"]
+        [OscParam::M, OscParam::K, OscParam::C]
     };
     let repeated: Vec<(&str, &str)> = base
         .params()
@@ -453,13 +455,13 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
         .collect();
     let mut kept = Vec::new();
     for name in names {
-        match repeated.iter().find(|(_, o)| o == name) {
+        match repeated.iter().find(|(_, o)| *o == name.name()) {
             Some((p, _)) if !quiet => tell!(
                 "`{name}` is not refitted: the base's `{p}` is the same term (give `[fit] system` \
                  to choose)"
             ),
             Some(_) => {}
-            None => kept.push(name.to_string()),
+            None => kept.push(name),
         }
     }
     kept
@@ -480,15 +482,16 @@ fn run_trajectory(
     let Some(spec) = &exp.discover else {
         bail!("{}: has no [discover] section", exp.path.display());
     };
-    let names = refitted(exp, data, base.as_ref(), quiet);
-    let setup = trajectory_setup(exp, data, &names);
+    let params = refitted(exp, data, base.as_ref(), quiet);
+    let names: Vec<String> = params.iter().map(OscParam::to_string).collect();
+    let setup = trajectory_setup(exp, data, &params);
     let settings = settings.clone();
     let started = Instant::now();
     if !quiet {
         tell!(
             "discovering from `{}` at trajectory level (refitting {}) over {} candidates on {} \
              cycles…",
-            spec.base,
+            spec.base_text(),
             names.join(", "),
             candidates.len(),
             cycles.len()
@@ -531,14 +534,14 @@ fn run_trajectory(
 /// The oscillator side of a trajectory-level discovery: the record's drive and initial
 /// state, the parameters `names` refitted with every model (and `x0`, `v0` unless
 /// `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
-fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[String]) -> TrajectorySetup {
+fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> TrajectorySetup {
     let k = &data.kinematics;
     let (x0, v0) = k.initial_state();
     let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0);
-    for name in names {
-        setup = setup.refit(system_param(name, &exp.system, k));
+    for &param in names {
+        setup = setup.refit(system_param(param, &exp.system, k));
     }
     setup = setup.force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),
@@ -572,7 +575,7 @@ fn write_trajectory_results(
                 && !stf_core::fit::INITIAL_STATE.contains(&p.name.as_str())
         })
         .collect();
-    let toml_entry = models_entry(&found.final_model_name, model_params.iter().copied())?;
+    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
     let system_entry = SystemEntry {
         system: names
             .iter()

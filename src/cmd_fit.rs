@@ -29,7 +29,7 @@ use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::Regime;
 
 /// Run `stf-lab fit`: the results are built in a staging folder and swapped in as a whole
@@ -128,9 +128,9 @@ fn write_fit_report(
     let level = data.level;
     let mut sections = Vec::new();
     if let Some(rec) = validation {
-        sections.push(crate::reporting::validation_section(rec, fits, out)?);
+        sections.push(crate::standard_report::validation_section(rec, fits, out)?);
     }
-    sections.extend(crate::reporting::record_sections(data, fits, out)?);
+    sections.extend(crate::standard_report::record_sections(data, fits, out)?);
     let forces: Vec<(&str, &[f64])> = match level {
         FitLevel::Force => fits
             .iter()
@@ -151,7 +151,7 @@ fn write_fit_report(
         ),
     ];
     if let Some(rec) = validation {
-        intro.push(crate::reporting::validation_intro(rec, fits));
+        intro.push(crate::standard_report::validation_intro(rec, fits));
     }
     let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
     if warned > 0 {
@@ -160,7 +160,7 @@ fn write_fit_report(
             fits.len()
         ));
     }
-    crate::reporting::write_report(
+    crate::standard_report::write_report(
         &format!("Fit: {}", exp.path.display()),
         intro,
         sections,
@@ -299,15 +299,19 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
 fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
     let stage = &exp.identify[i];
     if let Some(preset) = stage.preset {
-        let found: Vec<&String> = exp.identify[..i].iter().flat_map(|s| &s.free).collect();
-        for name in OscillatorParams::NAMES {
-            if !found.iter().any(|f| *f == name) {
-                system.set(name, preset.get(name).unwrap_or(0.0));
+        let found: Vec<OscParam> = exp.identify[..i]
+            .iter()
+            .flat_map(|s| &s.free)
+            .copied()
+            .collect();
+        for param in OscParam::ALL {
+            if !found.contains(&param) {
+                system[param] = preset[param];
             }
         }
     }
-    for (name, value) in &stage.set {
-        system.set(name, *value);
+    for &(param, value) in &stage.set {
+        system[param] = value;
     }
 }
 
@@ -331,7 +335,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let mut free: Vec<_> = stage
             .free
             .iter()
-            .map(|name| system_param(name, &system, &k))
+            .map(|&param| system_param(param, &system, &k))
             .collect();
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
@@ -359,9 +363,9 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             })?;
         bar.finish_and_clear();
         crate::interrupt::finished_step(format!("identification stage {}", i + 1));
-        for name in &stage.free {
-            if let Some(v) = result.value(name) {
-                system.set(name, v);
+        for &param in &stage.free {
+            if let Some(v) = result.value(param.name()) {
+                system[param] = v;
             }
         }
         let floor = NoiseFloor::displacement(k.sigma_x);
@@ -371,7 +375,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         rows.extend(rows_of(&label, &result, None, &warnings));
         stages.push(StageJson::new(
             stage.data.display().to_string(),
-            stage.free.clone(),
+            stage.free.iter().map(OscParam::to_string).collect(),
             &result,
             floor,
             warnings.clone(),

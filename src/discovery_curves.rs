@@ -30,7 +30,7 @@ pub struct FittedModel {
     /// Its parameters by name, as fitted.
     pub params: BTreeMap<String, f64>,
     /// The fitted offset (`f_off`, N, or `x_off`, m), if any.
-    pub offset: Option<Offset>,
+    pub offset: Option<FittedOffset>,
     /// The oscillator's parameters, all of them.
     pub system: OscillatorParams,
     /// The state the simulation started from (trajectory level).
@@ -39,7 +39,7 @@ pub struct FittedModel {
 
 /// A fitted constant offset.
 #[derive(Clone, Debug, Serialize)]
-pub struct Offset {
+pub struct FittedOffset {
     /// `f_off` or `x_off`.
     pub name: &'static str,
     /// Its value, N or m.
@@ -85,7 +85,7 @@ fn fitted(
             .zip(values)
             .map(|(s, &v)| (s.name.clone(), v))
             .collect(),
-        offset: value_of(offset).map(|value| Offset {
+        offset: value_of(offset).map(|value| FittedOffset {
             name: offset,
             value,
         }),

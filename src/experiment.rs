@@ -44,7 +44,7 @@ pub use drive::{Chirp, Drive};
 pub(crate) use filter::RawDrive;
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
-pub use models::{ModelEntry, ModelSource, ParamGiven};
+pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
 pub use output::OutputSpec;
 pub use simulate::SimulateSpec;
 pub use validate::ValidateSpec;

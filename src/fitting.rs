@@ -18,7 +18,7 @@ use stf_core::fit::{
     fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
     TrajectoryFit,
 };
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
@@ -286,26 +286,15 @@ impl ModelFit {
     }
 }
 
-fn fit_params(c: &ConfiguredModel) -> Vec<FitParam> {
-    c.params
-        .iter()
-        .map(|p| {
-            FitParam::new(p.name.clone(), p.value)
-                .bounds(p.min, p.max)
-                .fixed(p.fixed)
-        })
-        .collect()
-}
-
 /// Bounds for an oscillator parameter freed in a trajectory fit: a factor 5 around its
 /// start (from 0 when it starts at 0). An offset starts where it is set and may take either
 /// sign: `phi_off` within ±π, `f_off` and `u_off` within ± the record's force scale (the
 /// largest drive plus the spring's force at the largest |x|).
-pub fn system_param(name: &str, system: &OscillatorParams, k: &Kinematics) -> FitParam {
-    let value = system.get(name).unwrap_or(0.0);
-    let (min, max, scale) = match name {
-        "phi_off" => (-PI, PI, 0.01),
-        "f_off" | "u_off" => {
+pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) -> FitParam {
+    let value = system[param];
+    let (min, max, scale) = match param {
+        OscParam::PhiOff => (-PI, PI, 0.01),
+        OscParam::FOff | OscParam::UOff => {
             let x_max = k.x.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
             let drive_max = k.drive(system).iter().fold(0.0_f64, |m, d| m.max(d.abs()));
             let f = (drive_max + system.k * x_max).max(f64::MIN_POSITIVE);
@@ -314,7 +303,7 @@ pub fn system_param(name: &str, system: &OscillatorParams, k: &Kinematics) -> Fi
         _ if value > 0.0 => (value / 5.0, value * 5.0, 0.0),
         _ => (0.0, 10.0, 0.0),
     };
-    let p = FitParam::new(name, value).bounds(min, max);
+    let p = FitParam::new(param.name(), value).bounds(min, max);
     if scale > 0.0 {
         p.scale(scale)
     } else {
@@ -352,8 +341,8 @@ fn fit_force(
 ) -> Result<ModelFit> {
     let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
     let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-    for p in fit_params(c) {
-        fit = fit.param(p);
+    for p in &c.params {
+        fit = fit.param(p.clone());
     }
     if exp.fit.offset {
         fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
@@ -409,10 +398,10 @@ fn fit_trajectory(
     let mut free: Vec<FitParam> = Vec::new();
     if let Some(c) = configured {
         fit = fit.model(c.model.clone(), c.values());
-        free.extend(fit_params(c).into_iter().filter(|p| !p.fixed));
+        free.extend(c.params.iter().filter(|p| !p.fixed).cloned());
     }
-    for name in &exp.fit.system_free {
-        free.push(system_param(name, &exp.system, k));
+    for &param in &exp.fit.system_free {
+        free.push(system_param(param, &exp.system, k));
     }
     if exp.fit.offset {
         free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
@@ -431,9 +420,9 @@ fn fit_trajectory(
         .fit(&td, Some(observer))
         .with_context(|| format!("fitting `{label}`"))?;
     let mut system = exp.system;
-    for name in &exp.fit.system_free {
-        if let Some(v) = result.value(name) {
-            system.set(name, v);
+    for &param in &exp.fit.system_free {
+        if let Some(v) = result.value(param.name()) {
+            system[param] = v;
         }
     }
     let floor = NoiseFloor::displacement(k.sigma_x);

@@ -7,10 +7,10 @@ use std::path::Path;
 
 use anyhow::Result;
 use stf_core::fit::{FitResult, FitWarning, NoiseFloor};
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::report::{measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM};
-use crate::reporting::write_report;
+use crate::standard_report::write_report;
 
 /// One identification stage as fitted.
 pub struct StageOutcome {
@@ -46,15 +46,10 @@ fn significant(x: f64, digits: i32) -> String {
 
 /// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`.
 pub fn system_line(system: &OscillatorParams) -> String {
-    let units = [
-        "kg", "N/m", "N·s/m", "N", "N", "kg·m", "s/m", "N", "rad", "N",
-    ];
-    OscillatorParams::NAMES
-        .iter()
-        .zip(units)
-        .filter_map(|(name, unit)| Some((name, system.get(name)?, unit)))
-        .filter(|(name, value, _)| !name.ends_with("_off") || *value != 0.0)
-        .map(|(name, value, unit)| format!("{name} {} {unit}", significant(value, 6)))
+    OscParam::ALL
+        .into_iter()
+        .filter(|p| !p.is_offset() || system[*p] != 0.0)
+        .map(|p| format!("{p} {} {}", significant(system[p], 6), p.unit()))
         .collect::<Vec<_>>()
         .join(", ")
 }

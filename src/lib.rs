@@ -2,7 +2,7 @@
 //! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
 //! compare, discover, models, and [`campaign`]s of them over many records), scores fitted models on a second record ([`validation`]), and
 //! writes results ([`outputs`]: one `Serialize` type a file, written by [`output`]), figures
-//! and reports ([`report`], [`reporting`],
+//! and reports ([`report`], [`standard_report`],
 //! [`discovery_curves`]). The binary (`src/main.rs`) only parses the command line and
 //! calls one `cmd_*::run`; integration tests and fuzz targets use the same functions.
 
@@ -35,9 +35,9 @@ pub mod plausibility;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;
-pub mod reporting;
 pub mod results_dir;
 pub mod staged_files;
+pub mod standard_report;
 pub mod terminal;
 pub mod validation;
 pub mod verdict;

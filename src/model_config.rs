@@ -2,13 +2,15 @@
 //! parameter values, bounds and fixed/free switches resolved once. The entries come checked
 //! from the experiment file (`crate::experiment::ModelEntry`); what needs the registry —
 //! whether a name or script resolves, whether a parameter is the model's and within its
-//! bounds — is checked here.
+//! bounds — is checked here. A parameter's checked setting is core's
+//! [`stf_core::fit::FitParam`] (value, bounds, fixed), what every fit takes.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::{anyhow, Result};
 use stf_core::data::record_bounds::{widened, DataScales};
+use stf_core::fit::FitParam;
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 
@@ -16,28 +18,13 @@ use stf_plugins::ScriptRun;
 
 use crate::experiment::{ModelEntry, ParamGiven};
 
-/// A parameter's setting for a fit: value, bounds and whether it is held fixed.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct ParamSetting {
-    /// Name in the (summed) model.
-    pub name: String,
-    /// Initial or fixed value.
-    pub value: f64,
-    /// Lower bound.
-    pub min: f64,
-    /// Upper bound.
-    pub max: f64,
-    /// Held at its value.
-    pub fixed: bool,
-}
-
 /// A model ready to plug into the oscillator.
 #[derive(Clone)]
 pub struct ConfiguredModel {
     /// The model (a sum of the entry's parts).
     pub model: Arc<dyn ForceModel>,
-    /// Parameter settings, in the model's order.
-    pub params: Vec<ParamSetting>,
+    /// Parameter settings (name in the sum, value, bounds, fixed), in the model's order.
+    pub params: Vec<FitParam>,
 }
 
 impl ConfiguredModel {
@@ -97,17 +84,7 @@ pub fn configure_for(
         let line = entries.first().map_or(0, |e| e.line);
         anyhow!("{}:{}: {}", file.display(), line, e)
     })?;
-    let mut params: Vec<ParamSetting> = sum
-        .params()
-        .iter()
-        .map(|s| ParamSetting {
-            name: s.name.clone(),
-            value: s.default,
-            min: s.min,
-            max: s.max,
-            fixed: false,
-        })
-        .collect();
+    let mut params: Vec<FitParam> = sum.params().iter().map(FitParam::from_spec).collect();
     for entry in entries {
         for given in &entry.params {
             apply(&mut params, &sum, entry, given, file)?;
@@ -122,7 +99,7 @@ pub fn configure_for(
 /// Set the parameter `given` of `entry` in `params` (the settings of `sum`): it must be one
 /// of the sum's parameters, and its value within its bounds.
 fn apply(
-    params: &mut [ParamSetting],
+    params: &mut [FitParam],
     sum: &ModelSum,
     entry: &ModelEntry,
     given: &ParamGiven,
@@ -148,10 +125,7 @@ fn apply(
         ))
     })?;
     let p = &mut params[i];
-    p.value = given.value.unwrap_or(p.value);
-    p.min = given.min.unwrap_or(p.min);
-    p.max = given.max.unwrap_or(p.max);
-    p.fixed = given.fixed.unwrap_or(p.fixed);
+    given.set.apply(p);
     if !(p.value.is_finite() && p.min <= p.value && p.value <= p.max) {
         return Err(at(format!(
             "{} lies outside its bounds [{}, {}]",

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::regimes::{classify, Cycle, Regime, Signals};
+use stf_core::regimes::{classify, Cycle, Regime};
 
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
@@ -73,13 +73,7 @@ fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Opti
     let rotor = k.phi.is_some() || k.omega.is_some();
     let labels = match (data.record.f_stf.as_deref(), rotor) {
         (Some(f), true) => {
-            let sig = Signals {
-                t: &k.t,
-                x: &k.x,
-                v: &k.v,
-                a: &k.a,
-                f,
-            };
+            let sig = data.force_data().with_force(f);
             classify(&sig, cycles.clone(), &exp.regimes)
                 .ok()
                 .filter(|c| !c.no_stf)

@@ -16,11 +16,12 @@ use std::sync::Arc;
 use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
+use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
 use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectorySetup};
 use stf_core::fit::{TrajectoryData, Validation};
 use stf_core::physics::excitation::Excitation;
-use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms, Signals};
+use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms};
 
 use crate::experiment::{Experiment, FitLevel, ValidateSpec};
 use crate::fitting::{cycles_of, read_record, FitData, ModelFit, Predictor};
@@ -162,7 +163,7 @@ fn regimes_of(exp: &Experiment, data: &FitData) -> Option<(Vec<Cycle>, Vec<Regim
             &recovered
         }
     };
-    let sig = Signals {
+    let sig = ForceData {
         t: &k.t,
         x: &k.x,
         v: &k.v,

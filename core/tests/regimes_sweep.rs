@@ -14,6 +14,7 @@
 
 use std::sync::{Arc, OnceLock};
 
+use stf_core::data::force_data::ForceData;
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::oscillator::Oscillator;
@@ -21,7 +22,6 @@ use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::physics::param_spec::ParamSpec;
 use stf_core::regimes::{
     classify, compare, cycles_from_phase, rank_models, Classification, Regime, RegimeThresholds,
-    Signals,
 };
 use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
@@ -92,7 +92,7 @@ fn classified(run: &Trajectory, noise: &SensorNoise, seed: u64) -> Classified {
     let rec = sample_record(run, noise, seed, true);
     let phi = rec.phi.clone().unwrap();
     let f = rec.f_stf.clone().unwrap();
-    let sig = Signals {
+    let sig = ForceData {
         t: &run.t,
         x: &rec.x,
         v: &run.v,
@@ -188,7 +188,7 @@ fn a_sweep_without_stf_invents_no_regime() {
 fn comparison_ranks_the_truth_first_and_shows_a_damper_misses_the_on_off_force() {
     let run = jamming_run();
     let noisy = classified(run, &FORCE_NOISE, 2);
-    let sig = Signals {
+    let sig = ForceData {
         t: &run.t,
         x: &noisy.x,
         v: &run.v,

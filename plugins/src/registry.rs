@@ -16,7 +16,7 @@ use crate::script_model::ScriptModel;
 
 /// One model a user can pick.
 #[derive(Clone, Debug)]
-pub struct ModelEntry {
+pub struct ModelListing {
     /// The name to write in an experiment file (a built-in's name or a script's path).
     pub name: String,
     /// One line saying what the model is.
@@ -77,10 +77,10 @@ impl Registry {
 
     /// Every built-in model, then every script of the script directory (sorted by file name).
     /// A script that fails to load is listed with its error as summary and no parameters.
-    pub fn list(&self) -> Vec<ModelEntry> {
-        let mut entries: Vec<ModelEntry> = stf_models::BUILTINS
+    pub fn list(&self) -> Vec<ModelListing> {
+        let mut entries: Vec<ModelListing> = stf_models::BUILTINS
             .iter()
-            .map(|b| ModelEntry {
+            .map(|b| ModelListing {
                 name: b.name.to_string(),
                 summary: b.summary.to_string(),
                 params: (b.build)().params().to_vec(),
@@ -90,13 +90,13 @@ impl Registry {
         for path in self.scripts() {
             let name = path.display().to_string();
             entries.push(match ScriptModel::load(&path) {
-                Ok(m) => ModelEntry {
+                Ok(m) => ModelListing {
                     name,
                     summary: m.summary().to_string(),
                     params: m.params().to_vec(),
                     is_script: true,
                 },
-                Err(e) => ModelEntry {
+                Err(e) => ModelListing {
                     name,
                     summary: format!("(does not load: {e})"),
                     params: Vec::new(),

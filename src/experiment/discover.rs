@@ -1,8 +1,9 @@
 //! The `[discover]` section of an experiment file: the base model, the candidate effects,
 //! how many may be added, the held-out cycles, the scouting threshold and the fit level.
-//! Every key's shape is its serde type, so the checked section is a plain conversion.
+//! Every key's shape is its serde type, so the checked section is a plain conversion; the
+//! base `a + b` is split into its terms as it is read ([`base_terms`]), once.
 
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 
 use super::FitLevel;
 
@@ -10,7 +11,8 @@ use super::FitLevel;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawDiscover {
-    base: String,
+    #[serde(deserialize_with = "base_terms")]
+    base: Vec<String>,
     candidates: Option<Vec<String>>,
     max_effects: Option<usize>,
     holdout_every: Option<usize>,
@@ -21,8 +23,9 @@ pub(super) struct RawDiscover {
 /// A validated `[discover]` section.
 #[derive(Clone, Debug)]
 pub struct DiscoverSpec {
-    /// The base model: a name, a script path, or `a + b`.
-    pub base: String,
+    /// The base model's terms, in order: names or script paths (`base = "a + b"` as written;
+    /// `none` is the zero force).
+    pub base: Vec<String>,
     /// Candidate effects (default: the vocabulary of docs/ARCHITECTURE.md §5).
     pub candidates: Option<Vec<String>>,
     /// At most this many effects are added.
@@ -34,6 +37,25 @@ pub struct DiscoverSpec {
     /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
     /// `f_stf`.
     pub level: Option<FitLevel>,
+}
+
+/// `base = "a + b + …"` as its terms, trimmed; an empty term is an error.
+fn base_terms<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+    let text = String::deserialize(d)?;
+    let terms: Vec<String> = text.split('+').map(|t| t.trim().to_string()).collect();
+    if terms.iter().any(String::is_empty) {
+        return Err(serde::de::Error::custom(format!(
+            "`{text}` has an empty term: write model names or script paths joined by ` + `"
+        )));
+    }
+    Ok(terms)
+}
+
+impl DiscoverSpec {
+    /// The base as shown: its terms joined by ` + `.
+    pub fn base_text(&self) -> String {
+        self.base.join(" + ")
+    }
 }
 
 impl From<RawDiscover> for DiscoverSpec {
@@ -68,7 +90,7 @@ mod tests {
         .unwrap()
         .discover
         .unwrap();
-        assert_eq!(d.base, "viscous");
+        assert_eq!(d.base, ["viscous"]);
         assert_eq!(d.candidates, Some(vec!["yield".to_string()]));
         assert_eq!(
             (d.max_effects, d.holdout_every, d.scout_from),
@@ -85,5 +107,23 @@ mod tests {
                 && msg.contains("`force` or `trajectory`"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn the_base_is_read_as_its_terms_and_an_empty_term_is_an_error() {
+        let d = parse("[discover]\nbase = \" power_law +cubic_stiffness \"\n")
+            .unwrap()
+            .discover
+            .unwrap();
+        assert_eq!(d.base, ["power_law", "cubic_stiffness"]);
+        assert_eq!(d.base_text(), "power_law + cubic_stiffness");
+        for bad in ["power_law + ", "", "+ viscous"] {
+            let text = format!("\n[discover]\nbase = \"{bad}\"\n");
+            let msg = format!("{:#}", parse(&text).unwrap_err());
+            assert!(
+                msg.starts_with("exp.toml:3: `discover.base`: ") && msg.contains("empty term"),
+                "{msg}"
+            );
+        }
     }
 }

@@ -6,7 +6,7 @@
 use anyhow::Result;
 use serde::Deserialize;
 use stf_core::fit::{FitSettings, Solver};
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::OscParam;
 use toml::Spanned;
 
 use super::Ctx;
@@ -65,7 +65,7 @@ pub struct FitSpec {
     /// Optimiser settings.
     pub settings: FitSettings,
     /// Oscillator parameters fitted along with a model (trajectory level).
-    pub system_free: Vec<String>,
+    pub system_free: Vec<OscParam>,
     /// Fit a constant offset (force: `f_off`, trajectory: `x_off`).
     pub offset: bool,
     /// Trajectory level: fit the initial state `x0`, `v0` (the default, `initial = "fit"`)
@@ -92,20 +92,12 @@ pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> 
         return Ok(fit);
     };
     let (span, f) = (f.span(), f.get_ref());
-    if let Some(name) = f
+    fit.system_free = f
         .system
         .iter()
-        .find(|n| OscillatorParams::FORCED.get(n).is_none())
-    {
-        return Err(cx.at(
-            span,
-            "fit.system",
-            format!(
-                "`{name}` is not an oscillator parameter; known: {}",
-                OscillatorParams::NAMES.join(", ")
-            ),
-        ));
-    }
+        .map(|n| n.parse::<OscParam>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| cx.at(span, "fit.system", e))?;
     fit.level = f.level;
     if let Some(solver) = f.solver {
         fit.settings.solver = solver;
@@ -116,7 +108,6 @@ pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> 
     if let Some(seed) = f.seed {
         fit.settings.seed = seed;
     }
-    fit.system_free = f.system.clone();
     fit.offset = f.offset;
     fit.fit_initial = f.initial != Some(Initial::Record);
     Ok(fit)
@@ -143,7 +134,7 @@ mod tests {
         assert_eq!(f.level, Some(FitLevel::Trajectory));
         assert_eq!(f.settings.solver, Solver::NelderMead);
         assert_eq!((f.settings.max_iters, f.settings.seed), (50, 9));
-        assert_eq!(f.system_free, ["k", "c"]);
+        assert_eq!(f.system_free, [OscParam::K, OscParam::C]);
         assert!(f.offset && !f.fit_initial);
         let e = parse("[fit]\nlevel = \"force\"\ninitial = \"fit\"\n").unwrap();
         assert_eq!(e.fit.level, Some(FitLevel::Force));

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use toml::Spanned;
 
 use super::system::Preset;
@@ -32,9 +32,9 @@ pub struct StageSpec {
     /// Start values replaced by a preset before this stage.
     pub preset: Option<OscillatorParams>,
     /// Oscillator parameters fitted in this stage.
-    pub free: Vec<String>,
+    pub free: Vec<OscParam>,
     /// Values set (and held) before this stage.
-    pub set: Vec<(String, f64)>,
+    pub set: Vec<(OscParam, f64)>,
     /// Line in the file.
     pub line: usize,
 }
@@ -47,25 +47,14 @@ pub(super) fn check(stages: &[Spanned<RawStage>], cx: &Ctx, dir: &Path) -> Resul
         .enumerate()
         .map(|(i, st)| {
             let (span, r) = (st.span(), st.get_ref());
-            let names = r.free.iter().chain(r.set.keys());
-            if let Some(name) = names
-                .into_iter()
-                .find(|n| OscillatorParams::FORCED.get(n).is_none())
-            {
-                return Err(cx.at(
-                    span,
-                    &format!("identify[{i}]"),
-                    format!(
-                        "`{name}` is not an oscillator parameter; known: {}",
-                        OscillatorParams::NAMES.join(", ")
-                    ),
-                ));
-            }
+            let bad = |e| cx.at(span.clone(), &format!("identify[{i}]"), e);
+            let free = r.free.iter().map(|n| n.parse()).collect::<Result<_, _>>();
+            let set = r.set.iter().map(|(n, v)| n.parse().map(|p| (p, *v)));
             Ok(StageSpec {
                 data: dir.join(&r.data),
                 preset: r.preset.map(Preset::params),
-                free: r.free.clone(),
-                set: r.set.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+                free: free.map_err(bad)?,
+                set: set.collect::<Result<_, _>>().map_err(bad)?,
                 line: cx.line(span.start),
             })
         })
@@ -95,13 +84,10 @@ mod tests {
         assert_eq!(a.preset, Some(OscillatorParams::FREE));
         assert_eq!(
             (a.free.as_slice(), a.line),
-            (&["k".to_string(), "c".into()][..], 1)
+            (&[OscParam::K, OscParam::C][..], 1)
         );
         assert_eq!(b.preset, None);
-        assert_eq!(
-            (b.set.as_slice(), b.line),
-            (&[("T".to_string(), 0.5)][..], 6)
-        );
+        assert_eq!((b.set.as_slice(), b.line), (&[(OscParam::T, 0.5)][..], 6));
     }
 
     #[test]

@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 
 use anyhow::Result;
 use serde::Deserialize;
+use stf_core::fit::FitParam;
 use toml::Spanned;
 
 use super::Ctx;
@@ -19,17 +20,33 @@ enum RawParam {
     /// Just the value.
     Value(f64),
     /// Value with bounds and a fixed/free switch.
-    Table(RawParamTable),
+    Table(ParamOverride),
 }
 
-/// The table form of a parameter.
-#[derive(Clone, Debug, Default, Deserialize)]
+/// What an entry sets of a parameter — its table form as written (`{ value, min, max,
+/// fixed }`); what is not given keeps the model's default. It stays apart from the checked
+/// setting, core's [`FitParam`], because "not given" is part of it.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawParamTable {
-    value: Option<f64>,
-    min: Option<f64>,
-    max: Option<f64>,
-    fixed: Option<bool>,
+pub struct ParamOverride {
+    /// Initial or fixed value.
+    pub value: Option<f64>,
+    /// Lower bound.
+    pub min: Option<f64>,
+    /// Upper bound.
+    pub max: Option<f64>,
+    /// Held at its value in fits.
+    pub fixed: Option<bool>,
+}
+
+impl ParamOverride {
+    /// Set on `p` what this gives.
+    pub fn apply(&self, p: &mut FitParam) {
+        p.value = self.value.unwrap_or(p.value);
+        p.min = self.min.unwrap_or(p.min);
+        p.max = self.max.unwrap_or(p.max);
+        p.fixed = self.fixed.unwrap_or(p.fixed);
+    }
 }
 
 /// One `[[models]]` (or `[[simulate.truth]]`) entry as written.
@@ -62,20 +79,13 @@ impl ModelSource {
     }
 }
 
-/// A parameter's value and bounds as an entry gives them; what is not given keeps the
-/// model's default.
+/// A parameter as an entry gives it: its name, what it sets and where.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamGiven {
     /// The parameter's name in the (summed) model.
     pub name: String,
-    /// Initial or fixed value.
-    pub value: Option<f64>,
-    /// Lower bound.
-    pub min: Option<f64>,
-    /// Upper bound.
-    pub max: Option<f64>,
-    /// Held at its value in fits.
-    pub fixed: Option<bool>,
+    /// What is set; the rest keeps the model's default.
+    pub set: ParamOverride,
     /// Line of the parameter in the file (1-based).
     pub line: usize,
 }
@@ -131,25 +141,17 @@ fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
         .params
         .iter()
         .map(|(name, v)| {
-            let line = cx.line(v.span().start);
-            let name = name.clone();
-            match v.get_ref() {
-                RawParam::Value(value) => ParamGiven {
-                    name,
+            let set = match v.get_ref() {
+                RawParam::Value(value) => ParamOverride {
                     value: Some(*value),
-                    min: None,
-                    max: None,
-                    fixed: None,
-                    line,
+                    ..ParamOverride::default()
                 },
-                RawParam::Table(t) => ParamGiven {
-                    name,
-                    value: t.value,
-                    min: t.min,
-                    max: t.max,
-                    fixed: t.fixed,
-                    line,
-                },
+                RawParam::Table(t) => t.clone(),
+            };
+            ParamGiven {
+                name: name.clone(),
+                set,
+                line: cx.line(v.span().start),
             }
         })
         .collect();
@@ -186,17 +188,24 @@ mod tests {
         assert_eq!((m.line, m.key.as_str()), (1, "models[0]"));
         let n = ParamGiven {
             name: "n".into(),
-            value: Some(1.2),
-            min: Some(1.0),
-            max: None,
-            fixed: Some(true),
+            set: ParamOverride {
+                value: Some(1.2),
+                min: Some(1.0),
+                max: None,
+                fixed: Some(true),
+            },
             line: 4,
         };
         assert_eq!(m.params[1], n);
         assert_eq!(
-            (m.params[0].name.as_str(), m.params[0].value),
+            (m.params[0].name.as_str(), m.params[0].set.value),
             ("K", Some(2.0))
         );
+        let mut p = FitParam::new("n", 1.5).bounds(0.5, 3.0);
+        n.set.apply(&mut p);
+        assert_eq!(p, FitParam::new("n", 1.2).bounds(1.0, 3.0).fixed(true));
+        m.params[0].set.apply(&mut p);
+        assert_eq!(p, FitParam::new("n", 2.0).bounds(1.0, 3.0).fixed(true));
         assert_eq!(e.models[1].source, ModelSource::Script("m.rhai".into()));
         assert_eq!(
             (e.models[1].line, e.models[1].key.as_str()),

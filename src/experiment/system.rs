@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use toml::Spanned;
 
 use super::Ctx;
@@ -58,29 +58,28 @@ pub(super) fn check(raw: Option<&Spanned<RawSystem>>, cx: &Ctx) -> Result<Oscill
     let (span, s) = (s.span(), s.get_ref());
     let mut system = s.preset.unwrap_or(Preset::Forced).params();
     let given = [
-        ("m", s.m),
-        ("k", s.k),
-        ("c", s.c),
-        ("T", s.t_friction),
-        ("delta_T", s.delta_T),
-        ("F0", s.F0),
-        ("eta", s.eta),
-        ("f_off", s.f_off),
-        ("phi_off", s.phi_off),
-        ("u_off", s.u_off),
+        s.m,
+        s.k,
+        s.c,
+        s.t_friction,
+        s.delta_T,
+        s.F0,
+        s.eta,
+        s.f_off,
+        s.phi_off,
+        s.u_off,
     ];
-    for (name, value) in given {
+    for (param, value) in OscParam::ALL.into_iter().zip(given) {
         let Some(v) = value else { continue };
-        let must_be_positive = matches!(name, "m" | "k" | "eta");
-        let signed = OscillatorParams::OFFSETS.contains(&name);
-        if !v.is_finite() || (v < 0.0 && !signed) || (must_be_positive && v == 0.0) {
+        let must_be_positive = matches!(param, OscParam::M | OscParam::K | OscParam::Eta);
+        if !v.is_finite() || (v < 0.0 && !param.is_offset()) || (must_be_positive && v == 0.0) {
             return Err(cx.at(
                 span.clone(),
-                &format!("system.{name}"),
+                &format!("system.{param}"),
                 format!("{v} is not a valid value"),
             ));
         }
-        system.set(name, v);
+        system[param] = v;
     }
     Ok(system)
 }

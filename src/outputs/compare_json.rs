@@ -55,12 +55,12 @@ pub struct MeasuredJson<'a> {
     /// Each boundary with the rule that placed it, in words.
     pub boundary_notes: Vec<BoundaryNote>,
     /// The record's resonance peak.
-    pub resonance: Peak,
+    pub resonance: PeakJson,
 }
 
 /// A resonance peak.
 #[derive(Serialize)]
-pub struct Peak {
+pub struct PeakJson {
     /// Largest |x|, m.
     pub peak_x_m: f64,
     /// ω at the peak, rad/s; null without a rotor speed.
@@ -135,7 +135,7 @@ impl<'a> CompareJson<'a> {
                 cycles_per_regime,
                 boundaries: &measured.boundaries,
                 boundary_notes: crate::compare_loops::boundary_notes(measured),
-                resonance: Peak {
+                resonance: PeakJson {
                     peak_x_m: peak.amplitude,
                     peak_omega_rad_s: finite(peak.omega),
                 },

@@ -29,8 +29,8 @@ pub struct DiscoveryJson<'a> {
     pub drive: &'a Option<DriveReport>,
     /// The noise of the signal fitted (N or m) and how it was estimated.
     pub noise_estimate: NoiseEstimate,
-    /// The base model as `[discover] base` names it.
-    pub base: &'a str,
+    /// The base model as `[discover] base` names it (its terms joined by ` + `).
+    pub base: String,
     /// The effects named, in the order added (docs/ARCHITECTURE.md §5).
     pub effects: &'a [String],
     /// The base's held-out RMS error, in `gap_unit`.
@@ -141,7 +141,7 @@ impl<'a> DiscoveryJson<'a> {
             base: exp
                 .discover
                 .as_ref()
-                .map_or(found.base.as_str(), |d| d.base.as_str()),
+                .map_or_else(|| found.base.clone(), |d| d.base_text()),
             effects: &found.effects,
             gap_before: found.gap_before,
             gap_after: found.gap_after,

@@ -15,12 +15,12 @@ use toml_edit::Item;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModelsEntry {
     /// The array of tables `[[models]]`, with one entry.
-    pub models: [ModelEntry; 1],
+    pub models: [ModelEntryToml; 1],
 }
 
 /// One model of `[[models]]`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ModelEntry {
+pub struct ModelEntryToml {
     /// The first model of the sum (a built-in's name or a script's path).
     pub name: String,
     /// The models added to it, in order (omitted when none).
@@ -31,13 +31,14 @@ pub struct ModelEntry {
 }
 
 impl ModelsEntry {
-    /// The entry of the model `name` (`a + b + …`) with the values of `params`.
-    pub fn new<'a>(name: &str, params: impl IntoIterator<Item = &'a FittedParam>) -> Self {
-        let mut parts = name.split(" + ").map(str::to_string);
+    /// The entry of the model whose terms are `terms` (its first is `name`, the rest `plus`;
+    /// none is the zero force `none`) with the values of `params`.
+    pub fn new<'a>(terms: &[&str], params: impl IntoIterator<Item = &'a FittedParam>) -> Self {
+        let (name, plus) = terms.split_first().unwrap_or((&"none", &[]));
         ModelsEntry {
-            models: [ModelEntry {
-                name: parts.next().unwrap_or_default(),
-                plus: parts.collect(),
+            models: [ModelEntryToml {
+                name: name.to_string(),
+                plus: plus.iter().map(|t| t.to_string()).collect(),
                 params: params
                     .into_iter()
                     .map(|p| (p.name.clone(), p.value))
@@ -90,7 +91,7 @@ mod tests {
     #[test]
     fn a_sum_of_models_is_a_name_with_plus_and_inline_params() {
         let e = ModelsEntry::new(
-            "power_law + cubic_stiffness",
+            &["power_law", "cubic_stiffness"],
             &[param("K", 4.01), param("n", 1.5), param("k3", 2e4)],
         );
         assert_eq!(
@@ -98,10 +99,15 @@ mod tests {
             "[[models]]\nname = \"power_law\"\nplus = [\"cubic_stiffness\"]\n\
              params = { K = 4.01, n = 1.5, k3 = 20000.0 }\n"
         );
-        let single = ModelsEntry::new("viscous", &[param("c_s", 1.25)]);
+        let single = ModelsEntry::new(&["viscous"], &[param("c_s", 1.25)]);
         assert_eq!(
             single.to_toml().unwrap(),
             "[[models]]\nname = \"viscous\"\nparams = { c_s = 1.25 }\n"
+        );
+        let zero = ModelsEntry::new(&[], &[]);
+        assert_eq!(
+            zero.to_toml().unwrap(),
+            "[[models]]\nname = \"none\"\nparams = {}\n"
         );
     }
 
@@ -109,7 +115,7 @@ mod tests {
     fn names_are_escaped_and_every_number_reads_back() {
         let path = "scripts/my \"best\" model\\v2.rhai";
         let e = ModelsEntry::new(
-            path,
+            &[path],
             &[
                 param("we\"ird key", 1e25),
                 param("tiny", 1e-7),

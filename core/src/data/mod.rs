@@ -4,6 +4,7 @@
 
 pub mod bounded;
 pub mod estimate;
+pub mod force_data;
 pub mod kinematics;
 pub mod record;
 pub mod record_bounds;

@@ -120,6 +120,9 @@ impl ForceModel for Widened {
     fn summary(&self) -> &str {
         self.inner.summary()
     }
+    fn terms(&self) -> Vec<&str> {
+        self.inner.terms()
+    }
     fn params(&self) -> &[ParamSpec] {
         &self.specs
     }

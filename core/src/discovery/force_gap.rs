@@ -10,7 +10,7 @@
 use serde::Serialize;
 
 use crate::fit::ForceData;
-use crate::regimes::{classify, Cycle, RegimeThresholds, Signals};
+use crate::regimes::{classify, Cycle, RegimeThresholds};
 
 /// Number of ω bands of the breakdown.
 pub const OMEGA_BANDS: usize = 4;
@@ -82,18 +82,11 @@ pub fn locate_gap(r: &[f64], data: &ForceData, cycles: &[Cycle], floor: f64) -> 
     let mut breakdowns = Vec::new();
 
     // Regimes of the measured force.
-    let sig = Signals {
-        t: data.t,
-        x: data.x,
-        v: data.v,
-        a: data.a,
-        f: data.f,
-    };
     let th = RegimeThresholds {
         noise_sigma: Some(floor),
         ..RegimeThresholds::default()
     };
-    if let Ok(class) = classify(&sig, cycles.to_vec(), &th) {
+    if let Ok(class) = classify(data, cycles.to_vec(), &th) {
         let mut groups = Vec::new();
         for regime in crate::regimes::Regime::ALL {
             let mut idx = class

@@ -18,7 +18,7 @@ use crate::numerics::integrate::{integrate, Settings};
 use crate::physics::excitation::Excitation;
 use crate::physics::force_model::ForceModel;
 use crate::physics::oscillator::Oscillator;
-use crate::physics::oscillator_params::OscillatorParams;
+use crate::physics::oscillator_params::{OscParam, OscillatorParams};
 use crate::simulate::{Simulation, Trajectory};
 
 /// The oscillator side of a trajectory-level fit: everything but the STF model.
@@ -132,8 +132,9 @@ impl Rig<'_> {
                 if !self.fixed_start {
                     initial[i] = Some(v);
                 }
-            } else if !system.set(name, v) {
-                return Err(format!("`{name}` is not an oscillator parameter"));
+            } else {
+                let param: OscParam = name.parse().map_err(|e| format!("{e}"))?;
+                system[param] = v;
             }
         }
         let offset = if self.fit_offset {
@@ -176,7 +177,9 @@ impl Rig<'_> {
     pub fn system_of(&self, values: &[f64]) -> OscillatorParams {
         let mut system = self.system;
         for (name, &v) in self.oscillator.iter().zip(values) {
-            system.set(name, v);
+            if let Ok(param) = name.parse::<OscParam>() {
+                system[param] = v;
+            }
         }
         system
     }

@@ -6,6 +6,8 @@
 
 use thiserror::Error;
 
+use crate::data::force_data::ForceDataError;
+
 /// A fit request was invalid or could not be run.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FitError {
@@ -60,4 +62,10 @@ pub enum FitError {
     /// The optimiser itself reported an error.
     #[error("optimiser error: {0}")]
     Solver(String),
+}
+
+impl From<ForceDataError> for FitError {
+    fn from(e: ForceDataError) -> Self {
+        FitError::BadData(e.to_string())
+    }
 }

@@ -41,61 +41,8 @@ use super::fit_param::{full_values, FitParam};
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::solver::FitSettings;
+use crate::data::force_data::ForceData;
 use crate::physics::force_model::{ForceModel, ModelState};
-
-/// Measured kinematics and force, sample by sample (SI units, equal lengths).
-#[derive(Clone, Copy, Debug)]
-pub struct ForceData<'a> {
-    /// Time, s (strictly increasing).
-    pub t: &'a [f64],
-    /// Displacement, m.
-    pub x: &'a [f64],
-    /// Velocity, m/s.
-    pub v: &'a [f64],
-    /// Acceleration, m/s².
-    pub a: &'a [f64],
-    /// Measured STF force, N.
-    pub f: &'a [f64],
-}
-
-impl ForceData<'_> {
-    fn validate(&self) -> Result<(), FitError> {
-        let n = self.t.len();
-        let lens = [self.x.len(), self.v.len(), self.a.len(), self.f.len()];
-        if lens.iter().any(|&l| l != n) {
-            return Err(FitError::BadData(format!(
-                "t, x, v, a, f must have equal lengths (got {n}, {lens:?})"
-            )));
-        }
-        for (name, col) in [
-            ("t", self.t),
-            ("x", self.x),
-            ("v", self.v),
-            ("a", self.a),
-            ("f", self.f),
-        ] {
-            if let Some(i) = col.iter().position(|v| !v.is_finite()) {
-                return Err(FitError::BadData(format!(
-                    "{name}[{i}] = {} is not finite",
-                    col[i]
-                )));
-            }
-        }
-        if let Some(i) = self
-            .t
-            .windows(2)
-            .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
-        {
-            return Err(FitError::BadData(format!(
-                "time must increase strictly (t[{i}] = {}, t[{}] = {})",
-                self.t[i],
-                i + 1,
-                self.t[i + 1]
-            )));
-        }
-        Ok(())
-    }
-}
 
 /// A force-level calibration of one STF model (a [`crate::physics::model_sum::ModelSum`] is one model).
 #[derive(Clone)]
@@ -189,7 +136,7 @@ impl ForceFit {
                     .join(", "),
             });
         }
-        data.validate()?;
+        data.check_increasing()?;
         if let Some(rows) = rows {
             let n = data.t.len();
             if rows.windows(2).any(|w| w[0] >= w[1]) || rows.last().is_some_and(|&l| l >= n) {
@@ -213,7 +160,7 @@ impl ForceFit {
     /// The modelled force (with the offset, if any) at every sample for the full parameter
     /// vector `values` (the model's parameters, then the offset), along the kinematics.
     pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
-        data.validate()?;
+        data.check_increasing()?;
         let mut all = self.params();
         if values.len() != all.len() {
             return Err(FitError::BadData(format!(

@@ -43,9 +43,10 @@ mod transform;
 mod validation;
 mod warning;
 
+pub use crate::data::force_data::ForceData;
 pub use error::FitError;
 pub use fit_param::{full_values, FitParam};
-pub use force_fit::{ForceData, ForceFit, FORCE_OFFSET};
+pub use force_fit::{ForceFit, FORCE_OFFSET};
 pub use noise_floor::{NoiseFloor, Quantity};
 pub use objective::Residuals;
 pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};

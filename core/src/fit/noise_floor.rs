@@ -13,7 +13,8 @@
 use serde::Serialize;
 
 use super::error::FitError;
-use super::force_fit::{ForceData, ForceFit};
+use super::force_fit::ForceFit;
+use crate::data::force_data::ForceData;
 use crate::data::kinematics::MotionNoise;
 
 /// The quantity a fit's residuals measure.

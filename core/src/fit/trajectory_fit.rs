@@ -36,7 +36,7 @@ use crate::numerics::integrate::{integrate, Settings, Solution};
 use crate::physics::excitation::Excitation;
 use crate::physics::force_model::ForceModel;
 use crate::physics::oscillator::Oscillator;
-use crate::physics::oscillator_params::OscillatorParams;
+use crate::physics::oscillator_params::{OscParam, OscillatorParams};
 use crate::physics::param_spec::ParamSpec;
 
 /// A measured displacement record (SI units, equal lengths, time strictly increasing).
@@ -99,7 +99,7 @@ pub struct TrajectoryFit {
 /// Where a named parameter lives.
 #[derive(Clone, Copy, Debug)]
 enum Slot {
-    Oscillator(&'static str),
+    Oscillator(OscParam),
     Model(usize),
     Offset,
     Initial(usize),
@@ -162,7 +162,7 @@ impl TrajectoryFit {
         if let Some(i) = INITIAL_STATE.iter().position(|n| *n == name) {
             return Ok(Slot::Initial(i));
         }
-        let osc = OscillatorParams::NAMES.iter().find(|n| **n == name);
+        let osc = name.parse::<OscParam>().ok();
         let model = self
             .model
             .as_ref()
@@ -342,7 +342,7 @@ impl TrajectoryFit {
             .iter()
             .zip(slots)
             .filter_map(|(p, s)| match s {
-                Slot::Oscillator(name) if !p.fixed => Some(*name),
+                Slot::Oscillator(param) if !p.fixed => Some(param.name()),
                 _ => None,
             })
             .collect();
@@ -373,9 +373,7 @@ impl TrajectoryResiduals<'_> {
                 *free.next().ok_or("too few free values")?
             };
             match *slot {
-                Slot::Oscillator(name) => {
-                    system.set(name, value);
-                }
+                Slot::Oscillator(param) => system[param] = value,
                 Slot::Model(i) => {
                     if let Some(slot) = model_values.as_mut().and_then(|v| v.get_mut(i)) {
                         *slot = value;

@@ -37,8 +37,9 @@
 use serde::Serialize;
 
 use super::error::FitError;
-use super::force_fit::{ForceData, ForceFit};
+use super::force_fit::ForceFit;
 use super::trajectory_fit::{initial_state_params, TrajectoryData, TrajectoryFit, INITIAL_STATE};
+use crate::data::force_data::ForceData;
 
 /// A fitted model's error on a record it was not fitted to.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -74,6 +74,13 @@ pub trait ForceModel: Send + Sync {
         ""
     }
 
+    /// The names of the models this one adds up, in order: the model's own name for a single
+    /// model, the parts' terms for a sum ([`crate::physics::model_sum::ModelSum`]; none for
+    /// the zero force). The text `a + b` is only their display.
+    fn terms(&self) -> Vec<&str> {
+        vec![self.name()]
+    }
+
     /// The parameters, in the order in which their values are passed as `p`.
     fn params(&self) -> &[ParamSpec];
 

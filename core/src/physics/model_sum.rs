@@ -3,7 +3,8 @@
 //! The parameters of a sum are those of its parts, in order. A bare parameter name that more
 //! than one part uses is prefixed with its model's name (`power_law.K`); every parameter can
 //! also be addressed by its prefixed name, clash or not. Internal states are stacked the same
-//! way. Forces and added masses add.
+//! way. Forces and added masses add. A sum knows its terms as a list ([`ForceModel::terms`]);
+//! its name `a + b` is only their display (reports, JSON keys), never split again.
 
 use std::sync::Arc;
 
@@ -63,14 +64,11 @@ impl ModelSum {
         }
         param_offsets.push(specs.len());
         state_offsets.push(n_internal);
-        let name = if parts.is_empty() {
+        let terms: Vec<&str> = parts.iter().flat_map(|p| p.terms()).collect();
+        let name = if terms.is_empty() {
             "none".to_string()
         } else {
-            parts
-                .iter()
-                .map(|p| p.name().to_string())
-                .collect::<Vec<_>>()
-                .join(" + ")
+            terms.join(" + ")
         };
         Ok(ModelSum {
             name,
@@ -119,6 +117,10 @@ impl ForceModel for ModelSum {
 
     fn summary(&self) -> &str {
         "a sum of force models"
+    }
+
+    fn terms(&self) -> Vec<&str> {
+        self.parts.iter().flat_map(|p| p.terms()).collect()
     }
 
     fn params(&self) -> &[ParamSpec] {
@@ -261,6 +263,22 @@ mod tests {
         };
         assert_eq!(sum.force(&[1.0, 2.0, 3.0], &s, &mut []).unwrap(), 12.0);
         assert_eq!(sum.name(), "a + b + d");
+    }
+
+    #[test]
+    fn a_sum_lists_its_terms_flat_and_the_zero_sum_has_none() {
+        let inner: Arc<dyn ForceModel> =
+            Arc::new(ModelSum::new(vec![lin("a", "c"), lin("b", "e")]).unwrap());
+        assert_eq!(inner.terms(), ["a", "b"]);
+        let outer = ModelSum::new(vec![inner, lin("d", "f")]).unwrap();
+        assert_eq!(outer.terms(), ["a", "b", "d"]);
+        assert_eq!(outer.name(), "a + b + d");
+        assert_eq!(lin("a", "c").terms(), ["a"]);
+        let zero: Arc<dyn ForceModel> = Arc::new(ModelSum::new(Vec::new()).unwrap());
+        assert!(zero.terms().is_empty());
+        assert_eq!(zero.name(), "none");
+        let with_zero = ModelSum::new(vec![zero, lin("d", "f")]).unwrap();
+        assert_eq!((with_zero.terms(), with_zero.name()), (vec!["d"], "d"));
     }
 
     #[test]

@@ -27,11 +27,12 @@ use serde::Serialize;
 use super::boundaries::{find_boundaries, Boundaries};
 use super::cycles::Cycle;
 use super::error::RegimeError;
-use super::features::{features, CycleFeatures, Signals};
+use super::features::{features, CycleFeatures};
 use super::noise::noise_floor;
 pub use super::regime::Regime;
 use super::rules::place;
 use super::thresholds::RegimeThresholds;
+use crate::data::force_data::ForceData;
 
 /// A record's cycles, their features and labels.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -120,7 +121,7 @@ pub fn median_filter(labels: &[Regime], window: usize) -> Vec<Regime> {
 
 /// Classify the cycles of a record (see the [module doc](self) for the rules).
 pub fn classify(
-    sig: &Signals,
+    sig: &ForceData,
     cycles: Vec<Cycle>,
     th: &RegimeThresholds,
 ) -> Result<Classification, RegimeError> {

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use crate::data::force_data::ForceDataError;
+
 /// Why a regime analysis could not run.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum RegimeError {
@@ -59,6 +61,24 @@ pub enum RegimeError {
         /// The allowed range.
         why: &'static str,
     },
+}
+
+impl From<ForceDataError> for RegimeError {
+    fn from(e: ForceDataError) -> Self {
+        match e {
+            ForceDataError::LengthMismatch {
+                name,
+                len,
+                expected,
+            } => RegimeError::LengthMismatch {
+                name,
+                len,
+                expected,
+            },
+            ForceDataError::NonFinite { name, index, .. } => RegimeError::NonFinite { name, index },
+            ForceDataError::TimeNotIncreasing { index } => RegimeError::TimeNotIncreasing { index },
+        }
+    }
 }
 
 /// Check that every sample of `x` is finite.

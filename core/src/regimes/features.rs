@@ -28,42 +28,10 @@
 use serde::Serialize;
 
 use super::cycles::Cycle;
-use super::error::{check_finite, check_len, RegimeError};
+use super::error::RegimeError;
 use super::loops::{equivalent_damping, peak_window, phase_deg, smoothed_peak};
 use super::thresholds::RegimeThresholds;
-
-/// The signals of a record, sampled together: kinematics and the STF force.
-#[derive(Clone, Copy, Debug)]
-pub struct Signals<'a> {
-    /// Time, s.
-    pub t: &'a [f64],
-    /// Displacement, m.
-    pub x: &'a [f64],
-    /// Velocity, m/s.
-    pub v: &'a [f64],
-    /// Acceleration, m/s².
-    pub a: &'a [f64],
-    /// STF force, N (measured, or a model's on the same kinematics).
-    pub f: &'a [f64],
-}
-
-impl<'a> Signals<'a> {
-    /// Check that all signals have as many samples as `t` and are finite; the sample count.
-    pub fn check(&self) -> Result<usize, RegimeError> {
-        let n = self.t.len();
-        for (name, s) in [("x", self.x), ("v", self.v), ("a", self.a), ("f", self.f)] {
-            check_len(name, s, n)?;
-            check_finite(name, s)?;
-        }
-        check_finite("t", self.t)?;
-        Ok(n)
-    }
-
-    /// The same kinematics with another force.
-    pub fn with_force(&self, f: &'a [f64]) -> Signals<'a> {
-        Signals { f, ..*self }
-    }
-}
+use crate::data::force_data::ForceData;
 
 /// What the force does in one cycle; see the [module doc](self) for each field.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -184,7 +152,7 @@ fn abs_correlation(a: &[f64], b: &[f64]) -> f64 {
 /// Features of one cycle with force on-threshold `on_threshold` (N); see [`duty`] for
 /// `min_off_fraction`. The cycle must fit the signals (`end` < number of samples).
 pub fn cycle_features(
-    sig: &Signals,
+    sig: &ForceData,
     cycle: &Cycle,
     on_threshold: f64,
     min_off_fraction: f64,
@@ -243,7 +211,7 @@ pub fn cycle_features(
 
 /// Features of every cycle, with the on-threshold of `th` for noise σ `sigma` (N).
 pub fn features(
-    sig: &Signals,
+    sig: &ForceData,
     cycles: &[Cycle],
     th: &RegimeThresholds,
     sigma: f64,
@@ -291,8 +259,8 @@ mod tests {
     }
 
     impl Case {
-        fn sig(&self) -> Signals<'_> {
-            Signals {
+        fn sig(&self) -> ForceData<'_> {
+            ForceData {
                 t: &self.t,
                 x: &self.x,
                 v: &self.v,
@@ -433,13 +401,13 @@ mod tests {
             cycle_features(&c.sig(), &bad, 0.06, 0.05),
             Err(RegimeError::BadCycle { .. })
         ));
-        let short = Signals {
+        let short = ForceData {
             f: &c.f[..10],
             ..c.sig()
         };
         assert!(matches!(
-            short.check(),
-            Err(RegimeError::LengthMismatch { .. })
+            short.check().map_err(RegimeError::from),
+            Err(RegimeError::LengthMismatch { name: "f", .. })
         ));
     }
 }

@@ -295,10 +295,10 @@ pub fn rank_on_loops(meas: &Classification, results: &[(&str, &Comparison)]) -> 
 mod tests {
     use super::super::classify::classify;
     use super::super::cycles::cycles_from_phase;
-    use super::super::features::Signals;
     use super::super::metrics::compare;
     use super::super::thresholds::RegimeThresholds;
     use super::*;
+    use crate::data::force_data::ForceData;
     use rand::rngs::StdRng;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
@@ -317,7 +317,7 @@ mod tests {
         let g = Normal::new(0.0, 0.02).unwrap();
         let truth: Vec<f64> = v.iter().map(|v| 40.0 * v).collect();
         let f: Vec<f64> = truth.iter().map(|f| f + g.sample(&mut rng)).collect();
-        let sig = Signals {
+        let sig = ForceData {
             t: &t,
             x: &x,
             v: &v,

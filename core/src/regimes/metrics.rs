@@ -29,9 +29,10 @@ use serde::Serialize;
 use super::boundaries::{Boundaries, Boundary};
 use super::classify::{classify, Classification, Regime};
 use super::error::{check_len, RegimeError};
-use super::features::{CycleFeatures, Signals};
+use super::features::CycleFeatures;
 use super::loops::wrap_deg;
 use super::thresholds::RegimeThresholds;
+use crate::data::force_data::ForceData;
 
 /// One value per regime (`None`: the measurement has no cycle in that regime).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -307,7 +308,7 @@ fn boundary_error(a: Option<Boundary>, b: Option<Boundary>) -> Option<f64> {
 /// record `sig`, whose classification (with thresholds `th`) is `measured`.
 pub fn compare(
     measured: &Classification,
-    sig: &Signals,
+    sig: &ForceData,
     model_force: &[f64],
     th: &RegimeThresholds,
 ) -> Result<Comparison, RegimeError> {
@@ -366,7 +367,7 @@ mod tests {
     #[test]
     fn a_model_equal_to_the_measurement_has_no_error() {
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = Signals {
+        let sig = ForceData {
             t: &t,
             x: &x,
             v: &v,
@@ -389,7 +390,7 @@ mod tests {
         // exactly 0.5, energy error half the energy). Model B: the same force only while
         // |sin φ| < 0.5, i.e. on for 1/3 of the cycle.
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = Signals {
+        let sig = ForceData {
             t: &t,
             x: &x,
             v: &v,
@@ -427,7 +428,7 @@ mod tests {
     #[test]
     fn a_model_force_of_the_wrong_length_is_an_error() {
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = Signals {
+        let sig = ForceData {
             t: &t,
             x: &x,
             v: &v,

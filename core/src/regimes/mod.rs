@@ -26,7 +26,8 @@
 //! Everything works on plain slices; nothing here fits or simulates.
 //!
 //! ```
-//! use stf_core::regimes::{classify, cycles_from_phase, Regime, RegimeThresholds, Signals};
+//! use stf_core::data::force_data::ForceData;
+//! use stf_core::regimes::{classify, cycles_from_phase, Regime, RegimeThresholds};
 //! // 20 s at ω = 6 rad/s, 200 Hz, x = 10 mm·sin φ, a viscous force 20·v.
 //! let t: Vec<f64> = (0..4000).map(|i| i as f64 / 200.0).collect();
 //! let phi: Vec<f64> = t.iter().map(|t| 6.0 * t).collect();
@@ -34,7 +35,7 @@
 //! let v: Vec<f64> = phi.iter().map(|p| 0.06 * p.cos()).collect();
 //! let a: Vec<f64> = phi.iter().map(|p| -0.36 * p.sin()).collect();
 //! let f: Vec<f64> = v.iter().map(|v| 20.0 * v).collect();
-//! let sig = Signals { t: &t, x: &x, v: &v, a: &a, f: &f };
+//! let sig = ForceData { t: &t, x: &x, v: &v, a: &a, f: &f };
 //! let cycles = cycles_from_phase(&t, &phi).unwrap();
 //! let c = classify(&sig, cycles, &RegimeThresholds::default()).unwrap();
 //! assert!(!c.no_stf);
@@ -60,7 +61,7 @@ pub use boundaries::{find_boundaries, Boundaries, Boundary, BoundaryRule};
 pub use classify::{classify, label_cycles, median_filter, Classification};
 pub use cycles::{cycles_from_phase, cycles_from_x, phase_from_omega, segments, Cycle};
 pub use error::RegimeError;
-pub use features::{cycle_features, duty, features, CycleFeatures, Signals};
+pub use features::{cycle_features, duty, features, CycleFeatures};
 pub use loop_ranking::{rank_on_loops, LoopMetric, MetricRanking, PairedTest, RegimeRank};
 pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};
 pub use noise::noise_floor;

@@ -2,7 +2,8 @@
 //! histories of x, v, a against F_STF; hysteresis loops against x, v and a; measured against
 //! fitted; the frequency response), a table per command, `report.html` (self-contained) and
 //! `report.md`, with a CSV of every plotted series under `DIR/figures/`. With a `[validate]`
-//! record, its section comes first ([`validation_section`]).
+//! record, its section comes first ([`validation_section`]). The figures and documents
+//! themselves are [`crate::report`]'s; this module puts a command's together.
 
 use std::path::Path;
 
