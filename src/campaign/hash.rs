@@ -30,7 +30,7 @@ struct Entry<'a> {
 pub fn files_read(exp: &Experiment) -> Vec<PathBuf> {
     let mut specs: Vec<&str> = exp.models.iter().flat_map(|m| m.specs()).collect();
     if let Some(d) = &exp.discover {
-        specs.push(&d.base);
+        specs.extend(d.base.iter().map(String::as_str));
         specs.extend(d.candidates.iter().flatten().map(String::as_str));
     }
     let mut files: Vec<PathBuf> = specs
