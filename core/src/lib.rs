@@ -37,6 +37,7 @@
 pub mod data;
 pub mod discovery;
 pub mod fit;
+mod model_error;
 pub mod numerics;
 pub mod physics;
 pub mod regimes;

@@ -29,7 +29,6 @@
 //! ```
 
 use crate::physics::param_spec::ParamSpec;
-use thiserror::Error;
 
 /// The state a force model sees: time, displacement, velocity and its own internal variables.
 #[derive(Clone, Copy, Debug)]
@@ -44,25 +43,7 @@ pub struct ModelState<'a> {
     pub z: &'a [f64],
 }
 
-/// A force model failed to evaluate (a script error, a non-finite result, …).
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("model `{model}`: {message}")]
-pub struct ModelError {
-    /// The model's name, or a script's path.
-    pub model: String,
-    /// What went wrong; for scripts, with the line.
-    pub message: String,
-}
-
-impl ModelError {
-    /// An error of model `model` saying `message`.
-    pub fn new(model: impl Into<String>, message: impl Into<String>) -> Self {
-        ModelError {
-            model: model.into(),
-            message: message.into(),
-        }
-    }
-}
+pub use crate::model_error::ModelError;
 
 /// An STF force model: `F_STF = m_a·ẍ + f(t, x, v, z)`.
 pub trait ForceModel: Send + Sync {

@@ -1,6 +1,6 @@
 //! Why a simulation stopped.
 
-use crate::physics::force_model::ModelError;
+use crate::model_error::ModelError;
 use thiserror::Error;
 
 /// A simulation could not be completed; each failure says when it happened.
