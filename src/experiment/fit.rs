@@ -30,6 +30,14 @@ impl FitLevel {
             FitLevel::Trajectory => ("mm", 1e3),
         }
     }
+
+    /// The measured signal fits aim at: its column (`f_stf`, `x`) and what it is.
+    pub fn signal(self) -> (&'static str, &'static str) {
+        match self {
+            FitLevel::Force => ("f_stf", "STF force"),
+            FitLevel::Trajectory => ("x", "displacement"),
+        }
+    }
 }
 
 /// Where a trajectory fit's initial state comes from.

@@ -194,9 +194,9 @@ impl TrajectoryFit {
         self
     }
 
-    /// The names of the parameters given to [`TrajectoryFit::free`], in order.
-    pub fn free_names(&self) -> Vec<String> {
-        self.free.iter().map(|p| p.name.clone()).collect()
+    /// The parameters given to [`TrajectoryFit::free`], in order.
+    pub fn free_params(&self) -> &[FitParam] {
+        &self.free
     }
 
     /// Whether the initial state `x0`, `v0` is fitted.
