@@ -26,7 +26,7 @@ use stf_core::physics::model_sum::ModelSum;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
-use crate::fitting::{estimate_line, load_data_at, system_param, FitData};
+use crate::fitting::{estimate_line, load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::write_json;
 use crate::outputs::discovery_json::{Common, DiscoveryJson};
@@ -546,27 +546,23 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
     kept
 }
 
-/// The oscillator side of a trajectory-level discovery: the record's drive and initial
-/// state, the parameters `names` refitted with every model (and `x0`, `v0` unless
-/// `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
+/// The oscillator side of a trajectory-level discovery: the oscillator of
+/// [`oscillator_fit`], the parameters `names` refitted with every model (and `x0`, `v0`
+/// unless `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
 fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[String]) -> TrajectorySetup {
     let k = &data.kinematics;
-    let (x0, v0) = k.initial_state();
-    let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
-        .sim_settings(exp.integrator.clone())
-        .initial(x0, v0);
+    let mut fit = oscillator_fit(exp, data);
     for name in names {
-        setup = setup.refit(system_param(name, &exp.system, k));
+        fit = fit.free(system_param(name, &exp.system, k));
     }
-    setup = setup.force_hint(stf_core::discovery::ForceHint {
+    if exp.fit.fit_initial {
+        for p in k.initial_state_params() {
+            fit = fit.free(p);
+        }
+    }
+    TrajectorySetup::new(fit).force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),
         a: k.a.clone(),
         f: k.recovered_force(&exp.system),
-    });
-    if exp.fit.fit_initial {
-        for p in k.initial_state_params() {
-            setup = setup.refit(p);
-        }
-    }
-    setup
+    })
 }

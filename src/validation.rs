@@ -17,8 +17,8 @@ use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
 use stf_core::data::kinematics::Kinematics;
-use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectorySetup};
-use stf_core::fit::Validation;
+use stf_core::discovery::{Discovery, DiscoveryValidation};
+use stf_core::fit::{TrajectoryFit, Validation};
 use stf_core::physics::excitation::Excitation;
 use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms, Signals};
 
@@ -314,10 +314,10 @@ pub fn score_discovery(
         None => found.validate(&rec.data.force_data()),
         Some(_) => {
             let (x0, v0) = rec.data.kinematics.initial_state();
-            let setup = TrajectorySetup::new(exp.system, rec.excitation.clone())
+            let on = TrajectoryFit::new(exp.system, rec.excitation.clone())
                 .sim_settings(exp.integrator.clone())
                 .initial(x0, v0);
-            found.validate_trajectory(&setup, &rec.data.trajectory_data())
+            found.validate_trajectory(&on, &rec.data.trajectory_data())
         }
     };
     DiscoveryScore::of(rec, scored)

@@ -87,12 +87,12 @@ pub fn initial_state_params(x0: f64, v0: f64, x_span: f64, v_span: f64) -> [FitP
 /// A trajectory-level fit of the oscillator and, optionally, an STF model.
 #[derive(Clone)]
 pub struct TrajectoryFit {
-    system: OscillatorParams,
-    excitation: Arc<Excitation>,
-    model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
-    free: Vec<FitParam>,
-    initial: Option<(f64, f64)>,
-    sim: Settings,
+    pub(crate) system: OscillatorParams,
+    pub(crate) excitation: Arc<Excitation>,
+    pub(crate) model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
+    pub(crate) free: Vec<FitParam>,
+    pub(crate) initial: Option<(f64, f64)>,
+    pub(crate) sim: Settings,
     settings: FitSettings,
 }
 
