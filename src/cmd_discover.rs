@@ -18,11 +18,13 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use stf_core::data::record_bounds::widened;
 use stf_core::discovery::{
-    discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings, TrajectorySetup,
+    discover_force, discover_trajectory, Candidate, Discovery, DiscoveryError, DiscoverySettings,
+    TrajectorySetup,
 };
 use stf_core::fit::{FitSettings, FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
+use stf_core::regimes::Cycle;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
@@ -129,17 +131,8 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
         );
     }
     let started = Instant::now();
-    let found = match &refit {
-        // The record's kinematics noise enters the floor, its filter the test's blocks.
-        None => {
-            let settings = settings.kinematics(&data.kinematics);
-            discover_force(base, &candidates, &data.force_data(), &cycles, &settings)
-        }
-        Some((_, setup)) => {
-            let td = data.trajectory_data();
-            discover_trajectory(base, &candidates, &td, &cycles, setup, &settings)
-        }
-    };
+    let setup = refit.as_ref().map(|(_, setup)| setup);
+    let found = discover_at(&data, setup, (base, &candidates, &cycles), settings);
     bar.finish_and_clear();
     let found = found?;
     let wall = started.elapsed().as_secs_f64();
@@ -170,6 +163,26 @@ pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<
         )
     );
     Ok(())
+}
+
+/// Discover at `data`'s level: along the record's kinematics (their noise enters the floor,
+/// their filter the test's blocks), or simulating the oscillator of `setup`.
+fn discover_at(
+    data: &FitData,
+    setup: Option<&TrajectorySetup>,
+    (base, candidates, cycles): (Arc<dyn ForceModel>, &[Candidate], &[Cycle]),
+    settings: DiscoverySettings,
+) -> Result<Discovery, DiscoveryError> {
+    match setup {
+        None => {
+            let settings = settings.kinematics(&data.kinematics);
+            discover_force(base, candidates, &data.force_data(), cycles, &settings)
+        }
+        Some(setup) => {
+            let td = data.trajectory_data();
+            discover_trajectory(base, candidates, &td, cycles, setup, &settings)
+        }
+    }
 }
 
 /// The base model and the candidates of `[discover]`: the vocabulary of
@@ -335,7 +348,7 @@ fn write_results(
     write_json(&out.join("discovery.json"), &doc)?;
     let target = data.target();
     let (before, after) = modelled(target, found);
-    let signal = data.level.signal().0;
+    let signal = data.level.signal().column;
     crate::discovery_curves::write_curves(out, signal, &data.record.t, target, (&before, &after))?;
     Ok((toml_entry, system_entry))
 }

@@ -4,7 +4,9 @@
 //! The record is read, cut to the experiment's time window, and its kinematics derived
 //! once. Each model is then fitted on its own thread (rayon), deterministically, at force level
 //! (against `f_stf`, along the kinematics) or trajectory level (against `x`, simulating the
-//! oscillator driven as in the record).
+//! oscillator driven as in the record), along one path ([`fit_model`]): the level's fit is
+//! built, run, predicted with and given its noise floor by [`Predictor`], the one place that
+//! knows the two levels apart.
 
 use std::f64::consts::PI;
 use std::sync::Arc;

@@ -40,10 +40,7 @@ pub struct ValidationRecord {
 impl ValidationRecord {
     /// The unit of the errors: N at force level, m at trajectory level.
     pub fn unit(&self) -> &'static str {
-        match self.data.level {
-            FitLevel::Force => "N",
-            FitLevel::Trajectory => "m",
-        }
+        self.data.level.signal().si_unit
     }
 }
 

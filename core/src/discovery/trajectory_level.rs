@@ -430,14 +430,8 @@ impl SearchModel {
         if starts.len() < 2 {
             return starts.into_iter().next();
         }
-        let short = DiscoverySettings {
-            fit: settings
-                .fit
-                .clone()
-                .solver(Solver::LevenbergMarquardt)
-                .max_iters(START_ITERS),
-            ..settings.clone()
-        };
+        let mut short = settings.levenberg_marquardt(None);
+        short.fit = short.fit.max_iters(START_ITERS);
         let mut best: Option<(f64, SearchModel)> = None;
         for start in &starts {
             let Ok((stage, fit)) = start.fit_simulated(track, setup, train, &short) else {
@@ -970,10 +964,7 @@ impl Level for TrajectoryLevel<'_> {
         };
         match &self.scout {
             Some(s) => {
-                let lm = DiscoverySettings {
-                    fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-                    ..settings.clone()
-                };
+                let lm = settings.levenberg_marquardt(None);
                 scouted(start, s, (&self.rig, self.setup, &all), &lm).0
             }
             None => start,
@@ -1109,10 +1100,6 @@ impl Level for TrajectoryLevel<'_> {
         self.trial(&stage, &trial_settings(self.settings))
     }
 
-    fn reconsiders(&self) -> bool {
-        false
-    }
-
     fn polishes(&self) -> bool {
         true
     }
@@ -1123,10 +1110,7 @@ impl Level for TrajectoryLevel<'_> {
 
     /// Levenberg–Marquardt alone, from the training fit (near the optimum).
     fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
-        DiscoverySettings {
-            fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-            ..settings.clone()
-        }
+        settings.levenberg_marquardt(None)
     }
 
     fn closing_notes(
@@ -1156,8 +1140,6 @@ impl Level for TrajectoryLevel<'_> {
                 .start(&stage.model()?, &stage.values)
                 .map_err(DiscoveryError::BadData)
         };
-        let simulated =
-            |r: &[f64]| -> Vec<f64> { self.data.x.iter().zip(r).map(|(m, r)| m - r).collect() };
         Ok(Some(TrajectoryPart {
             system_before: self.rig.system_of(&before.values),
             system_after: self.rig.system_of(&after.values),
@@ -1165,8 +1147,6 @@ impl Level for TrajectoryLevel<'_> {
             s_after_mm2: s_mm2(rms(r_after)),
             initial_before: initial(before)?,
             initial_after: initial(after)?,
-            x_before: simulated(r_before),
-            x_after: simulated(r_after),
         }))
     }
 }
@@ -1180,14 +1160,7 @@ fn s_mm2(g: f64) -> f64 {
 /// not settle by then (a stiff relaxation wandering through thousands of simulations) is
 /// scored where it stopped, not chased by Nelder–Mead.
 fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
-    DiscoverySettings {
-        fit: settings
-            .fit
-            .clone()
-            .solver(Solver::LevenbergMarquardt)
-            .max_iters(settings.fit.max_iters.min(TRIAL_ITERS)),
-        ..settings.clone()
-    }
+    settings.levenberg_marquardt(Some(TRIAL_ITERS))
 }
 /// How far the record goes: its largest |x|, and the largest |v| of the force hint's
 /// filtered velocity or, without one, of central differences of x.
