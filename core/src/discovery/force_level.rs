@@ -454,10 +454,6 @@ impl Level for ForceLevel<'_> {
         &self.split
     }
 
-    fn samples(&self) -> usize {
-        self.data.t.len()
-    }
-
     fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
         SearchModel {
             values: base

@@ -43,8 +43,11 @@ pub(super) trait Level: Sync {
     /// The record's held-out split.
     fn split(&self) -> &HoldoutSplit;
 
-    /// Samples in the record.
-    fn samples(&self) -> usize;
+    /// Samples in the record: those the split trains on and those it holds out.
+    fn samples(&self) -> usize {
+        let split = self.split();
+        split.train.len() + split.holdout.len()
+    }
 
     /// The candidates the search may try, of those given, and notes on any left out (by
     /// default all, no note).

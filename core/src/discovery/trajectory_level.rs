@@ -912,10 +912,6 @@ impl Level for TrajectoryLevel<'_> {
         &self.split
     }
 
-    fn samples(&self) -> usize {
-        self.data.t.len()
-    }
-
     /// A candidate with a parameter that is the same term as a refitted one (`viscous`
     /// while `c` is refitted) would be fitted twice over the same valley: it is left out with
     /// a note saying why.
