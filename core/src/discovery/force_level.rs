@@ -60,16 +60,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<(SearchModel, ForceFit, FitResult), DiscoveryError> {
         let fit = self.force_fit(settings)?;
-        let result = fit_subset(&fit, data, subset, &settings.fit).map_err(|source| {
-            DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            }
-        })?;
-        let stage = SearchModel {
-            parts: self.parts.clone(),
-            values: result.params.iter().map(|p| p.value).collect(),
-        };
+        let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
         Ok((stage, fit, result))
     }
 
@@ -81,10 +72,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
         let (stage, fit, train) = self.fit(data, &split.train, settings)?;
-        let r = residuals(&fit, data, &stage.values).map_err(|source| DiscoveryError::Fit {
-            model: self.name(),
-            source,
-        })?;
+        let r = residuals(&fit, data, &stage.values).map_err(|e| self.fit_error(e))?;
         let h = rms_over(&r, &split.holdout);
         Ok(Trial {
             stage,
@@ -133,10 +121,7 @@ impl SearchModel {
         };
         let fit = self.force_fit(settings)?;
         fit.noise_floor(data, &self.values, sensor, motion)
-            .map_err(|source| DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            })
+            .map_err(|e| self.fit_error(e))
     }
 
     /// Measured minus modelled force at every sample.
@@ -146,10 +131,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<Vec<f64>, DiscoveryError> {
         let fit = self.force_fit(settings)?;
-        residuals(&fit, data, &self.values).map_err(|source| DiscoveryError::Fit {
-            model: self.name(),
-            source,
-        })
+        residuals(&fit, data, &self.values).map_err(|e| self.fit_error(e))
     }
 }
 

@@ -189,17 +189,7 @@ impl SearchModel {
                 p.fixed |= crate::fit::INITIAL_STATE.contains(&p.name.as_str());
             }
         }
-        let result = fit_on(track, &model, &params, subset, &settings.fit).map_err(|source| {
-            DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            }
-        })?;
-        let stage = SearchModel {
-            parts: self.parts.clone(),
-            values: result.params.iter().map(|p| p.value).collect(),
-        };
-        Ok((stage, result))
+        self.fitted(fit_on(track, &model, &params, subset, &settings.fit))
     }
 
     /// The simulated run of this stage at its values.
