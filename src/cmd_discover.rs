@@ -6,8 +6,10 @@
 //! already in the base, plus any scripts `[discover] candidates` lists. Writes
 //! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
 //! scores, and the final model as an experiment entry), a report and figures. A record
-//! without `f_stf` (or `[discover] level = "trajectory"`) is discovered at trajectory level
-//! (`run_trajectory`).
+//! without `f_stf` (or `[discover] level = "trajectory"`) is discovered at trajectory level,
+//! along the same path: what differs is the core level ([`discover_force`] or
+//! [`discover_trajectory`] with the refitted oscillator), the signal and unit
+//! ([`FitLevel::shown`]), the oscillator's entry and the figures ([`Drawn`]).
 
 use std::path::Path;
 use std::sync::Arc;
@@ -16,29 +18,30 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use stf_core::data::record_bounds::widened;
 use stf_core::discovery::{
-    discover_force, discover_trajectory, Candidate, Discovery, DiscoverySettings, TrajectoryPart,
+    discover_force, discover_trajectory, Candidate, Discovery, DiscoveryError, DiscoverySettings,
     TrajectorySetup,
 };
-use stf_core::fit::{FitSettings, FittedParam, TrajectoryData};
+use stf_core::fit::{FitSettings, FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::oscillator_params::OscParam;
+use stf_core::regimes::Cycle;
 use stf_plugins::ScriptRun;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
-use crate::fitting::{estimate_line, load_data_at, system_param, FitData};
+use crate::fitting::{estimate_line, load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::write_json;
 use crate::outputs::discovery_json::{Common, DiscoveryJson};
 use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::progress::{discovery_observer, Progress};
 use crate::report::{
-    measured_vs_fitted, measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM,
-    DISPLACEMENT_RESIDUAL_MM, STF_FORCE_RESIDUAL,
+    measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
+    DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
 };
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::standard_report::{record_sections, write_report};
-use crate::validation::{DiscoveryScore, ValidationRecord};
+use crate::validation::DiscoveryScore;
 use crate::{say, tell};
 
 /// The sum of `terms` (names or script paths; `none` is the zero force).
@@ -60,16 +63,6 @@ fn models_entry<'a>(
     ModelsEntry::new(&model.terms(), params)
         .to_toml()
         .context("cannot write the final model as an experiment entry")
-}
-
-/// The terminal's account of a discovery: each step's verdict, the `summary` line and the
-/// `held_out` line (the held-out cycles and the validation record).
-fn print_steps(found: &Discovery, summary: &str, held_out: &str) {
-    for step in &found.steps {
-        say!("  {}", step.verdict);
-    }
-    say!("{summary}");
-    say!("  {held_out}");
 }
 
 /// The effects named, or `none`.
@@ -121,65 +114,55 @@ pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: b
     }
     let validation = crate::validation::load(&exp, &data)?;
     let results = ResultsDir::begin(out_arg, force)?;
-    let out = results.path();
     let (base, candidates) = models_of(&exp, spec, &data)?;
     let cycles = crate::fitting::cycles_of(&data)?;
     let mut settings = settings_of(&exp, spec, data.level);
-    let started = Instant::now();
     let progress = Progress::new(quiet);
     let bar = progress.job("discover");
     let (unit, scale) = data.level.shown();
     settings.observer = discovery_observer(bar.clone(), unit, scale);
-    if data.level == FitLevel::Trajectory {
-        run_trajectory(
-            &exp,
-            &data,
-            base,
-            &candidates,
-            &cycles,
-            &settings,
-            (out, validation.as_ref()),
-            (quiet, &bar),
-        )?;
-        results.commit()?;
-        say!(
-            "{}",
-            wrote_line(
-                out_arg,
-                &["discovery.json", "discovered.csv"],
-                exp.output.report
-            )
-        );
-        return Ok(());
-    }
+    // The oscillator refitted with every model, at trajectory level.
+    let refit = (data.level == FitLevel::Trajectory).then(|| {
+        let params = refitted(&exp, &data, base.as_ref(), quiet);
+        let setup = trajectory_setup(&exp, &data, &params);
+        let names: Vec<String> = params.iter().map(OscParam::to_string).collect();
+        (names, setup)
+    });
     if !quiet {
+        let refitting = refit.as_ref().map_or(String::new(), |(names, _)| {
+            format!(" at trajectory level (refitting {})", names.join(", "))
+        });
         tell!(
-            "discovering from `{}` over {} candidates on {} cycles…",
+            "discovering from `{}`{refitting} over {} candidates on {} cycles…",
             spec.base_text(),
             candidates.len(),
             cycles.len()
         );
     }
-    // The record's kinematics noise enters the floor, its filter the test's blocks.
-    let settings = settings.kinematics(&data.kinematics);
-    let found = discover_force(base, &candidates, &data.force_data(), &cycles, &settings);
+    let started = Instant::now();
+    let setup = refit.as_ref().map(|(_, setup)| setup);
+    let found = discover_at(&data, setup, (base, &candidates, &cycles), settings);
     bar.finish_and_clear();
     let found = found?;
     let wall = started.elapsed().as_secs_f64();
     let score = validation
         .as_ref()
-        .map(|rec| crate::validation::score_force_discovery(&found, rec));
-    let toml_entry = models_entry(
-        found.final_model.as_ref(),
-        found.final_params.iter().filter(|p| p.name != "f_off"),
+        .map(|rec| crate::validation::score_discovery(&exp, &found, rec));
+    let names = refit
+        .as_ref()
+        .map_or(&[][..], |(names, _)| names.as_slice());
+    let entries = write_results(
+        &exp,
+        &data,
+        (&found, names),
+        score.as_ref(),
+        (results.path(), wall),
     )?;
-    write_force_results(&exp, &data, &found, score.as_ref(), &toml_entry, out)?;
     if exp.output.report {
-        force_report(&exp, &data, &found, score.as_ref(), out)?;
+        report(&exp, &data, &found, score.as_ref(), results.path())?;
     }
-
     results.commit()?;
-    print_force(spec, &found, score.as_ref(), (&toml_entry, wall));
+    print_summary(spec, &data, &found, score.as_ref(), (&entries, wall));
     say!(
         "{}",
         wrote_line(
@@ -189,6 +172,26 @@ pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: b
         )
     );
     Ok(())
+}
+
+/// Discover at `data`'s level: along the record's kinematics (their noise enters the floor,
+/// their filter the test's blocks), or simulating the oscillator of `setup`.
+fn discover_at(
+    data: &FitData,
+    setup: Option<&TrajectorySetup>,
+    (base, candidates, cycles): (Arc<dyn ForceModel>, &[Candidate], &[Cycle]),
+    settings: DiscoverySettings,
+) -> Result<Discovery, DiscoveryError> {
+    match setup {
+        None => {
+            let settings = settings.kinematics(&data.kinematics);
+            discover_force(base, candidates, &data.force_data(), cycles, &settings)
+        }
+        Some(setup) => {
+            let td = data.trajectory_data();
+            discover_trajectory(base, candidates, &td, cycles, setup, &settings)
+        }
+    }
 }
 
 /// The base model and the candidates of `[discover]`: the vocabulary of
@@ -240,36 +243,53 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
     settings
 }
 
-/// The terminal summary of a force-level discovery.
-fn print_force(
+/// The terminal summary of a discovery; `entries` are the final model's `[[models]]` and
+/// (trajectory level) `[system]` entries.
+fn print_summary(
     spec: &DiscoverSpec,
+    data: &FitData,
     found: &Discovery,
     score: Option<&DiscoveryScore>,
-    (toml_entry, wall): (&str, f64),
+    (entries, wall): (&(String, String), f64),
 ) {
-    say!(
-        "base `{}`: gap {:.4} N; {}",
-        spec.base_text(),
-        found.gap_before,
-        found.where_before.summary
-    );
-    let summary = format!(
-        "effects: {}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {:.1} s",
-        named(&found.effects),
-        found.gap_before,
-        found.gap_after,
-        found.noise_floor,
-        wall
-    );
-    print_steps(
-        found,
-        &summary,
-        &held_out_and_validation(found.holdout_cycles, score, "N", 1.0),
-    );
-    for note in &found.notes {
-        say!("  note: {note}");
+    let (unit, scale) = data.level.shown();
+    let effects = named(&found.effects);
+    let summary = match &found.trajectory {
+        None => {
+            say!(
+                "base `{}`: gap {:.4} N; {}",
+                spec.base_text(),
+                found.gap_before,
+                found.where_before.summary
+            );
+            format!(
+                "effects: {effects}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {wall:.1} s",
+                found.gap_before, found.gap_after, found.noise_floor,
+            )
+        }
+        Some(tf) => format!(
+            "effects: {effects}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {wall:.1} s",
+            tf.s_before_mm2,
+            tf.s_after_mm2,
+            found.noise_floor * 1e3,
+        ),
+    };
+    let held_out = held_out_and_validation(found.holdout_cycles, score, unit, scale);
+    for step in &found.steps {
+        say!("  {}", step.verdict);
     }
-    say!("final model, as an experiment entry:\n{toml_entry}");
+    say!("{summary}");
+    say!("  {held_out}");
+    if found.trajectory.is_none() {
+        for note in &found.notes {
+            say!("  note: {note}");
+        }
+    }
+    say!(
+        "final model, as an experiment entry:\n{}{}",
+        entries.0,
+        entries.1
+    );
 }
 
 /// The held-out cycles every step was scored on and, with `[validate]`, the base's and the
@@ -288,43 +308,110 @@ fn held_out_and_validation(
     }
 }
 
-/// `discovery.json` and `discovered.csv` of a force-level discovery.
-fn write_force_results(
+/// `discovery.json` and `discovered.csv`; returns the final model's `[[models]]` entry and,
+/// at trajectory level, the refitted oscillator's `[system]` entry (`names`; else empty).
+/// At force level the final parameters in the JSON hold the offset `f_off` too.
+fn write_results(
     exp: &Experiment,
     data: &FitData,
-    found: &Discovery,
+    (found, names): (&Discovery, &[String]),
     score: Option<&DiscoveryScore>,
-    toml_entry: &str,
-    out: &Path,
-) -> Result<()> {
-    let all: Vec<&FittedParam> = found.final_params.iter().collect();
-    let doc = DiscoveryJson::new(
-        Common {
-            exp,
-            data,
-            found,
-            score,
-        },
-        &all,
-        toml_entry.to_string(),
-        crate::discovery_curves::force_curves(found, exp.system),
-    );
+    (out, wall): (&Path, f64),
+) -> Result<(String, String)> {
+    let own = |p: &FittedParam| {
+        names.contains(&p.name)
+            || [FORCE_OFFSET, DISPLACEMENT_OFFSET].contains(&p.name.as_str())
+            || INITIAL_STATE.contains(&p.name.as_str())
+    };
+    let model_params: Vec<&FittedParam> = found.final_params.iter().filter(|p| !own(p)).collect();
+    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
+    let common = Common {
+        exp,
+        data,
+        found,
+        score,
+    };
+    let (doc, system_entry) = match &found.trajectory {
+        None => {
+            let all: Vec<&FittedParam> = found.final_params.iter().collect();
+            let curves = crate::discovery_curves::force_curves(found, exp.system);
+            let doc = DiscoveryJson::new(common, &all, toml_entry.clone(), curves);
+            (doc, String::new())
+        }
+        Some(tf) => {
+            let system_entry = SystemEntry {
+                system: names
+                    .iter()
+                    .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
+                    .collect(),
+            }
+            .to_toml()
+            .context("cannot write the refitted oscillator as a [system] entry")?;
+            let curves = crate::discovery_curves::trajectory_curves(found, tf);
+            let doc = DiscoveryJson::new(common, &model_params, toml_entry.clone(), curves)
+                .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
+            (doc, system_entry)
+        }
+    };
     write_json(&out.join("discovery.json"), &doc)?;
-    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
-    let (before, after) = (
-        minus(f, &found.residual_before),
-        minus(f, &found.residual_after),
-    );
-    crate::discovery_curves::write_curves(out, "f_stf", &data.record.t, f, (&before, &after))
+    let target = data.target();
+    let (before, after) = modelled(target, found);
+    let signal = data.level.signal().column;
+    crate::discovery_curves::write_curves(out, signal, &data.record.t, target, (&before, &after))?;
+    Ok((toml_entry, system_entry))
 }
 
-/// `measured − residual`, sample by sample: the modelled curve.
-fn minus(measured: &[f64], residual: &[f64]) -> Vec<f64> {
-    measured.iter().zip(residual).map(|(m, r)| m - r).collect()
+/// The base's and the final model's curves of the measured signal `target`: `target −
+/// residual`, sample by sample.
+fn modelled(target: &[f64], found: &Discovery) -> (Vec<f64>, Vec<f64>) {
+    let minus = |r: &[f64]| -> Vec<f64> { target.iter().zip(r).map(|(m, r)| m - r).collect() };
+    (minus(&found.residual_before), minus(&found.residual_after))
 }
 
-/// The report of a force-level discovery.
-fn force_report(
+/// What a discovery's report draws at one level: the section's title, the measured signal
+/// against the base and the final model, and their residuals (figure names, quantities,
+/// captions).
+struct Drawn {
+    title: &'static str,
+    signal: (&'static str, Quantity, &'static str),
+    residual: (&'static str, Quantity, &'static str),
+}
+
+/// [`Drawn`] at force level.
+const FORCE_DRAWN: Drawn = Drawn {
+    title: "Discovery",
+    signal: (
+        "discovery_force",
+        STF_FORCE,
+        "Measured STF force against the base and the final model.",
+    ),
+    residual: (
+        "discovery_residual",
+        STF_FORCE_RESIDUAL,
+        "Residual (measured − model) of the base (grey band) and of the final model.",
+    ),
+};
+
+/// [`Drawn`] at trajectory level.
+const TRAJECTORY_DRAWN: Drawn = Drawn {
+    title: "Discovery (trajectory level)",
+    signal: (
+        "discovery_x",
+        DISPLACEMENT_MM,
+        "Measured displacement against the simulated base and final model.",
+    ),
+    residual: (
+        "discovery_x_residual",
+        DISPLACEMENT_RESIDUAL_MM,
+        "Displacement residual (measured − simulated) of the base (grey band) and of the \
+         final model.",
+    ),
+};
+
+/// The report of a discovery: its notes, the steps' tables (force level), the measured
+/// signal against the base and the final model and their residuals (in the level's unit),
+/// the regime windows (force level) and the record's sections.
+fn report(
     exp: &Experiment,
     data: &FitData,
     found: &Discovery,
@@ -333,62 +420,75 @@ fn force_report(
 ) -> Result<()> {
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir)?;
-    let f = data.record.f_stf.as_deref().unwrap_or(&[]);
-    let (before, after) = (
-        minus(f, &found.residual_before),
-        minus(f, &found.residual_after),
-    );
-    let mut s = Section::new("Discovery");
+    let (unit, scale) = data.level.shown();
+    let drawn = match data.level {
+        FitLevel::Force => &FORCE_DRAWN,
+        FitLevel::Trajectory => &TRAJECTORY_DRAWN,
+    };
+    let shown = |v: &[f64]| v.iter().map(|v| v * scale).collect::<Vec<f64>>();
+    let target = data.target();
+    let (before, after) = modelled(target, found);
+    let mut s = Section::new(drawn.title);
     // The notes are the base's gap, each step's verdict and the final gap, in order.
     s.paragraphs.extend(found.notes.iter().cloned());
     s.paragraphs.push(format!(
         "{}.",
-        held_out_and_validation(found.holdout_cycles, score, "N", 1.0)
+        held_out_and_validation(found.holdout_cycles, score, unit, scale)
     ));
-    s.tables.extend(
-        found
+    if data.level == FitLevel::Force {
+        let tables = found
             .steps
             .iter()
             .enumerate()
-            .map(|(i, step)| step_table(i, step)),
-    );
-    let fig = measured_vs_fitted(
-        &dir,
-        "discovery_force",
-        &data.record.t,
-        f,
-        &[("base", &before), ("final", &after)],
-    )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Measured STF force against the base and the final model.",
-    ));
+            .map(|(i, step)| step_table(i, step));
+        s.tables.extend(tables);
+    }
+    let (name, quantity, caption) = drawn.signal;
+    let (b, a) = (shown(&before), shown(&after));
+    let curves = [("base", b.as_slice()), ("final", a.as_slice())];
     let fig = measured_vs_model(
         &dir,
-        "discovery_residual",
-        STF_FORCE_RESIDUAL,
+        name,
+        quantity,
         &data.record.t,
-        &found.residual_before,
-        &[("final", &found.residual_after)],
+        &shown(target),
+        &curves,
     )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Residual (measured − model) of the base (grey band) and of the final model.",
-    ));
+    s.figures.push(FigureRef::new(fig, caption));
+    let (name, quantity, caption) = drawn.residual;
+    let r_after = shown(&found.residual_after);
+    let fig = measured_vs_model(
+        &dir,
+        name,
+        quantity,
+        &data.record.t,
+        &shown(&found.residual_before),
+        &[("final", &r_after)],
+    )?;
+    s.figures.push(FigureRef::new(fig, caption));
     let mut sections = vec![s];
-    let curves = [("base", before.as_slice()), ("final", after.as_slice())];
-    sections.extend(crate::regime_figures::regime_section(
-        exp, data, &curves, out,
-    )?);
+    if data.level == FitLevel::Force {
+        let curves = [("base", before.as_slice()), ("final", after.as_slice())];
+        sections.extend(crate::regime_figures::regime_section(
+            exp, data, &curves, out,
+        )?);
+    }
     sections.extend(record_sections(data, &[], out)?);
-    let mut intro = vec![crate::verdict::discover_verdict(
+    let verdict = crate::verdict::discover_verdict(
         &found.effects,
-        found.gap_before,
-        found.gap_after,
-        found.noise_floor,
-        "N",
-    )];
-    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("N", 1.0))));
+        found.gap_before * scale,
+        found.gap_after * scale,
+        found.noise_floor * scale,
+        unit,
+    );
+    let mut intro = vec![match &found.trajectory {
+        None => verdict,
+        Some(tf) => format!(
+            "{verdict} S(μ) {:.4} → {:.4} mm².",
+            tf.s_before_mm2, tf.s_after_mm2
+        ),
+    }];
+    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));
     write_report(
         &format!("Discovery: {}", exp.path.display()),
         intro,
@@ -467,204 +567,23 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
     kept
 }
 
-/// `discover` at trajectory level: the simulated oscillator against the measured x.
-#[allow(clippy::too_many_arguments)]
-fn run_trajectory(
-    exp: &Experiment,
-    data: &FitData,
-    base: Arc<dyn ForceModel>,
-    candidates: &[Candidate],
-    cycles: &[stf_core::regimes::Cycle],
-    settings: &DiscoverySettings,
-    (out, validation): (&Path, Option<&ValidationRecord>),
-    (quiet, bar): (bool, &indicatif::ProgressBar),
-) -> Result<()> {
-    let Some(spec) = &exp.discover else {
-        bail!("{}: has no [discover] section", exp.path.display());
-    };
-    let params = refitted(exp, data, base.as_ref(), quiet);
-    let names: Vec<String> = params.iter().map(OscParam::to_string).collect();
-    let setup = trajectory_setup(exp, data, &params);
-    let settings = settings.clone();
-    let started = Instant::now();
-    if !quiet {
-        tell!(
-            "discovering from `{}` at trajectory level (refitting {}) over {} candidates on {} \
-             cycles…",
-            spec.base_text(),
-            names.join(", "),
-            candidates.len(),
-            cycles.len()
-        );
-    }
-    let td = TrajectoryData {
-        t: &data.record.t,
-        x: &data.record.x,
-    };
-    let found = discover_trajectory(base, candidates, &td, cycles, &setup, &settings);
-    bar.finish_and_clear();
-    let found = found?;
-    let tf = found
-        .trajectory
-        .as_ref()
-        .context("a trajectory-level discovery without its oscillator")?;
-    let wall = started.elapsed().as_secs_f64();
-    let score =
-        validation.map(|rec| crate::validation::score_trajectory_discovery(exp, &found, rec));
-    let (toml_entry, system_entry) =
-        write_trajectory_results(exp, data, (&found, tf), &names, score.as_ref(), (out, wall))?;
-    if exp.output.report {
-        trajectory_report(exp, data, (&found, tf), score.as_ref(), out)?;
-    }
-    let found = &found;
-    let summary = format!(
-        "effects: {}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {:.1} s",
-        named(&found.effects),
-        tf.s_before_mm2,
-        tf.s_after_mm2,
-        found.noise_floor * 1e3,
-        wall
-    );
-    let held_out = held_out_and_validation(found.holdout_cycles, score.as_ref(), "mm", 1e3);
-    print_steps(found, &summary, &held_out);
-    say!("final model, as an experiment entry:\n{toml_entry}{system_entry}");
-    Ok(())
-}
-
-/// The oscillator side of a trajectory-level discovery: the record's drive and initial
-/// state, the parameters `names` refitted with every model (and `x0`, `v0` unless
-/// `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
+/// The oscillator side of a trajectory-level discovery: the oscillator of
+/// [`oscillator_fit`], the parameters `names` refitted with every model (and `x0`, `v0`
+/// unless `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
 fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> TrajectorySetup {
     let k = &data.kinematics;
-    let (x0, v0) = k.initial_state();
-    let mut setup = TrajectorySetup::new(exp.system, Arc::new(k.excitation()))
-        .sim_settings(exp.integrator.clone())
-        .initial(x0, v0);
+    let mut fit = oscillator_fit(exp, data);
     for &param in names {
-        setup = setup.refit(system_param(param, &exp.system, k));
+        fit = fit.free(system_param(param, &exp.system, k));
     }
-    setup = setup.force_hint(stf_core::discovery::ForceHint {
+    if exp.fit.fit_initial {
+        for p in k.initial_state_params() {
+            fit = fit.free(p);
+        }
+    }
+    TrajectorySetup::new(fit).force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),
         a: k.a.clone(),
         f: k.recovered_force(&exp.system),
-    });
-    if exp.fit.fit_initial {
-        for p in k.initial_state_params() {
-            setup = setup.refit(p);
-        }
-    }
-    setup
-}
-
-/// `discovery.json` and `discovered.csv` of a trajectory-level discovery; returns the final
-/// model's `[[models]]` and `[system]` entries.
-fn write_trajectory_results(
-    exp: &Experiment,
-    data: &FitData,
-    (found, tf): (&Discovery, &TrajectoryPart),
-    names: &[String],
-    score: Option<&DiscoveryScore>,
-    (out, wall): (&Path, f64),
-) -> Result<(String, String)> {
-    let model_params: Vec<&FittedParam> = found
-        .final_params
-        .iter()
-        .filter(|p| {
-            !names.contains(&p.name)
-                && p.name != "x_off"
-                && !stf_core::fit::INITIAL_STATE.contains(&p.name.as_str())
-        })
-        .collect();
-    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
-    let system_entry = SystemEntry {
-        system: names
-            .iter()
-            .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
-            .collect(),
-    }
-    .to_toml()
-    .context("cannot write the refitted oscillator as a [system] entry")?;
-    let doc = DiscoveryJson::new(
-        Common {
-            exp,
-            data,
-            found,
-            score,
-        },
-        &model_params,
-        toml_entry.clone(),
-        crate::discovery_curves::trajectory_curves(found, tf),
-    )
-    .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
-    write_json(&out.join("discovery.json"), &doc)?;
-    let x = &data.record.x;
-    let curves = (tf.x_before.as_slice(), tf.x_after.as_slice());
-    crate::discovery_curves::write_curves(out, "x", &data.record.t, x, curves)?;
-    Ok((toml_entry, system_entry))
-}
-
-/// The report of a trajectory-level discovery.
-fn trajectory_report(
-    exp: &Experiment,
-    data: &FitData,
-    (found, tf): (&Discovery, &TrajectoryPart),
-    score: Option<&DiscoveryScore>,
-    out: &Path,
-) -> Result<()> {
-    let dir = out.join("figures");
-    std::fs::create_dir_all(&dir)?;
-    let mut s = Section::new("Discovery (trajectory level)");
-    s.paragraphs.extend(found.notes.iter().cloned());
-    s.paragraphs.push(format!(
-        "{}.",
-        held_out_and_validation(found.holdout_cycles, score, "mm", 1e3)
-    ));
-    let mm = |x: &[f64]| x.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
-    let fig = measured_vs_model(
-        &dir,
-        "discovery_x",
-        DISPLACEMENT_MM,
-        &data.record.t,
-        &mm(&data.record.x),
-        &[("base", &mm(&tf.x_before)), ("final", &mm(&tf.x_after))],
-    )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Measured displacement against the simulated base and final model.",
-    ));
-    let residual = |sim: &[f64]| mm(&minus(&data.record.x, sim));
-    let fig = measured_vs_model(
-        &dir,
-        "discovery_x_residual",
-        DISPLACEMENT_RESIDUAL_MM,
-        &data.record.t,
-        &residual(&tf.x_before),
-        &[("final", &residual(&tf.x_after))],
-    )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        "Displacement residual (measured − simulated) of the base (grey band) and of the \
-         final model.",
-    ));
-    let mut sections = vec![s];
-    sections.extend(record_sections(data, &[], out)?);
-    let mut intro = vec![format!(
-        "{} S(μ) {:.4} → {:.4} mm².",
-        crate::verdict::discover_verdict(
-            &found.effects,
-            found.gap_before * 1e3,
-            found.gap_after * 1e3,
-            found.noise_floor * 1e3,
-            "mm",
-        ),
-        tf.s_before_mm2,
-        tf.s_after_mm2,
-    )];
-    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary("mm", 1e3))));
-    write_report(
-        &format!("Discovery: {}", exp.path.display()),
-        intro,
-        sections,
-        out,
-    )
+    })
 }

@@ -105,10 +105,7 @@ fn write_fits(
 /// `fitted.csv`: t, the measured signal (`f_stf` or `x`) and each model's fit of it
 /// (`f_stf_<label>` or `x_<label>`).
 fn fitted_columns<'a>(data: &'a FitData, fits: &'a [ModelFit]) -> Columns<'a> {
-    let measured = match data.level {
-        FitLevel::Force => "f_stf",
-        FitLevel::Trajectory => "x",
-    };
+    let measured = data.level.signal().column;
     let columns = Columns::new()
         .with("t", &data.record.t)
         .with(measured, data.target());
@@ -175,11 +172,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
     say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
-        if data.level == FitLevel::Force {
-            "force"
-        } else {
-            "trajectory"
-        },
+        crate::outputs::level_name(data.level),
         data.record.len(),
         data.record.source
     );

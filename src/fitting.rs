@@ -4,7 +4,9 @@
 //! The record is read, cut to the experiment's time window, and its kinematics derived
 //! once. Each model is then fitted on its own thread (rayon), deterministically, at force level
 //! (against `f_stf`, along the kinematics) or trajectory level (against `x`, simulating the
-//! oscillator driven as in the record).
+//! oscillator driven as in the record), along one path ([`fit_model`]): the level's fit is
+//! built, run, predicted with and given its noise floor by [`Predictor`], the one place that
+//! knows the two levels apart.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -15,8 +17,8 @@ use stf_core::data::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
 use stf_core::fit::{
-    fit_warnings, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor, TrajectoryData,
-    TrajectoryFit,
+    fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor,
+    TrajectoryData, TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
@@ -64,6 +66,14 @@ impl FitData {
         match self.level {
             FitLevel::Force => self.record.f_stf.as_deref().unwrap_or(&[]),
             FitLevel::Trajectory => &self.record.x,
+        }
+    }
+
+    /// The trajectory-level data: the measured displacement.
+    pub fn trajectory_data(&self) -> TrajectoryData<'_> {
+        TrajectoryData {
+            t: &self.record.t,
+            x: &self.record.x,
         }
     }
 
@@ -311,7 +321,9 @@ pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) 
     }
 }
 
-/// Fit one configured model (or, with `None`, the bare oscillator) to `data`.
+/// Fit one configured model (or, with `None`, the bare oscillator) to `data`, at its level:
+/// the fit ([`Predictor::build`]), the prediction with the fitted values, the noise floor and
+/// the warnings.
 pub fn fit_model(
     exp: &Experiment,
     data: &FitData,
@@ -322,129 +334,146 @@ pub fn fit_model(
     let observer =
         |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
-    match data.level {
-        FitLevel::Force => fit_force(exp, data, configured, label, &observer),
-        FitLevel::Trajectory => fit_trajectory(exp, data, configured, label, &observer),
+    let predictor = Predictor::build(exp, data, configured)?;
+    let result = predictor
+        .fit(data, &observer)
+        .with_context(|| format!("fitting `{label}`"))?;
+    let params = predictor.params();
+    let values: Vec<f64> = params
+        .iter()
+        .map(|p| result.value(&p.name).unwrap_or(p.value))
+        .collect();
+    let fitted = predictor
+        .predict(data, &values)
+        .with_context(|| format!("predicting with the fitted `{label}`"))?;
+    let floor = predictor
+        .noise_floor(exp, data, &values)
+        .with_context(|| format!("the noise floor of `{label}`"))?;
+    let mut system = exp.system;
+    if let Predictor::Trajectory(_) = predictor {
+        for &param in &exp.fit.system_free {
+            if let Some(v) = result.value(param.name()) {
+                system[param] = v;
+            }
+        }
     }
+    Ok(ModelFit {
+        configured: configured.cloned(),
+        warnings: fit_warnings(&result, &params, floor.as_ref()),
+        result,
+        fitted,
+        system,
+        label,
+        floor,
+        predictor,
+        values,
+        validation: None,
+    })
 }
 
 /// A progress observer.
 type Observer<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
 
-/// [`fit_model`] at force level, with the noise floor and the warnings.
-fn fit_force(
-    exp: &Experiment,
-    data: &FitData,
-    configured: Option<&ConfiguredModel>,
-    label: String,
-    observer: &Observer,
-) -> Result<ModelFit> {
-    let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
-    let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-    for p in &c.params {
-        fit = fit.param(p.clone());
+impl Predictor {
+    /// The fit of `configured` (or the bare oscillator) at `data`'s level: the model's
+    /// parameters and the offset `f_off` (force level; a model is needed), or the model's free
+    /// parameters, the oscillator's of `[fit] system`, the offset `x_off` and the initial
+    /// state (trajectory level, the oscillator as [`oscillator_fit`] builds it).
+    fn build(
+        exp: &Experiment,
+        data: &FitData,
+        configured: Option<&ConfiguredModel>,
+    ) -> Result<Predictor> {
+        if data.level == FitLevel::Force {
+            let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
+            let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+            for p in &c.params {
+                fit = fit.param(p.clone());
+            }
+            if exp.fit.offset {
+                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
+            }
+            return Ok(Predictor::Force(fit));
+        }
+        let k = &data.kinematics;
+        let mut fit = oscillator_fit(exp, data).settings(exp.fit.settings.clone());
+        let mut free: Vec<FitParam> = Vec::new();
+        if let Some(c) = configured {
+            fit = fit.model(c.model.clone(), c.values());
+            free.extend(c.params.iter().filter(|p| !p.fixed).cloned());
+        }
+        for &param in &exp.fit.system_free {
+            free.push(system_param(param, &exp.system, k));
+        }
+        if exp.fit.offset {
+            free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+        }
+        if exp.fit.fit_initial {
+            free.extend(k.initial_state_params());
+        }
+        for p in free {
+            fit = fit.free(p);
+        }
+        Ok(Predictor::Trajectory(fit))
     }
-    if exp.fit.offset {
-        fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
-    }
-    let fd = data.force_data();
-    let result = fit
-        .fit(&fd, Some(observer))
-        .with_context(|| format!("fitting `{label}`"))?;
-    let values: Vec<f64> = fit
-        .params()
-        .iter()
-        .map(|p| result.value(&p.name).unwrap_or(p.value))
-        .collect();
-    let fitted = fit.predict(&fd, &values)?;
-    let sensor = match exp.regimes.noise_sigma {
-        Some(s) => Some(s),
-        None => stf_core::regimes::noise_floor(fd.f).ok(),
-    };
-    let floor = sensor
-        .map(|s| fit.noise_floor(&fd, &values, s, data.kinematics.motion_noise()))
-        .transpose()
-        .with_context(|| format!("the noise floor of `{label}`"))?;
-    let warnings = fit_warnings(&result, &fit.params(), floor.as_ref());
-    Ok(ModelFit {
-        configured: Some(c.clone()),
-        result,
-        fitted,
-        system: exp.system,
-        label,
-        floor,
-        warnings,
-        predictor: Predictor::Force(fit),
-        values,
-        validation: None,
-    })
-}
 
-/// [`fit_model`] at trajectory level, with the noise floor and the warnings.
-fn fit_trajectory(
-    exp: &Experiment,
-    data: &FitData,
-    configured: Option<&ConfiguredModel>,
-    label: String,
-    observer: &Observer,
-) -> Result<ModelFit> {
-    let k = &data.kinematics;
-    let excitation = Arc::new(k.excitation());
-    let (x0, v0) = k.initial_state();
-    let mut fit = TrajectoryFit::new(exp.system, excitation)
-        .sim_settings(exp.integrator.clone())
-        .settings(exp.fit.settings.clone())
-        .initial(x0, v0);
-    let mut free: Vec<FitParam> = Vec::new();
-    if let Some(c) = configured {
-        fit = fit.model(c.model.clone(), c.values());
-        free.extend(c.params.iter().filter(|p| !p.fixed).cloned());
-    }
-    for &param in &exp.fit.system_free {
-        free.push(system_param(param, &exp.system, k));
-    }
-    if exp.fit.offset {
-        free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
-    }
-    if exp.fit.fit_initial {
-        free.extend(k.initial_state_params());
-    }
-    for p in &free {
-        fit = fit.free(p.clone());
-    }
-    let td = TrajectoryData {
-        t: &data.record.t,
-        x: &data.record.x,
-    };
-    let result = fit
-        .fit(&td, Some(observer))
-        .with_context(|| format!("fitting `{label}`"))?;
-    let mut system = exp.system;
-    for &param in &exp.fit.system_free {
-        if let Some(v) = result.value(param.name()) {
-            system[param] = v;
+    /// The parameters fitted (or held), in the order of the fit's values.
+    fn params(&self) -> Vec<FitParam> {
+        match self {
+            Predictor::Force(f) => f.params(),
+            Predictor::Trajectory(f) => f.free_params().to_vec(),
         }
     }
-    let floor = NoiseFloor::displacement(k.sigma_x);
-    let values: Vec<f64> = free
-        .iter()
-        .map(|p| result.value(&p.name).unwrap_or(p.value))
-        .collect();
-    let fitted = fit
-        .predict(&td, &values)
-        .with_context(|| format!("simulating the fitted `{label}`"))?;
-    Ok(ModelFit {
-        configured: configured.cloned(),
-        warnings: fit_warnings(&result, &free, Some(&floor)),
-        result,
-        fitted,
-        system,
-        label,
-        floor: Some(floor),
-        predictor: Predictor::Trajectory(fit),
-        values,
-        validation: None,
-    })
+
+    /// Run the fit on `data`'s target signal.
+    fn fit(&self, data: &FitData, observer: &Observer) -> Result<FitResult, FitError> {
+        match self {
+            Predictor::Force(f) => f.fit(&data.force_data(), Some(observer)),
+            Predictor::Trajectory(f) => f.fit(&data.trajectory_data(), Some(observer)),
+        }
+    }
+
+    /// The target signal predicted with `values`.
+    fn predict(&self, data: &FitData, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        match self {
+            Predictor::Force(f) => f.predict(&data.force_data(), values),
+            Predictor::Trajectory(f) => f.predict(&data.trajectory_data(), values),
+        }
+    }
+
+    /// The record's noise floor for the fit at `values`: the force sensor's (`[regimes]
+    /// noise_sigma` or estimated) with the kinematics' propagated through the model at force
+    /// level, none if the sensor's could not be estimated; the displacement noise at
+    /// trajectory level.
+    fn noise_floor(
+        &self,
+        exp: &Experiment,
+        data: &FitData,
+        values: &[f64],
+    ) -> Result<Option<NoiseFloor>, FitError> {
+        let k = &data.kinematics;
+        let Predictor::Force(fit) = self else {
+            return Ok(Some(NoiseFloor::displacement(k.sigma_x)));
+        };
+        let fd = data.force_data();
+        let sensor = match exp.regimes.noise_sigma {
+            Some(s) => Some(s),
+            None => stf_core::regimes::noise_floor(fd.f).ok(),
+        };
+        sensor
+            .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
+            .transpose()
+    }
+}
+
+/// The oscillator of a trajectory-level fit or discovery: the experiment's, driven as in the
+/// record, from the record's initial state, simulated with the experiment's integrator.
+pub fn oscillator_fit(exp: &Experiment, data: &FitData) -> TrajectoryFit {
+    let k = &data.kinematics;
+    let (x0, v0) = k.initial_state();
+    TrajectoryFit::new(exp.system, Arc::new(k.excitation()))
+        .sim_settings(exp.integrator.clone())
+        .initial(x0, v0)
 }
 
 /// Configure and fit every model of the experiment, in parallel (bounds widened where the

@@ -67,18 +67,12 @@ pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<
     }
 
     if !fits.is_empty() {
-        let (unit, scale, what) = match data.level {
-            FitLevel::Force => ("N", 1.0, "STF force"),
-            FitLevel::Trajectory => ("mm", 1e3, "displacement"),
-        };
+        let (unit, scale) = data.level.shown();
+        let what = data.level.signal().what;
         let mut s = Section::new("Fits");
         s.paragraphs.push(format!(
             "Each model fitted to the measured {what} ({} level).",
-            if data.level == FitLevel::Force {
-                "force"
-            } else {
-                "trajectory"
-            }
+            crate::outputs::level_name(data.level)
         ));
         if let Some(drive) = &k.drive {
             s.paragraphs.push(format!("Drive: {drive}."));

@@ -8,7 +8,7 @@
 //! trajectory level the fitted oscillator and model driven by the record's drive against its
 //! `x` (m), from its own initial state (fitted on it when the fit fits `x0`, `v0`, else its
 //! estimate), per regime on the rotor rig. `discover` scores its base and final models
-//! ([`score_force_discovery`], [`score_trajectory_discovery`]). The scoring itself is core's
+//! ([`score_discovery`]). The scoring itself is core's
 //! (`stf_core::fit::Validation`).
 
 use std::sync::Arc;
@@ -18,8 +18,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
-use stf_core::discovery::{Discovery, DiscoveryValidation, TrajectorySetup};
-use stf_core::fit::{TrajectoryData, Validation};
+use stf_core::discovery::{Discovery, DiscoveryValidation};
+use stf_core::fit::{TrajectoryFit, Validation};
 use stf_core::physics::excitation::Excitation;
 use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms};
 
@@ -41,18 +41,7 @@ pub struct ValidationRecord {
 impl ValidationRecord {
     /// The unit of the errors: N at force level, m at trajectory level.
     pub fn unit(&self) -> &'static str {
-        match self.data.level {
-            FitLevel::Force => "N",
-            FitLevel::Trajectory => "m",
-        }
-    }
-
-    /// The displacement record, for simulations.
-    fn trajectory(&self) -> TrajectoryData<'_> {
-        TrajectoryData {
-            t: &self.data.record.t,
-            x: &self.data.record.x,
-        }
+        self.data.level.signal().si_unit
     }
 }
 
@@ -205,7 +194,7 @@ fn score_fit(fit: &ModelFit, rec: &ValidationRecord) -> ModelValidation {
         Predictor::Trajectory(f) => {
             let (x0, v0) = rec.data.kinematics.initial_state();
             let on_record = f.clone().excitation(rec.excitation.clone()).initial(x0, v0);
-            on_record.validate(&rec.trajectory(), &fit.values)
+            on_record.validate(&rec.data.trajectory_data(), &fit.values)
         }
     };
     let per_regime = match (&scored, &rec.regimes) {
@@ -311,21 +300,23 @@ impl DiscoveryScore {
     }
 }
 
-/// Score a force-level discovery's base and final models on the validation record.
-pub fn score_force_discovery(found: &Discovery, rec: &ValidationRecord) -> DiscoveryScore {
-    DiscoveryScore::of(rec, found.validate(&rec.data.force_data()))
-}
-
-/// Score a trajectory-level discovery's base and final models on the validation record,
-/// simulated with the experiment's integrator.
-pub fn score_trajectory_discovery(
+/// Score a discovery's base and final models on the validation record: along its
+/// kinematics (force level) or simulated with its drive and the experiment's integrator
+/// (trajectory level).
+pub fn score_discovery(
     exp: &Experiment,
     found: &Discovery,
     rec: &ValidationRecord,
 ) -> DiscoveryScore {
-    let (x0, v0) = rec.data.kinematics.initial_state();
-    let setup = TrajectorySetup::new(exp.system, rec.excitation.clone())
-        .sim_settings(exp.integrator.clone())
-        .initial(x0, v0);
-    DiscoveryScore::of(rec, found.validate_trajectory(&setup, &rec.trajectory()))
+    let scored = match &found.trajectory {
+        None => found.validate(&rec.data.force_data()),
+        Some(_) => {
+            let (x0, v0) = rec.data.kinematics.initial_state();
+            let on = TrajectoryFit::new(exp.system, rec.excitation.clone())
+                .sim_settings(exp.integrator.clone())
+                .initial(x0, v0);
+            found.validate_trajectory(&on, &rec.data.trajectory_data())
+        }
+    };
+    DiscoveryScore::of(rec, scored)
 }

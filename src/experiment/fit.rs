@@ -30,6 +30,33 @@ impl FitLevel {
             FitLevel::Trajectory => ("mm", 1e3),
         }
     }
+
+    /// The measured signal fits aim at.
+    pub fn signal(self) -> Signal {
+        match self {
+            FitLevel::Force => Signal {
+                column: "f_stf",
+                what: "STF force",
+                si_unit: "N",
+            },
+            FitLevel::Trajectory => Signal {
+                column: "x",
+                what: "displacement",
+                si_unit: "m",
+            },
+        }
+    }
+}
+
+/// The measured signal fits aim at, at one level, and how it is said.
+#[derive(Clone, Copy, Debug)]
+pub struct Signal {
+    /// Its column: `f_stf` or `x`.
+    pub column: &'static str,
+    /// What it is: `STF force` or `displacement`.
+    pub what: &'static str,
+    /// Its SI unit, that of the errors in JSON: N or m.
+    pub si_unit: &'static str,
 }
 
 /// Where a trajectory fit's initial state comes from.

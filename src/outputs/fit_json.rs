@@ -157,10 +157,7 @@ impl<'a> ModelFitJson<'a> {
                 .map(|p| p.name.as_str())
                 .collect(),
             rms: r.rms,
-            rms_unit: match level {
-                FitLevel::Force => "N",
-                FitLevel::Trajectory => "m",
-            },
+            rms_unit: level.signal().si_unit,
             s_mm2: r.s_mm2,
             aic: finite(r.aic),
             bic: finite(r.bic),

@@ -4,7 +4,7 @@
 //!
 //! At force level ([`Discovery::validate`]) each model predicts the STF force from the other
 //! record's kinematics with its fitted values and offset. At trajectory level
-//! ([`TrajectoryDiscovery::validate`]) each is simulated with the oscillator as refitted with
+//! ([`Discovery::validate_trajectory`]) each is simulated with the oscillator as refitted with
 //! it, driven by the other record's drive, from that record's initial state — refitted on it
 //! when the discovery fitted `x0`, `v0`, else its estimate less the offset — everything else
 //! as fitted ([`crate::fit::TrajectoryFit::validate`]).
@@ -13,7 +13,6 @@ use std::sync::Arc;
 
 use super::error::DiscoveryError;
 use super::findings::Discovery;
-use super::trajectory_level::TrajectorySetup;
 use crate::fit::{
     FitParam, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit, Validation,
     DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
@@ -76,17 +75,17 @@ impl Discovery {
 fn trajectory_score(
     (model, values, system): (&Arc<dyn ForceModel>, &[f64], OscillatorParams),
     params: &[FittedParam],
-    setup: &TrajectorySetup,
+    on: &TrajectoryFit,
     data: &TrajectoryData,
 ) -> Result<Validation, DiscoveryError> {
-    let mut fit = TrajectoryFit::new(system, setup.excitation.clone())
+    let mut fit = TrajectoryFit::new(system, on.excitation.clone())
         .model(model.clone(), values.to_vec())
-        .sim_settings(setup.sim.clone());
+        .sim_settings(on.sim.clone());
     // As the discovery's simulations: a fitted start is refitted from the estimate, a start
     // not fitted is the estimate less the offset.
     let offset = value_of(params, DISPLACEMENT_OFFSET).unwrap_or(0.0);
     let refit = value_of(params, INITIAL_STATE[0]).is_some();
-    if let Some((x0, v0)) = setup.initial {
+    if let Some((x0, v0)) = on.initial {
         fit = fit.initial(if refit { x0 } else { x0 - offset }, v0);
     }
     let mut held = Vec::new();
@@ -106,12 +105,12 @@ fn trajectory_score(
 
 impl Discovery {
     /// The base's and the final model's errors on another record's displacement `data`
-    /// (trajectory-level discovery; an error for a force-level one). `setup` gives that
-    /// record's drive, its initial-state estimate and the integrator; its `system` and
-    /// refitted parameters are not used.
+    /// (trajectory-level discovery; an error for a force-level one). `on` gives that
+    /// record's drive, its initial-state estimate and the integrator; its oscillator, model
+    /// and free parameters are not used.
     pub fn validate_trajectory(
         &self,
-        setup: &TrajectorySetup,
+        on: &TrajectoryFit,
         data: &TrajectoryData,
     ) -> Result<DiscoveryValidation, DiscoveryError> {
         let (d, Some(part)) = (self, &self.trajectory) else {
@@ -123,13 +122,13 @@ impl Discovery {
             before: trajectory_score(
                 (&d.base_model, &d.base_values, part.system_before),
                 &d.base_params,
-                setup,
+                on,
                 data,
             )?,
             after: trajectory_score(
                 (&d.final_model, &d.final_values, part.system_after),
                 &d.final_params,
-                setup,
+                on,
                 data,
             )?,
         })

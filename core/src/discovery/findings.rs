@@ -68,14 +68,15 @@ pub struct Discovery {
     pub final_fit: FitResult,
     /// Sentences for the report: where the gap lives, what each step found, the ties.
     pub notes: Vec<String>,
-    /// At trajectory level, the oscillator as refitted and the simulated motion (not
+    /// At trajectory level, the oscillator as refitted and S(μ) (not
     /// serialized); `None` at force level.
     #[serde(skip)]
     pub trajectory: Option<TrajectoryPart>,
 }
 
 /// What a trajectory-level discovery says beyond the shared report: the oscillator as
-/// refitted with the base and the final model, S(μ), and their simulated motion. The final
+/// refitted with the base and the final model, S(μ), and the states their simulations start
+/// from (their simulated x is the measured x less [`Discovery`]'s residuals). The final
 /// `final_params` of the shared report hold the refitted oscillator parameters too (and
 /// `x_off` if fitted).
 #[derive(Clone, Debug)]
@@ -93,10 +94,6 @@ pub struct TrajectoryPart {
     pub initial_before: [f64; 2],
     /// The same for the final model.
     pub initial_after: [f64; 2],
-    /// The base's simulated x (with the offset) at every sample, m.
-    pub x_before: Vec<f64>,
-    /// The final model's simulated x (with the offset) at every sample, m.
-    pub x_after: Vec<f64>,
 }
 
 impl Discovery {

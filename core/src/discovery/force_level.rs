@@ -19,7 +19,7 @@ use super::blocks::{block_length, Blocks};
 use super::candidate::Candidate;
 use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
-use super::findings::{Discovery, TrajectoryPart};
+use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
 use super::force_subset_fit::{fit_subset, residuals, rms_over};
 use super::holdout::HoldoutSplit;
@@ -60,16 +60,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<(SearchModel, ForceFit, FitResult), DiscoveryError> {
         let fit = self.force_fit(settings)?;
-        let result = fit_subset(&fit, data, subset, &settings.fit).map_err(|source| {
-            DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            }
-        })?;
-        let stage = SearchModel {
-            parts: self.parts.clone(),
-            values: result.params.iter().map(|p| p.value).collect(),
-        };
+        let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
         Ok((stage, fit, result))
     }
 
@@ -81,10 +72,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<Trial, DiscoveryError> {
         let (stage, fit, train) = self.fit(data, &split.train, settings)?;
-        let r = residuals(&fit, data, &stage.values).map_err(|source| DiscoveryError::Fit {
-            model: self.name(),
-            source,
-        })?;
+        let r = residuals(&fit, data, &stage.values).map_err(|e| self.fit_error(e))?;
         let h = rms_over(&r, &split.holdout);
         Ok(Trial {
             stage,
@@ -133,10 +121,7 @@ impl SearchModel {
         };
         let fit = self.force_fit(settings)?;
         fit.noise_floor(data, &self.values, sensor, motion)
-            .map_err(|source| DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            })
+            .map_err(|e| self.fit_error(e))
     }
 
     /// Measured minus modelled force at every sample.
@@ -146,10 +131,7 @@ impl SearchModel {
         settings: &DiscoverySettings,
     ) -> Result<Vec<f64>, DiscoveryError> {
         let fit = self.force_fit(settings)?;
-        residuals(&fit, data, &self.values).map_err(|source| DiscoveryError::Fit {
-            model: self.name(),
-            source,
-        })
+        residuals(&fit, data, &self.values).map_err(|e| self.fit_error(e))
     }
 }
 
@@ -446,24 +428,12 @@ impl Level for ForceLevel<'_> {
         &choice::FORCE
     }
 
-    fn n_before(&self) -> usize {
-        0
-    }
-
     fn settings(&self) -> &DiscoverySettings {
         self.settings
     }
 
     fn split(&self) -> &HoldoutSplit {
         &self.split
-    }
-
-    fn samples(&self) -> usize {
-        self.data.t.len()
-    }
-
-    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
-        (candidates.to_vec(), Vec::new())
     }
 
     fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
@@ -530,10 +500,6 @@ impl Level for ForceLevel<'_> {
             self.settings.floor_band(floor.propagated),
             self.settings,
         ))
-    }
-
-    fn search_notes(&self) -> Vec<String> {
-        Vec::new()
     }
 
     /// Blocks cut for `current`'s residual, its own floor: the block test
@@ -630,28 +596,6 @@ impl Level for ForceLevel<'_> {
         true
     }
 
-    fn polishes(&self) -> bool {
-        false
-    }
-
-    fn warns_unresolved(&self) -> bool {
-        false
-    }
-
-    /// From the training fit's values, which are near the optimum: Levenberg–Marquardt
-    /// alone, which never leaves the start for a worse point (the fallback of the default
-    /// solver was seen to wander off and end far worse), at a tolerance of at most 1e-9.
-    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
-        DiscoverySettings {
-            fit: settings
-                .fit
-                .clone()
-                .solver(crate::fit::Solver::LevenbergMarquardt)
-                .tol(settings.fit.tol.min(1e-9)),
-            ..settings.clone()
-        }
-    }
-
     fn closing_notes(
         &self,
         [gap_before, gap_after]: [f64; 2],
@@ -666,13 +610,6 @@ impl Level for ForceLevel<'_> {
         )];
         notes.extend(floor_doubts(floor, gap_after, self.settings));
         notes
-    }
-
-    fn part(
-        &self,
-        _: [(&SearchModel, &[f64]); 2],
-    ) -> Result<Option<TrajectoryPart>, DiscoveryError> {
-        Ok(None)
     }
 }
 

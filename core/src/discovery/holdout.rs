@@ -8,7 +8,8 @@
 use super::error::DiscoveryError;
 use crate::regimes::Cycle;
 
-/// Sample indices that train the fits and those held out to score them.
+/// Sample indices that train the fits and those held out to score them: together, every
+/// sample of the record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HoldoutSplit {
     /// Training samples, increasing.

@@ -8,7 +8,9 @@
 //! are started and fitted. The search itself — base fit, steps, acceptance, re-check of
 //! earlier effects, polish, final refit — is written once, in [`super::search`], over this
 //! trait. The steps a level does not run by default are its capabilities
-//! ([`Level::reconsiders`], [`Level::polishes`], [`Level::warns_unresolved`]).
+//! ([`Level::reconsiders`], [`Level::polishes`], [`Level::warns_unresolved`]); where one
+//! level has nothing of its own (notes, admitted candidates, parameters, a part of the
+//! result) the trait's default serves.
 
 use std::sync::Arc;
 
@@ -30,8 +32,10 @@ pub(super) trait Level: Sync {
     fn said(&self) -> &'static Said;
 
     /// The level's own parameters, fitted before the model's (the refitted oscillator's at
-    /// trajectory level; none at force level).
-    fn n_before(&self) -> usize;
+    /// trajectory level; none by default).
+    fn n_before(&self) -> usize {
+        0
+    }
 
     /// The settings of the run.
     fn settings(&self) -> &DiscoverySettings;
@@ -39,11 +43,17 @@ pub(super) trait Level: Sync {
     /// The record's held-out split.
     fn split(&self) -> &HoldoutSplit;
 
-    /// Samples in the record.
-    fn samples(&self) -> usize;
+    /// Samples in the record: those the split trains on and those it holds out.
+    fn samples(&self) -> usize {
+        let split = self.split();
+        split.train.len() + split.holdout.len()
+    }
 
-    /// The candidates the search may try, of those given, and notes on any left out.
-    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>);
+    /// The candidates the search may try, of those given, and notes on any left out (by
+    /// default all, no note).
+    fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
+        (candidates.to_vec(), Vec::new())
+    }
 
     /// Where the base's whole-record fit starts from: the level's own start values, the
     /// base's defaults and the offset (0) if fitted, improved as far as the level can before
@@ -90,8 +100,11 @@ pub(super) trait Level: Sync {
     /// the denominator of every step's explained fraction.
     fn base_excess(&self, current: &Trial, floor: &NoiseFloor) -> Result<f64, DiscoveryError>;
 
-    /// Notes on how the search runs at this level (said once, before the steps).
-    fn search_notes(&self) -> Vec<String>;
+    /// Notes on how the search runs at this level (said once, before the steps; none by
+    /// default).
+    fn search_notes(&self) -> Vec<String> {
+        Vec::new()
+    }
 
     /// `then` called with the yardstick of a step on `current`.
     fn measured<T>(
@@ -121,18 +134,30 @@ pub(super) trait Level: Sync {
         residual: &[f64],
     ) -> Result<Trial, DiscoveryError>;
 
-    /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`]).
-    fn reconsiders(&self) -> bool;
+    /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`];
+    /// not by default).
+    fn reconsiders(&self) -> bool {
+        false
+    }
 
     /// Whether an accepted trial is polished at the final fit's tolerance before the next
-    /// step ([`super::search`]).
-    fn polishes(&self) -> bool;
+    /// step ([`super::search`]; not by default).
+    fn polishes(&self) -> bool {
+        false
+    }
 
-    /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted.
-    fn warns_unresolved(&self) -> bool;
+    /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted
+    /// (not by default).
+    fn warns_unresolved(&self) -> bool {
+        false
+    }
 
-    /// The settings of the final whole-record refit, from the training fit.
-    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings;
+    /// The settings of the final whole-record refit, from the training fit's values, which
+    /// are near the optimum: by default [`DiscoverySettings::refined`] (the fallback of the
+    /// default solver was seen to wander off and end far worse).
+    fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
+        settings.refined()
+    }
 
     /// The notes that close a run: the gap before and after, against the final floor.
     fn closing_notes(
@@ -143,11 +168,14 @@ pub(super) trait Level: Sync {
         where_after: &str,
     ) -> Vec<String>;
 
-    /// The level's own part of the result (`None` at force level): what the base's and the
-    /// final model's whole-record fits `fits` (each with its residual) say beyond the shared
+    /// The level's own part of the result (none by default): what the base's and the final
+    /// model's whole-record fits `fits` (each with its residual) say beyond the shared
     /// report.
     fn part(
         &self,
         fits: [(&SearchModel, &[f64]); 2],
-    ) -> Result<Option<TrajectoryPart>, DiscoveryError>;
+    ) -> Result<Option<TrajectoryPart>, DiscoveryError> {
+        let _ = fits;
+        Ok(None)
+    }
 }

@@ -23,7 +23,7 @@ use super::progress::DiscoveryEvent;
 use super::reconsider::reconsider;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
-use crate::fit::{FitResult, Solver};
+use crate::fit::FitResult;
 use crate::physics::force_model::ForceModel;
 
 /// The base's whole-record fit and what it says.
@@ -46,7 +46,7 @@ pub(super) fn discover<L: Level>(
 ) -> Result<Discovery, DiscoveryError> {
     candidate::distinct(candidates)?;
     let base_name = base.name().to_string();
-    let in_base: Vec<String> = base_name.split(" + ").map(str::to_string).collect();
+    let in_base: Vec<String> = base.terms().into_iter().map(str::to_string).collect();
     let (kept, mut notes) = level.admitted(candidates);
     let candidates = kept.as_slice();
     settings.observer.emit(DiscoveryEvent::Base);
@@ -133,15 +133,7 @@ fn base_fit<L: Level>(
 /// screening fit stopped early (whose leftover misfit a later candidate's extra parameters
 /// would otherwise "explain").
 fn polished<L: Level>(level: &L, trial: Trial, settings: &DiscoverySettings) -> Trial {
-    let polish = DiscoverySettings {
-        fit: settings
-            .fit
-            .clone()
-            .solver(Solver::LevenbergMarquardt)
-            .tol(settings.fit.tol.min(1e-9)),
-        ..settings.clone()
-    };
-    match level.trial(&trial.stage, &polish) {
+    match level.trial(&trial.stage, &settings.refined()) {
         Ok(polished) if polished.train.rms <= trial.train.rms => polished,
         _ => trial,
     }

@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use super::candidate::Candidate;
 use super::error::DiscoveryError;
+use crate::fit::{FitError, FitResult};
 use crate::physics::force_model::ForceModel;
 use crate::physics::model_sum::ModelSum;
 
@@ -31,6 +32,28 @@ impl SearchModel {
             [one] => one.clone(),
             _ => Arc::new(ModelSum::new(self.parts.clone())?),
         })
+    }
+
+    /// A fit's error `source` as this stage's.
+    pub fn fit_error(&self, source: FitError) -> DiscoveryError {
+        DiscoveryError::Fit {
+            model: self.name(),
+            source,
+        }
+    }
+
+    /// This stage at the values of its fit `fitted`, and the fit (or its error, as this
+    /// stage's).
+    pub fn fitted(
+        &self,
+        fitted: Result<FitResult, FitError>,
+    ) -> Result<(SearchModel, FitResult), DiscoveryError> {
+        let result = fitted.map_err(|e| self.fit_error(e))?;
+        let stage = SearchModel {
+            parts: self.parts.clone(),
+            values: result.params.iter().map(|p| p.value).collect(),
+        };
+        Ok((stage, result))
     }
 
     /// The parts' names joined by ` + ` (`power_law + viscous`; the zero force `none` drops out

@@ -6,7 +6,7 @@ use super::error::DiscoveryError;
 use super::progress::Observer;
 use crate::data::kinematics::Kinematics;
 use crate::data::kinematics::MotionNoise;
-use crate::fit::FitSettings;
+use crate::fit::{FitSettings, Solver};
 
 /// How discovery fits, holds out data and decides that an effect is significant.
 ///
@@ -140,6 +140,23 @@ impl DiscoverySettings {
     /// part is `propagated` (N).
     pub(super) fn floor_band(&self, propagated: f64) -> f64 {
         (self.kinematics_uncertainty.powi(2) - 1.0) * propagated * propagated
+    }
+    /// These settings with every fit run by Levenberg–Marquardt alone, which never leaves its
+    /// start for a worse point, its iterations at most `max_iters` (`None`: as set).
+    pub(super) fn levenberg_marquardt(&self, max_iters: Option<u64>) -> Self {
+        let fit = self.fit.clone().solver(Solver::LevenbergMarquardt);
+        let iters = max_iters.map_or(fit.max_iters, |n| fit.max_iters.min(n));
+        DiscoverySettings {
+            fit: fit.max_iters(iters),
+            ..self.clone()
+        }
+    }
+    /// [`DiscoverySettings::levenberg_marquardt`] at a tolerance of at most 1e-9: for a fit
+    /// from near the optimum that must end there (the final refit, a polish).
+    pub(super) fn refined(&self) -> Self {
+        let mut s = self.levenberg_marquardt(None);
+        s.fit = s.fit.tol(self.fit.tol.min(1e-9));
+        s
     }
     /// The noise and the derivative filter of the kinematics `k` the force data were derived
     /// with: their noise enters the floor, the filter's window the length of the test's blocks.

@@ -51,43 +51,35 @@ use super::trajectory_gap::locate_x_gap;
 use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
 use crate::fit::{
     check_same_terms, FitParam, FitResult, FitSettings, ForceData, ForceFit, NoiseFloor, Solver,
-    TrajectoryData, DISPLACEMENT_OFFSET,
+    TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET,
 };
-use crate::numerics::integrate::Settings;
-use crate::physics::excitation::Excitation;
 use crate::physics::force_model::{ForceModel, Reach};
-use crate::physics::oscillator_params::OscillatorParams;
+use crate::physics::oscillator_params::{OscParam, OscillatorParams};
 use crate::physics::param_spec::ParamSpec;
 use crate::regimes::Cycle;
 
-/// The oscillator side of a trajectory-level discovery: its parameters, its drive, which of
-/// its parameters are refitted with every model, and how it is simulated.
+/// The oscillator side of a trajectory-level discovery: the oscillator, its drive, its
+/// initial state and integrator, and its parameters refitted with every model (names of
+/// [`OscillatorParams::NAMES`] or the initial state, with start values and bounds) — a
+/// [`TrajectoryFit`] without a model, whose free parameters are those refitted — and the
+/// force hint.
 ///
 /// ```
 /// use std::sync::Arc;
 /// use stf_core::discovery::TrajectorySetup;
 /// use stf_core::physics::excitation::Excitation;
-/// use stf_core::fit::FitParam;
+/// use stf_core::fit::{FitParam, TrajectoryFit};
 /// use stf_core::physics::oscillator_params::OscillatorParams;
-/// let setup = TrajectorySetup::new(OscillatorParams::FREE, Arc::new(Excitation::None))
-///     .refit(FitParam::new("k", 268.0).bounds(100.0, 400.0))
+/// let fit = TrajectoryFit::new(OscillatorParams::FREE, Arc::new(Excitation::None))
+///     .free(FitParam::new("k", 268.0).bounds(100.0, 400.0))
 ///     .initial(0.03, 0.0);
-/// assert_eq!(setup.oscillator.len(), 1);
+/// let setup = TrajectorySetup::new(fit);
+/// assert_eq!(setup.fit.free_params().len(), 1);
 /// ```
 #[derive(Clone)]
 pub struct TrajectorySetup {
-    /// The oscillator's parameters (start values of the refitted ones).
-    pub system: OscillatorParams,
-    /// What drives it: the measured rotor angle or the measured force `u`.
-    pub excitation: Arc<Excitation>,
-    /// Oscillator parameters refitted with every model: names of [`OscillatorParams::NAMES`],
-    /// start values and bounds.
-    pub oscillator: Vec<FitParam>,
-    /// Initial displacement (m) and velocity (m/s) of every simulation, before the offset;
-    /// `None`: the first measured x, at rest.
-    pub initial: Option<(f64, f64)>,
-    /// Integrator settings of the simulations.
-    pub sim: Settings,
+    /// The oscillator and its refitted parameters (the fit's settings and model unused).
+    pub fit: TrajectoryFit,
     /// The STF force recovered from the record's kinematics with the setup's oscillator, if
     /// known: every model is first fitted to it at force level (milliseconds) for its start.
     pub force_hint: Option<ForceHint>,
@@ -106,31 +98,12 @@ pub struct ForceHint {
 }
 
 impl TrajectorySetup {
-    /// The oscillator `system` driven by `excitation`, nothing refitted, default integrator.
-    pub fn new(system: OscillatorParams, excitation: Arc<Excitation>) -> Self {
+    /// The oscillator of `fit`, its free parameters refitted with every model, no force hint.
+    pub fn new(fit: TrajectoryFit) -> Self {
         TrajectorySetup {
-            system,
-            excitation,
-            oscillator: Vec::new(),
-            initial: None,
-            sim: Settings::default(),
+            fit,
             force_hint: None,
         }
-    }
-    /// Refit this oscillator parameter with every model.
-    pub fn refit(mut self, p: FitParam) -> Self {
-        self.oscillator.push(p);
-        self
-    }
-    /// Initial displacement (m) and velocity (m/s).
-    pub fn initial(mut self, x0: f64, v0: f64) -> Self {
-        self.initial = Some((x0, v0));
-        self
-    }
-    /// Integrator settings.
-    pub fn sim_settings(mut self, sim: Settings) -> Self {
-        self.sim = sim;
-        self
     }
     /// Start every model from its force-level fit to `hint`.
     pub fn force_hint(mut self, hint: ForceHint) -> Self {
@@ -183,7 +156,7 @@ impl SearchModel {
     fn params(&self, setup: &TrajectorySetup, model: &Arc<dyn ForceModel>) -> Vec<FitParam> {
         let mut out: Vec<FitParam> = Vec::with_capacity(self.values.len());
         let mut values = self.values.iter().copied();
-        for p in &setup.oscillator {
+        for p in &setup.fit.free {
             let v = values.next().unwrap_or(p.value);
             out.push(p.clone().value(inside(v, p.min, p.max)));
         }
@@ -216,17 +189,7 @@ impl SearchModel {
                 p.fixed |= crate::fit::INITIAL_STATE.contains(&p.name.as_str());
             }
         }
-        let result = fit_on(track, &model, &params, subset, &settings.fit).map_err(|source| {
-            DiscoveryError::Fit {
-                model: self.name(),
-                source,
-            }
-        })?;
-        let stage = SearchModel {
-            parts: self.parts.clone(),
-            values: result.params.iter().map(|p| p.value).collect(),
-        };
-        Ok((stage, result))
+        self.fitted(fit_on(track, &model, &params, subset, &settings.fit))
     }
 
     /// The simulated run of this stage at its values.
@@ -457,14 +420,8 @@ impl SearchModel {
         if starts.len() < 2 {
             return starts.into_iter().next();
         }
-        let short = DiscoverySettings {
-            fit: settings
-                .fit
-                .clone()
-                .solver(Solver::LevenbergMarquardt)
-                .max_iters(START_ITERS),
-            ..settings.clone()
-        };
+        let mut short = settings.levenberg_marquardt(None);
+        short.fit = short.fit.max_iters(START_ITERS);
         let mut best: Option<(f64, SearchModel)> = None;
         for start in &starts {
             let Ok((stage, fit)) = start.fit_simulated(track, setup, train, &short) else {
@@ -850,7 +807,7 @@ pub fn discover_trajectory(
     settings.validate()?;
     let level = TrajectoryLevel::new(data, cycles, setup, settings)?;
     let base_params: Vec<(&ParamSpec, bool)> = base.params().iter().map(|s| (s, true)).collect();
-    check_same_terms(&base_params, &level.rig.oscillator, &setup.excitation)
+    check_same_terms(&base_params, &level.rig.oscillator, &setup.fit.excitation)
         .map_err(|e| DiscoveryError::BadSettings(format!("the base `{}`: {e}", base.name())))?;
     search::discover(&level, base, candidates, settings)
 }
@@ -889,9 +846,9 @@ impl<'a> TrajectoryLevel<'a> {
                 data.x.len()
             )));
         }
-        for p in &setup.oscillator {
+        for p in &setup.fit.free {
             let initial = crate::fit::INITIAL_STATE.contains(&p.name.as_str());
-            if OscillatorParams::FORCED.get(&p.name).is_none() && !initial {
+            if p.name.parse::<OscParam>().is_err() && !initial {
                 return Err(DiscoveryError::BadSettings(format!(
                     "`{}` is not an oscillator parameter or the initial state; known: {}, x0, v0",
                     p.name,
@@ -901,11 +858,11 @@ impl<'a> TrajectoryLevel<'a> {
         }
         let floor = settings.floor_of(data.x, "displacement", "m")?;
         let rig = Rig {
-            system: setup.system,
-            excitation: setup.excitation.clone(),
-            oscillator: setup.oscillator.iter().map(|p| p.name.as_str()).collect(),
-            initial: setup.initial,
-            sim: setup.sim.clone(),
+            system: setup.fit.system,
+            excitation: setup.fit.excitation.clone(),
+            oscillator: setup.fit.free.iter().map(|p| p.name.as_str()).collect(),
+            initial: setup.fit.initial,
+            sim: setup.fit.sim.clone(),
             fit_offset: settings.fit_offset,
             fixed_start: false,
             t: data.t,
@@ -917,7 +874,7 @@ impl<'a> TrajectoryLevel<'a> {
             data,
             cycles,
             setup,
-            osc_start: setup.oscillator.iter().map(|p| p.value).collect(),
+            osc_start: setup.fit.free.iter().map(|p| p.value).collect(),
             screen: n / cycles.len().max(1) >= SCREEN_MIN_SAMPLES,
             rig,
             split,
@@ -934,7 +891,7 @@ impl Level for TrajectoryLevel<'_> {
     }
 
     fn n_before(&self) -> usize {
-        self.setup.oscillator.len()
+        self.setup.fit.free.len()
     }
 
     fn settings(&self) -> &DiscoverySettings {
@@ -943,10 +900,6 @@ impl Level for TrajectoryLevel<'_> {
 
     fn split(&self) -> &HoldoutSplit {
         &self.split
-    }
-
-    fn samples(&self) -> usize {
-        self.data.t.len()
     }
 
     /// A candidate with a parameter that is the same term as a refitted one (`viscous`
@@ -997,10 +950,7 @@ impl Level for TrajectoryLevel<'_> {
         };
         match &self.scout {
             Some(s) => {
-                let lm = DiscoverySettings {
-                    fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-                    ..settings.clone()
-                };
+                let lm = settings.levenberg_marquardt(None);
                 scouted(start, s, (&self.rig, self.setup, &all), &lm).0
             }
             None => start,
@@ -1136,10 +1086,6 @@ impl Level for TrajectoryLevel<'_> {
         self.trial(&stage, &trial_settings(self.settings))
     }
 
-    fn reconsiders(&self) -> bool {
-        false
-    }
-
     fn polishes(&self) -> bool {
         true
     }
@@ -1150,10 +1096,7 @@ impl Level for TrajectoryLevel<'_> {
 
     /// Levenberg–Marquardt alone, from the training fit (near the optimum).
     fn final_settings(&self, settings: &DiscoverySettings) -> DiscoverySettings {
-        DiscoverySettings {
-            fit: settings.fit.clone().solver(Solver::LevenbergMarquardt),
-            ..settings.clone()
-        }
+        settings.levenberg_marquardt(None)
     }
 
     fn closing_notes(
@@ -1183,8 +1126,6 @@ impl Level for TrajectoryLevel<'_> {
                 .start(&stage.model()?, &stage.values)
                 .map_err(DiscoveryError::BadData)
         };
-        let simulated =
-            |r: &[f64]| -> Vec<f64> { self.data.x.iter().zip(r).map(|(m, r)| m - r).collect() };
         Ok(Some(TrajectoryPart {
             system_before: self.rig.system_of(&before.values),
             system_after: self.rig.system_of(&after.values),
@@ -1192,8 +1133,6 @@ impl Level for TrajectoryLevel<'_> {
             s_after_mm2: s_mm2(rms(r_after)),
             initial_before: initial(before)?,
             initial_after: initial(after)?,
-            x_before: simulated(r_before),
-            x_after: simulated(r_after),
         }))
     }
 }
@@ -1207,14 +1146,7 @@ fn s_mm2(g: f64) -> f64 {
 /// not settle by then (a stiff relaxation wandering through thousands of simulations) is
 /// scored where it stopped, not chased by Nelder–Mead.
 fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
-    DiscoverySettings {
-        fit: settings
-            .fit
-            .clone()
-            .solver(Solver::LevenbergMarquardt)
-            .max_iters(settings.fit.max_iters.min(TRIAL_ITERS)),
-        ..settings.clone()
-    }
+    settings.levenberg_marquardt(Some(TRIAL_ITERS))
 }
 /// How far the record goes: its largest |x|, and the largest |v| of the force hint's
 /// filtered velocity or, without one, of central differences of x.
@@ -1234,6 +1166,7 @@ fn reach_of(data: &TrajectoryData, setup: &TrajectorySetup) -> Reach {
 mod tests {
     use super::*;
     use crate::numerics::interpolate::Linear;
+    use crate::physics::excitation::Excitation;
     use crate::physics::force_model::{ModelError, ModelState};
     use crate::physics::model_sum::ModelSum;
     use crate::physics::oscillator::Oscillator;
@@ -1373,12 +1306,14 @@ mod tests {
             FitParam::new(name, v).bounds(v / 5.0, v * 5.0)
         };
         let setup = TrajectorySetup::new(
-            system,
-            Arc::new(Excitation::Force(Linear::new(t.clone(), u))),
-        )
-        .refit(start("m"))
-        .refit(start("k"))
-        .refit(start("c"));
+            TrajectoryFit::new(
+                system,
+                Arc::new(Excitation::Force(Linear::new(t.clone(), u))),
+            )
+            .free(start("m"))
+            .free(start("k"))
+            .free(start("c")),
+        );
         let discovery = discover_trajectory(
             viscous(),
             candidates,

@@ -87,12 +87,12 @@ pub fn initial_state_params(x0: f64, v0: f64, x_span: f64, v_span: f64) -> [FitP
 /// A trajectory-level fit of the oscillator and, optionally, an STF model.
 #[derive(Clone)]
 pub struct TrajectoryFit {
-    system: OscillatorParams,
-    excitation: Arc<Excitation>,
-    model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
-    free: Vec<FitParam>,
-    initial: Option<(f64, f64)>,
-    sim: Settings,
+    pub(crate) system: OscillatorParams,
+    pub(crate) excitation: Arc<Excitation>,
+    pub(crate) model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
+    pub(crate) free: Vec<FitParam>,
+    pub(crate) initial: Option<(f64, f64)>,
+    pub(crate) sim: Settings,
     settings: FitSettings,
 }
 
@@ -194,9 +194,9 @@ impl TrajectoryFit {
         self
     }
 
-    /// The names of the parameters given to [`TrajectoryFit::free`], in order.
-    pub fn free_names(&self) -> Vec<String> {
-        self.free.iter().map(|p| p.name.clone()).collect()
+    /// The parameters given to [`TrajectoryFit::free`], in order.
+    pub fn free_params(&self) -> &[FitParam] {
+        &self.free
     }
 
     /// Whether the initial state `x0`, `v0` is fitted.

@@ -116,7 +116,7 @@ impl TrajectoryFit {
     /// doc of [`Validation`]. With `x0`, `v0` free, they are refitted from the estimate given to
     /// [`TrajectoryFit::initial`] (within a tenth of the record's range of x and v).
     pub fn validate(&self, data: &TrajectoryData, values: &[f64]) -> Result<Validation, FitError> {
-        let names = self.free_names();
+        let names: Vec<&str> = self.free_params().iter().map(|p| p.name.as_str()).collect();
         if values.len() != names.len() {
             return Err(FitError::BadData(format!(
                 "{} values given for {} parameters",
@@ -133,9 +133,9 @@ impl TrajectoryFit {
             .iter()
             .zip(values)
             .map(
-                |(name, &value)| match INITIAL_STATE.iter().position(|n| n == name) {
+                |(&name, &value)| match INITIAL_STATE.iter().position(|n| *n == name) {
                     Some(i) if refit => start[i].clone(),
-                    _ => super::FitParam::new(name.clone(), value).fixed(true),
+                    _ => super::FitParam::new(name, value).fixed(true),
                 },
             )
             .collect();
