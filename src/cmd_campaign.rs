@@ -11,7 +11,7 @@ use anyhow::{bail, Result};
 
 use crate::campaign::runner::{Pending, Runner};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
-use crate::campaign::{out_dir, report, table, Campaign, Unit};
+use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::output::write_json;
 use crate::say;
 
@@ -63,13 +63,26 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
     let table = table::collect(&campaign, out, &errors);
     write_json(&out.join("campaign.json"), &table)?;
     table::write_csv(&out.join("campaign.csv"), &table)?;
-    report::write(&table, out)?;
+    let global = campaign.global.as_ref().map(|_| global::write(&campaign, out));
+    let (global, global_error) = match global {
+        Some(Ok(g)) => (Some(g), None),
+        Some(Err(e)) => (None, Some(e)),
+        None => (None, None),
+    };
+    report::write(&table, global.as_ref(), out)?;
+    if let Some(g) = &global {
+        say!("global fit: {}", g.verdict);
+        say!("wrote {}", out.join(global::GLOBAL_JSON).display());
+    }
     say!(
         "wrote {0}/campaign.csv, {0}/campaign.json ({1} row(s)), {0}/report.html, {0}/report.md \
          and {0}/figures/",
         out.display(),
         table.rows.len()
     );
+    if let Some(e) = global_error {
+        return Err(e.context("the campaign's [global] fit failed"));
+    }
     if table.failed > 0 {
         bail!(
             "{} of {} unit(s) failed: their rows in {} say why",

@@ -8,6 +8,10 @@
 //! are in [`out_dir`]; `crate::cmd_campaign` runs it all.
 
 pub mod file;
+pub mod global;
+pub mod global_file;
+pub mod global_fit;
+pub mod global_report;
 pub mod hash;
 pub mod out_dir;
 pub mod report;
