@@ -435,8 +435,8 @@ fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) 
         || "no record was held out".to_string(),
         |h| {
             format!(
-                "on the held-out record {} the global fit predicts the force with RMS {:.4} N \
-                 against {:.4} N for the per-record alternative",
+                "on the held-out record {} the global fit predicts the force with RMS {:.5} N \
+                 against {:.5} N for the per-record alternative",
                 h.record, h.global_rms, h.per_record_rms
             )
         },
