@@ -209,7 +209,8 @@ pub fn run(campaign: &Campaign) -> Result<GlobalJson> {
         training.iter().map(|l| (l.unit.number, &l.joint)).collect();
     let starts: Vec<Vec<f64>> = training.iter().map(|l| l.own.values.clone()).collect();
     let layout = global_fit::layout(
-        spec,
+        &spec.shared,
+        &spec.laws,
         &configured.params,
         offset.as_ref(),
         &records,

@@ -18,7 +18,7 @@ use stf_core::fit::{
 };
 use stf_core::physics::force_model::ForceModel;
 
-use super::global_file::{GlobalSpec, Law};
+use super::global_file::Law;
 
 /// Where one value of a record's parameter vector comes from.
 #[derive(Clone, Debug)]
@@ -112,11 +112,12 @@ pub fn coefficient_name(p: &str) -> String {
     format!("{p}0")
 }
 
-/// θ's layout for `spec` over `records` (each named by its unit number), the model's
+/// θ's layout for the `shared` parameters and the `laws` over `records` (each named by its unit number), the model's
 /// parameters `model_params` (configured: start values and bounds) and the offset, if fitted.
 /// `starts` gives per record the values its own fit found (same order), to start from.
 pub fn layout(
-    spec: &GlobalSpec,
+    shared: &[String],
+    laws: &[Law],
     model_params: &[FitParam],
     offset: Option<&FitParam>,
     records: &[(usize, &JointRecord)],
@@ -129,8 +130,8 @@ pub fn layout(
     let mut sources = vec![Vec::new(); records.len()];
     for (k, p) in all.iter().enumerate() {
         let column: Vec<f64> = starts.iter().map(|s| s[k]).collect();
-        let law = spec.laws.iter().position(|l| l.param == p.name);
-        if let Some((index, law)) = law.filter(|_| !p.fixed).map(|i| (i, &spec.laws[i])) {
+        let law = laws.iter().position(|l| l.param == p.name);
+        if let Some((index, law)) = law.filter(|_| !p.fixed).map(|i| (i, &laws[i])) {
             let (c0, expo) = law_start(law, p, records, &column);
             let i = params.len();
             params.push(clamped(p.clone(), c0).named(coefficient_name(&p.name)));
@@ -148,7 +149,7 @@ pub fn layout(
                     law: index,
                 });
             }
-        } else if p.fixed || spec.shared.contains(&p.name) {
+        } else if p.fixed || shared.contains(&p.name) {
             let mean = column.iter().sum::<f64>() / column.len().max(1) as f64;
             let start = if p.fixed { p.value } else { mean };
             for s in &mut sources {
@@ -306,4 +307,99 @@ pub fn rms_of(record: &JointRecord, values: &[f64]) -> Result<f64> {
         .map(|(f, p)| (f - p).powi(2))
         .sum();
     Ok((ss / n).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stf_core::physics::force_model::{ModelError, ModelState};
+    use stf_core::physics::param_spec::ParamSpec;
+
+    /// f = a·v + b·x.
+    struct Lin(Vec<ParamSpec>);
+
+    impl ForceModel for Lin {
+        fn name(&self) -> &str {
+            "lin"
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.0
+        }
+        fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+            Ok(p[0] * s.v + p[1] * s.x)
+        }
+    }
+
+    fn model() -> Arc<dyn ForceModel> {
+        Arc::new(Lin(vec![
+            ParamSpec::new("a", "N·s/m", 1.0, 0.0, 100.0, ""),
+            ParamSpec::new("b", "N/m", 1.0, -10.0, 10.0, ""),
+        ]))
+    }
+
+    /// A record at condition `c` whose force is exactly `a·v + b·x`.
+    fn record(c: f64, a: f64, b: f64) -> JointRecord {
+        let t: Vec<f64> = (0..400).map(|i| i as f64 * 0.01).collect();
+        let x: Vec<f64> = t.iter().map(|t| (3.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 3.0 * (3.0 * t).cos()).collect();
+        let f = x.iter().zip(&v).map(|(x, v)| a * v + b * x).collect();
+        let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
+        JointRecord {
+            a: vec![0.0; t.len()],
+            t,
+            x,
+            v,
+            f,
+            fit: predictor(model(), &params, false),
+            conditions: vec![("c".into(), c)],
+        }
+    }
+
+    #[test]
+    fn a_law_and_a_shared_parameter_are_recovered_jointly() {
+        // a = 3·(c/2)^1.5, b = 0.7 on every record.
+        let records: Vec<JointRecord> = [1.0, 2.0, 3.0]
+            .iter()
+            .map(|&c| record(c, 3.0 * (c / 2.0_f64).powf(1.5), 0.7))
+            .collect();
+        let numbered: Vec<(usize, &JointRecord)> = records.iter().enumerate().collect();
+        let laws = [Law {
+            param: "a".into(),
+            condition: "c".into(),
+            reference: 2.0,
+        }];
+        let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
+        let starts = vec![vec![1.0, 1.0]; 3];
+        let layout = layout(&["b".into()], &laws, &params, None, &numbered, &starts);
+        let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["a0", "a_p", "b"]);
+        assert_eq!(layout.roles, ["law coefficient", "law exponent", "shared"]);
+        let refs: Vec<&JointRecord> = records.iter().collect();
+        let result = fit(&layout, &refs, &Default::default()).unwrap();
+        for (name, truth) in [("a0", 3.0), ("a_p", 1.5), ("b", 0.7)] {
+            let v = result.value(name).unwrap();
+            assert!((v - truth).abs() < 1e-6, "{name} = {v}");
+        }
+        assert_eq!(result.n_points, 1200);
+    }
+
+    #[test]
+    fn a_parameter_neither_shared_nor_a_law_stays_per_record() {
+        let records: Vec<JointRecord> = [(1.0, 2.0), (2.0, -1.0)]
+            .iter()
+            .map(|&(c, b)| record(c, 1.5, b))
+            .collect();
+        let numbered: Vec<(usize, &JointRecord)> =
+            records.iter().enumerate().map(|(i, r)| (i + 4, r)).collect();
+        let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
+        let starts = vec![vec![1.0, 1.0]; 2];
+        let layout = layout(&["a".into()], &[], &params, None, &numbered, &starts);
+        let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["a", "b@4", "b@5"]);
+        let refs: Vec<&JointRecord> = records.iter().collect();
+        let result = fit(&layout, &refs, &Default::default()).unwrap();
+        assert!((result.value("b@4").unwrap() - 2.0).abs() < 1e-6);
+        assert!((result.value("b@5").unwrap() + 1.0).abs() < 1e-6);
+        assert!((result.value("a").unwrap() - 1.5).abs() < 1e-6);
+    }
 }

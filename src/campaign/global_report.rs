@@ -43,7 +43,7 @@ pub fn section(g: &GlobalJson, figures: &Path) -> Result<Section> {
     ));
     for law in &g.laws {
         s.paragraphs.push(format!(
-            "{p} = {c}·({cond}/{r})^{e} (± one block-robust standard error).",
+            "{p} = ({c})·({cond}/{r})^({e}) (± one block-robust standard error).",
             p = law.param,
             c = with_error(law.coefficient, law.coefficient_std_error),
             cond = law.condition,
@@ -76,17 +76,21 @@ fn comparison(g: &GlobalJson) -> Table {
             c.n_params.to_string(),
             format!("{:.1}", c.aic),
             format!("{:.1}", c.bic),
-            held.map_or("—".into(), |h| format!("{h:.4} N")),
+            held.map_or("—".into(), |h| format!("{h:.5} N")),
         ]
     };
     let h = g.holdout.as_ref();
     Table {
         caption: format!(
-            "Over the {} training record(s) ({} samples). The per-record alternative on the \
-             held-out record uses the mean of the own-fit parameters of {}.",
+            "Over the {} training record(s) ({} samples). {}",
             g.records.len(),
             g.global.n_points,
-            h.map_or("—".into(), |h| h.per_record_from.join(", "))
+            h.map_or(String::new(), |h| format!(
+                "On the held-out record the per-record alternative takes the mean of the own \
+                 fits' parameters of {}; the record's own fit reaches {:.5} N.",
+                h.per_record_from.join(", "),
+                h.own_fit_rms
+            ))
         ),
         columns: ["fit", "RSS, N²", "parameters", "AIC", "BIC", "held-out RMS"]
             .map(String::from)
@@ -165,11 +169,12 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
         .collect();
     let curve = Curve {
         label: format!(
-            "global law: {}·({}/{})^{}",
-            carried(law.coefficient),
+            "global law: {} = {:.4}·({}/{})^{:.4}",
+            law.param,
+            law.coefficient,
             law.condition,
             carried(law.reference),
-            carried(law.exponent)
+            law.exponent
         ),
         points,
     };
