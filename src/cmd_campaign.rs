@@ -2,12 +2,14 @@
 //! — at most `--jobs` at once, each in a child process — skipping those whose inputs have not
 //! changed since they finished (unless `--force`), then write the campaign table and report.
 //! With `--unit N` it runs unit N alone, in this process: what each child, and later each
-//! Slurm array task, runs.
+//! Slurm array task, runs. With a `[global]` section, the joint fit of all records
+//! (`crate::campaign::global`) follows the units, into `DIR/global.json` and the report's
+//! first section.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
@@ -63,12 +65,7 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
     let table = table::collect(&campaign, out, &errors);
     write_json(&out.join("campaign.json"), &table)?;
     table::write_csv(&out.join("campaign.csv"), &table)?;
-    let global = campaign.global.as_ref().map(|_| global::write(&campaign, out));
-    let (global, global_error) = match global {
-        Some(Ok(g)) => (Some(g), None),
-        Some(Err(e)) => (None, Some(e)),
-        None => (None, None),
-    };
+    let (global, global_error) = global_fit(&campaign, out);
     report::write(&table, global.as_ref(), out)?;
     if let Some(g) = &global {
         say!("global fit: {}", g.verdict);
@@ -80,18 +77,40 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         out.display(),
         table.rows.len()
     );
-    if let Some(e) = global_error {
-        return Err(e.context("the campaign's [global] fit failed"));
-    }
     if table.failed > 0 {
+        let global = global_error.map_or(String::new(), |e| {
+            format!("; the [global] fit failed too: {e:#}")
+        });
         bail!(
-            "{} of {} unit(s) failed: their rows in {} say why",
+            "{} of {} unit(s) failed: their rows in {} say why{global}",
             table.failed,
             table.units,
             out.join("campaign.csv").display()
         );
     }
+    if let Some(e) = global_error {
+        return Err(e.context("the campaign's [global] fit failed"));
+    }
     Ok(())
+}
+
+/// The `[global]` fit, written to `DIR/global.json`, or its error; without `[global]` (or
+/// when it fails) a `global.json` left by an earlier run is removed, so none is stale.
+fn global_fit(campaign: &Campaign, out: &Path) -> (Option<global::GlobalJson>, Option<Error>) {
+    let stale = || {
+        let _ = std::fs::remove_file(out.join(global::GLOBAL_JSON));
+    };
+    match campaign.global.as_ref().map(|_| global::write(campaign, out)) {
+        Some(Ok(g)) => (Some(g), None),
+        Some(Err(e)) => {
+            stale();
+            (None, Some(e))
+        }
+        None => {
+            stale();
+            (None, None)
+        }
+    }
 }
 
 /// The units to run, each with its inputs' hash; a line for each unit skipped or rerun

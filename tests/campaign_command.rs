@@ -335,7 +335,8 @@ fn the_report_draws_each_parameter_against_each_condition() {
     );
     assert_eq!(csv.lines().count(), 4);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert_eq!(html.matches("data:image/png;base64").count(), 6);
+    // The 6 parameter figures and the global fit's law.
+    assert_eq!(html.matches("data:image/png;base64").count(), 7);
 }
 
 #[test]
