@@ -169,7 +169,14 @@ pub(super) fn check(
         let key = format!("global.laws.{param}");
         let offset = law.span().start;
         let law = law.get_ref();
-        if !names.contains(param) || param == stf_core::fit::FORCE_OFFSET {
+        if param == stf_core::fit::FORCE_OFFSET {
+            return Err(at.error(
+                offset,
+                &key,
+                "`f_off` is each record's force offset: it may be shared, not follow a law",
+            ));
+        }
+        if !names.contains(param) {
             return Err(at.error(offset, &key, lacks(param)));
         }
         if shared.contains(param) {
@@ -263,5 +270,73 @@ fn holdout_of(given: Option<&Spanned<String>>, units: &[Unit], at: &At) -> Resul
                 h.get_ref()
             ),
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::file::Campaign;
+
+    /// The campaign `text` (two records at c = 1 and 2 after it) parsed in a folder with a
+    /// record `r.csv` and an experiment `e.toml` fitting `power_law` with an offset.
+    fn parse(global: &str) -> anyhow::Result<Campaign> {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(dir.path().join("s.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(
+            dir.path().join("e.toml"),
+            "[fit]\noffset = true\n\n[[models]]\nname = \"power_law\"\n",
+        )
+        .unwrap();
+        let text = format!(
+            "[campaign]\nexperiment = \"e.toml\"\ncommand = \"fit\"\nconditions = [\"c\"]\n\n\
+             [[records]]\nfile = \"r.csv\"\nc = 1\n\n[[records]]\nfile = \"s.csv\"\nc = 2\n\n\
+             [global]\n{global}"
+        );
+        Campaign::parse(&dir.path().join("c.toml"), &text)
+    }
+
+    fn message(global: &str) -> String {
+        let e = format!("{:#}", parse(global).unwrap_err());
+        e.split_once("c.toml").map_or(e.clone(), |(_, m)| m.to_string())
+    }
+
+    #[test]
+    fn a_global_section_is_checked_into_its_spec() {
+        let c = parse(
+            "model = \"power_law\"\nshared = [\"n\", \"f_off\"]\nlaws = { K = { condition = \"c\", reference = 1 } }\n",
+        )
+        .unwrap();
+        let g = c.global.unwrap();
+        assert_eq!(g.shared, ["n", "f_off"]);
+        assert_eq!(g.laws[0].param, "K");
+        assert_eq!(g.laws[0].reference, 1.0);
+        assert_eq!((g.holdout, g.line), (None, 14));
+    }
+
+    #[test]
+    fn each_bad_global_key_is_named_with_its_line() {
+        assert_eq!(
+            message("shared = [\"n\"]\n"),
+            ":14: `global`: missing `model`: the model fitted jointly"
+        );
+        assert!(message("model = \"power_law\"\nshared = [\"n\", \"n\"]\n")
+            .starts_with(":16: `global.shared[1]`: `n` is listed twice"));
+        assert!(message(
+            "model = \"power_law\"\nshared = [\"K\"]\nlaws = { K = { condition = \"c\", reference = 1.0 } }\n"
+        )
+        .starts_with(":17: `global.laws.K`: `K` is shared already"));
+        assert!(message(
+            "model = \"power_law\"\nlaws = { K = { condition = \"c\", reference = 0.0 } }\n"
+        )
+        .starts_with(":16: `global.laws.K.reference`: a positive number, found 0"));
+        assert!(message(
+            "model = \"power_law\"\nlaws = { f_off = { condition = \"c\", reference = 1.0 } }\n"
+        )
+        .starts_with(":16: `global.laws.f_off`: `f_off` is each record's force offset"));
+        assert!(message("model = \"power_law\"\nholdout = \"r.csv\"\n")
+            .starts_with(":14: `global`: a global fit needs at least 2 records to fit; there are 1"));
+        assert!(message("model = \"power_law\"\nshraed = [\"n\"]\n")
+            .starts_with(":16: `global`: unknown field `shraed`"));
     }
 }
