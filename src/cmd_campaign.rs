@@ -100,7 +100,11 @@ fn global_fit(campaign: &Campaign, out: &Path) -> (Option<global::GlobalJson>, O
     let stale = || {
         let _ = std::fs::remove_file(out.join(global::GLOBAL_JSON));
     };
-    match campaign.global.as_ref().map(|_| global::write(campaign, out)) {
+    match campaign
+        .global
+        .as_ref()
+        .map(|_| global::write(campaign, out))
+    {
         Some(Ok(g)) => (Some(g), None),
         Some(Err(e)) => {
             stale();

@@ -354,7 +354,10 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
             .iter()
             .find(|p| p["name"] == name)
             .unwrap_or_else(|| panic!("no {name} in {g}"));
-        (p["value"].as_f64().unwrap(), p["std_error"].as_f64().unwrap())
+        (
+            p["value"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+        )
     };
     // K = 4·(c/0.40)^6, n = 1.5: the exponent within 5 % and within 3 standard errors.
     let (p, p_se) = param("K_p");
@@ -382,7 +385,11 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
     assert!(g["delta_bic"].as_f64().unwrap() < 0.0, "{}", g["delta_bic"]);
     assert_eq!(g["per_record"]["n_params"], 16);
     assert_eq!(g["supported"], true);
-    assert!(g["caveats"].as_array().unwrap().is_empty(), "{}", g["caveats"]);
+    assert!(
+        g["caveats"].as_array().unwrap().is_empty(),
+        "{}",
+        g["caveats"]
+    );
     println!(
         "K_p = {p} ± {p_se}, K0 = {k0} ± {k0_se}, n = {n} ± {n_se}; held-out RMS global \
          {global} N, per record {alone} N; ΔBIC {}",
@@ -394,8 +401,7 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
     assert!(global_at < md.find("## Parameters against").unwrap());
     assert!(md.contains("Sharing supported"), "{md}");
     assert!(out.join("figures/global_K_vs_concentration.png").is_file());
-    let csv =
-        std::fs::read_to_string(out.join("figures/global_K_vs_concentration.csv")).unwrap();
+    let csv = std::fs::read_to_string(out.join("figures/global_K_vs_concentration.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("global law"), "{csv}");
 }
 
@@ -406,11 +412,31 @@ fn bad_global_input_is_refused_before_any_unit_starts() {
     let text = std::fs::read_to_string(&file).unwrap();
     let line_of = |needle: &str, t: &str| t[..t.rfind(needle).unwrap()].matches('\n').count() + 1;
     let cases: Vec<(String, &str, String)> = vec![
-        ("shared = [\"n\"]", "shared = [\"m\"]", "`global.shared[0]`: `power_law` has no parameter `m` (it has: K, n)"),
-        ("condition = \"concentration\"", "condition = \"fill\"", "`global.laws.K.condition`: `fill` is not a condition"),
-        ("holdout = \"records/a2_c2.csv\"", "holdout = \"records/a9.csv\"", "`global.holdout`: `records/a9.csv` is not a record of this campaign"),
-        ("model = \"power_law\"", "model = \"bingham\"", "`global.model`: `bingham` is not a [[models]] entry"),
-        ("laws = { K =", "laws = { c =", "`global.laws.c`: `power_law` has no parameter `c`"),
+        (
+            "shared = [\"n\"]",
+            "shared = [\"m\"]",
+            "`global.shared[0]`: `power_law` has no parameter `m` (it has: K, n)",
+        ),
+        (
+            "condition = \"concentration\"",
+            "condition = \"fill\"",
+            "`global.laws.K.condition`: `fill` is not a condition",
+        ),
+        (
+            "holdout = \"records/a2_c2.csv\"",
+            "holdout = \"records/a9.csv\"",
+            "`global.holdout`: `records/a9.csv` is not a record of this campaign",
+        ),
+        (
+            "model = \"power_law\"",
+            "model = \"bingham\"",
+            "`global.model`: `bingham` is not a [[models]] entry",
+        ),
+        (
+            "laws = { K =",
+            "laws = { c =",
+            "`global.laws.c`: `power_law` has no parameter `c`",
+        ),
     ]
     .into_iter()
     .map(|(from, to, msg)| {

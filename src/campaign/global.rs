@@ -250,7 +250,11 @@ fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Result<
         v: k.v.clone(),
         a: k.a.clone(),
         f: data.record.f_stf.clone().unwrap_or_default(),
-        fit: global_fit::predictor(configured.model.clone(), &configured.params, gexp.fit.offset),
+        fit: global_fit::predictor(
+            configured.model.clone(),
+            &configured.params,
+            gexp.fit.offset,
+        ),
         conditions: unit.conditions.clone(),
     };
     Ok(Loaded { unit, joint, own })
@@ -391,7 +395,9 @@ fn assemble(
         training.iter().map(|l| l.own.result.rss).sum(),
         training.iter().map(|l| l.own.result.n_points).sum(),
         training.iter().map(|l| l.own.result.n_free).sum(),
-        training.iter().all(|l| l.own.result.convergence.converged()),
+        training
+            .iter()
+            .all(|l| l.own.result.convergence.converged()),
     );
     let delta_bic = global.bic - per_record.bic;
     let better_held = holdout

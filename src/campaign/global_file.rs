@@ -257,7 +257,9 @@ fn holdout_of(given: Option<&Spanned<String>>, units: &[Unit], at: &At) -> Resul
     let Some(h) = given else { return Ok(None) };
     let found = units.iter().position(|u| {
         u.record_given == *h.get_ref()
-            || Path::new(&u.record_given).components().eq(Path::new(h.get_ref()).components())
+            || Path::new(&u.record_given)
+                .components()
+                .eq(Path::new(h.get_ref()).components())
     });
     match found {
         Some(i) => Ok(Some(i)),
@@ -298,7 +300,8 @@ mod tests {
 
     fn message(global: &str) -> String {
         let e = format!("{:#}", parse(global).unwrap_err());
-        e.split_once("c.toml").map_or(e.clone(), |(_, m)| m.to_string())
+        e.split_once("c.toml")
+            .map_or(e.clone(), |(_, m)| m.to_string())
     }
 
     #[test]
@@ -334,8 +337,11 @@ mod tests {
             "model = \"power_law\"\nlaws = { f_off = { condition = \"c\", reference = 1.0 } }\n"
         )
         .starts_with(":16: `global.laws.f_off`: `f_off` is each record's force offset"));
-        assert!(message("model = \"power_law\"\nholdout = \"r.csv\"\n")
-            .starts_with(":14: `global`: a global fit needs at least 2 records to fit; there are 1"));
+        assert!(
+            message("model = \"power_law\"\nholdout = \"r.csv\"\n").starts_with(
+                ":14: `global`: a global fit needs at least 2 records to fit; there are 1"
+            )
+        );
         assert!(message("model = \"power_law\"\nshraed = [\"n\"]\n")
             .starts_with(":16: `global`: unknown field `shraed`"));
     }

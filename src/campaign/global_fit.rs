@@ -389,8 +389,11 @@ mod tests {
             .iter()
             .map(|&(c, b)| record(c, 1.5, b))
             .collect();
-        let numbered: Vec<(usize, &JointRecord)> =
-            records.iter().enumerate().map(|(i, r)| (i + 4, r)).collect();
+        let numbered: Vec<(usize, &JointRecord)> = records
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (i + 4, r))
+            .collect();
         let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
         let starts = vec![vec![1.0, 1.0]; 2];
         let layout = layout(&["a".into()], &[], &params, None, &numbered, &starts);

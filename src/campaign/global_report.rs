@@ -128,7 +128,8 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
     let mut series: Vec<ErrorSeries> = Vec::new();
     let mut xs = Vec::new();
     for r in &g.each_record {
-        let (Some(&x), Some(&(v, e))) = (r.conditions.get(&law.condition), r.params.get(&law.param))
+        let (Some(&x), Some(&(v, e))) =
+            (r.conditions.get(&law.condition), r.params.get(&law.param))
         else {
             continue;
         };
@@ -161,10 +162,7 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
     let points = (0..CURVE_POINTS)
         .map(|i| {
             let x = lo + (hi - lo) * i as f64 / (CURVE_POINTS - 1) as f64;
-            (
-                x,
-                law.coefficient * (x / law.reference).powf(law.exponent),
-            )
+            (x, law.coefficient * (x / law.reference).powf(law.exponent))
         })
         .collect();
     let curve = Curve {
