@@ -166,6 +166,8 @@ pub struct GlobalJson {
     pub each_record: Vec<PerRecord>,
     /// The joint fit's convergence and log.
     pub log: Vec<String>,
+    /// Wall time of the whole global step (reading, per-record and joint fits), s.
+    pub wall_seconds: f64,
 }
 
 /// A record loaded and fitted alone.
@@ -428,6 +430,7 @@ fn assemble(
             .map(|(i, l)| per_record_json(l, spec.holdout == Some(i)))
             .collect(),
         log: result.log,
+        wall_seconds: 0.0,
     }
 }
 
@@ -519,7 +522,9 @@ fn per_record_json(l: &Loaded, held_out: bool) -> PerRecord {
 
 /// Run `[global]` and write `DIR/global.json`.
 pub fn write(campaign: &Campaign, out: &Path) -> Result<GlobalJson> {
-    let json = run(campaign)?;
+    let started = std::time::Instant::now();
+    let mut json = run(campaign)?;
+    json.wall_seconds = started.elapsed().as_secs_f64();
     crate::output::write_json(&out.join(GLOBAL_JSON), &json)?;
     Ok(json)
 }

@@ -157,6 +157,8 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
             }),
         }
     }
+    // The held-out record last, so the colours of the others follow their order.
+    series.sort_by_key(|s| s.label == "held out");
     let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let points = (0..CURVE_POINTS)

@@ -238,4 +238,29 @@ mod tests {
         let none = error_bars(dir.path(), "n", "t", ("x", "y"), &[]);
         assert!(none.is_err());
     }
+
+    #[test]
+    fn a_curve_is_drawn_over_the_points_and_kept_in_the_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        let series = vec![ErrorSeries {
+            label: "records".into(),
+            points: vec![(1.0, 1.1, 0.1), (2.0, 3.9, 0.2)],
+        }];
+        let curve = Curve {
+            label: "law".into(),
+            points: (0..11)
+                .map(|i| (1.0 + 0.1 * i as f64, 1.0 + 0.3 * i as f64))
+                .collect(),
+        };
+        let files =
+            error_bars_with_curve(dir.path(), "c", "t", ("x", "y"), &series, Some(&curve)).unwrap();
+        let csv = std::fs::read_to_string(&files.csv).unwrap();
+        assert!(
+            csv.lines().next().unwrap().ends_with(",law: x,law: y"),
+            "{csv}"
+        );
+        assert_eq!(csv.lines().count(), 12, "{csv}");
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(svg.contains("law"), "the curve's legend");
+    }
 }
