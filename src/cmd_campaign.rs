@@ -2,16 +2,18 @@
 //! — at most `--jobs` at once, each in a child process — skipping those whose inputs have not
 //! changed since they finished (unless `--force`), then write the campaign table and report.
 //! With `--unit N` it runs unit N alone, in this process: what each child, and later each
-//! Slurm array task, runs.
+//! Slurm array task, runs. With a `[global]` section, the joint fit of all records
+//! (`crate::campaign::global`) follows the units, into `DIR/global.json` and the report's
+//! first section.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
-use crate::campaign::{out_dir, report, table, Campaign, Unit};
+use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::output::write_json;
 use crate::say;
 
@@ -63,7 +65,12 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
     let table = table::collect(&campaign, out, &errors);
     write_json(&out.join("campaign.json"), &table)?;
     table::write_csv(&out.join("campaign.csv"), &table)?;
-    report::write(&table, out)?;
+    let (global, global_error) = global_fit(&campaign, out);
+    report::write(&table, global.as_ref(), out)?;
+    if let Some(g) = &global {
+        say!("global fit: {}", g.verdict);
+        say!("wrote {}", out.join(global::GLOBAL_JSON).display());
+    }
     say!(
         "wrote {0}/campaign.csv, {0}/campaign.json ({1} row(s)), {0}/report.html, {0}/report.md \
          and {0}/figures/",
@@ -71,14 +78,43 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         table.rows.len()
     );
     if table.failed > 0 {
+        let global = global_error.map_or(String::new(), |e| {
+            format!("; the [global] fit failed too: {e:#}")
+        });
         bail!(
-            "{} of {} unit(s) failed: their rows in {} say why",
+            "{} of {} unit(s) failed: their rows in {} say why{global}",
             table.failed,
             table.units,
             out.join("campaign.csv").display()
         );
     }
+    if let Some(e) = global_error {
+        return Err(e.context("the campaign's [global] fit failed"));
+    }
     Ok(())
+}
+
+/// The `[global]` fit, written to `DIR/global.json`, or its error; without `[global]` (or
+/// when it fails) a `global.json` left by an earlier run is removed, so none is stale.
+fn global_fit(campaign: &Campaign, out: &Path) -> (Option<global::GlobalJson>, Option<Error>) {
+    let stale = || {
+        let _ = std::fs::remove_file(out.join(global::GLOBAL_JSON));
+    };
+    match campaign
+        .global
+        .as_ref()
+        .map(|_| global::write(campaign, out))
+    {
+        Some(Ok(g)) => (Some(g), None),
+        Some(Err(e)) => {
+            stale();
+            (None, Some(e))
+        }
+        None => {
+            stale();
+            (None, None)
+        }
+    }
 }
 
 /// The units to run, each with its inputs' hash; a line for each unit skipped or rerun

@@ -335,5 +335,126 @@ fn the_report_draws_each_parameter_against_each_condition() {
     );
     assert_eq!(csv.lines().count(), 4);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert_eq!(html.matches("data:image/png;base64").count(), 6);
+    // The 6 parameter figures and the global fit's law.
+    assert_eq!(html.matches("data:image/png;base64").count(), 7);
+}
+
+#[test]
+fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_record() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let g = read_json(&out.join("global.json"));
+    let param = |name: &str| {
+        let p = g["params"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("no {name} in {g}"));
+        (
+            p["value"].as_f64().unwrap(),
+            p["std_error"].as_f64().unwrap(),
+        )
+    };
+    // K = 4·(c/0.40)^6, n = 1.5: the exponent within 5 % and within 3 standard errors.
+    let (p, p_se) = param("K_p");
+    assert!((p - 6.0).abs() < 0.05 * 6.0, "K_p = {p}");
+    assert!((p - 6.0).abs() < 3.0 * p_se, "K_p = {p} ± {p_se}");
+    let (k0, k0_se) = param("K0");
+    assert!((k0 - 4.0).abs() < 3.0 * k0_se, "K0 = {k0} ± {k0_se}");
+    let (n, n_se) = param("n");
+    assert!((n - 1.5).abs() < 3.0 * n_se, "n = {n} ± {n_se}");
+    assert_eq!(g["params"].as_array().unwrap().len(), 3, "{}", g["params"]);
+    assert_eq!(g["laws"][0]["exponent"].as_f64().unwrap(), p);
+    // Fitted on the 8 others; the global fit wins on BIC and on the held-out record.
+    assert_eq!(g["records"].as_array().unwrap().len(), 8);
+    let h = &g["holdout"];
+    assert_eq!(h["record"], "records/a2_c2.csv");
+    assert_eq!(
+        h["per_record_from"],
+        serde_json::json!(["records/a1_c2.csv", "records/a3_c2.csv"])
+    );
+    let (global, alone) = (
+        h["global_rms"].as_f64().unwrap(),
+        h["per_record_rms"].as_f64().unwrap(),
+    );
+    assert!(global <= alone, "held-out RMS {global} against {alone}");
+    assert!(g["delta_bic"].as_f64().unwrap() < 0.0, "{}", g["delta_bic"]);
+    assert_eq!(g["per_record"]["n_params"], 16);
+    assert_eq!(g["supported"], true);
+    assert!(
+        g["caveats"].as_array().unwrap().is_empty(),
+        "{}",
+        g["caveats"]
+    );
+    println!(
+        "K_p = {p} ± {p_se}, K0 = {k0} ± {k0_se}, n = {n} ± {n_se}; held-out RMS global \
+         {global} N, per record {alone} N; ΔBIC {}",
+        g["delta_bic"]
+    );
+    // The report opens with the global fit and its figure.
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let global_at = md.find("## Global fit").expect("a Global fit section");
+    assert!(global_at < md.find("## Parameters against").unwrap());
+    assert!(md.contains("Sharing supported"), "{md}");
+    assert!(out.join("figures/global_K_vs_concentration.png").is_file());
+    let csv = std::fs::read_to_string(out.join("figures/global_K_vs_concentration.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("global law"), "{csv}");
+}
+
+#[test]
+fn bad_global_input_is_refused_before_any_unit_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let text = std::fs::read_to_string(&file).unwrap();
+    let line_of = |needle: &str, t: &str| t[..t.rfind(needle).unwrap()].matches('\n').count() + 1;
+    let cases: Vec<(String, &str, String)> = vec![
+        (
+            "shared = [\"n\"]",
+            "shared = [\"m\"]",
+            "`global.shared[0]`: `power_law` has no parameter `m` (it has: K, n)",
+        ),
+        (
+            "condition = \"concentration\"",
+            "condition = \"fill\"",
+            "`global.laws.K.condition`: `fill` is not a condition",
+        ),
+        (
+            "holdout = \"records/a2_c2.csv\"",
+            "holdout = \"records/a9.csv\"",
+            "`global.holdout`: `records/a9.csv` is not a record of this campaign",
+        ),
+        (
+            "model = \"power_law\"",
+            "model = \"bingham\"",
+            "`global.model`: `bingham` is not a [[models]] entry",
+        ),
+        (
+            "laws = { K =",
+            "laws = { c =",
+            "`global.laws.c`: `power_law` has no parameter `c`",
+        ),
+    ]
+    .into_iter()
+    .map(|(from, to, msg)| {
+        let t = text.replacen(from, to, 1);
+        let at = line_of(to, &t);
+        (t, to, format!(":{at}: {msg}"))
+    })
+    .collect();
+    for (t, what, expected) in cases {
+        std::fs::write(&file, &t).unwrap();
+        let out = tmp.path().join("out");
+        let run = campaign(&file, &out, &[]);
+        assert!(!run.status.success(), "{what}");
+        let e = stderr(&run);
+        assert!(
+            e.contains("campaign.toml") && e.contains(&expected),
+            "{what}: {e}\nexpected {expected}"
+        );
+        assert!(!out.exists(), "{what}: a unit started");
+    }
 }

@@ -74,6 +74,7 @@ struct RawCampaign {
     campaign: Option<Spanned<RawHeader>>,
     #[serde(default)]
     records: Vec<Spanned<BTreeMap<String, Spanned<toml::Value>>>>,
+    global: Option<Spanned<super::global_file::RawGlobal>>,
 }
 
 /// A checked campaign.
@@ -85,6 +86,8 @@ pub struct Campaign {
     pub conditions: Vec<String>,
     /// One unit per record, in the file's order.
     pub units: Vec<Unit>,
+    /// The joint fit of `[global]`, if any.
+    pub global: Option<super::global_file::GlobalSpec>,
 }
 
 /// Unit N: record N, its experiment and its command.
@@ -178,10 +181,26 @@ impl Campaign {
             .map(|(i, r)| check_record(i, r, &conditions, &defaults, &place))
             .collect::<Result<Vec<_>>>()?;
         check_experiments(&units, &place)?;
+        let default_experiment = defaults.experiment.map(|e| place.dir.join(e.get_ref()));
+        let global = raw
+            .global
+            .as_ref()
+            .map(|g| {
+                let at = super::global_file::At { path, text };
+                super::global_file::check(
+                    g,
+                    &conditions,
+                    &units,
+                    default_experiment.as_deref(),
+                    &at,
+                )
+            })
+            .transpose()?;
         Ok(Campaign {
             path: path.to_path_buf(),
             conditions,
             units,
+            global,
         })
     }
 

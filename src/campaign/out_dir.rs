@@ -19,6 +19,7 @@ pub const CAMPAIGN_NAMES: &[&str] = &[
     super::runner::LOGS,
     "campaign.json",
     "campaign.csv",
+    super::global::GLOBAL_JSON,
     "report.md",
     "report.html",
     "figures",

@@ -8,12 +8,14 @@ use std::path::Path;
 
 use anyhow::Result;
 
+use super::global::GlobalJson;
 use super::table::{param_names, CampaignJson, CampaignRow};
 use crate::digits::{carried, with_error};
 use crate::report::{self, ErrorPoint, ErrorSeries, FigureRef, Report, Section, Table};
 
-/// Write `report.md`, `report.html` and `figures/` of `table` into `out`.
-pub fn write(table: &CampaignJson, out: &Path) -> Result<()> {
+/// Write `report.md`, `report.html` and `figures/` of `table` into `out`, the global fit's
+/// section first when there is one.
+pub fn write(table: &CampaignJson, global: Option<&GlobalJson>, out: &Path) -> Result<()> {
     let mut doc = Report::new(format!("Campaign {}", table.campaign));
     let ok_units = table.units - table.failed;
     doc.intro.push(format!(
@@ -21,6 +23,10 @@ pub fn write(table: &CampaignJson, out: &Path) -> Result<()> {
          record and model; parameters in SI units, ± one standard error (block-robust).",
         table.units, table.campaign, table.failed
     ));
+    if let Some(g) = global {
+        doc.sections
+            .push(super::global_report::section(g, &out.join("figures"))?);
+    }
     let figures = parameter_figures(table, &out.join("figures"))?;
     if !figures.is_empty() {
         let mut section = Section::new("Parameters against the conditions");

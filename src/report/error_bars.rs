@@ -2,6 +2,7 @@
 //! condition's value, a vertical bar of ±1 standard error, one colour per series (the
 //! records that share the other conditions). Series sharing an x are nudged apart by a small
 //! fraction of the x span so their bars do not hide one another; the CSV holds the true x.
+//! A fitted curve (a law through the points) may be drawn over them, in black.
 //! The bars are drawn as plain paths (plotters' `ErrorBar` needs a feature this build does
 //! not enable, and two lines are all it is).
 
@@ -31,24 +32,37 @@ pub struct ErrorSeries {
     pub points: Vec<ErrorPoint>,
 }
 
+/// A curve drawn over the points (a fitted law), under its legend label.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    /// Legend label.
+    pub label: String,
+    /// Its points, in x order.
+    pub points: Vec<(f64, f64)>,
+}
+
 struct ErrorBarPlot<'a> {
     title: &'a str,
     x_label: &'a str,
     y_label: &'a str,
     series: &'a [ErrorSeries],
+    curve: Option<&'a Curve>,
 }
 
 impl ErrorBarPlot<'_> {
     /// The x and y ranges: every point with its bar.
     fn ranges(&self) -> Option<(std::ops::Range<f64>, std::ops::Range<f64>)> {
-        let xs: Vec<f64> = self.points().map(|p| p.0).collect();
-        let ys: Vec<f64> = self
+        let curve = self.curve.map_or(&[][..], |c| &c.points[..]);
+        let mut xs: Vec<f64> = self.points().map(|p| p.0).collect();
+        xs.extend(curve.iter().map(|p| p.0));
+        let mut ys: Vec<f64> = self
             .points()
             .flat_map(|(_, y, e)| {
                 let e = if e.is_finite() { e } else { 0.0 };
                 [y - e, y + e]
             })
             .collect();
+        ys.extend(curve.iter().map(|p| p.1));
         Some((padded_range(&xs)?, padded_range(&ys)?))
     }
 
@@ -62,12 +76,15 @@ impl Draw for ErrorBarPlot<'_> {
         let (xr, yr) = self.ranges().ok_or("no finite point")?;
         let (x_span, y_span) = (xr.end - xr.start, yr.end - yr.start);
         let root = root.titled(self.title, title_style()).map_err(msg)?;
-        let legend: Vec<(String, Swatch)> = self
+        let mut legend: Vec<(String, Swatch)> = self
             .series
             .iter()
             .enumerate()
             .map(|(i, s)| (s.label.clone(), Swatch::Dot(series_colour(i))))
             .collect();
+        if let Some(c) = self.curve {
+            legend.push((c.label.clone(), Swatch::Line(BLACK, 2)));
+        }
         let root = legend_strip(&root, &legend)?;
         let mut chart = ChartBuilder::on(&root)
             .margin(10)
@@ -87,6 +104,17 @@ impl Draw for ErrorBarPlot<'_> {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(msg)?;
+        if let Some(c) = self.curve {
+            let points: Vec<(f64, f64)> = c
+                .points
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .collect();
+            chart
+                .draw_series(LineSeries::new(points, BLACK.stroke_width(2)))
+                .map_err(msg)?;
+        }
         let n = self.series.len();
         for (i, s) in self.series.iter().enumerate() {
             let colour = series_colour(i);
@@ -128,8 +156,20 @@ pub fn error_bars(
     out_dir: &Path,
     name: &str,
     title: &str,
+    labels: (&str, &str),
+    series: &[ErrorSeries],
+) -> Result<FigureFiles, ReportError> {
+    error_bars_with_curve(out_dir, name, title, labels, series, None)
+}
+
+/// [`error_bars`] with `curve` drawn over the points; the CSV gains its x and y columns.
+pub fn error_bars_with_curve(
+    out_dir: &Path,
+    name: &str,
+    title: &str,
     (x_label, y_label): (&str, &str),
     series: &[ErrorSeries],
+    curve: Option<&Curve>,
 ) -> Result<FigureFiles, ReportError> {
     let all = series.iter().flat_map(|s| s.points.iter());
     if finite_bounds(all.map(|p| &p.1)).is_none() {
@@ -142,8 +182,9 @@ pub fn error_bars(
         x_label,
         y_label,
         series,
+        curve,
     };
-    let columns: Vec<Column> = series
+    let mut columns: Vec<Column> = series
         .iter()
         .flat_map(|s| {
             let of = |f: fn(&ErrorPoint) -> f64| s.points.iter().map(f).collect::<Vec<f64>>();
@@ -154,6 +195,11 @@ pub fn error_bars(
             ]
         })
         .collect();
+    if let Some(c) = curve {
+        let of = |f: fn(&(f64, f64)) -> f64| c.points.iter().map(f).collect::<Vec<f64>>();
+        columns.push(Column::new(format!("{}: {x_label}", c.label), of(|p| p.0)));
+        columns.push(Column::new(format!("{}: {y_label}", c.label), of(|p| p.1)));
+    }
     render(out_dir, name, SIZE, &plot, &columns)
 }
 
@@ -191,5 +237,30 @@ mod tests {
         assert_eq!(csv.lines().count(), 4, "{csv}");
         let none = error_bars(dir.path(), "n", "t", ("x", "y"), &[]);
         assert!(none.is_err());
+    }
+
+    #[test]
+    fn a_curve_is_drawn_over_the_points_and_kept_in_the_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        let series = vec![ErrorSeries {
+            label: "records".into(),
+            points: vec![(1.0, 1.1, 0.1), (2.0, 3.9, 0.2)],
+        }];
+        let curve = Curve {
+            label: "law".into(),
+            points: (0..11)
+                .map(|i| (1.0 + 0.1 * i as f64, 1.0 + 0.3 * i as f64))
+                .collect(),
+        };
+        let files =
+            error_bars_with_curve(dir.path(), "c", "t", ("x", "y"), &series, Some(&curve)).unwrap();
+        let csv = std::fs::read_to_string(&files.csv).unwrap();
+        assert!(
+            csv.lines().next().unwrap().ends_with(",law: x,law: y"),
+            "{csv}"
+        );
+        assert_eq!(csv.lines().count(), 12, "{csv}");
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(svg.contains("law"), "the curve's legend");
     }
 }

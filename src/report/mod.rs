@@ -53,7 +53,7 @@ pub use atomic::write_atomic as write_file_atomic;
 pub use decimate::{decimate_indices, decimate_union, MAX_POINTS_PER_LINE};
 pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;
-pub use error_bars::{error_bars, ErrorPoint, ErrorSeries};
+pub use error_bars::{error_bars, error_bars_with_curve, Curve, ErrorPoint, ErrorSeries};
 pub use extrema::{extrema, Extremum, ExtremumKind};
 pub use figure::FigureFiles;
 pub use frequency_response::{frequency_response, FrfCurve, FrfRole, RegimeChange};

@@ -1,0 +1,530 @@
+//! `[global]` run: each record read with its own experiment's layout and kinematics (as the
+//! per-record `fit` reads it), fitted alone with the global model (the per-record
+//! alternative, as `fit` would fit it), then all training records fitted jointly
+//! ([`super::global_fit`]), and the two compared ([`GlobalJson`], written to
+//! `DIR/global.json`):
+//!
+//! - over the training records: total RSS, parameters, AIC and BIC of each (the per-record
+//!   side sums the records' RSS, samples and free parameters; both use
+//!   `N·ln(RSS/N) + 2p` and `N·ln(RSS/N) + p·ln N`, as every fit does);
+//! - on the held-out record: the force RMS predicted by the global fit (laws evaluated at its
+//!   condition, shared values, per-record parameters at their mean over the training records)
+//!   against the per-record alternative: the mean of the per-record parameter values of the
+//!   training records nearest the held-out record in the laws' conditions (all of them when
+//!   there is no law).
+//!
+//! "Sharing supported" needs the global fit's BIC lower and its held-out RMS at most the
+//! alternative's; the caveats say when not to trust the verdict.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use indexmap::IndexMap;
+use rayon::prelude::*;
+use serde::Serialize;
+use stf_core::data::record_bounds::DataScales;
+use stf_core::fit::{FitParam, FitResult, FORCE_OFFSET};
+
+use super::file::{Campaign, Unit};
+use super::global_file::GlobalSpec;
+use super::global_fit::{self, JointRecord, Source};
+use crate::experiment::{Experiment, FitLevel};
+use crate::fitting::{self, ModelFit};
+use crate::model_config::configure_for;
+
+/// The name of the global fit's JSON in the campaign folder.
+pub const GLOBAL_JSON: &str = "global.json";
+
+/// A parameter of the global fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlobalParam {
+    /// `n`, `K0`, `K_p`, `f_off@3` (unit 3's own).
+    pub name: String,
+    /// `shared`, `law coefficient`, `law exponent` or `per record`.
+    pub role: String,
+    /// Best value.
+    pub value: f64,
+    /// Block-robust standard error (as every fit's).
+    pub std_error: f64,
+}
+
+/// A fitted law `param = coefficient·(condition/reference)^exponent`.
+#[derive(Clone, Debug, Serialize)]
+pub struct LawJson {
+    /// The model's parameter.
+    pub param: String,
+    /// The condition.
+    pub condition: String,
+    /// The condition's reference value.
+    pub reference: f64,
+    /// The parameter at the reference, with its standard error.
+    pub coefficient: f64,
+    /// Standard error of the coefficient.
+    pub coefficient_std_error: f64,
+    /// The exponent, with its standard error.
+    pub exponent: f64,
+    /// Standard error of the exponent.
+    pub exponent_std_error: f64,
+}
+
+/// Fit statistics of one side of the comparison, over the training records.
+#[derive(Clone, Debug, Serialize)]
+pub struct Criteria {
+    /// Residual sum of squares, N².
+    pub rss: f64,
+    /// Samples.
+    pub n_points: usize,
+    /// Free parameters.
+    pub n_params: usize,
+    /// RMS residual, N.
+    pub rms: f64,
+    /// N·ln(RSS/N) + 2p.
+    pub aic: f64,
+    /// N·ln(RSS/N) + p·ln N.
+    pub bic: f64,
+    /// Whether every fit behind it converged.
+    pub converged: bool,
+}
+
+impl Criteria {
+    fn of(rss: f64, n_points: usize, n_params: usize, converged: bool) -> Criteria {
+        let n = n_points as f64;
+        let p = n_params as f64;
+        let base = n * (rss / n).ln();
+        Criteria {
+            rss,
+            n_points,
+            n_params,
+            rms: (rss / n).sqrt(),
+            aic: base + 2.0 * p,
+            bic: base + p * n.ln(),
+            converged,
+        }
+    }
+}
+
+/// One record's own fit of the global model.
+#[derive(Clone, Debug, Serialize)]
+pub struct PerRecord {
+    /// Unit number.
+    pub unit: usize,
+    /// The record as written.
+    pub record: String,
+    /// Its conditions.
+    pub conditions: IndexMap<String, f64>,
+    /// Parameter values and standard errors, by name (model's, then `f_off`).
+    pub params: IndexMap<String, (f64, f64)>,
+    /// RMS residual, N.
+    pub rms: f64,
+    /// Whether it was the held-out record (not in either side's totals).
+    pub held_out: bool,
+}
+
+/// The held-out record's force RMS predicted both ways.
+#[derive(Clone, Debug, Serialize)]
+pub struct HoldoutJson {
+    /// The record as written.
+    pub record: String,
+    /// RMS of the global fit's prediction, N.
+    pub global_rms: f64,
+    /// RMS of the per-record alternative's prediction, N.
+    pub per_record_rms: f64,
+    /// The records whose own parameters were averaged for the alternative.
+    pub per_record_from: Vec<String>,
+    /// RMS of the record's own fit (the best either could do), N.
+    pub own_fit_rms: f64,
+}
+
+/// `global.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlobalJson {
+    /// The model as written in `[global]`.
+    pub model: String,
+    /// Parameters shared by every record.
+    pub shared: Vec<String>,
+    /// The records fitted (as written).
+    pub records: Vec<String>,
+    /// θ: every parameter of the joint fit.
+    pub params: Vec<GlobalParam>,
+    /// The fitted laws.
+    pub laws: Vec<LawJson>,
+    /// The joint fit.
+    pub global: Criteria,
+    /// The per-record fits, taken together.
+    pub per_record: Criteria,
+    /// Global BIC − per-record BIC (negative: the global fit is preferred).
+    pub delta_bic: f64,
+    /// The held-out record, if any.
+    pub holdout: Option<HoldoutJson>,
+    /// Whether sharing is supported (BIC lower and held-out RMS no worse).
+    pub supported: bool,
+    /// The verdict in words.
+    pub verdict: String,
+    /// When not to trust the verdict.
+    pub caveats: Vec<String>,
+    /// Each record's own fit.
+    pub each_record: Vec<PerRecord>,
+    /// The joint fit's convergence and log.
+    pub log: Vec<String>,
+    /// Wall time of the whole global step (reading, per-record and joint fits), s.
+    pub wall_seconds: f64,
+}
+
+/// A record loaded and fitted alone.
+struct Loaded<'c> {
+    unit: &'c Unit,
+    joint: JointRecord,
+    own: ModelFit,
+}
+
+/// Run `[global]` of `campaign` (which must have one).
+pub fn run(campaign: &Campaign) -> Result<GlobalJson> {
+    let Some(spec) = &campaign.global else {
+        bail!("{}: no [global] section", campaign.path.display());
+    };
+    let gexp = Experiment::load(&spec.experiment)?;
+    let at = |u: &Unit| format!("{}: record {}", campaign.path.display(), u.record_given);
+    let loaded: Vec<Loaded> = campaign
+        .units
+        .par_iter()
+        .map(|u| load_one(spec, &gexp, u).with_context(|| at(u)))
+        .collect::<Result<_>>()?;
+    let training: Vec<&Loaded> = loaded
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != spec.holdout)
+        .map(|(_, l)| l)
+        .collect();
+    let scales = union_scales(&training);
+    let configured = configure_for(
+        std::slice::from_ref(&spec.entry),
+        &gexp.path,
+        &gexp.dir,
+        &gexp.scripts,
+        Some(&scales),
+    )?;
+    let offset = gexp
+        .fit
+        .offset
+        .then(|| FitParam::new(FORCE_OFFSET, 0.0).bounds(-100.0, 100.0));
+    let records: Vec<(usize, &JointRecord)> =
+        training.iter().map(|l| (l.unit.number, &l.joint)).collect();
+    let starts: Vec<Vec<f64>> = training.iter().map(|l| l.own.values.clone()).collect();
+    let layout = global_fit::layout(
+        &spec.shared,
+        &spec.laws,
+        &configured.params,
+        offset.as_ref(),
+        &records,
+        &starts,
+    );
+    let joint: Vec<&JointRecord> = training.iter().map(|l| &l.joint).collect();
+    let result = global_fit::fit(&layout, &joint, &gexp.fit.settings)?;
+    let holdout = spec
+        .holdout
+        .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result))
+        .transpose()?;
+    Ok(assemble(spec, &loaded, &training, &layout, result, holdout))
+}
+
+/// Read `unit`'s record with its experiment's layout, derive its kinematics, fit the global
+/// model to it alone (as `fit` would, with the global experiment's settings).
+fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Result<Loaded<'c>> {
+    let mut exp = Experiment::load(&unit.experiment)?.with_data_file(unit.record.clone());
+    let data = fitting::load_data_at(&mut exp, Some(FitLevel::Force))?;
+    if data.level != FitLevel::Force {
+        bail!("a global fit is at force level: the record needs an `f_stf` column");
+    }
+    let scales = data.scales(&gexp.system);
+    let configured = configure_for(
+        std::slice::from_ref(&spec.entry),
+        &gexp.path,
+        &gexp.dir,
+        &gexp.scripts,
+        Some(&scales),
+    )?;
+    let hidden = indicatif::ProgressBar::hidden();
+    let own = fitting::fit_model(gexp, &data, Some(&configured), &hidden)?;
+    let k = &data.kinematics;
+    let joint = JointRecord {
+        t: k.t.clone(),
+        x: k.x.clone(),
+        v: k.v.clone(),
+        a: k.a.clone(),
+        f: data.record.f_stf.clone().unwrap_or_default(),
+        fit: global_fit::predictor(
+            configured.model.clone(),
+            &configured.params,
+            gexp.fit.offset,
+        ),
+        conditions: unit.conditions.clone(),
+    };
+    Ok(Loaded { unit, joint, own })
+}
+
+/// The data scales of all training records together (the model's bounds are widened to them
+/// as a per-record fit widens them to its record's).
+fn union_scales(training: &[&Loaded]) -> DataScales {
+    let cat = |f: fn(&JointRecord) -> &Vec<f64>| -> Vec<f64> {
+        training.iter().flat_map(|l| f(&l.joint).clone()).collect()
+    };
+    DataScales::of(
+        &cat(|r| &r.f),
+        &cat(|r| &r.x),
+        &cat(|r| &r.v),
+        &cat(|r| &r.a),
+    )
+}
+
+/// The held-out record predicted by the global fit and by the per-record alternative.
+fn holdout_json(
+    spec: &GlobalSpec,
+    held: &Loaded,
+    training: &[&Loaded],
+    layout: &global_fit::Layout,
+    result: &FitResult,
+) -> Result<HoldoutJson> {
+    let theta: Vec<f64> = result.params.iter().map(|p| p.value).collect();
+    let columns = layout.sources.first().map_or(0, Vec::len);
+    let global_values: Vec<f64> = (0..columns)
+        .map(|k| match &layout.sources[0][k] {
+            Source::Law {
+                coefficient,
+                exponent,
+                law,
+                ..
+            } => {
+                let law = &spec.laws[*law];
+                let ratio = held.joint.condition(&law.condition) / law.reference;
+                theta[*coefficient] * ratio.powf(theta[*exponent])
+            }
+            _ => mean(layout.sources.iter().map(|s| s[k].value(&theta))),
+        })
+        .collect();
+    let nearest = nearest_records(spec, held, training);
+    let alternative: Vec<f64> = (0..held.own.values.len())
+        .map(|k| mean(nearest.iter().map(|l| l.own.values[k])))
+        .collect();
+    Ok(HoldoutJson {
+        record: held.unit.record_given.clone(),
+        global_rms: global_fit::rms_of(&held.joint, &global_values)?,
+        per_record_rms: global_fit::rms_of(&held.joint, &alternative)?,
+        per_record_from: nearest
+            .iter()
+            .map(|l| l.unit.record_given.clone())
+            .collect(),
+        own_fit_rms: held.own.result.rms,
+    })
+}
+
+/// The mean of `values`.
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
+/// The training records nearest `held` in the laws' conditions (distance: the sum of
+/// |Δc|/reference; ties within 1e-9 all kept); all of them without a law.
+fn nearest_records<'a, 'c>(
+    spec: &GlobalSpec,
+    held: &Loaded,
+    training: &'a [&'a Loaded<'c>],
+) -> Vec<&'a Loaded<'c>> {
+    let distance = |l: &Loaded| -> f64 {
+        spec.laws
+            .iter()
+            .map(|law| {
+                (l.joint.condition(&law.condition) - held.joint.condition(&law.condition)).abs()
+                    / law.reference
+            })
+            .sum()
+    };
+    let best = training
+        .iter()
+        .map(|l| distance(l))
+        .fold(f64::INFINITY, f64::min);
+    training
+        .iter()
+        .filter(|l| distance(l) <= best + 1e-9)
+        .copied()
+        .collect()
+}
+
+/// Put the pieces into `global.json`'s shape, with the verdict and its caveats.
+fn assemble(
+    spec: &GlobalSpec,
+    loaded: &[Loaded],
+    training: &[&Loaded],
+    layout: &global_fit::Layout,
+    result: FitResult,
+    holdout: Option<HoldoutJson>,
+) -> GlobalJson {
+    let params: Vec<GlobalParam> = result
+        .params
+        .iter()
+        .zip(&layout.roles)
+        .map(|(p, role)| GlobalParam {
+            name: p.name.clone(),
+            role: role.to_string(),
+            value: p.value,
+            std_error: p.std_error,
+        })
+        .collect();
+    let laws = spec
+        .laws
+        .iter()
+        .filter_map(|l| {
+            let c = result.param(&global_fit::coefficient_name(&l.param))?;
+            let e = result.param(&global_fit::exponent_name(&l.param))?;
+            Some(LawJson {
+                param: l.param.clone(),
+                condition: l.condition.clone(),
+                reference: l.reference,
+                coefficient: c.value,
+                coefficient_std_error: c.std_error,
+                exponent: e.value,
+                exponent_std_error: e.std_error,
+            })
+        })
+        .collect();
+    let global = Criteria::of(
+        result.rss,
+        result.n_points,
+        result.n_free,
+        result.convergence.converged(),
+    );
+    let per_record = Criteria::of(
+        training.iter().map(|l| l.own.result.rss).sum(),
+        training.iter().map(|l| l.own.result.n_points).sum(),
+        training.iter().map(|l| l.own.result.n_free).sum(),
+        training
+            .iter()
+            .all(|l| l.own.result.convergence.converged()),
+    );
+    let delta_bic = global.bic - per_record.bic;
+    let better_held = holdout
+        .as_ref()
+        .is_none_or(|h| h.global_rms <= h.per_record_rms);
+    let supported = delta_bic < 0.0 && better_held;
+    let verdict = verdict_text(supported, delta_bic, holdout.as_ref());
+    let caveats = caveats(spec, training, &global, &per_record, holdout.is_some());
+    GlobalJson {
+        model: spec.model.clone(),
+        shared: spec.shared.clone(),
+        records: training
+            .iter()
+            .map(|l| l.unit.record_given.clone())
+            .collect(),
+        params,
+        laws,
+        global,
+        per_record,
+        delta_bic,
+        holdout,
+        supported,
+        verdict,
+        caveats,
+        each_record: loaded
+            .iter()
+            .enumerate()
+            .map(|(i, l)| per_record_json(l, spec.holdout == Some(i)))
+            .collect(),
+        log: result.log,
+        wall_seconds: 0.0,
+    }
+}
+
+/// The verdict in a sentence.
+fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) -> String {
+    let bic = if delta_bic < 0.0 {
+        format!("the global fit's BIC is lower by {:.1}", -delta_bic)
+    } else {
+        format!("the per-record fits' BIC is lower by {delta_bic:.1}")
+    };
+    let held = holdout.map_or_else(
+        || "no record was held out".to_string(),
+        |h| {
+            format!(
+                "on the held-out record {} the global fit predicts the force with RMS {:.5} N \
+                 against {:.5} N for the per-record alternative",
+                h.record, h.global_rms, h.per_record_rms
+            )
+        },
+    );
+    let head = if supported {
+        "sharing supported"
+    } else {
+        "sharing not supported"
+    };
+    format!("{head}: {bic}; {held}.")
+}
+
+/// When not to trust the verdict.
+fn caveats(
+    spec: &GlobalSpec,
+    training: &[&Loaded],
+    global: &Criteria,
+    per_record: &Criteria,
+    held_out: bool,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for law in &spec.laws {
+        let mut levels: Vec<f64> = training
+            .iter()
+            .map(|l| l.joint.condition(&law.condition))
+            .collect();
+        levels.sort_by(f64::total_cmp);
+        levels.dedup();
+        if levels.len() < 3 {
+            out.push(format!(
+                "the law of {} has {} level(s) of {} to fit: fewer than 3 cannot test its shape",
+                law.param,
+                levels.len(),
+                law.condition
+            ));
+        }
+    }
+    if training.len() < 3 {
+        out.push(format!(
+            "only {} records are fitted: too few to judge sharing",
+            training.len()
+        ));
+    }
+    if !global.converged {
+        out.push("the global fit did not converge".into());
+    }
+    if !per_record.converged {
+        out.push("some per-record fit did not converge".into());
+    }
+    if !held_out {
+        out.push("no record is held out: the verdict rests on the BIC alone".into());
+    }
+    out
+}
+
+/// A record's own fit, for the JSON and the figure.
+fn per_record_json(l: &Loaded, held_out: bool) -> PerRecord {
+    PerRecord {
+        unit: l.unit.number,
+        record: l.unit.record_given.clone(),
+        conditions: l.unit.conditions.iter().cloned().collect(),
+        params: l
+            .own
+            .result
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), (p.value, p.std_error)))
+            .collect(),
+        rms: l.own.result.rms,
+        held_out,
+    }
+}
+
+/// Run `[global]` and write `DIR/global.json`.
+pub fn write(campaign: &Campaign, out: &Path) -> Result<GlobalJson> {
+    let started = std::time::Instant::now();
+    let mut json = run(campaign)?;
+    json.wall_seconds = started.elapsed().as_secs_f64();
+    crate::output::write_json(&out.join(GLOBAL_JSON), &json)?;
+    Ok(json)
+}

@@ -1,0 +1,348 @@
+//! The `[global]` section of a campaign file: which model is fitted jointly to all records,
+//! which of its parameters are shared by every record, which follow a power law over a
+//! condition (`P = P0·(c/reference)^P_p`), and which record is held out. Parsed into a raw
+//! serde type and checked into a trusted [`GlobalSpec`] before any unit starts; every error
+//! names the campaign file, the line and the key, as the rest of the campaign file
+//! (`super::file`).
+//!
+//! ```toml
+//! [global]
+//! model = "power_law"            # one of the experiment's [[models]] (a sum: "a + b")
+//! shared = ["n"]                 # one value for every record
+//! laws = { K = { condition = "concentration", reference = 0.40 } }
+//! holdout = "records/a2_c2.csv"  # a record of the list, left out of every fit
+//! ```
+//!
+//! Parameters neither shared nor given a law stay per record (and so does the force offset
+//! `f_off` of an experiment with `[fit] offset = true`, unless it is shared).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::Result;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::file::Unit;
+use crate::experiment::{error_at, line_of, Experiment, ModelEntry};
+use crate::model_config::configure_for;
+
+/// A law as written: `{ condition = "…", reference = … }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawLaw {
+    condition: String,
+    reference: f64,
+}
+
+/// `[global]` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawGlobal {
+    model: Option<Spanned<String>>,
+    #[serde(default)]
+    shared: Vec<Spanned<String>>,
+    #[serde(default)]
+    laws: BTreeMap<String, Spanned<RawLaw>>,
+    holdout: Option<Spanned<String>>,
+}
+
+/// A parameter made a power law of a condition: `param = param0·(condition/reference)^p`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Law {
+    /// The model's parameter (`K`).
+    pub param: String,
+    /// The condition it follows (a name of `campaign.conditions`).
+    pub condition: String,
+    /// The condition's reference value, at which the parameter is `param0`.
+    pub reference: f64,
+}
+
+/// A checked `[global]` section.
+#[derive(Clone, Debug)]
+pub struct GlobalSpec {
+    /// The model as written (`power_law`, `a + b`).
+    pub model: String,
+    /// The experiment's `[[models]]` entry it names (in the campaign's experiment).
+    pub entry: ModelEntry,
+    /// The experiment the model and the fit settings come from: the campaign's, else the
+    /// first record's.
+    pub experiment: std::path::PathBuf,
+    /// Parameters with one value for every record.
+    pub shared: Vec<String>,
+    /// Parameters following a law of a condition.
+    pub laws: Vec<Law>,
+    /// The held-out record: an index into the campaign's units.
+    pub holdout: Option<usize>,
+    /// Line of `[global]` in the campaign file.
+    pub line: usize,
+}
+
+/// Where errors point: the campaign file and its text.
+pub(super) struct At<'a> {
+    pub path: &'a Path,
+    pub text: &'a str,
+}
+
+impl At<'_> {
+    fn error(&self, offset: usize, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+        error_at(self.path, line_of(self.text, offset), key, msg)
+    }
+}
+
+/// The label of a `[[models]]` entry: its models joined by ` + `.
+fn entry_label(entry: &ModelEntry) -> String {
+    entry.specs().collect::<Vec<_>>().join(" + ")
+}
+
+/// Compare model labels without spaces.
+fn same_label(a: &str, b: &str) -> bool {
+    let squeeze = |s: &str| s.chars().filter(|c| !c.is_whitespace()).collect::<String>();
+    squeeze(a) == squeeze(b)
+}
+
+/// Check `[global]` against the campaign's conditions and units (the experiment is the
+/// campaign's `experiment`, resolved, else the first unit's).
+pub(super) fn check(
+    raw: &Spanned<RawGlobal>,
+    conditions: &[String],
+    units: &[Unit],
+    experiment: Option<&Path>,
+    at: &At,
+) -> Result<GlobalSpec> {
+    let start = raw.span().start;
+    let g = raw.get_ref();
+    let Some(model) = &g.model else {
+        return Err(at.error(start, "global", "missing `model`: the model fitted jointly"));
+    };
+    let exp_path = experiment.map_or_else(|| units[0].experiment.clone(), Path::to_path_buf);
+    let exp = Experiment::load(&exp_path)?;
+    let Some(entry) = exp
+        .models
+        .iter()
+        .find(|e| same_label(&entry_label(e), model.get_ref()))
+    else {
+        let known: Vec<String> = exp.models.iter().map(entry_label).collect();
+        return Err(at.error(
+            model.span().start,
+            "global.model",
+            format!(
+                "`{}` is not a [[models]] entry of {} (it has: {})",
+                model.get_ref(),
+                exp_path.display(),
+                known.join(", ")
+            ),
+        ));
+    };
+    let configured = configure_for(
+        std::slice::from_ref(entry),
+        &exp.path,
+        &exp.dir,
+        &exp.scripts,
+        None,
+    )?;
+    let mut names: Vec<String> = configured.params.iter().map(|p| p.name.clone()).collect();
+    if exp.fit.offset {
+        names.push(stf_core::fit::FORCE_OFFSET.to_string());
+    }
+    let lacks = |name: &str| {
+        format!(
+            "`{}` has no parameter `{name}` (it has: {})",
+            model.get_ref(),
+            names.join(", ")
+        )
+    };
+    let mut shared = Vec::new();
+    for (i, s) in g.shared.iter().enumerate() {
+        let key = format!("global.shared[{i}]");
+        let name = s.get_ref();
+        if !names.contains(name) {
+            return Err(at.error(s.span().start, &key, lacks(name)));
+        }
+        if shared.contains(name) {
+            return Err(at.error(s.span().start, &key, format!("`{name}` is listed twice")));
+        }
+        shared.push(name.clone());
+    }
+    let mut laws = Vec::new();
+    for (param, law) in &g.laws {
+        let key = format!("global.laws.{param}");
+        let offset = law.span().start;
+        let law = law.get_ref();
+        if param == stf_core::fit::FORCE_OFFSET {
+            return Err(at.error(
+                offset,
+                &key,
+                "`f_off` is each record's force offset: it may be shared, not follow a law",
+            ));
+        }
+        if !names.contains(param) {
+            return Err(at.error(offset, &key, lacks(param)));
+        }
+        if shared.contains(param) {
+            return Err(at.error(
+                offset,
+                &key,
+                format!("`{param}` is shared already: a parameter is shared or follows a law"),
+            ));
+        }
+        if !conditions.contains(&law.condition) {
+            return Err(at.error(
+                offset,
+                &format!("{key}.condition"),
+                format!(
+                    "`{}` is not a condition: `campaign.conditions` lists [{}]",
+                    law.condition,
+                    conditions.join(", ")
+                ),
+            ));
+        }
+        if !(law.reference.is_finite() && law.reference > 0.0) {
+            return Err(at.error(
+                offset,
+                &format!("{key}.reference"),
+                format!("a positive number, found {}", law.reference),
+            ));
+        }
+        check_positive(units, &law.condition, &key, at)?;
+        laws.push(Law {
+            param: param.clone(),
+            condition: law.condition.clone(),
+            reference: law.reference,
+        });
+    }
+    let holdout = holdout_of(g.holdout.as_ref(), units, at)?;
+    let training = units.len() - usize::from(holdout.is_some());
+    if training < 2 {
+        return Err(at.error(
+            start,
+            "global",
+            format!("a global fit needs at least 2 records to fit; there are {training}"),
+        ));
+    }
+    Ok(GlobalSpec {
+        model: model.get_ref().clone(),
+        entry: entry.clone(),
+        experiment: exp_path,
+        shared,
+        laws,
+        holdout,
+        line: line_of(at.text, start),
+    })
+}
+
+/// Every record's `condition` is positive (a power law of it needs that).
+fn check_positive(units: &[Unit], condition: &str, key: &str, at: &At) -> Result<()> {
+    for (i, u) in units.iter().enumerate() {
+        let value = u
+            .conditions
+            .iter()
+            .find(|(n, _)| n == condition)
+            .map_or(f64::NAN, |(_, v)| *v);
+        if value.is_nan() || value <= 0.0 {
+            return Err(error_at(
+                at.path,
+                u.line,
+                &format!("records[{i}].{condition}"),
+                format!("`{key}` needs a positive `{condition}` on every record, found {value}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The held-out record's index: `holdout` must be a record's `file` as written (or the same
+/// file).
+fn holdout_of(given: Option<&Spanned<String>>, units: &[Unit], at: &At) -> Result<Option<usize>> {
+    let Some(h) = given else { return Ok(None) };
+    let found = units.iter().position(|u| {
+        u.record_given == *h.get_ref()
+            || Path::new(&u.record_given)
+                .components()
+                .eq(Path::new(h.get_ref()).components())
+    });
+    match found {
+        Some(i) => Ok(Some(i)),
+        None => Err(at.error(
+            h.span().start,
+            "global.holdout",
+            format!(
+                "`{}` is not a record of this campaign (give its `file` as written in \
+                 [[records]])",
+                h.get_ref()
+            ),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::file::Campaign;
+
+    /// The campaign `text` (two records at c = 1 and 2 after it) parsed in a folder with a
+    /// record `r.csv` and an experiment `e.toml` fitting `power_law` with an offset.
+    fn parse(global: &str) -> anyhow::Result<Campaign> {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(dir.path().join("s.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(
+            dir.path().join("e.toml"),
+            "[fit]\noffset = true\n\n[[models]]\nname = \"power_law\"\n",
+        )
+        .unwrap();
+        let text = format!(
+            "[campaign]\nexperiment = \"e.toml\"\ncommand = \"fit\"\nconditions = [\"c\"]\n\n\
+             [[records]]\nfile = \"r.csv\"\nc = 1\n\n[[records]]\nfile = \"s.csv\"\nc = 2\n\n\
+             [global]\n{global}"
+        );
+        Campaign::parse(&dir.path().join("c.toml"), &text)
+    }
+
+    fn message(global: &str) -> String {
+        let e = format!("{:#}", parse(global).unwrap_err());
+        e.split_once("c.toml")
+            .map_or(e.clone(), |(_, m)| m.to_string())
+    }
+
+    #[test]
+    fn a_global_section_is_checked_into_its_spec() {
+        let c = parse(
+            "model = \"power_law\"\nshared = [\"n\", \"f_off\"]\nlaws = { K = { condition = \"c\", reference = 1 } }\n",
+        )
+        .unwrap();
+        let g = c.global.unwrap();
+        assert_eq!(g.shared, ["n", "f_off"]);
+        assert_eq!(g.laws[0].param, "K");
+        assert_eq!(g.laws[0].reference, 1.0);
+        assert_eq!((g.holdout, g.line), (None, 14));
+    }
+
+    #[test]
+    fn each_bad_global_key_is_named_with_its_line() {
+        assert_eq!(
+            message("shared = [\"n\"]\n"),
+            ":14: `global`: missing `model`: the model fitted jointly"
+        );
+        assert!(message("model = \"power_law\"\nshared = [\"n\", \"n\"]\n")
+            .starts_with(":16: `global.shared[1]`: `n` is listed twice"));
+        assert!(message(
+            "model = \"power_law\"\nshared = [\"K\"]\nlaws = { K = { condition = \"c\", reference = 1.0 } }\n"
+        )
+        .starts_with(":17: `global.laws.K`: `K` is shared already"));
+        assert!(message(
+            "model = \"power_law\"\nlaws = { K = { condition = \"c\", reference = 0.0 } }\n"
+        )
+        .starts_with(":16: `global.laws.K.reference`: a positive number, found 0"));
+        assert!(message(
+            "model = \"power_law\"\nlaws = { f_off = { condition = \"c\", reference = 1.0 } }\n"
+        )
+        .starts_with(":16: `global.laws.f_off`: `f_off` is each record's force offset"));
+        assert!(
+            message("model = \"power_law\"\nholdout = \"r.csv\"\n").starts_with(
+                ":14: `global`: a global fit needs at least 2 records to fit; there are 1"
+            )
+        );
+        assert!(message("model = \"power_law\"\nshraed = [\"n\"]\n")
+            .starts_with(":16: `global`: unknown field `shraed`"));
+    }
+}

@@ -1,0 +1,202 @@
+//! The "Global fit" section at the top of the campaign report, from `global.json`
+//! ([`GlobalJson`]): the verdict and its caveats, the joint fit's parameters ± standard
+//! errors, the comparison table (RSS, parameters, AIC, BIC; held-out RMS both ways), and per
+//! law a figure of the records' own fitted values (± one standard error, one colour per value
+//! of the other conditions, the held-out record apart) with the fitted law drawn over them.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use super::global::{Criteria, GlobalJson, LawJson};
+use crate::digits::{carried, with_error};
+use crate::report::{self, Curve, ErrorSeries, FigureRef, Section, Table};
+
+/// Points along a law's curve in its figure.
+const CURVE_POINTS: usize = 200;
+
+/// The section, its figures written to `figures`.
+pub fn section(g: &GlobalJson, figures: &Path) -> Result<Section> {
+    let mut s = Section::new("Global fit");
+    s.paragraphs.push(format!(
+        "`{}` fitted jointly to the force of {} record(s){}{}{}. {}",
+        g.model,
+        g.records.len(),
+        if g.shared.is_empty() {
+            String::new()
+        } else {
+            format!(", sharing {}", g.shared.join(", "))
+        },
+        g.laws
+            .iter()
+            .map(|l| format!(
+                ", with {p} = {p}0·({c}/{r})^{p}_p",
+                p = l.param,
+                c = l.condition,
+                r = carried(l.reference)
+            ))
+            .collect::<String>(),
+        g.holdout
+            .as_ref()
+            .map_or(String::new(), |h| format!(", {} held out", h.record)),
+        capitalised(&g.verdict)
+    ));
+    for law in &g.laws {
+        s.paragraphs.push(format!(
+            "{p} = ({c})·({cond}/{r})^({e}) (± one block-robust standard error).",
+            p = law.param,
+            c = with_error(law.coefficient, law.coefficient_std_error),
+            cond = law.condition,
+            r = carried(law.reference),
+            e = with_error(law.exponent, law.exponent_std_error),
+        ));
+    }
+    s.warnings = g.caveats.iter().map(|c| capitalised(c) + ".").collect();
+    s.tables.push(comparison(g));
+    s.tables.push(params_table(g));
+    for law in &g.laws {
+        s.figures.push(law_figure(g, law, figures)?);
+    }
+    Ok(s)
+}
+
+/// "sharing …" → "Sharing …".
+fn capitalised(text: &str) -> String {
+    let mut c = text.chars();
+    c.next()
+        .map_or(String::new(), |f| f.to_uppercase().chain(c).collect())
+}
+
+/// Global against per-record: RSS, parameters, AIC, BIC, held-out RMS.
+fn comparison(g: &GlobalJson) -> Table {
+    let row = |name: &str, c: &Criteria, held: Option<f64>| {
+        vec![
+            name.to_string(),
+            format!("{:.4e}", c.rss),
+            c.n_params.to_string(),
+            format!("{:.1}", c.aic),
+            format!("{:.1}", c.bic),
+            held.map_or("—".into(), |h| format!("{h:.5} N")),
+        ]
+    };
+    let h = g.holdout.as_ref();
+    Table {
+        caption: format!(
+            "Over the {} training record(s) ({} samples). {}",
+            g.records.len(),
+            g.global.n_points,
+            h.map_or(String::new(), |h| format!(
+                "On the held-out record the per-record alternative takes the mean of the own \
+                 fits' parameters of {}; the record's own fit reaches {:.5} N.",
+                h.per_record_from.join(", "),
+                h.own_fit_rms
+            ))
+        ),
+        columns: ["fit", "RSS, N²", "parameters", "AIC", "BIC", "held-out RMS"]
+            .map(String::from)
+            .to_vec(),
+        rows: vec![
+            row("global", &g.global, h.map(|h| h.global_rms)),
+            row("per record", &g.per_record, h.map(|h| h.per_record_rms)),
+        ],
+    }
+}
+
+/// θ with standard errors.
+fn params_table(g: &GlobalJson) -> Table {
+    Table {
+        caption: "The joint fit's parameters (`P@N`: unit N's own).".into(),
+        columns: ["parameter", "role", "value ± standard error"]
+            .map(String::from)
+            .to_vec(),
+        rows: g
+            .params
+            .iter()
+            .map(|p| {
+                vec![
+                    p.name.clone(),
+                    p.role.clone(),
+                    with_error(p.value, p.std_error),
+                ]
+            })
+            .collect(),
+    }
+}
+
+/// The records' own values of `law.param` against its condition, with the law over them.
+fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
+    let mut series: Vec<ErrorSeries> = Vec::new();
+    let mut xs = Vec::new();
+    for r in &g.each_record {
+        let (Some(&x), Some(&(v, e))) =
+            (r.conditions.get(&law.condition), r.params.get(&law.param))
+        else {
+            continue;
+        };
+        xs.push(x);
+        let label = if r.held_out {
+            "held out".to_string()
+        } else {
+            let others: Vec<String> = r
+                .conditions
+                .iter()
+                .filter(|(c, _)| **c != law.condition)
+                .map(|(c, v)| format!("{c} = {}", carried(*v)))
+                .collect();
+            if others.is_empty() {
+                "records".into()
+            } else {
+                others.join(", ")
+            }
+        };
+        match series.iter_mut().find(|s| s.label == label) {
+            Some(s) => s.points.push((x, v, e)),
+            None => series.push(ErrorSeries {
+                label,
+                points: vec![(x, v, e)],
+            }),
+        }
+    }
+    // The held-out record last, so the colours of the others follow their order.
+    series.sort_by_key(|s| s.label == "held out");
+    let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let points = (0..CURVE_POINTS)
+        .map(|i| {
+            let x = lo + (hi - lo) * i as f64 / (CURVE_POINTS - 1) as f64;
+            (x, law.coefficient * (x / law.reference).powf(law.exponent))
+        })
+        .collect();
+    let curve = Curve {
+        label: format!(
+            "global law: {} = {:.4}·({}/{})^{:.4}",
+            law.param,
+            law.coefficient,
+            law.condition,
+            carried(law.reference),
+            law.exponent
+        ),
+        points,
+    };
+    let name = format!("global_{}_vs_{}", law.param, law.condition)
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect::<String>();
+    let title = format!("{}: {} against {}", g.model, law.param, law.condition);
+    let files = report::error_bars_with_curve(
+        dir,
+        &name,
+        &title,
+        (&law.condition, &law.param),
+        &series,
+        Some(&curve),
+    )?;
+    Ok(FigureRef::new(
+        files,
+        format!(
+            "Each record's own fitted {} (± one standard error) against {}, and the law the \
+             global fit found (black).",
+            law.param, law.condition
+        ),
+    ))
+}
