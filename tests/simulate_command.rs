@@ -179,6 +179,7 @@ fn bundled_records_regenerate_byte_for_byte() {
     let campaign: Vec<(String, String)> = ["a1", "a2", "a3"]
         .iter()
         .flat_map(|a| ["c1", "c2", "c3"].map(|c| format!("experiments/campaign/records/{a}_{c}")))
+        .chain(["experiments/campaign/records/a2_c4".to_string()])
         .map(|stem| (format!("{stem}.toml"), format!("{stem}.csv")))
         .collect();
     let campaign = campaign.iter().map(|(e, r)| (e.as_str(), r.as_str()));

@@ -407,7 +407,15 @@ fn assemble(
         .is_none_or(|h| h.global_rms <= h.per_record_rms);
     let supported = delta_bic < 0.0 && better_held;
     let verdict = verdict_text(supported, delta_bic, holdout.as_ref());
-    let caveats = caveats(spec, training, &global, &per_record, holdout.is_some());
+    let mut caveats = caveats(spec, training, &global, &per_record, holdout.is_some());
+    if holdout.as_ref().is_some_and(HoldoutJson::is_tie) {
+        caveats.push(format!(
+            "the held-out record does not tell the two fits apart (their RMS differ by under \
+             {:.0} %): hold out a record at a level of the law's condition that no other record \
+             shares to test what the law predicts",
+            TIE * 100.0
+        ));
+    }
     GlobalJson {
         model: spec.model.clone(),
         shared: spec.shared.clone(),
@@ -434,6 +442,17 @@ fn assemble(
     }
 }
 
+/// Held-out RMS values closer than this (relative) are a tie: the record cannot tell the
+/// two fits apart.
+const TIE: f64 = 0.01;
+
+impl HoldoutJson {
+    /// Whether the two fits predict the held-out record equally well, within [`TIE`].
+    fn is_tie(&self) -> bool {
+        (self.global_rms - self.per_record_rms).abs() <= TIE * self.per_record_rms
+    }
+}
+
 /// The verdict in a sentence.
 fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) -> String {
     let bic = if delta_bic < 0.0 {
@@ -444,9 +463,14 @@ fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) 
     let held = holdout.map_or_else(
         || "no record was held out".to_string(),
         |h| {
+            let tie = if h.is_tie() {
+                format!(" (a tie: within {:.0} %)", TIE * 100.0)
+            } else {
+                String::new()
+            };
             format!(
                 "on the held-out record {} the global fit predicts the force with RMS {:.5} N \
-                 against {:.5} N for the per-record alternative",
+                 against {:.5} N for the per-record alternative{tie}",
                 h.record, h.global_rms, h.per_record_rms
             )
         },
@@ -527,4 +551,29 @@ pub fn write(campaign: &Campaign, out: &Path) -> Result<GlobalJson> {
     json.wall_seconds = started.elapsed().as_secs_f64();
     crate::output::write_json(&out.join(GLOBAL_JSON), &json)?;
     Ok(json)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn holdout(global_rms: f64, per_record_rms: f64) -> HoldoutJson {
+        HoldoutJson {
+            record: "r.csv".into(),
+            global_rms,
+            per_record_rms,
+            per_record_from: Vec::new(),
+            own_fit_rms: global_rms,
+        }
+    }
+
+    #[test]
+    fn a_held_out_record_that_cannot_tell_the_fits_apart_is_called_a_tie() {
+        assert!(holdout(0.019757, 0.019767).is_tie());
+        assert!(!holdout(0.02038, 0.04556).is_tie());
+        let said = verdict_text(true, -117.6, Some(&holdout(0.019757, 0.019767)));
+        assert!(said.contains("(a tie: within 1 %)"), "{said}");
+        let said = verdict_text(true, -137.7, Some(&holdout(0.02038, 0.04556)));
+        assert!(!said.contains("tie"), "{said}");
+    }
 }
