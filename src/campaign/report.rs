@@ -56,21 +56,24 @@ fn ok_rows(table: &CampaignJson) -> impl Iterator<Item = &CampaignRow> {
 fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>> {
     let mut models: Vec<&str> = Vec::new();
     for r in ok_rows(table) {
-        if let Some(m) = r.model.as_deref().filter(|m| !models.contains(m)) {
+        if let Some(m) = r.result.model.as_deref().filter(|m| !models.contains(m)) {
             models.push(m);
         }
     }
     let mut figures = Vec::new();
     for model in models {
         let rows: Vec<&CampaignRow> = ok_rows(table)
-            .filter(|r| r.model.as_deref() == Some(model))
+            .filter(|r| r.result.model.as_deref() == Some(model))
             .collect();
         let owned: Vec<CampaignRow> = rows.iter().map(|r| (*r).clone()).collect();
         for param in param_names(&owned) {
             // A parameter held on every record (no standard error anywhere) has nothing to show.
-            let fitted = rows
-                .iter()
-                .any(|r| r.params.get(&param).is_some_and(|p| p.std_error.is_some()));
+            let fitted = rows.iter().any(|r| {
+                r.result
+                    .params
+                    .get(&param)
+                    .is_some_and(|p| p.std_error.is_some())
+            });
             if !fitted {
                 continue;
             }
@@ -118,7 +121,7 @@ fn series_of(
     let mut groups: BTreeMap<String, Vec<ErrorPoint>> = BTreeMap::new();
     let mut order: Vec<String> = Vec::new();
     for r in rows {
-        let (Some(x), Some(p)) = (r.conditions.get(condition), r.params.get(param)) else {
+        let (Some(x), Some(p)) = (r.conditions.get(condition), r.result.params.get(param)) else {
             continue;
         };
         let label: Vec<String> = conditions
@@ -191,6 +194,7 @@ fn table_of(table: &CampaignJson) -> Table {
                     .map_or(String::new(), |v| carried(*v).to_string())
             }));
             let params: Vec<String> = r
+                .result
                 .params
                 .iter()
                 .map(|(n, p)| match p.std_error {
@@ -198,19 +202,19 @@ fn table_of(table: &CampaignJson) -> Table {
                     None => format!("{n} = {}", carried(p.value)),
                 })
                 .collect();
-            let rms = match (r.rms, &r.rms_unit) {
+            let rms = match (r.result.rms, &r.result.rms_unit) {
                 (Some(v), Some(u)) => format!("{v:.4} {u}"),
                 _ => String::new(),
             };
             cells.extend([
-                r.model.clone().unwrap_or_default(),
+                r.result.model.clone().unwrap_or_default(),
                 params.join(", "),
                 rms,
-                r.best.map_or(
+                r.result.best.map_or(
                     String::new(),
                     |b| if b { "yes".into() } else { String::new() },
                 ),
-                r.warnings.join(", "),
+                r.result.warnings.join(", "),
                 match &r.error {
                     Some(e) => format!("failed: {e}"),
                     None => r.status.to_string(),

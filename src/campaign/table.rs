@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::file::{Campaign, CommandName};
 use super::unit::{read_unit_json, unit_dir, UnitStatus};
-use super::unit_results::{self, ModelResult, ParamValue};
+use super::unit_results::{self, ModelResult};
 use crate::digits::carried;
 
 /// One row: a model fitted to one record (or a failed unit).
@@ -31,30 +31,9 @@ pub struct CampaignRow {
     pub status: &'static str,
     /// Why the unit failed.
     pub error: Option<String>,
-    /// The model's label (null for a failed unit).
-    pub model: Option<String>,
-    /// Each parameter's value and standard error, SI units.
-    pub params: BTreeMap<String, ParamValue>,
-    /// RMS residual in `rms_unit` (`discover`: the final model's held-out gap).
-    pub rms: Option<f64>,
-    /// `N` or `m`.
-    pub rms_unit: Option<String>,
-    /// Akaike information criterion.
-    pub aic: Option<f64>,
-    /// Bayesian information criterion.
-    pub bic: Option<f64>,
-    /// Whether the fit converged.
-    pub converged: Option<bool>,
-    /// The unit's best model (`fit`: by AIC, the simplest within ΔAIC 2; `compare`: overall).
-    pub best: Option<bool>,
-    /// Kinds of the fit's warnings (`not_converged`, `above_noise_floor`, …).
-    pub warnings: Vec<String>,
-    /// The error on the `[validate]` record.
-    pub validation_rms: Option<f64>,
-    /// Effects named (`discover`).
-    pub effects: Option<Vec<String>>,
-    /// The base model's held-out gap (`discover`), unit of `rms`.
-    pub gap_before: Option<f64>,
+    /// The model's results (empty for a failed unit), flattened into the row.
+    #[serde(flatten)]
+    pub result: ModelResult,
     /// Wall time of the unit's command, s.
     pub wall_seconds: Option<f64>,
 }
@@ -89,18 +68,7 @@ pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>
             conditions: unit.conditions.iter().cloned().collect(),
             status: "ok",
             error: None,
-            model: None,
-            params: BTreeMap::new(),
-            rms: None,
-            rms_unit: None,
-            aic: None,
-            bic: None,
-            converged: None,
-            best: None,
-            warnings: Vec::new(),
-            validation_rms: None,
-            effects: None,
-            gap_before: None,
+            result: ModelResult::default(),
             wall_seconds: json.as_ref().map(|u| u.wall_seconds),
         };
         let results = match (&json, errors.get(&unit.number)) {
@@ -116,7 +84,10 @@ pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>
             (Some(_), None) => unit_results::read(unit.command, &dir).map_err(|e| format!("{e:#}")),
         };
         match results {
-            Ok(models) => rows.extend(models.into_iter().map(|m| with_model(&base, m))),
+            Ok(models) => rows.extend(models.into_iter().map(|result| CampaignRow {
+                result,
+                ..base.clone()
+            })),
             Err(e) => {
                 failed += 1;
                 rows.push(CampaignRow {
@@ -136,30 +107,11 @@ pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>
     }
 }
 
-/// `base` with a model's results.
-fn with_model(base: &CampaignRow, m: ModelResult) -> CampaignRow {
-    CampaignRow {
-        model: Some(m.model),
-        params: m.params,
-        rms: m.rms,
-        rms_unit: m.rms_unit,
-        aic: m.aic,
-        bic: m.bic,
-        converged: m.converged,
-        best: m.best,
-        warnings: m.warnings,
-        validation_rms: m.validation_rms,
-        effects: m.effects,
-        gap_before: m.gap_before,
-        ..base.clone()
-    }
-}
-
 /// Every parameter name of the table, in order of first appearance.
 pub fn param_names(rows: &[CampaignRow]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
     for r in rows {
-        for name in r.params.keys() {
+        for name in r.result.params.keys() {
             if !names.contains(name) {
                 names.push(name.clone());
             }
@@ -219,23 +171,24 @@ fn csv_row(r: &CampaignRow, conditions: &[String], names: &[String]) -> Vec<Stri
         r.status.to_string(),
     ];
     f.extend(conditions.iter().map(|c| num(r.conditions.get(c).copied())));
-    f.push(r.model.clone().unwrap_or_default());
+    let m = &r.result;
+    f.push(m.model.clone().unwrap_or_default());
     for n in names {
-        let p = r.params.get(n);
+        let p = m.params.get(n);
         f.push(num(p.map(|p| p.value)));
         f.push(num(p.and_then(|p| p.std_error)));
     }
     f.extend([
-        num(r.rms),
-        r.rms_unit.clone().unwrap_or_default(),
-        num(r.aic),
-        num(r.bic),
-        flag(r.converged),
-        flag(r.best),
-        r.warnings.join(";"),
-        num(r.validation_rms),
-        r.effects.as_ref().map(|e| e.join(";")).unwrap_or_default(),
-        num(r.gap_before),
+        num(m.rms),
+        m.rms_unit.clone().unwrap_or_default(),
+        num(m.aic),
+        num(m.bic),
+        flag(m.converged),
+        flag(m.best),
+        m.warnings.join(";"),
+        num(m.validation_rms),
+        m.effects.as_ref().map(|e| e.join(";")).unwrap_or_default(),
+        num(m.gap_before),
         num(r.wall_seconds),
         r.error.clone().unwrap_or_default(),
     ]);

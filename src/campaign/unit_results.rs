@@ -88,11 +88,12 @@ pub struct ParamValue {
     pub std_error: Option<f64>,
 }
 
-/// A model's results in one unit, what a row of the table shows.
-#[derive(Clone, Debug, Default)]
+/// A model's results in one unit, what a row of the table shows (all empty for a failed
+/// unit's row).
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct ModelResult {
-    /// The model's label (or the discovered model's name).
-    pub model: String,
+    /// The model's label (or the discovered model's name); null for a failed unit.
+    pub model: Option<String>,
     /// The model's parameters.
     pub params: BTreeMap<String, ParamValue>,
     /// RMS residual (`fit`, `compare`) or held-out gap after discovery.
@@ -132,7 +133,7 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
                 .into_iter()
                 .map(|m| {
                     let mut r = of_fit(m.fit);
-                    r.best = Some(best.as_deref() == Some(r.model.as_str()));
+                    r.best = Some(best.is_some() && best == r.model);
                     r
                 })
                 .collect())
@@ -140,7 +141,7 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
         CommandName::Discover => {
             let d: DiscoveryFile = read_json(&dir.join("discovery.json"))?;
             Ok(vec![ModelResult {
-                model: d.final_model.name,
+                model: Some(d.final_model.name),
                 params: params(&d.final_model.params, &d.final_model.std_errors, &[]),
                 rms: Some(d.gap_after),
                 rms_unit: Some(d.gap_unit),
@@ -181,7 +182,7 @@ fn with_best_by_aic(models: Vec<ModelFit>) -> Vec<ModelResult> {
 fn of_fit(m: ModelFit) -> ModelResult {
     ModelResult {
         params: params(&m.params, &m.std_errors, &m.fixed),
-        model: m.label,
+        model: Some(m.label),
         rms: Some(m.rms),
         rms_unit: Some(m.rms_unit),
         aic: m.aic,
