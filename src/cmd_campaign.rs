@@ -5,16 +5,23 @@
 //! Slurm array task, runs. With a `[global]` section, the joint fit of all records
 //! (`crate::campaign::global`) follows the units, into `DIR/global.json` and the report's
 //! first section.
+//!
+//! With `--slurm` the units not finished are submitted instead as a Slurm job array, and a
+//! job after it runs `--collect`: the table, report and `[global]` fit from the units' folders
+//! — the same step a local run ends with — naming every unit that is missing or failed
+//! (`crate::campaign::slurm`). `--dry-run` shows what `--slurm` would submit.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::{bail, Error, Result};
+use anyhow::{bail, Context, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
+use crate::campaign::{slurm, slurm_script};
+use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
-use crate::output::write_json;
+use crate::output::{resolve, write_json};
 use crate::say;
 
 /// The command line's settings.
@@ -27,6 +34,18 @@ pub struct Settings {
     pub jobs: Option<usize>,
     /// Run this unit alone, in this process.
     pub unit: Option<usize>,
+    /// Only build the table, report and `[global]` fit from the finished units.
+    pub collect: bool,
+    /// Submit to Slurm instead of running here.
+    pub slurm: Option<SlurmSettings>,
+}
+
+/// `--slurm` and its settings.
+pub struct SlurmSettings {
+    /// Partition, time, memory and account of the jobs.
+    pub options: SlurmOptions,
+    /// Print the scripts and commands; submit and write nothing.
+    pub dry_run: bool,
 }
 
 /// Run `stf-lab campaign`.
@@ -37,6 +56,13 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         run_one(&campaign, n, out, settings.force, settings.quiet)?;
         say!("wrote {}", unit_dir(out, campaign.unit(n)?).display());
         return Ok(());
+    }
+    if settings.collect {
+        let _lock = out_dir::begin(out)?;
+        return collect(&campaign, out);
+    }
+    if let Some(slurm) = &settings.slurm {
+        return submit(&campaign, out, settings.force, slurm);
     }
     if settings.jobs == Some(0) {
         bail!("--jobs 0: give at least 1");
@@ -62,10 +88,107 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         .into_iter()
         .filter_map(|f| f.error.map(|e| (f.number, e)))
         .collect();
-    let table = table::collect(&campaign, out, &errors);
+    finish(&campaign, out, &errors)
+}
+
+/// `--collect`: the table, report and `[global]` fit from the units' folders, as a run ends;
+/// a unit without a `unit.json` of its present inputs is a failed row saying it did not
+/// finish (and where its Slurm log is, if it has one).
+fn collect(campaign: &Campaign, out: &Path) -> Result<()> {
+    let mut errors = BTreeMap::new();
+    for unit in &campaign.units {
+        let dir = unit_dir(out, unit);
+        let why = match read_unit_json(&dir) {
+            None => format!("it did not finish: no unit.json in {}", dir.display()),
+            Some(u) if u.inputs_hash != inputs_hash(unit)? => format!(
+                "it did not finish: the unit.json in {} is from other inputs",
+                dir.display()
+            ),
+            Some(_) => continue,
+        };
+        let log = out.join(SLURM).join(format!("unit-{}.log", unit.number));
+        let log = match log.is_file() {
+            true => format!(" (its log: {})", log.display()),
+            false => String::new(),
+        };
+        errors.insert(unit.number, format!("{why}{log}"));
+    }
+    finish(campaign, out, &errors)
+}
+
+/// `--slurm`: submit the units not finished as a job array and the collect step after it
+/// (or, with `--dry-run`, show the scripts and commands). Nothing to run: collect here.
+fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings) -> Result<()> {
+    settings.options.check()?;
+    let lock = match settings.dry_run {
+        true => {
+            out_dir::check(out)?;
+            None
+        }
+        false => Some(out_dir::begin(out)?),
+    };
+    let pending = plan(campaign, out, force)?;
+    say!(
+        "campaign {}: {} unit(s), {} to run",
+        campaign.path.display(),
+        campaign.units.len(),
+        pending.len()
+    );
+    if pending.is_empty() {
+        if settings.dry_run {
+            say!("nothing would be submitted: without --dry-run the table is collected here");
+            return Ok(());
+        }
+        say!("nothing to submit: the table is collected here");
+        return collect(campaign, out);
+    }
+    let job = Job {
+        exe: std::env::current_exe().context("cannot find this program for the batch scripts")?,
+        campaign: resolve(&campaign.path),
+        out: resolve(out),
+        units: pending.iter().map(|p| p.unit.number).collect(),
+        force,
+        options: &settings.options,
+    };
+    let scripts = job.scripts()?;
+    if settings.dry_run {
+        say!("dry run: nothing is submitted or written\n");
+        say!("{}", slurm::dry_run_text(&job, &scripts).trim_end());
+        return Ok(());
+    }
+    slurm::write_scripts(&job, &scripts)?;
+    let ids = slurm::submit(&job)?;
+    drop(lock);
+    let folder = job.folder();
+    say!(
+        "units job: {} (array {}, logs {}/unit-N.log)",
+        ids.units_job,
+        slurm_script::array_spec(&job.units),
+        folder.display()
+    );
+    say!(
+        "collect job: {} (after job {} ends, log {}/collect.log)",
+        ids.collect_job,
+        ids.units_job,
+        folder.display()
+    );
+    say!(
+        "follow with: squeue -j {},{}; the table and report are written into {} by the collect \
+         job",
+        ids.units_job,
+        ids.collect_job,
+        out.display()
+    );
+    Ok(())
+}
+
+/// The table, report and `[global]` fit of the units in `out`; `errors` holds, by unit, why
+/// a unit has no results. An error naming the failed units after everything is written.
+fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> Result<()> {
+    let table = table::collect(campaign, out, errors);
     write_json(&out.join("campaign.json"), &table)?;
     table::write_csv(&out.join("campaign.csv"), &table)?;
-    let (global, global_error) = global_fit(&campaign, out);
+    let (global, global_error) = global_fit(campaign, out);
     report::write(&table, global.as_ref(), out)?;
     if let Some(g) = &global {
         say!("global fit: {}", g.verdict);
@@ -82,10 +205,11 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
             format!("; the [global] fit failed too: {e:#}")
         });
         bail!(
-            "{} of {} unit(s) failed: their rows in {} say why{global}",
+            "{} of {} unit(s) failed: their rows in {} say why{global}{}",
             table.failed,
             table.units,
-            out.join("campaign.csv").display()
+            out.join("campaign.csv").display(),
+            failed_units(&table)
         );
     }
     if let Some(e) = global_error {
@@ -141,6 +265,20 @@ fn plan<'a>(campaign: &'a Campaign, out: &Path, force: bool) -> Result<Vec<Pendi
         pending.push(Pending { unit, dir, hash });
     }
     Ok(pending)
+}
+
+/// A line per failed unit of `table`: `\n  unit 3 (rec.csv): why` (the first line of why).
+fn failed_units(table: &table::CampaignJson) -> String {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut text = String::new();
+    for row in table.rows.iter().filter(|r| r.status != "ok") {
+        if seen.insert(row.unit) {
+            let why = row.error.as_deref().unwrap_or("failed");
+            let why = why.lines().next().unwrap_or("");
+            text.push_str(&format!("\n  unit {} ({}): {why}", row.unit, row.record));
+        }
+    }
+    text
 }
 
 /// `unit 3 (rec.csv)`.

@@ -17,6 +17,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use stf_lab::campaign::slurm_script::SlurmOptions;
 use stf_lab::{
     cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt, tell,
 };
@@ -105,6 +106,29 @@ enum Command {
         /// Run unit N (the N-th record, from 1) alone, in this process, into DIR/units/.
         #[arg(long, value_name = "N")]
         unit: Option<usize>,
+        /// Only build the table, report and [global] fit from the finished units (what the
+        /// Slurm collect job runs); fails naming the units missing or failed.
+        #[arg(long, conflicts_with_all = ["unit", "jobs", "force", "slurm"])]
+        collect: bool,
+        /// Submit the units not finished to Slurm as a job array, and a collect job after it;
+        /// scripts and logs go to DIR/slurm/.
+        #[arg(long, conflicts_with_all = ["unit", "jobs"])]
+        slurm: bool,
+        /// Slurm partition of the jobs (default: the cluster's).
+        #[arg(long, value_name = "P", requires = "slurm")]
+        partition: Option<String>,
+        /// Slurm time limit per unit, e.g. 01:00:00 (default: the partition's).
+        #[arg(long, value_name = "HH:MM:SS", requires = "slurm")]
+        time: Option<String>,
+        /// Slurm memory per unit, e.g. 2G (default: the cluster's).
+        #[arg(long, value_name = "SIZE", requires = "slurm")]
+        mem: Option<String>,
+        /// Slurm account to charge (default: the user's).
+        #[arg(long, value_name = "A", requires = "slurm")]
+        account: Option<String>,
+        /// With --slurm: print the batch scripts and sbatch commands; submit and write nothing.
+        #[arg(long, requires = "slurm")]
+        dry_run: bool,
     },
 }
 
@@ -143,6 +167,13 @@ fn main() -> ExitCode {
             force,
             jobs,
             unit,
+            collect,
+            slurm,
+            partition,
+            time,
+            mem,
+            account,
+            dry_run,
         } => cmd_campaign::run(
             &campaign,
             &out,
@@ -151,6 +182,16 @@ fn main() -> ExitCode {
                 quiet,
                 jobs,
                 unit,
+                collect,
+                slurm: slurm.then_some(cmd_campaign::SlurmSettings {
+                    options: SlurmOptions {
+                        partition,
+                        time,
+                        mem,
+                        account,
+                    },
+                    dry_run,
+                }),
             },
         ),
     };

@@ -1,8 +1,8 @@
 //! Campaigns: many records, one command (`stf-lab campaign CAMPAIGN.toml --out DIR`). A
 //! campaign file ([`file`]) lists records with their conditions and the work for each; unit N
 //! is (record N, its experiment, its command), run into `DIR/units/<NNN>-<stem>/` by
-//! [`unit`] — in a child process of the local [`runner`], or, later, a Slurm array task —
-//! and recognised as finished by the hash of its inputs ([`hash`]). After the units, the
+//! [`unit`] — in a child process of the local [`runner`], or a Slurm array task ([`slurm`],
+//! [`slurm_script`]) — and recognised as finished by the hash of its inputs ([`hash`]). After the units, the
 //! [`table`] (`campaign.csv`, `campaign.json`: a row per record × model) and the
 //! [`report`] are built from the units' JSON ([`unit_results`]). The output folder's rules
 //! are in [`out_dir`]; `crate::cmd_campaign` runs it all. A `[global]` section
@@ -19,6 +19,8 @@ pub mod hash;
 pub mod out_dir;
 pub mod report;
 pub mod runner;
+pub mod slurm;
+pub mod slurm_script;
 pub mod table;
 pub mod unit;
 pub mod unit_results;

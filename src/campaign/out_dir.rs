@@ -17,6 +17,7 @@ use crate::output_lock::OutputLock;
 pub const CAMPAIGN_NAMES: &[&str] = &[
     super::unit::UNITS,
     super::runner::LOGS,
+    super::slurm_script::SLURM,
     "campaign.json",
     "campaign.csv",
     super::global::GLOBAL_JSON,
