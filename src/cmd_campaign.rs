@@ -17,10 +17,10 @@ use std::path::Path;
 use anyhow::{bail, Context, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
-use crate::campaign::{slurm, slurm_script};
 use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
+use crate::campaign::{slurm, slurm_script};
 use crate::output::{resolve, write_json};
 use crate::say;
 

@@ -30,8 +30,14 @@ pub struct Submitted {
 pub fn dry_run_text(job: &Job, scripts: &Scripts) -> String {
     let folder = job.folder();
     let mut text = String::new();
-    for (name, body) in [(UNITS_SCRIPT, &scripts.units), (COLLECT_SCRIPT, &scripts.collect)] {
-        text.push_str(&format!("==> {} <==\n{body}\n", folder.join(name).display()));
+    for (name, body) in [
+        (UNITS_SCRIPT, &scripts.units),
+        (COLLECT_SCRIPT, &scripts.collect),
+    ] {
+        text.push_str(&format!(
+            "==> {} <==\n{body}\n",
+            folder.join(name).display()
+        ));
     }
     text.push_str("==> submitted with <==\n");
     for line in commands_shown(&folder) {

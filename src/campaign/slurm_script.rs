@@ -173,9 +173,12 @@ impl Job<'_> {
 
 /// A path quoted for `sh`.
 fn quote(path: &Path) -> Result<String> {
-    let text = path
-        .to_str()
-        .with_context(|| format!("{}: a path the batch script can hold must be UTF-8", path.display()))?;
+    let text = path.to_str().with_context(|| {
+        format!(
+            "{}: a path the batch script can hold must be UTF-8",
+            path.display()
+        )
+    })?;
     Ok(shlex::try_quote(text)
         .with_context(|| format!("{}: cannot be quoted for the shell", path.display()))?
         .into_owned())
@@ -291,8 +294,12 @@ mod tests {
         };
         let s = job.scripts().unwrap();
         assert!(s.units.contains("#SBATCH --array=1-2,4\n"), "{}", s.units);
-        assert!(s.units.contains("#SBATCH --output=/data/out/slurm/unit-%a.log\n"));
-        assert!(s.units.contains("#SBATCH --partition=short\n#SBATCH --time=00:10:00\n"));
+        assert!(s
+            .units
+            .contains("#SBATCH --output=/data/out/slurm/unit-%a.log\n"));
+        assert!(s
+            .units
+            .contains("#SBATCH --partition=short\n#SBATCH --time=00:10:00\n"));
         assert!(s.units.contains("#SBATCH --mem=1G\n") && !s.units.contains("--account"));
         assert!(
             s.units.contains(
@@ -302,7 +309,11 @@ mod tests {
             "{}",
             s.units
         );
-        assert!(s.collect.contains(" --out /data/out --collect --quiet\n"), "{}", s.collect);
+        assert!(
+            s.collect.contains(" --out /data/out --collect --quiet\n"),
+            "{}",
+            s.collect
+        );
         assert!(!s.collect.contains("--array"));
     }
 
@@ -318,6 +329,9 @@ mod tests {
             options: &options,
         };
         let e = job.scripts().err().unwrap().to_string();
-        assert!(e.contains("/data/run 100%/slurm") && e.contains("' '"), "{e}");
+        assert!(
+            e.contains("/data/run 100%/slurm") && e.contains("' '"),
+            "{e}"
+        );
     }
 }

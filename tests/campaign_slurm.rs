@@ -1,0 +1,517 @@
+//! `stf-lab campaign --slurm`: a small campaign (three records of the bundled example and a
+//! `[global]` fit) run through a real single-node Slurm, brought up on this machine by
+//! `tests/slurm/start.sh`, gives the units, `campaign.json`, `campaign.csv` and
+//! `global.json` of a local run, timing fields apart; a unit that fails on the cluster is
+//! named by the collect job. Without Slurm (no `sbatch`, `slurmctld`, `slurmd` or `munged`
+//! on PATH, or not root) these two tests say why they are skipped and pass, unless
+//! `STF_LAB_REQUIRE_SLURM=1` (CI), where they fail.
+//!
+//! The other tests need no Slurm: `--dry-run` prints the scripts and calls no `sbatch`, a
+//! stand-in `sbatch` shows what is submitted and in which order, a missing `sbatch` is a
+//! clear error, and `--collect` names the units that did not finish.
+//!
+//! Every wait has a time limit and ends with the jobs' and daemons' logs.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use common::{read_json, root, stf_lab};
+
+/// The folder of the test cluster's files (`tests/slurm/start.sh`'s default).
+const SLURM_DIR: &str = "/tmp/stf-lab-slurm";
+
+/// The longest wait for a submitted campaign's collect job to end.
+const JOB_TIMEOUT: Duration = Duration::from_secs(300);
+
+/// Three records of the bundled campaign (three concentrations, three amplitudes) copied into
+/// `dir`, with its experiment, a `[global]` fit (n shared, K a law of the concentration) and,
+/// when `broken`, a fourth record that cannot be read. The campaign file's path.
+fn small_campaign(dir: &Path, broken: bool) -> PathBuf {
+    let from = root().join("experiments/campaign");
+    std::fs::create_dir_all(dir.join("records")).unwrap();
+    std::fs::copy(from.join("power_law.toml"), dir.join("power_law.toml")).unwrap();
+    let records = [
+        ("a1_c1", 0.035, 0.36),
+        ("a2_c2", 0.0462, 0.40),
+        ("a3_c3", 0.06, 0.44),
+    ];
+    let mut text = String::from(
+        "[campaign]\nexperiment = \"power_law.toml\"\ncommand = \"fit\"\n\
+         conditions = [\"F0\", \"concentration\"]\n",
+    );
+    for (stem, f0, c) in records {
+        let name = format!("records/{stem}.csv");
+        std::fs::copy(from.join(&name), dir.join(&name)).unwrap();
+        text.push_str(&format!(
+            "\n[[records]]\nfile = \"{name}\"\nF0 = {f0}\nconcentration = {c}\n"
+        ));
+    }
+    if broken {
+        std::fs::write(dir.join("records/broken.csv"), "t,phi,x\n0,0,0\n1,zero,0\n").unwrap();
+        text.push_str(
+            "\n[[records]]\nfile = \"records/broken.csv\"\nF0 = 1\nconcentration = 0.5\n",
+        );
+    } else {
+        text.push_str(
+            "\n[global]\nmodel = \"power_law\"\nshared = [\"n\"]\n\
+             laws = { K = { condition = \"concentration\", reference = 0.40 } }\n",
+        );
+    }
+    let file = dir.join("campaign.toml");
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// `stf-lab campaign FILE --out OUT ARGS…`, with `env` set.
+fn campaign(file: &Path, out: &Path, args: &[&str], env: &[(&str, &std::ffi::OsStr)]) -> Output {
+    let mut cmd = stf_lab();
+    cmd.arg("campaign")
+        .arg(file)
+        .arg("--out")
+        .arg(out)
+        .args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().unwrap()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Whether `name` is an executable file in a folder of PATH.
+fn on_path(name: &str) -> bool {
+    std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(name).is_file()))
+}
+
+/// The test cluster's `SLURM_CONF`, Slurm brought up once for this test binary; `None` (the
+/// test is skipped) when this machine cannot run it, unless `STF_LAB_REQUIRE_SLURM=1`.
+fn slurm() -> Option<PathBuf> {
+    static STARTED: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let started = STARTED.get_or_init(|| {
+        let missing: Vec<&str> = ["sbatch", "squeue", "slurmctld", "slurmd", "munged"]
+            .into_iter()
+            .filter(|n| !on_path(n))
+            .collect();
+        if !missing.is_empty() {
+            return Err(format!(
+                "not on PATH: {} (apt-get install -y slurm-wlm munge)",
+                missing.join(", ")
+            ));
+        }
+        let uid = Command::new("id")
+            .arg("-u")
+            .output()
+            .map(|o| text(&o.stdout));
+        if uid.ok().as_deref().map(str::trim) != Some("0") {
+            return Err("tests/slurm/start.sh runs slurmd, which needs root".into());
+        }
+        let start = Command::new(root().join("tests/slurm/start.sh"))
+            .env("STF_LAB_SLURM_DIR", SLURM_DIR)
+            .output()
+            .unwrap();
+        assert!(
+            start.status.success(),
+            "tests/slurm/start.sh failed:\n{}{}",
+            text(&start.stdout),
+            text(&start.stderr)
+        );
+        println!("{}", text(&start.stdout).trim());
+        Ok(Path::new(SLURM_DIR).join("slurm.conf"))
+    });
+    match started {
+        Ok(conf) => Some(conf.clone()),
+        Err(why) if std::env::var("STF_LAB_REQUIRE_SLURM").as_deref() == Ok("1") => {
+            panic!("STF_LAB_REQUIRE_SLURM=1 but Slurm cannot run here: {why}")
+        }
+        Err(why) => {
+            println!("skipped: no single-node Slurm on this machine: {why}");
+            None
+        }
+    }
+}
+
+/// The job ids `--slurm` printed: (units job, collect job).
+fn job_ids(stdout: &str) -> (String, String) {
+    let id = |key: &str| {
+        let line = stdout.lines().find_map(|l| l.strip_prefix(key));
+        let line = line.unwrap_or_else(|| panic!("no {key:?} line in:\n{stdout}"));
+        line.split_whitespace().next().unwrap().to_string()
+    };
+    (id("units job: "), id("collect job: "))
+}
+
+/// What a campaign's Slurm jobs and the test cluster logged, for a failure's message.
+fn logs(out: &Path, conf: &Path) -> String {
+    let mut said = String::new();
+    let squeue = Command::new("squeue")
+        .args(["--states=all", "-o", "%i %j %T %r"])
+        .env("SLURM_CONF", conf)
+        .output();
+    if let Ok(o) = squeue {
+        said.push_str(&format!(
+            "---- squeue\n{}{}",
+            text(&o.stdout),
+            text(&o.stderr)
+        ));
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(out.join("slurm"))
+        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+        .unwrap_or_default();
+    files.sort();
+    files.push(Path::new(SLURM_DIR).join("slurmctld.log"));
+    files.push(Path::new(SLURM_DIR).join("slurmd.log"));
+    for f in files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "log"))
+    {
+        let body = std::fs::read_to_string(f).unwrap_or_default();
+        let tail: Vec<&str> = body.lines().rev().take(30).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        said.push_str(&format!("---- {}\n{}\n", f.display(), tail.join("\n")));
+    }
+    said
+}
+
+/// Wait until job `id` has ended; its final state (`COMPLETED`, `FAILED`, …). Panics with
+/// the logs after [`JOB_TIMEOUT`].
+fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
+    let started = Instant::now();
+    let ended = [
+        "COMPLETED",
+        "FAILED",
+        "CANCELLED",
+        "TIMEOUT",
+        "NODE_FAIL",
+        "OUT_OF_MEMORY",
+        "BOOT_FAIL",
+        "DEADLINE",
+        "PREEMPTED",
+    ];
+    loop {
+        let o = Command::new("squeue")
+            .args(["-h", "--states=all", "-j", id, "-o", "%T"])
+            .env("SLURM_CONF", conf)
+            .output()
+            .unwrap();
+        let state = text(&o.stdout).trim().to_string();
+        if let Some(s) = ended.iter().find(|s| state.starts_with(**s)) {
+            return s.to_string();
+        }
+        assert!(
+            started.elapsed() < JOB_TIMEOUT,
+            "job {id} has not ended after {JOB_TIMEOUT:?} (state {state:?}):\n{}",
+            logs(out, conf)
+        );
+        std::thread::sleep(Duration::from_millis(500));
+    }
+}
+
+/// A JSON or CSV result with its timing fields (`wall_seconds`) left out and the output
+/// folder's path replaced by `OUT`, as text.
+fn comparable(path: &Path, out: &Path) -> String {
+    let body = std::fs::read_to_string(path).unwrap();
+    let body = body.replace(out.to_str().unwrap(), "OUT");
+    if path.extension().is_some_and(|e| e == "json") {
+        let mut value: serde_json::Value = serde_json::from_str(&body).unwrap();
+        drop_timing(&mut value);
+        return serde_json::to_string_pretty(&value).unwrap();
+    }
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .from_reader(body.as_bytes());
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    let keep: Vec<usize> = (0..rows.first().map_or(0, |r| r.len()))
+        .filter(|&i| &rows[0][i] != "wall_seconds")
+        .collect();
+    rows.iter()
+        .map(|r| keep.iter().map(|&i| &r[i]).collect::<Vec<_>>().join(","))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Remove every `wall_seconds` key.
+fn drop_timing(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Object(map) => {
+            map.remove("wall_seconds");
+            map.values_mut().for_each(drop_timing);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(drop_timing),
+        _ => {}
+    }
+}
+
+/// The JSON and CSV results under `out` (units and campaign), by path relative to `out`.
+fn results(out: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut folders = vec![out.to_path_buf()];
+    while let Some(dir) = folders.pop() {
+        for e in std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()) {
+            let name = e.strip_prefix(out).unwrap().to_path_buf();
+            if e.is_dir() && (dir != out || name == Path::new("units")) {
+                folders.push(e);
+            } else if e.extension().is_some_and(|x| x == "json" || x == "csv") {
+                found.push(name);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+#[test]
+fn a_campaign_through_single_node_slurm_gives_the_local_run_s_outputs() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    let local = tmp.path().join("local");
+    let run = campaign(&file, &local, &["--jobs", "1", "--quiet"], &[]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+
+    let cluster = tmp.path().join("cluster");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
+    let run = campaign(&file, &cluster, &flags, &env);
+    assert!(
+        run.status.success(),
+        "{}{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
+    let (units, collect) = job_ids(&text(&run.stdout));
+    let state = wait_for(&collect, &cluster, &conf);
+    assert_eq!(state, "COMPLETED", "{}", logs(&cluster, &conf));
+    assert_eq!(wait_for(&units, &cluster, &conf), "COMPLETED");
+
+    let names = results(&local);
+    assert_eq!(names, results(&cluster));
+    for want in [
+        "campaign.json",
+        "campaign.csv",
+        "global.json",
+        "units/002-a2_c2/unit.json",
+    ] {
+        assert!(names.contains(&PathBuf::from(want)), "{want} in {names:?}");
+    }
+    assert!(names.iter().filter(|n| n.ends_with("fit.json")).count() == 3);
+    for name in &names {
+        assert_eq!(
+            comparable(&local.join(name), &local),
+            comparable(&cluster.join(name), &cluster),
+            "{} differs between the local and the Slurm run",
+            name.display()
+        );
+    }
+    // The array ran every unit, each logged in DIR/slurm/.
+    for n in 1..=3 {
+        assert!(
+            cluster.join(format!("slurm/unit-{n}.log")).is_file(),
+            "unit {n}'s log"
+        );
+    }
+
+    // Submitted again, every unit is finished: nothing goes to Slurm, the table is collected
+    // at once.
+    let again = campaign(&file, &cluster, &flags, &env);
+    let said = text(&again.stdout);
+    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    assert!(
+        said.contains("nothing to submit: the table is collected here"),
+        "{said}"
+    );
+    assert!(!said.contains("units job:"), "{said}");
+}
+
+#[test]
+fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), true);
+    let out = tmp.path().join("out");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let run = campaign(&file, &out, &["--slurm", "--time", "00:10:00"], &env);
+    assert!(
+        run.status.success(),
+        "{}{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
+    let (_, collect) = job_ids(&text(&run.stdout));
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "FAILED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    assert!(
+        log.contains("1 of 4 unit(s) failed") && log.contains("unit 4 (records/broken.csv): "),
+        "{log}"
+    );
+    let rows = read_json(&out.join("campaign.json"))["rows"].clone();
+    let failed: Vec<&serde_json::Value> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["status"] == "failed")
+        .collect();
+    assert_eq!(failed.len(), 1);
+    assert!(
+        failed[0]["error"].as_str().unwrap().contains("broken.csv"),
+        "{}",
+        failed[0]
+    );
+}
+
+/// A stand-in `sbatch` in `dir` that appends its arguments to `dir/calls` and prints the
+/// job ids 41, then 42.
+fn fake_sbatch(dir: &Path) {
+    let script = "#!/bin/sh\n\
+        echo \"$@\" >> \"$(dirname \"$0\")/calls\"\n\
+        n=$(wc -l < \"$(dirname \"$0\")/calls\")\n\
+        echo $((40 + n))\n";
+    let path = dir.join("sbatch");
+    std::fs::write(&path, script).unwrap();
+    let mut mode = std::fs::metadata(&path).unwrap().permissions();
+    std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
+    std::fs::set_permissions(&path, mode).unwrap();
+}
+
+/// PATH with `dir` first.
+fn path_with(dir: &Path) -> std::ffi::OsString {
+    let rest = std::env::var_os("PATH").unwrap_or_default();
+    let mut all = vec![dir.to_path_buf()];
+    all.extend(std::env::split_paths(&rest));
+    std::env::join_paths(all).unwrap()
+}
+
+#[test]
+fn a_dry_run_prints_the_scripts_of_the_unfinished_units_and_submits_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    let out = tmp.path().join("out");
+    // Unit 2 is finished: only units 1 and 3 go into the array.
+    let run = campaign(&file, &out, &["--unit", "2", "--quiet"], &[]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    fake_sbatch(&bin);
+    let path = path_with(&bin);
+    let flags = [
+        "--slurm",
+        "--dry-run",
+        "--partition",
+        "short",
+        "--time",
+        "00:20:00",
+        "--mem",
+        "2G",
+        "--account",
+        "lab",
+    ];
+    let run = campaign(&file, &out, &flags, &[("PATH", path.as_os_str())]);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    assert!(!bin.join("calls").exists(), "--dry-run called sbatch");
+    assert!(!out.join("slurm").exists(), "--dry-run wrote the scripts");
+    let out = out.canonicalize().unwrap();
+    let slurm = out.join("slurm");
+    for line in [
+        "#SBATCH --array=1,3".to_string(),
+        format!("#SBATCH --output={}/unit-%a.log", slurm.display()),
+        "#SBATCH --partition=short".into(),
+        "#SBATCH --time=00:20:00".into(),
+        "#SBATCH --mem=2G".into(),
+        "#SBATCH --account=lab".into(),
+        "--unit \"$SLURM_ARRAY_TASK_ID\"".into(),
+        format!("--out {} --collect --quiet", out.display()),
+        format!("sbatch --parsable {}/units.sbatch", slurm.display()),
+        format!(
+            "sbatch --parsable --dependency=afterany:<units job id> {}/collect.sbatch",
+            slurm.display()
+        ),
+    ] {
+        assert!(said.contains(&line), "no {line:?} in:\n{said}");
+    }
+    assert_eq!(
+        said.matches("#SBATCH --partition=short").count(),
+        2,
+        "{said}"
+    );
+}
+
+#[test]
+fn the_collect_job_is_submitted_after_the_array_whatever_its_tasks_end_with() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    let out = tmp.path().join("out");
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    fake_sbatch(&bin);
+    let path = path_with(&bin);
+    let run = campaign(&file, &out, &["--slurm"], &[("PATH", path.as_os_str())]);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    assert_eq!(job_ids(&said), ("41".to_string(), "42".to_string()));
+    let slurm = out.canonicalize().unwrap().join("slurm");
+    let calls = std::fs::read_to_string(bin.join("calls")).unwrap();
+    assert_eq!(
+        calls,
+        format!(
+            "--parsable {0}/units.sbatch\n--parsable --dependency=afterany:41 {0}/collect.sbatch\n",
+            slurm.display()
+        )
+    );
+    let units = std::fs::read_to_string(slurm.join("units.sbatch")).unwrap();
+    assert!(units.contains("#SBATCH --array=1-3\n"), "{units}");
+    assert!(slurm.join("collect.sbatch").is_file());
+}
+
+#[test]
+fn slurm_without_sbatch_is_a_clear_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--slurm"], &[("PATH", empty.as_os_str())]);
+    assert!(!run.status.success());
+    let e = text(&run.stderr);
+    assert!(e.contains("sbatch is not on PATH"), "{e}");
+}
+
+#[test]
+fn collect_names_the_units_that_did_not_finish() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--unit", "1", "--quiet"], &[]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let run = campaign(&file, &out, &["--collect", "--quiet"], &[]);
+    assert!(!run.status.success());
+    let e = text(&run.stderr);
+    assert!(e.contains("2 of 3 unit(s) failed"), "{e}");
+    for (n, stem) in [(2, "a2_c2"), (3, "a3_c3")] {
+        assert!(
+            e.contains(&format!(
+                "unit {n} (records/{stem}.csv): it did not finish: no unit.json in"
+            )),
+            "{e}"
+        );
+    }
+    let rows = read_json(&out.join("campaign.json"))["rows"].clone();
+    let ok = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["status"] == "ok")
+        .count();
+    assert_eq!(ok, 2, "unit 1's two models");
+}
