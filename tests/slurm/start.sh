@@ -55,7 +55,7 @@ fi
 
 mkdir -p "$dir/state" "$dir/spool" "$dir/munge"
 chmod 0755 "$dir"
-chmod 0700 "$dir/munge"
+chmod 0755 "$dir/munge"
 
 # munged: our own key, socket and files.
 if [[ ! -s $dir/munge/munge.key ]]; then
@@ -97,6 +97,7 @@ JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 JobCompType=jobcomp/none
 MpiDefault=none
+MailProg=/bin/true
 SwitchType=switch/none
 SchedulerType=sched/backfill
 SelectType=select/cons_tres
