@@ -120,6 +120,7 @@ fn collect(campaign: &Campaign, out: &Path) -> Result<()> {
 /// (or, with `--dry-run`, show the scripts and commands). Nothing to run: collect here.
 fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings) -> Result<()> {
     settings.options.check()?;
+    slurm_script::check_sbatch_path(&resolve(out).join(SLURM))?;
     let lock = match settings.dry_run {
         true => {
             out_dir::check(out)?;

@@ -179,8 +179,9 @@ fn logs(out: &Path, conf: &Path) -> String {
     said
 }
 
-/// Wait until job `id` has ended; its final state (`COMPLETED`, `FAILED`, …). Panics with
-/// the logs after [`JOB_TIMEOUT`].
+/// Wait until job `id` (each task of an array) has ended; its final states, distinct and
+/// sorted (`COMPLETED`, `FAILED`, …, joined by `,`). Panics with the logs after
+/// [`JOB_TIMEOUT`].
 fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
     let started = Instant::now();
     let ended = [
@@ -200,13 +201,20 @@ fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
             .env("SLURM_CONF", conf)
             .output()
             .unwrap();
-        let state = text(&o.stdout).trim().to_string();
-        if let Some(s) = ended.iter().find(|s| state.starts_with(**s)) {
-            return s.to_string();
+        let said = text(&o.stdout);
+        let mut states: Vec<&str> = said.split_whitespace().collect();
+        states.sort();
+        states.dedup();
+        if !states.is_empty()
+            && states
+                .iter()
+                .all(|s| ended.iter().any(|e| s.starts_with(e)))
+        {
+            return states.join(",");
         }
         assert!(
             started.elapsed() < JOB_TIMEOUT,
-            "job {id} has not ended after {JOB_TIMEOUT:?} (state {state:?}):\n{}",
+            "job {id} has not ended after {JOB_TIMEOUT:?} (states {states:?}):\n{}",
             logs(out, conf)
         );
         std::thread::sleep(Duration::from_millis(500));

@@ -185,7 +185,7 @@ fn quote(path: &Path) -> Result<String> {
 }
 
 /// Refuse a folder Slurm's `--output` and `--chdir` lines would misread.
-fn check_sbatch_path(folder: &Path) -> Result<()> {
+pub fn check_sbatch_path(folder: &Path) -> Result<()> {
     let text = folder.to_string_lossy();
     if let Some(c) = text
         .chars()
