@@ -351,13 +351,15 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
         text(&run.stdout),
         text(&run.stderr)
     );
-    let (_, collect) = job_ids(&text(&run.stdout));
+    let (units, collect) = job_ids(&text(&run.stdout));
     assert_eq!(
         wait_for(&collect, &out, &conf),
         "FAILED",
         "{}",
         logs(&out, &conf)
     );
+    // Three tasks ran their unit, the fourth failed; the collect job ran all the same.
+    assert_eq!(wait_for(&units, &out, &conf), "COMPLETED,FAILED");
     let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
     assert!(
         log.contains("1 of 4 unit(s) failed") && log.contains("unit 4 (records/broken.csv): "),
