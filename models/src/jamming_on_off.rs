@@ -56,7 +56,8 @@ builtin! {
     JammingOnOff: "jamming_on_off",
     "on–off jamming: F = K_j·|v|^n_j·sign v only above a critical speed v_c",
     params [
-        ParamSpec::new("K_j", "N·(s/m)^n_j", 100.0, 0.0, 1e5, "drag coefficient of the jammed fluid"),
+        ParamSpec::new("K_j", "N·(s/m)^n_j", 100.0, 0.0, 1e5,
+            "drag coefficient of the jammed fluid"),
         ParamSpec::new(
             "n_j",
             "",

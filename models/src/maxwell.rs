@@ -31,7 +31,8 @@ builtin! {
     Maxwell: "maxwell",
     "viscoelastic force with memory dF/dt = (c_m·v − F)/τ",
     params [
-        ParamSpec::new("c_m", "N·s/m", 5.0, 0.0, 1e4, "dashpot viscosity: the damping of slow motion"),
+        ParamSpec::new("c_m", "N·s/m", 5.0, 0.0, 1e4,
+            "dashpot viscosity: the damping of slow motion"),
         ParamSpec::new("tau", "s", 0.05, 1e-4, 10.0, "relaxation time; the spring is c_m/tau"),
     ];
     impl {
