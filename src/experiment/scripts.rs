@@ -41,11 +41,23 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
     let (span, r) = (raw.span(), raw.get_ref());
     let counts = [
         ("max_bytes", count(&mut limits.max_bytes, r.max_bytes)),
-        ("max_functions", count(&mut limits.max_functions, r.max_functions)),
+        (
+            "max_functions",
+            count(&mut limits.max_functions, r.max_functions),
+        ),
         ("max_nodes", count(&mut limits.max_nodes, r.max_nodes)),
-        ("max_constants", count(&mut limits.max_constants, r.max_constants)),
-        ("call_operations", count(&mut limits.call_operations, r.call_operations)),
-        ("run_operations", count(&mut limits.run_operations, r.run_operations)),
+        (
+            "max_constants",
+            count(&mut limits.max_constants, r.max_constants),
+        ),
+        (
+            "call_operations",
+            count(&mut limits.call_operations, r.call_operations),
+        ),
+        (
+            "run_operations",
+            count(&mut limits.run_operations, r.run_operations),
+        ),
     ];
     if let Some((key, _)) = counts.into_iter().find(|(_, ok)| !ok) {
         let key = format!("scripts.{key}");
