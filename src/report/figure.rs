@@ -29,6 +29,20 @@ pub const SIZE: (u32, u32) = (1000, 600);
 /// Width × height of a figure with three stacked panels, pixels.
 pub const SIZE_TALL: (u32, u32) = (1000, 1000);
 
+/// The builder of a one-panel chart filling `root`: the margins and label areas every
+/// full-width figure uses.
+pub fn one_panel<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .margin(10)
+        .margin_right(30)
+        .x_label_area_size(50)
+        .y_label_area_size(90);
+    builder
+}
+
 /// A chart on plain `f64` axes.
 pub type Chart2d<'a, DB> = ChartContext<
     'a,

@@ -12,8 +12,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, draw_mesh, finite_points, legend_strip, msg, render, same_length, title_style,
-    Draw, FigureFiles, Swatch, SIZE,
+    axis_desc_style, draw_mesh, finite_points, legend_strip, msg, one_panel, render, same_length,
+    title_style, Draw, FigureFiles, Swatch, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -158,11 +158,7 @@ impl Draw for MeasuredVsFittedPlot {
             .titled(self.quantity.title, title_style())
             .map_err(msg)?;
         let root = legend_strip(&root, &self.legend_entries())?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .margin_right(30)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
+        let mut chart = one_panel(&root)
             .build_cartesian_2d(t_range.clone(), f_range.clone())
             .map_err(msg)?;
         let desc = ("time t, s", self.quantity.label);
