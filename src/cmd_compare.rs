@@ -337,32 +337,22 @@ fn errors_table(c: &Compared) -> Table {
     let cell = |m: &stf_core::regimes::RegimeMetrics| {
         format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
     };
-    Table {
-        caption:
-            "Relative force RMS error per regime (on–off duty error in brackets); lower is better."
-                .into(),
-        columns: [
-            "model",
-            "pre-resonance",
-            "resonance",
-            "post-resonance",
-            "overall",
-        ]
-        .iter()
-        .map(|c| c.to_string())
-        .collect(),
-        rows: c
-            .fits
-            .iter()
-            .zip(&c.comparisons)
-            .map(|(f, cmp)| {
-                let mut row = vec![f.label.clone()];
-                for r in Regime::ALL {
-                    row.push(cmp.per_regime.get(r).map_or("—".to_string(), cell));
-                }
-                row.push(cell(&cmp.overall));
-                row
-            })
-            .collect(),
-    }
+    let caption =
+        "Relative force RMS error per regime (on–off duty error in brackets); lower is better.";
+    let columns = [
+        "model",
+        "pre-resonance",
+        "resonance",
+        "post-resonance",
+        "overall",
+    ];
+    let rows = c.fits.iter().zip(&c.comparisons).map(|(f, cmp)| {
+        let mut row = vec![f.label.clone()];
+        for r in Regime::ALL {
+            row.push(cmp.per_regime.get(r).map_or("—".to_string(), cell));
+        }
+        row.push(cell(&cmp.overall));
+        row
+    });
+    Table::new(caption, &columns).with_rows(rows.collect())
 }

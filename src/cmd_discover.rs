@@ -499,38 +499,26 @@ fn report(
 
 /// The table of step `i`'s candidates (force level).
 fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
-    Table {
-        caption: format!("Step {}: candidates added to `{}`", i + 1, step.current),
-        columns: [
-            "candidate",
-            "held-out RMS, N",
-            "ΔBIC",
-            "paired z (units)",
-            "explains of the excess",
-            "significant",
+    let caption = format!("Step {}: candidates added to `{}`", i + 1, step.current);
+    let columns = [
+        "candidate",
+        "held-out RMS, N",
+        "ΔBIC",
+        "paired z (units)",
+        "explains of the excess",
+        "significant",
+    ];
+    let rows = step.candidates.iter().map(|c| {
+        vec![
+            c.name.clone(),
+            format!("{:.5}", c.holdout_rms),
+            format!("{:.1}", c.delta_bic),
+            format!("{:.1} ({})", c.gain_z, c.effective_n),
+            format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),
+            crate::standard_report::yes_no(c.significant),
         ]
-        .iter()
-        .map(|c| c.to_string())
-        .collect(),
-        rows: step
-            .candidates
-            .iter()
-            .map(|c| {
-                vec![
-                    c.name.clone(),
-                    format!("{:.5}", c.holdout_rms),
-                    format!("{:.1}", c.delta_bic),
-                    format!("{:.1} ({})", c.gain_z, c.effective_n),
-                    format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),
-                    if c.significant {
-                        "yes".into()
-                    } else {
-                        "no".into()
-                    },
-                ]
-            })
-            .collect(),
-    }
+    });
+    Table::new(caption, &columns).with_rows(rows.collect())
 }
 
 /// The oscillator parameters refitted with every model at trajectory level: `[fit] system`,

@@ -185,13 +185,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
             .params
             .iter()
             .filter(|p| !p.fixed)
-            .map(|p| {
-                format!(
-                    "{} = {}",
-                    p.name,
-                    crate::digits::with_error(p.value, p.std_error)
-                )
-            })
+            .map(crate::digits::param_with_error)
             .collect();
         say!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
@@ -271,11 +265,7 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
         result
             .params
             .iter()
-            .map(|p| format!(
-                "{} = {}",
-                p.name,
-                crate::digits::with_error(p.value, p.std_error)
-            ))
+            .map(crate::digits::param_with_error)
             .collect::<Vec<_>>()
             .join(", "),
         if result.convergence.converged() {

@@ -134,14 +134,8 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
         row.extend(Regime::ALL.iter().map(|&r| cell(c, r, true)));
         rows.push(row);
     }
-    Table {
-        caption: "Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area), equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in N·s/m, the phase of the force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak force.".into(),
-        columns: ["source", "pre-resonance", "resonance", "post-resonance"]
-            .iter()
-            .map(|c| c.to_string())
-            .collect(),
-        rows,
-    }
+    let columns = ["source", "pre-resonance", "resonance", "post-resonance"];
+    Table::new("Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area), equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in N·s/m, the phase of the force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak force.", &columns).with_rows(rows)
 }
 
 /// One line per loop metric: the best model overall and in each regime, with the test.

@@ -34,6 +34,11 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     s
 }
 
+/// `name = value ± error` of a fitted parameter ([`with_error`]).
+pub fn param_with_error(p: &stf_core::fit::FittedParam) -> String {
+    format!("{} = {}", p.name, with_error(p.value, p.std_error))
+}
+
 /// `value ± error` for a person to read: the value to the error's second significant digit,
 /// the error to two digits, each in plain notation between 10⁻³ and 10⁶ and in exponent form
 /// outside it (`5.336e-6 ± 2.6e-8`, not `0.00001 ± 2.57e-8`). Without a usable error (zero,

@@ -89,34 +89,28 @@ fn verdict(stages: &[StageOutcome], system: &OscillatorParams) -> String {
 
 fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
     let mut section = Section::new(format!("Stage {}: {}", i + 1, s.record));
-    section.tables.push(Table {
-        caption: format!(
-            "Stage {} values (± standard error); S(μ) = {:.4} mm², {} evaluations, {}.",
-            i + 1,
-            s.result.s_mm2.unwrap_or(f64::NAN),
-            s.result.evaluations,
-            if s.result.convergence.converged() {
-                "converged"
-            } else {
-                "did not converge"
-            }
-        ),
-        columns: ["parameter", "value", "standard error"]
-            .map(String::from)
-            .to_vec(),
-        rows: s
-            .result
-            .params
-            .iter()
-            .map(|p| {
-                vec![
-                    p.name.clone(),
-                    format!("{:.6}", p.value),
-                    format!("{:.2e}", p.std_error),
-                ]
-            })
-            .collect(),
+    let caption = format!(
+        "Stage {} values (± standard error); S(μ) = {:.4} mm², {} evaluations, {}.",
+        i + 1,
+        s.result.s_mm2.unwrap_or(f64::NAN),
+        s.result.evaluations,
+        if s.result.convergence.converged() {
+            "converged"
+        } else {
+            "did not converge"
+        }
+    );
+    let rows = s.result.params.iter().map(|p| {
+        vec![
+            p.name.clone(),
+            format!("{:.6}", p.value),
+            format!("{:.2e}", p.std_error),
+        ]
     });
+    let columns = ["parameter", "value", "standard error"];
+    section
+        .tables
+        .push(Table::new(caption, &columns).with_rows(rows.collect()));
     section.warnings = s.warnings.iter().map(|w| w.to_string()).collect();
     if s.simulated.len() == s.x.len() {
         let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();

@@ -25,140 +25,142 @@ use stf_core::regimes::Regime;
 pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<Vec<Section>> {
     let dir = out.join("figures");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let k = &data.kinematics;
     let mut sections = Vec::new();
-
     if let Some(f) = data.record.f_stf.as_deref() {
-        let mut s = Section::new("The record");
-        s.paragraphs.push(format!(
-            "{} samples of {}; v and a from a polynomial filter of order {} over {} samples \
-             (acceleration noise ≈ {:.3} m/s²).",
-            data.record.len(),
-            data.record.source,
-            k.motion_filter.order(),
-            k.motion_filter.window(),
-            k.sigma_a
-        ));
-
-        let motion = Motion {
-            t: &k.t,
-            x: &k.x,
-            v: &k.v,
-            a: &k.a,
-        };
-        let th = time_history(&dir, "time_history", &motion, f)?;
-        s.figures.push(FigureRef::new(
-            th,
-            "Displacement, velocity and acceleration against the STF force; extrema of F_STF marked.",
-        ));
-        let mm = |s: &[f64]| s.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
-        for (name, label, series) in [
-            ("hysteresis_x", "displacement x, mm", mm(&k.x)),
-            ("hysteresis_v", "velocity v, mm/s", mm(&k.v)),
-            ("hysteresis_a", "acceleration a, m/s²", k.a.clone()),
-        ] {
-            let fig = hysteresis(&dir, name, (label, &series), f, &k.t)?;
-            s.figures.push(FigureRef::new(
-                fig,
-                format!("Hysteresis loop of F_STF against {label}, coloured by time."),
-            ));
-        }
-        sections.push(s);
+        sections.push(record_section(data, f, &dir)?);
     }
-
     if !fits.is_empty() {
-        let (unit, scale) = data.level.shown();
-        let what = data.level.signal().what;
-        let mut s = Section::new("Fits");
-        s.paragraphs.push(format!(
-            "Each model fitted to the measured {what} ({} level).",
-            crate::outputs::level_name(data.level)
-        ));
-        if let Some(drive) = &k.drive {
-            s.paragraphs.push(format!("Drive: {drive}."));
-        }
-        s.paragraphs.push(warning_rules(fits));
-        let mut table = Table {
-            caption: "Fitted parameters (± standard error), RMS residual and information criteria."
-                .into(),
-            columns: [
-                "model",
-                "parameters",
-                &format!("RMS, {unit}"),
-                "AIC",
-                "BIC",
-                "converged",
-                "warnings",
-            ]
-            .iter()
-            .map(|c| c.to_string())
-            .collect(),
-            rows: Vec::new(),
-        };
-        for f in fits {
-            let params: Vec<String> = f
-                .result
-                .params
-                .iter()
-                .map(|p| {
-                    if p.fixed {
-                        format!("{} = {:.5} (fixed)", p.name, p.value)
-                    } else {
-                        format!(
-                            "{} = {}",
-                            p.name,
-                            crate::digits::with_error(p.value, p.std_error)
-                        )
-                    }
-                })
-                .collect();
-            table.rows.push(vec![
-                f.label.clone(),
-                params.join(", "),
-                format!("{:.4}", f.result.rms * scale),
-                format!("{:.1}", f.result.aic),
-                format!("{:.1}", f.result.bic),
-                if f.result.convergence.converged() {
-                    "yes".into()
-                } else {
-                    "no".into()
-                },
-                match f.warnings.len() {
-                    0 => "none".into(),
-                    n => format!("⚠ {n} (above)"),
-                },
-            ]);
-        }
-        s.tables.push(table);
-        s.warnings = fits
-            .iter()
-            .flat_map(|f| f.warnings.iter().map(move |w| format!("{}: {w}", f.label)))
-            .collect();
-        let scaled = |s: &[f64]| s.iter().map(|v| v * scale).collect::<Vec<f64>>();
-        let fitted: Vec<(&str, Vec<f64>)> = fits
-            .iter()
-            .map(|f| (f.label.as_str(), scaled(&f.fitted)))
-            .collect();
-        let curves: Vec<(&str, &[f64])> = fitted.iter().map(|(l, v)| (*l, v.as_slice())).collect();
-        let quantity = match data.level {
-            FitLevel::Force => STF_FORCE,
-            FitLevel::Trajectory => DISPLACEMENT_MM,
-        };
-        let fig = measured_vs_model(
-            &dir,
-            "measured_vs_fitted",
-            quantity,
-            &data.record.t,
-            &scaled(data.target()),
-            &curves,
-        )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            format!("Measured {what} against each fitted model."),
-        ));
-        sections.push(s);
+        sections.push(fits_section(data, fits, &dir)?);
     }
     Ok(sections)
+}
+
+/// "The record": its time history and hysteresis loops of the STF force `f`.
+fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
+    let k = &data.kinematics;
+    let mut s = Section::new("The record");
+    s.paragraphs.push(format!(
+        "{} samples of {}; v and a from a polynomial filter of order {} over {} samples \
+         (acceleration noise ≈ {:.3} m/s²).",
+        data.record.len(),
+        data.record.source,
+        k.motion_filter.order(),
+        k.motion_filter.window(),
+        k.sigma_a
+    ));
+    let motion = Motion {
+        t: &k.t,
+        x: &k.x,
+        v: &k.v,
+        a: &k.a,
+    };
+    let th = time_history(dir, "time_history", &motion, f)?;
+    s.figures.push(FigureRef::new(
+        th,
+        "Displacement, velocity and acceleration against the STF force; extrema of F_STF marked.",
+    ));
+    let mm = |s: &[f64]| s.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
+    for (name, label, series) in [
+        ("hysteresis_x", "displacement x, mm", mm(&k.x)),
+        ("hysteresis_v", "velocity v, mm/s", mm(&k.v)),
+        ("hysteresis_a", "acceleration a, m/s²", k.a.clone()),
+    ] {
+        let fig = hysteresis(dir, name, (label, &series), f, &k.t)?;
+        s.figures.push(FigureRef::new(
+            fig,
+            format!("Hysteresis loop of F_STF against {label}, coloured by time."),
+        ));
+    }
+    Ok(s)
+}
+
+/// "Fits": the fitted parameters, the warnings, and the measured signal against each model.
+fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section> {
+    let (unit, scale) = data.level.shown();
+    let what = data.level.signal().what;
+    let mut s = Section::new("Fits");
+    s.paragraphs.push(format!(
+        "Each model fitted to the measured {what} ({} level).",
+        crate::outputs::level_name(data.level)
+    ));
+    if let Some(drive) = &data.kinematics.drive {
+        s.paragraphs.push(format!("Drive: {drive}."));
+    }
+    s.paragraphs.push(warning_rules(fits));
+    let rms = format!("RMS, {unit}");
+    let columns = [
+        "model",
+        "parameters",
+        &rms,
+        "AIC",
+        "BIC",
+        "converged",
+        "warnings",
+    ];
+    let caption = "Fitted parameters (± standard error), RMS residual and information criteria.";
+    let rows = fits.iter().map(|f| fit_row(f, scale)).collect();
+    s.tables.push(Table::new(caption, &columns).with_rows(rows));
+    s.warnings = fits
+        .iter()
+        .flat_map(|f| f.warnings.iter().map(move |w| format!("{}: {w}", f.label)))
+        .collect();
+    let scaled = |s: &[f64]| s.iter().map(|v| v * scale).collect::<Vec<f64>>();
+    let fitted: Vec<(&str, Vec<f64>)> = fits
+        .iter()
+        .map(|f| (f.label.as_str(), scaled(&f.fitted)))
+        .collect();
+    let curves: Vec<(&str, &[f64])> = fitted.iter().map(|(l, v)| (*l, v.as_slice())).collect();
+    let quantity = match data.level {
+        FitLevel::Force => STF_FORCE,
+        FitLevel::Trajectory => DISPLACEMENT_MM,
+    };
+    let fig = measured_vs_model(
+        dir,
+        "measured_vs_fitted",
+        quantity,
+        &data.record.t,
+        &scaled(data.target()),
+        &curves,
+    )?;
+    s.figures.push(FigureRef::new(
+        fig,
+        format!("Measured {what} against each fitted model."),
+    ));
+    Ok(s)
+}
+
+/// A model's row of the fits table: its parameters (± standard error), RMS (`scale` from
+/// SI), information criteria, convergence and warnings.
+fn fit_row(f: &ModelFit, scale: f64) -> Vec<String> {
+    let params: Vec<String> = f
+        .result
+        .params
+        .iter()
+        .map(|p| {
+            if p.fixed {
+                format!("{} = {:.5} (fixed)", p.name, p.value)
+            } else {
+                crate::digits::param_with_error(p)
+            }
+        })
+        .collect();
+    vec![
+        f.label.clone(),
+        params.join(", "),
+        format!("{:.4}", f.result.rms * scale),
+        format!("{:.1}", f.result.aic),
+        format!("{:.1}", f.result.bic),
+        yes_no(f.result.convergence.converged()),
+        match f.warnings.len() {
+            0 => "none".into(),
+            n => format!("⚠ {n} (above)"),
+        },
+    ]
+}
+
+/// `yes` or `no`, a table's cell of a flag.
+pub fn yes_no(flag: bool) -> String {
+    if flag { "yes" } else { "no" }.into()
 }
 
 /// The sentence of the report's intro on the validation record: the best model there.

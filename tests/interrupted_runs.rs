@@ -17,6 +17,25 @@ fn fit(dir: &Path, experiment: &str) -> Command {
     c
 }
 
+/// The identification, signalled with `signal` (`-INT`, `-TERM`) `after_ms` after it
+/// starts while it works: its exit code and its message.
+fn signalled_identification(dir: &Path, signal: &str, after_ms: u64) -> (Option<i32>, String) {
+    let child = fit(dir, "experiments/paper_identification.toml")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(after_ms));
+    let status = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let result = child.wait_with_output().unwrap();
+    let msg = String::from_utf8_lossy(&result.stderr).into_owned();
+    (result.status.code(), msg)
+}
+
 /// The results in `dir` are whole: fit.json parses and fitted.csv has every row.
 fn assert_whole(dir: &Path, rows: usize) {
     let json = std::fs::read(dir.join("fit.json")).unwrap();
@@ -64,25 +83,13 @@ fn a_killed_fit_leaves_whole_results() {
 fn ctrl_c_says_what_had_finished_and_writes_nothing() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("id");
-    let child = fit(&dir, "experiments/paper_identification.toml")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // Stage 1 (free vibration) takes well under a second; stage 2 far longer.
-    std::thread::sleep(Duration::from_millis(2500));
-    let status = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let result = child.wait_with_output().unwrap();
-    let msg = String::from_utf8_lossy(&result.stderr);
-    if result.status.success() {
+    let (code, msg) = signalled_identification(&dir, "-INT", 2500);
+    if code == Some(0) {
         // The machine was fast enough to finish first: nothing to check.
         return;
     }
-    assert_eq!(result.status.code(), Some(130), "{msg}");
+    assert_eq!(code, Some(130), "{msg}");
     assert!(msg.contains("interrupted"), "{msg}");
     // Unless the signal came after the results were put in place, nothing is there.
     let written = msg.contains("the results were already written");
@@ -98,25 +105,13 @@ fn sigterm_removes_the_staged_folder_and_keeps_the_old_results() {
         .unwrap();
     assert!(first.status.success());
     let before = std::fs::read(dir.join("fit.json")).unwrap();
-    let child = fit(&dir, "experiments/paper_identification.toml")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // The identification's second stage takes seconds: the signal lands while it works.
-    std::thread::sleep(Duration::from_millis(1500));
-    let status = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let result = child.wait_with_output().unwrap();
-    let msg = String::from_utf8_lossy(&result.stderr);
-    if result.status.success() {
+    let (code, msg) = signalled_identification(&dir, "-TERM", 1500);
+    if code == Some(0) {
         // The machine was fast enough to finish first: nothing to check.
         return;
     }
-    assert_eq!(result.status.code(), Some(130), "{msg}");
+    assert_eq!(code, Some(130), "{msg}");
     if msg.contains("the results were already written") {
         // The signal came after the new results were put in place: they are whole and new.
         let now = std::fs::read(dir.join("fit.json")).unwrap();

@@ -14,6 +14,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+
 use stf_lab::report;
 use stf_lab::report::test_signals::damped_sine;
 use stf_lab::report::{FigureRef, Motion, Report, Section, Table};
@@ -234,17 +236,8 @@ fn every_bundled_report_lays_out_every_figure_in_headless_chromium() {
         ("discover", "trajectory_discovery"),
     ] {
         let out = tmp.path().join(example);
-        let run = Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-            .args([command, "--quiet", "--out"])
-            .arg(&out)
-            .arg(root.join("experiments").join(format!("{example}.toml")))
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        let experiment = root.join("experiments").join(format!("{example}.toml"));
+        common::run_ok(command, &experiment, &out);
         let page = out.join("report.html").canonicalize().unwrap();
         let html = std::fs::read_to_string(&page).unwrap();
         let figures = html.matches("<img src=\"data:image/png;base64,").count();

@@ -1,11 +1,9 @@
 //! End-to-end tests of `stf-lab simulate` and `stf-lab models`.
 
 use std::path::Path;
-use std::process::Command;
 
-fn stf_lab() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_stf-lab"))
-}
+mod common;
+use common::{root, simulate, stf_lab, succeeded};
 
 fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.join(name);
@@ -30,20 +28,7 @@ fn simulate_writes_a_record_and_a_reproducible_sidecar() {
     let dir = tempfile::tempdir().unwrap();
     let exp = write(dir.path(), "exp.toml", SHORT);
     let out = dir.path().join("rec.csv");
-    let status = stf_lab()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    succeeded(simulate(&exp, &out, &[]));
     let first = std::fs::read(&out).unwrap();
     let sidecar: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("rec.json")).unwrap()).unwrap();
@@ -52,27 +37,10 @@ fn simulate_writes_a_record_and_a_reproducible_sidecar() {
     assert_eq!(sidecar["summary"]["samples"], 801);
 
     // A second run refuses to clobber, and with --force gives the same bytes.
-    let again = stf_lab()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let again = simulate(&exp, &out, &[]);
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
-    let forced = stf_lab()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--force",
-        ])
-        .output()
-        .unwrap();
+    let forced = simulate(&exp, &out, &["--force"]);
     assert!(forced.status.success());
     assert_eq!(std::fs::read(&out).unwrap(), first);
 }
@@ -85,15 +53,7 @@ fn an_unknown_model_is_named_with_file_line_and_the_known_models() {
         "bad.toml",
         "[simulate]\nconstant = { omega = 5.0, t1 = 1.0 }\n\n[[simulate.truth]]\nname = \"viscuos\"\n",
     );
-    let out = stf_lab()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            dir.path().join("unused.csv").to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let out = simulate(&exp, &dir.path().join("unused.csv"), &[]);
     assert!(!out.status.success());
     let msg = String::from_utf8_lossy(&out.stderr);
     assert!(msg.contains("bad.toml:4"), "{msg}");
@@ -109,26 +69,15 @@ fn models_lists_the_builtins_with_parameters() {
     assert!(text.contains("viscous") && text.contains("c_s"), "{text}");
 }
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
 #[test]
 fn the_readme_example_prints_the_reference_figures() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("paper_sweep.csv");
-    let run = stf_lab()
-        .arg("simulate")
-        .arg(root().join("experiments/paper_sweep.toml"))
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let run = succeeded(simulate(
+        &root().join("experiments/paper_sweep.toml"),
+        &out,
+        &[],
+    ));
     let text = String::from_utf8_lossy(&run.stdout);
     assert!(
         text.contains("peak |x| = 41.69 mm at ω = 6.22 rad/s"),
@@ -150,15 +99,7 @@ fn a_run_too_long_for_memory_is_refused_before_it_starts() {
         "[simulate]\nconstant = { omega = 6.0, t1 = 1e9 }\nrate = 1e6\n",
     );
     let out = dir.path().join("rec.csv");
-    let run = stf_lab()
-        .args([
-            "simulate",
-            exp.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let run = simulate(&exp, &out, &[]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
@@ -213,14 +154,7 @@ fn bundled_records_regenerate_byte_for_byte() {
     .chain(campaign)
     {
         let out = dir.path().join("again.csv");
-        let run = stf_lab()
-            .arg("simulate")
-            .arg(root().join(exp))
-            .arg("--out")
-            .arg(&out)
-            .arg("--force")
-            .output()
-            .unwrap();
+        let run = simulate(&root().join(exp), &out, &["--force"]);
         assert!(
             run.status.success(),
             "{exp}: {}",

@@ -12,72 +12,42 @@
 //! |---|---|---|---|---|
 //! | `m_a` | kg | 0.5 | [0, 20] | mass of fluid moving with the blade |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "fluid moving with the blade F = m_a·ẍ";
-
-/// Added mass of fluid carried by the blade; see the [module doc](self).
-pub struct AddedMass {
-    specs: Vec<ParamSpec>,
-}
-
-impl AddedMass {
-    /// The model with its parameter `m_a`.
-    pub fn new() -> Self {
-        AddedMass {
-            specs: vec![ParamSpec::new(
-                "m_a",
-                "kg",
-                0.5,
-                0.0,
-                20.0,
-                "mass of fluid carried along with the blade",
-            )
-            .same_as("m")],
+builtin! {
+    /// Added mass of fluid carried by the blade; see the [module doc](self).
+    AddedMass: "added_mass",
+    "fluid moving with the blade F = m_a·ẍ",
+    params [
+        ParamSpec::new("m_a", "kg", 0.5, 0.0, 20.0, "mass of fluid carried along with the blade")
+            .same_as("m"),
+    ];
+    impl {
+        #[inline]
+        fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
+            let [m_a] = take(self.name(), p)?;
+            Ok(m_a)
         }
-    }
-}
-
-impl Default for AddedMass {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl ForceModel for AddedMass {
-    fn name(&self) -> &str {
-        "added_mass"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
-        let [m_a] = take(self.name(), p)?;
-        Ok(m_a)
-    }
-    #[inline]
-    fn force(&self, p: &[f64], _s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        take::<1>(self.name(), p)?;
-        Ok(0.0)
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        _s: &ModelState,
-        a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        take::<1>(self.name(), p)?;
-        grad[0] = a;
-        Ok(true)
+        #[inline]
+        fn force(&self, p: &[f64], _s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            take::<1>(self.name(), p)?;
+            Ok(0.0)
+        }
+        fn gradient(
+            &self,
+            p: &[f64],
+            _s: &ModelState,
+            a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            take::<1>(self.name(), p)?;
+            grad[0] = a;
+            Ok(true)
+        }
     }
 }
 
@@ -86,6 +56,7 @@ mod tests {
     use super::*;
     use std::sync::Arc;
     use stf_core::physics::excitation::{Excitation, RotorAngle};
+    use stf_core::physics::force_model::ForceModel;
     use stf_core::physics::oscillator::Oscillator;
     use stf_core::physics::oscillator_params::OscillatorParams;
 

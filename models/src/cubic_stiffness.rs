@@ -10,66 +10,36 @@
 //! |---|---|---|---|---|
 //! | `k3` | N/m³ | 1e5 | [0, 1e9] | cubic stiffness (0.1 N at 1 cm, 7.4 N at 42 mm) |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "elastic jammed network F = k3·x³";
-
-/// Cubic (Duffing) stiffness; see the [module doc](self).
-pub struct CubicStiffness {
-    specs: Vec<ParamSpec>,
-}
-
-impl CubicStiffness {
-    /// The model with its parameter `k3`.
-    pub fn new() -> Self {
-        CubicStiffness {
-            specs: vec![ParamSpec::new(
-                "k3",
-                "N/m³",
-                1e5,
-                0.0,
-                1e9,
-                "cubic stiffness of the jammed network",
-            )],
+builtin! {
+    /// Cubic (Duffing) stiffness; see the [module doc](self).
+    CubicStiffness: "cubic_stiffness",
+    "elastic jammed network F = k3·x³",
+    params [
+        ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "cubic stiffness of the jammed network"),
+    ];
+    impl {
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [k3] = take(self.name(), p)?;
+            Ok(k3 * s.x * s.x * s.x)
         }
-    }
-}
-
-impl Default for CubicStiffness {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl ForceModel for CubicStiffness {
-    fn name(&self) -> &str {
-        "cubic_stiffness"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [k3] = take(self.name(), p)?;
-        Ok(k3 * s.x * s.x * s.x)
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        _a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        take::<1>(self.name(), p)?;
-        grad[0] = s.x * s.x * s.x;
-        Ok(true)
+        fn gradient(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            _a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            take::<1>(self.name(), p)?;
+            grad[0] = s.x * s.x * s.x;
+            Ok(true)
+        }
     }
 }
 
@@ -77,6 +47,7 @@ impl ForceModel for CubicStiffness {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use stf_core::physics::force_model::ForceModel;
 
     #[test]
     fn force_is_k3_x_cubed_whatever_the_velocity() {

@@ -44,65 +44,66 @@
 //! | `v_c` | m/s | 0.05 | [0, 1] | critical speed of jamming onset |
 //! | `w` | m/s | 0.002 | [1e-4, 0.1] | width of the onset gate |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
+use stf_core::physics::force_model::{ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::power_law::{power_law_force, power_law_gradient};
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "on–off jamming: F = K_j·|v|^n_j·sign v only above a critical speed v_c";
-
-/// On–off jamming above a critical speed; see the [module doc](self).
-pub struct JammingOnOff {
-    specs: Vec<ParamSpec>,
-}
-
-impl JammingOnOff {
-    /// The model with its parameters `K_j`, `n_j`, `v_c` and `w`.
-    pub fn new() -> Self {
-        JammingOnOff {
-            specs: vec![
-                ParamSpec::new(
-                    "K_j",
-                    "N·(s/m)^n_j",
-                    100.0,
-                    0.0,
-                    1e5,
-                    "drag coefficient of the jammed fluid",
-                ),
-                ParamSpec::new(
-                    "n_j",
-                    "",
-                    2.0,
-                    1.0,
-                    4.0,
-                    "exponent of the jammed drag (2: momentum transfer to the jamming front)",
-                ),
-                ParamSpec::new(
-                    "v_c",
-                    "m/s",
-                    0.05,
-                    0.0,
-                    1.0,
-                    "critical speed above which the fluid jams",
-                ),
-                ParamSpec::new(
-                    "w",
-                    "m/s",
-                    0.002,
-                    1e-4,
-                    0.1,
-                    "width of the smooth jamming gate",
-                ),
-            ],
+builtin! {
+    /// On–off jamming above a critical speed; see the [module doc](self).
+    JammingOnOff: "jamming_on_off",
+    "on–off jamming: F = K_j·|v|^n_j·sign v only above a critical speed v_c",
+    params [
+        ParamSpec::new("K_j", "N·(s/m)^n_j", 100.0, 0.0, 1e5,
+            "drag coefficient of the jammed fluid"),
+        ParamSpec::new(
+            "n_j",
+            "",
+            2.0,
+            1.0,
+            4.0,
+            "exponent of the jammed drag (2: momentum transfer to the jamming front)",
+        ),
+        ParamSpec::new("v_c", "m/s", 0.05, 0.0, 1.0, "critical speed above which the fluid jams"),
+        ParamSpec::new("w", "m/s", 0.002, 1e-4, 0.1, "width of the smooth jamming gate"),
+    ];
+    impl {
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [k_j, n_j, v_c, w] = take(self.name(), p)?;
+            Ok(power_law_force(k_j, n_j, s.v) * jamming_gate(s.v.abs(), v_c, w))
         }
-    }
-}
-
-impl Default for JammingOnOff {
-    fn default() -> Self {
-        Self::new()
+        fn gradient(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            _a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            let [k_j, n_j, v_c, w] = take(self.name(), p)?;
+            let speed = s.v.abs();
+            let (dk, dn) = power_law_gradient(k_j, n_j, s.v);
+            let gate = jamming_gate(speed, v_c, w);
+            // dG/dq = ½·sech²(q), q = (|v| − v_c)/w; a hard switch (w = 0) has no slope.
+            let (dvc, dw) = if w > 0.0 {
+                let q = (speed - v_c) / w;
+                let slope = 0.5 / q.cosh().powi(2) * power_law_force(k_j, n_j, s.v);
+                (-slope / w, -slope * q / w)
+            } else {
+                (0.0, 0.0)
+            };
+            grad[..4].copy_from_slice(&[dk * gate, dn * gate, dvc, dw]);
+            Ok(true)
+        }
+        /// A gate open at every speed but the slowest 5 % of the record's (`v_c + 2w` below it):
+        /// the ungated `power_law`.
+        fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
+            let [k_j, n_j, v_c, w] = take(self.name(), p).ok()?;
+            (v_c + 2.0 * w < NEGLIGIBLE_SHARE * reach.v)
+                .then(|| ("power_law".to_string(), vec![k_j, n_j]))
+        }
     }
 }
 
@@ -118,56 +119,11 @@ pub fn jamming_gate(speed: f64, v_c: f64, w: f64) -> f64 {
     }
 }
 
-impl ForceModel for JammingOnOff {
-    fn name(&self) -> &str {
-        "jamming_on_off"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [k_j, n_j, v_c, w] = take(self.name(), p)?;
-        Ok(power_law_force(k_j, n_j, s.v) * jamming_gate(s.v.abs(), v_c, w))
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        _a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        let [k_j, n_j, v_c, w] = take(self.name(), p)?;
-        let speed = s.v.abs();
-        let (dk, dn) = power_law_gradient(k_j, n_j, s.v);
-        let gate = jamming_gate(speed, v_c, w);
-        // dG/dq = ½·sech²(q), q = (|v| − v_c)/w; a hard switch (w = 0) has no slope.
-        let (dvc, dw) = if w > 0.0 {
-            let q = (speed - v_c) / w;
-            let slope = 0.5 / q.cosh().powi(2) * power_law_force(k_j, n_j, s.v);
-            (-slope / w, -slope * q / w)
-        } else {
-            (0.0, 0.0)
-        };
-        grad[..4].copy_from_slice(&[dk * gate, dn * gate, dvc, dw]);
-        Ok(true)
-    }
-    /// A gate open at every speed but the slowest 5 % of the record's (`v_c + 2w` below it):
-    /// the ungated `power_law`.
-    fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
-        let [k_j, n_j, v_c, w] = take(self.name(), p).ok()?;
-        (v_c + 2.0 * w < NEGLIGIBLE_SHARE * reach.v)
-            .then(|| ("power_law".to_string(), vec![k_j, n_j]))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use stf_core::physics::force_model::ForceModel;
 
     fn at(v: f64) -> f64 {
         let m = JammingOnOff::new();

@@ -28,7 +28,10 @@ use std::sync::Arc;
 
 use stf_core::physics::force_model::ForceModel;
 
+use builtin::Builtin;
+
 pub mod added_mass;
+mod builtin;
 pub mod cubic_stiffness;
 pub mod jamming_on_off;
 pub mod maxwell;
@@ -48,49 +51,28 @@ pub struct BuiltinEntry {
     pub build: fn() -> Arc<dyn ForceModel>,
 }
 
+impl BuiltinEntry {
+    /// The entry of the built-in `M`.
+    const fn of<M: Builtin>() -> Self {
+        BuiltinEntry {
+            name: M::NAME,
+            summary: M::SUMMARY,
+            build: || Arc::new(M::default()),
+        }
+    }
+}
+
 /// Every built-in model, in the order they are listed to users. The names are those of the
 /// discovery vocabulary (docs/ARCHITECTURE.md §5).
 pub const BUILTINS: &[BuiltinEntry] = &[
-    BuiltinEntry {
-        name: "viscous",
-        summary: viscous::SUMMARY,
-        build: || Arc::new(viscous::Viscous::new()),
-    },
-    BuiltinEntry {
-        name: "power_law",
-        summary: power_law::SUMMARY,
-        build: || Arc::new(power_law::PowerLaw::new()),
-    },
-    BuiltinEntry {
-        name: "added_mass",
-        summary: added_mass::SUMMARY,
-        build: || Arc::new(added_mass::AddedMass::new()),
-    },
-    BuiltinEntry {
-        name: "yield",
-        summary: yield_stress::SUMMARY,
-        build: || Arc::new(yield_stress::Yield::new()),
-    },
-    BuiltinEntry {
-        name: "wall_impact",
-        summary: wall_impact::SUMMARY,
-        build: || Arc::new(wall_impact::WallImpact::new()),
-    },
-    BuiltinEntry {
-        name: "cubic_stiffness",
-        summary: cubic_stiffness::SUMMARY,
-        build: || Arc::new(cubic_stiffness::CubicStiffness::new()),
-    },
-    BuiltinEntry {
-        name: "maxwell",
-        summary: maxwell::SUMMARY,
-        build: || Arc::new(maxwell::Maxwell::new()),
-    },
-    BuiltinEntry {
-        name: "jamming_on_off",
-        summary: jamming_on_off::SUMMARY,
-        build: || Arc::new(jamming_on_off::JammingOnOff::new()),
-    },
+    BuiltinEntry::of::<viscous::Viscous>(),
+    BuiltinEntry::of::<power_law::PowerLaw>(),
+    BuiltinEntry::of::<added_mass::AddedMass>(),
+    BuiltinEntry::of::<yield_stress::Yield>(),
+    BuiltinEntry::of::<wall_impact::WallImpact>(),
+    BuiltinEntry::of::<cubic_stiffness::CubicStiffness>(),
+    BuiltinEntry::of::<maxwell::Maxwell>(),
+    BuiltinEntry::of::<jamming_on_off::JammingOnOff>(),
 ];
 
 /// The built-in model called `name`, if there is one.

@@ -20,81 +20,43 @@
 //! | `c_m` | N·s/m | 5 | [0, 1e4] | viscosity of the dashpot (the long-time damping) |
 //! | `tau` | s | 0.05 | [1e-4, 10] | relaxation time; spring stiffness is c_m/τ |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "viscoelastic force with memory dF/dt = (c_m·v − F)/τ";
-
-/// Maxwell viscoelastic element; see the [module doc](self).
-pub struct Maxwell {
-    specs: Vec<ParamSpec>,
-}
-
-impl Maxwell {
-    /// The model with its parameters `c_m` and `tau`.
-    pub fn new() -> Self {
-        Maxwell {
-            specs: vec![
-                ParamSpec::new(
-                    "c_m",
-                    "N·s/m",
-                    5.0,
-                    0.0,
-                    1e4,
-                    "dashpot viscosity: the damping of slow motion",
-                ),
-                ParamSpec::new(
-                    "tau",
-                    "s",
-                    0.05,
-                    1e-4,
-                    10.0,
-                    "relaxation time; the spring is c_m/tau",
-                ),
-            ],
+builtin! {
+    /// Maxwell viscoelastic element; see the [module doc](self).
+    Maxwell: "maxwell",
+    "viscoelastic force with memory dF/dt = (c_m·v − F)/τ",
+    params [
+        ParamSpec::new("c_m", "N·s/m", 5.0, 0.0, 1e4,
+            "dashpot viscosity: the damping of slow motion"),
+        ParamSpec::new("tau", "s", 0.05, 1e-4, 10.0, "relaxation time; the spring is c_m/tau"),
+    ];
+    impl {
+        fn n_internal(&self) -> usize {
+            1
         }
-    }
-}
-
-impl Default for Maxwell {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl ForceModel for Maxwell {
-    fn name(&self) -> &str {
-        "maxwell"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    fn n_internal(&self) -> usize {
-        1
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [c_m, tau] = take(self.name(), p)?;
-        if tau.is_nan() || tau <= 0.0 {
-            return Err(ModelError::new(
-                self.name(),
-                format!("relaxation time tau must be positive, got {tau}"),
-            ));
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [c_m, tau] = take(self.name(), p)?;
+            if tau.is_nan() || tau <= 0.0 {
+                return Err(ModelError::new(
+                    self.name(),
+                    format!("relaxation time tau must be positive, got {tau}"),
+                ));
+            }
+            let (Some(&f), Some(rate)) = (s.z.first(), dz.first_mut()) else {
+                return Err(ModelError::new(
+                    self.name(),
+                    "needs one internal state (the force) and its rate",
+                ));
+            };
+            *rate = (c_m * s.v - f) / tau;
+            Ok(f)
         }
-        let (Some(&f), Some(rate)) = (s.z.first(), dz.first_mut()) else {
-            return Err(ModelError::new(
-                self.name(),
-                "needs one internal state (the force) and its rate",
-            ));
-        };
-        *rate = (c_m * s.v - f) / tau;
-        Ok(f)
     }
 }
 
@@ -102,6 +64,7 @@ impl ForceModel for Maxwell {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+    use stf_core::physics::force_model::ForceModel;
 
     /// Integrates the model's state along v(t) = V·sin ωt with classical RK4 and returns
     /// (amplitude, phase) of the force over the last `fit` periods, from its projections on

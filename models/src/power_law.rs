@@ -12,48 +12,43 @@
 //! | `K` | N·(s/m)ⁿ | 5 | [0, 1e4] | consistency: the force at 1 m/s |
 //! | `n` | — | 1.6 | [1, 4] | flow index; n > 1 thickens |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach};
+use stf_core::physics::force_model::{ModelError, ModelState, Reach};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "shear thickening F = K·|v|ⁿ·sign v (n > 1)";
-
-/// Power-law drag of the blade, `F = K·|v|ⁿ·sign v`; see the [module doc](self).
-pub struct PowerLaw {
-    specs: Vec<ParamSpec>,
-}
-
-impl PowerLaw {
-    /// The model with its parameters `K` and `n`.
-    pub fn new() -> Self {
-        PowerLaw {
-            specs: vec![
-                ParamSpec::new(
-                    "K",
-                    "N·(s/m)ⁿ",
-                    5.0,
-                    0.0,
-                    1e4,
-                    "consistency: drag at a speed of 1 m/s",
-                ),
-                ParamSpec::new(
-                    "n",
-                    "",
-                    1.6,
-                    1.0,
-                    4.0,
-                    "flow index; n > 1 is shear thickening",
-                ),
-            ],
+builtin! {
+    /// Power-law drag of the blade, `F = K·|v|ⁿ·sign v`; see the [module doc](self).
+    PowerLaw: "power_law",
+    "shear thickening F = K·|v|ⁿ·sign v (n > 1)",
+    params [
+        ParamSpec::new("K", "N·(s/m)ⁿ", 5.0, 0.0, 1e4, "consistency: drag at a speed of 1 m/s"),
+        ParamSpec::new("n", "", 1.6, 1.0, 4.0, "flow index; n > 1 is shear thickening"),
+    ];
+    impl {
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [k, n] = take(self.name(), p)?;
+            Ok(power_law_force(k, n, s.v))
         }
-    }
-}
-
-impl Default for PowerLaw {
-    fn default() -> Self {
-        Self::new()
+        fn gradient(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            _a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            let [k, n] = take(self.name(), p)?;
+            let (dk, dn) = power_law_gradient(k, n, s.v);
+            grad[..2].copy_from_slice(&[dk, dn]);
+            Ok(true)
+        }
+        /// An exponent of 1 (within 0.02): `K·v`, the `viscous` law.
+        fn reduces_to(&self, p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
+            let [k, n] = take(self.name(), p).ok()?;
+            ((n - 1.0).abs() < 0.02).then(|| ("viscous".to_string(), vec![k]))
+        }
     }
 }
 
@@ -80,44 +75,11 @@ pub fn power_law_gradient(k: f64, n: f64, v: f64) -> (f64, f64) {
     (unit, k * unit * ln)
 }
 
-impl ForceModel for PowerLaw {
-    fn name(&self) -> &str {
-        "power_law"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [k, n] = take(self.name(), p)?;
-        Ok(power_law_force(k, n, s.v))
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        _a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        let [k, n] = take(self.name(), p)?;
-        let (dk, dn) = power_law_gradient(k, n, s.v);
-        grad[..2].copy_from_slice(&[dk, dn]);
-        Ok(true)
-    }
-    /// An exponent of 1 (within 0.02): `K·v`, the `viscous` law.
-    fn reduces_to(&self, p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
-        let [k, n] = take(self.name(), p).ok()?;
-        ((n - 1.0).abs() < 0.02).then(|| ("viscous".to_string(), vec![k]))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use stf_core::physics::force_model::ForceModel;
 
     fn at(v: f64, p: &[f64]) -> f64 {
         let s = ModelState {

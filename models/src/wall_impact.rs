@@ -22,43 +22,47 @@
 //! | `p` | — | 1.5 | [1, 3] | contact exponent (Hertz: 1.5) |
 //! | `c_r` | s/m | 0.5 | [0, 10] | Hunt–Crossley damping factor α |
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
+use stf_core::physics::force_model::{ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "Hunt–Crossley wall contact once |x| passes a gap";
-
-/// Contact of the jammed plug with the container walls; see the [module doc](self).
-pub struct WallImpact {
-    specs: Vec<ParamSpec>,
-}
-
-impl WallImpact {
-    /// The model with its parameters `k_w`, `gap`, `p` and `c_r`.
-    pub fn new() -> Self {
-        WallImpact {
-            specs: vec![
-                ParamSpec::new("k_w", "N/m^p", 3e5, 0.0, 1e9, "contact stiffness"),
-                ParamSpec::new(
-                    "gap",
-                    "m",
-                    0.01,
-                    0.0,
-                    0.1,
-                    "free travel before the plug meets the wall",
-                ),
-                ParamSpec::new("p", "", 1.5, 1.0, 3.0, "contact exponent (Hertz: 1.5)"),
-                ParamSpec::new("c_r", "s/m", 0.5, 0.0, 10.0, "Hunt–Crossley damping factor"),
-            ],
+builtin! {
+    /// Contact of the jammed plug with the container walls; see the [module doc](self).
+    WallImpact: "wall_impact",
+    "Hunt–Crossley wall contact once |x| passes a gap",
+    params [
+        ParamSpec::new("k_w", "N/m^p", 3e5, 0.0, 1e9, "contact stiffness"),
+        ParamSpec::new("gap", "m", 0.01, 0.0, 0.1, "free travel before the plug meets the wall"),
+        ParamSpec::new("p", "", 1.5, 1.0, 3.0, "contact exponent (Hertz: 1.5)"),
+        ParamSpec::new("c_r", "s/m", 0.5, 0.0, 10.0, "Hunt–Crossley damping factor"),
+    ];
+    impl {
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [k_w, gap, expo, c_r] = take(self.name(), p)?;
+            Ok(hunt_crossley(k_w, gap, expo, c_r, s.x, s.v))
         }
-    }
-}
-
-impl Default for WallImpact {
-    fn default() -> Self {
-        Self::new()
+        fn gradient(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            _a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            let [k_w, gap, expo, c_r] = take(self.name(), p)?;
+            grad[..4].copy_from_slice(&hunt_crossley_gradient(k_w, gap, expo, c_r, s.x, s.v));
+            Ok(true)
+        }
+        /// No gap, exponent 3 (within 0.1) and negligible damping: `k_w·x³`, a cubic spring.
+        fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
+            let [k_w, gap, expo, c_r] = take(self.name(), p).ok()?;
+            let cubic = gap < NEGLIGIBLE_SHARE * reach.x
+                && (expo - 3.0).abs() < 0.1
+                && c_r * reach.v < NEGLIGIBLE_SHARE;
+            cubic.then(|| ("cubic_stiffness".to_string(), vec![k_w]))
+        }
     }
 }
 
@@ -95,42 +99,6 @@ pub fn hunt_crossley_gradient(k_w: f64, gap: f64, p: f64, c_r: f64, x: f64, v: f
         f * delta.ln(),
         k_w * elastic * 1.5 * v,
     ]
-}
-
-impl ForceModel for WallImpact {
-    fn name(&self) -> &str {
-        "wall_impact"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [k_w, gap, expo, c_r] = take(self.name(), p)?;
-        Ok(hunt_crossley(k_w, gap, expo, c_r, s.x, s.v))
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        _a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        let [k_w, gap, expo, c_r] = take(self.name(), p)?;
-        grad[..4].copy_from_slice(&hunt_crossley_gradient(k_w, gap, expo, c_r, s.x, s.v));
-        Ok(true)
-    }
-    /// No gap, exponent 3 (within 0.1) and negligible damping: `k_w·x³`, a cubic spring.
-    fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
-        let [k_w, gap, expo, c_r] = take(self.name(), p).ok()?;
-        let cubic = gap < NEGLIGIBLE_SHARE * reach.x
-            && (expo - 3.0).abs() < 0.1
-            && c_r * reach.v < NEGLIGIBLE_SHARE;
-        cubic.then(|| ("cubic_stiffness".to_string(), vec![k_w]))
-    }
 }
 
 #[cfg(test)]

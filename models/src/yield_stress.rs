@@ -16,76 +16,44 @@
 //! The file is `yield_stress.rs` because `yield` is a reserved word in Rust; the model's
 //! name is `yield`.
 
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
+use crate::builtin::builtin;
 use crate::values::take;
 
-/// One line for listings.
-pub const SUMMARY: &str = "yield (Coulomb-like) resistance F ≈ F_y·sign v";
-
-/// Velocity-independent yield resistance; see the [module doc](self).
-pub struct Yield {
-    specs: Vec<ParamSpec>,
-}
-
-impl Yield {
-    /// The model with its parameters `F_y` and `v_s`.
-    pub fn new() -> Self {
-        Yield {
-            specs: vec![
-                ParamSpec::new("F_y", "N", 0.2, 0.0, 50.0, "yield force of the jammed plug"),
-                ParamSpec::new(
-                    "v_s",
-                    "m/s",
-                    1e-3,
-                    1e-6,
-                    0.1,
-                    "speed over which sign v is smoothed",
-                ),
-            ],
+builtin! {
+    /// Velocity-independent yield resistance; see the [module doc](self).
+    Yield: "yield",
+    "yield (Coulomb-like) resistance F ≈ F_y·sign v",
+    params [
+        ParamSpec::new("F_y", "N", 0.2, 0.0, 50.0, "yield force of the jammed plug"),
+        ParamSpec::new("v_s", "m/s", 1e-3, 1e-6, 0.1, "speed over which sign v is smoothed"),
+    ];
+    impl {
+        #[inline]
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            let [f_y, v_s] = take(self.name(), p)?;
+            let norm = s.v.hypot(v_s);
+            Ok(if norm > 0.0 { f_y * s.v / norm } else { 0.0 })
         }
-    }
-}
-
-impl Default for Yield {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl ForceModel for Yield {
-    fn name(&self) -> &str {
-        "yield"
-    }
-    fn summary(&self) -> &str {
-        SUMMARY
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-    #[inline]
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        let [f_y, v_s] = take(self.name(), p)?;
-        let norm = s.v.hypot(v_s);
-        Ok(if norm > 0.0 { f_y * s.v / norm } else { 0.0 })
-    }
-    fn gradient(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        _a: f64,
-        grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        let [f_y, v_s] = take(self.name(), p)?;
-        let norm = s.v.hypot(v_s);
-        let (df, dv) = if norm > 0.0 {
-            (s.v / norm, -f_y * s.v * v_s / (norm * norm * norm))
-        } else {
-            (0.0, 0.0)
-        };
-        grad[..2].copy_from_slice(&[df, dv]);
-        Ok(true)
+        fn gradient(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            _a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            let [f_y, v_s] = take(self.name(), p)?;
+            let norm = s.v.hypot(v_s);
+            let (df, dv) = if norm > 0.0 {
+                (s.v / norm, -f_y * s.v * v_s / (norm * norm * norm))
+            } else {
+                (0.0, 0.0)
+            };
+            grad[..2].copy_from_slice(&[df, dv]);
+            Ok(true)
+        }
     }
 }
 
@@ -93,6 +61,7 @@ impl ForceModel for Yield {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use stf_core::physics::force_model::ForceModel;
 
     fn at(v: f64, p: &[f64]) -> f64 {
         let s = ModelState {

@@ -10,26 +10,15 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use stf_core::physics::excitation::{Excitation, RotorAngle};
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
-use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::{Simulation, Trajectory};
 use stf_plugins::ScriptModel;
 
-/// The native twin of `models/scripts/power_law.rhai`.
-struct NativePowerLaw(Vec<ParamSpec>);
-impl ForceModel for NativePowerLaw {
-    fn name(&self) -> &str {
-        "native_power_law"
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.0
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-    }
-}
+#[path = "../tests/support/mod.rs"]
+mod support;
+use support::NativePowerLaw;
 
 fn sweep(model: Arc<dyn ForceModel>, p: &[f64]) -> (Trajectory, Duration) {
     let osc = Oscillator::new(

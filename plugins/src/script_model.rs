@@ -210,6 +210,9 @@ impl ScriptModel {
         self
     }
 
+    /// Compile `source` (shown as `path`) in `run` and check it: its size, its syntax, the
+    /// contract functions, its parameters and internal states, and one call of each
+    /// function at the defaults.
     fn compile(
         name: String,
         path: String,
@@ -221,48 +224,12 @@ impl ScriptModel {
             line,
         };
         let limits = run.limits();
-        let too_large = |message: String| ScriptError::TooLarge {
-            path: path.clone(),
-            message,
-        };
-        script_size::check_bytes(source, limits).map_err(too_large)?;
-        let mut ast = sandbox::engine()
-            .compile(source)
-            .map_err(|e| ScriptError::Syntax {
-                at: at(e.1.line()),
-                message: e.0.to_string(),
-            })?;
-        script_size::check_ast(&ast, limits).map_err(too_large)?;
-        ast.set_source(path.as_str());
-
+        let ast = parse(source, &path, limits)?;
         let defined: Vec<(String, usize)> = ast
             .iter_functions()
             .map(|f| (f.name.to_string(), f.params.len()))
             .collect();
-        for &(fname, arity, signature, required) in CONTRACT {
-            let arities: Vec<usize> = defined
-                .iter()
-                .filter(|(n, _)| n == fname)
-                .map(|(_, a)| *a)
-                .collect();
-            if arities.contains(&arity) {
-                continue;
-            }
-            if let Some(&wrong) = arities.first() {
-                return Err(ScriptError::Contract {
-                    at: at(fn_line(source, fname)),
-                    message: format!(
-                        "fn {fname} takes {wrong} argument(s); it must be fn {signature}"
-                    ),
-                });
-            }
-            if required {
-                return Err(ScriptError::Contract {
-                    at: at(None),
-                    message: format!("the script must define fn {signature}"),
-                });
-            }
-        }
+        check_contract(&defined, source, at)?;
         let has =
             |fname: &str, arity: usize| defined.iter().any(|(n, a)| n == fname && *a == arity);
 
@@ -290,7 +257,6 @@ impl ScriptModel {
             at: at(e.line),
             message: e.message,
         };
-
         let params_line = fn_line(source, "params");
         let value = model.call("params", ()).map_err(runtime)?;
         model.specs = parse_params(value, &param_docs(source, params_line)).map_err(|message| {
@@ -299,21 +265,8 @@ impl ScriptModel {
                 message,
             }
         })?;
-
         if has("n_internal", 0) {
-            let line = fn_line(source, "n_internal");
-            let value = model.call("n_internal", ()).map_err(runtime)?;
-            model.n_internal = value
-                .as_int()
-                .ok()
-                .and_then(|n| usize::try_from(n).ok())
-                .filter(|&n| n <= MAX_INTERNAL)
-                .ok_or_else(|| ScriptError::Contract {
-                    at: at(line),
-                    message: format!(
-                        "n_internal() must return an integer from 0 to {MAX_INTERNAL}, not {value}"
-                    ),
-                })?;
+            model.n_internal = model.read_n_internal(source, at)?;
         }
         if model.n_internal > 0 && !model.has_rates {
             return Err(ScriptError::Contract {
@@ -325,13 +278,34 @@ impl ScriptModel {
             });
         }
         model.compiled = model.translate(&ast);
-        model.force_operations = model
-            .check_at_defaults()
+        model.force_operations = model.check_at_defaults().map_err(runtime)?;
+        Ok(model)
+    }
+
+    /// What `n_internal()` returns: an integer from 0 to [`MAX_INTERNAL`]; `at` places
+    /// an error.
+    fn read_n_internal(
+        &self,
+        source: &str,
+        at: impl Fn(Option<usize>) -> ScriptLocation,
+    ) -> Result<usize, ScriptError> {
+        let value = self
+            .call("n_internal", ())
             .map_err(|e| ScriptError::Runtime {
                 at: at(e.line),
                 message: e.message,
             })?;
-        Ok(model)
+        value
+            .as_int()
+            .ok()
+            .and_then(|n| usize::try_from(n).ok())
+            .filter(|&n| n <= MAX_INTERNAL)
+            .ok_or_else(|| ScriptError::Contract {
+                at: at(fn_line(source, "n_internal")),
+                message: format!(
+                    "n_internal() must return an integer from 0 to {MAX_INTERNAL}, not {value}"
+                ),
+            })
     }
 
     /// Translate the hot functions to closures; `None` if any is outside the subset.
@@ -572,6 +546,59 @@ impl ForceModel for ScriptModel {
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
         self.eval_force(p, s, dz).map_err(|e| self.model_error(e))
     }
+}
+
+/// The syntax tree of `source`, shown as `path`, within the size `limits`.
+fn parse(source: &str, path: &str, limits: &ScriptLimits) -> Result<rhai::AST, ScriptError> {
+    let too_large = |message: String| ScriptError::TooLarge {
+        path: path.to_string(),
+        message,
+    };
+    script_size::check_bytes(source, limits).map_err(too_large)?;
+    let mut ast = sandbox::engine()
+        .compile(source)
+        .map_err(|e| ScriptError::Syntax {
+            at: ScriptLocation {
+                path: path.to_string(),
+                line: e.1.line(),
+            },
+            message: e.0.to_string(),
+        })?;
+    script_size::check_ast(&ast, limits).map_err(too_large)?;
+    ast.set_source(path);
+    Ok(ast)
+}
+
+/// Every contract function `defined` (name, arity) takes its arguments, and the required
+/// ones are there; `at` places an error.
+fn check_contract(
+    defined: &[(String, usize)],
+    source: &str,
+    at: impl Fn(Option<usize>) -> ScriptLocation,
+) -> Result<(), ScriptError> {
+    for &(fname, arity, signature, required) in CONTRACT {
+        let arities: Vec<usize> = defined
+            .iter()
+            .filter(|(n, _)| n == fname)
+            .map(|(_, a)| *a)
+            .collect();
+        if arities.contains(&arity) {
+            continue;
+        }
+        if let Some(&wrong) = arities.first() {
+            return Err(ScriptError::Contract {
+                at: at(fn_line(source, fname)),
+                message: format!("fn {fname} takes {wrong} argument(s); it must be fn {signature}"),
+            });
+        }
+        if required {
+            return Err(ScriptError::Contract {
+                at: at(None),
+                message: format!("the script must define fn {signature}"),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Equal bit for bit (so -0.0 and 0.0 get separate parameter maps).

@@ -6,30 +6,19 @@ use std::sync::Arc;
 
 use stf_core::numerics::integrate::SimError;
 use stf_core::physics::excitation::{Excitation, RotorAngle};
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
-use stf_core::physics::param_spec::{defaults, ParamSpec};
+use stf_core::physics::param_spec::defaults;
 use stf_core::simulate::{Simulation, Trajectory};
 use stf_plugins::registry::{check_script, Registry};
 use stf_plugins::{ScriptError, ScriptLimits, ScriptModel, ScriptRun};
 
+mod support;
+use support::NativePowerLaw;
+
 fn scripts_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts")
-}
-
-/// The native power law, with the formula of the built-in.
-struct NativePowerLaw(Vec<ParamSpec>);
-impl ForceModel for NativePowerLaw {
-    fn name(&self) -> &str {
-        "native_power_law"
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.0
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-    }
 }
 
 fn sweep(

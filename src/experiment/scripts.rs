@@ -40,45 +40,28 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
     };
     let (span, r) = (raw.span(), raw.get_ref());
     let counts = [
-        ("max_bytes", r.max_bytes, &mut limits.max_bytes),
-        ("max_functions", r.max_functions, &mut limits.max_functions),
-        ("max_nodes", r.max_nodes, &mut limits.max_nodes),
-        ("max_constants", r.max_constants, &mut limits.max_constants),
-    ];
-    for (key, value, slot) in counts {
-        if let Some(v) = value {
-            if v == 0 {
-                return Err(cx.at(
-                    span.clone(),
-                    &format!("scripts.{key}"),
-                    "must be at least 1",
-                ));
-            }
-            *slot = v;
-        }
-    }
-    for (key, value, slot) in [
+        ("max_bytes", count(&mut limits.max_bytes, r.max_bytes)),
+        (
+            "max_functions",
+            count(&mut limits.max_functions, r.max_functions),
+        ),
+        ("max_nodes", count(&mut limits.max_nodes, r.max_nodes)),
+        (
+            "max_constants",
+            count(&mut limits.max_constants, r.max_constants),
+        ),
         (
             "call_operations",
-            r.call_operations,
-            &mut limits.call_operations,
+            count(&mut limits.call_operations, r.call_operations),
         ),
         (
             "run_operations",
-            r.run_operations,
-            &mut limits.run_operations,
+            count(&mut limits.run_operations, r.run_operations),
         ),
-    ] {
-        if let Some(v) = value {
-            if v == 0 {
-                return Err(cx.at(
-                    span.clone(),
-                    &format!("scripts.{key}"),
-                    "must be at least 1",
-                ));
-            }
-            *slot = v;
-        }
+    ];
+    if let Some((key, _)) = counts.into_iter().find(|(_, ok)| !ok) {
+        let key = format!("scripts.{key}");
+        return Err(cx.at(span, &key, "must be at least 1"));
     }
     if let Some(s) = r.call_seconds {
         if !(s > 0.0) {
@@ -91,6 +74,18 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
         limits.call_seconds = s;
     }
     Ok(ScriptRun::new(limits))
+}
+
+/// Set `slot` to `value` if given; `false` if that is 0, not a count of at least 1.
+fn count<T: PartialEq + Default>(slot: &mut T, value: Option<T>) -> bool {
+    match value {
+        Some(v) if v == T::default() => false,
+        Some(v) => {
+            *slot = v;
+            true
+        }
+        None => true,
+    }
 }
 
 #[cfg(test)]

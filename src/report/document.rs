@@ -61,6 +61,23 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
 }
 
+impl Table {
+    /// An empty table with its caption and column headers.
+    pub fn new(caption: impl Into<String>, columns: &[&str]) -> Self {
+        Table {
+            caption: caption.into(),
+            columns: columns.iter().map(|c| c.to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// The same table with `rows`.
+    pub fn with_rows(mut self, rows: Vec<Vec<String>>) -> Self {
+        self.rows = rows;
+        self
+    }
+}
+
 /// A figure in a report: its files and a caption saying what it shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FigureRef {

@@ -29,6 +29,54 @@ pub const SIZE: (u32, u32) = (1000, 600);
 /// Width × height of a figure with three stacked panels, pixels.
 pub const SIZE_TALL: (u32, u32) = (1000, 1000);
 
+/// The builder of a one-panel chart filling `root`: the margins and label areas every
+/// full-width figure uses.
+pub fn one_panel<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .margin(10)
+        .margin_right(30)
+        .x_label_area_size(50)
+        .y_label_area_size(90);
+    builder
+}
+
+/// A chart on plain `f64` axes.
+pub type Chart2d<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// Draw `chart`'s mesh: the axes described as `desc` (x, y) in `desc_style`, ticks labelled
+/// to the digits each axis's range needs ([`tick_label`]), `labels` ticks (x, y) if given
+/// (else plotters' default), and no light grid lines.
+pub fn draw_mesh<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    desc: (impl Into<String>, impl Into<String>),
+    labels: Option<(usize, usize)>,
+    desc_style: TextStyle,
+) -> Result<(), String> {
+    let (x, y) = (chart.x_range(), chart.y_range());
+    let (xs, ys) = (x.end - x.start, y.end - y.start);
+    let x_ticks = |v: &f64| tick_label(*v, xs);
+    let y_ticks = |v: &f64| tick_label(*v, ys);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(desc.0)
+        .y_desc(desc.1)
+        .x_label_formatter(&x_ticks)
+        .y_label_formatter(&y_ticks)
+        .axis_desc_style(desc_style)
+        .label_style(tick_style())
+        .light_line_style(WHITE.mix(0.0));
+    if let Some((nx, ny)) = labels {
+        mesh.x_labels(nx).y_labels(ny);
+    }
+    mesh.draw().map_err(msg)
+}
+
 /// Title text style.
 pub fn title_style() -> TextStyle<'static> {
     TextStyle::from((FAMILY, 26).into_font())

@@ -12,8 +12,8 @@ use plotters::prelude::*;
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, draw_legend, finite_points, msg, render, same_length, tick_label, tick_style,
-    title_style, Draw, FigureFiles, SIZE,
+    axis_desc_style, draw_legend, finite_points, msg, one_panel, render, same_length, tick_label,
+    tick_style, title_style, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -186,11 +186,7 @@ impl Draw for FrequencyResponsePlot {
         let root = root
             .titled("Frequency response: local maxima of x", title_style())
             .map_err(msg)?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .margin_right(30)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
+        let mut chart = one_panel(&root)
             .build_cartesian_2d(w_range.clone(), x_range.clone())
             .map_err(msg)?;
         let (ws, xs) = (w_range.end - w_range.start, x_range.end - x_range.start);

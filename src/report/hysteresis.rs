@@ -9,8 +9,8 @@ use plotters::prelude::*;
 use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, msg, render, same_length, tick_label, tick_style, title_style, Draw,
-    FigureFiles, SIZE,
+    axis_desc_style, draw_mesh, msg, render, same_length, tick_label, tick_style, title_style,
+    Draw, FigureFiles, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -72,18 +72,12 @@ impl Draw for HysteresisPlot {
             .y_label_area_size(90)
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
-        let (xs, fs) = (x_range.end - x_range.start, f_range.end - f_range.start);
-        chart
-            .configure_mesh()
-            .x_desc(self.label.as_str())
-            .y_desc(F_LABEL)
-            .x_label_formatter(&|v| tick_label(*v, xs))
-            .y_label_formatter(&|v| tick_label(*v, fs))
-            .axis_desc_style(axis_desc_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        draw_mesh(
+            &mut chart,
+            (self.label.as_str(), F_LABEL),
+            None,
+            axis_desc_style(),
+        )?;
         let runs = self.coloured_runs(t_range.start, t_range.end);
         chart
             .draw_series(

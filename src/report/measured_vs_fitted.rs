@@ -12,7 +12,7 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, finite_points, legend_strip, msg, render, same_length, tick_label, tick_style,
+    axis_desc_style, draw_mesh, finite_points, legend_strip, msg, one_panel, render, same_length,
     title_style, Draw, FigureFiles, Swatch, SIZE,
 };
 use super::plot_range::{exact_range, padded_range};
@@ -158,25 +158,11 @@ impl Draw for MeasuredVsFittedPlot {
             .titled(self.quantity.title, title_style())
             .map_err(msg)?;
         let root = legend_strip(&root, &self.legend_entries())?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .margin_right(30)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
+        let mut chart = one_panel(&root)
             .build_cartesian_2d(t_range.clone(), f_range.clone())
             .map_err(msg)?;
-        let (ts, fs) = (t_range.end - t_range.start, f_range.end - f_range.start);
-        chart
-            .configure_mesh()
-            .x_desc("time t, s")
-            .y_desc(self.quantity.label)
-            .x_label_formatter(&|v| tick_label(*v, ts))
-            .y_label_formatter(&|v| tick_label(*v, fs))
-            .axis_desc_style(axis_desc_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        let desc = ("time t, s", self.quantity.label);
+        draw_mesh(&mut chart, desc, None, axis_desc_style())?;
         if dense(&self.measured) {
             return self.draw_envelopes(&mut chart);
         }

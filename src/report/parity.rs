@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    legend_strip, legend_style, msg, render, same_length, tick_label, tick_style, title_style,
-    Draw, FigureFiles, Swatch,
+    draw_mesh, legend_strip, legend_style, msg, render, same_length, tick_label, tick_style,
+    title_style, Draw, FigureFiles, Swatch,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -118,7 +118,6 @@ impl ParityPlot {
     ) -> Result<(), String> {
         let range = padded_range(measured.iter().chain(fitted.iter().flatten()))
             .ok_or_else(|| format!("{name}: no finite value"))?;
-        let span = range.end - range.start;
         let mut chart = ChartBuilder::on(area)
             .caption(name, legend_style())
             .margin(8)
@@ -126,19 +125,9 @@ impl ParityPlot {
             .y_label_area_size(62)
             .build_cartesian_2d(range.clone(), range.clone())
             .map_err(msg)?;
-        chart
-            .configure_mesh()
-            .x_desc(format!("measured {}", self.quantity.label))
-            .y_desc(format!("fitted {}", self.quantity.label))
-            .x_labels(5)
-            .y_labels(5)
-            .x_label_formatter(&|v| tick_label(*v, span))
-            .y_label_formatter(&|v| tick_label(*v, span))
-            .axis_desc_style(tick_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        let label = &self.quantity.label;
+        let desc = (format!("measured {label}"), format!("fitted {label}"));
+        draw_mesh(&mut chart, desc, Some((5, 5)), tick_style())?;
         let per_model = 3_000 / fitted.len().max(1);
         for (i, f) in fitted.iter().enumerate() {
             let colour = series_colour(i).mix(0.35).filled();
@@ -185,23 +174,12 @@ impl ParityPlot {
             .y_label_area_size(62)
             .build_cartesian_2d(range.clone(), 0.0..top)
             .map_err(msg)?;
-        chart
-            .configure_mesh()
-            .x_desc(format!(
-                "residual (measured − fitted) {}; beyond ±{}: off the plot",
-                self.quantity.label,
-                tick_label(range.end, span)
-            ))
-            .y_desc("density")
-            .x_labels(5)
-            .y_labels(4)
-            .x_label_formatter(&|v| tick_label(*v, span))
-            .y_label_formatter(&|v| tick_label(*v, top))
-            .axis_desc_style(tick_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        let x_desc = format!(
+            "residual (measured − fitted) {}; beyond ±{}: off the plot",
+            self.quantity.label,
+            tick_label(range.end, span)
+        );
+        draw_mesh(&mut chart, (x_desc, "density"), Some((5, 4)), tick_style())?;
         for (i, h) in histograms.iter().enumerate() {
             let steps = h.iter().enumerate().flat_map(|(b, d)| {
                 let x0 = range.start + b as f64 * width;

@@ -8,8 +8,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, draw_legend, msg, render, tick_label, tick_style, title_style, Draw,
-    FigureFiles, SIZE,
+    axis_desc_style, draw_legend, msg, one_panel, render, tick_label, tick_style, title_style,
+    Draw, FigureFiles, SIZE,
 };
 use super::series_csv::Column;
 use super::ReportError;
@@ -34,11 +34,7 @@ impl Draw for RegimeErrorPlot {
         let root = root
             .titled("Errors of each model, regime by regime", title_style())
             .map_err(msg)?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .margin_right(30)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
+        let mut chart = one_panel(&root)
             .build_cartesian_2d(0.0..n_groups as f64, 0.0..top)
             .map_err(msg)?;
         let groups = self.groups.clone();

@@ -4,7 +4,6 @@
 //! one (a wide grey line). A long record squeezed into one plot is a solid band; a window of
 //! a few cycles shows the loops' shapes.
 
-use std::ops::Range;
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -12,7 +11,7 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    finite_points, legend_strip, legend_style, msg, render, same_length, tick_label, tick_style,
+    draw_mesh, finite_points, legend_strip, legend_style, msg, render, same_length, tick_style,
     title_style, Draw, FigureFiles, Swatch,
 };
 use super::plot_range::{exact_range, padded_range};
@@ -89,21 +88,7 @@ impl WindowsPlot<'_> {
         let mut chart = builder
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
-        let span = |r: &Range<f64>| r.end - r.start;
-        let (xs, fs) = (span(&x_range), span(&f_range));
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(F_LABEL)
-            .x_labels(5)
-            .y_labels(6)
-            .x_label_formatter(&|v| tick_label(*v, xs))
-            .y_label_formatter(&|v| tick_label(*v, fs))
-            .axis_desc_style(tick_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        draw_mesh(&mut chart, (x_label, F_LABEL), Some((5, 6)), tick_style())?;
         let x = &x[r.clone()];
         chart
             .draw_series(LineSeries::new(

@@ -27,7 +27,23 @@ pub fn run(command: &str, experiment: &Path, out: &Path) -> Output {
 
 /// The same, asserting success (the failure message is the program's).
 pub fn run_ok(command: &str, experiment: &Path, out: &Path) -> Output {
-    let output = run(command, experiment, out);
+    succeeded(run(command, experiment, out))
+}
+
+/// `stf-lab simulate EXPERIMENT --out RECORD`, then the `extra` flags.
+pub fn simulate(experiment: &Path, record: &Path, extra: &[&str]) -> Output {
+    stf_lab()
+        .arg("simulate")
+        .arg(experiment)
+        .arg("--out")
+        .arg(record)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// `output` of a run that must have succeeded (the failure message is the program's).
+pub fn succeeded(output: Output) -> Output {
     assert!(
         output.status.success(),
         "{}",
@@ -38,18 +54,7 @@ pub fn run_ok(command: &str, experiment: &Path, out: &Path) -> Output {
 
 /// `stf-lab simulate EXPERIMENT --out RECORD`, asserting success.
 pub fn simulate_ok(experiment: &Path, record: &Path) {
-    let sim = stf_lab()
-        .arg("simulate")
-        .arg(experiment)
-        .arg("--out")
-        .arg(record)
-        .output()
-        .unwrap();
-    assert!(
-        sim.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sim.stderr)
-    );
+    succeeded(simulate(experiment, record, &[]));
 }
 
 /// A JSON result file.

@@ -1,0 +1,82 @@
+//! The shape every built-in model shares, written once: [`builtin!`] declares a model's
+//! struct, its one-line `SUMMARY`, its parameter specs, `new`/`Default`, and the
+//! `name`/`summary`/`params` of its [`ForceModel`] impl; the model's file states only its
+//! name, summary, parameters and physics (`force`, `gradient`, …). [`Builtin`] gives the
+//! table in `lib.rs` the name and summary of each type.
+//!
+//! A macro rather than a trait with default methods: `ForceModel` (in core) needs `params`
+//! to lend a slice the model owns, and a trait cannot add fields to a struct.
+
+use stf_core::physics::force_model::ForceModel;
+
+/// A built-in model: its name in experiment files and its one line for listings.
+pub trait Builtin: ForceModel + Default + 'static {
+    /// The name used in experiment files (docs/ARCHITECTURE.md §5).
+    const NAME: &'static str;
+    /// One line saying what the model is.
+    const SUMMARY: &'static str;
+}
+
+/// Declare a built-in model:
+///
+/// ```ignore
+/// builtin! {
+///     /// Doc of the struct.
+///     Viscous: "viscous", "Newtonian drag F = c_s·v",
+///     params [ParamSpec::new("c_s", "N·s/m", 2.0, 0.0, 1e4, "damping coefficient")];
+///     impl { fn force(…) … }
+/// }
+/// ```
+///
+/// makes `pub const SUMMARY`, `pub struct Viscous` with `new()` and `Default`, its
+/// [`Builtin`] impl and its `ForceModel` impl: `name`, `summary`, `params` and the methods in
+/// the `impl` block.
+macro_rules! builtin {
+    (
+        $(#[$attr:meta])*
+        $ty:ident: $name:literal, $summary:literal,
+        params [$($spec:expr),+ $(,)?];
+        impl { $($body:tt)* }
+    ) => {
+        /// One line for listings.
+        pub const SUMMARY: &str = $summary;
+
+        $(#[$attr])*
+        pub struct $ty {
+            specs: Vec<stf_core::physics::param_spec::ParamSpec>,
+        }
+
+        impl $ty {
+            /// The model with its parameters at their defaults (the module doc's table).
+            pub fn new() -> Self {
+                $ty { specs: vec![$($spec),+] }
+            }
+        }
+
+        impl Default for $ty {
+            fn default() -> Self {
+                Self::new()
+            }
+        }
+
+        impl $crate::builtin::Builtin for $ty {
+            const NAME: &'static str = $name;
+            const SUMMARY: &'static str = SUMMARY;
+        }
+
+        impl stf_core::physics::force_model::ForceModel for $ty {
+            fn name(&self) -> &str {
+                $name
+            }
+            fn summary(&self) -> &str {
+                SUMMARY
+            }
+            fn params(&self) -> &[stf_core::physics::param_spec::ParamSpec] {
+                &self.specs
+            }
+            $($body)*
+        }
+    };
+}
+
+pub(crate) use builtin;
