@@ -19,7 +19,7 @@ pub trait Builtin: ForceModel + Default + 'static {
 
 /// Declare a built-in model:
 ///
-/// ```ignore
+/// ```text
 /// builtin! {
 ///     /// Doc of the struct.
 ///     Viscous: "viscous", "Newtonian drag F = c_s·v",
