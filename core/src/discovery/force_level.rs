@@ -1,8 +1,8 @@
 //! The force level of discovery ([`ForceLevel`], a [`Level`] for the loop of
 //! [`super::search`]): records with a measured F_STF and kinematics, every model fitted to
 //! the force along them. Its candidates start from a small multi-start ([`candidate_starts`],
-//! [`best_trial`]); earlier effects are re-checked after each acceptance
-//! ([`super::reconsider`]).
+//! [`best_trial`]); by default earlier effects are re-checked after each
+//! acceptance ([`super::reconsider`]) and an accepted model is not polished.
 //!
 //! Each step cuts the held-out cycles into blocks at least as long as the residual's
 //! correlation ([`super::blocks`]) and measures the current model's noise floor — the force
@@ -21,7 +21,7 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
-use super::force_subset_fit::{fit_subset, residuals, rms_over};
+use super::force_subset_fit::{fit_subset, residuals};
 use super::holdout::HoldoutSplit;
 use super::level::Level;
 use super::progress::DiscoveryEvent;
@@ -62,24 +62,6 @@ impl SearchModel {
         let fit = self.force_fit(settings)?;
         let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
         Ok((stage, fit, result))
-    }
-
-    /// Fit on the training samples and score on the held-out ones.
-    fn trial(
-        &self,
-        data: &ForceData,
-        split: &HoldoutSplit,
-        settings: &DiscoverySettings,
-    ) -> Result<Trial, DiscoveryError> {
-        let (stage, fit, train) = self.fit(data, &split.train, settings)?;
-        let r = residuals(&fit, data, &stage.values).map_err(|e| self.fit_error(e))?;
-        let h = rms_over(&r, &split.holdout);
-        Ok(Trial {
-            stage,
-            train,
-            holdout: split.holdout.iter().map(|&i| r[i]).collect(),
-            holdout_mse: h * h,
-        })
     }
 
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
@@ -279,11 +261,9 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
 /// of a candidate. Its evaluations and wall time are those of all the runs; the first run's
 /// error if every run fails.
 fn best_trial(
+    level: &ForceLevel,
     starts: &[Vec<f64>],
     stage: impl Fn(&[f64]) -> SearchModel,
-    data: &ForceData,
-    split: &HoldoutSplit,
-    settings: &DiscoverySettings,
 ) -> Result<Trial, DiscoveryError> {
     let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
     if let Some(released) = stages.first().and_then(SearchModel::released) {
@@ -293,7 +273,7 @@ fn best_trial(
     let mut first_error = None;
     let (mut evaluations, mut wall) = (0, 0.0);
     for stage in &stages {
-        match stage.trial(data, split, settings) {
+        match level.trial(stage, level.settings) {
             Ok(trial) => {
                 evaluations += trial.train.evaluations;
                 wall += trial.train.wall_seconds;
@@ -462,17 +442,14 @@ impl Level for ForceLevel<'_> {
         stage.residuals(self.data, self.settings)
     }
 
-    fn trial(
-        &self,
-        stage: &SearchModel,
-        settings: &DiscoverySettings,
-    ) -> Result<Trial, DiscoveryError> {
-        stage.trial(self.data, &self.split, settings)
+    /// The held-out samples' residuals.
+    fn held_out(&self, r: &[f64]) -> Vec<f64> {
+        self.split.holdout.iter().map(|&i| r[i]).collect()
     }
 
     /// From the defaults: the training fit of the base as it stood.
     fn first_trial(&self, start: &SearchModel, _: &SearchModel) -> Result<Trial, DiscoveryError> {
-        start.trial(self.data, &self.split, self.settings)
+        self.trial(start, self.settings)
     }
 
     /// The force sensor's noise with the kinematics' propagated through the model.
@@ -553,13 +530,9 @@ impl Level for ForceLevel<'_> {
                     &current_residual,
                     settings.extra_starts,
                 );
-                let best = best_trial(
-                    &starts,
-                    |start| current.stage.with(&c.model, start, 0),
-                    data,
-                    split,
-                    settings,
-                );
+                let best = best_trial(self, &starts, |start| {
+                    current.stage.with(&c.model, start, 0)
+                });
                 let n_own = c.model.params().len();
                 let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
                 emit_scored(settings, step, Some(&s));
@@ -583,16 +556,12 @@ impl Level for ForceLevel<'_> {
             residual,
             settings.extra_starts,
         );
-        best_trial(
-            &starts,
-            |start| rest.inserting(part, 0, &c.model, start),
-            self.data,
-            &self.split,
-            settings,
-        )
+        best_trial(self, &starts, |start| {
+            rest.inserting(part, 0, &c.model, start)
+        })
     }
 
-    fn reconsiders(&self) -> bool {
+    fn recheck_default(&self) -> bool {
         true
     }
 
