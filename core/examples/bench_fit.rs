@@ -16,7 +16,8 @@ use std::time::Instant;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use stf_core::fit::{FitParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::data::force_data::ForceData;
+use stf_core::fit::{FitParam, ForceFit, TrajectoryData, TrajectoryFit};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::oscillator::Oscillator;
@@ -60,13 +61,7 @@ fn main() {
         ParamSpec::new("K", "N (s/m)^n", 1.0, 0.0, 100.0, ""),
         ParamSpec::new("n", "", 1.2, 1.0, 4.0, ""),
     ]));
-    let data = ForceData {
-        t: &t,
-        x: &x,
-        v: &v,
-        a: &a,
-        f: &f,
-    };
+    let data = ForceData::new(&t, &x, &v, &a, &f);
     let r = ForceFit::new(model)
         .fit(&data, None)
         .unwrap_or_else(|e| panic!("{e}"));

@@ -27,8 +27,9 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::fit::{FitParam, FitResult, ForceFit, TrajectoryData, TrajectoryFit};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::oscillator::Oscillator;
@@ -95,13 +96,7 @@ fn force_fit(run: &Trajectory, seed: u64, force: Force) -> FitResult {
         Force::Measured => rec.f_stf.clone().unwrap_or_default(),
         Force::Recovered => k.recovered_force(&SMOOTH),
     };
-    let data = ForceData {
-        t: &k.t,
-        x: &k.x,
-        v: &k.v,
-        a: &k.a,
-        f: &f,
-    };
+    let data = ForceData::new(&k.t, &k.x, &k.v, &k.a, &f);
     ForceFit::new(power_law())
         .fit(&data, None)
         .unwrap_or_else(|e| panic!("{e}"))

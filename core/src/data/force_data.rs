@@ -53,6 +53,11 @@ pub enum ForceDataError {
 }
 
 impl<'a> ForceData<'a> {
+    /// The signals `t, x, v, a, f`, in the order of the fields.
+    pub fn new(t: &'a [f64], x: &'a [f64], v: &'a [f64], a: &'a [f64], f: &'a [f64]) -> Self {
+        ForceData { t, x, v, a, f }
+    }
+
     /// The signals by name, `t` first.
     fn named(&self) -> [(&'static str, &'a [f64]); 5] {
         [

@@ -29,7 +29,8 @@ use super::score::CandidateScore;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
-use crate::fit::{FitParam, FitResult, ForceData, ForceFit, NoiseFloor, FORCE_OFFSET};
+use crate::data::force_data::ForceData;
+use crate::fit::{FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
@@ -321,7 +322,7 @@ fn best_trial(
 /// ```
 /// use std::sync::Arc;
 /// use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
-/// use stf_core::fit::ForceData;
+/// use stf_core::data::force_data::ForceData;
 /// use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 /// use stf_core::physics::param_spec::ParamSpec;
 /// use stf_core::regimes::cycles_from_phase;
@@ -346,7 +347,7 @@ fn best_trial(
 /// let f: Vec<f64> = (0..t.len())
 ///     .map(|i| 2.0 * v[i] + 0.5 * x[i] + 1e-4 * ((i * 7919 % 13) as f64 - 6.0))
 ///     .collect();
-/// let data = ForceData { t: &t, x: &x, v: &v, a: &a, f: &f };
+/// let data = ForceData::new(&t, &x, &v, &a, &f);
 /// let cycles = cycles_from_phase(&t, &phi).unwrap();
 /// let found = discover_force(damper, &[Candidate::new("spring", spring)], &data, &cycles,
 ///                            &DiscoverySettings::default()).unwrap();
@@ -713,13 +714,7 @@ mod tests {
         let x = vec![0.0; n];
         let a = vec![0.0; n];
         let r: Vec<f64> = v.iter().map(|v| 0.5 * (v / 0.02).tanh()).collect();
-        let data = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &r,
-        };
+        let data = ForceData::new(&t, &x, &v, &a, &r);
         let all: Vec<usize> = (0..n).collect();
         let starts = candidate_starts(&smooth(), &data, &all, &r, 1);
         assert_eq!(starts.len(), 2, "{starts:?}");

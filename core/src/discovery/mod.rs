@@ -23,7 +23,7 @@
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
 //! docs/ARCHITECTURE.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
 //!
-//! [`ForceData`]: crate::fit::ForceData
+//! [`ForceData`]: crate::data::force_data::ForceData
 
 pub mod acceptance;
 pub mod before_after_validation;

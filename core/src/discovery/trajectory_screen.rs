@@ -48,13 +48,7 @@ impl SearchModel {
         let kept: Vec<usize> = train.iter().copied().step_by(stride).collect();
         let [t, x, v, a, f] = [rig.t, rig.x, &hint.v, &hint.a, &hint.f]
             .map(|s| kept.iter().map(|&i| s[i]).collect::<Vec<f64>>());
-        let data = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let data = ForceData::new(&t, &x, &v, &a, &f);
         let subset: Vec<usize> = (0..kept.len()).collect();
         let mut best: Option<(f64, Vec<f64>)> = None;
         // Also from the current values with the last part's amplitude near zero: the model

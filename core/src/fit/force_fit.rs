@@ -10,7 +10,8 @@
 //!
 //! ```
 //! use std::sync::Arc;
-//! use stf_core::fit::{ForceData, ForceFit};
+//! use stf_core::data::force_data::ForceData;
+//! use stf_core::fit::ForceFit;
 //! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 //! use stf_core::physics::param_spec::ParamSpec;
 //! struct Lin(Vec<ParamSpec>);
@@ -26,7 +27,7 @@
 //! let v: Vec<f64> = t.iter().map(|t| (5.0 * t).cos()).collect();
 //! let f: Vec<f64> = v.iter().map(|v| 3.0 * v).collect();
 //! let zeros = vec![0.0; t.len()];
-//! let data = ForceData { t: &t, x: &zeros, v: &v, a: &zeros, f: &f };
+//! let data = ForceData::new(&t, &zeros, &v, &zeros, &f);
 //! let result = ForceFit::new(model).fit(&data, None).unwrap();
 //! assert!((result.value("c").unwrap() - 3.0).abs() < 1e-6);
 //! ```
