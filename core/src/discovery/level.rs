@@ -209,3 +209,49 @@ pub(super) trait Level: Sync {
         Ok(None)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::force_level::ForceLevel;
+    use super::super::trajectory_level::TrajectoryLevel;
+    use super::super::trajectory_setup::TrajectorySetup;
+    use super::*;
+    use crate::data::force_data::ForceData;
+    use crate::fit::{TrajectoryData, TrajectoryFit};
+    use crate::physics::excitation::Excitation;
+    use crate::physics::oscillator_params::OscillatorParams;
+    use crate::regimes::cycles_from_phase;
+
+    /// (re-check, polish) of each level with the settings `s`.
+    fn choices(s: &DiscoverySettings) -> [(bool, bool); 2] {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 / 100.0).collect();
+        let phi: Vec<f64> = t.iter().map(|t| 6.0 * t).collect();
+        let x: Vec<f64> = phi
+            .iter()
+            .map(|p| 0.01 * p.sin() + 1e-4 * (7.0 * p).cos())
+            .collect();
+        let cycles = cycles_from_phase(&t, &phi).unwrap();
+        let data = ForceData::new(&t, &x, &x, &x, &x);
+        let force = ForceLevel::new(&data, &cycles, s).unwrap();
+        let setup = TrajectorySetup::new(TrajectoryFit::new(
+            OscillatorParams::FREE,
+            Arc::new(Excitation::None),
+        ));
+        let xs = TrajectoryData { t: &t, x: &x };
+        let trajectory = TrajectoryLevel::new(&xs, &cycles, &setup, s).unwrap();
+        [
+            (force.reconsiders(), force.polishes()),
+            (trajectory.reconsiders(), trajectory.polishes()),
+        ]
+    }
+
+    #[test]
+    fn recheck_and_polish_follow_the_settings_else_each_level_s_default() {
+        let s = DiscoverySettings::default();
+        assert_eq!(choices(&s), [(true, false), (false, true)]);
+        let swapped = s.clone().recheck(Some(false)).polish(Some(true));
+        assert_eq!(choices(&swapped), [(false, true), (false, true)]);
+        let other = s.recheck(Some(true)).polish(Some(false));
+        assert_eq!(choices(&other), [(true, false), (true, false)]);
+    }
+}

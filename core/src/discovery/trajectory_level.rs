@@ -414,6 +414,3 @@ fn reach_of(data: &TrajectoryData, setup: &TrajectorySetup) -> Reach {
         }
     }
 }
-
-#[cfg(test)]
-mod tests;

@@ -1,17 +1,22 @@
 //! Trajectory-level discovery on simulated rig records: an effect named from x only, none
 //! named where none is, and a scouted long record that agrees with the whole one.
 
-use super::*;
-use crate::fit::{FitParam, TrajectoryFit};
-use crate::numerics::interpolate::Linear;
-use crate::physics::excitation::Excitation;
-use crate::physics::force_model::{ModelError, ModelState};
-use crate::physics::model_sum::ModelSum;
-use crate::physics::oscillator::Oscillator;
-use crate::physics::param_spec::ParamSpec;
-use crate::regimes::cycles_from_x;
-use crate::simulate::synthetic::{sample_record, SensorNoise};
-use crate::simulate::Simulation;
+use std::sync::Arc;
+
+use stf_core::discovery::{
+    discover_trajectory, Candidate, Discovery, DiscoverySettings, TrajectoryPart, TrajectorySetup,
+};
+use stf_core::fit::{FitParam, TrajectoryData, TrajectoryFit};
+use stf_core::numerics::interpolate::Linear;
+use stf_core::physics::excitation::Excitation;
+use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::oscillator::Oscillator;
+use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::physics::param_spec::ParamSpec;
+use stf_core::regimes::cycles_from_x;
+use stf_core::simulate::synthetic::{sample_record, SensorNoise};
+use stf_core::simulate::Simulation;
 
 /// A one-parameter force `p·g(x, v)`.
 struct Term(&'static str, Vec<ParamSpec>, fn(&ModelState) -> f64);
@@ -239,4 +244,17 @@ fn without_the_cubic_term_nothing_is_named() {
     );
     assert!(d.effects.is_empty(), "{:?}", d.steps);
     assert!(d.gap_before < 2.0 * d.noise_floor);
+}
+
+#[test]
+fn the_re_check_on_and_the_polish_off_name_the_same_effect_at_trajectory_level() {
+    let settings = DiscoverySettings::default()
+        .recheck(Some(true))
+        .polish(Some(false));
+    let found = discover_on(record(1e4), &settings);
+    let d = &found.discovery;
+    assert_eq!(d.effects, ["cubic_stiffness"]);
+    let k3 = d.value("k3").unwrap();
+    assert!((k3 / 1e4 - 1.0).abs() < 0.2, "k3 = {k3}");
+    assert!(found.part.s_after_mm2 < 0.5 * found.part.s_before_mm2);
 }
