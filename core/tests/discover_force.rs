@@ -5,30 +5,15 @@ use std::sync::Arc;
 
 use stf_core::data::force_data::ForceData;
 use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::{ForceModel, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 use stf_core::regimes::cycles_from_phase;
 
-/// A one-parameter force `p·g(x, v)`.
-struct Term(&'static str, Vec<ParamSpec>, fn(&ModelState) -> f64);
-impl ForceModel for Term {
-    fn name(&self) -> &str {
-        self.0
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.1
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * (self.2)(s))
-    }
-}
+mod support;
 
+/// `p·g(state)`, p in [0, 100] from 1.
 fn term(name: &'static str, g: fn(&ModelState) -> f64) -> Arc<dyn ForceModel> {
-    Arc::new(Term(
-        name,
-        vec![ParamSpec::new("p", "", 1.0, 0.0, 100.0, "")],
-        g,
-    ))
+    support::term(name, ParamSpec::new("p", "", 1.0, 0.0, 100.0, ""), g)
 }
 
 #[test]

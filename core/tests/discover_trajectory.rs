@@ -9,7 +9,7 @@ use stf_core::discovery::{
 use stf_core::fit::{FitParam, TrajectoryData, TrajectoryFit};
 use stf_core::numerics::interpolate::Linear;
 use stf_core::physics::excitation::Excitation;
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
+use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
@@ -18,40 +18,44 @@ use stf_core::regimes::cycles_from_x;
 use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::Simulation;
 
-/// A one-parameter force `p·g(x, v)`.
-struct Term(&'static str, Vec<ParamSpec>, fn(&ModelState) -> f64);
-impl ForceModel for Term {
-    fn name(&self) -> &str {
-        self.0
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.1
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * (self.2)(s))
-    }
-}
+mod support;
+use support::term;
 
 fn viscous() -> Arc<dyn ForceModel> {
-    let spec = vec![ParamSpec::new("c_s", "N·s/m", 1.0, 0.0, 100.0, "")];
-    Arc::new(Term("viscous", spec, |s| s.v))
+    term(
+        "viscous",
+        ParamSpec::new("c_s", "N·s/m", 1.0, 0.0, 100.0, ""),
+        |s| s.v,
+    )
 }
 fn cubic() -> Arc<dyn ForceModel> {
-    let spec = vec![ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "")];
-    Arc::new(Term("cubic_stiffness", spec, |s| s.x.powi(3)))
+    term(
+        "cubic_stiffness",
+        ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, ""),
+        |s| s.x.powi(3),
+    )
 }
 fn quadratic() -> Arc<dyn ForceModel> {
-    let spec = vec![ParamSpec::new("K2", "N·s²/m²", 1.0, 0.0, 1e4, "")];
-    Arc::new(Term("quadratic_damping", spec, |s| s.v * s.v.abs()))
+    term(
+        "quadratic_damping",
+        ParamSpec::new("K2", "N·s²/m²", 1.0, 0.0, 1e4, ""),
+        |s| s.v * s.v.abs(),
+    )
 }
 
 fn stiffening() -> Arc<dyn ForceModel> {
-    let spec = vec![ParamSpec::new("k2", "N/m²", 1e3, 0.0, 1e7, "")];
-    Arc::new(Term("quadratic_stiffness", spec, |s| s.x * s.x.abs()))
+    term(
+        "quadratic_stiffness",
+        ParamSpec::new("k2", "N/m²", 1e3, 0.0, 1e7, ""),
+        |s| s.x * s.x.abs(),
+    )
 }
 fn cubic_damping() -> Arc<dyn ForceModel> {
-    let spec = vec![ParamSpec::new("c3", "N·s³/m³", 1.0, 0.0, 1e4, "")];
-    Arc::new(Term("cubic_damping", spec, |s| s.v.powi(3)))
+    term(
+        "cubic_damping",
+        ParamSpec::new("c3", "N·s³/m³", 1.0, 0.0, 1e4, ""),
+        |s| s.v.powi(3),
+    )
 }
 
 /// The trolley without friction, driven by a chirp force 0.5 → 1.5 Hz over 20 s at
