@@ -7,11 +7,14 @@ use std::sync::Arc;
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
+/// A force as a function of the parameters and the state.
+type ForceOf = Box<dyn Fn(&[f64], &ModelState) -> f64 + Send + Sync>;
+
 /// A memoryless force `force(p, state)` named `name` with the parameters `specs`.
 pub struct Law {
     name: &'static str,
     specs: Vec<ParamSpec>,
-    force: Box<dyn Fn(&[f64], &ModelState) -> f64 + Send + Sync>,
+    force: ForceOf,
 }
 
 impl ForceModel for Law {
