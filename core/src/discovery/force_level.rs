@@ -491,11 +491,9 @@ impl Level for ForceLevel<'_> {
         let blocks = self.blocks(&self.residual(&current.stage)?);
         let floor = self.floor(&current.stage)?;
         let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
         let units = |h: &[f64]| blocks.rms(h);
         Ok(then(&Yardstick {
             gain_z: &gain_z,
-            tie_z: &tie_z,
             units: &units,
             base_excess,
             floor,

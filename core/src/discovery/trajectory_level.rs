@@ -308,7 +308,6 @@ impl Level for TrajectoryLevel<'_> {
         let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
         Ok(then(&Yardstick {
             gain_z: &test,
-            tie_z: &cycle_gain_z,
             units: &|h: &[f64]| h.to_vec(),
             base_excess,
             floor: NoiseFloor::displacement(self.floor),
