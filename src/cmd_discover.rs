@@ -240,7 +240,7 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
     if let Some(n) = spec.scout_from {
         settings = settings.scout_from(n);
     }
-    settings
+    settings.recheck(spec.recheck).polish(spec.polish)
 }
 
 /// The terminal summary of a discovery; `entries` are the final model's `[[models]]` and

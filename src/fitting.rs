@@ -14,11 +14,12 @@ use std::sync::Arc;
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
 use stf_core::data::estimate::{linear_oscillator, LinearEstimate};
+use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
 use stf_core::fit::{
-    fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceData, ForceFit, NoiseFloor,
-    TrajectoryData, TrajectoryFit,
+    fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor, TrajectoryData,
+    TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 

@@ -16,27 +16,16 @@ use std::time::Instant;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use stf_core::fit::{FitParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::data::force_data::ForceData;
+use stf_core::fit::{FitParam, ForceFit, TrajectoryData, TrajectoryFit};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
-use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::Simulation;
 
-struct PowerLaw(Vec<ParamSpec>);
-
-impl ForceModel for PowerLaw {
-    fn name(&self) -> &str {
-        "power_law"
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.0
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-    }
-}
+#[path = "../tests/support/mod.rs"]
+mod support;
+use support::power_law;
 
 fn main() {
     let mut rng = StdRng::seed_from_u64(1);
@@ -56,17 +45,8 @@ fn main() {
         let vi = *v.last().unwrap_or(&0.0);
         f.push(4.0 * vi.abs().powf(1.5) * vi.signum() + noise.sample(&mut rng));
     }
-    let model = Arc::new(PowerLaw(vec![
-        ParamSpec::new("K", "N (s/m)^n", 1.0, 0.0, 100.0, ""),
-        ParamSpec::new("n", "", 1.2, 1.0, 4.0, ""),
-    ]));
-    let data = ForceData {
-        t: &t,
-        x: &x,
-        v: &v,
-        a: &a,
-        f: &f,
-    };
+    let model = power_law();
+    let data = ForceData::new(&t, &x, &v, &a, &f);
     let r = ForceFit::new(model)
         .fit(&data, None)
         .unwrap_or_else(|e| panic!("{e}"));

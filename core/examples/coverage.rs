@@ -27,36 +27,18 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
-use stf_core::fit::{FitParam, FitResult, ForceData, ForceFit, TrajectoryData, TrajectoryFit};
+use stf_core::fit::{FitParam, FitResult, ForceFit, TrajectoryData, TrajectoryFit};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
-use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
-use stf_core::physics::param_spec::ParamSpec;
 use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
 
-struct PowerLaw(Vec<ParamSpec>);
-
-impl ForceModel for PowerLaw {
-    fn name(&self) -> &str {
-        "power_law"
-    }
-    fn params(&self) -> &[ParamSpec] {
-        &self.0
-    }
-    fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
-        Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-    }
-}
-
-fn power_law() -> Arc<dyn ForceModel> {
-    Arc::new(PowerLaw(vec![
-        ParamSpec::new("K", "N (s/m)^n", 1.0, 0.0, 100.0, ""),
-        ParamSpec::new("n", "", 1.2, 1.0, 4.0, ""),
-    ]))
-}
+#[path = "../tests/support/mod.rs"]
+mod support;
+use support::power_law;
 
 const TRUTH: [f64; 2] = [5.0, 1.6];
 
@@ -95,13 +77,7 @@ fn force_fit(run: &Trajectory, seed: u64, force: Force) -> FitResult {
         Force::Measured => rec.f_stf.clone().unwrap_or_default(),
         Force::Recovered => k.recovered_force(&SMOOTH),
     };
-    let data = ForceData {
-        t: &k.t,
-        x: &k.x,
-        v: &k.v,
-        a: &k.a,
-        f: &f,
-    };
+    let data = ForceData::new(&k.t, &k.x, &k.v, &k.a, &f);
     ForceFit::new(power_law())
         .fit(&data, None)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -7,9 +7,8 @@ use std::sync::Arc;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use stf_core::fit::{
-    Convergence, FitError, FitParam, FitProgress, FitSettings, ForceData, ForceFit, Solver,
-};
+use stf_core::data::force_data::ForceData;
+use stf_core::fit::{Convergence, FitError, FitParam, FitProgress, FitSettings, ForceFit, Solver};
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::param_spec::ParamSpec;

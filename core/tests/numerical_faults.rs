@@ -4,7 +4,8 @@
 
 use std::sync::Arc;
 
-use stf_core::fit::{FitParam, ForceData, ForceFit};
+use stf_core::data::force_data::ForceData;
+use stf_core::fit::{FitParam, ForceFit};
 use stf_core::numerics::integrate::{integrate, OdeSystem, Settings, SimError};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
@@ -139,13 +140,7 @@ impl ForceModel for Damper {
 #[test]
 fn a_truth_beyond_the_bound_ends_at_the_bound_honestly() {
     let (t, x, v, a, f) = linear_data();
-    let data = ForceData {
-        t: &t,
-        x: &x,
-        v: &v,
-        a: &a,
-        f: &f,
-    };
+    let data = ForceData::new(&t, &x, &v, &a, &f);
     let model = Arc::new(Damper {
         specs: vec![ParamSpec::new("c", "N·s/m", 0.5, 0.0, 1.0, "")],
     });
@@ -163,13 +158,7 @@ fn a_flat_objective_gives_no_finite_uncertainty() {
     let (t, x, v, a, f) = linear_data();
     let zero = vec![0.0; t.len()];
     // The force does not depend on c when v is zero everywhere: the objective is flat.
-    let data = ForceData {
-        t: &t,
-        x: &x,
-        v: &zero,
-        a: &a,
-        f: &f,
-    };
+    let data = ForceData::new(&t, &x, &zero, &a, &f);
     let model = Arc::new(Damper {
         specs: vec![ParamSpec::new("c", "N·s/m", 0.5, 0.0, 10.0, "")],
     });

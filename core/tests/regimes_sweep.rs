@@ -92,13 +92,7 @@ fn classified(run: &Trajectory, noise: &SensorNoise, seed: u64) -> Classified {
     let rec = sample_record(run, noise, seed, true);
     let phi = rec.phi.clone().unwrap();
     let f = rec.f_stf.clone().unwrap();
-    let sig = ForceData {
-        t: &run.t,
-        x: &rec.x,
-        v: &run.v,
-        a: &run.a,
-        f: &f,
-    };
+    let sig = ForceData::new(&run.t, &rec.x, &run.v, &run.a, &f);
     let cycles = cycles_from_phase(&run.t, &phi).unwrap();
     let c = classify(&sig, cycles, &amplitude_rule()).unwrap();
     Classified { x: rec.x, f, c }
@@ -188,13 +182,7 @@ fn a_sweep_without_stf_invents_no_regime() {
 fn comparison_ranks_the_truth_first_and_shows_a_damper_misses_the_on_off_force() {
     let run = jamming_run();
     let noisy = classified(run, &FORCE_NOISE, 2);
-    let sig = ForceData {
-        t: &run.t,
-        x: &noisy.x,
-        v: &run.v,
-        a: &run.a,
-        f: &noisy.f,
-    };
+    let sig = ForceData::new(&run.t, &noisy.x, &run.v, &run.a, &noisy.f);
     let th = amplitude_rule();
     let truth: Vec<f64> = run.v.iter().map(|&v| jamming_force(&TRUTH, v)).collect();
     // The best viscous force c·v in the least-squares sense, and a jamming law with the wrong

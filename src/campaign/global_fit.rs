@@ -73,8 +73,8 @@ pub struct JointRecord {
 
 impl JointRecord {
     /// The record's force data.
-    pub fn data(&self) -> stf_core::fit::ForceData<'_> {
-        stf_core::fit::ForceData {
+    pub fn data(&self) -> stf_core::data::force_data::ForceData<'_> {
+        stf_core::data::force_data::ForceData {
             t: &self.t,
             x: &self.x,
             v: &self.v,

@@ -1,5 +1,6 @@
 //! The `[discover]` section of an experiment file: the base model, the candidate effects,
-//! how many may be added, the held-out cycles, the scouting threshold and the fit level.
+//! how many may be added, the held-out cycles, the scouting threshold, the fit level and
+//! whether earlier effects are re-checked and accepted models polished.
 //! Every key's shape is its serde type, so the checked section is a plain conversion; the
 //! base `a + b` is split into its terms as it is read ([`base_terms`]), once.
 
@@ -18,6 +19,8 @@ pub(super) struct RawDiscover {
     holdout_every: Option<usize>,
     level: Option<FitLevel>,
     scout_from: Option<usize>,
+    recheck: Option<bool>,
+    polish: Option<bool>,
 }
 
 /// A validated `[discover]` section.
@@ -37,6 +40,12 @@ pub struct DiscoverSpec {
     /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
     /// `f_stf`.
     pub level: Option<FitLevel>,
+    /// Re-check earlier effects after each acceptance; `None`: the level's default (on at
+    /// force level, off at trajectory level).
+    pub recheck: Option<bool>,
+    /// Polish an accepted model before the next step; `None`: the level's default (off at
+    /// force level, on at trajectory level).
+    pub polish: Option<bool>,
 }
 
 /// `base = "a + b + …"` as its terms, trimmed; an empty term is an error.
@@ -67,6 +76,8 @@ impl From<RawDiscover> for DiscoverSpec {
             holdout_every: d.holdout_every,
             scout_from: d.scout_from,
             level: d.level,
+            recheck: d.recheck,
+            polish: d.polish,
         }
     }
 }
@@ -105,6 +116,28 @@ mod tests {
         assert!(
             msg.starts_with("exp.toml:4: `discover.level`: unknown variant `forces`")
                 && msg.contains("`force` or `trajectory`"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn recheck_and_polish_are_read_and_default_to_the_level_s_own() {
+        let d = parse("[discover]\nbase = \"viscous\"\nrecheck = false\npolish = true\n")
+            .unwrap()
+            .discover
+            .unwrap();
+        assert_eq!((d.recheck, d.polish), (Some(false), Some(true)));
+        let d = parse("[discover]\nbase = \"viscous\"\n")
+            .unwrap()
+            .discover
+            .unwrap();
+        assert_eq!((d.recheck, d.polish), (None, None));
+        let msg = format!(
+            "{:#}",
+            parse("\n[discover]\nbase = \"viscous\"\npolish = \"yes\"\n").unwrap_err()
+        );
+        assert!(
+            msg.starts_with("exp.toml:4: `discover.polish`: invalid type"),
             "{msg}"
         );
     }

@@ -6,6 +6,8 @@
 
 use thiserror::Error;
 
+use crate::physics::force_model::ModelState;
+
 /// Kinematics and STF force, sample by sample (SI units, equal lengths).
 #[derive(Clone, Copy, Debug)]
 pub struct ForceData<'a> {
@@ -53,6 +55,21 @@ pub enum ForceDataError {
 }
 
 impl<'a> ForceData<'a> {
+    /// The signals `t, x, v, a, f`, in the order of the fields.
+    pub fn new(t: &'a [f64], x: &'a [f64], v: &'a [f64], a: &'a [f64], f: &'a [f64]) -> Self {
+        ForceData { t, x, v, a, f }
+    }
+
+    /// The state a force model sees at sample `i`, with the internal state `z`.
+    pub fn state<'z>(&self, i: usize, z: &'z [f64]) -> ModelState<'z> {
+        ModelState {
+            t: self.t[i],
+            x: self.x[i],
+            v: self.v[i],
+            z,
+        }
+    }
+
     /// The signals by name, `t` first.
     fn named(&self) -> [(&'static str, &'a [f64]); 5] {
         [

@@ -167,6 +167,26 @@ pub fn choose(
     Some((winner, tied.into_iter().filter(|&i| i != winner).collect()))
 }
 
+/// The paired z of the gain of per-cycle RMS residuals `new` over `reference`, on the log
+/// scale: `dᵢ = 2·ln(reference_i / new_i)` (the log-ratio of cycle i's mean squared residual),
+/// `z = mean(d) / (sd(d)/√N)`. A cycle is the unit: residuals within one are correlated. The
+/// log makes cycles of small and large amplitude count alike: an effect that grows with
+/// amplitude (a cubic spring) removes most of each cycle's misfit, a different share of
+/// different sizes, and a difference of squares would vary so much across cycles that a few
+/// held-out cycles could never show it. +∞ for a consistent gain without spread, 0 with fewer
+/// than two cycles or no difference.
+pub(super) fn cycle_gain_z(reference: &[f64], new: &[f64]) -> f64 {
+    let d: Vec<f64> = reference
+        .iter()
+        .zip(new)
+        .map(|(a, b)| 2.0 * (a.max(f64::MIN_POSITIVE) / b.max(f64::MIN_POSITIVE)).ln())
+        .collect();
+    if d.iter().any(|v| !v.is_finite()) {
+        return 0.0;
+    }
+    mean_z(&d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -355,5 +375,18 @@ mod tests {
         let mut sc = score("a", 0.01, 100.0, -1e3, -1e3);
         sc.failure = Some("diverged".into());
         assert!(!is_significant(&sc, &s));
+    }
+
+    #[test]
+    fn the_cycle_gain_counts_ratios_not_differences() {
+        // Cycles of very different size, each halved: a perfectly consistent gain.
+        assert_eq!(
+            cycle_gain_z(&[1.0, 10.0, 0.1], &[0.5, 5.0, 0.05]),
+            f64::INFINITY
+        );
+        // Better on some, worse on others: no evidence.
+        let z = cycle_gain_z(&[1.0, 1.0, 1.0, 1.0], &[0.9, 1.1, 0.95, 1.05]);
+        assert!(z.abs() < 1.0, "{z}");
+        assert_eq!(cycle_gain_z(&[1.0], &[0.1]), 0.0);
     }
 }

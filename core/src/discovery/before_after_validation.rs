@@ -13,8 +13,9 @@ use std::sync::Arc;
 
 use super::error::DiscoveryError;
 use super::findings::Discovery;
+use crate::data::force_data::ForceData;
 use crate::fit::{
-    FitParam, FittedParam, ForceData, ForceFit, TrajectoryData, TrajectoryFit, Validation,
+    FitParam, FittedParam, ForceFit, TrajectoryData, TrajectoryFit, Validation,
     DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
 };
 use crate::physics::force_model::ForceModel;

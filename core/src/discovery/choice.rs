@@ -64,11 +64,9 @@ pub(super) type Units<'a> = &'a (dyn Fn(&[f64]) -> Vec<f64> + Sync);
 
 /// What a step measures a candidate's held-out gain with and against.
 pub(super) struct Yardstick<'a> {
-    /// The paired test.
+    /// The paired test; its z also decides whether the best candidate beats another (a tie
+    /// when not).
     pub gain_z: GainTest<'a>,
-    /// The paired test that decides whether the best candidate beats another (a tie when
-    /// not): the trials' `holdout`, the other's first.
-    pub tie_z: &'a (dyn Fn(&[f64], &[f64]) -> f64 + Sync),
     /// The units of a trial's `holdout`.
     pub units: Units<'a>,
     /// The base's held-out mean square above the noise floor (at least what is resolved).
@@ -236,7 +234,12 @@ pub(super) fn decide(
         .iter()
         .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
         .collect();
-    let choice = acceptance::choose(&scores, &holdout, yardstick.tie_z, settings);
+    let choice = acceptance::choose(
+        &scores,
+        &holdout,
+        &|a, b| (yardstick.gain_z)(a, b).0,
+        settings,
+    );
     let mut step = step_on(current, scores, yardstick);
     let Some((winner, ties)) = choice else {
         step.verdict = rejected(&step, said, settings);

@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use crate::fit::ForceData;
+use crate::data::force_data::ForceData;
 use crate::regimes::{classify, Cycle, RegimeThresholds};
 
 /// Number of ω bands of the breakdown.
@@ -256,13 +256,7 @@ mod tests {
                 omega: std::f64::consts::TAU,
             })
             .collect();
-        let data = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let data = ForceData::new(&t, &x, &v, &a, &f);
         let g = locate_gap(&r, &data, &cycles, 0.01);
         let by_v = g.breakdown("|v|").unwrap();
         assert!(by_v.contrast > 10.0, "{by_v:?}");

@@ -1,8 +1,8 @@
 //! The force level of discovery ([`ForceLevel`], a [`Level`] for the loop of
 //! [`super::search`]): records with a measured F_STF and kinematics, every model fitted to
 //! the force along them. Its candidates start from a small multi-start ([`candidate_starts`],
-//! [`best_trial`]); earlier effects are re-checked after each acceptance
-//! ([`super::reconsider`]).
+//! [`best_trial`]); by default earlier effects are re-checked after each
+//! acceptance ([`super::reconsider`]) and an accepted model is not polished.
 //!
 //! Each step cuts the held-out cycles into blocks at least as long as the residual's
 //! correlation ([`super::blocks`]) and measures the current model's noise floor — the force
@@ -21,7 +21,7 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
-use super::force_subset_fit::{fit_subset, residuals, rms_over};
+use super::force_subset_fit::{fit_subset, residuals};
 use super::holdout::HoldoutSplit;
 use super::level::Level;
 use super::progress::DiscoveryEvent;
@@ -29,7 +29,8 @@ use super::score::CandidateScore;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
-use crate::fit::{FitParam, FitResult, ForceData, ForceFit, NoiseFloor, FORCE_OFFSET};
+use crate::data::force_data::ForceData;
+use crate::fit::{FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
@@ -62,24 +63,6 @@ impl SearchModel {
         let fit = self.force_fit(settings)?;
         let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
         Ok((stage, fit, result))
-    }
-
-    /// Fit on the training samples and score on the held-out ones.
-    fn trial(
-        &self,
-        data: &ForceData,
-        split: &HoldoutSplit,
-        settings: &DiscoverySettings,
-    ) -> Result<Trial, DiscoveryError> {
-        let (stage, fit, train) = self.fit(data, &split.train, settings)?;
-        let r = residuals(&fit, data, &stage.values).map_err(|e| self.fit_error(e))?;
-        let h = rms_over(&r, &split.holdout);
-        Ok(Trial {
-            stage,
-            train,
-            holdout: split.holdout.iter().map(|&i| r[i]).collect(),
-            holdout_mse: h * h,
-        })
     }
 
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
@@ -279,11 +262,9 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
 /// of a candidate. Its evaluations and wall time are those of all the runs; the first run's
 /// error if every run fails.
 fn best_trial(
+    level: &ForceLevel,
     starts: &[Vec<f64>],
     stage: impl Fn(&[f64]) -> SearchModel,
-    data: &ForceData,
-    split: &HoldoutSplit,
-    settings: &DiscoverySettings,
 ) -> Result<Trial, DiscoveryError> {
     let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
     if let Some(released) = stages.first().and_then(SearchModel::released) {
@@ -293,7 +274,7 @@ fn best_trial(
     let mut first_error = None;
     let (mut evaluations, mut wall) = (0, 0.0);
     for stage in &stages {
-        match stage.trial(data, split, settings) {
+        match level.trial(stage, level.settings) {
             Ok(trial) => {
                 evaluations += trial.train.evaluations;
                 wall += trial.train.wall_seconds;
@@ -341,7 +322,7 @@ fn best_trial(
 /// ```
 /// use std::sync::Arc;
 /// use stf_core::discovery::{discover_force, Candidate, DiscoverySettings};
-/// use stf_core::fit::ForceData;
+/// use stf_core::data::force_data::ForceData;
 /// use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 /// use stf_core::physics::param_spec::ParamSpec;
 /// use stf_core::regimes::cycles_from_phase;
@@ -366,7 +347,7 @@ fn best_trial(
 /// let f: Vec<f64> = (0..t.len())
 ///     .map(|i| 2.0 * v[i] + 0.5 * x[i] + 1e-4 * ((i * 7919 % 13) as f64 - 6.0))
 ///     .collect();
-/// let data = ForceData { t: &t, x: &x, v: &v, a: &a, f: &f };
+/// let data = ForceData::new(&t, &x, &v, &a, &f);
 /// let cycles = cycles_from_phase(&t, &phi).unwrap();
 /// let found = discover_force(damper, &[Candidate::new("spring", spring)], &data, &cycles,
 ///                            &DiscoverySettings::default()).unwrap();
@@ -462,17 +443,14 @@ impl Level for ForceLevel<'_> {
         stage.residuals(self.data, self.settings)
     }
 
-    fn trial(
-        &self,
-        stage: &SearchModel,
-        settings: &DiscoverySettings,
-    ) -> Result<Trial, DiscoveryError> {
-        stage.trial(self.data, &self.split, settings)
+    /// The held-out samples' residuals.
+    fn held_out(&self, r: &[f64]) -> Vec<f64> {
+        self.split.holdout.iter().map(|&i| r[i]).collect()
     }
 
     /// From the defaults: the training fit of the base as it stood.
     fn first_trial(&self, start: &SearchModel, _: &SearchModel) -> Result<Trial, DiscoveryError> {
-        start.trial(self.data, &self.split, self.settings)
+        self.trial(start, self.settings)
     }
 
     /// The force sensor's noise with the kinematics' propagated through the model.
@@ -513,11 +491,9 @@ impl Level for ForceLevel<'_> {
         let blocks = self.blocks(&self.residual(&current.stage)?);
         let floor = self.floor(&current.stage)?;
         let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let tie_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks).0;
         let units = |h: &[f64]| blocks.rms(h);
         Ok(then(&Yardstick {
             gain_z: &gain_z,
-            tie_z: &tie_z,
             units: &units,
             base_excess,
             floor,
@@ -553,13 +529,9 @@ impl Level for ForceLevel<'_> {
                     &current_residual,
                     settings.extra_starts,
                 );
-                let best = best_trial(
-                    &starts,
-                    |start| current.stage.with(&c.model, start, 0),
-                    data,
-                    split,
-                    settings,
-                );
+                let best = best_trial(self, &starts, |start| {
+                    current.stage.with(&c.model, start, 0)
+                });
                 let n_own = c.model.params().len();
                 let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
                 emit_scored(settings, step, Some(&s));
@@ -583,16 +555,12 @@ impl Level for ForceLevel<'_> {
             residual,
             settings.extra_starts,
         );
-        best_trial(
-            &starts,
-            |start| rest.inserting(part, 0, &c.model, start),
-            self.data,
-            &self.split,
-            settings,
-        )
+        best_trial(self, &starts, |start| {
+            rest.inserting(part, 0, &c.model, start)
+        })
     }
 
-    fn reconsiders(&self) -> bool {
+    fn recheck_default(&self) -> bool {
         true
     }
 
@@ -744,13 +712,7 @@ mod tests {
         let x = vec![0.0; n];
         let a = vec![0.0; n];
         let r: Vec<f64> = v.iter().map(|v| 0.5 * (v / 0.02).tanh()).collect();
-        let data = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &r,
-        };
+        let data = ForceData::new(&t, &x, &v, &a, &r);
         let all: Vec<usize> = (0..n).collect();
         let starts = candidate_starts(&smooth(), &data, &all, &r, 1);
         assert_eq!(starts.len(), 2, "{starts:?}");

@@ -5,7 +5,8 @@
 //! only; only the residuals of the chosen samples enter the least squares. With every sample
 //! chosen this is an ordinary [`ForceFit`].
 
-use crate::fit::{FitResult, FitSettings, ForceData, ForceFit};
+use crate::data::force_data::ForceData;
+use crate::fit::{FitResult, FitSettings, ForceFit};
 
 /// Fit `fit`'s parameters (its own settings are not used: `settings` are) on the samples
 /// `subset` of `data` (strictly increasing); statistics (RMS, AIC, BIC, standard errors) are

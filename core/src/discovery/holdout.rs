@@ -57,6 +57,25 @@ impl HoldoutSplit {
     }
 }
 
+/// The RMS of `r` over each held-out cycle: `holdout` holds whole cycles of increasing
+/// samples, never two neighbouring cycles (one in `holdout_every` ≥ 2 is held out), so each
+/// run of consecutive indices is one cycle.
+pub(super) fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
+    let mut out = Vec::new();
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (k, &i) in holdout.iter().enumerate() {
+        let value = r.get(i).copied().unwrap_or(f64::NAN);
+        sum += value * value;
+        count += 1;
+        let ends = holdout.get(k + 1).is_none_or(|&next| next != i + 1);
+        if ends {
+            out.push((sum / count as f64).sqrt());
+            (sum, count) = (0.0, 0);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,5 +106,14 @@ mod tests {
         assert!(HoldoutSplit::new(30, &cycles, 4).is_err());
         assert!(HoldoutSplit::new(15, &cycles, 2).is_err());
         assert!(HoldoutSplit::new(30, &cycles, 1).is_err());
+    }
+
+    #[test]
+    fn held_out_cycles_are_the_runs_of_consecutive_samples() {
+        let r = [3.0, 1.0, 1.0, 9.0, 9.0, 2.0, 2.0, 2.0, 4.0];
+        let rms = cycle_rms(&r, &[1, 2, 5, 6, 7]);
+        assert_eq!(rms, vec![1.0, 2.0]);
+        assert_eq!(cycle_rms(&r, &[0, 8]), vec![3.0, 4.0]);
+        assert!(cycle_rms(&r, &[]).is_empty());
     }
 }

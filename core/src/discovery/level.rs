@@ -7,10 +7,11 @@
 //! a gain is measured against), the unit its gap is said in, and how the candidates of a step
 //! are started and fitted. The search itself — base fit, steps, acceptance, re-check of
 //! earlier effects, polish, final refit — is written once, in [`super::search`], over this
-//! trait. The steps a level does not run by default are its capabilities
-//! ([`Level::reconsiders`], [`Level::polishes`], [`Level::warns_unresolved`]); where one
-//! level has nothing of its own (notes, admitted candidates, parameters, a part of the
-//! result) the trait's default serves.
+//! trait, and so is the trial of a stage ([`Level::trial`]: fit on the training samples,
+//! score on the held-out ones). The re-check and the polish run at either level, as the
+//! settings say, each level having its default ([`Level::recheck_default`],
+//! [`Level::polish_default`]). Where one level has nothing of its own (notes, admitted
+//! candidates, parameters, a part of the result) the trait's default serves.
 
 use std::sync::Arc;
 
@@ -19,6 +20,7 @@ use super::choice::{Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::TrajectoryPart;
 use super::force_gap::GapLocation;
+use super::force_subset_fit::rms_over;
 use super::holdout::HoldoutSplit;
 use super::score::CandidateScore;
 use super::search_model::SearchModel;
@@ -71,12 +73,28 @@ pub(super) trait Level: Sync {
     /// Measured minus modelled signal at every sample, for `stage` at its values.
     fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError>;
 
-    /// Fit `stage` on the training samples and score it on the held-out ones.
+    /// The held-out residual by the level's unit of evidence, from `r` (every sample): the
+    /// held-out samples at force level, each held-out cycle's RMS at trajectory level.
+    fn held_out(&self, r: &[f64]) -> Vec<f64>;
+
+    /// Fit `stage` on the training samples and score it on the held-out ones: the one trial
+    /// step of both levels (`fit` on the split's training samples, `residual` at every
+    /// sample, `held_out` of it).
     fn trial(
         &self,
         stage: &SearchModel,
         settings: &DiscoverySettings,
-    ) -> Result<Trial, DiscoveryError>;
+    ) -> Result<Trial, DiscoveryError> {
+        let (stage, train) = self.fit(stage, &self.split().train, settings)?;
+        let r = self.residual(&stage)?;
+        let h = rms_over(&r, &self.split().holdout);
+        Ok(Trial {
+            stage,
+            train,
+            holdout: self.held_out(&r),
+            holdout_mse: h * h,
+        })
+    }
 
     /// The trial every candidate of the first step is measured against: of the base from
     /// its defaults (`start`) or from its whole-record fit (`base_full`).
@@ -134,16 +152,28 @@ pub(super) trait Level: Sync {
         residual: &[f64],
     ) -> Result<Trial, DiscoveryError>;
 
-    /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`];
-    /// not by default).
-    fn reconsiders(&self) -> bool {
+    /// Whether earlier effects are re-checked after each acceptance when the settings do not
+    /// say ([`DiscoverySettings::recheck`]; not by default).
+    fn recheck_default(&self) -> bool {
         false
     }
 
-    /// Whether an accepted trial is polished at the final fit's tolerance before the next
-    /// step ([`super::search`]; not by default).
-    fn polishes(&self) -> bool {
+    /// Whether an accepted trial is polished when the settings do not say
+    /// ([`DiscoverySettings::polish`]; not by default).
+    fn polish_default(&self) -> bool {
         false
+    }
+
+    /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`]):
+    /// as the settings say, else the level's default.
+    fn reconsiders(&self) -> bool {
+        self.settings().recheck.unwrap_or(self.recheck_default())
+    }
+
+    /// Whether an accepted trial is polished at the final fit's tolerance before the next
+    /// step ([`super::search`]): as the settings say, else the level's default.
+    fn polishes(&self) -> bool {
+        self.settings().polish.unwrap_or(self.polish_default())
     }
 
     /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted
@@ -177,5 +207,51 @@ pub(super) trait Level: Sync {
     ) -> Result<Option<TrajectoryPart>, DiscoveryError> {
         let _ = fits;
         Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::force_level::ForceLevel;
+    use super::super::trajectory_level::TrajectoryLevel;
+    use super::super::trajectory_setup::TrajectorySetup;
+    use super::*;
+    use crate::data::force_data::ForceData;
+    use crate::fit::{TrajectoryData, TrajectoryFit};
+    use crate::physics::excitation::Excitation;
+    use crate::physics::oscillator_params::OscillatorParams;
+    use crate::regimes::cycles_from_phase;
+
+    /// (re-check, polish) of each level with the settings `s`.
+    fn choices(s: &DiscoverySettings) -> [(bool, bool); 2] {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 / 100.0).collect();
+        let phi: Vec<f64> = t.iter().map(|t| 6.0 * t).collect();
+        let x: Vec<f64> = phi
+            .iter()
+            .map(|p| 0.01 * p.sin() + 1e-4 * (7.0 * p).cos())
+            .collect();
+        let cycles = cycles_from_phase(&t, &phi).unwrap();
+        let data = ForceData::new(&t, &x, &x, &x, &x);
+        let force = ForceLevel::new(&data, &cycles, s).unwrap();
+        let setup = TrajectorySetup::new(TrajectoryFit::new(
+            OscillatorParams::FREE,
+            Arc::new(Excitation::None),
+        ));
+        let xs = TrajectoryData { t: &t, x: &x };
+        let trajectory = TrajectoryLevel::new(&xs, &cycles, &setup, s).unwrap();
+        [
+            (force.reconsiders(), force.polishes()),
+            (trajectory.reconsiders(), trajectory.polishes()),
+        ]
+    }
+
+    #[test]
+    fn recheck_and_polish_follow_the_settings_else_each_level_s_default() {
+        let s = DiscoverySettings::default();
+        assert_eq!(choices(&s), [(true, false), (false, true)]);
+        let swapped = s.clone().recheck(Some(false)).polish(Some(true));
+        assert_eq!(choices(&swapped), [(false, true), (false, true)]);
+        let other = s.recheck(Some(true)).polish(Some(false));
+        assert_eq!(choices(&other), [(true, false), (true, false)]);
     }
 }

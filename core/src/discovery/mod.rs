@@ -23,7 +23,7 @@
 //! Core knows no model library: the caller passes the base and the candidates (built-ins of
 //! docs/ARCHITECTURE.md §5, scripts) as [`std::sync::Arc`]`<dyn ForceModel>`.
 //!
-//! [`ForceData`]: crate::fit::ForceData
+//! [`ForceData`]: crate::data::force_data::ForceData
 
 pub mod acceptance;
 pub mod before_after_validation;
@@ -41,12 +41,17 @@ pub mod progress;
 mod reconsider;
 pub mod score;
 mod scout;
+mod scout_ranking;
 mod search;
 mod search_model;
 pub mod settings;
 mod trajectory_gap;
 pub mod trajectory_level;
+mod trajectory_screen;
+pub mod trajectory_setup;
+mod trajectory_starts;
 mod trajectory_subset_fit;
+mod trajectory_trials;
 
 pub use before_after_validation::DiscoveryValidation;
 pub use candidate::Candidate;
@@ -58,4 +63,5 @@ pub use holdout::HoldoutSplit;
 pub use progress::{DiscoveryEvent, Observer};
 pub use score::{CandidateScore, Step};
 pub use settings::DiscoverySettings;
-pub use trajectory_level::{discover_trajectory, ForceHint, TrajectorySetup};
+pub use trajectory_level::discover_trajectory;
+pub use trajectory_setup::{ForceHint, TrajectorySetup};

@@ -79,6 +79,14 @@ pub struct DiscoverySettings {
     /// trial on the whole record starts from there (default
     /// [`super::scout::SCOUT_FROM`]; 0: never). Scores and verdicts are the whole record's.
     pub scout_from: usize,
+    /// Re-check the earlier effects after each acceptance ([`super::reconsider`]): each
+    /// replaced in turn by every candidate not in the model. `None`: the level's default (on
+    /// at force level, off at trajectory level).
+    pub recheck: Option<bool>,
+    /// Polish an accepted model at the final fit's tolerance before the next step
+    /// ([`super::search`]). `None`: the level's default (off at force level, on at trajectory
+    /// level).
+    pub polish: Option<bool>,
     /// Called as the run goes (step, candidate, score): for a live display.
     #[serde(skip)]
     pub observer: Observer,
@@ -100,6 +108,8 @@ impl Default for DiscoverySettings {
             filter_window: None,
             extra_starts: 1,
             scout_from: super::scout::SCOUT_FROM,
+            recheck: None,
+            polish: None,
             observer: Observer::default(),
         }
     }
@@ -190,6 +200,18 @@ impl DiscoverySettings {
     /// Scout records of at least `n` samples (0: never).
     pub fn scout_from(mut self, n: usize) -> Self {
         self.scout_from = n;
+        self
+    }
+
+    /// Re-check earlier effects after each acceptance (`None`: the level's default).
+    pub fn recheck(mut self, on: Option<bool>) -> Self {
+        self.recheck = on;
+        self
+    }
+
+    /// Polish an accepted model before the next step (`None`: the level's default).
+    pub fn polish(mut self, on: Option<bool>) -> Self {
+        self.polish = on;
         self
     }
 

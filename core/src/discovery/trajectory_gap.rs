@@ -9,20 +9,14 @@
 
 use super::force_gap::{locate_gap, summary, GapBreakdown, GapLocation};
 use super::trajectory_subset_fit::Run;
-use crate::fit::ForceData;
+use crate::data::force_data::ForceData;
 use crate::regimes::Cycle;
 
 /// Locate the x residual of `run` (m) over `cycles`, with displacement noise floor `floor`
 /// (m, > 0).
 pub(super) fn locate_x_gap(run: &Run, cycles: &[Cycle], floor: f64) -> GapLocation {
     let s = &run.sim;
-    let data = ForceData {
-        t: &s.t,
-        x: &s.x,
-        v: &s.v,
-        a: &s.a,
-        f: &s.f_stf,
-    };
+    let data = ForceData::new(&s.t, &s.x, &s.v, &s.a, &s.f_stf);
     let mut g = locate_gap(&run.residual, &data, cycles, floor);
     g.breakdowns.retain(|b| b.by != "regime");
     g.summary = summarise_mm(g.rms, floor, &g.breakdowns);

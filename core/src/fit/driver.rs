@@ -35,6 +35,48 @@ pub fn run(
     trajectory: bool,
 ) -> Result<FitResult, FitError> {
     let clock = Instant::now();
+    let free = checked(problem, params, settings)?;
+    let obj = Objective::new(
+        problem,
+        free.iter().map(|p| p.transform()).collect(),
+        observer,
+    );
+    let u0 = vec![0.0; obj.dim()];
+    if obj.cost(&u0).is_none() {
+        return Err(FitError::StartFails(
+            obj.last_failure().unwrap_or_else(|| "unknown".into()),
+        ));
+    }
+    let mut chain = Chain {
+        obj: &obj,
+        free: &free,
+        settings,
+        trajectory,
+        iterations: 0,
+        log: Vec::new(),
+    };
+    let (u, convergence) = chain.solve(&u0)?;
+    let (u, convergence) = chain.no_worse_than(u0, u, convergence);
+    finish(
+        &obj,
+        params,
+        &u,
+        settings,
+        convergence,
+        chain.iterations,
+        chain.log,
+        trajectory,
+        clock,
+    )
+}
+
+/// The free members of `params` after checking the settings, each parameter, that no name
+/// is given twice, and that `problem` has more samples than free parameters.
+fn checked<'p>(
+    problem: &dyn Residuals,
+    params: &'p [FitParam],
+    settings: &FitSettings,
+) -> Result<Vec<&'p FitParam>, FitError> {
     settings.validate()?;
     for (i, p) in params.iter().enumerate() {
         p.validate()?;
@@ -50,129 +92,124 @@ pub fn run(
             free.len()
         )));
     }
-    let obj = Objective::new(
-        problem,
-        free.iter().map(|p| p.transform()).collect(),
-        observer,
-    );
-    let p = obj.dim();
-    let u0 = vec![0.0; p];
-    if obj.cost(&u0).is_none() {
-        return Err(FitError::StartFails(
-            obj.last_failure().unwrap_or_else(|| "unknown".into()),
-        ));
-    }
-    let mut log = Vec::new();
-    let mut iterations = 0;
-    let (u, convergence) = if p == 0 {
-        log.push("no free parameters: evaluated only".to_string());
-        (
-            u0.clone(),
-            Convergence::Converged {
-                reason: "nothing to fit".into(),
-            },
-        )
-    } else {
-        // In a trajectory fit a refinement that pins a parameter on a bound stops there; the
-        // parameter is then released (see `release_pinned`).
-        let at_bound = |u: &[f64]| !pinned(&obj, &free, u).is_empty();
-        let stop_at_bound: BoundStop = trajectory.then_some(&at_bound);
-        let lm = |start: &[f64], iterations: &mut u64, log: &mut Vec<String>| {
-            obj.set_stage(SolverStage::LevenbergMarquardt);
-            let out = levenberg_marquardt::refine(
-                &obj,
-                start,
-                settings.max_iters,
-                settings.tol,
-                settings.fd_step,
-                stop_at_bound,
-            );
-            *iterations += out.iterations;
-            log.push(format!(
-                "levenberg_marquardt: {} iterations, {:?}",
-                out.iterations, out.convergence
-            ));
-            (out.u, out.convergence)
-        };
-        match settings.solver {
-            Solver::NelderMead => {
-                let (u, it, conv) = nelder_mead(&obj, &u0, settings.simplex_tol, settings)?;
-                iterations += it;
-                log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
-                (u, conv)
-            }
+    Ok(free)
+}
+
+/// The solver chain of a fit: its objective, free parameters and settings, and the
+/// iterations and log of its stages so far.
+struct Chain<'a> {
+    obj: &'a Objective<'a>,
+    free: &'a [&'a FitParam],
+    settings: &'a FitSettings,
+    trajectory: bool,
+    iterations: u64,
+    log: Vec<String>,
+}
+
+impl Chain<'_> {
+    /// The stages of the chosen solver from `u0` (then, in a trajectory fit, the release of
+    /// pinned parameters): where they end and how.
+    fn solve(&mut self, u0: &[f64]) -> Result<(Vec<f64>, Convergence), FitError> {
+        if u0.is_empty() {
+            self.log.push("no free parameters: evaluated only".into());
+            let reason = "nothing to fit".into();
+            return Ok((u0.to_vec(), Convergence::Converged { reason }));
+        }
+        let settings = self.settings;
+        let (u, convergence) = match settings.solver {
+            Solver::NelderMead => self.nelder_mead(u0, settings.simplex_tol)?,
             Solver::Auto => {
-                let (u, conv) = lm(&u0, &mut iterations, &mut log);
+                let (u, conv) = self.lm(u0);
                 if conv.converged() {
                     (u, conv)
                 } else {
                     // From where Levenberg–Marquardt got to, not from the start: restarting
                     // from the start threw its progress away, and a simplex from there was
                     // seen to end far worse.
-                    log.push(
+                    self.log.push(
                         "levenberg_marquardt did not converge: Nelder–Mead from its best \
                          point, then again"
                             .into(),
                     );
                     let tol = settings.simplex_tol.max(settings.presearch_tol);
-                    let (u, it, conv) = nelder_mead(&obj, &u, tol, settings)?;
-                    iterations += it;
-                    log.push(format!("nelder_mead: {it} iterations, {conv:?}"));
-                    lm(&u, &mut iterations, &mut log)
+                    let (u, _) = self.nelder_mead(&u, tol)?;
+                    self.lm(&u)
                 }
             }
-            Solver::LevenbergMarquardt => lm(&u0, &mut iterations, &mut log),
+            Solver::LevenbergMarquardt => self.lm(u0),
             Solver::ParticleSwarm => {
-                let (u, it) = particle_swarm(&obj, &u0, settings)?;
-                iterations += it;
-                log.push(format!("particle_swarm: {it} iterations"));
-                lm(&u, &mut iterations, &mut log)
+                let (u, it) = particle_swarm(self.obj, u0, settings)?;
+                self.iterations += it;
+                self.log.push(format!("particle_swarm: {it} iterations"));
+                self.lm(&u)
+            }
+        };
+        Ok(if self.trajectory {
+            release_pinned(self, u, convergence)
+        } else {
+            (u, convergence)
+        })
+    }
+
+    /// Levenberg–Marquardt from `start`, logged. In a trajectory fit a refinement that pins a
+    /// parameter on a bound stops there; the parameter is then released (see
+    /// [`release_pinned`]).
+    fn lm(&mut self, start: &[f64]) -> (Vec<f64>, Convergence) {
+        let (obj, free, settings) = (self.obj, self.free, self.settings);
+        let at_bound = |u: &[f64]| !pinned(obj, free, u).is_empty();
+        let stop_at_bound: BoundStop = self.trajectory.then_some(&at_bound);
+        obj.set_stage(SolverStage::LevenbergMarquardt);
+        let out = levenberg_marquardt::refine(
+            obj,
+            start,
+            settings.max_iters,
+            settings.tol,
+            settings.fd_step,
+            stop_at_bound,
+        );
+        self.iterations += out.iterations;
+        self.log.push(format!(
+            "levenberg_marquardt: {} iterations, {:?}",
+            out.iterations, out.convergence
+        ));
+        (out.u, out.convergence)
+    }
+
+    /// Nelder–Mead from `start` to the simplex tolerance `tol`, logged.
+    fn nelder_mead(
+        &mut self,
+        start: &[f64],
+        tol: f64,
+    ) -> Result<(Vec<f64>, Convergence), FitError> {
+        let (u, it, conv) = nelder_mead(self.obj, start, tol, self.settings)?;
+        self.iterations += it;
+        self.log
+            .push(format!("nelder_mead: {it} iterations, {conv:?}"));
+        Ok((u, conv))
+    }
+
+    /// A fit never ends worse than its start: whatever the chain did, the start `u0` is kept
+    /// if it is better than where the chain ended (`u`, `convergence`).
+    fn no_worse_than(
+        &mut self,
+        u0: Vec<f64>,
+        u: Vec<f64>,
+        convergence: Convergence,
+    ) -> (Vec<f64>, Convergence) {
+        let start_cost = self.obj.cost(&u0).unwrap_or(f64::INFINITY);
+        match self.obj.cost(&u) {
+            Some(c) if c <= start_cost => (u, convergence),
+            end => {
+                self.log.push(format!(
+                    "the solvers ended worse than the start (mean square {} > \
+                     {start_cost:e}): the start is kept",
+                    end.map_or("failed".to_string(), |c| format!("{c:e}"))
+                ));
+                let reason = "no solver improved on the start".into();
+                (u0, Convergence::Failed { reason })
             }
         }
-    };
-    let (u, convergence) = if trajectory && p > 0 {
-        release_pinned(
-            &obj,
-            &free,
-            u,
-            convergence,
-            settings,
-            &mut iterations,
-            &mut log,
-        )
-    } else {
-        (u, convergence)
-    };
-    // A fit never ends worse than its start: whatever the chain did, the start is kept if
-    // it is better.
-    let start_cost = obj.cost(&u0).unwrap_or(f64::INFINITY);
-    let (u, convergence) = match obj.cost(&u) {
-        Some(c) if c <= start_cost => (u, convergence),
-        end => {
-            log.push(format!(
-                "the solvers ended worse than the start (mean square {} > {start_cost:e}): \
-                 the start is kept",
-                end.map_or("failed".to_string(), |c| format!("{c:e}"))
-            ));
-            (
-                u0,
-                Convergence::Failed {
-                    reason: "no solver improved on the start".into(),
-                },
-            )
-        }
-    };
-    finish(
-        &obj,
-        params,
-        &u,
-        settings,
-        convergence,
-        iterations,
-        log,
-        trajectory,
-        clock,
-    )
+    }
 }
 
 /// Closest a parameter may end to a bound, as a fraction of its typical size (its scale: the
@@ -206,14 +243,11 @@ fn pinned(obj: &Objective, free: &[&FitParam], u: &[f64]) -> Vec<usize> {
 /// runs again from there; the better end is kept. (Force-level fits, cheap to refine, let the
 /// refinement run on along the bound instead: there a parameter often belongs on its bound.)
 fn release_pinned(
-    obj: &Objective,
-    free: &[&FitParam],
+    chain: &mut Chain,
     u: Vec<f64>,
     convergence: Convergence,
-    settings: &FitSettings,
-    iterations: &mut u64,
-    log: &mut Vec<String>,
 ) -> (Vec<f64>, Convergence) {
+    let (obj, free, settings) = (chain.obj, chain.free, chain.settings);
     let stuck = pinned(obj, free, &u);
     if stuck.is_empty() {
         return (u, convergence);
@@ -234,11 +268,11 @@ fn release_pinned(
         settings.fd_step,
         Some(&|u: &[f64]| !pinned(obj, free, u).is_empty()),
     );
-    *iterations += out.iterations;
+    chain.iterations += out.iterations;
     let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
     match obj.cost(&out.u) {
         Some(c) if c < cost => {
-            log.push(format!(
+            chain.log.push(format!(
                 "{} ended on a bound: released to the start, levenberg_marquardt again: {} \
                  iterations, {:?} (mean square {cost:e} → {c:e})",
                 names.join(", "),
@@ -248,7 +282,7 @@ fn release_pinned(
             (out.u, out.convergence)
         }
         end => {
-            log.push(format!(
+            chain.log.push(format!(
                 "{} ended on a bound: released to the start, the refinement ended no better \
                  ({}); the bound is kept",
                 names.join(", "),

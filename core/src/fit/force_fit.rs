@@ -10,7 +10,8 @@
 //!
 //! ```
 //! use std::sync::Arc;
-//! use stf_core::fit::{ForceData, ForceFit};
+//! use stf_core::data::force_data::ForceData;
+//! use stf_core::fit::ForceFit;
 //! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 //! use stf_core::physics::param_spec::ParamSpec;
 //! struct Lin(Vec<ParamSpec>);
@@ -26,7 +27,7 @@
 //! let v: Vec<f64> = t.iter().map(|t| (5.0 * t).cos()).collect();
 //! let f: Vec<f64> = v.iter().map(|v| 3.0 * v).collect();
 //! let zeros = vec![0.0; t.len()];
-//! let data = ForceData { t: &t, x: &zeros, v: &v, a: &zeros, f: &f };
+//! let data = ForceData::new(&t, &zeros, &v, &zeros, &f);
 //! let result = ForceFit::new(model).fit(&data, None).unwrap();
 //! assert!((result.value("c").unwrap() - 3.0).abs() < 1e-6);
 //! ```
@@ -221,12 +222,7 @@ impl Residuals for ForceResiduals<'_> {
         if m.n_internal() == 0 {
             for k in 0..self.len() {
                 let i = self.row(k);
-                let s = ModelState {
-                    t: d.t[i],
-                    x: d.x[i],
-                    v: d.v[i],
-                    z: &[],
-                };
+                let s = d.state(i, &[]);
                 let (ma, f) = m.mass_and_force(p, &s, &mut []).map_err(err)?;
                 sink(k, d.f[i] - (ma * d.a[i] + f + offset));
             }
@@ -262,12 +258,7 @@ impl Residuals for ForceResiduals<'_> {
         let d = &self.data;
         for k in 0..self.len() {
             let i = self.row(k);
-            let s = ModelState {
-                t: d.t[i],
-                x: d.x[i],
-                v: d.v[i],
-                z: &state,
-            };
+            let s = d.state(i, &state);
             match m.gradient(p, &s, d.a[i], &mut grad) {
                 Ok(true) => {}
                 Ok(false) => return None,
@@ -304,12 +295,7 @@ fn integrate_state(
     let last = d.t.len() - 1;
     let mut next = 0;
     for i in 0..=last {
-        let s = ModelState {
-            t: d.t[i],
-            x: d.x[i],
-            v: d.v[i],
-            z,
-        };
+        let s = d.state(i, z);
         let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
         if let Some(k) = k {
             let (ma, f) = m.mass_and_force(p, &s, k1)?;
@@ -339,12 +325,7 @@ fn integrate_state(
         for j in 0..nz {
             zs[j] = z[j] + h * k3[j];
         }
-        let se = ModelState {
-            t: d.t[i + 1],
-            x: d.x[i + 1],
-            v: d.v[i + 1],
-            z: zs,
-        };
+        let se = d.state(i + 1, zs);
         m.rates(p, &se, k4)?;
         for j in 0..nz {
             z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);

@@ -90,147 +90,204 @@ pub fn refine(
     fd_step: f64,
     stop_at_bound: BoundStop,
 ) -> Refined {
-    let n = obj.len();
-    let p = obj.dim();
-    let mut u = u0.to_vec();
+    let (n, p) = (obj.len(), obj.dim());
     let mut r = vec![0.0; n];
-    let mut trial = vec![0.0; n];
-    let Some(mut rss) = obj.residuals_user(&obj.to_user(&u), &mut r) else {
+    let Some(rss) = obj.residuals_user(&obj.to_user(u0), &mut r) else {
+        let reason = "the start of the refinement cannot be evaluated".into();
         return Refined {
-            u,
+            u: u0.to_vec(),
             iterations: 0,
-            convergence: Convergence::Failed {
-                reason: "the start of the refinement cannot be evaluated".into(),
-            },
+            convergence: Convergence::Failed { reason },
         };
     };
-    let mut jac = DMatrix::<f64>::zeros(n, p);
-    let mut steps = vec![fd_step; p];
-    // An exact Jacobian where the problem gives one; else differences whose steps grow above
-    // the residuals' noise, measured once (lazily: an exact Jacobian needs no noise).
-    let mut floor: Option<StepFloor> = None;
-    let mut lambda = 1e-3;
-    let mut nu = 2.0;
+    let mut lm = Lm {
+        obj,
+        u: u0.to_vec(),
+        r,
+        trial: vec![0.0; n],
+        rss,
+        lambda: 1e-3,
+        nu: 2.0,
+        jac: DMatrix::<f64>::zeros(n, p),
+        steps: vec![fd_step; p],
+        floor: None,
+        fd_step,
+    };
     for iter in 1..=max_iters {
+        let all_exact = lm.jacobian();
+        let jt = lm.jac.transpose();
+        let a = &jt * &lm.jac;
+        let g = &jt * DVector::from_column_slice(&lm.r);
+        let (cosine, inner_cosine) = lm.cosines(&a, &g);
+        let end = if lm.rss.sqrt() == 0.0 || cosine < tol.sqrt() * 1e-2 {
+            Some(Convergence::Converged {
+                reason: format!("residuals orthogonal to the Jacobian (cosine {cosine:.1e})"),
+            })
+        } else {
+            lm.step(
+                &a,
+                &g,
+                (tol, all_exact.then_some(inner_cosine)),
+                stop_at_bound,
+            )
+        };
+        if let Some(convergence) = end {
+            return Refined {
+                u: lm.u,
+                iterations: iter,
+                convergence,
+            };
+        }
+    }
+    Refined {
+        u: lm.u,
+        iterations: max_iters,
+        convergence: Convergence::MaxIterations,
+    }
+}
+
+/// A refinement under way: the point, its residuals and cost, the damping, the Jacobian and
+/// its difference steps.
+struct Lm<'a> {
+    obj: &'a Objective<'a>,
+    u: Vec<f64>,
+    r: Vec<f64>,
+    /// The residuals of the last trial point.
+    trial: Vec<f64>,
+    rss: f64,
+    lambda: f64,
+    nu: f64,
+    jac: DMatrix<f64>,
+    steps: Vec<f64>,
+    /// The difference steps' floor above the residuals' noise, measured once (lazily: an
+    /// exact Jacobian needs no noise).
+    floor: Option<StepFloor>,
+    fd_step: f64,
+}
+
+impl Lm<'_> {
+    /// The Jacobian at `u`: exact where the problem gives one, else differences whose steps
+    /// grow above the residuals' noise; non-finite entries zeroed. Whether it is all exact.
+    fn jacobian(&mut self) -> bool {
+        let (obj, p) = (self.obj, self.u.len());
         let exact = obj
-            .jacobian_internal(&u, &mut jac)
+            .jacobian_internal(&self.u, &mut self.jac)
             .unwrap_or_else(|| vec![false; p]);
         let all_exact = exact.iter().all(|&e| e);
         if !all_exact {
-            let floor = floor.get_or_insert_with(|| StepFloor {
-                noise: residual_noise(&u, &r, &vec![NOISE_PROBE; p], &|point, out| {
+            let (u, r, fd_step) = (&self.u, &self.r, self.fd_step);
+            let floor = self.floor.get_or_insert_with(|| StepFloor {
+                noise: residual_noise(u, r, &vec![NOISE_PROBE; p], &|point, out| {
                     obj.residuals_user(&obj.to_user(point), out).is_some()
                 })
                 .unwrap_or(0.0),
                 max: vec![MAX_FD_STEP.max(fd_step); p],
             });
             forward_difference(
-                &u,
-                &r,
-                &mut steps,
+                u,
+                r,
+                &mut self.steps,
                 floor,
                 &|_, _| false,
                 &|point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
                 &exact,
-                &mut jac,
+                &mut self.jac,
             );
         }
-        jac.iter_mut()
+        self.jac
+            .iter_mut()
             .filter(|v| !v.is_finite())
             .for_each(|v| *v = 0.0);
-        let jt = jac.transpose();
-        let a = &jt * &jac;
-        let g = &jt * DVector::from_column_slice(&r);
-        let rnorm = rss.sqrt();
-        let cosine = (0..p)
-            .filter(|&j| a[(j, j)] > 0.0)
-            .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
-            .fold(0.0_f64, f64::max);
-        // The same over the parameters away from their bounds (where the map is not flat): a
-        // parameter pressing on its bound has a large cosine that no step can use.
-        let inner_cosine = (0..p)
-            .filter(|&j| a[(j, j)] > 0.0 && !obj.transforms()[j].saturated(u[j]))
-            .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
-            .fold(0.0_f64, f64::max);
-        if rnorm == 0.0 || cosine < tol.sqrt() * 1e-2 {
-            return Refined {
-                u,
-                iterations: iter,
-                convergence: Convergence::Converged {
-                    reason: format!("residuals orthogonal to the Jacobian (cosine {cosine:.1e})"),
-                },
-            };
-        }
-        let dmax = (0..p).map(|j| a[(j, j)]).fold(0.0_f64, f64::max);
+        all_exact
+    }
+
+    /// The largest cosine between the residuals and a column of the Jacobian (`a` = JᵀJ,
+    /// `g` = Jᵀr), over all parameters and over those away from their bounds (where the map
+    /// is not flat: a parameter pressing on its bound has a large cosine that no step can
+    /// use).
+    fn cosines(&self, a: &DMatrix<f64>, g: &DVector<f64>) -> (f64, f64) {
+        let rnorm = self.rss.sqrt();
+        let transforms = self.obj.transforms();
+        let cosine = |inner: bool| {
+            (0..self.u.len())
+                .filter(|&j| a[(j, j)] > 0.0 && !(inner && transforms[j].saturated(self.u[j])))
+                .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
+                .fold(0.0_f64, f64::max)
+        };
+        (cosine(false), cosine(true))
+    }
+
+    /// One iteration's step: the damping raised until a step lowers the cost, then lowered
+    /// (Nielsen). How the refinement ends, if it does here: stopped on a bound, a small
+    /// change (below `tol`; `inner_cosine` as [`small_change`] reads it), or no step lowering
+    /// the cost at any damping.
+    fn step(
+        &mut self,
+        a: &DMatrix<f64>,
+        g: &DVector<f64>,
+        (tol, inner_cosine): (f64, Option<f64>),
+        stop_at_bound: BoundStop,
+    ) -> Option<Convergence> {
+        let dmax = (0..self.u.len()).map(|j| a[(j, j)]).fold(0.0_f64, f64::max);
         let floor = (1e-12 * dmax).max(f64::MIN_POSITIVE);
         loop {
-            let mut m = a.clone();
-            for j in 0..p {
-                m[(j, j)] += lambda * a[(j, j)].max(floor);
+            let Some((cand, new_rss, rho, step_size)) = self.tried(a, g, floor) else {
+                self.lambda *= self.nu;
+                self.nu *= 2.0;
+                if self.lambda > LAMBDA_MAX {
+                    let reason = "no step lowers the cost any further".into();
+                    return Some(Convergence::Converged { reason });
+                }
+                continue;
+            };
+            let drop = (self.rss - new_rss) / self.rss;
+            self.u = cand;
+            self.rss = new_rss;
+            std::mem::swap(&mut self.r, &mut self.trial);
+            self.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+            self.nu = 2.0;
+            if stop_at_bound.is_some_and(|pinned| pinned(&self.u)) {
+                let reason = "stopped on a parameter's bound".into();
+                return Some(Convergence::Converged { reason });
             }
-            let step = m.cholesky().map(|c| {
-                let delta = c.solve(&(-&g));
-                // A step of at most MAX_STEP scales: a long one would run into the flat,
-                // saturated part of a bound transform and stall there.
-                let longest = delta.amax();
-                if longest > MAX_STEP {
-                    delta * (MAX_STEP / longest)
-                } else {
-                    delta
-                }
-            });
-            let accepted = step.and_then(|delta| {
-                let cand: Vec<f64> = u.iter().zip(delta.iter()).map(|(a, b)| a + b).collect();
-                let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut trial)?;
-                let predicted = -2.0 * g.dot(&delta) - delta.dot(&(&a * &delta));
-                let rho = (rss - new_rss) / predicted;
-                (new_rss < rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
-            });
-            match accepted {
-                Some((cand, new_rss, rho, step_size)) => {
-                    let drop = (rss - new_rss) / rss;
-                    u = cand;
-                    rss = new_rss;
-                    std::mem::swap(&mut r, &mut trial);
-                    lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
-                    nu = 2.0;
-                    if stop_at_bound.is_some_and(|pinned| pinned(&u)) {
-                        return Refined {
-                            u,
-                            iterations: iter,
-                            convergence: Convergence::Converged {
-                                reason: "stopped on a parameter's bound".into(),
-                            },
-                        };
-                    }
-                    if drop < tol || step_size < 1e-12 {
-                        return Refined {
-                            u,
-                            iterations: iter,
-                            convergence: small_change(drop, tol, all_exact.then_some(inner_cosine)),
-                        };
-                    }
-                    break;
-                }
-                None => {
-                    lambda *= nu;
-                    nu *= 2.0;
-                    if lambda > LAMBDA_MAX {
-                        return Refined {
-                            u,
-                            iterations: iter,
-                            convergence: Convergence::Converged {
-                                reason: "no step lowers the cost any further".into(),
-                            },
-                        };
-                    }
-                }
+            if drop < tol || step_size < 1e-12 {
+                return Some(small_change(drop, tol, inner_cosine));
             }
+            return None;
         }
     }
-    Refined {
-        u,
-        iterations: max_iters,
-        convergence: Convergence::MaxIterations,
+
+    /// The step at the current damping (diagonal at least `floor`), if it lowers the cost
+    /// with a positive gain ratio: the point, its cost, the ratio and the step's length.
+    fn tried(
+        &mut self,
+        a: &DMatrix<f64>,
+        g: &DVector<f64>,
+        floor: f64,
+    ) -> Option<(Vec<f64>, f64, f64, f64)> {
+        let mut m = a.clone();
+        for j in 0..self.u.len() {
+            m[(j, j)] += self.lambda * a[(j, j)].max(floor);
+        }
+        let delta = m.cholesky()?.solve(&(-g));
+        // A step of at most MAX_STEP scales: a long one would run into the flat, saturated
+        // part of a bound transform and stall there.
+        let longest = delta.amax();
+        let delta = if longest > MAX_STEP {
+            delta * (MAX_STEP / longest)
+        } else {
+            delta
+        };
+        let cand: Vec<f64> = self
+            .u
+            .iter()
+            .zip(delta.iter())
+            .map(|(a, b)| a + b)
+            .collect();
+        let obj = self.obj;
+        let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut self.trial)?;
+        let predicted = -2.0 * g.dot(&delta) - delta.dot(&(a * &delta));
+        let rho = (self.rss - new_rss) / predicted;
+        (new_rss < self.rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
     }
 }

@@ -3,7 +3,7 @@
 //! Two kinds of fit share one engine:
 //!
 //! - [`ForceFit`]: force level — an STF model's force `m_a·a + f(t, x, v, z) + f_off` against a
-//!   measured F_STF, along measured kinematics ([`ForceData`]).
+//!   measured F_STF, along measured kinematics ([`ForceData`](crate::data::force_data::ForceData)).
 //! - [`TrajectoryFit`]: trajectory level, as in the source study — simulate the oscillator
 //!   (with or without an STF model) and minimise `S(μ) = mean((x_exp − x_sim − x_off)²)`.
 //!
@@ -43,7 +43,6 @@ mod transform;
 mod validation;
 mod warning;
 
-pub use crate::data::force_data::ForceData;
 pub use error::FitError;
 pub use fit_param::{full_values, FitParam};
 pub use force_fit::{ForceFit, FORCE_OFFSET};

@@ -158,13 +158,7 @@ mod tests {
         ]));
         let t: Vec<f64> = (0..50).map(|i| i as f64 * 0.01).collect();
         let zeros = vec![0.0; t.len()];
-        let data = ForceData {
-            t: &t,
-            x: &zeros,
-            v: &zeros,
-            a: &zeros,
-            f: &zeros,
-        };
+        let data = ForceData::new(&t, &zeros, &zeros, &zeros, &zeros);
         let motion = MotionNoise {
             x: 1e-4,
             v: 0.01,

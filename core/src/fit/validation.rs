@@ -12,7 +12,8 @@
 //!
 //! ```
 //! use std::sync::Arc;
-//! use stf_core::fit::{ForceData, ForceFit};
+//! use stf_core::data::force_data::ForceData;
+//! use stf_core::fit::ForceFit;
 //! use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 //! use stf_core::physics::param_spec::ParamSpec;
 //! struct Lin(Vec<ParamSpec>);
@@ -29,7 +30,7 @@
 //! let v: Vec<f64> = t.iter().map(|t| (5.0 * t).cos()).collect();
 //! let f: Vec<f64> = v.iter().map(|v| 3.0 * v).collect();
 //! let zeros = vec![0.0; t.len()];
-//! let other = ForceData { t: &t, x: &zeros, v: &v, a: &zeros, f: &f };
+//! let other = ForceData::new(&t, &zeros, &v, &zeros, &f);
 //! let score = fit.validate(&other, &[2.9]).unwrap();
 //! assert!((score.normalised - 1.0 / 30.0).abs() < 1e-12);
 //! ```

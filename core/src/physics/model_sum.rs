@@ -108,6 +108,14 @@ impl ModelSum {
     fn states(&self, i: usize) -> std::ops::Range<usize> {
         self.state_offsets[i]..self.state_offsets[i + 1]
     }
+
+    /// The state part `i` sees: the sum's `s` with its own internal states only.
+    fn local<'s>(&self, i: usize, s: &ModelState<'s>) -> ModelState<'s> {
+        ModelState {
+            z: &s.z[self.states(i)],
+            ..*s
+        }
+    }
 }
 
 impl ForceModel for ModelSum {
@@ -140,10 +148,7 @@ impl ForceModel for ModelSum {
     fn added_mass(&self, p: &[f64], s: &ModelState) -> Result<f64, ModelError> {
         let mut total = 0.0;
         for (i, part) in self.parts.iter().enumerate() {
-            let local = ModelState {
-                z: &s.z[self.states(i)],
-                ..*s
-            };
+            let local = self.local(i, s);
             total += part.added_mass(self.part_slices(i, p), &local)?;
         }
         Ok(total)
@@ -153,10 +158,7 @@ impl ForceModel for ModelSum {
         let mut total = 0.0;
         for (i, part) in self.parts.iter().enumerate() {
             let states = self.states(i);
-            let local = ModelState {
-                z: &s.z[states.clone()],
-                ..*s
-            };
+            let local = self.local(i, s);
             total += part.force(self.part_slices(i, p), &local, &mut dz[states])?;
         }
         Ok(total)
@@ -171,10 +173,7 @@ impl ForceModel for ModelSum {
         let (mut mass, mut force) = (0.0, 0.0);
         for (i, part) in self.parts.iter().enumerate() {
             let states = self.states(i);
-            let local = ModelState {
-                z: &s.z[states.clone()],
-                ..*s
-            };
+            let local = self.local(i, s);
             let (m, f) = part.mass_and_force(self.part_slices(i, p), &local, &mut dz[states])?;
             mass += m;
             force += f;
@@ -188,10 +187,7 @@ impl ForceModel for ModelSum {
             if states.is_empty() {
                 continue;
             }
-            let local = ModelState {
-                z: &s.z[states.clone()],
-                ..*s
-            };
+            let local = self.local(i, s);
             part.rates(self.part_slices(i, p), &local, &mut dz[states])?;
         }
         Ok(())

@@ -101,11 +101,6 @@ impl OscillatorParams {
     pub fn get(&self, name: &str) -> Option<f64> {
         name.parse::<OscParam>().ok().map(|p| self[p])
     }
-
-    /// Natural frequency √(k/m), rad/s.
-    pub fn natural_frequency(&self) -> f64 {
-        (self.k / self.m).sqrt()
-    }
 }
 
 /// One of the oscillator's parameters, in the order of [`OscillatorParams::NAMES`]; its text

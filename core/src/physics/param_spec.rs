@@ -56,8 +56,3 @@ impl ParamSpec {
 pub fn defaults(specs: &[ParamSpec]) -> Vec<f64> {
     specs.iter().map(|s| s.default).collect()
 }
-
-/// Index of the parameter called `name`, if any.
-pub fn index_of(specs: &[ParamSpec], name: &str) -> Option<usize> {
-    specs.iter().position(|s| s.name == name)
-}

@@ -69,18 +69,25 @@ pub fn cycles_from_phase(t: &[f64], phi: &[f64]) -> Result<Vec<Cycle>, RegimeErr
             cuts.push(i);
         }
     }
-    Ok(cuts
-        .windows(2)
+    Ok(between(&cuts, t, |s, e| {
+        (phi[e] - phi[s]).abs() / (t[e] - t[s])
+    }))
+}
+
+/// The cycles between consecutive `cuts` (sample indices) at times `t`, each's ω from
+/// `omega(start, end)`.
+fn between(cuts: &[usize], t: &[f64], omega: impl Fn(usize, usize) -> f64) -> Vec<Cycle> {
+    cuts.windows(2)
         .map(|w| {
             let (s, e) = (w[0], w[1]);
             Cycle {
                 start: s,
                 end: e,
                 t_mid: 0.5 * (t[s] + t[e]),
-                omega: (phi[e] - phi[s]).abs() / (t[e] - t[s]),
+                omega: omega(s, e),
             }
         })
-        .collect())
+        .collect()
 }
 
 /// `count` equal stretches of a record that has too few cycles of its own to hold some out
@@ -128,18 +135,7 @@ pub fn cycles_from_x(t: &[f64], x: &[f64], hysteresis: f64) -> Result<Vec<Cycle>
             armed = false;
         }
     }
-    Ok(cuts
-        .windows(2)
-        .map(|w| {
-            let (s, e) = (w[0], w[1]);
-            Cycle {
-                start: s,
-                end: e,
-                t_mid: 0.5 * (t[s] + t[e]),
-                omega: TAU / (t[e] - t[s]),
-            }
-        })
-        .collect())
+    Ok(between(&cuts, t, |s, e| TAU / (t[e] - t[s])))
 }
 
 /// The rotor angle (rad, from 0) integrated from its speed `omega` (rad/s) by the trapezoid

@@ -260,13 +260,7 @@ mod tests {
 
     impl Case {
         fn sig(&self) -> ForceData<'_> {
-            ForceData {
-                t: &self.t,
-                x: &self.x,
-                v: &self.v,
-                a: &self.a,
-                f: &self.f,
-            }
+            ForceData::new(&self.t, &self.x, &self.v, &self.a, &self.f)
         }
         fn cycle(&self, n: usize, k: usize, omega: f64) -> Cycle {
             Cycle {

@@ -317,13 +317,7 @@ mod tests {
         let g = Normal::new(0.0, 0.02).unwrap();
         let truth: Vec<f64> = v.iter().map(|v| 40.0 * v).collect();
         let f: Vec<f64> = truth.iter().map(|f| f + g.sample(&mut rng)).collect();
-        let sig = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let sig = ForceData::new(&t, &x, &v, &a, &f);
         let th = RegimeThresholds::default();
         let meas = classify(&sig, cycles_from_phase(&t, &phi).unwrap(), &th).unwrap();
         let weak: Vec<f64> = truth.iter().map(|f| 0.7 * f).collect();

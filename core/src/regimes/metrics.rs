@@ -367,13 +367,7 @@ mod tests {
     #[test]
     fn a_model_equal_to_the_measurement_has_no_error() {
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let sig = ForceData::new(&t, &x, &v, &a, &f);
         let th = RegimeThresholds::default();
         let m = classify(&sig, cycles_from_phase(&t, &phi).unwrap(), &th).unwrap();
         let c = compare(&m, &sig, &f, &th).unwrap();
@@ -390,13 +384,7 @@ mod tests {
         // exactly 0.5, energy error half the energy). Model B: the same force only while
         // |sin φ| < 0.5, i.e. on for 1/3 of the cycle.
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let sig = ForceData::new(&t, &x, &v, &a, &f);
         let th = RegimeThresholds::default();
         let m = classify(&sig, cycles_from_phase(&t, &phi).unwrap(), &th).unwrap();
         let half: Vec<f64> = f.iter().map(|f| 0.5 * f).collect();
@@ -428,13 +416,7 @@ mod tests {
     #[test]
     fn a_model_force_of_the_wrong_length_is_an_error() {
         let (t, phi, [x, v, a, f]) = record(|_, v| 40.0 * v);
-        let sig = ForceData {
-            t: &t,
-            x: &x,
-            v: &v,
-            a: &a,
-            f: &f,
-        };
+        let sig = ForceData::new(&t, &x, &v, &a, &f);
         let th = RegimeThresholds::default();
         let m = classify(&sig, cycles_from_phase(&t, &phi).unwrap(), &th).unwrap();
         assert!(compare(&m, &sig, &f[1..], &th).is_err());

@@ -35,7 +35,7 @@
 //! let v: Vec<f64> = phi.iter().map(|p| 0.06 * p.cos()).collect();
 //! let a: Vec<f64> = phi.iter().map(|p| -0.36 * p.sin()).collect();
 //! let f: Vec<f64> = v.iter().map(|v| 20.0 * v).collect();
-//! let sig = ForceData { t: &t, x: &x, v: &v, a: &a, f: &f };
+//! let sig = ForceData::new(&t, &x, &v, &a, &f);
 //! let cycles = cycles_from_phase(&t, &phi).unwrap();
 //! let c = classify(&sig, cycles, &RegimeThresholds::default()).unwrap();
 //! assert!(!c.no_stf);

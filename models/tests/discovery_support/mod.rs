@@ -11,9 +11,9 @@
 
 use std::sync::Arc;
 
+use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
 use stf_core::discovery::{discover_force, Candidate, Discovery, DiscoverySettings};
-use stf_core::fit::ForceData;
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;

@@ -96,16 +96,6 @@ const EXPLICIT_RHO_H: f64 = 2.0;
 /// Rodas4 steps in a row that must satisfy it.
 const EXPLICIT_READINGS: u32 = 3;
 
-/// What the run has done so far (for tests and benchmarks).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct Work {
-    pub stats: Stats,
-    /// Accepted Rodas4 steps.
-    pub stiff_steps: u64,
-    /// Hand-overs from the explicit to the stiff method.
-    pub to_stiff: u64,
-}
-
 /// Integrate with `policy`: the sampled states, row after row, and the work. The requests are
 /// checked by the caller.
 pub(super) fn integrate(
@@ -116,95 +106,172 @@ pub(super) fn integrate(
     s: &Settings,
     policy: Policy,
 ) -> Result<(Vec<f64>, Stats), SimError> {
-    let mut work = Work::default();
-    let states = run(sys, t0, y0, t_out, s, policy, &mut work)?;
-    Ok((states, work.stats))
+    // Every sample is written once, in place (the run ends with an error otherwise).
+    let mut out = Samples {
+        t_out,
+        n: y0.len(),
+        states: vec![0.0; t_out.len() * y0.len()],
+        next: 0,
+    };
+    out.write(t0, 1.0, t0, |_, row| row.copy_from_slice(y0));
+    let Some(&t_end) = t_out.last().filter(|_| out.next < t_out.len()) else {
+        return Ok((out.states, Stats::default()));
+    };
+    let mut run = Run::start(sys, (t0, y0), t_end, s, policy)?;
+    run.until(t_end, &mut out)?;
+    run.stats.rhs_calls = run.calls;
+    Ok((out.states, run.stats))
 }
 
-/// The integration loop; returns the sampled states and counts its work in `work`.
-pub(super) fn run(
-    sys: &dyn OdeSystem,
-    t0: f64,
-    y0: &[f64],
-    t_out: &[f64],
-    s: &Settings,
-    policy: Policy,
-    work: &mut Work,
-) -> Result<Vec<f64>, SimError> {
-    let n = y0.len();
-    // Every sample is written once, in place (the run ends with an error otherwise).
-    let mut states = vec![0.0; t_out.len() * n];
-    let mut next_out = 0;
-    while next_out < t_out.len() && t_out[next_out] <= t0 {
-        states[next_out * n..(next_out + 1) * n].copy_from_slice(y0);
-        next_out += 1;
-    }
-    let Some(&t_end) = t_out.last() else {
-        return Ok(states);
-    };
-    if next_out == t_out.len() {
-        return Ok(states);
-    }
-    let span = t_end - t0;
-    let h_max = if s.h_max > 0.0 {
-        s.h_max.min(span)
-    } else {
-        span
-    };
-    let mut calls = 0u64;
+/// The sampled states, row after row, and the next sample to write.
+struct Samples<'a> {
+    t_out: &'a [f64],
+    n: usize,
+    states: Vec<f64>,
+    next: usize,
+}
 
-    let mut t = t0;
-    let mut y = y0.to_vec();
-    let mut f0 = vec![0.0; n];
-    sys.rhs(t, &y, &mut f0)?;
-    calls += 1;
-    check_finite(&f0, t, "the right-hand side at the start")?;
-
-    let mut mode = match policy {
-        Policy::Switching => Mode::Explicit,
-        Policy::StiffOnly => Mode::Stiff,
-    };
-    let order = if mode == Mode::Explicit { 5.0 } else { 4.0 };
-    let mut h = initial_step(sys, t, &y, &f0, order, h_max, s, &mut calls)?;
-    let mut dp = DormandPrince::new(n);
-    let mut ro = Rodas4::new(n);
-    let mut linearised = false;
-
-    // Controller state.
-    let mut rejected_last = false;
-    let mut gustafsson: Option<(f64, f64)> = None; // Rodas4: (h, err) of the last accepted step
-    let mut non_finite_last = false;
-    // Switching state.
-    let (mut stiff_count, mut calm_count, mut explicit_count) = (0u32, 0u32, 0u32);
-    let mut steps = 0u64;
-    let mut explicit_accepted = 0u64;
-    let mut jacobian_stiff = false;
-    let mut jac = vec![0.0; n * n];
-    let mut approach = sys
-        .switching_component()
-        .filter(|&j| j < n)
-        .map(Approach::new);
-
-    while t < t_end {
-        if steps >= u64::from(s.max_steps) {
-            work.stats.rhs_calls = calls;
-            return Err(SimError::TooManySteps { time: t, steps });
+impl Samples<'_> {
+    /// Every sample up to `t_new` of the step of size `h` from `t`, each from `dense(θ, row)`
+    /// at its fraction θ of the step.
+    fn write(&mut self, t: f64, h: f64, t_new: f64, dense: impl Fn(f64, &mut [f64])) {
+        let (n, inv_h) = (self.n, 1.0 / h);
+        while self.next < self.t_out.len() && self.t_out[self.next] <= t_new {
+            let row = &mut self.states[self.next * n..(self.next + 1) * n];
+            dense(((self.t_out[self.next] - t) * inv_h).clamp(0.0, 1.0), row);
+            self.next += 1;
         }
-        let mut last = false;
-        let mut at_breakpoint = None;
-        if t + 1.01 * h >= t_end {
-            h = t_end - t;
-            last = true;
-        } else if let Some(b) = breakpoint_after(sys, t).filter(|&b| b < t_end) {
-            if t + 1.01 * h >= b {
-                h = b - t;
-                at_breakpoint = Some(b);
+    }
+}
+
+/// A run: the state, both methods, the step-size controllers' and the switch's state, and
+/// the work.
+struct Run<'a> {
+    sys: &'a dyn OdeSystem,
+    s: &'a Settings,
+    policy: Policy,
+    h_max: f64,
+    calls: u64,
+    stats: Stats,
+    t: f64,
+    y: Vec<f64>,
+    f0: Vec<f64>,
+    h: f64,
+    mode: Mode,
+    dp: DormandPrince,
+    ro: Rodas4,
+    /// Whether Rodas4 holds the Jacobian at the current state.
+    linearised: bool,
+    rejected_last: bool,
+    /// Rodas4: (h, err) of the last accepted step.
+    gustafsson: Option<(f64, f64)>,
+    non_finite_last: bool,
+    stiff_count: u32,
+    calm_count: u32,
+    explicit_count: u32,
+    explicit_accepted: u64,
+    jacobian_stiff: bool,
+    jac: Vec<f64>,
+    approach: Option<Approach>,
+}
+
+impl<'a> Run<'a> {
+    /// A run from `(t0, y0)` towards `t_end`: the right-hand side at the start and the first
+    /// step size.
+    fn start(
+        sys: &'a dyn OdeSystem,
+        (t0, y0): (f64, &[f64]),
+        t_end: f64,
+        s: &'a Settings,
+        policy: Policy,
+    ) -> Result<Self, SimError> {
+        let n = y0.len();
+        let span = t_end - t0;
+        let h_max = if s.h_max > 0.0 {
+            s.h_max.min(span)
+        } else {
+            span
+        };
+        let mut calls = 0u64;
+        let y = y0.to_vec();
+        let mut f0 = vec![0.0; n];
+        sys.rhs(t0, &y, &mut f0)?;
+        calls += 1;
+        check_finite(&f0, t0, "the right-hand side at the start")?;
+        let mode = match policy {
+            Policy::Switching => Mode::Explicit,
+            Policy::StiffOnly => Mode::Stiff,
+        };
+        let order = if mode == Mode::Explicit { 5.0 } else { 4.0 };
+        let h = initial_step(sys, t0, &y, &f0, order, h_max, s, &mut calls)?;
+        Ok(Run {
+            sys,
+            s,
+            policy,
+            h_max,
+            calls,
+            stats: Stats::default(),
+            t: t0,
+            y,
+            f0,
+            h,
+            mode,
+            dp: DormandPrince::new(n),
+            ro: Rodas4::new(n),
+            linearised: false,
+            rejected_last: false,
+            gustafsson: None,
+            non_finite_last: false,
+            stiff_count: 0,
+            calm_count: 0,
+            explicit_count: 0,
+            explicit_accepted: 0,
+            jacobian_stiff: false,
+            jac: vec![0.0; n * n],
+            approach: sys
+                .switching_component()
+                .filter(|&j| j < n)
+                .map(Approach::new),
+        })
+    }
+
+    /// Step to `t_end`, writing the samples into `out`.
+    fn until(&mut self, t_end: f64, out: &mut Samples) -> Result<(), SimError> {
+        let mut steps = 0u64;
+        while self.t < t_end {
+            if steps >= u64::from(self.s.max_steps) {
+                return Err(SimError::TooManySteps {
+                    time: self.t,
+                    steps,
+                });
+            }
+            let t_new = self.step_end(t_end)?;
+            steps += 1;
+            match self.mode {
+                Mode::Explicit => self.explicit_step(t_new, out)?,
+                Mode::Stiff => self.stiff_step(t_new, out)?,
             }
         }
-        let resolvable = h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
+        Ok(())
+    }
+
+    /// Where the next step ends: `t_end` for the last one, a breakpoint it would cross, or
+    /// `t + h` (`h` shortened to match); an error when the step is too small to resolve.
+    fn step_end(&mut self, t_end: f64) -> Result<f64, SimError> {
+        let t = self.t;
+        let mut t_new = None;
+        if t + 1.01 * self.h >= t_end {
+            self.h = t_end - t;
+            t_new = Some(t_end);
+        } else if let Some(b) = breakpoint_after(self.sys, t).filter(|&b| b < t_end) {
+            if t + 1.01 * self.h >= b {
+                self.h = b - t;
+                t_new = Some(b);
+            }
+        }
+        let resolvable = self.h.abs() > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE);
         if !resolvable {
-            work.stats.rhs_calls = calls;
-            return Err(if non_finite_last {
+            return Err(if self.non_finite_last {
                 SimError::NonFinite {
                     time: t,
                     what: "the solution at every step size tried".into(),
@@ -213,156 +280,180 @@ pub(super) fn run(
                 SimError::StepSizeTooSmall { time: t }
             });
         }
-        steps += 1;
-        let t_new = match (last, at_breakpoint) {
-            (true, _) => t_end,
-            (false, Some(b)) => b,
-            (false, None) => t + h,
-        };
-        match mode {
-            Mode::Explicit => {
-                let trial = dp.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
-                let err = trial.err;
-                non_finite_last = !err.is_finite();
-                let err_root = fifth_root(err);
-                if err <= 1.0 {
-                    dp.accept(&y, &f0, h);
-                    let inv_h = 1.0 / h;
-                    while next_out < t_out.len() && t_out[next_out] <= t_new {
-                        let row = &mut states[next_out * n..(next_out + 1) * n];
-                        dp.dense(((t_out[next_out] - t) * inv_h).clamp(0.0, 1.0), row);
-                        next_out += 1;
-                    }
-                    let f_old = approach.map_or(0.0, |ap| f0[ap.component()]);
-                    if let Some(ap) = approach.as_mut() {
-                        ap.accepted(&y, &dp.y_new, h);
-                    }
-                    dp.advance(&mut y, &mut f0);
-                    let t_prev = t;
-                    t = t_new;
-                    work.stats.accepted += 1;
-                    let fac =
-                        (err_root / SAFETY).clamp(1.0 / EXPLICIT_GROWTH, 1.0 / EXPLICIT_SHRINK);
-                    let mut h_new = (h / fac).min(h_max);
-                    if rejected_last {
-                        h_new = h_new.min(h);
-                    }
-                    rejected_last = false;
-                    if let Some(ap) = &approach {
-                        h_new = ap.cap(h_new, &y, &f0, f_old, h);
-                    }
-                    h = h_new;
-                    if policy == Policy::Switching {
-                        explicit_accepted += 1;
-                        let mut stiff_now = false;
-                        if explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
-                            calls += sys.jacobian(t, &y, &f0, &mut jac)?;
-                            let rho_h = spectral_radius(&jac, n) * (t - t_prev);
-                            stiff_now = jacobian_stiff && rho_h > JACOBIAN_STIFF_RHO_H;
-                            jacobian_stiff = rho_h > JACOBIAN_STIFF_RHO_H;
-                        }
-                        if trial.h_lambda > STIFF_H_LAMBDA {
-                            calm_count = 0;
-                            stiff_count += 1;
-                        } else {
-                            calm_count += 1;
-                            if calm_count >= CALM_READINGS {
-                                stiff_count = 0;
-                            }
-                        }
-                        if stiff_now || stiff_count >= STIFF_READINGS {
-                            {
-                                mode = Mode::Stiff;
-                                work.to_stiff += 1;
-                                stiff_count = 0;
-                                explicit_count = 0;
-                                jacobian_stiff = false;
-                                gustafsson = None;
-                                linearised = false;
-                            }
-                        }
-                    }
-                } else {
-                    work.stats.rejected += 1;
-                    rejected_last = true;
-                    h /= if err.is_finite() {
-                        (err_root / SAFETY).min(1.0 / EXPLICIT_SHRINK)
-                    } else {
-                        1.0 / EXPLICIT_SHRINK
-                    };
-                }
-            }
-            Mode::Stiff => {
-                if !linearised {
-                    ro.linearise(sys, t, &y, &f0, &mut calls)?;
-                    if !ro.jacobian_is_finite() {
-                        work.stats.rhs_calls = calls;
-                        return Err(SimError::NonFinite {
-                            time: t,
-                            what: "the Jacobian".into(),
-                        });
-                    }
-                    linearised = true;
-                }
-                let err = ro.trial(sys, t, &y, &f0, h, s.rtol, s.atol, &mut calls)?;
-                non_finite_last = !err.is_finite();
-                let fac = if err.is_finite() {
-                    (err.powf(0.25) / 0.9).clamp(1.0 / 6.0, 5.0)
-                } else {
-                    5.0
-                };
-                if err <= 1.0 {
-                    let rho = ro.spectral_radius();
-                    ro.accept(&y);
-                    let inv_h = 1.0 / h;
-                    while next_out < t_out.len() && t_out[next_out] <= t_new {
-                        let row = &mut states[next_out * n..(next_out + 1) * n];
-                        ro.dense(((t_out[next_out] - t) * inv_h).clamp(0.0, 1.0), row);
-                        next_out += 1;
-                    }
-                    ro.advance(&mut y);
-                    t = t_new;
-                    sys.rhs(t, &y, &mut f0)?;
-                    calls += 1;
-                    check_finite(&f0, t, "the right-hand side")?;
-                    linearised = false;
-                    work.stats.accepted += 1;
-                    work.stiff_steps += 1;
-                    let mut fac = fac;
-                    if let Some((h_acc, err_acc)) = gustafsson {
-                        let fac_pred = (h_acc / h) * (err * err / err_acc).powf(0.25) / 0.9;
-                        fac = fac.max(fac_pred.clamp(1.0 / 6.0, 5.0));
-                    }
-                    gustafsson = Some((h, err.max(1e-2)));
-                    let mut h_new = (h / fac).min(h_max);
-                    if rejected_last {
-                        h_new = h_new.min(h);
-                    }
-                    rejected_last = false;
-                    h = h_new;
-                    if policy == Policy::Switching {
-                        if rho * h <= EXPLICIT_RHO_H {
-                            explicit_count += 1;
-                            if explicit_count >= EXPLICIT_READINGS {
-                                mode = Mode::Explicit;
-                                explicit_count = 0;
-                                stiff_count = 0;
-                                calm_count = 0;
-                            }
-                        } else {
-                            explicit_count = 0;
-                        }
-                    }
-                } else {
-                    work.stats.rejected += 1;
-                    rejected_last = true;
-                    h /= fac;
-                }
+        Ok(t_new.unwrap_or(t + self.h))
+    }
+
+    /// One Dormand–Prince trial step to `t_new`: accepted (samples written, the step size
+    /// controlled and capped towards a reversal, stiffness watched) or rejected.
+    fn explicit_step(&mut self, t_new: f64, out: &mut Samples) -> Result<(), SimError> {
+        let (s, h) = (self.s, self.h);
+        let trial = self.dp.trial(
+            self.sys,
+            self.t,
+            &self.y,
+            &self.f0,
+            h,
+            s.rtol,
+            s.atol,
+            &mut self.calls,
+        )?;
+        let err = trial.err;
+        self.non_finite_last = !err.is_finite();
+        let err_root = fifth_root(err);
+        if err > 1.0 {
+            self.stats.rejected += 1;
+            self.rejected_last = true;
+            self.h /= if err.is_finite() {
+                (err_root / SAFETY).min(1.0 / EXPLICIT_SHRINK)
+            } else {
+                1.0 / EXPLICIT_SHRINK
+            };
+            return Ok(());
+        }
+        self.dp.accept(&self.y, &self.f0, h);
+        let dp = &self.dp;
+        out.write(self.t, h, t_new, |theta, row| dp.dense(theta, row));
+        let f_old = self.approach.map_or(0.0, |ap| self.f0[ap.component()]);
+        if let Some(ap) = self.approach.as_mut() {
+            ap.accepted(&self.y, &self.dp.y_new, h);
+        }
+        self.dp.advance(&mut self.y, &mut self.f0);
+        let t_prev = self.t;
+        self.t = t_new;
+        self.stats.accepted += 1;
+        let fac = (err_root / SAFETY).clamp(1.0 / EXPLICIT_GROWTH, 1.0 / EXPLICIT_SHRINK);
+        let mut h_new = self.next_h(h / fac);
+        if let Some(ap) = &self.approach {
+            h_new = ap.cap(h_new, &self.y, &self.f0, f_old, h);
+        }
+        self.h = h_new;
+        if self.policy == Policy::Switching {
+            self.watch_stiffness(trial.h_lambda, t_prev)?;
+        }
+        Ok(())
+    }
+
+    /// The step size after an accepted step, from the controller's `h_new`: at most `h_max`,
+    /// and no larger than the step just taken after a rejection.
+    fn next_h(&mut self, h_new: f64) -> f64 {
+        let mut h_new = h_new.min(self.h_max);
+        if self.rejected_last {
+            h_new = h_new.min(self.h);
+        }
+        self.rejected_last = false;
+        h_new
+    }
+
+    /// After an accepted explicit step from `t_prev` whose indicator read `h_lambda`: hand over
+    /// to Rodas4 when Hairer's indicator or the Jacobian's spectral radius reads stiff often
+    /// enough.
+    fn watch_stiffness(&mut self, h_lambda: f64, t_prev: f64) -> Result<(), SimError> {
+        self.explicit_accepted += 1;
+        let mut stiff_now = false;
+        if self.explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
+            self.calls += self
+                .sys
+                .jacobian(self.t, &self.y, &self.f0, &mut self.jac)?;
+            let rho_h = spectral_radius(&self.jac, self.y.len()) * (self.t - t_prev);
+            stiff_now = self.jacobian_stiff && rho_h > JACOBIAN_STIFF_RHO_H;
+            self.jacobian_stiff = rho_h > JACOBIAN_STIFF_RHO_H;
+        }
+        if h_lambda > STIFF_H_LAMBDA {
+            self.calm_count = 0;
+            self.stiff_count += 1;
+        } else {
+            self.calm_count += 1;
+            if self.calm_count >= CALM_READINGS {
+                self.stiff_count = 0;
             }
         }
+        if stiff_now || self.stiff_count >= STIFF_READINGS {
+            self.mode = Mode::Stiff;
+            self.stiff_count = 0;
+            self.explicit_count = 0;
+            self.jacobian_stiff = false;
+            self.gustafsson = None;
+            self.linearised = false;
+        }
+        Ok(())
     }
-    work.stats.rhs_calls = calls;
-    Ok(states)
+
+    /// One Rodas4 trial step to `t_new` (the Jacobian taken at the step's start): accepted
+    /// (samples written, Gustafsson's controller, the explicit method watched for) or
+    /// rejected.
+    fn stiff_step(&mut self, t_new: f64, out: &mut Samples) -> Result<(), SimError> {
+        let (s, h) = (self.s, self.h);
+        if !self.linearised {
+            self.ro
+                .linearise(self.sys, self.t, &self.y, &self.f0, &mut self.calls)?;
+            if !self.ro.jacobian_is_finite() {
+                return Err(SimError::NonFinite {
+                    time: self.t,
+                    what: "the Jacobian".into(),
+                });
+            }
+            self.linearised = true;
+        }
+        let err = self.ro.trial(
+            self.sys,
+            self.t,
+            &self.y,
+            &self.f0,
+            h,
+            s.rtol,
+            s.atol,
+            &mut self.calls,
+        )?;
+        self.non_finite_last = !err.is_finite();
+        let mut fac = if err.is_finite() {
+            (err.powf(0.25) / 0.9).clamp(1.0 / 6.0, 5.0)
+        } else {
+            5.0
+        };
+        if err > 1.0 {
+            self.stats.rejected += 1;
+            self.rejected_last = true;
+            self.h /= fac;
+            return Ok(());
+        }
+        let rho = self.ro.spectral_radius();
+        self.ro.accept(&self.y);
+        let ro = &self.ro;
+        out.write(self.t, h, t_new, |theta, row| ro.dense(theta, row));
+        self.ro.advance(&mut self.y);
+        self.t = t_new;
+        self.sys.rhs(self.t, &self.y, &mut self.f0)?;
+        self.calls += 1;
+        check_finite(&self.f0, self.t, "the right-hand side")?;
+        self.linearised = false;
+        self.stats.accepted += 1;
+        if let Some((h_acc, err_acc)) = self.gustafsson {
+            let fac_pred = (h_acc / h) * (err * err / err_acc).powf(0.25) / 0.9;
+            fac = fac.max(fac_pred.clamp(1.0 / 6.0, 5.0));
+        }
+        self.gustafsson = Some((h, err.max(1e-2)));
+        self.h = self.next_h(h / fac);
+        if self.policy == Policy::Switching {
+            self.watch_explicit(rho);
+        }
+        Ok(())
+    }
+
+    /// After an accepted Rodas4 step with spectral radius `rho`: hand back to the explicit
+    /// method when it would be stable at the next step size often enough in a row.
+    fn watch_explicit(&mut self, rho: f64) {
+        if rho * self.h <= EXPLICIT_RHO_H {
+            self.explicit_count += 1;
+            if self.explicit_count >= EXPLICIT_READINGS {
+                self.mode = Mode::Explicit;
+                self.explicit_count = 0;
+                self.stiff_count = 0;
+                self.calm_count = 0;
+            }
+        } else {
+            self.explicit_count = 0;
+        }
+    }
 }
 
 /// `x^(1/5)` for the step-size controller, in a fraction of `powf`'s cost (it runs once per

@@ -1,0 +1,170 @@
+//! Which scouted candidates are tried on the whole record ([`super::scout`]): each ranked by
+//! the gain of its scout fit ([`Trials::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
+//! their gain is a small share of the best one's ([`left_out`]); and where a scouted fit
+//! continues on the whole record ([`scouted`]).
+
+use super::choice::Trial;
+use super::force_subset_fit::rms_over;
+use super::scout::Scout;
+use super::search_model::SearchModel;
+use super::settings::DiscoverySettings;
+use super::trajectory_setup::TrajectorySetup;
+use super::trajectory_subset_fit::{Rig, Track};
+use super::trajectory_trials::Trials;
+use crate::regimes::Cycle;
+
+/// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
+/// out by their fits on the scout (see [`Trials::step`]).
+pub(super) const SCOUT_KEEP: usize = 3;
+
+/// The least share of the best candidate's gain on the scout for a candidate to be tried on
+/// the whole record in a scouted step (see [`Trials::step`]). A candidate that lowers the
+/// scout's mean square by a fraction of what the best one does cannot win the step unless
+/// the best one fails on the whole record; on Silverbox's 100 000 samples `jamming_on_off`
+/// (5 % of the excess explained) cost more than the two cubic springs' trials together.
+pub(super) const SCOUT_SHARE: f64 = 0.2;
+
+/// Why a scouted candidate is not fitted on the whole record, if it is not: its scout rank
+/// (`rank` of `of`, gain in m²) is past [`SCOUT_KEEP`], its gain is under [`SCOUT_SHARE`] of
+/// the best candidate's `best`, or its scout fit (`start_rms`, m) is no better than the
+/// current model's training RMS `current` on the whole record — where the search failed, and
+/// a short polish does not climb out.
+pub(super) fn left_out(
+    scout_rank: Option<(usize, usize, f64)>,
+    best: f64,
+    start_rms: f64,
+    current: f64,
+) -> Option<String> {
+    if let Some((r, of, gain)) = scout_rank {
+        if r >= SCOUT_KEEP {
+            return Some(format!(
+                "not fitted on the whole record: the scout ranks it {} of {of} (it lowers the \
+                 scout's mean square by {:.3e} mm²)",
+                r + 1,
+                gain * 1e6
+            ));
+        }
+        if best > 0.0 && gain < SCOUT_SHARE * best {
+            return Some(format!(
+                "not fitted on the whole record: on the scout it lowers the mean square by \
+                 {:.3e} mm², less than {:.0} % of the best candidate's {:.3e} mm²",
+                gain * 1e6,
+                SCOUT_SHARE * 100.0,
+                best * 1e6
+            ));
+        }
+    }
+    (start_rms >= current).then(|| {
+        format!(
+            "not fitted on the whole record: its scout fit leaves the training RMS at {:.4} mm, \
+             not below the current model's {:.4} mm",
+            start_rms * 1e3,
+            current * 1e3
+        )
+    })
+}
+
+/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples; `None` for a
+/// shorter record, or when the record makes no scout.
+pub(super) fn scout_of<'r>(
+    rig: &Rig<'r>,
+    cycles: &[Cycle],
+    train: &[usize],
+    settings: &DiscoverySettings,
+) -> Option<Scout<'r>> {
+    if settings.scout_from == 0 || rig.t.len() < settings.scout_from {
+        return None;
+    }
+    Scout::new(rig, cycles, train)
+}
+
+impl Trials<'_, '_> {
+    /// Each searched candidate's rank among them by the gain of its scout fit over the
+    /// current model on the scout, their number and the gain (mean square, m²); all `None`
+    /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
+    pub(super) fn scout_ranks(
+        &self,
+        searched: &[Option<(SearchModel, f64, f64)>],
+        current: &Trial,
+    ) -> Vec<Option<(usize, usize, f64)>> {
+        let mut out = vec![None; searched.len()];
+        let of = searched.iter().flatten().count();
+        let Some(scout) = self.level.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
+            return out;
+        };
+        let Ok(model) = current.stage.model() else {
+            return out;
+        };
+        let Ok(r) = scout.residual(&model, &current.stage.values) else {
+            return out;
+        };
+        let reference = rms_over(&r, &scout.train).powi(2);
+        let mut order: Vec<(usize, f64)> = searched
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.as_ref().map(|(_, ms, _)| (i, reference - ms)))
+            .collect();
+        order.sort_by(|a, b| b.1.total_cmp(&a.1));
+        for (r, (i, gain)) in order.into_iter().enumerate() {
+            out[i] = Some((r, of, gain));
+        }
+        out
+    }
+}
+
+/// Where a fit scouted on `scout` continues on the whole record: `stage` fitted on the scout
+/// if that lowers the whole record's RMS at the samples `train`, else `stage` (one
+/// simulation of each); with its mean square on the scout's training samples (m²) and its RMS
+/// at `train` (m).
+pub(super) fn scouted(
+    stage: SearchModel,
+    scout: &Scout,
+    (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),
+    settings: &DiscoverySettings,
+) -> (SearchModel, f64, f64) {
+    let on_scout = |s: &SearchModel| {
+        s.model()
+            .ok()
+            .and_then(|m| scout.residual(&m, &s.values).ok())
+            .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
+    };
+    let train_rms = |s: &SearchModel| {
+        s.residual(rig)
+            .map_or(f64::INFINITY, |r| rms_over(&r, train))
+    };
+    let before = train_rms(&stage);
+    let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) else {
+        let ms = on_scout(&stage);
+        return (stage, ms, before);
+    };
+    let after = train_rms(&fitted);
+    if after < before {
+        (fitted, fit.rms * fit.rms, after)
+    } else {
+        let ms = on_scout(&stage);
+        (stage, ms, before)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scouted_candidate_is_left_out_by_rank_by_share_or_by_a_failed_search() {
+        let best = 4e-8;
+        let kept = left_out(Some((1, 5, 0.5 * best)), best, 1e-3, 2e-3);
+        assert_eq!(kept, None);
+        let ranked = left_out(Some((SCOUT_KEEP, 5, 0.9 * best)), best, 1e-3, 2e-3).unwrap();
+        assert!(ranked.contains("ranks it 4 of 5"), "{ranked}");
+        let share = left_out(Some((2, 5, 0.1 * best)), best, 1e-3, 2e-3).unwrap();
+        assert!(share.contains("less than 20 % of the best"), "{share}");
+        // No positive gain anywhere: the share rule has nothing to measure against.
+        assert_eq!(left_out(Some((2, 5, -1e-9)), -1e-10, 1e-3, 2e-3), None);
+        let failed = left_out(None, best, 2e-3, 2e-3).unwrap();
+        assert!(
+            failed.contains("not below the current model's 2.0000 mm"),
+            "{failed}"
+        );
+    }
+}

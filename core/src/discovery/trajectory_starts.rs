@@ -1,0 +1,145 @@
+//! Where a candidate's trajectory fit starts: the force-level start, and a screen of the new
+//! effect's amplitude on three bases, the best after a short fit
+//! ([`SearchModel::starts`], [`SearchModel::started`]).
+
+use super::force_level::inside;
+use super::force_subset_fit::rms_over;
+use super::search_model::SearchModel;
+use super::settings::DiscoverySettings;
+use super::trajectory_setup::TrajectorySetup;
+use super::trajectory_subset_fit::Track;
+use crate::physics::param_spec::ParamSpec;
+
+/// Factors of the new effect's first parameter tried before its fit (see
+/// [`SearchModel::starts`]).
+pub(super) const SCREEN: [f64; 6] = [1.0, 3.0, 0.3, 0.1, 0.03, 0.01];
+
+/// Iterations of the short Levenberg–Marquardt fit that ranks a candidate's starts (see
+/// [`SearchModel::started`]).
+pub(super) const START_ITERS: u64 = 6;
+
+impl SearchModel {
+    /// The starts of this stage's fit (a new effect last): the force-level start `hinted` (on
+    /// the current oscillator and on the setup's, to which its force was recovered: a base
+    /// whose friction `T` has absorbed a yield force would count it twice), and the screened
+    /// start — of three bases (the current values, the current model on the
+    /// setup's oscillator `osc_start`, every parameter at its default on `osc_start`) with the
+    /// effect's first parameter (its amplitude, by the models' convention) at each of `SCREEN`
+    /// × its default, the one of lowest training S, one simulation each.
+    ///
+    /// A trajectory is a strongly non-linear function of a stiffness or a force amplitude, so
+    /// a fit from a default far from the data's value ends in a local minimum worse than the
+    /// model without the effect; the screen starts it near the right size. A base that lacks
+    /// an effect often refits the oscillator, and its own law, into a basin of their own (a
+    /// lower `k` standing in for a missing stiffening) from which the sum cannot climb out;
+    /// the other bases start outside it. The force-level start is kept apart: its starting S
+    /// can be the worse while its basin is the right one (a power law gone linear standing in
+    /// for a missing yield force: 0.47 mm screened against 0.07 mm from the force-level start
+    /// after six iterations, on the paper's sweep). Parameters with a negative lower bound or
+    /// a non-positive default are not scaled.
+    pub(super) fn starts(
+        &self,
+        track: &dyn Track,
+        train: &[usize],
+        osc_start: &[f64],
+        hinted: Option<&SearchModel>,
+    ) -> Vec<SearchModel> {
+        // The force-level fit is to the force recovered with the setup's oscillator: it is
+        // tried on that oscillator, and on the current one.
+        let mut out: Vec<SearchModel> = Vec::new();
+        if let Some(h) = hinted.filter(|h| h.values.len() == self.values.len()) {
+            out.push(h.clone());
+            let on_setup = h.on_oscillator(osc_start);
+            if on_setup != h.values {
+                out.push(SearchModel {
+                    parts: self.parts.clone(),
+                    values: on_setup,
+                });
+            }
+        }
+        let screen = self.amplitude(osc_start.len()).zip(self.model().ok());
+        let mut best = (f64::INFINITY, self.values.clone());
+        for values in self.bases(osc_start) {
+            if let Some(((i, spec), model)) = &screen {
+                let mut values = values;
+                for f in SCREEN {
+                    values[*i] = inside(spec.default * f, spec.min, spec.max);
+                    if let Ok(residual) = track.residual(model, &values) {
+                        let s = rms_over(&residual, train);
+                        if s < best.0 {
+                            best = (s, values.clone());
+                        }
+                    }
+                }
+            }
+        }
+        if !out.iter().any(|o| o.values == best.1) {
+            out.push(SearchModel {
+                parts: self.parts.clone(),
+                values: best.1,
+            });
+        }
+        out
+    }
+
+    /// The current values; the current model on the oscillator `osc_start`; every parameter
+    /// at its default on `osc_start` (the offset, if any, as it is).
+    pub(super) fn bases(&self, osc_start: &[f64]) -> [Vec<f64>; 3] {
+        let from_start = self.on_oscillator(osc_start);
+        let mut fresh = from_start.clone();
+        let defaults = self
+            .parts
+            .iter()
+            .flat_map(|p| p.params().iter().map(|s| s.default));
+        for (v, d) in fresh.iter_mut().skip(osc_start.len()).zip(defaults) {
+            *v = d;
+        }
+        [self.values.clone(), from_start, fresh]
+    }
+
+    /// This stage's values with the oscillator's (the first ones) set to `osc`.
+    pub(super) fn on_oscillator(&self, osc: &[f64]) -> Vec<f64> {
+        let mut values = self.values.clone();
+        for (v, &s) in values.iter_mut().zip(osc) {
+            *v = s;
+        }
+        values
+    }
+
+    /// The last part's first parameter and its index in `values` (after `n_osc` oscillator
+    /// values), if it can be screened: a non-negative lower bound and a positive default.
+    pub(super) fn amplitude(&self, n_osc: usize) -> Option<(usize, ParamSpec)> {
+        let extra = self.parts.last()?;
+        let spec = extra.params().first()?;
+        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
+        let i = (n_osc + n_model).checked_sub(extra.params().len())?;
+        (spec.min >= 0.0 && spec.default > 0.0 && i < self.values.len()).then(|| (i, spec.clone()))
+    }
+
+    /// The best of `starts` after a short fit of each (`START_ITERS` Levenberg–Marquardt
+    /// iterations on the training samples): the stage a full fit continues from. One start
+    /// is returned as it is.
+    pub(super) fn started(
+        starts: Vec<SearchModel>,
+        track: &dyn Track,
+        setup: &TrajectorySetup,
+        train: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Option<SearchModel> {
+        if starts.len() < 2 {
+            return starts.into_iter().next();
+        }
+        let mut short = settings.levenberg_marquardt(None);
+        short.fit = short.fit.max_iters(START_ITERS);
+        let mut best: Option<(f64, SearchModel)> = None;
+        for start in &starts {
+            let Ok((stage, fit)) = start.fit_simulated(track, setup, train, &short) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|(rms, _)| fit.rms < *rms) {
+                best = Some((fit.rms, stage));
+            }
+        }
+        best.map(|(_, s)| s).or_else(|| starts.into_iter().next())
+    }
+}

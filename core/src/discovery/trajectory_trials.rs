@@ -1,0 +1,242 @@
+//! A trajectory-level step's trials: a stage simulated and fitted on a [`Track`] (the whole
+//! record or the scout), and every candidate of a step searched, screened and scored
+//! ([`Trials::step`]); the trial itself is the one of [`Level::trial`].
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::candidate::Candidate;
+use super::choice::{self, Trial, Yardstick};
+use super::error::DiscoveryError;
+use super::force_level::{emit_scored, inside};
+use super::level::Level;
+use super::score::CandidateScore;
+use super::scout_ranking::{left_out, scouted};
+use super::search_model::SearchModel;
+use super::settings::DiscoverySettings;
+use super::trajectory_level::TrajectoryLevel;
+use super::trajectory_screen::{ForceScreen, SCREEN_KEEP};
+use super::trajectory_setup::TrajectorySetup;
+use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
+use crate::fit::{FitParam, FitResult, DISPLACEMENT_OFFSET};
+use crate::physics::force_model::ForceModel;
+
+impl SearchModel {
+    /// Every parameter of the fit, starting from this stage's values.
+    pub(super) fn params(
+        &self,
+        setup: &TrajectorySetup,
+        model: &Arc<dyn ForceModel>,
+    ) -> Vec<FitParam> {
+        let mut out: Vec<FitParam> = Vec::with_capacity(self.values.len());
+        let mut values = self.values.iter().copied();
+        for p in &setup.fit.free {
+            let v = values.next().unwrap_or(p.value);
+            out.push(p.clone().value(inside(v, p.min, p.max)));
+        }
+        for spec in model.params() {
+            let v = values.next().unwrap_or(spec.default);
+            out.push(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
+        }
+        if let Some(v) = values.next() {
+            out.push(
+                FitParam::new(DISPLACEMENT_OFFSET, v.clamp(-0.05, 0.05))
+                    .bounds(-0.05, 0.05)
+                    .scale(1e-3),
+            );
+        }
+        out
+    }
+
+    /// Fit on `subset`: the stage with the fitted values, and the fit.
+    pub(super) fn fit_simulated(
+        &self,
+        track: &dyn Track,
+        setup: &TrajectorySetup,
+        subset: &[usize],
+        settings: &DiscoverySettings,
+    ) -> Result<(SearchModel, FitResult), DiscoveryError> {
+        let model = self.model()?;
+        let mut params = self.params(setup, &model);
+        if track.fixes_start() {
+            for p in &mut params {
+                p.fixed |= crate::fit::INITIAL_STATE.contains(&p.name.as_str());
+            }
+        }
+        self.fitted(fit_on(track, &model, &params, subset, &settings.fit))
+    }
+
+    /// The simulated run of this stage at its values.
+    pub(super) fn run(&self, rig: &Rig) -> Result<Run, DiscoveryError> {
+        let model = self.model()?;
+        rig.run(&model, &self.values)
+            .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
+    }
+
+    /// The displacement residual of this stage at its values (the integration alone).
+    pub(super) fn residual(&self, rig: &Rig) -> Result<Vec<f64>, DiscoveryError> {
+        let model = self.model()?;
+        rig.residual(&model, &self.values)
+            .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
+    }
+}
+
+/// Most Levenberg–Marquardt iterations of a candidate's trial at trajectory level.
+pub(super) const TRIAL_ITERS: u64 = 60;
+
+/// Most Levenberg–Marquardt iterations of a candidate's trial on the whole record after its
+/// scout (see [`super::scout`]).
+pub(super) const SCOUTED_TRIAL_ITERS: u64 = 15;
+
+/// What every candidate trial of a step shares: the level and the step's yardstick.
+pub(super) struct Trials<'a, 'r> {
+    pub level: &'a TrajectoryLevel<'r>,
+    pub yardstick: &'a Yardstick<'a>,
+}
+
+impl Trials<'_, '_> {
+    /// The scores of the candidates `tried` against `current` in `step`, in their order.
+    ///
+    /// A screen first (when the setup has a force hint): each candidate, added to the current
+    /// model, is fitted at force level to the force recovered from the kinematics (a
+    /// fraction of a second each), and ranked by how much it lowers that fit's mean square
+    /// below the current model's. When the best gain is at least [`SCREEN_MIN_GAIN`] of the
+    /// current model's mean square, only the best [`SCREEN_KEEP`] are fitted at trajectory
+    /// level (starts, short fits, the trial; in parallel) and the others are reported as not
+    /// fitted, with their gain and rank; otherwise all are fitted. A trajectory fit costs
+    /// hundreds of simulations. On a scouted record each candidate's values are searched on
+    /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
+    /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
+    pub(super) fn step(
+        &self,
+        step: usize,
+        tried: &[&Candidate],
+        current: &Trial,
+    ) -> Vec<(CandidateScore, Option<Trial>)> {
+        let n_osc = self.level.rig.oscillator.len();
+        let withs: Vec<SearchModel> = tried
+            .iter()
+            .map(|c| {
+                let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+                current.stage.with(&c.model, &defaults, n_osc)
+            })
+            .collect();
+        let ForceScreen {
+            hinted,
+            gains,
+            rank,
+            screened,
+        } = self.force_screen(&withs, current);
+        let searched: Vec<Option<(SearchModel, f64, f64)>> = (0..tried.len())
+            .into_par_iter()
+            .map(|i| {
+                if screened && rank[i] >= SCREEN_KEEP {
+                    return None;
+                }
+                self.level
+                    .settings
+                    .observer
+                    .candidate(step, i, tried.len(), &tried[i].name);
+                let h = hinted[i].as_ref().map(|(s, _)| s);
+                Some(self.searched(withs[i].clone(), h))
+            })
+            .collect();
+        let scout_rank = self.scout_ranks(&searched, current);
+        let best_scout_gain = scout_rank
+            .iter()
+            .flatten()
+            .map(|&(_, _, gain)| gain)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (0..tried.len())
+            .into_par_iter()
+            .map(|i| {
+                let c = &tried[i];
+                let Some((stage, _, start_rms)) = &searched[i] else {
+                    let why = format!(
+                        "not fitted at trajectory level: the force-level screen ranks it {} of \
+                         {} (it lowers the recovered force's mean square by {:.3e} N²)",
+                        rank[i] + 1,
+                        tried.len(),
+                        gains[i].unwrap_or(f64::NAN)
+                    );
+                    return (choice::failed(&c.name, why), None);
+                };
+                if let Some(why) = left_out(
+                    scout_rank[i],
+                    best_scout_gain,
+                    *start_rms,
+                    current.train.rms,
+                ) {
+                    return (choice::failed(&c.name, why), None);
+                }
+                let s = self.scored(c, stage.clone(), current);
+                emit_scored(self.level.settings, step, Some(&s));
+                s
+            })
+            .collect()
+    }
+
+    /// Where candidate `with`'s trial starts (`with`: the current model with it added at its
+    /// defaults; `hinted`: its force-level start): the best of its starts, fitted on the
+    /// scout when there is one; its mean square on the scout's training samples (m²;
+    /// infinite without a scout) and its RMS on the whole record's training samples (m; NaN
+    /// without a scout).
+    pub(super) fn searched(
+        &self,
+        with: SearchModel,
+        hinted: Option<&SearchModel>,
+    ) -> (SearchModel, f64, f64) {
+        let (track, train): (&dyn Track, &[usize]) = match self.level.scout.as_ref() {
+            Some(scout) => (scout, &scout.train),
+            None => (&self.level.rig, &self.level.split.train),
+        };
+        let starts = with.starts(track, train, &self.level.osc_start, hinted);
+        let stage =
+            SearchModel::started(starts, track, self.level.setup, train, self.level.settings)
+                .unwrap_or(with);
+        match self.level.scout.as_ref() {
+            Some(scout) => {
+                let on = (
+                    &self.level.rig,
+                    self.level.setup,
+                    self.level.split.train.as_slice(),
+                );
+                scouted(stage, scout, on, &trial_settings(self.level.settings))
+            }
+            None => (stage, f64::INFINITY, f64::NAN),
+        }
+    }
+
+    /// The trial of candidate `c` from `stage` on the whole record, scored against
+    /// `current`. Scouted, the search is done: the trial polishes, at most
+    /// `SCOUTED_TRIAL_ITERS` iterations (a candidate still wandering then is scored where it
+    /// stopped, as one wandering on the whole record is after `TRIAL_ITERS`).
+    pub(super) fn scored(
+        &self,
+        c: &Candidate,
+        stage: SearchModel,
+        current: &Trial,
+    ) -> (CandidateScore, Option<Trial>) {
+        let mut settings = trial_settings(self.level.settings);
+        if self.level.scout.as_ref().is_some() {
+            let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
+            settings.fit = settings.fit.max_iters(iters);
+        }
+        choice::scored(
+            &c.name,
+            c.model.params().len(),
+            self.level.trial(&stage, &settings),
+            current,
+            self.yardstick,
+            self.level.settings,
+        )
+    }
+}
+
+/// Levenberg–Marquardt alone, at most `TRIAL_ITERS` iterations: a candidate whose fit does
+/// not settle by then (a stiff relaxation wandering through thousands of simulations) is
+/// scored where it stopped, not chased by Nelder–Mead.
+pub(super) fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
+    settings.levenberg_marquardt(Some(TRIAL_ITERS))
+}
