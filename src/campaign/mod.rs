@@ -7,16 +7,18 @@
 //! [`report`] are built from the units' JSON ([`unit_results`]). The output folder's rules
 //! are in [`out_dir`]; `crate::cmd_campaign` runs it all. A `[global]` section
 //! ([`global_file`]) adds a joint fit of all records with shared and law parameters
-//! ([`global_fit`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
+//! ([`global_records`], [`global_fit`], [`prediction_cache`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
 //! shown first in the report ([`global_report`]).
 
 pub mod file;
 pub mod global;
 pub mod global_file;
 pub mod global_fit;
+pub mod global_records;
 pub mod global_report;
 pub mod hash;
 pub mod out_dir;
+pub mod prediction_cache;
 pub mod report;
 pub mod runner;
 pub mod table;
