@@ -421,6 +421,73 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
     assert!(csv.lines().next().unwrap().contains("global law"), "{csv}");
 }
 
+/// The parameter `name` of global.json's θ: value and standard error.
+fn global_param(g: &serde_json::Value, name: &str) -> (f64, f64) {
+    let p = g["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {g}"));
+    (
+        p["value"].as_f64().unwrap(),
+        p["std_error"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn the_trajectory_level_global_fit_recovers_the_law_from_x_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path()).with_file_name("trajectory_campaign.toml");
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let g = read_json(&out.join("global.json"));
+    assert_eq!((g["level"].as_str(), g["rms_unit"].as_str()), (Some("trajectory"), Some("mm")));
+    // K = 4·(c/0.40)^6, n = 1.5: the exponent within 5 % and within 2 standard errors.
+    let (p, p_se) = global_param(&g, "K_p");
+    assert!((p - 6.0).abs() < 0.05 * 6.0, "K_p = {p}");
+    assert!((p - 6.0).abs() < 2.0 * p_se, "K_p = {p} ± {p_se}");
+    let (k0, k0_se) = global_param(&g, "K0");
+    assert!((k0 - 4.0).abs() < 3.0 * k0_se, "K0 = {k0} ± {k0_se}");
+    let (n, n_se) = global_param(&g, "n");
+    assert!((n - 1.5).abs() < 0.01 * 1.5, "n = {n}");
+    assert!((n - 1.5).abs() < 3.0 * n_se, "n = {n} ± {n_se}");
+    // θ: K0, K_p, n and each training record's own initial state x0@N, v0@N.
+    let names: Vec<&str> = g["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names.len(), 3 + 2 * 9, "{names:?}");
+    assert!(names.contains(&"x0@1") && names.contains(&"v0@9") && !names.contains(&"x0@10"));
+    // RMS in mm, near the records' x noise (0.05 mm); the held-out record (concentration
+    // 0.46, beyond those fitted) is predicted by the law as well as by its own fit, far
+    // better than by the nearest records' own values.
+    let rms = g["global"]["rms"].as_f64().unwrap();
+    assert!(rms > 0.04 && rms < 0.06, "global RMS {rms} mm");
+    let h = &g["holdout"];
+    let (global, alone, own) = (
+        h["global_rms"].as_f64().unwrap(),
+        h["per_record_rms"].as_f64().unwrap(),
+        h["own_fit_rms"].as_f64().unwrap(),
+    );
+    assert!(global < 0.8 * alone, "held-out RMS {global} against {alone}");
+    assert!(global < 1.02 * own, "held-out RMS {global} against its own fit's {own}");
+    assert!(g["delta_bic"].as_f64().unwrap() < 0.0, "{}", g["delta_bic"]);
+    assert_eq!(g["supported"], true);
+    println!(
+        "trajectory: K_p = {p} ± {p_se}, K0 = {k0} ± {k0_se}, n = {n} ± {n_se}; held-out RMS \
+         global {global} mm, per record {alone} mm, own {own} mm; ΔBIC {}; global step {} s, \
+         joint fit {} s",
+        g["delta_bic"], g["wall_seconds"], g["joint_fit_seconds"]
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("displacement (trajectory level)"), "{md}");
+    assert!(md.contains(" mm"), "{md}");
+}
+
 #[test]
 fn bad_global_input_is_refused_before_any_unit_starts() {
     let tmp = tempfile::tempdir().unwrap();

@@ -175,6 +175,11 @@ pub struct GlobalJson {
     pub log: Vec<String>,
     /// Wall time of the whole global step (reading, per-record and joint fits), s.
     pub wall_seconds: f64,
+    /// Wall time of the joint fit alone, s.
+    pub joint_fit_seconds: f64,
+    /// Evaluations of the joint residuals (each a prediction of every training record,
+    /// those cached apart: a Jacobian column of a per-record parameter predicts one record).
+    pub joint_fit_evaluations: u64,
 }
 
 /// Run `[global]` of `campaign` (which must have one).
@@ -360,6 +365,8 @@ fn assemble(
             .enumerate()
             .map(|(i, l)| per_record_json(l, spec.holdout == Some(i), shown.1))
             .collect(),
+        joint_fit_seconds: result.wall_seconds,
+        joint_fit_evaluations: result.evaluations,
         log: result.log,
         wall_seconds: 0.0,
     }

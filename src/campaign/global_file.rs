@@ -359,16 +359,22 @@ fn holdout_of(given: Option<&Spanned<String>>, units: &[Unit], at: &At) -> Resul
 #[cfg(test)]
 mod tests {
     use super::super::file::Campaign;
+    use crate::experiment::FitLevel;
 
     /// The campaign `text` (two records at c = 1 and 2 after it) parsed in a folder with a
     /// record `r.csv` and an experiment `e.toml` fitting `power_law` with an offset.
     fn parse(global: &str) -> anyhow::Result<Campaign> {
+        parse_with("[fit]\noffset = true\n", global)
+    }
+
+    /// [`parse`] with the experiment's `[fit]` section `fit`.
+    fn parse_with(fit: &str, global: &str) -> anyhow::Result<Campaign> {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
         std::fs::write(dir.path().join("s.csv"), "t,phi,x\n0,0,0\n").unwrap();
         std::fs::write(
             dir.path().join("e.toml"),
-            "[fit]\noffset = true\n\n[[models]]\nname = \"power_law\"\n",
+            format!("{fit}\n[[models]]\nname = \"power_law\"\nparams = {{ n = {{ value = 1.5, fixed = true }} }}\n"),
         )
         .unwrap();
         let text = format!(
@@ -380,7 +386,11 @@ mod tests {
     }
 
     fn message(global: &str) -> String {
-        let e = format!("{:#}", parse(global).unwrap_err());
+        message_of(parse(global))
+    }
+
+    fn message_of(parsed: anyhow::Result<Campaign>) -> String {
+        let e = format!("{:#}", parsed.unwrap_err());
         e.split_once("c.toml")
             .map_or(e.clone(), |(_, m)| m.to_string())
     }
@@ -396,6 +406,33 @@ mod tests {
         assert_eq!(g.laws[0].param, "K");
         assert_eq!(g.laws[0].reference, 1.0);
         assert_eq!((g.holdout, g.line), (None, 14));
+        assert_eq!(g.level, FitLevel::Force);
+    }
+
+    #[test]
+    fn at_trajectory_level_the_parameters_are_those_a_trajectory_fit_frees() {
+        let fit = "[fit]\nlevel = \"trajectory\"\nsystem = [\"k\"]\noffset = true\n";
+        let c = parse_with(fit, "model = \"power_law\"\nshared = [\"k\", \"x_off\"]\n").unwrap();
+        let g = c.global.unwrap();
+        assert_eq!((g.level, g.shared), (FitLevel::Trajectory, vec!["k".into(), "x_off".into()]));
+        // `[global] level` overrides the experiment's.
+        let g = parse_with(fit, "model = \"power_law\"\nlevel = \"force\"\n").unwrap();
+        assert_eq!(g.global.unwrap().level, FitLevel::Force);
+        let m = message_of(parse_with(fit, "model = \"power_law\"\nshared = [\"x0\"]\n"));
+        assert!(
+            m.starts_with(":16: `global.shared[0]`: `x0` is each record's initial state"),
+            "{m}"
+        );
+        // n is fixed: a trajectory fit does not free it; f_off is the force level's offset.
+        let m = message_of(parse_with(fit, "model = \"power_law\"\nshared = [\"n\"]\n"));
+        assert!(m.contains("has no parameter `n` (it has: K, k, x_off)"), "{m}");
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nlaws = { x_off = { condition = \"c\", reference = 1 } }\n",
+        ));
+        assert!(m.contains("`global.laws.x_off`: `x_off` is each record's offset"), "{m}");
+        let m = message_of(parse_with(fit, "model = \"power_law\"\nlevel = \"motion\"\n"));
+        assert!(m.contains("unknown variant `motion`"), "{m}");
     }
 
     #[test]
