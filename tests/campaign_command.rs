@@ -443,7 +443,10 @@ fn the_trajectory_level_global_fit_recovers_the_law_from_x_alone() {
     let run = campaign(&file, &out, &["--quiet"]);
     assert!(run.status.success(), "{}", stderr(&run));
     let g = read_json(&out.join("global.json"));
-    assert_eq!((g["level"].as_str(), g["rms_unit"].as_str()), (Some("trajectory"), Some("mm")));
+    assert_eq!(
+        (g["level"].as_str(), g["rms_unit"].as_str()),
+        (Some("trajectory"), Some("mm"))
+    );
     // K = 4·(c/0.40)^6, n = 1.5: the exponent within 5 % and within 2 standard errors.
     let (p, p_se) = global_param(&g, "K_p");
     assert!((p - 6.0).abs() < 0.05 * 6.0, "K_p = {p}");
@@ -473,8 +476,14 @@ fn the_trajectory_level_global_fit_recovers_the_law_from_x_alone() {
         h["per_record_rms"].as_f64().unwrap(),
         h["own_fit_rms"].as_f64().unwrap(),
     );
-    assert!(global < 0.8 * alone, "held-out RMS {global} against {alone}");
-    assert!(global < 1.02 * own, "held-out RMS {global} against its own fit's {own}");
+    assert!(
+        global < 0.8 * alone,
+        "held-out RMS {global} against {alone}"
+    );
+    assert!(
+        global < 1.02 * own,
+        "held-out RMS {global} against its own fit's {own}"
+    );
     assert!(g["delta_bic"].as_f64().unwrap() < 0.0, "{}", g["delta_bic"]);
     assert_eq!(g["supported"], true);
     println!(

@@ -219,7 +219,10 @@ pub fn run(campaign: &Campaign) -> Result<GlobalJson> {
     let joint: Vec<&JointRecord> = training.iter().map(|l| &l.joint).collect();
     let trajectory = spec.level == FitLevel::Trajectory;
     let settings = if trajectory {
-        gexp.fit.settings.clone().for_simulation(gexp.integrator.rtol)
+        gexp.fit
+            .settings
+            .clone()
+            .for_simulation(gexp.integrator.rtol)
     } else {
         gexp.fit.settings.clone()
     };
@@ -589,9 +592,19 @@ mod tests {
     fn a_held_out_record_that_cannot_tell_the_fits_apart_is_called_a_tie() {
         assert!(holdout(0.019757, 0.019767).is_tie());
         assert!(!holdout(0.02038, 0.04556).is_tie());
-        let said = verdict_text(true, -117.6, Some(&holdout(0.019757, 0.019767)), FitLevel::Force);
+        let said = verdict_text(
+            true,
+            -117.6,
+            Some(&holdout(0.019757, 0.019767)),
+            FitLevel::Force,
+        );
         assert!(said.contains("(a tie: within 1 %)"), "{said}");
-        let said = verdict_text(true, -137.7, Some(&holdout(0.02038, 0.04556)), FitLevel::Force);
+        let said = verdict_text(
+            true,
+            -137.7,
+            Some(&holdout(0.02038, 0.04556)),
+            FitLevel::Force,
+        );
         assert!(!said.contains("tie"), "{said}");
     }
 }

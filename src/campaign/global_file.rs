@@ -270,7 +270,12 @@ fn check_law(
     let key = format!("global.laws.{param}");
     let offset = law.span().start;
     let law = law.get_ref();
-    if [stf_core::fit::FORCE_OFFSET, stf_core::fit::DISPLACEMENT_OFFSET].contains(&param) {
+    if [
+        stf_core::fit::FORCE_OFFSET,
+        stf_core::fit::DISPLACEMENT_OFFSET,
+    ]
+    .contains(&param)
+    {
         return Err(at.error(
             offset,
             &key,
@@ -321,10 +326,10 @@ fn check_positive(units: &[Unit], condition: &str, key: &str, at: &At) -> Result
             .find(|(n, _)| n == condition)
             .map_or(f64::NAN, |(_, v)| *v);
         if value.is_nan() || value <= 0.0 {
-            return Err(error_at(
+            return Err(u.entry_error(
                 at.path,
-                u.line,
                 &format!("records[{i}].{condition}"),
+                condition,
                 format!("`{key}` needs a positive `{condition}` on every record, found {value}"),
             ));
         }
@@ -414,24 +419,39 @@ mod tests {
         let fit = "[fit]\nlevel = \"trajectory\"\nsystem = [\"k\"]\noffset = true\n";
         let c = parse_with(fit, "model = \"power_law\"\nshared = [\"k\", \"x_off\"]\n").unwrap();
         let g = c.global.unwrap();
-        assert_eq!((g.level, g.shared), (FitLevel::Trajectory, vec!["k".into(), "x_off".into()]));
+        assert_eq!(
+            (g.level, g.shared),
+            (FitLevel::Trajectory, vec!["k".into(), "x_off".into()])
+        );
         // `[global] level` overrides the experiment's.
         let g = parse_with(fit, "model = \"power_law\"\nlevel = \"force\"\n").unwrap();
         assert_eq!(g.global.unwrap().level, FitLevel::Force);
-        let m = message_of(parse_with(fit, "model = \"power_law\"\nshared = [\"x0\"]\n"));
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nshared = [\"x0\"]\n",
+        ));
         assert!(
             m.starts_with(":16: `global.shared[0]`: `x0` is each record's initial state"),
             "{m}"
         );
         // n is fixed: a trajectory fit does not free it; f_off is the force level's offset.
         let m = message_of(parse_with(fit, "model = \"power_law\"\nshared = [\"n\"]\n"));
-        assert!(m.contains("has no parameter `n` (it has: K, k, x_off)"), "{m}");
+        assert!(
+            m.contains("has no parameter `n` (it has: K, k, x_off)"),
+            "{m}"
+        );
         let m = message_of(parse_with(
             fit,
             "model = \"power_law\"\nlaws = { x_off = { condition = \"c\", reference = 1 } }\n",
         ));
-        assert!(m.contains("`global.laws.x_off`: `x_off` is each record's offset"), "{m}");
-        let m = message_of(parse_with(fit, "model = \"power_law\"\nlevel = \"motion\"\n"));
+        assert!(
+            m.contains("`global.laws.x_off`: `x_off` is each record's offset"),
+            "{m}"
+        );
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nlevel = \"motion\"\n",
+        ));
         assert!(m.contains("unknown variant `motion`"), "{m}");
     }
 

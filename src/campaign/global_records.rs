@@ -79,8 +79,11 @@ pub fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Res
         _ => {
             let mut params = configured.params.clone();
             params.extend(gexp.fit.offset.then(force_offset));
-            let fit =
-                global_fit::predictor(configured.model.clone(), &configured.params, gexp.fit.offset);
+            let fit = global_fit::predictor(
+                configured.model.clone(),
+                &configured.params,
+                gexp.fit.offset,
+            );
             let f = data.record.f_stf.clone().unwrap_or_default();
             (f, RecordFit::Force(fit), params)
         }

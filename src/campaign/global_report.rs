@@ -85,7 +85,11 @@ fn comparison(g: &GlobalJson) -> Table {
             held.map_or("—".into(), |h| format!("{h:.5} {unit}")),
         ]
     };
-    let rss_unit = if g.level == "trajectory" { "m²" } else { "N²" };
+    let rss_unit = if g.level == "trajectory" {
+        "m²"
+    } else {
+        "N²"
+    };
     let h = g.holdout.as_ref();
     Table {
         caption: format!(

@@ -1,5 +1,5 @@
 //! Campaigns: many records, one command (`stf-lab campaign CAMPAIGN.toml --out DIR`). A
-//! campaign file ([`file`]) lists records with their conditions and the work for each; unit N
+//! campaign file ([`file`]) lists records (or names a CSV table of them, [`records_table`]) with their conditions and the work for each; unit N
 //! is (record N, its experiment, its command), run into `DIR/units/<NNN>-<stem>/` by
 //! [`unit`] — in a child process of the local [`runner`], or, later, a Slurm array task —
 //! and recognised as finished by the hash of its inputs ([`hash`]). After the units, the
@@ -19,6 +19,7 @@ pub mod global_report;
 pub mod hash;
 pub mod out_dir;
 pub mod prediction_cache;
+pub mod records_table;
 pub mod report;
 pub mod runner;
 pub mod table;

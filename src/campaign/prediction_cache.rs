@@ -44,7 +44,10 @@ impl PredictionCache {
     fn lookup(&self, values: &[f64]) -> Option<Arc<Vec<f64>>> {
         let mut entries = self.lock();
         let same = |v: &[f64]| {
-            v.len() == values.len() && v.iter().zip(values).all(|(a, b)| a.to_bits() == b.to_bits())
+            v.len() == values.len()
+                && v.iter()
+                    .zip(values)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
         };
         let i = entries.iter().position(|(v, _)| same(v))?;
         let entry = entries.remove(i);
@@ -73,10 +76,18 @@ mod tests {
             calls.set(calls.get() + 1);
             Ok::<_, String>(vec![v * 2.0])
         };
-        assert_eq!(*cache.get_or_predict(&[1.0], || predict(1.0)).unwrap(), [2.0]);
-        assert_eq!(*cache.get_or_predict(&[1.0], || predict(1.0)).unwrap(), [2.0]);
+        assert_eq!(
+            *cache.get_or_predict(&[1.0], || predict(1.0)).unwrap(),
+            [2.0]
+        );
+        assert_eq!(
+            *cache.get_or_predict(&[1.0], || predict(1.0)).unwrap(),
+            [2.0]
+        );
         assert_eq!(calls.get(), 1);
-        cache.get_or_predict(&[1.0 + 1e-15], || predict(1.0)).unwrap();
+        cache
+            .get_or_predict(&[1.0 + 1e-15], || predict(1.0))
+            .unwrap();
         assert_eq!(calls.get(), 2);
         let failed = cache.get_or_predict(&[5.0], || Err::<Vec<f64>, _>("diverged".to_string()));
         assert!(failed.is_err());
@@ -94,7 +105,9 @@ mod tests {
         };
         cache.get_or_predict(&[0.0], || predict(0.0)).unwrap();
         for i in 1..100 {
-            cache.get_or_predict(&[f64::from(i)], || predict(f64::from(i))).unwrap();
+            cache
+                .get_or_predict(&[f64::from(i)], || predict(f64::from(i)))
+                .unwrap();
             cache.get_or_predict(&[0.0], || predict(0.0)).unwrap();
         }
         assert_eq!(calls.get(), 100);

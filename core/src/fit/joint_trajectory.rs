@@ -61,8 +61,8 @@ mod tests {
             .collect();
         let problem = Sine { t, y };
         let params = [FitParam::new("a", 1e-3).bounds(0.0, 1e-2)];
-        let fit = fit_trajectory_residuals(&problem, &params, &FitSettings::default(), None)
-            .unwrap();
+        let fit =
+            fit_trajectory_residuals(&problem, &params, &FitSettings::default(), None).unwrap();
         let a = fit.value("a").unwrap();
         assert!((a / 3e-3 - 1.0).abs() < 1e-3, "a = {a}");
         let s = fit.s_mm2.unwrap();
