@@ -325,14 +325,28 @@ fn the_report_draws_each_parameter_against_each_condition() {
             "{figure}"
         );
     }
-    // The figure's data are the table's: the K of each record with its error, by F0.
+    // The figure's data are the table's: the K of each record with its error, by F0; the
+    // axes carry the units (K's from its ParamSpec, F0's from `campaign.units`, none given
+    // for the concentration).
     let csv =
         std::fs::read_to_string(out.join("figures/power_law_K_vs_concentration.csv")).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
-        header.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,F0 = 0.035: standard error,"),
+        header.starts_with(
+            "F0 = 0.035 kg·m: concentration,F0 = 0.035 kg·m: K [N·(s/m)ⁿ],F0 = 0.035 kg·m: \
+             standard error,"
+        ),
         "{header}"
     );
+    for (figure, axis) in [
+        ("power_law_n_vs_F0", "n [–]"),
+        ("power_law_n_vs_F0", "F0 [kg·m]"),
+        ("viscous_c_s_vs_F0", "c_s [N·s/m]"),
+        ("global_K_vs_concentration", "K [N·(s/m)ⁿ]"),
+    ] {
+        let svg = std::fs::read_to_string(out.join(format!("figures/{figure}.svg"))).unwrap();
+        assert!(svg.contains(axis), "{figure}: no axis `{axis}`");
+    }
     // The header and a row per concentration (four at F0 = 0.0462, three at the others).
     assert_eq!(csv.lines().count(), 5);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();

@@ -64,6 +64,8 @@ struct RawHeader {
     command: Option<Spanned<CommandName>>,
     #[serde(default)]
     conditions: Vec<Spanned<String>>,
+    #[serde(default)]
+    units: BTreeMap<String, Spanned<String>>,
     records: Option<Spanned<String>>,
 }
 
@@ -88,6 +90,8 @@ pub struct Campaign {
     pub path: PathBuf,
     /// Condition names, in the order of `campaign.conditions`.
     pub conditions: Vec<String>,
+    /// The unit of a condition, where `campaign.units` gives one (for the figures' axes).
+    pub condition_units: BTreeMap<String, String>,
     /// One unit per record, in the file's order.
     pub units: Vec<Unit>,
     /// The joint fit of `[global]`, if any.
@@ -182,6 +186,7 @@ impl Campaign {
             return Err(error_at(path, 1, "campaign", "missing section [campaign]"));
         };
         let conditions = check_conditions(&header, path, text)?;
+        let condition_units = check_units(&header, &conditions, path, text)?;
         let dir = folder_of(path);
         let defaults = Defaults {
             experiment: header.get_ref().experiment.as_ref(),
@@ -211,6 +216,7 @@ impl Campaign {
         Ok(Campaign {
             path: path.to_path_buf(),
             conditions,
+            condition_units,
             units,
             global,
         })
@@ -314,6 +320,40 @@ fn check_conditions(header: &Spanned<RawHeader>, path: &Path, text: &str) -> Res
         names.push(name);
     }
     Ok(names)
+}
+
+/// `campaign.units`, checked: each key a listed condition, each unit a non-empty string.
+fn check_units(
+    header: &Spanned<RawHeader>,
+    conditions: &[String],
+    path: &Path,
+    text: &str,
+) -> Result<BTreeMap<String, String>> {
+    let mut out = BTreeMap::new();
+    for (name, unit) in &header.get_ref().units {
+        let at = |msg: String| {
+            error_at(
+                path,
+                line_of(text, unit.span().start),
+                &format!("campaign.units.{name}"),
+                msg,
+            )
+        };
+        if !conditions.contains(name) {
+            return Err(at(format!(
+                "`{name}` is not a condition: `campaign.conditions` lists [{}]",
+                conditions.join(", ")
+            )));
+        }
+        let unit = unit.get_ref().trim();
+        if unit.is_empty() {
+            return Err(at(
+                "an empty unit: leave the condition out of `units`".into()
+            ));
+        }
+        out.insert(name.clone(), unit.to_string());
+    }
+    Ok(out)
 }
 
 /// What `[campaign]` gives every record.
@@ -562,6 +602,13 @@ mod tests {
         assert_eq!(c.units[1].conditions, vec![("c".to_string(), 2.5)]);
         assert_eq!((c.units[0].line, c.units[1].line), (6, 10));
         assert_eq!(c.units[1].folder_name(), "002-r");
+        assert!(c.condition_units.is_empty());
+        let with_unit = HEAD.replace("c\"]", "c\"]\nunits = { c = \"kg·m\" }");
+        let c = parse(&format!(
+            "{with_unit}\n[[records]]\nfile = \"r.csv\"\nc = 1\n"
+        ))
+        .unwrap();
+        assert_eq!(c.condition_units["c"], "kg·m");
         assert!(c.unit(3).is_err() && c.unit(0).is_err());
     }
 
@@ -660,6 +707,14 @@ mod tests {
             .starts_with(":2: `campaign.conditions[1]`: `a` is listed twice"));
         let no_work = "[campaign]\n\n[[records]]\nfile = \"r.csv\"\n";
         assert!(message(no_work).starts_with(":3: `records[0]`: no experiment"));
+        assert!(
+            message("[campaign]\nconditions = [\"a\"]\nunits = { b = \"m\" }\n")
+                .starts_with(":3: `campaign.units.b`: `b` is not a condition")
+        );
+        assert!(
+            message("[campaign]\nconditions = [\"a\"]\nunits = { a = \" \" }\n")
+                .starts_with(":3: `campaign.units.a`: an empty unit")
+        );
         assert!(message("[campaign]\nexperimnt = \"e.toml\"\n")
             .starts_with(":2: `campaign`: unknown field `experimnt`"));
     }

@@ -57,6 +57,10 @@ pub struct LawJson {
     pub condition: String,
     /// The condition's reference value.
     pub reference: f64,
+    /// The parameter's SI unit, from its model's `ParamSpec` (empty: dimensionless).
+    pub unit: String,
+    /// The condition's unit, where `campaign.units` gives one.
+    pub condition_unit: Option<String>,
     /// The parameter at the reference, with its standard error.
     pub coefficient: f64,
     /// Standard error of the coefficient.
@@ -145,6 +149,8 @@ pub struct GlobalJson {
     pub model: String,
     /// `force` or `trajectory`: what the fits aim at.
     pub level: String,
+    /// A condition's unit, where `campaign.units` gives one.
+    pub condition_units: std::collections::BTreeMap<String, String>,
     /// The unit of every RMS: `N` (force level) or `mm` (trajectory level).
     pub rms_unit: String,
     /// Parameters shared by every record.
@@ -231,7 +237,13 @@ pub fn run(campaign: &Campaign) -> Result<GlobalJson> {
         .holdout
         .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result))
         .transpose()?;
-    Ok(assemble(spec, &loaded, &training, &layout, result, holdout))
+    let units = Units {
+        model: configured.model.clone(),
+        conditions: campaign.condition_units.clone(),
+    };
+    Ok(assemble(
+        spec, &units, &loaded, &training, &layout, result, holdout,
+    ))
 }
 
 /// The held-out record predicted by the global fit and by the per-record alternative.
@@ -323,6 +335,7 @@ fn nearest_records<'a, 'c>(
 /// Put the pieces into `global.json`'s shape, with the verdict and its caveats.
 fn assemble(
     spec: &GlobalSpec,
+    units: &Units,
     loaded: &[Loaded],
     training: &[&Loaded],
     layout: &global_fit::Layout,
@@ -348,6 +361,7 @@ fn assemble(
     GlobalJson {
         model: spec.model.clone(),
         level: level_name(spec.level).into(),
+        condition_units: units.conditions.clone(),
         rms_unit: shown.0.into(),
         shared: spec.shared.clone(),
         records: training
@@ -355,7 +369,7 @@ fn assemble(
             .map(|l| l.unit.record_given.clone())
             .collect(),
         params: theta_json(&result, layout),
-        laws: laws_json(spec, &result),
+        laws: laws_json(spec, &result, units),
         global,
         per_record,
         delta_bic,
@@ -372,6 +386,25 @@ fn assemble(
         joint_fit_evaluations: result.evaluations,
         log: result.log,
         wall_seconds: 0.0,
+    }
+}
+
+/// Where the laws' units come from.
+struct Units {
+    /// The global model (its parameters' `ParamSpec`s).
+    model: std::sync::Arc<dyn stf_core::physics::force_model::ForceModel>,
+    /// `campaign.units`.
+    conditions: std::collections::BTreeMap<String, String>,
+}
+
+impl Units {
+    /// The unit of the model's parameter `name` (empty if it has none or is not the model's).
+    fn param(&self, name: &str) -> String {
+        self.model
+            .params()
+            .iter()
+            .find(|s| s.name == name)
+            .map_or_else(String::new, |s| s.unit.clone())
     }
 }
 
@@ -399,7 +432,7 @@ fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalPara
 }
 
 /// Each law's coefficient and exponent with their errors.
-fn laws_json(spec: &GlobalSpec, result: &FitResult) -> Vec<LawJson> {
+fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJson> {
     spec.laws
         .iter()
         .filter_map(|l| {
@@ -409,6 +442,8 @@ fn laws_json(spec: &GlobalSpec, result: &FitResult) -> Vec<LawJson> {
                 param: l.param.clone(),
                 condition: l.condition.clone(),
                 reference: l.reference,
+                unit: units.param(&l.param),
+                condition_unit: units.conditions.get(&l.condition).cloned(),
                 coefficient: c.value,
                 coefficient_std_error: c.std_error,
                 exponent: e.value,

@@ -159,7 +159,7 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
                 .conditions
                 .iter()
                 .filter(|(c, _)| **c != law.condition)
-                .map(|(c, v)| format!("{c} = {}", carried(*v)))
+                .map(|(c, v)| super::report::value_label(c, *v, g.condition_units.get(c)))
                 .collect();
             if others.is_empty() {
                 "records".into()
@@ -205,7 +205,10 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
         dir,
         &name,
         &title,
-        (&law.condition, &law.param),
+        (
+            &super::report::axis_label(&law.condition, law.condition_unit.as_deref()),
+            &super::report::axis_label(&law.param, Some(&law.unit)),
+        ),
         &series,
         Some(&curve),
     )?;

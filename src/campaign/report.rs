@@ -82,10 +82,18 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
                 if distinct < 2 {
                     continue;
                 }
-                let series = series_of(&rows, &param, condition, &table.conditions);
+                let series = series_of(&rows, &param, condition, table);
                 let name = file_name(&format!("{model}_{param}_vs_{condition}"));
                 let title = format!("{model}: {param} against {condition}");
-                let files = report::error_bars(dir, &name, &title, (condition, &param), &series)?;
+                let unit = rows
+                    .iter()
+                    .find_map(|r| r.result.params.get(&param)?.unit.as_deref());
+                let x = axis_label(
+                    condition,
+                    table.condition_units.get(condition).map(String::as_str),
+                );
+                let y = axis_label(&param, unit);
+                let files = report::error_bars(dir, &name, &title, (&x, &y), &series)?;
                 figures.push(FigureRef::new(
                     files,
                     format!(
@@ -98,6 +106,24 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
         }
     }
     Ok(figures)
+}
+
+/// An axis's label: the name and its unit in brackets (`K [N·(s/m)ⁿ]`, `n [–]` for a
+/// dimensionless one), the name alone when the unit is not known.
+pub(super) fn axis_label(name: &str, unit: Option<&str>) -> String {
+    match unit.map(str::trim) {
+        None => name.to_string(),
+        Some("") => format!("{name} [–]"),
+        Some(u) => format!("{name} [{u}]"),
+    }
+}
+
+/// `name = value unit` (the unit where the campaign gives one) for a legend.
+pub(super) fn value_label(name: &str, value: f64, unit: Option<&String>) -> String {
+    match unit {
+        Some(u) => format!("{name} = {} {u}", carried(value)),
+        None => format!("{name} = {}", carried(value)),
+    }
 }
 
 /// How many different values `condition` takes over `rows`.
@@ -116,7 +142,7 @@ fn series_of(
     rows: &[&CampaignRow],
     param: &str,
     condition: &str,
-    conditions: &[String],
+    table: &CampaignJson,
 ) -> Vec<ErrorSeries> {
     let mut groups: BTreeMap<String, Vec<ErrorPoint>> = BTreeMap::new();
     let mut order: Vec<String> = Vec::new();
@@ -124,13 +150,13 @@ fn series_of(
         let (Some(x), Some(p)) = (r.conditions.get(condition), r.result.params.get(param)) else {
             continue;
         };
-        let label: Vec<String> = conditions
+        let label: Vec<String> = table
+            .conditions
             .iter()
             .filter(|c| *c != condition)
             .filter_map(|c| {
-                r.conditions
-                    .get(c)
-                    .map(|v| format!("{c} = {}", carried(*v)))
+                let v = r.conditions.get(c)?;
+                Some(value_label(c, *v, table.condition_units.get(c)))
             })
             .collect();
         let label = if label.is_empty() {

@@ -45,6 +45,8 @@ pub struct CampaignJson {
     pub campaign: String,
     /// Condition names.
     pub conditions: Vec<String>,
+    /// A condition's unit, where `campaign.units` gives one.
+    pub condition_units: BTreeMap<String, String>,
     /// Units in the campaign.
     pub units: usize,
     /// Units that failed.
@@ -101,6 +103,7 @@ pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>
     CampaignJson {
         campaign: campaign.path.display().to_string(),
         conditions: campaign.conditions.clone(),
+        condition_units: campaign.condition_units.clone(),
         units: campaign.units.len(),
         failed,
         rows,
