@@ -512,6 +512,39 @@ fn the_trajectory_level_global_fit_recovers_the_law_from_x_alone() {
 }
 
 #[test]
+fn a_rerun_removes_stale_figures_and_lists_stale_unit_folders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(out.join("figures/global_K_vs_concentration.png").is_file());
+    assert_eq!(rows(&out).len(), 20);
+    // The held-out record and [global] removed from the campaign: its figure goes, its unit
+    // folder stays (the user's results) and is named.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let last = text.find("# A denser suspension").unwrap();
+    std::fs::write(&file, &text[..last]).unwrap();
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(!out.join("figures/global_K_vs_concentration.png").exists());
+    assert!(!out.join("figures/global_K_vs_concentration.csv").exists());
+    assert!(out
+        .join("figures/power_law_K_vs_concentration.png")
+        .is_file());
+    assert!(out.join("units/010-a2_c4/unit.json").is_file());
+    let json = read_json(&out.join("campaign.json"));
+    assert_eq!(json["stale_units"], serde_json::json!(["010-a2_c4"]));
+    assert_eq!(rows(&out).len(), 18);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("units/ holds 1 folder(s) that no unit of this campaign writes"),
+        "{md}"
+    );
+    assert!(md.contains("010-a2_c4"), "{md}");
+}
+
+#[test]
 fn bad_global_input_is_refused_before_any_unit_starts() {
     let tmp = tempfile::tempdir().unwrap();
     let file = bundled_copy(tmp.path());
