@@ -17,10 +17,13 @@ use std::sync::{Arc, Mutex};
 /// difference steps of a Jacobian, with room to spare.
 const KEPT: usize = 16;
 
+/// A prediction and the values it was made at.
+type Entry = (Vec<f64>, Arc<Vec<f64>>);
+
 /// A record's recent predictions, most recently used first.
 #[derive(Default)]
 pub struct PredictionCache {
-    entries: Mutex<Vec<(Vec<f64>, Arc<Vec<f64>>)>>,
+    entries: Mutex<Vec<Entry>>,
 }
 
 impl PredictionCache {
@@ -56,7 +59,7 @@ impl PredictionCache {
         Some(hit)
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<(Vec<f64>, Arc<Vec<f64>>)>> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Entry>> {
         self.entries
             .lock()
             .unwrap_or_else(|poisoned| poisoned.into_inner())
