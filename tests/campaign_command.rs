@@ -325,14 +325,28 @@ fn the_report_draws_each_parameter_against_each_condition() {
             "{figure}"
         );
     }
-    // The figure's data are the table's: the K of each record with its error, by F0.
+    // The figure's data are the table's: the K of each record with its error, by F0; the
+    // axes carry the units (K's from its ParamSpec, F0's from `campaign.units`, none given
+    // for the concentration).
     let csv =
         std::fs::read_to_string(out.join("figures/power_law_K_vs_concentration.csv")).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
-        header.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,F0 = 0.035: standard error,"),
+        header.starts_with(
+            "F0 = 0.035 kg·m: concentration,F0 = 0.035 kg·m: K [N·(s/m)ⁿ],F0 = 0.035 kg·m: \
+             standard error,"
+        ),
         "{header}"
     );
+    for (figure, axis) in [
+        ("power_law_n_vs_F0", "n [–]"),
+        ("power_law_n_vs_F0", "F0 [kg·m]"),
+        ("viscous_c_s_vs_F0", "c_s [N·s/m]"),
+        ("global_K_vs_concentration", "K [N·(s/m)ⁿ]"),
+    ] {
+        let svg = std::fs::read_to_string(out.join(format!("figures/{figure}.svg"))).unwrap();
+        assert!(svg.contains(axis), "{figure}: no axis `{axis}`");
+    }
     // The header and a row per concentration (four at F0 = 0.0462, three at the others).
     assert_eq!(csv.lines().count(), 5);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
@@ -419,6 +433,115 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
     assert!(out.join("figures/global_K_vs_concentration.png").is_file());
     let csv = std::fs::read_to_string(out.join("figures/global_K_vs_concentration.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("global law"), "{csv}");
+}
+
+/// The parameter `name` of global.json's θ: value and standard error.
+fn global_param(g: &serde_json::Value, name: &str) -> (f64, f64) {
+    let p = g["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {g}"));
+    (
+        p["value"].as_f64().unwrap(),
+        p["std_error"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn the_trajectory_level_global_fit_recovers_the_law_from_x_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path()).with_file_name("trajectory_campaign.toml");
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let g = read_json(&out.join("global.json"));
+    assert_eq!(
+        (g["level"].as_str(), g["rms_unit"].as_str()),
+        (Some("trajectory"), Some("mm"))
+    );
+    // K = 4·(c/0.40)^6, n = 1.5: the exponent within 5 % and within 2 standard errors.
+    let (p, p_se) = global_param(&g, "K_p");
+    assert!((p - 6.0).abs() < 0.05 * 6.0, "K_p = {p}");
+    assert!((p - 6.0).abs() < 2.0 * p_se, "K_p = {p} ± {p_se}");
+    let (k0, k0_se) = global_param(&g, "K0");
+    assert!((k0 - 4.0).abs() < 3.0 * k0_se, "K0 = {k0} ± {k0_se}");
+    let (n, n_se) = global_param(&g, "n");
+    assert!((n - 1.5).abs() < 0.01 * 1.5, "n = {n}");
+    assert!((n - 1.5).abs() < 3.0 * n_se, "n = {n} ± {n_se}");
+    // θ: K0, K_p, n and each training record's own initial state x0@N, v0@N.
+    let names: Vec<&str> = g["params"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names.len(), 3 + 2 * 9, "{names:?}");
+    assert!(names.contains(&"x0@1") && names.contains(&"v0@9") && !names.contains(&"x0@10"));
+    // RMS in mm, near the records' x noise (0.05 mm); the held-out record (concentration
+    // 0.46, beyond those fitted) is predicted by the law as well as by its own fit, far
+    // better than by the nearest records' own values.
+    let rms = g["global"]["rms"].as_f64().unwrap();
+    assert!(rms > 0.04 && rms < 0.06, "global RMS {rms} mm");
+    let h = &g["holdout"];
+    let (global, alone, own) = (
+        h["global_rms"].as_f64().unwrap(),
+        h["per_record_rms"].as_f64().unwrap(),
+        h["own_fit_rms"].as_f64().unwrap(),
+    );
+    assert!(
+        global < 0.8 * alone,
+        "held-out RMS {global} against {alone}"
+    );
+    assert!(
+        global < 1.02 * own,
+        "held-out RMS {global} against its own fit's {own}"
+    );
+    assert!(g["delta_bic"].as_f64().unwrap() < 0.0, "{}", g["delta_bic"]);
+    assert_eq!(g["supported"], true);
+    println!(
+        "trajectory: K_p = {p} ± {p_se}, K0 = {k0} ± {k0_se}, n = {n} ± {n_se}; held-out RMS \
+         global {global} mm, per record {alone} mm, own {own} mm; ΔBIC {}; global step {} s, \
+         joint fit {} s",
+        g["delta_bic"], g["wall_seconds"], g["joint_fit_seconds"]
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("displacement (trajectory level)"), "{md}");
+    assert!(md.contains(" mm"), "{md}");
+}
+
+#[test]
+fn a_rerun_removes_stale_figures_and_lists_stale_unit_folders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = bundled_copy(tmp.path());
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(out.join("figures/global_K_vs_concentration.png").is_file());
+    assert_eq!(rows(&out).len(), 20);
+    // The held-out record and [global] removed from the campaign: its figure goes, its unit
+    // folder stays (the user's results) and is named.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let last = text.find("# A denser suspension").unwrap();
+    std::fs::write(&file, &text[..last]).unwrap();
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(!out.join("figures/global_K_vs_concentration.png").exists());
+    assert!(!out.join("figures/global_K_vs_concentration.csv").exists());
+    assert!(out
+        .join("figures/power_law_K_vs_concentration.png")
+        .is_file());
+    assert!(out.join("units/010-a2_c4/unit.json").is_file());
+    let json = read_json(&out.join("campaign.json"));
+    assert_eq!(json["stale_units"], serde_json::json!(["010-a2_c4"]));
+    assert_eq!(rows(&out).len(), 18);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("units/ holds 1 folder(s) that no unit of this campaign writes"),
+        "{md}"
+    );
+    assert!(md.contains("010-a2_c4"), "{md}");
 }
 
 #[test]

@@ -31,7 +31,7 @@ use crate::experiment::{error_at, line_of, Ctx, Experiment};
 pub const MAX_CAMPAIGN_BYTES: u64 = 16 << 20;
 
 /// Record keys that are not conditions.
-const RECORD_KEYS: [&str; 3] = ["file", "experiment", "command"];
+pub(super) const RECORD_KEYS: [&str; 3] = ["file", "experiment", "command"];
 
 /// The command a unit runs on its record.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
@@ -64,6 +64,9 @@ struct RawHeader {
     command: Option<Spanned<CommandName>>,
     #[serde(default)]
     conditions: Vec<Spanned<String>>,
+    #[serde(default)]
+    units: BTreeMap<String, Spanned<String>>,
+    records: Option<Spanned<String>>,
 }
 
 /// The whole file as written; a record is a table of any keys (its conditions are named by
@@ -73,9 +76,12 @@ struct RawHeader {
 struct RawCampaign {
     campaign: Option<Spanned<RawHeader>>,
     #[serde(default)]
-    records: Vec<Spanned<BTreeMap<String, Spanned<toml::Value>>>>,
+    records: Vec<RawRecord>,
     global: Option<Spanned<super::global_file::RawGlobal>>,
 }
+
+/// A `[[records]]` table as written.
+type RawRecord = Spanned<BTreeMap<String, Spanned<toml::Value>>>;
 
 /// A checked campaign.
 #[derive(Clone, Debug)]
@@ -84,6 +90,8 @@ pub struct Campaign {
     pub path: PathBuf,
     /// Condition names, in the order of `campaign.conditions`.
     pub conditions: Vec<String>,
+    /// The unit of a condition, where `campaign.units` gives one (for the figures' axes).
+    pub condition_units: BTreeMap<String, String>,
     /// One unit per record, in the file's order.
     pub units: Vec<Unit>,
     /// The joint fit of `[global]`, if any.
@@ -107,12 +115,31 @@ pub struct Unit {
     pub command: CommandName,
     /// Each condition's value, in the order of `campaign.conditions`.
     pub conditions: Vec<(String, f64)>,
-    /// Line of the record's entry in the campaign file.
+    /// Line of the record's entry in the campaign file (or its row in the records table).
     #[serde(skip)]
     pub line: usize,
+    /// The records table the entry is a row of (`campaign.records`); `None`: a
+    /// `[[records]]` table of the campaign file.
+    #[serde(skip)]
+    pub origin: Option<PathBuf>,
 }
 
 impl Unit {
+    /// An error about this unit's entry, at its line: of the `campaign` file under `key`, or
+    /// of the records table it is a row of, under `column`.
+    pub fn entry_error(
+        &self,
+        campaign: &Path,
+        key: &str,
+        column: &str,
+        msg: impl std::fmt::Display,
+    ) -> anyhow::Error {
+        match &self.origin {
+            Some(table) => error_at(table, self.line, column, msg),
+            None => error_at(campaign, self.line, key, msg),
+        }
+    }
+
     /// The unit's folder under `units/`: `NNN-<record stem>` (characters other than letters,
     /// digits, `-`, `_` and `.` become `_`).
     pub fn folder_name(&self) -> String {
@@ -159,27 +186,17 @@ impl Campaign {
             return Err(error_at(path, 1, "campaign", "missing section [campaign]"));
         };
         let conditions = check_conditions(&header, path, text)?;
-        if raw.records.is_empty() {
-            let line = line_of(text, header.span().start);
-            return Err(error_at(
-                path,
-                line,
-                "records",
-                "no records: add a [[records]] table with `file` for each",
-            ));
-        }
+        let condition_units = check_units(&header, &conditions, path, text)?;
         let dir = folder_of(path);
         let defaults = Defaults {
             experiment: header.get_ref().experiment.as_ref(),
             command: header.get_ref().command.as_ref().map(|c| *c.get_ref()),
         };
         let place = Place { path, text, dir };
-        let units = raw
-            .records
-            .iter()
-            .enumerate()
-            .map(|(i, r)| check_record(i, r, &conditions, &defaults, &place))
-            .collect::<Result<Vec<_>>>()?;
+        let units = match &header.get_ref().records {
+            Some(table) => table_units(table, &raw.records, &conditions, &defaults, &place)?,
+            None => toml_units(&header, &raw.records, &conditions, &defaults, &place)?,
+        };
         check_experiments(&units, &place)?;
         let default_experiment = defaults.experiment.map(|e| place.dir.join(e.get_ref()));
         let global = raw
@@ -199,6 +216,7 @@ impl Campaign {
         Ok(Campaign {
             path: path.to_path_buf(),
             conditions,
+            condition_units,
             units,
             global,
         })
@@ -215,6 +233,64 @@ impl Campaign {
             ),
         }
     }
+}
+
+/// The units of `[[records]]` tables.
+fn toml_units(
+    header: &Spanned<RawHeader>,
+    records: &[RawRecord],
+    conditions: &[String],
+    defaults: &Defaults,
+    place: &Place,
+) -> Result<Vec<Unit>> {
+    if records.is_empty() {
+        return Err(place.error(
+            header.span().start,
+            "records",
+            "no records: add a [[records]] table with `file` for each, or `campaign.records = \
+             \"table.csv\"`",
+        ));
+    }
+    records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| check_record(i, r, conditions, defaults, place))
+        .collect()
+}
+
+/// The units of the records table `campaign.records` (no `[[records]]` beside it).
+fn table_units(
+    table: &Spanned<String>,
+    records: &[RawRecord],
+    conditions: &[String],
+    defaults: &Defaults,
+    place: &Place,
+) -> Result<Vec<Unit>> {
+    let here = || {
+        format!(
+            "{}:{}: `campaign.records`",
+            place.path.display(),
+            line_of(place.text, table.span().start)
+        )
+    };
+    if let Some(first) = records.first() {
+        return Err(place.error(
+            first.span().start,
+            "records[0]",
+            format!(
+                "both `campaign.records = \"{}\"` and [[records]] tables: give the records one \
+                 way",
+                table.get_ref()
+            ),
+        ));
+    }
+    let row_defaults = super::records_table::RowDefaults {
+        experiment: defaults.experiment.map(|e| e.get_ref().as_str()),
+        command: defaults.command,
+        dir: &place.dir,
+    };
+    super::records_table::read(&place.dir.join(table.get_ref()), conditions, &row_defaults)
+        .with_context(here)
 }
 
 /// `campaign.conditions`, checked: names unique and not a record key.
@@ -246,6 +322,40 @@ fn check_conditions(header: &Spanned<RawHeader>, path: &Path, text: &str) -> Res
     Ok(names)
 }
 
+/// `campaign.units`, checked: each key a listed condition, each unit a non-empty string.
+fn check_units(
+    header: &Spanned<RawHeader>,
+    conditions: &[String],
+    path: &Path,
+    text: &str,
+) -> Result<BTreeMap<String, String>> {
+    let mut out = BTreeMap::new();
+    for (name, unit) in &header.get_ref().units {
+        let at = |msg: String| {
+            error_at(
+                path,
+                line_of(text, unit.span().start),
+                &format!("campaign.units.{name}"),
+                msg,
+            )
+        };
+        if !conditions.contains(name) {
+            return Err(at(format!(
+                "`{name}` is not a condition: `campaign.conditions` lists [{}]",
+                conditions.join(", ")
+            )));
+        }
+        let unit = unit.get_ref().trim();
+        if unit.is_empty() {
+            return Err(at(
+                "an empty unit: leave the condition out of `units`".into()
+            ));
+        }
+        out.insert(name.clone(), unit.to_string());
+    }
+    Ok(out)
+}
+
 /// What `[campaign]` gives every record.
 struct Defaults<'a> {
     experiment: Option<&'a Spanned<String>>,
@@ -268,7 +378,7 @@ impl Place<'_> {
 /// Record `i` checked into unit `i + 1`.
 fn check_record(
     i: usize,
-    raw: &Spanned<BTreeMap<String, Spanned<toml::Value>>>,
+    raw: &RawRecord,
     conditions: &[String],
     defaults: &Defaults,
     place: &Place,
@@ -324,6 +434,7 @@ fn check_record(
         command,
         conditions: values,
         line: line_of(place.text, start),
+        origin: None,
     })
 }
 
@@ -420,7 +531,7 @@ fn check_experiments(units: &[Unit], place: &Place) -> Result<()> {
     let mut parsed: HashMap<&Path, Experiment> = HashMap::new();
     for (i, unit) in units.iter().enumerate() {
         let key = format!("records[{i}]");
-        let at = |msg: String| error_at(place.path, unit.line, &key, msg);
+        let at = |msg: String| unit.entry_error(place.path, &key, "experiment", msg);
         if !parsed.contains_key(unit.experiment.as_path()) {
             if !unit.experiment.is_file() {
                 return Err(at(format!(
@@ -428,13 +539,17 @@ fn check_experiments(units: &[Unit], place: &Place) -> Result<()> {
                     unit.experiment.display()
                 )));
             }
-            let exp = Experiment::load(&unit.experiment).with_context(|| {
-                format!(
-                    "{}:{}: `{key}`: the experiment {} does not parse",
-                    place.path.display(),
-                    unit.line,
-                    unit.experiment.display()
-                )
+            let exp = Experiment::load(&unit.experiment).map_err(|e| {
+                let at = unit.entry_error(
+                    place.path,
+                    &key,
+                    "experiment",
+                    format!(
+                        "the experiment {} does not parse",
+                        unit.experiment.display()
+                    ),
+                );
+                e.context(at.to_string())
             })?;
             parsed.insert(&unit.experiment, exp);
         }
@@ -487,6 +602,13 @@ mod tests {
         assert_eq!(c.units[1].conditions, vec![("c".to_string(), 2.5)]);
         assert_eq!((c.units[0].line, c.units[1].line), (6, 10));
         assert_eq!(c.units[1].folder_name(), "002-r");
+        assert!(c.condition_units.is_empty());
+        let with_unit = HEAD.replace("c\"]", "c\"]\nunits = { c = \"kg·m\" }");
+        let c = parse(&format!(
+            "{with_unit}\n[[records]]\nfile = \"r.csv\"\nc = 1\n"
+        ))
+        .unwrap();
+        assert_eq!(c.condition_units["c"], "kg·m");
         assert!(c.unit(3).is_err() && c.unit(0).is_err());
     }
 
@@ -521,6 +643,58 @@ mod tests {
     }
 
     #[test]
+    fn records_may_come_from_a_table_but_not_both_ways_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
+        std::fs::write(
+            dir.path().join("e.toml"),
+            "[[models]]\nname = \"power_law\"\n",
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("t.csv"), "file,c\nr.csv,1\nr.csv,2\n").unwrap();
+        let path = dir.path().join("c.toml");
+        let head = format!("{HEAD}records = \"t.csv\"\n");
+        let c = Campaign::parse(&path, &head).unwrap();
+        assert_eq!(c.units.len(), 2);
+        assert_eq!(c.units[1].conditions, [("c".to_string(), 2.0)]);
+        let both = format!("{head}\n[[records]]\nfile = \"r.csv\"\nc = 1\n");
+        let e = format!("{:#}", Campaign::parse(&path, &both).unwrap_err());
+        assert!(
+            e.contains(
+                "c.toml:7: `records[0]`: both `campaign.records = \"t.csv\"` and [[records]]"
+            ),
+            "{e}"
+        );
+        std::fs::write(dir.path().join("t.csv"), "file,c\nr.csv,1\nr.csv,two\n").unwrap();
+        let e = format!("{:#}", Campaign::parse(&path, &head).unwrap_err());
+        assert!(e.contains("c.toml:5: `campaign.records`: "), "{e}");
+        assert!(
+            e.contains("t.csv:3: `c`: a condition is a finite number, found \"two\""),
+            "{e}"
+        );
+        // A row's experiment that does not exist is named at the table's line and column.
+        std::fs::write(
+            dir.path().join("t.csv"),
+            "file,c,experiment\nr.csv,1,none.toml\n",
+        )
+        .unwrap();
+        let e = format!("{:#}", Campaign::parse(&path, &head).unwrap_err());
+        assert!(
+            e.contains("t.csv:2: `experiment`: no such experiment"),
+            "{e}"
+        );
+        let e = format!(
+            "{:#}",
+            Campaign::parse(&path, &HEAD.replace("c\"]", "c\"]\nrecords = \"none.csv\""))
+                .unwrap_err()
+        );
+        assert!(
+            e.contains("cannot read the records table") && e.contains("none.csv"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn the_header_is_checked_too() {
         assert_eq!(
             message("[[records]]\nfile = \"r.csv\"\n"),
@@ -533,6 +707,14 @@ mod tests {
             .starts_with(":2: `campaign.conditions[1]`: `a` is listed twice"));
         let no_work = "[campaign]\n\n[[records]]\nfile = \"r.csv\"\n";
         assert!(message(no_work).starts_with(":3: `records[0]`: no experiment"));
+        assert!(
+            message("[campaign]\nconditions = [\"a\"]\nunits = { b = \"m\" }\n")
+                .starts_with(":3: `campaign.units.b`: `b` is not a condition")
+        );
+        assert!(
+            message("[campaign]\nconditions = [\"a\"]\nunits = { a = \" \" }\n")
+                .starts_with(":3: `campaign.units.a`: an empty unit")
+        );
         assert!(message("[campaign]\nexperimnt = \"e.toml\"\n")
             .starts_with(":2: `campaign`: unknown field `experimnt`"));
     }

@@ -1,17 +1,19 @@
-//! `[global]` run: each record read with its own experiment's layout and kinematics (as the
-//! per-record `fit` reads it), fitted alone with the global model (the per-record
-//! alternative, as `fit` would fit it), then all training records fitted jointly
-//! ([`super::global_fit`]), and the two compared ([`GlobalJson`], written to
-//! `DIR/global.json`):
+//! `[global]` run: each record read and fitted alone with the global model at the global
+//! fit's level ([`super::global_records`]: the per-record alternative, as `fit` would fit
+//! it), then all training records fitted jointly ([`super::global_fit`]), and the two
+//! compared ([`GlobalJson`], written to `DIR/global.json`; RMS values in N at force level,
+//! in mm at trajectory level, `rms_unit`):
 //!
 //! - over the training records: total RSS, parameters, AIC and BIC of each (the per-record
 //!   side sums the records' RSS, samples and free parameters; both use
 //!   `N·ln(RSS/N) + 2p` and `N·ln(RSS/N) + p·ln N`, as every fit does);
-//! - on the held-out record: the force RMS predicted by the global fit (laws evaluated at its
-//!   condition, shared values, per-record parameters at their mean over the training records)
-//!   against the per-record alternative: the mean of the per-record parameter values of the
-//!   training records nearest the held-out record in the laws' conditions (all of them when
-//!   there is no law).
+//! - on the held-out record: the RMS of the force (or displacement) predicted by the global
+//!   fit (laws evaluated at its condition, shared values, per-record parameters at their mean
+//!   over the training records) against the per-record alternative: the mean of the
+//!   per-record parameter values of the training records nearest the held-out record in the
+//!   laws' conditions (all of them when there is no law). At trajectory level both simulate
+//!   the held-out record's own oscillator from its own initial state as estimated from the
+//!   record (never fitted to it).
 //!
 //! "Sharing supported" needs the global fit's BIC lower and its held-out RMS at most the
 //! alternative's; the caveats say when not to trust the verdict.
@@ -22,15 +24,13 @@ use anyhow::{bail, Context, Result};
 use indexmap::IndexMap;
 use rayon::prelude::*;
 use serde::Serialize;
-use stf_core::data::record_bounds::DataScales;
-use stf_core::fit::{FitParam, FitResult, FORCE_OFFSET};
+use stf_core::fit::{FitResult, INITIAL_STATE};
 
 use super::file::{Campaign, Unit};
 use super::global_file::GlobalSpec;
 use super::global_fit::{self, JointRecord, Source};
+use super::global_records::{self, load_one, rebound, union_scales, Loaded};
 use crate::experiment::{Experiment, FitLevel};
-use crate::fitting::{self, ModelFit};
-use crate::model_config::configure_for;
 
 /// The name of the global fit's JSON in the campaign folder.
 pub const GLOBAL_JSON: &str = "global.json";
@@ -57,6 +57,10 @@ pub struct LawJson {
     pub condition: String,
     /// The condition's reference value.
     pub reference: f64,
+    /// The parameter's SI unit, from its model's `ParamSpec` (empty: dimensionless).
+    pub unit: String,
+    /// The condition's unit, where `campaign.units` gives one.
+    pub condition_unit: Option<String>,
     /// The parameter at the reference, with its standard error.
     pub coefficient: f64,
     /// Standard error of the coefficient.
@@ -70,13 +74,13 @@ pub struct LawJson {
 /// Fit statistics of one side of the comparison, over the training records.
 #[derive(Clone, Debug, Serialize)]
 pub struct Criteria {
-    /// Residual sum of squares, N².
+    /// Residual sum of squares, SI: N² (force level) or m² (trajectory level).
     pub rss: f64,
     /// Samples.
     pub n_points: usize,
     /// Free parameters.
     pub n_params: usize,
-    /// RMS residual, N.
+    /// RMS residual, in `rms_unit` (N or mm).
     pub rms: f64,
     /// N·ln(RSS/N) + 2p.
     pub aic: f64,
@@ -87,7 +91,9 @@ pub struct Criteria {
 }
 
 impl Criteria {
-    fn of(rss: f64, n_points: usize, n_params: usize, converged: bool) -> Criteria {
+    /// The criteria of a fit with residual sum of squares `rss` (SI) over `n_points`
+    /// samples and `n_params` free parameters; its RMS shown ×`shown` (1 in N, 1e3 in mm).
+    fn of(rss: f64, n_points: usize, n_params: usize, converged: bool, shown: f64) -> Criteria {
         let n = n_points as f64;
         let p = n_params as f64;
         let base = n * (rss / n).ln();
@@ -95,7 +101,7 @@ impl Criteria {
             rss,
             n_points,
             n_params,
-            rms: (rss / n).sqrt(),
+            rms: shown * (rss / n).sqrt(),
             aic: base + 2.0 * p,
             bic: base + p * n.ln(),
             converged,
@@ -112,26 +118,27 @@ pub struct PerRecord {
     pub record: String,
     /// Its conditions.
     pub conditions: IndexMap<String, f64>,
-    /// Parameter values and standard errors, by name (model's, then `f_off`).
+    /// Parameter values and standard errors, by name (force level: the model's, then
+    /// `f_off`; trajectory level: the fit's free parameters).
     pub params: IndexMap<String, (f64, f64)>,
-    /// RMS residual, N.
+    /// RMS residual, in `rms_unit`.
     pub rms: f64,
     /// Whether it was the held-out record (not in either side's totals).
     pub held_out: bool,
 }
 
-/// The held-out record's force RMS predicted both ways.
+/// The held-out record's RMS predicted both ways, in `rms_unit`.
 #[derive(Clone, Debug, Serialize)]
 pub struct HoldoutJson {
     /// The record as written.
     pub record: String,
-    /// RMS of the global fit's prediction, N.
+    /// RMS of the global fit's prediction.
     pub global_rms: f64,
-    /// RMS of the per-record alternative's prediction, N.
+    /// RMS of the per-record alternative's prediction.
     pub per_record_rms: f64,
     /// The records whose own parameters were averaged for the alternative.
     pub per_record_from: Vec<String>,
-    /// RMS of the record's own fit (the best either could do), N.
+    /// RMS of the record's own fit (the best either could do).
     pub own_fit_rms: f64,
 }
 
@@ -140,6 +147,12 @@ pub struct HoldoutJson {
 pub struct GlobalJson {
     /// The model as written in `[global]`.
     pub model: String,
+    /// `force` or `trajectory`: what the fits aim at.
+    pub level: String,
+    /// A condition's unit, where `campaign.units` gives one.
+    pub condition_units: std::collections::BTreeMap<String, String>,
+    /// The unit of every RMS: `N` (force level) or `mm` (trajectory level).
+    pub rms_unit: String,
     /// Parameters shared by every record.
     pub shared: Vec<String>,
     /// The records fitted (as written).
@@ -168,13 +181,11 @@ pub struct GlobalJson {
     pub log: Vec<String>,
     /// Wall time of the whole global step (reading, per-record and joint fits), s.
     pub wall_seconds: f64,
-}
-
-/// A record loaded and fitted alone.
-struct Loaded<'c> {
-    unit: &'c Unit,
-    joint: JointRecord,
-    own: ModelFit,
+    /// Wall time of the joint fit alone, s.
+    pub joint_fit_seconds: f64,
+    /// Evaluations of the joint residuals (each a prediction of every training record,
+    /// those cached apart: a Jacobian column of a per-record parameter predicts one record).
+    pub joint_fit_evaluations: u64,
 }
 
 /// Run `[global]` of `campaign` (which must have one).
@@ -184,96 +195,55 @@ pub fn run(campaign: &Campaign) -> Result<GlobalJson> {
     };
     let gexp = Experiment::load(&spec.experiment)?;
     let at = |u: &Unit| format!("{}: record {}", campaign.path.display(), u.record_given);
-    let loaded: Vec<Loaded> = campaign
+    let mut loaded: Vec<Loaded> = campaign
         .units
         .par_iter()
         .map(|u| load_one(spec, &gexp, u).with_context(|| at(u)))
         .collect::<Result<_>>()?;
+    let is_training = |i: usize| Some(i) != spec.holdout;
+    let scales = union_scales(
+        loaded
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| is_training(*i))
+            .map(|(_, l)| &l.joint),
+    );
+    let configured = global_records::configure(spec, &gexp, &scales)?;
+    for l in &mut loaded {
+        rebound(&mut l.joint, &configured);
+    }
     let training: Vec<&Loaded> = loaded
         .iter()
         .enumerate()
-        .filter(|(i, _)| Some(*i) != spec.holdout)
+        .filter(|(i, _)| is_training(*i))
         .map(|(_, l)| l)
         .collect();
-    let scales = union_scales(&training);
-    let configured = configure_for(
-        std::slice::from_ref(&spec.entry),
-        &gexp.path,
-        &gexp.dir,
-        &gexp.scripts,
-        Some(&scales),
-    )?;
-    let offset = gexp
-        .fit
-        .offset
-        .then(|| FitParam::new(FORCE_OFFSET, 0.0).bounds(-100.0, 100.0));
     let records: Vec<(usize, &JointRecord)> =
         training.iter().map(|l| (l.unit.number, &l.joint)).collect();
     let starts: Vec<Vec<f64>> = training.iter().map(|l| l.own.values.clone()).collect();
-    let layout = global_fit::layout(
-        &spec.shared,
-        &spec.laws,
-        &configured.params,
-        offset.as_ref(),
-        &records,
-        &starts,
-    );
+    let layout = global_fit::layout(&spec.shared, &spec.laws, &records, &starts);
     let joint: Vec<&JointRecord> = training.iter().map(|l| &l.joint).collect();
-    let result = global_fit::fit(&layout, &joint, &gexp.fit.settings)?;
+    let trajectory = spec.level == FitLevel::Trajectory;
+    let settings = if trajectory {
+        gexp.fit
+            .settings
+            .clone()
+            .for_simulation(gexp.integrator.rtol)
+    } else {
+        gexp.fit.settings.clone()
+    };
+    let result = global_fit::fit(&layout, &joint, &settings, trajectory)?;
     let holdout = spec
         .holdout
         .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result))
         .transpose()?;
-    Ok(assemble(spec, &loaded, &training, &layout, result, holdout))
-}
-
-/// Read `unit`'s record with its experiment's layout, derive its kinematics, fit the global
-/// model to it alone (as `fit` would, with the global experiment's settings).
-fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Result<Loaded<'c>> {
-    let mut exp = Experiment::load(&unit.experiment)?.with_data_file(unit.record.clone());
-    let data = fitting::load_data_at(&mut exp, Some(FitLevel::Force))?;
-    if data.level != FitLevel::Force {
-        bail!("a global fit is at force level: the record needs an `f_stf` column");
-    }
-    let scales = data.scales(&gexp.system);
-    let configured = configure_for(
-        std::slice::from_ref(&spec.entry),
-        &gexp.path,
-        &gexp.dir,
-        &gexp.scripts,
-        Some(&scales),
-    )?;
-    let hidden = indicatif::ProgressBar::hidden();
-    let own = fitting::fit_model(gexp, &data, Some(&configured), &hidden)?;
-    let k = &data.kinematics;
-    let joint = JointRecord {
-        t: k.t.clone(),
-        x: k.x.clone(),
-        v: k.v.clone(),
-        a: k.a.clone(),
-        f: data.record.f_stf.clone().unwrap_or_default(),
-        fit: global_fit::predictor(
-            configured.model.clone(),
-            &configured.params,
-            gexp.fit.offset,
-        ),
-        conditions: unit.conditions.clone(),
+    let units = Units {
+        model: configured.model.clone(),
+        conditions: campaign.condition_units.clone(),
     };
-    Ok(Loaded { unit, joint, own })
-}
-
-/// The data scales of all training records together (the model's bounds are widened to them
-/// as a per-record fit widens them to its record's).
-fn union_scales(training: &[&Loaded]) -> DataScales {
-    let cat = |f: fn(&JointRecord) -> &Vec<f64>| -> Vec<f64> {
-        training.iter().flat_map(|l| f(&l.joint).clone()).collect()
-    };
-    DataScales::of(
-        &cat(|r| &r.f),
-        &cat(|r| &r.x),
-        &cat(|r| &r.v),
-        &cat(|r| &r.a),
-    )
+    Ok(assemble(
+        spec, &units, &loaded, &training, &layout, result, holdout,
+    ))
 }
 
 /// The held-out record predicted by the global fit and by the per-record alternative.
@@ -298,23 +268,35 @@ fn holdout_json(
                 let ratio = held.joint.condition(&law.condition) / law.reference;
                 theta[*coefficient] * ratio.powf(theta[*exponent])
             }
-            _ => mean(layout.sources.iter().map(|s| s[k].value(&theta))),
+            _ => own_state(held, k)
+                .unwrap_or_else(|| mean(layout.sources.iter().map(|s| s[k].value(&theta)))),
         })
         .collect();
     let nearest = nearest_records(spec, held, training);
     let alternative: Vec<f64> = (0..held.own.values.len())
-        .map(|k| mean(nearest.iter().map(|l| l.own.values[k])))
+        .map(|k| {
+            own_state(held, k).unwrap_or_else(|| mean(nearest.iter().map(|l| l.own.values[k])))
+        })
         .collect();
+    let shown = spec.level.shown().1;
     Ok(HoldoutJson {
         record: held.unit.record_given.clone(),
-        global_rms: global_fit::rms_of(&held.joint, &global_values)?,
-        per_record_rms: global_fit::rms_of(&held.joint, &alternative)?,
+        global_rms: shown * global_fit::rms_of(&held.joint, &global_values)?,
+        per_record_rms: shown * global_fit::rms_of(&held.joint, &alternative)?,
         per_record_from: nearest
             .iter()
             .map(|l| l.unit.record_given.clone())
             .collect(),
-        own_fit_rms: held.own.result.rms,
+        own_fit_rms: shown * held.own.result.rms,
     })
+}
+
+/// The held-out record's own estimate of its `k`-th parameter if it is its initial state
+/// (`x0`, `v0`: the start its own fit takes, from the record, never fitted to it): another
+/// record's initial state says nothing about this one's.
+fn own_state(held: &Loaded, k: usize) -> Option<f64> {
+    let p = held.joint.params.get(k)?;
+    INITIAL_STATE.contains(&p.name.as_str()).then_some(p.value)
 }
 
 /// The mean of `values`.
@@ -353,78 +335,41 @@ fn nearest_records<'a, 'c>(
 /// Put the pieces into `global.json`'s shape, with the verdict and its caveats.
 fn assemble(
     spec: &GlobalSpec,
+    units: &Units,
     loaded: &[Loaded],
     training: &[&Loaded],
     layout: &global_fit::Layout,
     result: FitResult,
     holdout: Option<HoldoutJson>,
 ) -> GlobalJson {
-    let params: Vec<GlobalParam> = result
-        .params
-        .iter()
-        .zip(&layout.roles)
-        .map(|(p, role)| GlobalParam {
-            name: p.name.clone(),
-            role: role.to_string(),
-            value: p.value,
-            std_error: p.std_error,
-        })
-        .collect();
-    let laws = spec
-        .laws
-        .iter()
-        .filter_map(|l| {
-            let c = result.param(&global_fit::coefficient_name(&l.param))?;
-            let e = result.param(&global_fit::exponent_name(&l.param))?;
-            Some(LawJson {
-                param: l.param.clone(),
-                condition: l.condition.clone(),
-                reference: l.reference,
-                coefficient: c.value,
-                coefficient_std_error: c.std_error,
-                exponent: e.value,
-                exponent_std_error: e.std_error,
-            })
-        })
-        .collect();
+    let shown = spec.level.shown();
     let global = Criteria::of(
         result.rss,
         result.n_points,
         result.n_free,
         result.convergence.converged(),
+        shown.1,
     );
-    let per_record = Criteria::of(
-        training.iter().map(|l| l.own.result.rss).sum(),
-        training.iter().map(|l| l.own.result.n_points).sum(),
-        training.iter().map(|l| l.own.result.n_free).sum(),
-        training
-            .iter()
-            .all(|l| l.own.result.convergence.converged()),
-    );
+    let per_record = per_record_criteria(training, shown.1);
     let delta_bic = global.bic - per_record.bic;
     let better_held = holdout
         .as_ref()
         .is_none_or(|h| h.global_rms <= h.per_record_rms);
     let supported = delta_bic < 0.0 && better_held;
-    let verdict = verdict_text(supported, delta_bic, holdout.as_ref());
-    let mut caveats = caveats(spec, training, &global, &per_record, holdout.is_some());
-    if holdout.as_ref().is_some_and(HoldoutJson::is_tie) {
-        caveats.push(format!(
-            "the held-out record does not tell the two fits apart (their RMS differ by under \
-             {:.0} %): hold out a record at a level of the law's condition that no other record \
-             shares to test what the law predicts",
-            TIE * 100.0
-        ));
-    }
+    let verdict = verdict_text(supported, delta_bic, holdout.as_ref(), spec.level);
+    let caveats = all_caveats(spec, training, &global, &per_record, holdout.as_ref());
     GlobalJson {
         model: spec.model.clone(),
+        level: level_name(spec.level).into(),
+        condition_units: units.conditions.clone(),
+        rms_unit: shown.0.into(),
         shared: spec.shared.clone(),
         records: training
             .iter()
             .map(|l| l.unit.record_given.clone())
             .collect(),
-        params,
-        laws,
+        params: theta_json(&result, layout),
+        laws: laws_json(spec, &result, units),
         global,
         per_record,
         delta_bic,
@@ -435,11 +380,111 @@ fn assemble(
         each_record: loaded
             .iter()
             .enumerate()
-            .map(|(i, l)| per_record_json(l, spec.holdout == Some(i)))
+            .map(|(i, l)| per_record_json(l, spec.holdout == Some(i), shown.1))
             .collect(),
+        joint_fit_seconds: result.wall_seconds,
+        joint_fit_evaluations: result.evaluations,
         log: result.log,
         wall_seconds: 0.0,
     }
+}
+
+/// Where the laws' units come from.
+struct Units {
+    /// The global model (its parameters' `ParamSpec`s).
+    model: std::sync::Arc<dyn stf_core::physics::force_model::ForceModel>,
+    /// `campaign.units`.
+    conditions: std::collections::BTreeMap<String, String>,
+}
+
+impl Units {
+    /// The unit of the model's parameter `name` (empty if it has none or is not the model's).
+    fn param(&self, name: &str) -> String {
+        self.model
+            .params()
+            .iter()
+            .find(|s| s.name == name)
+            .map_or_else(String::new, |s| s.unit.clone())
+    }
+}
+
+/// `force` or `trajectory`, as `[fit] level` is written.
+fn level_name(level: FitLevel) -> &'static str {
+    match level {
+        FitLevel::Force => "force",
+        FitLevel::Trajectory => "trajectory",
+    }
+}
+
+/// θ with its roles and standard errors.
+fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalParam> {
+    result
+        .params
+        .iter()
+        .zip(&layout.roles)
+        .map(|(p, role)| GlobalParam {
+            name: p.name.clone(),
+            role: role.to_string(),
+            value: p.value,
+            std_error: p.std_error,
+        })
+        .collect()
+}
+
+/// Each law's coefficient and exponent with their errors.
+fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJson> {
+    spec.laws
+        .iter()
+        .filter_map(|l| {
+            let c = result.param(&global_fit::coefficient_name(&l.param))?;
+            let e = result.param(&global_fit::exponent_name(&l.param))?;
+            Some(LawJson {
+                param: l.param.clone(),
+                condition: l.condition.clone(),
+                reference: l.reference,
+                unit: units.param(&l.param),
+                condition_unit: units.conditions.get(&l.condition).cloned(),
+                coefficient: c.value,
+                coefficient_std_error: c.std_error,
+                exponent: e.value,
+                exponent_std_error: e.std_error,
+            })
+        })
+        .collect()
+}
+
+/// The per-record fits of the training records taken together: their RSS, samples and free
+/// parameters summed.
+fn per_record_criteria(training: &[&Loaded], shown: f64) -> Criteria {
+    Criteria::of(
+        training.iter().map(|l| l.own.result.rss).sum(),
+        training.iter().map(|l| l.own.result.n_points).sum(),
+        training.iter().map(|l| l.own.result.n_free).sum(),
+        training
+            .iter()
+            .all(|l| l.own.result.convergence.converged()),
+        shown,
+    )
+}
+
+/// [`caveats`], and a held-out record that cannot tell the fits apart.
+fn all_caveats(
+    spec: &GlobalSpec,
+    training: &[&Loaded],
+    global: &Criteria,
+    per_record: &Criteria,
+    holdout: Option<&HoldoutJson>,
+) -> Vec<String> {
+    let mut out = caveats(spec, training, global, per_record, holdout.is_some());
+    if holdout.is_some_and(HoldoutJson::is_tie) {
+        out.push(format!(
+            "the held-out record does not tell the two fits apart (their RMS differ by under \
+             {:.0} %): hold out a record at a level of the law's condition that no other record \
+             shares to test what the law predicts",
+            TIE * 100.0
+        ));
+    }
+    out
 }
 
 /// Held-out RMS values closer than this (relative) are a tie: the record cannot tell the
@@ -454,7 +499,17 @@ impl HoldoutJson {
 }
 
 /// The verdict in a sentence.
-fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) -> String {
+fn verdict_text(
+    supported: bool,
+    delta_bic: f64,
+    holdout: Option<&HoldoutJson>,
+    level: FitLevel,
+) -> String {
+    let (unit, _) = level.shown();
+    let (signal, digits) = match level {
+        FitLevel::Force => ("force", 5),
+        FitLevel::Trajectory => ("displacement", 4),
+    };
     let bic = if delta_bic < 0.0 {
         format!("the global fit's BIC is lower by {:.1}", -delta_bic)
     } else {
@@ -469,8 +524,9 @@ fn verdict_text(supported: bool, delta_bic: f64, holdout: Option<&HoldoutJson>) 
                 String::new()
             };
             format!(
-                "on the held-out record {} the global fit predicts the force with RMS {:.5} N \
-                 against {:.5} N for the per-record alternative{tie}",
+                "on the held-out record {} the global fit predicts the {signal} with RMS \
+                 {:.digits$} {unit} against {:.digits$} {unit} for the per-record \
+                 alternative{tie}",
                 h.record, h.global_rms, h.per_record_rms
             )
         },
@@ -527,7 +583,7 @@ fn caveats(
 }
 
 /// A record's own fit, for the JSON and the figure.
-fn per_record_json(l: &Loaded, held_out: bool) -> PerRecord {
+fn per_record_json(l: &Loaded, held_out: bool, shown: f64) -> PerRecord {
     PerRecord {
         unit: l.unit.number,
         record: l.unit.record_given.clone(),
@@ -539,7 +595,7 @@ fn per_record_json(l: &Loaded, held_out: bool) -> PerRecord {
             .iter()
             .map(|p| (p.name.clone(), (p.value, p.std_error)))
             .collect(),
-        rms: l.own.result.rms,
+        rms: shown * l.own.result.rms,
         held_out,
     }
 }
@@ -571,9 +627,19 @@ mod tests {
     fn a_held_out_record_that_cannot_tell_the_fits_apart_is_called_a_tie() {
         assert!(holdout(0.019757, 0.019767).is_tie());
         assert!(!holdout(0.02038, 0.04556).is_tie());
-        let said = verdict_text(true, -117.6, Some(&holdout(0.019757, 0.019767)));
+        let said = verdict_text(
+            true,
+            -117.6,
+            Some(&holdout(0.019757, 0.019767)),
+            FitLevel::Force,
+        );
         assert!(said.contains("(a tie: within 1 %)"), "{said}");
-        let said = verdict_text(true, -137.7, Some(&holdout(0.02038, 0.04556)));
+        let said = verdict_text(
+            true,
+            -137.7,
+            Some(&holdout(0.02038, 0.04556)),
+            FitLevel::Force,
+        );
         assert!(!said.contains("tie"), "{said}");
     }
 }

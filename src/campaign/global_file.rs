@@ -11,10 +11,14 @@
 //! shared = ["n"]                 # one value for every record
 //! laws = { K = { condition = "concentration", reference = 0.40 } }
 //! holdout = "records/a2_c2.csv"  # a record of the list, left out of every fit
+//! level = "trajectory"           # force | trajectory; default: the experiment's [fit] level, else force
 //! ```
 //!
 //! Parameters neither shared nor given a law stay per record (and so does the force offset
-//! `f_off` of an experiment with `[fit] offset = true`, unless it is shared).
+//! `f_off` of an experiment with `[fit] offset = true`, unless it is shared). At trajectory
+//! level the parameters are those a trajectory `fit` frees: the model's free ones, the
+//! oscillator's of `[fit] system`, `x_off` with `offset`; the initial state `x0`, `v0` is each
+//! record's own and may be neither shared nor given a law.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -24,7 +28,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::file::Unit;
-use crate::experiment::{error_at, line_of, Experiment, ModelEntry};
+use crate::experiment::{error_at, line_of, Experiment, FitLevel, ModelEntry};
 use crate::model_config::configure_for;
 
 /// A law as written: `{ condition = "…", reference = … }`.
@@ -45,6 +49,7 @@ pub(super) struct RawGlobal {
     #[serde(default)]
     laws: BTreeMap<String, Spanned<RawLaw>>,
     holdout: Option<Spanned<String>>,
+    level: Option<FitLevel>,
 }
 
 /// A parameter made a power law of a condition: `param = param0·(condition/reference)^p`.
@@ -74,6 +79,8 @@ pub struct GlobalSpec {
     pub laws: Vec<Law>,
     /// The held-out record: an index into the campaign's units.
     pub holdout: Option<usize>,
+    /// What every fit aims at: `level`, else the experiment's `[fit] level`, else force.
+    pub level: FitLevel,
     /// Line of `[global]` in the campaign file.
     pub line: usize,
 }
@@ -117,100 +124,22 @@ pub(super) fn check(
     };
     let exp_path = experiment.map_or_else(|| units[0].experiment.clone(), Path::to_path_buf);
     let exp = Experiment::load(&exp_path)?;
-    let Some(entry) = exp
-        .models
+    let entry = find_entry(&exp, model, at)?;
+    let level = g.level.or(exp.fit.level).unwrap_or(FitLevel::Force);
+    let names = Names {
+        model: model.get_ref(),
+        params: param_names(&exp, entry, level)?,
+    };
+    let shared = check_shared(&g.shared, &names, at)?;
+    let laws = g
+        .laws
         .iter()
-        .find(|e| same_label(&entry_label(e), model.get_ref()))
-    else {
-        let known: Vec<String> = exp.models.iter().map(entry_label).collect();
-        return Err(at.error(
-            model.span().start,
-            "global.model",
-            format!(
-                "`{}` is not a [[models]] entry of {} (it has: {})",
-                model.get_ref(),
-                exp_path.display(),
-                known.join(", ")
-            ),
-        ));
-    };
-    let configured = configure_for(
-        std::slice::from_ref(entry),
-        &exp.path,
-        &exp.dir,
-        &exp.scripts,
-        None,
-    )?;
-    let mut names: Vec<String> = configured.params.iter().map(|p| p.name.clone()).collect();
-    if exp.fit.offset {
-        names.push(stf_core::fit::FORCE_OFFSET.to_string());
-    }
-    let lacks = |name: &str| {
-        format!(
-            "`{}` has no parameter `{name}` (it has: {})",
-            model.get_ref(),
-            names.join(", ")
-        )
-    };
-    let mut shared = Vec::new();
-    for (i, s) in g.shared.iter().enumerate() {
-        let key = format!("global.shared[{i}]");
-        let name = s.get_ref();
-        if !names.contains(name) {
-            return Err(at.error(s.span().start, &key, lacks(name)));
-        }
-        if shared.contains(name) {
-            return Err(at.error(s.span().start, &key, format!("`{name}` is listed twice")));
-        }
-        shared.push(name.clone());
-    }
-    let mut laws = Vec::new();
-    for (param, law) in &g.laws {
-        let key = format!("global.laws.{param}");
-        let offset = law.span().start;
-        let law = law.get_ref();
-        if param == stf_core::fit::FORCE_OFFSET {
-            return Err(at.error(
-                offset,
-                &key,
-                "`f_off` is each record's force offset: it may be shared, not follow a law",
-            ));
-        }
-        if !names.contains(param) {
-            return Err(at.error(offset, &key, lacks(param)));
-        }
-        if shared.contains(param) {
-            return Err(at.error(
-                offset,
-                &key,
-                format!("`{param}` is shared already: a parameter is shared or follows a law"),
-            ));
-        }
-        if !conditions.contains(&law.condition) {
-            return Err(at.error(
-                offset,
-                &format!("{key}.condition"),
-                format!(
-                    "`{}` is not a condition: `campaign.conditions` lists [{}]",
-                    law.condition,
-                    conditions.join(", ")
-                ),
-            ));
-        }
-        if !(law.reference.is_finite() && law.reference > 0.0) {
-            return Err(at.error(
-                offset,
-                &format!("{key}.reference"),
-                format!("a positive number, found {}", law.reference),
-            ));
-        }
-        check_positive(units, &law.condition, &key, at)?;
-        laws.push(Law {
-            param: param.clone(),
-            condition: law.condition.clone(),
-            reference: law.reference,
-        });
-    }
+        .map(|(param, law)| {
+            let law = check_law(param, law, &names, &shared, conditions, at)?;
+            check_positive(units, &law.condition, &format!("global.laws.{param}"), at)?;
+            Ok(law)
+        })
+        .collect::<Result<Vec<_>>>()?;
     let holdout = holdout_of(g.holdout.as_ref(), units, at)?;
     let training = units.len() - usize::from(holdout.is_some());
     if training < 2 {
@@ -227,7 +156,164 @@ pub(super) fn check(
         shared,
         laws,
         holdout,
+        level,
         line: line_of(at.text, start),
+    })
+}
+
+/// The `[[models]]` entry of `exp` that `model` names.
+fn find_entry<'e>(exp: &'e Experiment, model: &Spanned<String>, at: &At) -> Result<&'e ModelEntry> {
+    exp.models
+        .iter()
+        .find(|e| same_label(&entry_label(e), model.get_ref()))
+        .ok_or_else(|| {
+            let known: Vec<String> = exp.models.iter().map(entry_label).collect();
+            at.error(
+                model.span().start,
+                "global.model",
+                format!(
+                    "`{}` is not a [[models]] entry of {} (it has: {})",
+                    model.get_ref(),
+                    exp.path.display(),
+                    known.join(", ")
+                ),
+            )
+        })
+}
+
+/// The parameters a record's fit of `entry` has at `level` (in the order its values take):
+/// the model's (at trajectory level the free ones, then the oscillator's of `[fit] system`),
+/// then the offset with `[fit] offset`; at trajectory level the initial state `x0`, `v0`
+/// (when fitted) is left out: it is each record's own.
+fn param_names(exp: &Experiment, entry: &ModelEntry, level: FitLevel) -> Result<Vec<String>> {
+    let configured = configure_for(
+        std::slice::from_ref(entry),
+        &exp.path,
+        &exp.dir,
+        &exp.scripts,
+        None,
+    )?;
+    let trajectory = level == FitLevel::Trajectory;
+    let mut names: Vec<String> = configured
+        .params
+        .iter()
+        .filter(|p| !(trajectory && p.fixed))
+        .map(|p| p.name.clone())
+        .collect();
+    if trajectory {
+        names.extend(exp.fit.system_free.iter().map(|p| p.name().to_string()));
+    }
+    if exp.fit.offset {
+        names.push(offset_name(level).to_string());
+    }
+    Ok(names)
+}
+
+/// The constant offset a fit at `level` frees with `[fit] offset`.
+fn offset_name(level: FitLevel) -> &'static str {
+    match level {
+        FitLevel::Force => stf_core::fit::FORCE_OFFSET,
+        FitLevel::Trajectory => stf_core::fit::DISPLACEMENT_OFFSET,
+    }
+}
+
+/// The model as written and the parameters its fit has.
+struct Names<'a> {
+    model: &'a str,
+    params: Vec<String>,
+}
+
+impl Names<'_> {
+    /// Why `name` cannot be shared or follow a law: it is not a parameter of the fit.
+    fn lacks(&self, name: &str) -> String {
+        if stf_core::fit::INITIAL_STATE.contains(&name) {
+            return format!(
+                "`{name}` is each record's initial state: it stays per record (set `[fit] \
+                 initial = \"record\"` to take it from the records instead)"
+            );
+        }
+        format!(
+            "`{}` has no parameter `{name}` (it has: {})",
+            self.model,
+            self.params.join(", ")
+        )
+    }
+}
+
+/// `shared`, checked: parameters of the fit, each once.
+fn check_shared(given: &[Spanned<String>], names: &Names, at: &At) -> Result<Vec<String>> {
+    let mut shared = Vec::new();
+    for (i, s) in given.iter().enumerate() {
+        let key = format!("global.shared[{i}]");
+        let name = s.get_ref();
+        if !names.params.contains(name) {
+            return Err(at.error(s.span().start, &key, names.lacks(name)));
+        }
+        if shared.contains(name) {
+            return Err(at.error(s.span().start, &key, format!("`{name}` is listed twice")));
+        }
+        shared.push(name.clone());
+    }
+    Ok(shared)
+}
+
+/// The law of `param`, checked: a parameter of the fit (not an offset, not shared), over a
+/// listed condition, with a positive reference.
+fn check_law(
+    param: &str,
+    law: &Spanned<RawLaw>,
+    names: &Names,
+    shared: &[String],
+    conditions: &[String],
+    at: &At,
+) -> Result<Law> {
+    let key = format!("global.laws.{param}");
+    let offset = law.span().start;
+    let law = law.get_ref();
+    if [
+        stf_core::fit::FORCE_OFFSET,
+        stf_core::fit::DISPLACEMENT_OFFSET,
+    ]
+    .contains(&param)
+    {
+        return Err(at.error(
+            offset,
+            &key,
+            format!("`{param}` is each record's offset: it may be shared, not follow a law"),
+        ));
+    }
+    if !names.params.iter().any(|n| n == param) {
+        return Err(at.error(offset, &key, names.lacks(param)));
+    }
+    if shared.iter().any(|s| s == param) {
+        return Err(at.error(
+            offset,
+            &key,
+            format!("`{param}` is shared already: a parameter is shared or follows a law"),
+        ));
+    }
+    if !conditions.contains(&law.condition) {
+        return Err(at.error(
+            offset,
+            &format!("{key}.condition"),
+            format!(
+                "`{}` is not a condition: `campaign.conditions` lists [{}]",
+                law.condition,
+                conditions.join(", ")
+            ),
+        ));
+    }
+    if !(law.reference.is_finite() && law.reference > 0.0) {
+        return Err(at.error(
+            offset,
+            &format!("{key}.reference"),
+            format!("a positive number, found {}", law.reference),
+        ));
+    }
+    Ok(Law {
+        param: param.to_string(),
+        condition: law.condition.clone(),
+        reference: law.reference,
     })
 }
 
@@ -240,10 +326,10 @@ fn check_positive(units: &[Unit], condition: &str, key: &str, at: &At) -> Result
             .find(|(n, _)| n == condition)
             .map_or(f64::NAN, |(_, v)| *v);
         if value.is_nan() || value <= 0.0 {
-            return Err(error_at(
+            return Err(u.entry_error(
                 at.path,
-                u.line,
                 &format!("records[{i}].{condition}"),
+                condition,
                 format!("`{key}` needs a positive `{condition}` on every record, found {value}"),
             ));
         }
@@ -278,16 +364,22 @@ fn holdout_of(given: Option<&Spanned<String>>, units: &[Unit], at: &At) -> Resul
 #[cfg(test)]
 mod tests {
     use super::super::file::Campaign;
+    use crate::experiment::FitLevel;
 
     /// The campaign `text` (two records at c = 1 and 2 after it) parsed in a folder with a
     /// record `r.csv` and an experiment `e.toml` fitting `power_law` with an offset.
     fn parse(global: &str) -> anyhow::Result<Campaign> {
+        parse_with("[fit]\noffset = true\n", global)
+    }
+
+    /// [`parse`] with the experiment's `[fit]` section `fit`.
+    fn parse_with(fit: &str, global: &str) -> anyhow::Result<Campaign> {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("r.csv"), "t,phi,x\n0,0,0\n").unwrap();
         std::fs::write(dir.path().join("s.csv"), "t,phi,x\n0,0,0\n").unwrap();
         std::fs::write(
             dir.path().join("e.toml"),
-            "[fit]\noffset = true\n\n[[models]]\nname = \"power_law\"\n",
+            format!("{fit}\n[[models]]\nname = \"power_law\"\nparams = {{ n = {{ value = 1.5, fixed = true }} }}\n"),
         )
         .unwrap();
         let text = format!(
@@ -299,7 +391,11 @@ mod tests {
     }
 
     fn message(global: &str) -> String {
-        let e = format!("{:#}", parse(global).unwrap_err());
+        message_of(parse(global))
+    }
+
+    fn message_of(parsed: anyhow::Result<Campaign>) -> String {
+        let e = format!("{:#}", parsed.unwrap_err());
         e.split_once("c.toml")
             .map_or(e.clone(), |(_, m)| m.to_string())
     }
@@ -315,6 +411,48 @@ mod tests {
         assert_eq!(g.laws[0].param, "K");
         assert_eq!(g.laws[0].reference, 1.0);
         assert_eq!((g.holdout, g.line), (None, 14));
+        assert_eq!(g.level, FitLevel::Force);
+    }
+
+    #[test]
+    fn at_trajectory_level_the_parameters_are_those_a_trajectory_fit_frees() {
+        let fit = "[fit]\nlevel = \"trajectory\"\nsystem = [\"k\"]\noffset = true\n";
+        let c = parse_with(fit, "model = \"power_law\"\nshared = [\"k\", \"x_off\"]\n").unwrap();
+        let g = c.global.unwrap();
+        assert_eq!(
+            (g.level, g.shared),
+            (FitLevel::Trajectory, vec!["k".into(), "x_off".into()])
+        );
+        // `[global] level` overrides the experiment's.
+        let g = parse_with(fit, "model = \"power_law\"\nlevel = \"force\"\n").unwrap();
+        assert_eq!(g.global.unwrap().level, FitLevel::Force);
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nshared = [\"x0\"]\n",
+        ));
+        assert!(
+            m.starts_with(":16: `global.shared[0]`: `x0` is each record's initial state"),
+            "{m}"
+        );
+        // n is fixed: a trajectory fit does not free it; f_off is the force level's offset.
+        let m = message_of(parse_with(fit, "model = \"power_law\"\nshared = [\"n\"]\n"));
+        assert!(
+            m.contains("has no parameter `n` (it has: K, k, x_off)"),
+            "{m}"
+        );
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nlaws = { x_off = { condition = \"c\", reference = 1 } }\n",
+        ));
+        assert!(
+            m.contains("`global.laws.x_off`: `x_off` is each record's offset"),
+            "{m}"
+        );
+        let m = message_of(parse_with(
+            fit,
+            "model = \"power_law\"\nlevel = \"motion\"\n",
+        ));
+        assert!(m.contains("unknown variant `motion`"), "{m}");
     }
 
     #[test]
@@ -336,7 +474,7 @@ mod tests {
         assert!(message(
             "model = \"power_law\"\nlaws = { f_off = { condition = \"c\", reference = 1.0 } }\n"
         )
-        .starts_with(":16: `global.laws.f_off`: `f_off` is each record's force offset"));
+        .starts_with(":16: `global.laws.f_off`: `f_off` is each record's offset"));
         assert!(
             message("model = \"power_law\"\nholdout = \"r.csv\"\n").starts_with(
                 ":14: `global`: a global fit needs at least 2 records to fit; there are 1"

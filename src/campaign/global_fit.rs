@@ -1,24 +1,33 @@
-//! The joint force-level fit of `[global]`: every training record's measured F_STF against
-//! the model's force along its kinematics, in one least-squares problem over
-//! θ = (shared parameters, each law's coefficient `P0` and exponent `P_p`, the per-record
-//! parameters `P@N` of unit N). It runs through the core's generic fitter
-//! ([`stf_core::fit::fit_residuals`]: the same solver stages, Levenberg–Marquardt refinement and
-//! block-robust standard errors as every per-record fit), each record's residuals predicted
-//! by a [`ForceFit`] built as the per-record `fit` builds it.
+//! The joint fit of `[global]`: every training record's measured signal against its
+//! prediction, in one least-squares problem over θ = (shared parameters, each law's
+//! coefficient `P0` and exponent `P_p`, the per-record parameters `P@N` of unit N). At force
+//! level a record's measured F_STF is predicted along its kinematics by a [`ForceFit`] built as
+//! the per-record `fit` builds it; at trajectory level its measured x by simulating its
+//! oscillator with a [`TrajectoryFit`], the one its own `fit` ran. It runs through the core's
+//! generic fitter ([`stf_core::fit::fit_residuals`], at trajectory level
+//! [`stf_core::fit::fit_trajectory_residuals`]: the same solver stages, refinement rules and
+//! block-robust standard errors as every per-record fit of that level). A trial θ at which a
+//! record's simulation fails is an error of the residuals: the fitter scores it as a penalty
+//! and rejects the step, as in a per-record trajectory fit.
 //!
 //! The residuals of all records are laid end to end, so the covariance's blocks of
 //! consecutive samples may straddle two records at a boundary: a handful of blocks among
 //! hundreds, taken as correlated when they are not, which errs on the side of larger errors.
+//! Each record keeps its last predictions ([`PredictionCache`]), so a Jacobian column of a
+//! per-record parameter re-simulates only its own record.
 
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use rayon::prelude::*;
 use stf_core::fit::{
-    fit_residuals, full_values, FitParam, FitResult, ForceFit, Residuals, FORCE_OFFSET,
+    fit_residuals, fit_trajectory_residuals, full_values, FitError, FitParam, FitResult, ForceFit,
+    Residuals, TrajectoryData, TrajectoryFit, FORCE_OFFSET,
 };
 use stf_core::physics::force_model::ForceModel;
 
 use super::global_file::Law;
+use super::prediction_cache::PredictionCache;
 
 /// Where one value of a record's parameter vector comes from.
 #[derive(Clone, Debug)]
@@ -53,9 +62,26 @@ impl Source {
     }
 }
 
-/// One record in the joint problem: its force data and how θ maps to its parameters.
+/// How a record's signal is predicted.
+pub enum RecordFit {
+    /// Force level: the model's force along the record's kinematics.
+    Force(ForceFit),
+    /// Trajectory level: the record's oscillator with the model, simulated from its first
+    /// sample; `t`, `x` the measured record (s, m).
+    Trajectory {
+        /// The fit the record's own `fit` ran.
+        fit: TrajectoryFit,
+        /// Times, s.
+        t: Vec<f64>,
+        /// Measured displacement, m.
+        x: Vec<f64>,
+    },
+}
+
+/// One record in the joint problem: its data, how θ maps to its parameters and how they
+/// predict its signal.
 pub struct JointRecord {
-    /// The record's times, kinematics and measured force.
+    /// The record's times (of its kinematics), s.
     pub t: Vec<f64>,
     /// Displacement, m.
     pub x: Vec<f64>,
@@ -63,12 +89,18 @@ pub struct JointRecord {
     pub v: Vec<f64>,
     /// Acceleration, m/s².
     pub a: Vec<f64>,
-    /// Measured F_STF, N.
+    /// Force, N: measured F_STF (force level, the signal fitted) or the force recovered with
+    /// the record's oscillator (trajectory level: only the data scales use it).
     pub f: Vec<f64>,
-    /// The predictor (the model's parameters, then the offset if any).
-    pub fit: ForceFit,
+    /// The predictor.
+    pub fit: RecordFit,
+    /// The record's parameters, in the order of the predictor's values (force level: the
+    /// model's, then the offset; trajectory level: the fit's free parameters).
+    pub params: Vec<FitParam>,
     /// The record's conditions, by name.
     pub conditions: Vec<(String, f64)>,
+    /// Its recent predictions.
+    pub cache: PredictionCache,
 }
 
 impl JointRecord {
@@ -81,6 +113,28 @@ impl JointRecord {
             a: &self.a,
             f: &self.f,
         }
+    }
+
+    /// The measured signal the fit aims at: F_STF (N) or x (m).
+    pub fn target(&self) -> &[f64] {
+        match &self.fit {
+            RecordFit::Force(_) => &self.f,
+            RecordFit::Trajectory { x, .. } => x,
+        }
+    }
+
+    /// The signal predicted with `values` (in the order of [`JointRecord::params`]).
+    pub fn predict(&self, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        match &self.fit {
+            RecordFit::Force(fit) => fit.predict(&self.data(), values),
+            RecordFit::Trajectory { fit, t, x } => fit.predict(&TrajectoryData { t, x }, values),
+        }
+    }
+
+    /// [`JointRecord::predict`] through the record's cache.
+    fn predict_cached(&self, values: &[f64]) -> Result<Arc<Vec<f64>>, String> {
+        self.cache
+            .get_or_predict(values, || self.predict(values).map_err(|e| e.to_string()))
     }
 
     /// The value of a condition (NaN if the record lacks it).
@@ -112,64 +166,92 @@ pub fn coefficient_name(p: &str) -> String {
     format!("{p}0")
 }
 
-/// θ's layout for the `shared` parameters and the `laws` over `records` (each named by its unit number), the model's
-/// parameters `model_params` (configured: start values and bounds) and the offset, if fitted.
-/// `starts` gives per record the values its own fit found (same order), to start from.
+/// θ's layout for the `shared` parameters and the `laws` over `records` (each named by its
+/// unit number; their [`JointRecord::params`] name the same parameters in the same order,
+/// start values and bounds configured). `starts` gives per record the values its own fit
+/// found (same order), to start from. A shared parameter or a law's coefficient takes the
+/// widest of the records' bounds.
 pub fn layout(
     shared: &[String],
     laws: &[Law],
-    model_params: &[FitParam],
-    offset: Option<&FitParam>,
     records: &[(usize, &JointRecord)],
     starts: &[Vec<f64>],
 ) -> Layout {
-    let mut all: Vec<FitParam> = model_params.to_vec();
-    all.extend(offset.cloned());
-    let mut params = Vec::new();
-    let mut roles = Vec::new();
-    let mut sources = vec![Vec::new(); records.len()];
-    for (k, p) in all.iter().enumerate() {
+    let mut layout = Layout {
+        params: Vec::new(),
+        roles: Vec::new(),
+        sources: vec![Vec::new(); records.len()],
+    };
+    let Some((_, first)) = records.first() else {
+        return layout;
+    };
+    for (k, p) in first.params.iter().enumerate() {
         let column: Vec<f64> = starts.iter().map(|s| s[k]).collect();
+        let widest = widest(p, records.iter().map(|(_, r)| &r.params[k]));
         let law = laws.iter().position(|l| l.param == p.name);
-        if let Some((index, law)) = law.filter(|_| !p.fixed).map(|i| (i, &laws[i])) {
-            let (c0, expo) = law_start(law, p, records, &column);
-            let i = params.len();
-            params.push(clamped(p.clone(), c0).named(coefficient_name(&p.name)));
-            params.push(
-                FitParam::new(exponent_name(&p.name), expo)
-                    .bounds(-50.0, 50.0)
-                    .scale(1.0),
-            );
-            roles.extend(["law coefficient", "law exponent"]);
-            for (j, (_, r)) in records.iter().enumerate() {
-                sources[j].push(Source::Law {
-                    coefficient: i,
-                    exponent: i + 1,
-                    ratio: r.condition(&law.condition) / law.reference,
-                    law: index,
-                });
-            }
+        if let Some(index) = law.filter(|_| !p.fixed) {
+            layout.push_law(index, &laws[index], &widest, records, &column);
         } else if p.fixed || shared.contains(&p.name) {
             let mean = column.iter().sum::<f64>() / column.len().max(1) as f64;
             let start = if p.fixed { p.value } else { mean };
-            for s in &mut sources {
-                s.push(Source::Theta(params.len()));
+            for s in &mut layout.sources {
+                s.push(Source::Theta(layout.params.len()));
             }
-            params.push(clamped(p.clone(), start));
-            roles.push("shared");
+            layout.params.push(clamped(widest, start));
+            layout.roles.push("shared");
         } else {
-            for (j, (unit, _)) in records.iter().enumerate() {
-                sources[j].push(Source::Theta(params.len()));
-                params.push(clamped(p.clone(), column[j]).named(format!("{}@{unit}", p.name)));
-                roles.push("per record");
+            for (j, (unit, r)) in records.iter().enumerate() {
+                let own = r.params[k].clone();
+                layout.sources[j].push(Source::Theta(layout.params.len()));
+                let name = format!("{}@{unit}", own.name);
+                layout.params.push(clamped(own, column[j]).named(name));
+                layout.roles.push("per record");
             }
         }
     }
-    Layout {
-        params,
-        roles,
-        sources,
+    layout
+}
+
+impl Layout {
+    /// θ's entries for law `index` of parameter `p` (its widest bounds): the coefficient
+    /// and the exponent, started from the line through the records' own values `column`.
+    fn push_law(
+        &mut self,
+        index: usize,
+        law: &Law,
+        p: &FitParam,
+        records: &[(usize, &JointRecord)],
+        column: &[f64],
+    ) {
+        let (c0, expo) = law_start(law, p, records, column);
+        let i = self.params.len();
+        self.params
+            .push(clamped(p.clone(), c0).named(coefficient_name(&p.name)));
+        self.params.push(
+            FitParam::new(exponent_name(&p.name), expo)
+                .bounds(-50.0, 50.0)
+                .scale(1.0),
+        );
+        self.roles.extend(["law coefficient", "law exponent"]);
+        for (j, (_, r)) in records.iter().enumerate() {
+            self.sources[j].push(Source::Law {
+                coefficient: i,
+                exponent: i + 1,
+                ratio: r.condition(&law.condition) / law.reference,
+                law: index,
+            });
+        }
     }
+}
+
+/// `p` with the widest bounds among `all` (the same parameter on every record).
+fn widest<'a>(p: &FitParam, all: impl Iterator<Item = &'a FitParam>) -> FitParam {
+    let mut out = p.clone();
+    for q in all {
+        out.min = out.min.min(q.min);
+        out.max = out.max.max(q.max);
+    }
+    out
 }
 
 /// Renaming a fit parameter.
@@ -247,31 +329,37 @@ impl Residuals for Joint<'_> {
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
         let theta = full_values(self.params, x)?;
-        for ((r, sources), &start) in self.records.iter().zip(self.sources).zip(&self.starts) {
-            let values: Vec<f64> = sources.iter().map(|s| s.value(&theta)).collect();
-            let predicted = r
-                .fit
-                .predict(&r.data(), &values)
-                .map_err(|e| e.to_string())?;
-            for (i, (f, p)) in r.f.iter().zip(&predicted).enumerate() {
-                sink(start + i, f - p);
+        let predicted: Vec<Arc<Vec<f64>>> = self
+            .records
+            .par_iter()
+            .zip(self.sources)
+            .map(|(r, sources)| {
+                let values: Vec<f64> = sources.iter().map(|s| s.value(&theta)).collect();
+                r.predict_cached(&values)
+            })
+            .collect::<Result<_, String>>()?;
+        for ((r, p), &start) in self.records.iter().zip(&predicted).zip(&self.starts) {
+            for (i, (y, p)) in r.target().iter().zip(p.iter()).enumerate() {
+                sink(start + i, y - p);
             }
         }
         Ok(())
     }
 }
 
-/// Fit θ of `layout` to `records` (in the layout's order) with `settings`.
+/// Fit θ of `layout` to `records` (in the layout's order) with `settings`; `trajectory`:
+/// by the rules of a trajectory fit (the records' residuals are displacements).
 pub fn fit(
     layout: &Layout,
     records: &[&JointRecord],
     settings: &stf_core::fit::FitSettings,
+    trajectory: bool,
 ) -> Result<FitResult> {
     let mut starts = Vec::with_capacity(records.len());
     let mut len = 0;
     for r in records {
         starts.push(len);
-        len += r.f.len();
+        len += r.target().len();
     }
     let problem = Joint {
         params: &layout.params,
@@ -280,7 +368,12 @@ pub fn fit(
         starts,
         len,
     };
-    fit_residuals(&problem, &layout.params, settings, None).context("the global fit")
+    let result = if trajectory {
+        fit_trajectory_residuals(&problem, &layout.params, settings, None)
+    } else {
+        fit_residuals(&problem, &layout.params, settings, None)
+    };
+    result.context("the global fit")
 }
 
 /// A record's predictor as the per-record `fit` builds it: the model with its configured
@@ -296,12 +389,13 @@ pub fn predictor(model: Arc<dyn ForceModel>, params: &[FitParam], offset: bool) 
     fit
 }
 
-/// The force RMS of `values` (model's, then offset) predicting `record`.
+/// The RMS of `record`'s measured signal against its prediction with `values` (in its
+/// parameters' order), SI (N or m).
 pub fn rms_of(record: &JointRecord, values: &[f64]) -> Result<f64> {
-    let predicted = record.fit.predict(&record.data(), values)?;
-    let n = record.f.len().max(1) as f64;
-    let ss: f64 = record
-        .f
+    let predicted = record.predict(values)?;
+    let target = record.target();
+    let n = target.len().max(1) as f64;
+    let ss: f64 = target
         .iter()
         .zip(&predicted)
         .map(|(f, p)| (f - p).powi(2))
@@ -350,8 +444,10 @@ mod tests {
             x,
             v,
             f,
-            fit: predictor(model(), &params, false),
+            fit: RecordFit::Force(predictor(model(), &params, false)),
+            params,
             conditions: vec![("c".into(), c)],
+            cache: PredictionCache::default(),
         }
     }
 
@@ -368,14 +464,13 @@ mod tests {
             condition: "c".into(),
             reference: 2.0,
         }];
-        let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
         let starts = vec![vec![1.0, 1.0]; 3];
-        let layout = layout(&["b".into()], &laws, &params, None, &numbered, &starts);
+        let layout = layout(&["b".into()], &laws, &numbered, &starts);
         let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, ["a0", "a_p", "b"]);
         assert_eq!(layout.roles, ["law coefficient", "law exponent", "shared"]);
         let refs: Vec<&JointRecord> = records.iter().collect();
-        let result = fit(&layout, &refs, &Default::default()).unwrap();
+        let result = fit(&layout, &refs, &Default::default(), false).unwrap();
         for (name, truth) in [("a0", 3.0), ("a_p", 1.5), ("b", 0.7)] {
             let v = result.value(name).unwrap();
             assert!((v - truth).abs() < 1e-6, "{name} = {v}");
@@ -394,13 +489,12 @@ mod tests {
             .enumerate()
             .map(|(i, r)| (i + 4, r))
             .collect();
-        let params: Vec<FitParam> = model().params().iter().map(FitParam::from_spec).collect();
         let starts = vec![vec![1.0, 1.0]; 2];
-        let layout = layout(&["a".into()], &[], &params, None, &numbered, &starts);
+        let layout = layout(&["a".into()], &[], &numbered, &starts);
         let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, ["a", "b@4", "b@5"]);
         let refs: Vec<&JointRecord> = records.iter().collect();
-        let result = fit(&layout, &refs, &Default::default()).unwrap();
+        let result = fit(&layout, &refs, &Default::default(), false).unwrap();
         assert!((result.value("b@4").unwrap() - 2.0).abs() < 1e-6);
         assert!((result.value("b@5").unwrap() + 1.0).abs() < 1e-6);
         assert!((result.value("a").unwrap() - 1.5).abs() < 1e-6);

@@ -19,8 +19,13 @@ const CURVE_POINTS: usize = 200;
 pub fn section(g: &GlobalJson, figures: &Path) -> Result<Section> {
     let mut s = Section::new("Global fit");
     s.paragraphs.push(format!(
-        "`{}` fitted jointly to the force of {} record(s){}{}{}. {}",
+        "`{}` fitted jointly to the {} of {} record(s){}{}{}. {}",
         g.model,
+        if g.level == "trajectory" {
+            "displacement (trajectory level)"
+        } else {
+            "force"
+        },
         g.records.len(),
         if g.shared.is_empty() {
             String::new()
@@ -69,6 +74,7 @@ fn capitalised(text: &str) -> String {
 
 /// Global against per-record: RSS, parameters, AIC, BIC, held-out RMS.
 fn comparison(g: &GlobalJson) -> Table {
+    let unit = &g.rms_unit;
     let row = |name: &str, c: &Criteria, held: Option<f64>| {
         vec![
             name.to_string(),
@@ -76,8 +82,13 @@ fn comparison(g: &GlobalJson) -> Table {
             c.n_params.to_string(),
             format!("{:.1}", c.aic),
             format!("{:.1}", c.bic),
-            held.map_or("—".into(), |h| format!("{h:.5} N")),
+            held.map_or("—".into(), |h| format!("{h:.5} {unit}")),
         ]
+    };
+    let rss_unit = if g.level == "trajectory" {
+        "m²"
+    } else {
+        "N²"
     };
     let h = g.holdout.as_ref();
     Table {
@@ -87,14 +98,21 @@ fn comparison(g: &GlobalJson) -> Table {
             g.global.n_points,
             h.map_or(String::new(), |h| format!(
                 "On the held-out record the per-record alternative takes the mean of the own \
-                 fits' parameters of {}; the record's own fit reaches {:.5} N.",
+                 fits' parameters of {}; the record's own fit reaches {:.5} {unit}.",
                 h.per_record_from.join(", "),
                 h.own_fit_rms
             ))
         ),
-        columns: ["fit", "RSS, N²", "parameters", "AIC", "BIC", "held-out RMS"]
-            .map(String::from)
-            .to_vec(),
+        columns: [
+            "fit",
+            &format!("RSS, {rss_unit}"),
+            "parameters",
+            "AIC",
+            "BIC",
+            "held-out RMS",
+        ]
+        .map(String::from)
+        .to_vec(),
         rows: vec![
             row("global", &g.global, h.map(|h| h.global_rms)),
             row("per record", &g.per_record, h.map(|h| h.per_record_rms)),
@@ -141,7 +159,7 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
                 .conditions
                 .iter()
                 .filter(|(c, _)| **c != law.condition)
-                .map(|(c, v)| format!("{c} = {}", carried(*v)))
+                .map(|(c, v)| super::report::value_label(c, *v, g.condition_units.get(c)))
                 .collect();
             if others.is_empty() {
                 "records".into()
@@ -187,7 +205,10 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
         dir,
         &name,
         &title,
-        (&law.condition, &law.param),
+        (
+            &super::report::axis_label(&law.condition, law.condition_unit.as_deref()),
+            &super::report::axis_label(&law.param, Some(&law.unit)),
+        ),
         &series,
         Some(&curve),
     )?;

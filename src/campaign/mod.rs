@@ -1,5 +1,5 @@
 //! Campaigns: many records, one command (`stf-lab campaign CAMPAIGN.toml --out DIR`). A
-//! campaign file ([`file`]) lists records with their conditions and the work for each; unit N
+//! campaign file ([`file`]) lists records (or names a CSV table of them, [`records_table`]) with their conditions and the work for each; unit N
 //! is (record N, its experiment, its command), run into `DIR/units/<NNN>-<stem>/` by
 //! [`unit`] — in a child process of the local [`runner`], or a Slurm array task ([`slurm`],
 //! [`slurm_script`]) — and recognised as finished by the hash of its inputs ([`hash`]). After the units, the
@@ -7,16 +7,19 @@
 //! [`report`] are built from the units' JSON ([`unit_results`]). The output folder's rules
 //! are in [`out_dir`]; `crate::cmd_campaign` runs it all. A `[global]` section
 //! ([`global_file`]) adds a joint fit of all records with shared and law parameters
-//! ([`global_fit`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
+//! ([`global_records`], [`global_fit`], [`prediction_cache`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
 //! shown first in the report ([`global_report`]).
 
 pub mod file;
 pub mod global;
 pub mod global_file;
 pub mod global_fit;
+pub mod global_records;
 pub mod global_report;
 pub mod hash;
 pub mod out_dir;
+pub mod prediction_cache;
+pub mod records_table;
 pub mod report;
 pub mod runner;
 pub mod slurm;

@@ -1,12 +1,15 @@
 //! The campaign's report: `report.md` and `report.html` (the house's report module,
 //! `crate::report`) with, for each model's fitted parameter, a figure of its value against
 //! each condition with ±1 standard error bars — one series per combination of the other
-//! conditions — and the campaign table. Figures go to `figures/` as SVG, PNG and CSV.
+//! conditions — and the campaign table. Figures go to `figures/` as SVG, PNG and CSV; an
+//! earlier run's figures that this one does not draw are removed from there, and unit folders
+//! of records no longer in the campaign are named in a note (never deleted: they are the
+//! user's results).
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use super::global::GlobalJson;
 use super::table::{param_names, CampaignJson, CampaignRow};
@@ -23,6 +26,14 @@ pub fn write(table: &CampaignJson, global: Option<&GlobalJson>, out: &Path) -> R
          record and model; parameters in SI units, ± one standard error (block-robust).",
         table.units, table.campaign, table.failed
     ));
+    if !table.stale_units.is_empty() {
+        doc.intro.push(format!(
+            "Note: units/ holds {} folder(s) that no unit of this campaign writes (records \
+             removed from it since an earlier run), left as they were and not in the table: {}.",
+            table.stale_units.len(),
+            table.stale_units.join(", ")
+        ));
+    }
     if let Some(g) = global {
         doc.sections
             .push(super::global_report::section(g, &out.join("figures"))?);
@@ -44,6 +55,33 @@ pub fn write(table: &CampaignJson, global: Option<&GlobalJson>, out: &Path) -> R
     doc.sections.push(section);
     report::write_markdown(&doc, &out.join("report.md"))?;
     report::write_html(&doc, &out.join("report.html"))?;
+    remove_stale_figures(&doc, &out.join("figures"))
+}
+
+/// Remove the files of `dir` (the campaign's own `figures/`) that this report does not draw:
+/// an earlier run's figures of a parameter, condition or law the campaign no longer has.
+/// The program's temporaries and anything not a regular file are left alone.
+fn remove_stale_figures(doc: &Report, dir: &Path) -> Result<()> {
+    let drawn: Vec<&std::ffi::OsStr> = doc
+        .sections
+        .iter()
+        .flat_map(|s| &s.figures)
+        .flat_map(|f| [&f.files.svg, &f.files.png, &f.files.csv])
+        .filter_map(|p| p.file_name())
+        .collect();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for entry in entries.filter_map(|e| e.ok()) {
+        let name = entry.file_name();
+        let regular = entry.file_type().is_ok_and(|t| t.is_file());
+        if regular && !drawn.contains(&name.as_os_str()) && !name.to_string_lossy().starts_with('.')
+        {
+            std::fs::remove_file(entry.path()).with_context(|| {
+                format!("cannot remove the stale figure {}", entry.path().display())
+            })?;
+        }
+    }
     Ok(())
 }
 
@@ -82,10 +120,18 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
                 if distinct < 2 {
                     continue;
                 }
-                let series = series_of(&rows, &param, condition, &table.conditions);
+                let series = series_of(&rows, &param, condition, table);
                 let name = file_name(&format!("{model}_{param}_vs_{condition}"));
                 let title = format!("{model}: {param} against {condition}");
-                let files = report::error_bars(dir, &name, &title, (condition, &param), &series)?;
+                let unit = rows
+                    .iter()
+                    .find_map(|r| r.result.params.get(&param)?.unit.as_deref());
+                let x = axis_label(
+                    condition,
+                    table.condition_units.get(condition).map(String::as_str),
+                );
+                let y = axis_label(&param, unit);
+                let files = report::error_bars(dir, &name, &title, (&x, &y), &series)?;
                 figures.push(FigureRef::new(
                     files,
                     format!(
@@ -98,6 +144,24 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
         }
     }
     Ok(figures)
+}
+
+/// An axis's label: the name and its unit in brackets (`K [N·(s/m)ⁿ]`, `n [–]` for a
+/// dimensionless one), the name alone when the unit is not known.
+pub(super) fn axis_label(name: &str, unit: Option<&str>) -> String {
+    match unit.map(str::trim) {
+        None => name.to_string(),
+        Some("") => format!("{name} [–]"),
+        Some(u) => format!("{name} [{u}]"),
+    }
+}
+
+/// `name = value unit` (the unit where the campaign gives one) for a legend.
+pub(super) fn value_label(name: &str, value: f64, unit: Option<&String>) -> String {
+    match unit {
+        Some(u) => format!("{name} = {} {u}", carried(value)),
+        None => format!("{name} = {}", carried(value)),
+    }
 }
 
 /// How many different values `condition` takes over `rows`.
@@ -116,7 +180,7 @@ fn series_of(
     rows: &[&CampaignRow],
     param: &str,
     condition: &str,
-    conditions: &[String],
+    table: &CampaignJson,
 ) -> Vec<ErrorSeries> {
     let mut groups: BTreeMap<String, Vec<ErrorPoint>> = BTreeMap::new();
     let mut order: Vec<String> = Vec::new();
@@ -124,13 +188,13 @@ fn series_of(
         let (Some(x), Some(p)) = (r.conditions.get(condition), r.result.params.get(param)) else {
             continue;
         };
-        let label: Vec<String> = conditions
+        let label: Vec<String> = table
+            .conditions
             .iter()
             .filter(|c| *c != condition)
             .filter_map(|c| {
-                r.conditions
-                    .get(c)
-                    .map(|v| format!("{c} = {}", carried(*v)))
+                let v = r.conditions.get(c)?;
+                Some(value_label(c, *v, table.condition_units.get(c)))
             })
             .collect();
         let label = if label.is_empty() {

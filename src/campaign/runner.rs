@@ -4,7 +4,10 @@
 //! goes to `DIR/logs/<unit folder>.log`; one line is printed per unit as it finishes (ok or
 //! failed, wall time). How a unit ended is read from its `unit.json`, checked against the
 //! inputs' hash the runner expects; a child that died without one is a failure naming its
-//! exit status and its log.
+//! exit status and its log. A log is written to a temporary file beside it (the `tempfile`
+//! crate) and renamed over the last one when the child has ended, so a run killed midway
+//! leaves the previous log whole; a child that ended without its `unit.json` gets a closing
+//! line saying that its log may stop short.
 //!
 //! Threads from the standard library: each only waits on its child, so a pool crate would
 //! add nothing.
@@ -86,9 +89,15 @@ impl Runner<'_> {
     fn run_child(&self, exe: &Path, logs: &Path, p: &Pending) -> Finished {
         let started = Instant::now();
         let log = logs.join(format!("{}.log", p.unit.folder_name()));
-        let status = std::fs::File::create(&log)
-            .and_then(|f| Ok((f.try_clone()?, f)))
-            .and_then(|(out, err)| {
+        let staged = tempfile::Builder::new()
+            .prefix(&format!(".{}.", p.unit.folder_name()))
+            .suffix(".log.tmp")
+            .tempfile_in(logs);
+        let status = staged
+            .as_ref()
+            .map_err(|e| e.kind().into())
+            .and_then(|tmp| {
+                let (out, err) = (tmp.as_file().try_clone()?, tmp.as_file().try_clone()?);
                 Command::new(exe)
                     .arg("campaign")
                     .arg(self.campaign)
@@ -103,23 +112,44 @@ impl Runner<'_> {
                     .status()
             });
         let wall = started.elapsed();
-        let error = match status {
-            Err(e) => Some(format!("cannot start {}: {e}", exe.display())),
-            Ok(status) => match read_unit_json(&p.dir).filter(|u| u.inputs_hash == p.hash) {
-                Some(u) if u.status == UnitStatus::Ok => None,
-                Some(u) => Some(u.error.unwrap_or_else(|| "failed".into())),
-                None => Some(format!(
-                    "the unit ended ({status}) without writing its unit.json: see {}",
-                    log.display()
-                )),
-            },
+        let unit_json = read_unit_json(&p.dir).filter(|u| u.inputs_hash == p.hash);
+        let partial = unit_json.is_none();
+        let mut error = match (status, unit_json) {
+            (Err(e), _) => Some(format!("cannot start {}: {e}", exe.display())),
+            (Ok(_), Some(u)) if u.status == UnitStatus::Ok => None,
+            (Ok(_), Some(u)) => Some(u.error.unwrap_or_else(|| "failed".into())),
+            (Ok(status), None) => Some(format!(
+                "the unit ended ({status}) without writing its unit.json: see {}",
+                log.display()
+            )),
         };
+        if let Ok(tmp) = staged {
+            if let Err(e) = finish_log(tmp, &log, partial) {
+                error.get_or_insert_with(|| format!("cannot write {}: {e}", log.display()));
+            }
+        }
         Finished {
             number: p.unit.number,
             error,
             wall,
         }
     }
+}
+
+/// Put the child's staged log in place at `log`; `partial`: the child ended without its
+/// `unit.json` (killed, crashed), which a last line says (its output may stop short).
+fn finish_log(tmp: tempfile::NamedTempFile, log: &Path, partial: bool) -> std::io::Result<()> {
+    if partial {
+        use std::io::{Seek, SeekFrom, Write};
+        let mut f = tmp.as_file();
+        f.seek(SeekFrom::End(0))?;
+        writeln!(
+            f,
+            "\n[stf-lab campaign] the unit ended without writing its unit.json: this log may \
+             stop short of what the unit did"
+        )?;
+    }
+    tmp.persist(log).map(|_| ()).map_err(|e| e.error)
 }
 
 /// `[3/9] unit 4 rec_a2_c1.csv: ok, 2.4 s` (or `failed, 0.3 s: why`).
@@ -138,4 +168,39 @@ fn progress_line(count: usize, total: usize, unit: &Unit, f: &Finished) -> Strin
 /// The first line of a message.
 fn first_line(text: &str) -> &str {
     text.lines().next().unwrap_or("")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_log_replaces_the_last_one_whole_and_says_when_it_may_stop_short() {
+        let dir = tempfile::tempdir().unwrap();
+        let log = dir.path().join("001-r.log");
+        std::fs::write(&log, "the last run's log\n").unwrap();
+        let staged = tempfile::NamedTempFile::new_in(dir.path()).unwrap();
+        std::fs::write(staged.path(), "fitted 1 model(s)\n").unwrap();
+        // Until the child ends, the last log is untouched.
+        assert_eq!(
+            std::fs::read_to_string(&log).unwrap(),
+            "the last run's log\n"
+        );
+        finish_log(staged, &log, false).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(&log).unwrap(),
+            "fitted 1 model(s)\n"
+        );
+        let staged = tempfile::NamedTempFile::new_in(dir.path()).unwrap();
+        std::fs::write(staged.path(), "reading the rec").unwrap();
+        finish_log(staged, &log, true).unwrap();
+        let text = std::fs::read_to_string(&log).unwrap();
+        assert!(
+            text.starts_with(
+                "reading the rec\n[stf-lab campaign] the unit ended without writing its unit.json"
+            ),
+            "{text}"
+        );
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 }

@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use indexmap::IndexMap;
 use serde::Serialize;
 
-use super::file::{Campaign, CommandName};
+use super::file::{Campaign, CommandName, Unit};
 use super::unit::{read_unit_json, unit_dir, UnitStatus};
 use super::unit_results::{self, ModelResult};
 use crate::digits::carried;
@@ -45,12 +45,17 @@ pub struct CampaignJson {
     pub campaign: String,
     /// Condition names.
     pub conditions: Vec<String>,
+    /// A condition's unit, where `campaign.units` gives one.
+    pub condition_units: BTreeMap<String, String>,
     /// Units in the campaign.
     pub units: usize,
     /// Units that failed.
     pub failed: usize,
     /// The rows.
     pub rows: Vec<CampaignRow>,
+    /// Folders under `units/` that no unit of the campaign writes (records removed from the
+    /// campaign since an earlier run): listed, never deleted.
+    pub stale_units: Vec<String>,
 }
 
 /// The table of `campaign` from its output folder `out`; `errors` holds, by unit number, why
@@ -101,10 +106,29 @@ pub fn collect(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>
     CampaignJson {
         campaign: campaign.path.display().to_string(),
         conditions: campaign.conditions.clone(),
+        condition_units: campaign.condition_units.clone(),
         units: campaign.units.len(),
         failed,
         rows,
+        stale_units: stale_unit_folders(campaign, out),
     }
+}
+
+/// The folders under `DIR/units/` that are no unit's of `campaign` (sorted; the program's
+/// temporaries aside).
+pub fn stale_unit_folders(campaign: &Campaign, out: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(out.join(super::unit::UNITS)) else {
+        return Vec::new();
+    };
+    let current: Vec<String> = campaign.units.iter().map(Unit::folder_name).collect();
+    let mut stale: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with('.') && !current.contains(n))
+        .collect();
+    stale.sort();
+    stale
 }
 
 /// Every parameter name of the table, in order of first appearance.

@@ -1,7 +1,8 @@
 //! What the campaign table takes from a unit's results: the parts of `fit.json`,
 //! `compare.json` and `discovery.json` it needs, deserialized (unknown keys ignored; the keys
 //! are the contracts of `crate::outputs`, docs/ARCHITECTURE.md §6), turned into one
-//! [`ModelResult`] per fitted model.
+//! [`ModelResult`] per fitted model; of a `fit` unit also `params.csv`'s `unit` column (each
+//! parameter's unit, from its model's `ParamSpec` or the oscillator's), for the figures' axes.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -86,6 +87,9 @@ pub struct ParamValue {
     pub value: f64,
     /// Its block-robust standard error; null where not determined or held.
     pub std_error: Option<f64>,
+    /// Its SI unit (empty: dimensionless), as `params.csv` gives it; null where unknown
+    /// (`compare`, `discover`).
+    pub unit: Option<String>,
 }
 
 /// A model's results in one unit, what a row of the table shows (all empty for a failed
@@ -123,7 +127,15 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
     match command {
         CommandName::Fit => {
             let file: FitFile = read_json(&dir.join("fit.json"))?;
-            Ok(with_best_by_aic(file.models))
+            let units = param_units(&dir.join("params.csv"));
+            let mut models = with_best_by_aic(file.models);
+            for m in &mut models {
+                for (name, p) in &mut m.params {
+                    let key = (m.model.clone().unwrap_or_default(), name.clone());
+                    p.unit = units.get(&key).cloned();
+                }
+            }
+            Ok(models)
         }
         CommandName::Compare => {
             let file: CompareFile = read_json(&dir.join("compare.json"))?;
@@ -151,6 +163,27 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
             }])
         }
     }
+}
+
+/// A row of `params.csv`: the parts the figures need.
+#[derive(Debug, Deserialize)]
+struct ParamUnitRow {
+    model: String,
+    parameter: String,
+    unit: String,
+}
+
+/// Each (model, parameter)'s unit in `params.csv`; none if the file is missing or unreadable
+/// (the figures then show names alone).
+fn param_units(path: &Path) -> BTreeMap<(String, String), String> {
+    let Ok(mut reader) = csv::Reader::from_path(path) else {
+        return BTreeMap::new();
+    };
+    reader
+        .deserialize::<ParamUnitRow>()
+        .filter_map(Result::ok)
+        .map(|r| ((r.model, r.parameter), r.unit))
+        .collect()
 }
 
 /// A JSON file of a unit, read into the parts the table needs.
@@ -208,7 +241,15 @@ fn params(
             } else {
                 errors.get(name).copied().flatten()
             };
-            (name.clone(), ParamValue { value, std_error })
+            let unit = None;
+            (
+                name.clone(),
+                ParamValue {
+                    value,
+                    std_error,
+                    unit,
+                },
+            )
         })
         .collect()
 }
