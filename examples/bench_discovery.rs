@@ -113,7 +113,8 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, String)> {
     }
     let out = dir.join(&stem);
     let clock = Instant::now();
-    stf_lab::cmd_discover::run(&exp, &out, true, true)?;
+    let loaded = stf_lab::experiment::Experiment::load(&exp)?;
+    stf_lab::cmd_discover::run_experiment(loaded, &out, true, true)?;
     let wall = clock.elapsed().as_secs_f64();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;

@@ -162,14 +162,9 @@ fn compare_fits(
     })
 }
 
-/// Run `stf-lab compare`: the results are built in a staging folder and swapped in as a
-/// whole ([`ResultsDir`]).
-pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
-    run_experiment(Experiment::load(exp_path)?, out_arg, force, quiet)
-}
-
-/// [`run`] on an experiment already loaded (a campaign's unit: its record set with
-/// [`Experiment::with_data_file`]).
+/// Run `stf-lab compare` on an experiment loaded (from its file, or a campaign's unit: its
+/// record set with [`Experiment::with_data_file`]): the results are built in a staging
+/// folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let data = load_data(&mut exp)?;
     if data.level != FitLevel::Force {

@@ -89,14 +89,9 @@ fn force_fit_settings(from: &FitSettings) -> FitSettings {
     fit
 }
 
-/// Run `stf-lab discover`.
-/// The results are built in a staging folder and swapped in as a whole ([`ResultsDir`]).
-pub fn run(exp_path: &Path, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
-    run_experiment(Experiment::load(exp_path)?, out_arg, force, quiet)
-}
-
-/// [`run`] on an experiment already loaded (a campaign's unit: its record set with
-/// [`Experiment::with_data_file`]).
+/// Run `stf-lab discover` on an experiment loaded (from its file, or a campaign's unit: its
+/// record set with [`Experiment::with_data_file`]): the results are built in a staging
+/// folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
     let Some(spec) = exp.discover.clone() else {
         bail!(

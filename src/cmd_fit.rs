@@ -32,14 +32,9 @@ use crate::validation::ValidationRecord;
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::Regime;
 
-/// Run `stf-lab fit`: the results are built in a staging folder and swapped in as a whole
-/// ([`ResultsDir`]).
-pub fn run(exp_path: &Path, out: &Path, force: bool, quiet: bool) -> Result<()> {
-    run_experiment(Experiment::load(exp_path)?, out, force, quiet)
-}
-
-/// [`run`] on an experiment already loaded (a campaign's unit: its record set with
-/// [`Experiment::with_data_file`]).
+/// Run `stf-lab fit` on an experiment loaded (from its file, or a campaign's unit: its
+/// record set with [`Experiment::with_data_file`]): the results are built in a staging
+/// folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let progress = Progress::new(quiet);
     if !exp.identify.is_empty() {

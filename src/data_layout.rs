@@ -129,13 +129,13 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
     }
     if let Some(m) = &raw.max_bytes {
         let v = *m.get_ref();
-        if !(v >= 1.0 && v <= u64::MAX as f64) {
-            return Err(cx.at(
-                m.span(),
-                "data.max_bytes",
-                format!("{v} is not a size in bytes (at least 1)"),
-            ));
-        }
+        let what = format!("{v} is not a size in bytes (at least 1)");
+        cx.ensure(
+            v >= 1.0 && v <= u64::MAX as f64,
+            m.span(),
+            "data.max_bytes",
+            what,
+        )?;
         opts = opts.max_bytes(v as u64);
     }
     opts.check().map_err(|e| {

@@ -215,13 +215,16 @@ impl Experiment {
     }
 }
 
+/// `text` parsed as the experiment file `exp.toml`: what the tests of every section check.
+#[cfg(test)]
+pub(crate) fn parse_exp(text: &str) -> Result<Experiment> {
+    Experiment::parse(Path::new("exp.toml"), text)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn parse(text: &str) -> Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
+    use crate::experiment::parse_exp as parse;
 
     #[test]
     fn the_design_example_parses() {

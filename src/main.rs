@@ -19,7 +19,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use stf_lab::campaign::slurm_script::SlurmOptions;
 use stf_lab::{
-    cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate, interrupt, tell,
+    cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate,
+    experiment::Experiment, interrupt, tell,
 };
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.
@@ -150,17 +151,20 @@ fn main() -> ExitCode {
             experiment,
             out,
             force,
-        } => cmd_fit::run(&experiment, &out, force, quiet),
+        } => Experiment::load(&experiment)
+            .and_then(|exp| cmd_fit::run_experiment(exp, &out, force, quiet)),
         Command::Compare {
             experiment,
             out,
             force,
-        } => cmd_compare::run(&experiment, &out, force, quiet),
+        } => Experiment::load(&experiment)
+            .and_then(|exp| cmd_compare::run_experiment(exp, &out, force, quiet)),
         Command::Discover {
             experiment,
             out,
             force,
-        } => cmd_discover::run(&experiment, &out, force, quiet),
+        } => Experiment::load(&experiment)
+            .and_then(|exp| cmd_discover::run_experiment(exp, &out, force, quiet)),
         Command::Campaign {
             campaign,
             out,

@@ -138,10 +138,9 @@ fn apply(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::Experiment;
 
     fn models_of(text: &str) -> Result<ConfiguredModel> {
-        let exp = Experiment::parse(Path::new("exp.toml"), text)?;
+        let exp = crate::experiment::parse_exp(text)?;
         configure(&exp.models, &exp.path, &exp.dir, &exp.scripts)
     }
 

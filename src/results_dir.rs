@@ -324,6 +324,14 @@ mod tests {
         std::fs::read_to_string(dir.join(name)).unwrap()
     }
 
+    /// A temporary folder holding the results folder `fit/` of an earlier run (`fit.json`: A).
+    fn old_results() -> (tempfile::TempDir, PathBuf) {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("fit");
+        write(&out, "fit.json", "A");
+        (tmp, out)
+    }
+
     #[test]
     fn the_closing_line_names_only_what_was_written() {
         let out = Path::new("out");
@@ -339,9 +347,7 @@ mod tests {
 
     #[test]
     fn a_commit_replaces_the_whole_folder() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (tmp, out) = old_results();
         write(&out, "report.md", "A");
         let run = ResultsDir::begin(&out, true).unwrap();
         write(run.path(), "fit.json", "B");
@@ -362,9 +368,7 @@ mod tests {
 
     #[test]
     fn a_run_dropped_before_its_commit_leaves_the_old_results_and_no_staging() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (_tmp, out) = old_results();
         let run = ResultsDir::begin(&out, true).unwrap();
         let staging = run.path().to_path_buf();
         write(&staging, "fit.json", "B");
@@ -375,9 +379,7 @@ mod tests {
 
     #[test]
     fn a_crash_between_the_renames_is_repaired_by_the_next_run() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (tmp, out) = old_results();
         // A run that stops after step 1: the output is missing, old and new lie beside it.
         let old = tmp.path().join(".fit.old-4242");
         let staging = tmp.path().join(".fit.new-4242");
@@ -393,9 +395,7 @@ mod tests {
 
     #[test]
     fn a_crash_after_the_swap_leaves_the_new_results_and_the_old_is_cleaned() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (tmp, out) = old_results();
         let old = tmp.path().join(".fit.old-4242");
         let staging = tmp.path().join(".fit.new-4242");
         write(&staging, "fit.json", "B");
@@ -412,9 +412,7 @@ mod tests {
 
     #[test]
     fn repair_touches_only_its_own_names() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (tmp, out) = old_results();
         for other in [".fit.new-x", ".fit.older-1", ".fits.new-1", "fit.new-1"] {
             write(&tmp.path().join(other), "keep", "");
         }
@@ -426,9 +424,7 @@ mod tests {
 
     #[test]
     fn refuses_strangers_non_folders_and_unforced_replacement() {
-        let tmp = tempfile::tempdir().unwrap();
-        let out = tmp.path().join("fit");
-        write(&out, "fit.json", "A");
+        let (tmp, out) = old_results();
         let e = ResultsDir::begin(&out, false).unwrap_err().to_string();
         assert!(e.contains("pass --force"), "{e}");
         write(&out, "notes.txt", "mine");

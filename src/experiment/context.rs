@@ -44,6 +44,21 @@ impl<'a> Ctx<'a> {
         error_at(self.file, line_of(self.text, span.start), key, msg)
     }
 
+    /// Nothing when `holds`, else the error [`Ctx::at`] gives: the shape of every range check.
+    pub(crate) fn ensure(
+        &self,
+        holds: bool,
+        span: Range<usize>,
+        key: &str,
+        msg: impl std::fmt::Display,
+    ) -> anyhow::Result<()> {
+        if holds {
+            Ok(())
+        } else {
+            Err(self.at(span, key, msg))
+        }
+    }
+
     /// A deserialisation error of the file's text: its line, the key path of the value it is
     /// about (none for a key unknown at the top level) and serde's message.
     pub(crate) fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {
@@ -70,14 +85,9 @@ fn key_path(e: &toml::de::Error) -> Option<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
-    use std::path::Path;
 
     fn message(text: &str) -> String {
-        format!(
-            "{:#}",
-            Experiment::parse(Path::new("exp.toml"), text).unwrap_err()
-        )
+        format!("{:#}", crate::experiment::parse_exp(text).unwrap_err())
     }
 
     #[test]

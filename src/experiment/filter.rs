@@ -141,13 +141,8 @@ fn drive_smoothing(raw: &RawDrive) -> Result<DriveSmoothing, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
     use super::*;
-    use std::path::Path;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
+    use crate::experiment::parse_exp as parse;
 
     #[test]
     fn the_drive_reconstruction_is_a_setting() {

@@ -73,16 +73,10 @@ mod tests {
 
 #[cfg(test)]
 mod refused_at_parse {
-    use std::path::Path;
-
-    use crate::experiment::Experiment;
 
     /// The parse error of `text` (it must fail).
     fn error(text: &str) -> String {
-        format!(
-            "{:#}",
-            Experiment::parse(Path::new("exp.toml"), text).unwrap_err()
-        )
+        format!("{:#}", crate::experiment::parse_exp(text).unwrap_err())
     }
 
     #[test]

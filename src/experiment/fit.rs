@@ -142,13 +142,8 @@ pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> 
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
     use super::*;
-    use std::path::Path;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
+    use crate::experiment::parse_exp as parse;
 
     #[test]
     fn the_section_s_keys_set_the_fit() {

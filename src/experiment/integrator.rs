@@ -49,13 +49,9 @@ pub(super) fn check(raw: Option<&Spanned<RawIntegrator>>, cx: &Ctx) -> Result<Se
     {
         let Some(v) = value else { continue };
         let off = name == "h_max" && v == 0.0;
-        if !off && !(lo..=hi).contains(&v) {
-            return Err(cx.at(
-                span.clone(),
-                &format!("integrator.{name}"),
-                format!("{v} is outside the accepted range [{lo:e}, {hi:e}]{what}"),
-            ));
-        }
+        let range = format!("{v} is outside the accepted range [{lo:e}, {hi:e}]{what}");
+        let key = format!("integrator.{name}");
+        cx.ensure(off || (lo..=hi).contains(&v), span.clone(), &key, range)?;
         *slot = v;
     }
     Ok(integrator)
@@ -63,13 +59,8 @@ pub(super) fn check(raw: Option<&Spanned<RawIntegrator>>, cx: &Ctx) -> Result<Se
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
-    use std::path::Path;
+    use crate::experiment::parse_exp as parse;
     use stf_core::numerics::integrate::Method;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
 
     #[test]
     fn tolerances_that_would_run_for_minutes_are_refused_with_the_range() {

@@ -166,13 +166,8 @@ fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
     use super::*;
-    use std::path::Path;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
+    use crate::experiment::parse_exp as parse;
 
     #[test]
     fn an_entry_is_checked_into_its_source_sum_and_parameters_with_their_lines() {

@@ -27,12 +27,10 @@ impl From<Option<&RawOutput>> for OutputSpec {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
-    use std::path::Path;
 
     #[test]
     fn reports_are_written_unless_turned_off() {
-        let parse = |text: &str| Experiment::parse(Path::new("exp.toml"), text).unwrap();
+        let parse = |text: &str| crate::experiment::parse_exp(text).unwrap();
         assert!(parse("").output.report);
         assert!(parse("[output]\n").output.report);
         assert!(!parse("[output]\nreport = false\n").output.report);

@@ -24,13 +24,8 @@ pub(super) fn check(raw: Option<&Spanned<toml::Value>>, cx: &Ctx) -> Result<Regi
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
-    use std::path::Path;
+    use crate::experiment::parse_exp as parse;
     use stf_core::regimes::RegimeThresholds;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
 
     #[test]
     fn thresholds_parse_and_a_bad_one_names_the_section() {

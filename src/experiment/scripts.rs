@@ -64,13 +64,8 @@ pub(super) fn run(raw: Option<&Spanned<RawScripts>>, cx: &Ctx) -> Result<ScriptR
         return Err(cx.at(span, &key, "must be at least 1"));
     }
     if let Some(s) = r.call_seconds {
-        if !(s > 0.0) {
-            return Err(cx.at(
-                span,
-                "scripts.call_seconds",
-                format!("{s} must be a positive number of seconds"),
-            ));
-        }
+        let what = format!("{s} must be a positive number of seconds");
+        cx.ensure(s > 0.0, span, "scripts.call_seconds", what)?;
         limits.call_seconds = s;
     }
     Ok(ScriptRun::new(limits))
@@ -90,15 +85,9 @@ fn count<T: PartialEq + Default>(slot: &mut T, value: Option<T>) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use std::path::Path;
+    use crate::experiment::parse_exp as parse;
 
     use stf_plugins::ScriptLimits;
-
-    use crate::experiment::Experiment;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
 
     #[test]
     fn the_keys_set_the_limits_and_the_rest_keep_their_defaults() {

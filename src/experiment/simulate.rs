@@ -88,12 +88,14 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
         t1,
         mut as_json,
     } = the_drive(s, cx, span.clone())?;
-    if !(t1 > t0) {
-        return Err(cx.at(span, "simulate", format!("t1 = {t1} must exceed t0 = {t0}")));
-    }
-    if !(s.rate > 0.0 && s.rate.is_finite()) {
-        return Err(cx.at(span, "simulate.rate", "must be a positive number"));
-    }
+    let order = format!("t1 = {t1} must exceed t0 = {t0}");
+    cx.ensure(t1 > t0, span.clone(), "simulate", order)?;
+    cx.ensure(
+        s.rate > 0.0,
+        span.clone(),
+        "simulate.rate",
+        "must be a positive number",
+    )?;
     let max_samples = sample_limit(cx, &span, s, t0, t1)?;
     as_json["rate"] = s.rate.into();
     as_json["noise"] = s.noise.into();
@@ -138,41 +140,31 @@ fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64
         None => DEFAULT_MAX_SAMPLES,
         Some(m) => {
             let v = *m.get_ref();
-            if !(v >= 2.0 && v <= u64::MAX as f64) {
-                return Err(cx.at(
-                    m.span(),
-                    "simulate.max_samples",
-                    format!("{v} is not a sample count (at least 2)"),
-                ));
-            }
+            let what = format!("{v} is not a sample count (at least 2)");
+            cx.ensure(
+                v >= 2.0 && v <= u64::MAX as f64,
+                m.span(),
+                "simulate.max_samples",
+                what,
+            )?;
             v as u64
         }
     };
     let count = sample_count(t0, t1, s.rate);
-    if !(count <= limit as f64) {
-        return Err(cx.at(
-            span.clone(),
-            "simulate.rate",
-            format!(
-                "{} samples/s from t0 = {t0} to t1 = {t1} s asks for {} samples, over the limit \
-                 of {limit} (`simulate.max_samples`; a run holds about 140 bytes a sample)",
-                s.rate,
-                count_text(count)
-            ),
-        ));
-    }
+    let asked = format!(
+        "{} samples/s from t0 = {t0} to t1 = {t1} s asks for {} samples, over the limit of \
+         {limit} (`simulate.max_samples`; a run holds about 140 bytes a sample)",
+        s.rate,
+        count_text(count)
+    );
+    cx.ensure(count <= limit as f64, span.clone(), "simulate.rate", asked)?;
     Ok(limit)
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
     use super::*;
-    use std::path::Path;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
+    use crate::experiment::parse_exp as parse;
 
     #[test]
     fn a_run_too_long_for_memory_names_the_key_the_samples_and_the_limit() {

@@ -72,13 +72,14 @@ pub(super) fn check(raw: Option<&Spanned<RawSystem>>, cx: &Ctx) -> Result<Oscill
     for (param, value) in OscParam::ALL.into_iter().zip(given) {
         let Some(v) = value else { continue };
         let must_be_positive = matches!(param, OscParam::M | OscParam::K | OscParam::Eta);
-        if !v.is_finite() || (v < 0.0 && !param.is_offset()) || (must_be_positive && v == 0.0) {
-            return Err(cx.at(
-                span.clone(),
-                &format!("system.{param}"),
-                format!("{v} is not a valid value"),
-            ));
-        }
+        let valid = (v >= 0.0 || param.is_offset()) && !(must_be_positive && v == 0.0);
+        let key = format!("system.{param}");
+        cx.ensure(
+            valid,
+            span.clone(),
+            &key,
+            format!("{v} is not a valid value"),
+        )?;
         system[param] = v;
     }
     Ok(system)
@@ -86,13 +87,8 @@ pub(super) fn check(raw: Option<&Spanned<RawSystem>>, cx: &Ctx) -> Result<Oscill
 
 #[cfg(test)]
 mod tests {
-    use super::super::Experiment;
-    use std::path::Path;
+    use crate::experiment::parse_exp as parse;
     use stf_core::physics::oscillator_params::OscillatorParams;
-
-    fn parse(text: &str) -> anyhow::Result<Experiment> {
-        Experiment::parse(Path::new("exp.toml"), text)
-    }
 
     #[test]
     fn a_preset_with_values_over_it_is_the_system() {

@@ -61,13 +61,8 @@ pub(super) fn spec(
     let r = raw.get_ref();
     let window = r.window.map(|[a, b]| (a, b));
     if let Some((a, b)) = window {
-        if !(a.is_finite() && b.is_finite() && b > a) {
-            return Err(cx.at(
-                raw.span(),
-                "validate.window",
-                format!("[{a}, {b}] is empty"),
-            ));
-        }
+        let empty = format!("[{a}, {b}] is empty");
+        cx.ensure(b > a, raw.span(), "validate.window", empty)?;
     }
     let given = r.file.get_ref().clone();
     if given.trim().is_empty() {

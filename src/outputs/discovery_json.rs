@@ -12,7 +12,7 @@ use stf_core::numerics::derivative::NoiseEstimate;
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{std_errors_by_name, values_by_name};
+use super::{errors_by_name, values_by_name};
 use crate::discovery_curves::FittedCurves;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
@@ -155,7 +155,7 @@ impl<'a> DiscoveryJson<'a> {
             final_model: FinalModelJson {
                 name: &found.final_model_name,
                 params: values_by_name(model_params.iter().copied()),
-                std_errors: std_errors_by_name(&found.final_params),
+                std_errors: errors_by_name(&found.final_params, |p| p.std_error),
                 experiment_entry,
                 system: None,
             },

@@ -10,7 +10,7 @@ use stf_core::numerics::derivative::NoiseEstimate;
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{finite, level_name, std_errors_by_name, values_by_name};
+use super::{errors_by_name, finite, level_name, values_by_name};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::validation::ModelValidation;
@@ -143,12 +143,8 @@ impl<'a> ModelFitJson<'a> {
             label: &fit.label,
             level: level_name(level),
             params: values_by_name(&r.params),
-            std_errors: std_errors_by_name(&r.params),
-            naive_std_errors: r
-                .params
-                .iter()
-                .map(|p| (p.name.clone(), finite(p.naive_std_error)))
-                .collect(),
+            std_errors: errors_by_name(&r.params, |p| p.std_error),
+            naive_std_errors: errors_by_name(&r.params, |p| p.naive_std_error),
             error_blocks: r.error_blocks,
             fixed: r
                 .params

@@ -8,7 +8,7 @@ use serde::Serialize;
 use stf_core::fit::{Convergence, FitResult, FitWarning, NoiseFloor, StatedWarning};
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{finite, std_errors_by_name, values_by_name};
+use super::{errors_by_name, finite, values_by_name};
 
 /// The whole of the identification's `fit.json`.
 #[derive(Serialize)]
@@ -102,7 +102,7 @@ impl StageJson {
             record,
             free,
             params: values_by_name(&result.params),
-            std_errors: std_errors_by_name(&result.params),
+            std_errors: errors_by_name(&result.params, |p| p.std_error),
             s_mm2: result.s_mm2,
             rms: result.rms,
             aic: finite(result.aic),

@@ -46,11 +46,15 @@ pub fn values_by_name<'a>(
         .collect()
 }
 
-/// Parameters by name: each one's standard error (`null` where the data do not give it).
-pub fn std_errors_by_name(params: &[FittedParam]) -> BTreeMap<String, Option<f64>> {
+/// Parameters by name: each one's `error` (its standard error or another; `null` where the
+/// data do not give it).
+pub fn errors_by_name(
+    params: &[FittedParam],
+    error: impl Fn(&FittedParam) -> f64,
+) -> BTreeMap<String, Option<f64>> {
     params
         .iter()
-        .map(|p| (p.name.clone(), finite(p.std_error)))
+        .map(|p| (p.name.clone(), finite(error(p))))
         .collect()
 }
 

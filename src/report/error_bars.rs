@@ -13,7 +13,7 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, legend_strip, msg, render, tick_label, tick_style, title_style, Draw,
+    axis_desc_style, draw_mesh, legend_strip, msg, one_panel, render, title_style, Draw,
     FigureFiles, Swatch, SIZE,
 };
 use super::plot_range::{finite_bounds, padded_range};
@@ -74,7 +74,7 @@ impl ErrorBarPlot<'_> {
 impl Draw for ErrorBarPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let (xr, yr) = self.ranges().ok_or("no finite point")?;
-        let (x_span, y_span) = (xr.end - xr.start, yr.end - yr.start);
+        let x_span = xr.end - xr.start;
         let root = root.titled(self.title, title_style()).map_err(msg)?;
         let mut legend: Vec<(String, Swatch)> = self
             .series
@@ -86,24 +86,9 @@ impl Draw for ErrorBarPlot<'_> {
             legend.push((c.label.clone(), Swatch::Line(BLACK, 2)));
         }
         let root = legend_strip(&root, &legend)?;
-        let mut chart = ChartBuilder::on(&root)
-            .margin(10)
-            .margin_right(30)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
-            .build_cartesian_2d(xr.clone(), yr.clone())
-            .map_err(msg)?;
-        chart
-            .configure_mesh()
-            .x_desc(self.x_label)
-            .y_desc(self.y_label)
-            .x_label_formatter(&|v| tick_label(*v, x_span))
-            .y_label_formatter(&|v| tick_label(*v, y_span))
-            .axis_desc_style(axis_desc_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(msg)?;
+        let mut chart = one_panel(&root).build_cartesian_2d(xr, yr).map_err(msg)?;
+        let desc = (self.x_label, self.y_label);
+        draw_mesh(&mut chart, desc, None, axis_desc_style())?;
         if let Some(c) = self.curve {
             let points: Vec<(f64, f64)> = c
                 .points
