@@ -387,28 +387,7 @@ fn finish(
     } else {
         None
     };
-    let mut fitted = Vec::with_capacity(params.len());
-    let mut k = 0;
-    for q in params {
-        if q.fixed {
-            fitted.push(FittedParam {
-                name: q.name.clone(),
-                value: q.value,
-                std_error: 0.0,
-                naive_std_error: 0.0,
-                fixed: true,
-            });
-        } else if let Some(e) = &errors {
-            fitted.push(FittedParam {
-                name: q.name.clone(),
-                value: x[k],
-                std_error: e.robust.std_errors[k],
-                naive_std_error: e.naive[k],
-                fixed: false,
-            });
-            k += 1;
-        }
-    }
+    let fitted = fitted_params(params, &x, errors.as_ref());
     let nf = n as f64;
     let mean = rss / nf;
     let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
@@ -447,6 +426,35 @@ fn finish(
         convergence,
         log,
     })
+}
+
+/// Every parameter as fitted: a fixed one at its value with no error, a free one at its entry
+/// of the free values `x` with its standard errors (none when nothing was free to fit).
+fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec<FittedParam> {
+    let mut free = x.iter().enumerate();
+    params
+        .iter()
+        .filter_map(|q| {
+            if q.fixed {
+                return Some(FittedParam {
+                    name: q.name.clone(),
+                    value: q.value,
+                    std_error: 0.0,
+                    naive_std_error: 0.0,
+                    fixed: true,
+                });
+            }
+            let e = errors?;
+            let (k, &value) = free.next()?;
+            Some(FittedParam {
+                name: q.name.clone(),
+                value,
+                std_error: e.robust.std_errors[k],
+                naive_std_error: e.naive[k],
+                fixed: false,
+            })
+        })
+        .collect()
 }
 
 /// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:

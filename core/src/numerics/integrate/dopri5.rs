@@ -118,36 +118,19 @@ pub(super) fn integrate(
         if let Some(e) = error.borrow_mut().take() {
             return Err(e);
         }
-        let st = result.map_err(|e| match e {
-            IntegrationError::StepSizeUnderflow { x } => SimError::StepSizeTooSmall { time: x },
-            IntegrationError::MaxNumStepReached { x, n_step } => SimError::TooManySteps {
-                time: x,
-                steps: u64::from(n_step),
-            },
-            IntegrationError::StiffnessDetected { x } => SimError::StepSizeTooSmall { time: x },
-        })?;
+        let st = result.map_err(sim_error)?;
         stats.accepted = u64::from(st.accepted_steps);
         stats.rejected = u64::from(st.rejected_steps);
+        let missing = |t: f64| {
+            SimError::BadSettings(format!(
+                "no solution at t = {t} s (integrated {t0} → {t_end})"
+            ))
+        };
         if step.is_some() {
-            // Dense samples are t0, t0 + dx, …: outputs[k] is sample k + 1.
-            let ys = solver.y_out();
-            let ts = solver.x_out();
-            for (k, &t) in outputs.iter().enumerate() {
-                let i = k + 1;
-                let (ti, yi) = ts
-                    .get(i)
-                    .zip(ys.get(i))
-                    .ok_or(SimError::BadSettings(format!(
-                        "no solution at t = {t} s (integrated {t0} → {t_end})"
-                    )))?;
-                debug_assert!((ti - t).abs() < 1e-6);
-                states.extend_from_slice(yi.as_slice());
-            }
+            dense_samples(&solver, outputs, &mut states, missing)?;
         } else {
             for &t in outputs {
-                let y = model.evaluate(t).ok_or(SimError::BadSettings(format!(
-                    "no solution at t = {t} s (integrated {t0} → {t_end})"
-                )))?;
+                let y = model.evaluate(t).ok_or_else(|| missing(t))?;
                 states.extend_from_slice(y.as_slice());
             }
         }
@@ -158,6 +141,36 @@ pub(super) fn integrate(
         dim,
         stats,
     })
+}
+
+/// The solver's failure as the simulation's error.
+fn sim_error(e: IntegrationError) -> SimError {
+    match e {
+        IntegrationError::StepSizeUnderflow { x } => SimError::StepSizeTooSmall { time: x },
+        IntegrationError::MaxNumStepReached { x, n_step } => SimError::TooManySteps {
+            time: x,
+            steps: u64::from(n_step),
+        },
+        IntegrationError::StiffnessDetected { x } => SimError::StepSizeTooSmall { time: x },
+    }
+}
+
+/// The states at `outputs` from the solver's dense samples t0, t0 + dx, …: `outputs[k]` is
+/// sample k + 1.
+fn dense_samples<F: Fn(f64) -> SimError>(
+    solver: &Dopri5<f64, DVector<f64>, Adapter<'_>>,
+    outputs: &[f64],
+    states: &mut Vec<f64>,
+    missing: F,
+) -> Result<(), SimError> {
+    let (ys, ts) = (solver.y_out(), solver.x_out());
+    for (k, &t) in outputs.iter().enumerate() {
+        let i = k + 1;
+        let (ti, yi) = ts.get(i).zip(ys.get(i)).ok_or_else(|| missing(t))?;
+        debug_assert!((ti - t).abs() < 1e-6);
+        states.extend_from_slice(yi.as_slice());
+    }
+    Ok(())
 }
 
 #[cfg(test)]
