@@ -282,16 +282,7 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
         },
     ];
     for (t, expected, what) in cases {
-        std::fs::write(&file, &t).unwrap();
-        let out = tmp.path().join("out");
-        let run = campaign(&file, &out, &[]);
-        assert!(!run.status.success(), "{what}");
-        let e = stderr(&run);
-        assert!(
-            e.contains("campaign.toml") && e.contains(&expected),
-            "{what}: {e}"
-        );
-        assert!(!out.exists(), "{what}: a unit started");
+        assert_refused_before_any_unit(&file, tmp.path(), &t, &what, &expected);
     }
     // A folder holding anything a campaign does not write is refused.
     std::fs::write(&file, &text).unwrap();
@@ -585,15 +576,21 @@ fn bad_global_input_is_refused_before_any_unit_starts() {
     })
     .collect();
     for (t, what, expected) in cases {
-        std::fs::write(&file, &t).unwrap();
-        let out = tmp.path().join("out");
-        let run = campaign(&file, &out, &[]);
-        assert!(!run.status.success(), "{what}");
-        let e = stderr(&run);
-        assert!(
-            e.contains("campaign.toml") && e.contains(&expected),
-            "{what}: {e}\nexpected {expected}"
-        );
-        assert!(!out.exists(), "{what}: a unit started");
+        assert_refused_before_any_unit(&file, tmp.path(), &t, what, &expected);
     }
+}
+
+/// Write campaign text `t` to `file` and run it into `dir/out`: it must fail, naming the
+/// campaign file and `expected`, before any unit starts (no `out` folder). `what` names the case.
+fn assert_refused_before_any_unit(file: &Path, dir: &Path, t: &str, what: &str, expected: &str) {
+    std::fs::write(file, t).unwrap();
+    let out = dir.join("out");
+    let run = campaign(file, &out, &[]);
+    assert!(!run.status.success(), "{what}");
+    let e = stderr(&run);
+    assert!(
+        e.contains("campaign.toml") && e.contains(expected),
+        "{what}: {e}\nexpected {expected}"
+    );
+    assert!(!out.exists(), "{what}: a unit started");
 }
