@@ -1,5 +1,6 @@
 //! Settings of a discovery run, with named setters and the documented acceptance thresholds.
 
+use derive_setters::Setters;
 use serde::{Deserialize, Serialize};
 
 use super::error::DiscoveryError;
@@ -16,7 +17,7 @@ use crate::fit::{FitSettings, Solver};
 /// assert!(s.validate().is_ok());
 /// assert!(DiscoverySettings::default().holdout_every(1).validate().is_err());
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Setters)]
 #[serde(default)]
 pub struct DiscoverySettings {
     /// Most effects added (default 3).
@@ -63,12 +64,14 @@ pub struct DiscoverySettings {
     /// and the verdict says the kinematics' part is missing. Set from the record by
     /// [`DiscoverySettings::kinematics`]; not read from a file.
     #[serde(skip)]
+    #[setters(skip)]
     pub motion_noise: Option<MotionNoise>,
     /// Window of the derivative filter that made v and a, samples: the filtered noise is
     /// correlated over it, so the force-level paired test's blocks are at least twice as long
     /// (see [`super::blocks`]). `None`: the block length is estimated from the residual's
     /// autocorrelation alone. Set by [`DiscoverySettings::kinematics`]; not read from a file.
     #[serde(skip)]
+    #[setters(skip)]
     pub filter_window: Option<usize>,
     /// Starts of a candidate's trial besides its defaults: the best points of a coarse grid
     /// over its nonlinear parameters, scored by variable projection on the current residual;
@@ -89,6 +92,7 @@ pub struct DiscoverySettings {
     pub polish: Option<bool>,
     /// Called as the run goes (step, candidate, score): for a live display.
     #[serde(skip)]
+    #[setters(skip)]
     pub observer: Observer,
 }
 
@@ -116,36 +120,6 @@ impl Default for DiscoverySettings {
 }
 
 impl DiscoverySettings {
-    /// Most effects added.
-    pub fn max_effects(mut self, n: usize) -> Self {
-        self.max_effects = n;
-        self
-    }
-    /// Hold out every k-th whole cycle.
-    pub fn holdout_every(mut self, k: usize) -> Self {
-        self.holdout_every = k;
-        self
-    }
-    /// Least paired z of a held-out gain.
-    pub fn min_gain_sigma(mut self, z: f64) -> Self {
-        self.min_gain_sigma = z;
-        self
-    }
-    /// Least fall of the BIC.
-    pub fn min_bic_drop(mut self, d: f64) -> Self {
-        self.min_bic_drop = d;
-        self
-    }
-    /// Least share of the current model's excess over the floor a candidate must explain.
-    pub fn min_explained(mut self, share: f64) -> Self {
-        self.min_explained = share;
-        self
-    }
-    /// How far the kinematics' part of the force floor may be from its estimate (a factor).
-    pub fn kinematics_uncertainty(mut self, factor: f64) -> Self {
-        self.kinematics_uncertainty = factor;
-        self
-    }
     /// The width in mean square (N²) of the uncertainty of a force floor whose kinematics'
     /// part is `propagated` (N).
     pub(super) fn floor_band(&self, propagated: f64) -> f64 {
@@ -173,45 +147,6 @@ impl DiscoverySettings {
     pub fn kinematics(mut self, k: &Kinematics) -> Self {
         self.motion_noise = Some(k.motion_noise());
         self.filter_window = Some(k.motion_filter.window());
-        self
-    }
-    /// Settings of every fit.
-    pub fn fit(mut self, fit: FitSettings) -> Self {
-        self.fit = fit;
-        self
-    }
-    /// σ of the force noise, N (instead of the estimate).
-    pub fn noise_sigma(mut self, sigma: Option<f64>) -> Self {
-        self.noise_sigma = sigma;
-        self
-    }
-    /// Fit a constant force offset with every model.
-    pub fn fit_offset(mut self, on: bool) -> Self {
-        self.fit_offset = on;
-        self
-    }
-
-    /// Starts of a candidate's trial besides its defaults.
-    pub fn extra_starts(mut self, n: usize) -> Self {
-        self.extra_starts = n;
-        self
-    }
-
-    /// Scout records of at least `n` samples (0: never).
-    pub fn scout_from(mut self, n: usize) -> Self {
-        self.scout_from = n;
-        self
-    }
-
-    /// Re-check earlier effects after each acceptance (`None`: the level's default).
-    pub fn recheck(mut self, on: Option<bool>) -> Self {
-        self.recheck = on;
-        self
-    }
-
-    /// Polish an accepted model before the next step (`None`: the level's default).
-    pub fn polish(mut self, on: Option<bool>) -> Self {
-        self.polish = on;
         self
     }
 
