@@ -8,6 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::atomic::{ensure_dir, write_atomic};
+use super::colour::series_colour;
 use super::font::{ensure_registered, FAMILY};
 use super::raster::svg_to_png;
 use super::series_csv::{write_csv, Column};
@@ -23,6 +24,13 @@ pub struct FigureFiles {
     /// Every plotted series, one column per quantity, headed with its unit.
     pub csv: PathBuf,
 }
+
+/// The STF force axis, as every figure labels it.
+pub const F_LABEL: &str = "F_STF, N";
+/// The time axis, as every figure labels it.
+pub const T_LABEL: &str = "time t, s";
+/// A measured signal is a wide light-grey line under the models' lines, so both stay visible.
+pub const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
 
 /// Width × height of a one-panel figure, pixels.
 pub const SIZE: (u32, u32) = (1000, 600);
@@ -198,6 +206,56 @@ pub fn msg<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
+/// `root` under the figure's `title`, in the title style: the area below it.
+pub fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    root.titled(title, title_style()).map_err(msg)
+}
+
+/// The builder of one small panel of a grid of panels, `caption` above it if given.
+pub fn small_panel<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: Option<&str>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .margin(8)
+        .x_label_area_size(42)
+        .y_label_area_size(62);
+    if let Some(c) = caption {
+        builder.caption(c, legend_style());
+    }
+    builder
+}
+
+/// Draw a line through `points` on `chart` in `style`.
+pub fn draw_line<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: ShapeStyle,
+) -> Result<(), String> {
+    chart
+        .draw_series(LineSeries::new(points, style))
+        .map_err(msg)?;
+    Ok(())
+}
+
+/// The legend entries of model lines: each label, with `suffix`, in its series colour.
+pub fn model_entries<'a>(
+    labels: impl IntoIterator<Item = &'a str>,
+    suffix: &str,
+) -> Vec<(String, Swatch)> {
+    let entry = |(i, label)| {
+        (
+            format!("{label}{suffix}"),
+            Swatch::Line(series_colour(i), 3),
+        )
+    };
+    labels.into_iter().enumerate().map(entry).collect()
+}
+
 /// A figure that can draw itself on any plotters backend.
 pub trait Draw {
     /// Draw on `root` (already filled white).
@@ -257,6 +315,20 @@ pub fn same_length(what: &str, a: &[f64], b: &[f64]) -> Result<(), ReportError> 
             left: a.len(),
             right: b.len(),
         })
+    }
+}
+
+/// Refuse a figure (`figure`, as its errors name it) when one of `series` (`(what, values)`)
+/// has no finite value.
+pub fn require_finite(figure: &str, series: &[(&str, &[f64])]) -> Result<(), ReportError> {
+    match series
+        .iter()
+        .find(|(_, s)| !s.iter().any(|v| v.is_finite()))
+    {
+        Some((what, _)) => Err(ReportError::NoData {
+            what: format!("{figure}: {what}"),
+        }),
+        None => Ok(()),
     }
 }
 

@@ -13,7 +13,7 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
     axis_desc_style, draw_legend, finite_points, msg, one_panel, render, same_length, tick_label,
-    tick_style, title_style, Draw, FigureFiles, SIZE,
+    tick_style, titled, Draw, FigureFiles, SIZE,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -183,9 +183,7 @@ impl Draw for FrequencyResponsePlot {
                 .flat_map(|c| c.x_peak.iter().chain(&c.trend)),
         )
         .ok_or_else(no_data)?;
-        let root = root
-            .titled("Frequency response: local maxima of x", title_style())
-            .map_err(msg)?;
+        let root = titled(root, "Frequency response: local maxima of x")?;
         let mut chart = one_panel(&root)
             .build_cartesian_2d(w_range.clone(), x_range.clone())
             .map_err(msg)?;

@@ -9,8 +9,8 @@ use plotters::prelude::*;
 use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, draw_mesh, msg, render, same_length, tick_label, tick_style, title_style,
-    Draw, FigureFiles, SIZE,
+    axis_desc_style, draw_mesh, msg, render, require_finite, same_length, tick_label, tick_style,
+    titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -20,8 +20,6 @@ use super::ReportError;
 const COLOUR_STEPS: usize = 256;
 /// Width of the colour bar's strip (bar 28 px, then ticks and the axis label), pixels.
 const COLOUR_BAR_WIDTH: u32 = 150;
-const F_LABEL: &str = "F_STF, N";
-const T_LABEL: &str = "time t, s";
 
 struct HysteresisPlot {
     label: String,
@@ -57,12 +55,8 @@ impl Draw for HysteresisPlot {
         let x_range = padded_range(&self.x).ok_or_else(|| no_data(&self.label))?;
         let f_range = padded_range(&self.f).ok_or_else(|| no_data(F_LABEL))?;
         let t_range = exact_range(&self.t).ok_or_else(|| no_data(T_LABEL))?;
-        let root = root
-            .titled(
-                &format!("Hysteresis: F_STF against {}, coloured by time", self.label),
-                title_style(),
-            )
-            .map_err(msg)?;
+        let title = format!("Hysteresis: F_STF against {}, coloured by time", self.label);
+        let root = titled(root, &title)?;
         let (width, _) = root.dim_in_pixel();
         let (main, bar) = root.split_horizontally(width.saturating_sub(COLOUR_BAR_WIDTH));
 
@@ -136,13 +130,7 @@ pub fn hysteresis(
     let (label, x) = against;
     same_length(&format!("hysteresis: {label} and F_STF"), x, f_stf)?;
     same_length("hysteresis: t and F_STF", t, f_stf)?;
-    for (what, s) in [("t", t), (label, x), ("F_STF", f_stf)] {
-        if !s.iter().any(|v| v.is_finite()) {
-            return Err(ReportError::NoData {
-                what: format!("hysteresis: {what}"),
-            });
-        }
-    }
+    require_finite("hysteresis", &[("t", t), (label, x), ("F_STF", f_stf)])?;
     let keep = decimate_union(&[x, f_stf], MAX_POINTS_PER_LINE);
     let plot = HysteresisPlot {
         label: label.to_string(),

@@ -4,7 +4,6 @@
 
 use std::path::Path;
 
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -12,15 +11,13 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, draw_mesh, finite_points, legend_strip, msg, one_panel, render, same_length,
-    title_style, Draw, FigureFiles, Swatch, SIZE,
+    axis_desc_style, draw_line, draw_mesh, finite_points, legend_strip, model_entries, msg,
+    one_panel, render, require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch,
+    MEASURED_GREY, SIZE, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
 use super::ReportError;
-
-/// The measured force is a wide light-grey band under the fitted lines, so both stay visible.
-const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
 
 /// What a measured-vs-modelled figure shows: its title, the quantity with its unit (axis and
 /// CSV columns) and what the model curves are.
@@ -98,9 +95,9 @@ struct MeasuredVsFittedPlot {
 impl MeasuredVsFittedPlot {
     /// A record of hundreds of cycles: the measured envelope as a grey band, each model's as
     /// its upper and lower edge (the cycles themselves are in the regime windows).
-    fn draw_envelopes<'a, DB: DrawingBackend + 'a>(
+    fn draw_envelopes<DB: DrawingBackend>(
         &self,
-        chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+        chart: &mut Chart2d<'_, DB>,
     ) -> Result<(), String> {
         let buckets = buckets_for(&self.measured);
         let measured = envelope(&self.t, &self.measured, buckets);
@@ -111,13 +108,9 @@ impl MeasuredVsFittedPlot {
             let colour = series_colour(i);
             let edges = envelope(&self.t, f, buckets);
             let upper = edges.iter().map(|&(t, _, hi)| (t, hi));
+            draw_line(chart, upper, colour.stroke_width(2))?;
             let lower = edges.iter().map(|&(t, lo, _)| (t, lo));
-            chart
-                .draw_series(LineSeries::new(upper, colour.stroke_width(2)))
-                .map_err(msg)?;
-            chart
-                .draw_series(LineSeries::new(lower, colour.stroke_width(2)))
-                .map_err(msg)?;
+            draw_line(chart, lower, colour.stroke_width(2))?;
         }
         Ok(())
     }
@@ -130,17 +123,11 @@ impl MeasuredVsFittedPlot {
         } else {
             ""
         };
-        let mut entries = vec![(
-            format!("{}{suffix}", self.quantity.band),
-            Swatch::Line(MEASURED_GREY, 6),
-        )];
-        for (i, (label, _)) in self.fitted.iter().enumerate() {
-            entries.push((
-                format!("{label}{suffix}"),
-                Swatch::Line(series_colour(i), 3),
-            ));
-        }
-        entries
+        let band = format!("{}{suffix}", self.quantity.band);
+        let models = model_entries(self.fitted.iter().map(|(l, _)| l.as_str()), suffix);
+        std::iter::once((band, Swatch::Line(MEASURED_GREY, 6)))
+            .chain(models)
+            .collect()
     }
 }
 
@@ -154,32 +141,20 @@ impl Draw for MeasuredVsFittedPlot {
                 .chain(self.fitted.iter().flat_map(|(_, f)| f)),
         )
         .ok_or_else(no_data)?;
-        let root = root
-            .titled(self.quantity.title, title_style())
-            .map_err(msg)?;
-        let root = legend_strip(&root, &self.legend_entries())?;
+        let root = legend_strip(&titled(root, self.quantity.title)?, &self.legend_entries())?;
         let mut chart = one_panel(&root)
             .build_cartesian_2d(t_range.clone(), f_range.clone())
             .map_err(msg)?;
-        let desc = ("time t, s", self.quantity.label);
+        let desc = (T_LABEL, self.quantity.label);
         draw_mesh(&mut chart, desc, None, axis_desc_style())?;
         if dense(&self.measured) {
             return self.draw_envelopes(&mut chart);
         }
-        chart
-            .draw_series(LineSeries::new(
-                finite_points(&self.t, &self.measured),
-                MEASURED_GREY.stroke_width(6),
-            ))
-            .map_err(msg)?;
+        let measured = finite_points(&self.t, &self.measured);
+        draw_line(&mut chart, measured, MEASURED_GREY.stroke_width(6))?;
         for (i, (_, f)) in self.fitted.iter().enumerate() {
-            let colour = series_colour(i);
-            chart
-                .draw_series(LineSeries::new(
-                    finite_points(&self.t, f),
-                    colour.stroke_width(2),
-                ))
-                .map_err(msg)?;
+            let style = series_colour(i).stroke_width(2);
+            draw_line(&mut chart, finite_points(&self.t, f), style)?;
         }
         Ok(())
     }
@@ -213,11 +188,8 @@ pub fn measured_vs_model(
     for (label, f) in fitted {
         same_length(&format!("measured vs fitted: t and {label}"), t, f)?;
     }
-    if !measured.iter().any(|v| v.is_finite()) {
-        return Err(ReportError::NoData {
-            what: format!("measured vs fitted: measured {}", quantity.label),
-        });
-    }
+    let what = format!("measured {}", quantity.label);
+    require_finite("measured vs fitted", &[(&what, measured)])?;
     let mut all: Vec<&[f64]> = vec![measured];
     all.extend(fitted.iter().map(|(_, f)| *f));
     let keep = decimate_union(&all, MAX_POINTS_PER_LINE);

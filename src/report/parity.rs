@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    draw_mesh, legend_strip, legend_style, msg, render, same_length, tick_label, tick_style,
-    title_style, Draw, FigureFiles, Swatch,
+    draw_line, draw_mesh, legend_strip, model_entries, msg, render, same_length, small_panel,
+    tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -118,11 +118,7 @@ impl ParityPlot {
     ) -> Result<(), String> {
         let range = padded_range(measured.iter().chain(fitted.iter().flatten()))
             .ok_or_else(|| format!("{name}: no finite value"))?;
-        let mut chart = ChartBuilder::on(area)
-            .caption(name, legend_style())
-            .margin(8)
-            .x_label_area_size(42)
-            .y_label_area_size(62)
+        let mut chart = small_panel(area, Some(name))
             .build_cartesian_2d(range.clone(), range.clone())
             .map_err(msg)?;
         let label = &self.quantity.label;
@@ -139,13 +135,8 @@ impl ParityPlot {
                 )
                 .map_err(msg)?;
         }
-        chart
-            .draw_series(LineSeries::new(
-                [(range.start, range.start), (range.end, range.end)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(msg)?;
-        Ok(())
+        let diagonal = [(range.start, range.start), (range.end, range.end)];
+        draw_line(&mut chart, diagonal, BLACK.stroke_width(1))
     }
 
     fn residuals<DB: DrawingBackend>(
@@ -168,10 +159,7 @@ impl ParityPlot {
             .max(f64::MIN_POSITIVE)
             * 1.1;
         let span = range.end - range.start;
-        let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .x_label_area_size(42)
-            .y_label_area_size(62)
+        let mut chart = small_panel(area, None)
             .build_cartesian_2d(range.clone(), 0.0..top)
             .map_err(msg)?;
         let x_desc = format!(
@@ -185,19 +173,14 @@ impl ParityPlot {
                 let x0 = range.start + b as f64 * width;
                 [(x0, *d), (x0 + width, *d)]
             });
-            let colour = series_colour(i);
-            chart
-                .draw_series(LineSeries::new(steps, colour.stroke_width(2)))
-                .map_err(msg)?;
+            draw_line(&mut chart, steps, series_colour(i).stroke_width(2))?;
         }
         if let Some(s) = sigma {
             let curve = (0..=200).map(|k| {
                 let x = range.start + span * k as f64 / 200.0;
                 (x, bell(x, s))
             });
-            chart
-                .draw_series(LineSeries::new(curve, GREY.stroke_width(2)))
-                .map_err(msg)?;
+            draw_line(&mut chart, curve, GREY.stroke_width(2))?;
         }
         Ok(())
     }
@@ -205,12 +188,7 @@ impl ParityPlot {
     /// The legend the panels share, above them: each model's colour (its scatter and its
     /// histogram) and the noise floor's curve.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let mut entries: Vec<(String, Swatch)> = self
-            .models
-            .iter()
-            .enumerate()
-            .map(|(i, m)| (m.clone(), Swatch::Line(series_colour(i), 3)))
-            .collect();
+        let mut entries = model_entries(self.models.iter().map(String::as_str), "");
         if self.quantity.noise_sigma.is_some_and(|s| s > 0.0) {
             entries.push(("noise floor".into(), Swatch::Line(GREY, 3)));
         }
@@ -220,13 +198,8 @@ impl ParityPlot {
 
 impl Draw for ParityPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let root = root
-            .titled(
-                "Measured against fitted, and the residual's distribution, by regime",
-                title_style(),
-            )
-            .map_err(msg)?;
-        let root = legend_strip(&root, &self.legend_entries())?;
+        let title = "Measured against fitted, and the residual's distribution, by regime";
+        let root = legend_strip(&titled(root, title)?, &self.legend_entries())?;
         let cells = root.split_evenly((2, self.groups.len()));
         let n = self.groups.len();
         for (k, group) in self.groups.iter().enumerate() {

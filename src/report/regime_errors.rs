@@ -8,8 +8,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, draw_legend, msg, one_panel, render, tick_label, tick_style, title_style,
-    Draw, FigureFiles, SIZE,
+    axis_desc_style, draw_legend, msg, one_panel, render, tick_label, tick_style, titled, Draw,
+    FigureFiles, SIZE,
 };
 use super::series_csv::Column;
 use super::ReportError;
@@ -31,9 +31,7 @@ impl Draw for RegimeErrorPlot {
             .max(1e-9)
             * 1.15;
         let n_groups = self.groups.len();
-        let root = root
-            .titled("Errors of each model, regime by regime", title_style())
-            .map_err(msg)?;
+        let root = titled(root, "Errors of each model, regime by regime")?;
         let mut chart = one_panel(&root)
             .build_cartesian_2d(0.0..n_groups as f64, 0.0..top)
             .map_err(msg)?;

@@ -11,8 +11,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    draw_mesh, finite_points, legend_strip, legend_style, msg, render, same_length, tick_style,
-    title_style, Draw, FigureFiles, Swatch,
+    draw_line, draw_mesh, finite_points, legend_strip, model_entries, msg, render, same_length,
+    small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, MEASURED_GREY,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -47,9 +47,6 @@ pub struct WindowSeries<'a> {
     pub models: &'a [(&'a str, &'a [f64])],
 }
 
-const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
-const F_LABEL: &str = "F_STF, N";
-
 struct WindowsPlot<'a> {
     series: WindowSeries<'a>,
     windows: Vec<RegimeWindow>,
@@ -77,33 +74,16 @@ impl WindowsPlot<'_> {
             padded_range(&x[r.clone()])
         }
         .ok_or_else(no_data)?;
-        let mut builder = ChartBuilder::on(area);
-        builder
-            .margin(8)
-            .x_label_area_size(42)
-            .y_label_area_size(62);
-        if let Some(c) = caption {
-            builder.caption(c, legend_style());
-        }
-        let mut chart = builder
+        let mut chart = small_panel(area, caption)
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
         draw_mesh(&mut chart, (x_label, F_LABEL), Some((5, 6)), tick_style())?;
         let x = &x[r.clone()];
-        chart
-            .draw_series(LineSeries::new(
-                finite_points(x, &s.f[r.clone()]),
-                MEASURED_GREY.stroke_width(5),
-            ))
-            .map_err(msg)?;
+        let measured = finite_points(x, &s.f[r.clone()]);
+        draw_line(&mut chart, measured, MEASURED_GREY.stroke_width(5))?;
         for (i, (_, m)) in s.models.iter().enumerate() {
-            let colour = series_colour(i);
-            chart
-                .draw_series(LineSeries::new(
-                    finite_points(x, &m[r.clone()]),
-                    colour.stroke_width(2),
-                ))
-                .map_err(msg)?;
+            let style = series_colour(i).stroke_width(2);
+            draw_line(&mut chart, finite_points(x, &m[r.clone()]), style)?;
         }
         Ok(())
     }
@@ -111,25 +91,15 @@ impl WindowsPlot<'_> {
     /// The legend the panels share, above them: the measured force and each model's.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
         let measured = ("measured".to_string(), Swatch::Line(MEASURED_GREY, 5));
-        let models = self.series.models.iter().enumerate();
-        std::iter::once(measured)
-            .chain(
-                models
-                    .map(|(i, (label, _))| (label.to_string(), Swatch::Line(series_colour(i), 3))),
-            )
-            .collect()
+        let models = model_entries(self.series.models.iter().map(|(l, _)| *l), "");
+        std::iter::once(measured).chain(models).collect()
     }
 }
 
 impl Draw for WindowsPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let root = root
-            .titled(
-                "A few cycles of each regime: the STF force over time and against x, v, a",
-                title_style(),
-            )
-            .map_err(msg)?;
-        let root = legend_strip(&root, &self.legend_entries())?;
+        let title = "A few cycles of each regime: the STF force over time and against x, v, a";
+        let root = legend_strip(&titled(root, title)?, &self.legend_entries())?;
         let s = &self.series;
         let rows: [(&str, &[f64]); 4] = [
             ("time t, s", s.t),

@@ -14,8 +14,8 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, finite_points, legend_strip, msg, render, same_length, tick_label, tick_style,
-    title_style, Draw, FigureFiles, Swatch, SIZE_TALL,
+    axis_desc_style, finite_points, legend_strip, msg, render, require_finite, same_length,
+    tick_label, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -33,9 +33,6 @@ pub struct Motion<'a> {
     /// Acceleration, m/s².
     pub a: &'a [f64],
 }
-
-const F_LABEL: &str = "F_STF, N";
-const T_LABEL: &str = "time t, s";
 
 struct TimeHistoryPlot {
     t: Vec<f64>,
@@ -179,9 +176,7 @@ const MAX_MARKS: usize = 80;
 
 impl Draw for TimeHistoryPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let root = root
-            .titled("Motion against the STF force", title_style())
-            .map_err(msg)?;
+        let root = titled(root, "Motion against the STF force")?;
         let root = legend_strip(&root, &self.legend_entries())?;
         for (i, area) in root.split_evenly((3, 1)).iter().enumerate() {
             self.panel(area, i)?;
@@ -204,13 +199,7 @@ pub fn time_history(
     same_length("time history: t and v", t, v)?;
     same_length("time history: t and a", t, a)?;
     same_length("time history: t and F_STF", t, f_stf)?;
-    for (what, s) in [("t", t), ("x", x), ("F_STF", f_stf)] {
-        if !s.iter().any(|v| v.is_finite()) {
-            return Err(ReportError::NoData {
-                what: format!("time history: {what}"),
-            });
-        }
-    }
+    require_finite("time history", &[("t", t), ("x", x), ("F_STF", f_stf)])?;
 
     let marks_full = extrema(f_stf, noise_delta(f_stf));
     let mut keep = decimate_union(&[x, v, a, f_stf], MAX_POINTS_PER_LINE);
