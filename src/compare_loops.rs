@@ -90,26 +90,10 @@ pub fn boundary_lines(c: &Classification) -> Vec<String> {
 
 /// Per-regime energy and loop metrics: measured, then each model (`labels` with `comparisons`).
 pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
-    let mut rows = Vec::new();
     let cell = |c: &Comparison, r: Regime, model: bool| {
         c.per_regime.get(r).map_or("—".to_string(), |m| {
-            let (e, ceq, px, duty, peak) = if model {
-                (
-                    m.model_energy,
-                    m.model_c_eq,
-                    m.model_phase_x,
-                    m.model_duty,
-                    m.model_peak_force,
-                )
-            } else {
-                (
-                    m.measured_energy,
-                    m.measured_c_eq,
-                    m.measured_phase_x,
-                    m.measured_duty,
-                    m.measured_peak_force,
-                )
-            };
+            let pick = |measured: f64, modelled: f64| if model { modelled } else { measured };
+            let px = pick(m.measured_phase_x, m.model_phase_x);
             let phase = if px.is_finite() {
                 format!("{px:.0}°")
             } else {
@@ -117,23 +101,20 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
             };
             format!(
                 "{} mJ · c_eq {} · {phase} · duty {} · {} N",
-                fixed(e * 1e3, 2),
-                fixed(ceq, 1),
-                fixed(duty, 2),
-                fixed(peak, 2)
+                fixed(pick(m.measured_energy, m.model_energy) * 1e3, 2),
+                fixed(pick(m.measured_c_eq, m.model_c_eq), 1),
+                fixed(pick(m.measured_duty, m.model_duty), 2),
+                fixed(pick(m.measured_peak_force, m.model_peak_force), 2)
             )
         })
     };
-    if let Some(first) = comparisons.first() {
-        let mut row = vec!["measured".to_string()];
-        row.extend(Regime::ALL.iter().map(|&r| cell(first, r, false)));
-        rows.push(row);
-    }
-    for (label, c) in labels.iter().zip(comparisons) {
-        let mut row = vec![label.to_string()];
-        row.extend(Regime::ALL.iter().map(|&r| cell(c, r, true)));
-        rows.push(row);
-    }
+    let row = |label: &str, c: &Comparison, model: bool| {
+        let cells = Regime::ALL.iter().map(|&r| cell(c, r, model));
+        std::iter::once(label.to_string()).chain(cells).collect()
+    };
+    let measured = comparisons.first().map(|c| row("measured", c, false));
+    let models = labels.iter().zip(comparisons).map(|(l, c)| row(l, c, true));
+    let rows = measured.into_iter().chain(models).collect();
     let columns = ["source", "pre-resonance", "resonance", "post-resonance"];
     Table::new("Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area), equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in N·s/m, the phase of the force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak force.", &columns).with_rows(rows)
 }

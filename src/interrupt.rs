@@ -9,7 +9,7 @@
 //! output ([`crate::results_dir`]).
 
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard, OnceLock};
+use std::sync::{Mutex, MutexGuard};
 
 /// What the run has done so far, as the interrupt message tells it.
 #[derive(Clone, Debug, Default)]
@@ -22,18 +22,15 @@ pub struct RunState {
     pub written: Vec<String>,
 }
 
-fn state() -> &'static Mutex<RunState> {
-    static STATE: OnceLock<Mutex<RunState>> = OnceLock::new();
-    STATE.get_or_init(|| Mutex::new(RunState::default()))
-}
-
-fn swap_lock() -> &'static Mutex<()> {
-    static SWAP: OnceLock<Mutex<()>> = OnceLock::new();
-    SWAP.get_or_init(|| Mutex::new(()))
-}
+static STATE: Mutex<RunState> = Mutex::new(RunState {
+    finished: Vec::new(),
+    staged: Vec::new(),
+    written: Vec::new(),
+});
+static SWAP: Mutex<()> = Mutex::new(());
 
 fn update(change: impl FnOnce(&mut RunState)) {
-    if let Ok(mut s) = state().lock() {
+    if let Ok(mut s) = STATE.lock() {
         change(&mut s);
     }
 }
@@ -61,8 +58,7 @@ pub fn written(what: impl Into<String>) {
 /// Hold interrupts off while results are put in place: an interrupt waits until the guard is
 /// dropped.
 pub fn hold_off() -> MutexGuard<'static, ()> {
-    swap_lock()
-        .lock()
+    SWAP.lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
@@ -98,7 +94,7 @@ fn remove_staged(path: &Path) {
 pub fn install() {
     let _ = ctrlc::set_handler(|| {
         let _swap = hold_off();
-        let now = state().lock().map(|s| s.clone()).unwrap_or_default();
+        let now = STATE.lock().map(|s| s.clone()).unwrap_or_default();
         for path in &now.staged {
             remove_staged(path);
         }

@@ -109,7 +109,6 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
         .iter()
         .map(|f| (f.label.as_str(), scaled(&f.fitted)))
         .collect();
-    let curves: Vec<(&str, &[f64])> = fitted.iter().map(|(l, v)| (*l, v.as_slice())).collect();
     let quantity = match data.level {
         FitLevel::Force => STF_FORCE,
         FitLevel::Trajectory => DISPLACEMENT_MM,
@@ -120,7 +119,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
         quantity,
         &data.record.t,
         &scaled(data.target()),
-        &curves,
+        &fitted,
     )?;
     s.figures.push(FigureRef::new(
         fig,
@@ -231,15 +230,13 @@ pub fn validation_section(
             FitLevel::Trajectory => DISPLACEMENT_VALIDATION_MM,
         };
         let measured: Vec<f64> = rec.data.target().iter().map(|x| x * scale).collect();
-        let curves: Vec<(&str, &[f64])> =
-            predicted.iter().map(|(l, p)| (*l, p.as_slice())).collect();
         let fig = measured_vs_model(
             &dir,
             "validation",
             quantity,
             &rec.data.record.t,
             &measured,
-            &curves,
+            &predicted,
         )?;
         s.figures.push(FigureRef::new(
             fig,
@@ -252,11 +249,11 @@ pub fn validation_section(
 /// The table of each model's error on the validation record: overall, against the measured
 /// RMS, per regime, and its RMS on the estimation record (in `unit`, `scale` from SI).
 fn validation_table(fits: &[ModelFit], unit: &str, scale: f64) -> Table {
-    let mut columns: Vec<String> = ["model", "validation RMS", "of the measured RMS"]
-        .iter()
-        .map(|c| c.to_string())
-        .collect();
-    columns[1].push_str(&format!(", {unit}"));
+    let mut columns = vec![
+        "model".to_string(),
+        format!("validation RMS, {unit}"),
+        "of the measured RMS".into(),
+    ];
     columns.extend(Regime::ALL.iter().map(|r| format!("{}, {unit}", r.name())));
     columns.push(format!("estimation RMS, {unit}"));
     let cell = |x: Option<f64>, digits: usize| x.map_or("—".into(), |x| format!("{x:.digits$}"));
@@ -350,9 +347,11 @@ pub fn write_report(
     sections: Vec<Section>,
     out: &Path,
 ) -> Result<()> {
-    let mut report = Report::new(title);
-    report.intro = intro;
-    report.sections = sections;
+    let report = Report {
+        title: title.into(),
+        intro,
+        sections,
+    };
     write_html(&report, &out.join("report.html"))?;
     write_markdown(&report, &out.join("report.md"))?;
     Ok(())

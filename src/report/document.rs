@@ -71,6 +71,17 @@ impl Table {
         }
     }
 
+    /// The number of columns: the header's or the longest row's, whichever is wider.
+    pub fn width(&self) -> usize {
+        let rows = self.rows.iter().map(Vec::len);
+        rows.chain([self.columns.len()]).max().unwrap_or(0)
+    }
+
+    /// The cells of `row` (or of the header), padded with empty cells to [`Table::width`].
+    pub fn cells<'a>(&self, row: &'a [String]) -> impl Iterator<Item = &'a str> {
+        (0..self.width()).map(move |i| row.get(i).map_or("", String::as_str))
+    }
+
     /// The same table with `rows`.
     pub fn with_rows(mut self, rows: Vec<Vec<String>>) -> Self {
         self.rows = rows;

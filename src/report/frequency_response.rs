@@ -20,17 +20,18 @@ use super::series_csv::Column;
 use super::smoothing::{smooth_trend, Smoothing};
 use super::ReportError;
 
-/// What a frequency response is, which sets how it is drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// What a frequency response is, which sets how it is drawn; in drawing order (models first,
+/// then the record, then the reference on top).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum FrfRole {
+    /// The oscillator with a fitted model: a coloured trend over faint maxima.
+    #[default]
+    Model,
     /// The record: grey maxima under a dark trend.
     Measured,
     /// The oscillator without STF: a black dashed trend drawn over the others, so a model
     /// whose response equals it cannot hide it.
     Reference,
-    /// The oscillator with a fitted model: a coloured trend over faint maxima.
-    #[default]
-    Model,
 }
 
 /// One frequency response: the local maxima of x of one record, in time order.
@@ -85,6 +86,8 @@ impl FrequencyResponsePlot {
         let [pre, post] = self.changes;
         let lo = pre.map_or(w.start, |c| c.omega);
         let hi = post.map_or(w.end, |c| c.omega);
+        let pad = 0.01 * (w.end - w.start);
+        let mut names = Vec::new();
         if pre.is_some() || post.is_some() {
             chart
                 .draw_series([Rectangle::new(
@@ -92,7 +95,16 @@ impl FrequencyResponsePlot {
                     RESONANCE_SHADE.filled(),
                 )])
                 .map_err(msg)?;
+            let first = if pre.is_some() {
+                "pre-resonance"
+            } else {
+                "resonance"
+            };
+            names.push((w.start + pad, first));
         }
+        let after = |c: RegimeChange, name| (c.omega + c.uncertainty + pad, name);
+        names.extend(pre.map(|c| after(c, "resonance")));
+        names.extend(post.map(|c| after(c, "post-resonance")));
         for c in self.changes.iter().flatten() {
             let band = [
                 (c.omega - c.uncertainty, x.start),
@@ -104,23 +116,6 @@ impl FrequencyResponsePlot {
         }
         let top = x.end - 0.04 * (x.end - x.start);
         let style = tick_style().color(&RGBColor(90, 90, 90));
-        let mut names = Vec::new();
-        if let Some(c) = pre {
-            names.push((w.start + 0.01 * (w.end - w.start), "pre-resonance"));
-            names.push((
-                c.omega + c.uncertainty + 0.01 * (w.end - w.start),
-                "resonance",
-            ));
-        }
-        if let Some(c) = post {
-            if pre.is_none() {
-                names.push((w.start + 0.01 * (w.end - w.start), "resonance"));
-            }
-            names.push((
-                c.omega + c.uncertainty + 0.01 * (w.end - w.start),
-                "post-resonance",
-            ));
-        }
         chart
             .draw_series(
                 names
@@ -201,16 +196,10 @@ impl Draw for FrequencyResponsePlot {
             .bold_line_style(BLACK.mix(0.08))
             .draw()
             .map_err(msg)?;
-        // Models first, then the record, then the reference on top.
-        let order = |r: FrfRole| match r {
-            FrfRole::Model => 0,
-            FrfRole::Measured => 1,
-            FrfRole::Reference => 2,
-        };
-        let mut drawn: Vec<(usize, &PlottedCurve)> = self.curves.iter().enumerate().collect();
-        drawn.sort_by_key(|(_, c)| order(c.role));
+        let mut drawn: Vec<&PlottedCurve> = self.curves.iter().collect();
+        drawn.sort_by_key(|c| c.role);
         let mut model = 0;
-        for (_, c) in drawn {
+        for c in drawn {
             let colour = series_colour(model);
             if c.role == FrfRole::Model {
                 model += 1;

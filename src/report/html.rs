@@ -58,18 +58,11 @@ const LAYOUT_CHECK: &str = r#"
 
 /// Escape text for HTML content and attribute values.
 pub fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
-    out
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace('\'', "&#39;")
 }
 
 /// A paragraph's text as HTML: escaped, with `code` spans (backticks, as in the Markdown
@@ -120,17 +113,9 @@ fn table_html(out: &mut String, table: &Table) {
         let _ = write!(out, "<th>{}</th>", escape(c));
     }
     out.push_str("</tr></thead>\n<tbody>\n");
-    let width = table
-        .rows
-        .iter()
-        .map(Vec::len)
-        .chain([table.columns.len()])
-        .max()
-        .unwrap_or(0);
     for row in &table.rows {
         out.push_str("<tr>");
-        for i in 0..width {
-            let cell = row.get(i).map(String::as_str).unwrap_or("");
+        for cell in table.cells(row) {
             let class = if looks_numeric(cell) {
                 " class=\"num\""
             } else {

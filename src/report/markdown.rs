@@ -39,23 +39,15 @@ fn table_md(out: &mut String, table: &Table) {
     if !table.caption.is_empty() {
         let _ = writeln!(out, "**{}**\n", md_text(&table.caption));
     }
-    let width = table
-        .rows
-        .iter()
-        .map(Vec::len)
-        .chain([table.columns.len()])
-        .max()
-        .unwrap_or(0);
-    let header: Vec<String> = (0..width)
-        .map(|i| cell(table.columns.get(i).map(String::as_str).unwrap_or("")))
-        .collect();
-    let _ = writeln!(out, "| {} |", header.join(" | "));
-    let _ = writeln!(out, "|{}", " --- |".repeat(width));
-    for row in &table.rows {
-        let cells: Vec<String> = (0..width)
-            .map(|i| cell(row.get(i).map(String::as_str).unwrap_or("")))
-            .collect();
+    for (i, row) in std::iter::once(&table.columns)
+        .chain(&table.rows)
+        .enumerate()
+    {
+        let cells: Vec<String> = table.cells(row).map(cell).collect();
         let _ = writeln!(out, "| {} |", cells.join(" | "));
+        if i == 0 {
+            let _ = writeln!(out, "|{}", " --- |".repeat(table.width()));
+        }
     }
     out.push('\n');
 }

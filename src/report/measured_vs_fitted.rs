@@ -160,19 +160,6 @@ impl Draw for MeasuredVsFittedPlot {
     }
 }
 
-/// Draw the measured STF force and each model's fitted force (`(model label, force)`, N) over
-/// time `t` (s) to `out_dir/name.{svg,png,csv}`. The CSV holds t, the measured force and one
-/// column per model, as plotted.
-pub fn measured_vs_fitted(
-    out_dir: &Path,
-    name: &str,
-    t: &[f64],
-    measured: &[f64],
-    fitted: &[(&str, &[f64])],
-) -> Result<FigureFiles, ReportError> {
-    measured_vs_model(out_dir, name, STF_FORCE, t, measured, fitted)
-}
-
 /// Draw the measured `quantity` and each model's (`(model label, values)`) over time `t` (s)
 /// to `out_dir/name.{svg,png,csv}`. The CSV holds t, the measured values and one column per
 /// model, as plotted.
@@ -182,16 +169,16 @@ pub fn measured_vs_model(
     quantity: Quantity,
     t: &[f64],
     measured: &[f64],
-    fitted: &[(&str, &[f64])],
+    fitted: &[(&str, impl AsRef<[f64]>)],
 ) -> Result<FigureFiles, ReportError> {
     same_length("measured vs fitted: t and measured", t, measured)?;
     for (label, f) in fitted {
-        same_length(&format!("measured vs fitted: t and {label}"), t, f)?;
+        same_length(&format!("measured vs fitted: t and {label}"), t, f.as_ref())?;
     }
     let what = format!("measured {}", quantity.label);
     require_finite("measured vs fitted", &[(&what, measured)])?;
     let mut all: Vec<&[f64]> = vec![measured];
-    all.extend(fitted.iter().map(|(_, f)| *f));
+    all.extend(fitted.iter().map(|(_, f)| f.as_ref()));
     let keep = decimate_union(&all, MAX_POINTS_PER_LINE);
     let plot = MeasuredVsFittedPlot {
         quantity,
@@ -199,7 +186,7 @@ pub fn measured_vs_model(
         measured: pick(measured, &keep),
         fitted: fitted
             .iter()
-            .map(|(label, f)| (label.to_string(), pick(f, &keep)))
+            .map(|(label, f)| (label.to_string(), pick(f.as_ref(), &keep)))
             .collect(),
     };
     let mut columns = vec![
@@ -229,9 +216,10 @@ mod tests {
         let linear: Vec<f64> = s.v.iter().map(|v| 25.0 * v).collect();
         let quadratic: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
         let dir = tempfile::tempdir().unwrap();
-        let files = measured_vs_fitted(
+        let files = measured_vs_model(
             dir.path(),
             "fit",
+            STF_FORCE,
             &s.t,
             &s.f,
             &[("linear", &linear), ("power law", &quadratic)],

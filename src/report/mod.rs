@@ -61,7 +61,7 @@ pub use html::write_html;
 pub use hysteresis::hysteresis;
 pub use markdown::{md_text, write_markdown};
 pub use measured_vs_fitted::{
-    measured_vs_fitted, measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
+    measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
 pub use parity::{parity, ParityQuantity, SampleGroup};
