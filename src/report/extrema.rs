@@ -2,6 +2,8 @@
 //! maximum counts only once the signal has fallen `delta` below it, a minimum only once it has
 //! risen `delta` above it, so noise smaller than `delta` makes no extra extrema.
 
+use super::plot_range::finite_bounds;
+
 /// Whether an extremum is a maximum or a minimum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ExtremumKind {
@@ -73,14 +75,9 @@ pub fn extrema(y: &[f64], delta: f64) -> Vec<Extremum> {
 /// (σ ≈ 1.4826 · median|Δ²y| / √6, which ignores a smooth trend).
 pub fn noise_delta(y: &[f64]) -> f64 {
     let finite: Vec<f64> = y.iter().copied().filter(|v| v.is_finite()).collect();
-    let (lo, hi) = finite
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    if hi <= lo {
+    let Some((lo, hi)) = finite_bounds(&finite).filter(|(lo, hi)| hi > lo) else {
         return 0.0;
-    }
+    };
     let mut d2: Vec<f64> = finite
         .windows(3)
         .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())

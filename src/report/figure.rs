@@ -67,13 +67,26 @@ pub fn draw_mesh<DB: DrawingBackend>(
     labels: Option<(usize, usize)>,
     desc_style: TextStyle,
 ) -> Result<(), String> {
+    let desc = (Some(desc.0.into()), desc.1.into());
+    draw_mesh_with(chart, desc, labels, desc_style)
+}
+
+/// [`draw_mesh`], the x axis described only if `desc.0` is given.
+pub fn draw_mesh_with<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    desc: (Option<String>, String),
+    labels: Option<(usize, usize)>,
+    desc_style: TextStyle,
+) -> Result<(), String> {
     let (x, y) = (chart.x_range(), chart.y_range());
     let (xs, ys) = (x.end - x.start, y.end - y.start);
     let x_ticks = |v: &f64| tick_label(*v, xs);
     let y_ticks = |v: &f64| tick_label(*v, ys);
     let mut mesh = chart.configure_mesh();
-    mesh.x_desc(desc.0)
-        .y_desc(desc.1)
+    if let Some(x_desc) = desc.0 {
+        mesh.x_desc(x_desc);
+    }
+    mesh.y_desc(desc.1)
         .x_label_formatter(&x_ticks)
         .y_label_formatter(&y_ticks)
         .axis_desc_style(desc_style)

@@ -14,8 +14,9 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, finite_points, legend_strip, msg, render, require_finite, same_length,
-    tick_label, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL, T_LABEL,
+    axis_desc_style, draw_mesh_with, finite_points, legend_strip, msg, render, require_finite,
+    same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL,
+    T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -60,24 +61,9 @@ impl TimeHistoryPlot {
             .build_cartesian_2d(t_range.clone(), y_range.clone())
             .map_err(msg)?
             .set_secondary_coord(t_range.clone(), f_range.clone());
-        let (ts, ys, fs) = (
-            t_range.end - t_range.start,
-            y_range.end - y_range.start,
-            f_range.end - f_range.start,
-        );
-        let x_fmt = |v: &f64| tick_label(*v, ts);
-        let y_fmt = |v: &f64| tick_label(*v, ys);
-        let mut mesh = chart.configure_mesh();
-        mesh.y_desc(*label)
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .axis_desc_style(axis_desc_style())
-            .label_style(tick_style())
-            .light_line_style(WHITE.mix(0.0));
-        if index == 2 {
-            mesh.x_desc(T_LABEL);
-        }
-        mesh.draw().map_err(msg)?;
+        let desc = ((index == 2).then(|| T_LABEL.into()), label.to_string());
+        draw_mesh_with(&mut chart, desc, None, axis_desc_style())?;
+        let fs = f_range.end - f_range.start;
         chart
             .configure_secondary_axes()
             .y_desc(F_LABEL)
