@@ -95,49 +95,43 @@ fn fitted(
 }
 
 /// The values behind a force-level discovery's curves; `system` is the experiment's.
-pub fn force_curves(found: &Discovery, system: OscillatorParams) -> FittedCurves {
+pub fn force_curves(d: &Discovery, system: OscillatorParams) -> FittedCurves {
+    let of = |model, values, params| fitted(model, values, params, FORCE_OFFSET, system);
     FittedCurves {
-        base: fitted(
-            &found.base_model,
-            &found.base_values,
-            &found.base_params,
-            FORCE_OFFSET,
-            system,
-        ),
-        final_model: fitted(
-            &found.final_model,
-            &found.final_values,
-            &found.final_params,
-            FORCE_OFFSET,
-            system,
-        ),
+        base: of(&d.base_model, &d.base_values, &d.base_params),
+        final_model: of(&d.final_model, &d.final_values, &d.final_params),
     }
 }
 
 /// The values behind a trajectory-level discovery's curves.
 pub fn trajectory_curves(d: &Discovery, tf: &TrajectoryPart) -> FittedCurves {
-    let initial = |[x0, v0]: [f64; 2], params: &[FittedParam]| InitialState {
-        x0,
-        v0,
-        fitted: params.iter().any(|p| p.name == INITIAL_STATE[0]),
+    let of = |model, values, params: &[FittedParam], system, [x0, v0]: [f64; 2]| {
+        let initial = InitialState {
+            x0,
+            v0,
+            fitted: params.iter().any(|p| p.name == INITIAL_STATE[0]),
+        };
+        FittedModel {
+            initial: Some(initial),
+            ..fitted(model, values, params, DISPLACEMENT_OFFSET, system)
+        }
     };
-    let mut base = fitted(
-        &d.base_model,
-        &d.base_values,
-        &d.base_params,
-        DISPLACEMENT_OFFSET,
-        tf.system_before,
-    );
-    base.initial = Some(initial(tf.initial_before, &d.base_params));
-    let mut final_model = fitted(
-        &d.final_model,
-        &d.final_values,
-        &d.final_params,
-        DISPLACEMENT_OFFSET,
-        tf.system_after,
-    );
-    final_model.initial = Some(initial(tf.initial_after, &d.final_params));
-    FittedCurves { base, final_model }
+    FittedCurves {
+        base: of(
+            &d.base_model,
+            &d.base_values,
+            &d.base_params,
+            tf.system_before,
+            tf.initial_before,
+        ),
+        final_model: of(
+            &d.final_model,
+            &d.final_values,
+            &d.final_params,
+            tf.system_after,
+            tf.initial_after,
+        ),
+    }
 }
 
 /// Write `discovered.csv` into `out`: t, the measured `signal` (`f_stf` or `x`) and the

@@ -85,12 +85,13 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
         done: usize,
         best: Option<(String, f64, f64)>,
     }
-    let state = Mutex::new(StepState {
-        step: 0,
+    let fresh = |step| StepState {
+        step,
         started: Instant::now(),
         done: 0,
         best: None,
-    });
+    };
+    let state = Mutex::new(fresh(0));
     Observer::new(move |event| {
         let Ok(mut s) = state.lock() else {
             return;
@@ -104,12 +105,7 @@ pub fn discovery_observer(bar: ProgressBar, unit: &'static str, scale: f64) -> O
                 name,
             } => {
                 if *step != s.step {
-                    *s = StepState {
-                        step: *step,
-                        started: Instant::now(),
-                        done: 0,
-                        best: None,
-                    };
+                    *s = fresh(*step);
                 }
                 let left = (s.done > 0).then(|| {
                     let each = s.started.elapsed().as_secs_f64() / s.done as f64;

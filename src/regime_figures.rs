@@ -46,16 +46,12 @@ fn stretches(cycles: &[Cycle], labels: Option<&[Regime]>) -> Vec<Stretch> {
     Regime::ALL
         .iter()
         .filter_map(|&r| {
-            let mut best: Option<(usize, usize)> = None;
-            let mut i = 0;
-            while i < labels.len() {
-                let j = (i..labels.len())
-                    .find(|&j| labels[j] != labels[i])
-                    .unwrap_or(labels.len());
-                if labels[i] == r && best.is_none_or(|(_, n)| j - i > n) {
-                    best = Some((i, j - i));
+            let (mut best, mut start): (Option<(usize, usize)>, usize) = (None, 0);
+            for run in labels.chunk_by(|a, b| a == b) {
+                if run[0] == r && best.is_none_or(|(_, n)| run.len() > n) {
+                    best = Some((start, run.len()));
                 }
-                i = j;
+                start += run.len();
             }
             best.map(|(first, count)| Stretch {
                 name: r.name().replace('_', "-"),

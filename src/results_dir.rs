@@ -136,15 +136,8 @@ impl Drop for ResultsDir {
 /// The last component of `target`, refused if it has none (`.`, `..`, `/`): the folder is
 /// swapped by name in its parent.
 fn folder_name(target: &Path) -> Result<String> {
-    match target.file_name() {
-        Some(n)
-            if target
-                .components()
-                .next_back()
-                .is_some_and(|c| matches!(c, std::path::Component::Normal(_))) =>
-        {
-            Ok(n.to_string_lossy().into_owned())
-        }
+    match target.components().next_back() {
+        Some(std::path::Component::Normal(n)) => Ok(n.to_string_lossy().into_owned()),
         _ => bail!(
             "{}: give the output folder by name (e.g. out/fit): it is replaced as a whole",
             target.display()

@@ -14,9 +14,9 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_mesh_with, finite_points, legend_strip, msg, render, require_finite,
-    same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL,
-    T_LABEL,
+    axis_desc_style, draw_mesh_with, finite_points, legend_strip, model_entries, msg, render,
+    require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
+    F_LABEL, SIZE_TALL, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -93,16 +93,8 @@ impl TimeHistoryPlot {
     /// the marks of its extrema.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
         let suffix = if self.is_dense() { " (envelope)" } else { "" };
-        let mut entries = vec![
-            (
-                format!("motion, left axis{suffix}"),
-                Swatch::Line(series_colour(0), 3),
-            ),
-            (
-                format!("{F_LABEL}, right axis{suffix}"),
-                Swatch::Line(series_colour(1), 3),
-            ),
-        ];
+        let lines = ["motion, left axis", &format!("{F_LABEL}, right axis")];
+        let mut entries = model_entries(lines, suffix);
         if !self.marks.is_empty() && self.marks.len() <= MAX_MARKS {
             entries.push(("F_STF maxima".into(), Swatch::Dot(BLACK)));
             entries.push(("minima".into(), Swatch::Ring));
@@ -206,27 +198,21 @@ pub fn time_history(
             .map(|e| (t[e.index], f_stf[e.index], e.kind))
             .collect(),
     };
-    let kind_code = |k: ExtremumKind| match k {
-        ExtremumKind::Max => 1.0,
-        ExtremumKind::Min => -1.0,
-    };
+    let marks = |of: fn(&(f64, f64, ExtremumKind)) -> f64| plot.marks.iter().map(of).collect();
     let columns = vec![
         Column::new("t, s", plot.t.clone()),
         Column::new("x, mm", plot.panels[0].1.clone()),
         Column::new("v, mm/s", plot.panels[1].1.clone()),
         Column::new("a, m/s²", plot.panels[2].1.clone()),
         Column::new(F_LABEL, plot.f.clone()),
-        Column::new(
-            "F_STF extremum t, s",
-            plot.marks.iter().map(|m| m.0).collect(),
-        ),
-        Column::new(
-            "F_STF extremum, N",
-            plot.marks.iter().map(|m| m.1).collect(),
-        ),
+        Column::new("F_STF extremum t, s", marks(|m| m.0)),
+        Column::new("F_STF extremum, N", marks(|m| m.1)),
         Column::new(
             "F_STF extremum kind (1 max, -1 min)",
-            plot.marks.iter().map(|m| kind_code(m.2)).collect(),
+            marks(|m| match m.2 {
+                ExtremumKind::Max => 1.0,
+                ExtremumKind::Min => -1.0,
+            }),
         ),
     ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
