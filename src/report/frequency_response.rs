@@ -264,16 +264,11 @@ pub fn frequency_response(
             ]
         })
         .collect();
-    render(
-        out_dir,
-        name,
-        SIZE,
-        &FrequencyResponsePlot {
-            curves: plotted,
-            changes,
-        },
-        &columns,
-    )
+    let plot = FrequencyResponsePlot {
+        curves: plotted,
+        changes,
+    };
+    render(out_dir, name, SIZE, &plot, &columns)
 }
 
 #[cfg(test)]

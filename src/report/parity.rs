@@ -11,6 +11,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
+use super::decimate::pick;
 use super::figure::{
     draw_line, draw_mesh, legend_strip, model_entries, msg, render, same_length, small_panel,
     tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
@@ -234,37 +235,30 @@ pub fn parity(
             what: "parity: no group of samples, or no model".into(),
         });
     }
-    let pick = |v: &[f64], g: &SampleGroup| g.samples.iter().map(|&i| v[i]).collect::<Vec<f64>>();
     let plotted: Vec<(String, Vec<f64>, Vec<Vec<f64>>)> = groups
         .iter()
         .map(|g| {
+            let of = |v: &[f64]| pick(v, &g.samples);
             (
                 g.name.clone(),
-                pick(measured, g),
-                models.iter().map(|(_, f)| pick(f, g)).collect(),
+                of(measured),
+                models.iter().map(|(_, f)| of(f)).collect(),
             )
         })
         .collect();
+    let rows: Vec<usize> = groups.iter().flat_map(|g| g.samples.clone()).collect();
     let mut columns = vec![
-        Column::new(
-            "group",
-            groups
-                .iter()
-                .enumerate()
-                .flat_map(|(k, g)| std::iter::repeat_n((k + 1) as f64, g.samples.len()))
-                .collect(),
-        ),
+        Column::numbered("group", groups.iter().map(|g| g.samples.len())),
         Column::new(
             format!("measured {}", quantity.label),
-            plotted.iter().flat_map(|p| p.1.clone()).collect(),
+            pick(measured, &rows),
         ),
     ];
-    for (i, (label, _)) in models.iter().enumerate() {
-        columns.push(Column::new(
-            format!("{label} {}", quantity.label),
-            plotted.iter().flat_map(|p| p.2[i].clone()).collect(),
-        ));
-    }
+    columns.extend(
+        models
+            .iter()
+            .map(|(label, f)| Column::new(format!("{label} {}", quantity.label), pick(f, &rows))),
+    );
     let size = (480 * plotted.len() as u32 + 40, 900);
     let plot = ParityPlot {
         quantity: quantity.clone(),

@@ -146,13 +146,8 @@ pub fn regime_windows(
     }
     let rows: Vec<usize> = windows.iter().flat_map(|w| w.start..w.end).collect();
     let pick = |v: &[f64]| rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
-    let number: Vec<f64> = windows
-        .iter()
-        .enumerate()
-        .flat_map(|(k, w)| std::iter::repeat_n((k + 1) as f64, w.end - w.start))
-        .collect();
     let mut columns = vec![
-        Column::new("window", number),
+        Column::numbered("window", windows.iter().map(|w| w.end - w.start)),
         Column::new("t, s", pick(s.t)),
         Column::new("x, mm", pick(s.x_mm)),
         Column::new("v, mm/s", pick(s.v_mm)),

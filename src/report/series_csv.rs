@@ -24,6 +24,14 @@ impl Column {
             values,
         }
     }
+
+    /// A column numbering consecutive groups of rows from 1, the groups `lengths` rows long.
+    pub fn numbered(name: &str, lengths: impl Iterator<Item = usize>) -> Self {
+        let numbers = lengths
+            .enumerate()
+            .flat_map(|(k, n)| std::iter::repeat_n((k + 1) as f64, n));
+        Self::new(name, numbers.collect())
+    }
 }
 
 /// The CSV text of `columns` (numbers in Rust's shortest exact form; quoting by `csv`).
