@@ -175,14 +175,11 @@ pub fn check_replaceable(target: &Path, force: bool) -> Result<()> {
     let Ok(entries) = std::fs::read_dir(target) else {
         return Ok(());
     };
-    let mut held = Vec::new();
-    for entry in entries {
-        let entry = entry.with_context(|| format!("cannot read folder {}", target.display()))?;
-        let name = entry.file_name().to_string_lossy().into_owned();
-        if !is_temporary_name(&name) {
-            held.push(name);
-        }
-    }
+    let mut held = entries
+        .map(|e| Ok(e?.file_name().to_string_lossy().into_owned()))
+        .collect::<std::io::Result<Vec<String>>>()
+        .with_context(|| format!("cannot read folder {}", target.display()))?;
+    held.retain(|n| !is_temporary_name(n));
     held.sort();
     if let Some(stranger) = held.iter().find(|n| !RESULT_NAMES.contains(&n.as_str())) {
         bail!(

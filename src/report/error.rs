@@ -57,3 +57,10 @@ pub enum ReportError {
     #[error("the embedded font cannot be loaded")]
     Font,
 }
+
+impl ReportError {
+    /// [`ReportError::NoData`] about `what`.
+    pub fn no_data(what: impl Into<String>) -> Self {
+        Self::NoData { what: what.into() }
+    }
+}

@@ -338,9 +338,7 @@ pub fn require_finite(figure: &str, series: &[(&str, &[f64])]) -> Result<(), Rep
         .iter()
         .find(|(_, s)| !s.iter().any(|v| v.is_finite()))
     {
-        Some((what, _)) => Err(ReportError::NoData {
-            what: format!("{figure}: {what}"),
-        }),
+        Some((what, _)) => Err(ReportError::no_data(format!("{figure}: {what}"))),
         None => Ok(()),
     }
 }

@@ -247,9 +247,7 @@ pub fn frequency_response(
         .iter()
         .any(|c| !finite_points(&c.omega, &c.x_peak).is_empty());
     if !has_data {
-        return Err(ReportError::NoData {
-            what: "frequency response".into(),
-        });
+        return Err(ReportError::no_data("frequency response"));
     }
     let columns: Vec<Column> = plotted
         .iter()

@@ -231,9 +231,9 @@ pub fn parity(
         .filter(|g| !g.samples.is_empty() && g.samples.iter().all(|&i| i < measured.len()))
         .collect();
     if groups.is_empty() || models.is_empty() {
-        return Err(ReportError::NoData {
-            what: "parity: no group of samples, or no model".into(),
-        });
+        return Err(ReportError::no_data(
+            "parity: no group of samples, or no model",
+        ));
     }
     let plotted: Vec<(String, Vec<f64>, Vec<Vec<f64>>)> = groups
         .iter()

@@ -14,13 +14,13 @@ use super::figure::{
 use super::series_csv::Column;
 use super::ReportError;
 
-struct RegimeErrorPlot {
-    groups: Vec<String>,
-    models: Vec<(String, Vec<f64>)>,
-    y_label: String,
+struct RegimeErrorPlot<'a> {
+    groups: &'a [&'a str],
+    models: &'a [(&'a str, Vec<f64>)],
+    y_label: &'a str,
 }
 
-impl Draw for RegimeErrorPlot {
+impl Draw for RegimeErrorPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let top = self
             .models
@@ -35,20 +35,20 @@ impl Draw for RegimeErrorPlot {
         let mut chart = one_panel(&root)
             .build_cartesian_2d(0.0..n_groups as f64, 0.0..top)
             .map_err(msg)?;
-        let groups = self.groups.clone();
+        let groups = self.groups;
         chart
             .configure_mesh()
             .x_labels(n_groups * 2 + 1)
             .x_label_formatter(&|x| {
                 let i = x.floor() as usize;
                 if (x - i as f64 - 0.5).abs() < 0.26 {
-                    groups.get(i).cloned().unwrap_or_default()
+                    groups.get(i).map_or(String::new(), |g| g.to_string())
                 } else {
                     String::new()
                 }
             })
             .disable_x_mesh()
-            .y_desc(self.y_label.as_str())
+            .y_desc(self.y_label)
             .y_label_formatter(&|v| tick_label(*v, top))
             .x_desc("regime")
             .axis_desc_style(axis_desc_style())
@@ -70,7 +70,7 @@ impl Draw for RegimeErrorPlot {
             chart
                 .draw_series(bars)
                 .map_err(msg)?
-                .label(label.as_str())
+                .label(*label)
                 .legend(move |(x, y)| {
                     Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.filled())
                 });
@@ -89,17 +89,12 @@ pub fn regime_errors(
     y_label: &str,
 ) -> Result<FigureFiles, ReportError> {
     if models.is_empty() || groups.is_empty() {
-        return Err(ReportError::NoData {
-            what: "regime errors: no model or no regime".into(),
-        });
+        return Err(ReportError::no_data("regime errors: no model or no regime"));
     }
     let plot = RegimeErrorPlot {
-        groups: groups.iter().map(|g| g.to_string()).collect(),
-        models: models
-            .iter()
-            .map(|(l, v)| (l.to_string(), v.clone()))
-            .collect(),
-        y_label: y_label.to_string(),
+        groups,
+        models,
+        y_label,
     };
     let columns: Vec<Column> = std::iter::once(Column::new(
         "regime (0 pre-resonance, 1 resonance, 2 post-resonance, 3 overall)",

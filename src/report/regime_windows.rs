@@ -140,9 +140,9 @@ pub fn regime_windows(
         .cloned()
         .collect();
     if windows.is_empty() {
-        return Err(ReportError::NoData {
-            what: "regime windows: no window of at least two samples".into(),
-        });
+        return Err(ReportError::no_data(
+            "regime windows: no window of at least two samples",
+        ));
     }
     let rows: Vec<usize> = windows.iter().flat_map(|w| w.start..w.end).collect();
     let pick = |v: &[f64]| rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
