@@ -9,7 +9,7 @@ use anyhow::Result;
 use stf_core::fit::{FitResult, FitWarning, NoiseFloor};
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
-use crate::report::{measured_vs_model, FigureRef, Section, Table, DISPLACEMENT_MM};
+use crate::report::{measured_vs_model, milli, FigureRef, Section, Table, DISPLACEMENT_MM};
 use crate::standard_report::write_report;
 
 /// One identification stage as fitted.
@@ -113,14 +113,13 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
         .push(Table::new(caption, &columns).with_rows(rows.collect()));
     section.warnings = s.warnings.iter().map(|w| w.to_string()).collect();
     if s.simulated.len() == s.x.len() {
-        let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
-        let simulated = mm(&s.simulated);
+        let simulated = milli(&s.simulated);
         let fig = measured_vs_model(
             dir,
             &format!("stage_{}", i + 1),
             DISPLACEMENT_MM,
             &s.t,
-            &mm(&s.x),
+            &milli(&s.x),
             &[("identified", &simulated)],
         )?;
         section.figures.push(FigureRef::new(

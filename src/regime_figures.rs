@@ -13,7 +13,7 @@ use stf_core::regimes::{classify, Cycle, Regime};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::report::{
-    parity, regime_windows, FigureRef, ParityQuantity, RegimeWindow, SampleGroup, Section,
+    milli, parity, regime_windows, FigureRef, ParityQuantity, RegimeWindow, SampleGroup, Section,
     WindowSeries,
 };
 
@@ -130,8 +130,7 @@ pub fn regime_section(
     }
     let dir = out.join("figures");
     let k = &data.kinematics;
-    let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
-    let (x_mm, v_mm) = (mm(&k.x), mm(&k.v));
+    let (x_mm, v_mm) = (milli(&k.x), milli(&k.v));
     let windows = windows_of(&found, &cycles);
     let series = WindowSeries {
         t: &k.t,

@@ -14,9 +14,9 @@ use stf_core::fit::{CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::report::{
-    frequency_response, hysteresis, measured_vs_model, time_history, write_html, write_markdown,
-    FigureRef, FrfCurve, Motion, RegimeChange, Report, Section, Smoothing, Table, DISPLACEMENT_MM,
-    DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
+    frequency_response, hysteresis, measured_vs_model, milli, time_history, write_html,
+    write_markdown, FigureRef, FrfCurve, Motion, RegimeChange, Report, Section, Smoothing, Table,
+    DISPLACEMENT_MM, DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
 };
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
@@ -59,10 +59,9 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
         th,
         "Displacement, velocity and acceleration against the STF force; extrema of F_STF marked.",
     ));
-    let mm = |s: &[f64]| s.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
     for (name, label, series) in [
-        ("hysteresis_x", "displacement x, mm", mm(&k.x)),
-        ("hysteresis_v", "velocity v, mm/s", mm(&k.v)),
+        ("hysteresis_x", "displacement x, mm", milli(&k.x)),
+        ("hysteresis_v", "velocity v, mm/s", milli(&k.v)),
         ("hysteresis_a", "acceleration a, m/s²", k.a.clone()),
     ] {
         let fig = hysteresis(dir, name, (label, &series), f, &k.t)?;
@@ -347,11 +346,9 @@ pub fn write_report(
     sections: Vec<Section>,
     out: &Path,
 ) -> Result<()> {
-    let report = Report {
-        title: title.into(),
-        intro,
-        sections,
-    };
+    let mut report = Report::new(title);
+    report.intro = intro;
+    report.sections = sections;
     write_html(&report, &out.join("report.html"))?;
     write_markdown(&report, &out.join("report.md"))?;
     Ok(())

@@ -22,15 +22,12 @@ pub fn best_by_aic(fits: &[(f64, usize)]) -> Option<usize> {
         .map(|f| f.0)
         .filter(|a| a.is_finite())
         .min_by(f64::total_cmp)?;
-    // The simplest, and the lowest AIC among equally simple ones.
-    (0..fits.len())
+    let mut near: Vec<usize> = (0..fits.len())
         .filter(|&i| fits[i].0.is_finite() && fits[i].0 - lowest < AIC_TIE)
-        .min_by(|&a, &b| {
-            fits[a]
-                .1
-                .cmp(&fits[b].1)
-                .then(fits[a].0.total_cmp(&fits[b].0))
-        })
+        .collect();
+    // The lowest AIC first among equally simple ones.
+    near.sort_by(|&a, &b| fits[a].0.total_cmp(&fits[b].0));
+    near.into_iter().min_by_key(|&i| fits[i].1)
 }
 
 /// The verdict of a set of fits: the best by AIC, how far the others are behind (ΔAIC and

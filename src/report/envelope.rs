@@ -3,6 +3,9 @@
 //! smallest and largest value in each of a few hundred time buckets — and leaves the shape of
 //! the cycles to the zoomed windows ([`super::regime_windows`]).
 
+use super::figure::finite_points;
+use super::plot_range::finite_bounds;
+
 /// How many time buckets an envelope has (about two pixels each on a 1000-pixel figure).
 pub const BUCKETS: usize = 400;
 /// More crossings of the mid-range than this in one plot, and a line is a solid band.
@@ -16,19 +19,15 @@ pub fn dense(y: &[f64]) -> bool {
 
 /// How many times `y` crosses the middle of its range (with a margin).
 fn crossings(y: &[f64]) -> usize {
-    let finite = || y.iter().filter(|v| v.is_finite());
-    let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-        (a.min(v), b.max(v))
-    });
-    if !(lo < hi) {
+    let Some((lo, hi)) = finite_bounds(y).filter(|(lo, hi)| lo < hi) else {
         return 0;
-    }
+    };
     // A crossing counts once the value is a fifth of the half-range past the middle, so noise
     // about the middle of a quiet stretch is not counted.
     let (mid, band) = (0.5 * (lo + hi), 0.1 * (hi - lo));
     let mut side = 0;
     let mut count = 0;
-    for &v in finite() {
+    for &v in y.iter().filter(|v| v.is_finite()) {
         let now = if v > mid + band {
             1
         } else if v < mid - band {
@@ -54,12 +53,7 @@ pub fn buckets_for(y: &[f64]) -> usize {
 /// The lower and upper edge of `y` over `buckets` equal stretches of `t`: `(t_mid, min, max)`
 /// of each stretch that has a finite sample.
 pub fn envelope(t: &[f64], y: &[f64], buckets: usize) -> Vec<(f64, f64, f64)> {
-    let finite: Vec<(f64, f64)> = t
-        .iter()
-        .zip(y)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(a, b)| (*a, *b))
-        .collect();
+    let finite = finite_points(t, y);
     let (Some(first), Some(last)) = (finite.first(), finite.last()) else {
         return Vec::new();
     };

@@ -343,6 +343,11 @@ pub fn require_finite(figure: &str, series: &[(&str, &[f64])]) -> Result<(), Rep
     }
 }
 
+/// Metres (per second) in millimetres (per second), the unit the rig's motion is read in.
+pub fn milli(values: &[f64]) -> Vec<f64> {
+    values.iter().map(|v| v * 1e3).collect()
+}
+
 /// The finite (x, y) pairs of two series, for drawing.
 pub fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
     x.iter()

@@ -55,7 +55,7 @@ pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;
 pub use error_bars::{error_bars, error_bars_with_curve, Curve, ErrorPoint, ErrorSeries};
 pub use extrema::{extrema, Extremum, ExtremumKind};
-pub use figure::FigureFiles;
+pub use figure::{milli, FigureFiles};
 pub use frequency_response::{frequency_response, FrfCurve, FrfRole, RegimeChange};
 pub use html::write_html;
 pub use hysteresis::hysteresis;

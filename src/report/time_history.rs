@@ -14,8 +14,8 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_mesh_with, finite_points, legend_strip, model_entries, msg, render,
-    require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
+    axis_desc_style, draw_mesh_with, finite_points, legend_strip, milli, model_entries, msg,
+    render, require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
     F_LABEL, SIZE_TALL, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
@@ -216,11 +216,6 @@ pub fn time_history(
         ),
     ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
-}
-
-/// Metres (per second) in millimetres (per second), the unit the rig's motion is read in.
-fn milli(values: &[f64]) -> Vec<f64> {
-    values.iter().map(|v| v * 1e3).collect()
 }
 
 #[cfg(test)]
