@@ -84,23 +84,17 @@ pub fn sibling(target: &Path, tag: &str) -> PathBuf {
 /// (`report::atomic::temporary_sibling`), or the record writer's `.<name>.<pid>.tmp`: left
 /// only by a run that was killed while writing.
 pub fn is_temporary_name(name: &str) -> bool {
-    let Some(rest) = name.strip_prefix('.') else {
-        return false;
-    };
-    let Some(at) = rest.rfind(".tmp") else {
-        return false;
-    };
-    let (before, after) = rest.split_at(at);
-    let after = &after[4..];
-    if !(after.is_empty() || (after.starts_with('.') && !after[1..].contains('.'))) {
-        return false;
-    }
-    let Some(dot) = before.rfind('.') else {
-        return false;
-    };
-    let id = &before[dot + 1..];
     let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    dot > 0
+    let parts = name
+        .strip_prefix('.')
+        .and_then(|rest| rest.rsplit_once(".tmp"));
+    let Some(((stem, id), ext)) = parts.and_then(|(b, ext)| Some((b.rsplit_once('.')?, ext)))
+    else {
+        return false;
+    };
+    let one_ext = ext.is_empty() || ext.strip_prefix('.').is_some_and(|e| !e.contains('.'));
+    one_ext
+        && !stem.is_empty()
         && match id.split_once('-') {
             Some((pid, n)) => digits(pid) && digits(n),
             None => digits(id),
