@@ -71,6 +71,14 @@ pub fn check_distinct(outputs: &[(&str, &Path)]) -> Result<()> {
     Ok(())
 }
 
+/// The folder that holds `target` (`.` for a bare name).
+pub fn parent_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 /// A path beside `target` named `.<name>.<tag>` (its lock file, staging folder …).
 pub fn sibling(target: &Path, tag: &str) -> PathBuf {
     let name = target

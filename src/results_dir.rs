@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use crate::output::{is_temporary_name, sibling};
+use crate::output::{is_temporary_name, parent_of, sibling};
 use crate::output_lock::OutputLock;
 
 /// Every name this program writes in an output folder (all commands).
@@ -142,14 +142,6 @@ fn folder_name(target: &Path) -> Result<String> {
             "{}: give the output folder by name (e.g. out/fit): it is replaced as a whole",
             target.display()
         ),
-    }
-}
-
-/// The folder that holds `target` (`.` for a bare name).
-fn parent_of(target: &Path) -> PathBuf {
-    match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
     }
 }
 

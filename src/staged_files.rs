@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::output::{check_regular_or_new, is_temporary_name};
+use crate::output::{check_regular_or_new, is_temporary_name, parent_of};
 
 /// Files staged beside their targets, not yet in place.
 #[derive(Debug, Default)]
@@ -101,11 +101,7 @@ pub fn is_temporary_of(entry: &str, target: &Path) -> bool {
 /// Remove this program's temporaries of `target` left beside it by a killed run (call with
 /// the output's lock held). The names removed.
 pub fn clean_stale(target: &Path) -> Result<Vec<String>> {
-    let dir = match target.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let Ok(entries) = std::fs::read_dir(&dir) else {
+    let Ok(entries) = std::fs::read_dir(parent_of(target)) else {
         return Ok(Vec::new());
     };
     let mut removed = Vec::new();

@@ -299,19 +299,15 @@ pub fn render(
         csv: out_dir.join(format!("{name}.csv")),
     };
 
+    let failed = |path: &PathBuf| {
+        let path = path.clone();
+        move |message| ReportError::Plot { path, message }
+    };
     let mut svg = String::new();
-    draw_on(SVGBackend::with_string(&mut svg, size), plot).map_err(|message| {
-        ReportError::Plot {
-            path: files.svg.clone(),
-            message,
-        }
-    })?;
+    draw_on(SVGBackend::with_string(&mut svg, size), plot).map_err(failed(&files.svg))?;
     write_atomic(&files.svg, svg.as_bytes())?;
 
-    let png = svg_to_png(&svg).map_err(|message| ReportError::Plot {
-        path: files.png.clone(),
-        message,
-    })?;
+    let png = svg_to_png(&svg).map_err(failed(&files.png))?;
     write_atomic(&files.png, &png)?;
 
     write_csv(&files.csv, columns)?;

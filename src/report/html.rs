@@ -96,11 +96,8 @@ fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
 }
 
 fn looks_numeric(cell: &str) -> bool {
-    let t = cell.trim();
-    !t.is_empty()
-        && t.split_whitespace()
-            .next()
-            .is_some_and(|w| w.parse::<f64>().is_ok())
+    let first = cell.split_whitespace().next();
+    first.is_some_and(|w| w.parse::<f64>().is_ok())
 }
 
 fn table_html(out: &mut String, table: &Table) {
@@ -143,12 +140,6 @@ fn warnings_html(out: &mut String, warnings: &[String]) {
     out.push_str("</ul>\n</div>\n");
 }
 
-fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
-}
-
 fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<(), ReportError> {
     let png = std::fs::read(&figure.files.png).map_err(|source| ReportError::Read {
         path: figure.files.png.clone(),
@@ -168,8 +159,22 @@ fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<()
         "<figcaption><b>Figure {number}.</b> {} <span class=\"files\">Files beside this page: \
          {} (vector), {} (the plotted data).</span></figcaption>\n</figure>",
         escape(&figure.caption),
-        escape(&file_name(&figure.files.svg)),
-        escape(&file_name(&figure.files.csv)),
+        escape(
+            &figure
+                .files
+                .svg
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+        ),
+        escape(
+            &figure
+                .files
+                .csv
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+        ),
     );
     Ok(())
 }

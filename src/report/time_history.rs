@@ -14,9 +14,9 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_mesh_with, finite_points, legend_strip, milli, model_entries, msg,
-    render, require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
-    F_LABEL, SIZE_TALL, T_LABEL,
+    axis_desc_style, draw_line, draw_mesh_with, finite_points, legend_strip, milli, model_entries,
+    msg, render, require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles,
+    Swatch, F_LABEL, SIZE_TALL, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -132,12 +132,7 @@ impl TimeHistoryPlot {
                 .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
                 .map_err(msg)?;
         } else {
-            chart
-                .draw_series(LineSeries::new(
-                    finite_points(&self.t, y),
-                    c_motion.stroke_width(2),
-                ))
-                .map_err(msg)?;
+            draw_line(chart, finite_points(&self.t, y), c_motion.stroke_width(2))?;
             chart
                 .draw_secondary_series(LineSeries::new(
                     finite_points(&self.t, &self.f),
