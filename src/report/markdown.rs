@@ -94,16 +94,13 @@ pub fn to_markdown(report: &Report, base: &Path) -> String {
         }
         for figure in &section.figures {
             number += 1;
+            let f = &figure.files;
+            let [png, svg, csv] = [&f.png, &f.svg, &f.csv].map(|p| relative_link(p, base));
             let _ = writeln!(
                 out,
-                "![Figure {number}: {}]({})\n\n*Figure {number}.* {} (vector: [{}]({}), data: [{}]({}))\n",
+                "![Figure {number}: {}]({png})\n\n*Figure {number}.* {} (vector: [{svg}]({svg}), data: [{csv}]({csv}))\n",
                 cell(&figure.caption),
-                relative_link(&figure.files.png, base),
                 md_text(&figure.caption),
-                relative_link(&figure.files.svg, base),
-                relative_link(&figure.files.svg, base),
-                relative_link(&figure.files.csv, base),
-                relative_link(&figure.files.csv, base),
             );
         }
     }
