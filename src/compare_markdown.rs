@@ -102,17 +102,15 @@ fn errors_table(md: &mut String, c: &Compared) {
 fn misses_and_warnings(md: &mut String, c: &Compared) {
     for (f, cmp) in c.fits.iter().zip(&c.comparisons) {
         for r in Regime::ALL {
-            if let Some(m) = cmp.per_regime.get(r) {
-                if m.duty_error > 0.2 {
-                    let _ = writeln!(
-                        md,
-                        "- {} misses the on–off behaviour in {}: duty {:.2} against the measured {:.2}",
-                        f.label,
-                        r.name().replace('_', "-"),
-                        m.model_duty,
-                        m.measured_duty
-                    );
-                }
+            if let Some(m) = cmp.per_regime.get(r).filter(|m| m.duty_error > 0.2) {
+                let _ = writeln!(
+                    md,
+                    "- {} misses the on–off behaviour in {}: duty {:.2} against the measured {:.2}",
+                    f.label,
+                    r.name().replace('_', "-"),
+                    m.model_duty,
+                    m.measured_duty
+                );
             }
         }
     }

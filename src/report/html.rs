@@ -87,12 +87,9 @@ pub fn inline(text: &str) -> String {
 
 /// Width and height from a PNG's header, if it is one.
 fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
-    if bytes.len() < 24 || &bytes[..8] != b"\x89PNG\r\n\x1a\n" {
-        return None;
-    }
-    let w = u32::from_be_bytes(bytes[16..20].try_into().ok()?);
-    let h = u32::from_be_bytes(bytes[20..24].try_into().ok()?);
-    Some((w, h))
+    let header = bytes.strip_prefix(b"\x89PNG\r\n\x1a\n")?;
+    let at = |i: usize| Some(u32::from_be_bytes(header.get(i..i + 4)?.try_into().ok()?));
+    Some((at(8)?, at(12)?))
 }
 
 fn looks_numeric(cell: &str) -> bool {
