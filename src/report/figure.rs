@@ -317,14 +317,13 @@ pub fn render(
 /// Check that two series have the same length.
 pub fn same_length(what: &str, a: &[f64], b: &[f64]) -> Result<(), ReportError> {
     if a.len() == b.len() {
-        Ok(())
-    } else {
-        Err(ReportError::LengthMismatch {
-            what: what.to_string(),
-            left: a.len(),
-            right: b.len(),
-        })
+        return Ok(());
     }
+    Err(ReportError::LengthMismatch {
+        what: what.to_string(),
+        left: a.len(),
+        right: b.len(),
+    })
 }
 
 /// Refuse a figure (`figure`, as its errors name it) when one of `series` (`(what, values)`)

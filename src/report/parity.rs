@@ -42,11 +42,11 @@ pub struct ParityQuantity {
 const BINS: usize = 40;
 const GREY: RGBColor = RGBColor(120, 120, 120);
 
-struct ParityPlot {
-    quantity: ParityQuantity,
+struct ParityPlot<'a> {
+    quantity: &'a ParityQuantity,
     /// Per group: name, measured, and per model the fitted values.
     groups: Vec<(String, Vec<f64>, Vec<Vec<f64>>)>,
-    models: Vec<String>,
+    models: &'a [(&'a str, &'a [f64])],
 }
 
 /// The residuals' axis: symmetric about 0, wide enough for the best model's residual (4× its
@@ -111,7 +111,7 @@ fn thin(n: usize, max: usize) -> impl Iterator<Item = usize> {
     (0..n).step_by(n.div_ceil(max.max(1)).max(1))
 }
 
-impl ParityPlot {
+impl ParityPlot<'_> {
     fn parity<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
@@ -189,7 +189,7 @@ impl ParityPlot {
     /// The legend the panels share, above them: each model's colour (its scatter and its
     /// histogram) and the noise floor's curve.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let mut entries = model_entries(self.models.iter().map(String::as_str), "");
+        let mut entries = model_entries(self.models.iter().map(|(l, _)| *l), "");
         if self.quantity.noise_sigma.is_some_and(|s| s > 0.0) {
             entries.push(("noise floor".into(), Swatch::Line(GREY, 3)));
         }
@@ -197,7 +197,7 @@ impl ParityPlot {
     }
 }
 
-impl Draw for ParityPlot {
+impl Draw for ParityPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let title = "Measured against fitted, and the residual's distribution, by regime";
         let root = legend_strip(&titled(root, title)?, &self.legend_entries())?;
@@ -261,9 +261,9 @@ pub fn parity(
     );
     let size = (480 * plotted.len() as u32 + 40, 900);
     let plot = ParityPlot {
-        quantity: quantity.clone(),
+        quantity,
         groups: plotted,
-        models: models.iter().map(|(l, _)| l.to_string()).collect(),
+        models,
     };
     render(out_dir, name, size, &plot, &columns)
 }
