@@ -452,7 +452,7 @@ impl ScriptModel {
             (Some(c), "added_mass") => c.added_mass.as_ref(),
             _ => None,
         };
-        if let Some(f) = compiled.and_then(|c| c.number(p, s.t, s.x, s.v, s.z)) {
+        if let Some(f) = compiled.and_then(|c| c.number(p, s)) {
             return Ok(f);
         }
         let value = self.call(fname, self.args(p, s))?;
@@ -469,7 +469,7 @@ impl ScriptModel {
         let f = self.eval_number("force", p, s)?;
         if self.n_internal > 0 {
             let rates = self.compiled.as_ref().and_then(|c| c.rates.as_ref());
-            if rates.is_some_and(|r| r.array(p, s.t, s.x, s.v, s.z, dz).is_some()) {
+            if rates.is_some_and(|r| r.array(p, s, dz).is_some()) {
                 return Ok(f);
             }
             let value = self.call("rates", self.args(p, s))?;
