@@ -484,23 +484,6 @@ fn split_chain(flags: ASTFlags, rest: &Expr) -> Option<(&Expr, ChainRest<'_>)> {
     })
 }
 
-/// Binary operators rhai evaluates with its built-in fast path.
-#[derive(Clone, Copy)]
-enum BinOp {
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Rem,
-    Pow,
-    Eq,
-    Ne,
-    Lt,
-    Le,
-    Gt,
-    Ge,
-}
-
 fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
     if args.len() == 1 {
         let a = args.pop()?;
@@ -517,26 +500,12 @@ fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
             _ => None,
         };
     }
-    let op = match token {
-        Token::Plus => BinOp::Add,
-        Token::Minus => BinOp::Sub,
-        Token::Multiply => BinOp::Mul,
-        Token::Divide => BinOp::Div,
-        Token::Modulo => BinOp::Rem,
-        Token::PowerOf => BinOp::Pow,
-        Token::EqualsTo => BinOp::Eq,
-        Token::NotEqualsTo => BinOp::Ne,
-        Token::LessThan => BinOp::Lt,
-        Token::LessThanEqualsTo => BinOp::Le,
-        Token::GreaterThan => BinOp::Gt,
-        Token::GreaterThanEqualsTo => BinOp::Ge,
-        _ => return None,
-    };
-    if args.len() != 2 {
+    // The binary operators are those `float_op` knows.
+    if args.len() != 2 || float_op(token, 0.0, 0.0).is_none() {
         return None;
     }
-    let b = args.pop()?;
-    Some(binary_node(args.pop()?, b, move |x, y| binary(op, x, y)))
+    let (op, b) = (token.clone(), args.pop()?);
+    Some(binary_node(args.pop()?, b, move |x, y| binary(&op, x, y)))
 }
 
 /// A node applying `op` to the values of `a` and `b`; `None` from `op` bails out.
@@ -556,27 +525,27 @@ fn binary_node(
 /// rhai's built-in binary operators on the subset's types; `None` where rhai errs or
 /// dispatches to a registered function.
 #[inline]
-fn binary(op: BinOp, a: Val, b: Val) -> Option<Val> {
+fn binary(op: &Token, a: Val, b: Val) -> Option<Val> {
     match (a, b) {
-        (Val::Float(x), Val::Float(y)) => Some(float_op(op, x, y)),
-        (Val::Float(x), Val::Int(y)) => Some(float_op(op, x, y as f64)),
-        (Val::Int(x), Val::Float(y)) => Some(float_op(op, x as f64, y)),
+        (Val::Float(x), Val::Float(y)) => float_op(op, x, y),
+        (Val::Float(x), Val::Int(y)) => float_op(op, x, y as f64),
+        (Val::Int(x), Val::Float(y)) => float_op(op, x as f64, y),
         (Val::Int(x), Val::Int(y)) => int_op(op, x, y),
         (Val::Bool(x), Val::Bool(y)) => compare(op, x, y).map(Val::Bool),
         _ => None,
     }
 }
 
-/// A comparison on integers or bools (`false < true`); `None` for an arithmetic `op`.
+/// A comparison on integers or bools (`false < true`); `None` for any other `op`.
 #[inline]
-fn compare<T: PartialOrd>(op: BinOp, x: T, y: T) -> Option<bool> {
+fn compare<T: PartialOrd>(op: &Token, x: T, y: T) -> Option<bool> {
     Some(match op {
-        BinOp::Eq => x == y,
-        BinOp::Ne => x != y,
-        BinOp::Lt => x < y,
-        BinOp::Le => x <= y,
-        BinOp::Gt => x > y,
-        BinOp::Ge => x >= y,
+        Token::EqualsTo => x == y,
+        Token::NotEqualsTo => x != y,
+        Token::LessThan => x < y,
+        Token::LessThanEqualsTo => x <= y,
+        Token::GreaterThan => x > y,
+        Token::GreaterThanEqualsTo => x >= y,
         _ => return None,
     })
 }
@@ -584,7 +553,7 @@ fn compare<T: PartialOrd>(op: BinOp, x: T, y: T) -> Option<bool> {
 /// rhai's float operators (checked build: comparisons with a relative epsilon).
 #[inline]
 #[allow(clippy::float_cmp)]
-fn float_op(op: BinOp, x: f64, y: f64) -> Val {
+fn float_op(op: &Token, x: f64, y: f64) -> Option<Val> {
     let max = || {
         if x * y == 0.0 {
             1.0
@@ -596,32 +565,33 @@ fn float_op(op: BinOp, x: f64, y: f64) -> Val {
         let m = max();
         Val::Bool(if m == 0.0 { zero } else { test(x, y, m) })
     };
-    match op {
-        BinOp::Add => Val::Float(x + y),
-        BinOp::Sub => Val::Float(x - y),
-        BinOp::Mul => Val::Float(x * y),
-        BinOp::Div => Val::Float(x / y),
-        BinOp::Rem => Val::Float(x % y),
-        BinOp::Pow => Val::Float(x.powf(y)),
-        BinOp::Eq => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
-        BinOp::Ne => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
-        BinOp::Gt => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
-        BinOp::Ge => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
-        BinOp::Lt => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
-        BinOp::Le => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
-    }
+    Some(match op {
+        Token::Plus => Val::Float(x + y),
+        Token::Minus => Val::Float(x - y),
+        Token::Multiply => Val::Float(x * y),
+        Token::Divide => Val::Float(x / y),
+        Token::Modulo => Val::Float(x % y),
+        Token::PowerOf => Val::Float(x.powf(y)),
+        Token::EqualsTo => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
+        Token::NotEqualsTo => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
+        Token::GreaterThan => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
+        Token::GreaterThanEqualsTo => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
+        Token::LessThan => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
+        Token::LessThanEqualsTo => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
+        _ => return None,
+    })
 }
 
 /// rhai's checked integer operators; `None` where rhai raises an error.
 #[inline]
-fn int_op(op: BinOp, x: i64, y: i64) -> Option<Val> {
+fn int_op(op: &Token, x: i64, y: i64) -> Option<Val> {
     Some(match op {
-        BinOp::Add => Val::Int(x.checked_add(y)?),
-        BinOp::Sub => Val::Int(x.checked_sub(y)?),
-        BinOp::Mul => Val::Int(x.checked_mul(y)?),
-        BinOp::Div => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
-        BinOp::Rem => Val::Int(x.checked_rem(y)?),
-        BinOp::Pow => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
+        Token::Plus => Val::Int(x.checked_add(y)?),
+        Token::Minus => Val::Int(x.checked_sub(y)?),
+        Token::Multiply => Val::Int(x.checked_mul(y)?),
+        Token::Divide => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
+        Token::Modulo => Val::Int(x.checked_rem(y)?),
+        Token::PowerOf => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
         _ => Val::Bool(compare(op, x, y)?),
     })
 }
