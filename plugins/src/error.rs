@@ -14,6 +14,16 @@ pub struct ScriptLocation {
     pub line: Option<usize>,
 }
 
+impl ScriptLocation {
+    /// `line` (when known) of the script at `path`.
+    pub fn new(path: &str, line: Option<usize>) -> Self {
+        ScriptLocation {
+            path: path.to_string(),
+            line,
+        }
+    }
+}
+
 impl fmt::Display for ScriptLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.line {
