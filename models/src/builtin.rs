@@ -1,5 +1,5 @@
 //! The shape every built-in model shares, written once: [`builtin!`] declares a model's
-//! struct, its one-line `SUMMARY`, its parameter specs, `new`/`Default`, and the
+//! struct, its one-line summary, its parameter specs, `new`/`Default`, and the
 //! `name`/`summary`/`params` of its [`ForceModel`] impl; the model's file states only its
 //! name, summary, parameters and physics (`force`, `gradient`, …). [`Builtin`] gives the
 //! table in `lib.rs` the name and summary of each type.
@@ -28,7 +28,7 @@ pub trait Builtin: ForceModel + Default + 'static {
 /// }
 /// ```
 ///
-/// makes `pub const SUMMARY`, `pub struct Viscous` with `new()` and `Default`, its
+/// makes `pub struct Viscous` with `new()` and `Default`, its
 /// [`Builtin`] impl and its `ForceModel` impl: `name`, `summary`, `params` and the methods in
 /// the `impl` block.
 macro_rules! builtin {
@@ -38,9 +38,6 @@ macro_rules! builtin {
         params [$($spec:expr),+ $(,)?];
         impl { $($body:tt)* }
     ) => {
-        /// One line for listings.
-        pub const SUMMARY: &str = $summary;
-
         $(#[$attr])*
         pub struct $ty {
             specs: Vec<stf_core::physics::param_spec::ParamSpec>,
@@ -61,7 +58,7 @@ macro_rules! builtin {
 
         impl $crate::builtin::Builtin for $ty {
             const NAME: &'static str = $name;
-            const SUMMARY: &'static str = SUMMARY;
+            const SUMMARY: &'static str = $summary;
         }
 
         impl stf_core::physics::force_model::ForceModel for $ty {
@@ -69,7 +66,7 @@ macro_rules! builtin {
                 $name
             }
             fn summary(&self) -> &str {
-                SUMMARY
+                $summary
             }
             fn params(&self) -> &[stf_core::physics::param_spec::ParamSpec] {
                 &self.specs

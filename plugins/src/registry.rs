@@ -43,8 +43,8 @@ impl Registry {
     /// The built-in models; scripts load in `run` (its limits and operation budgets).
     pub fn in_run(run: ScriptRun) -> Self {
         Registry {
-            script_dir: None,
             run,
+            ..Registry::default()
         }
     }
 
@@ -52,7 +52,7 @@ impl Registry {
     pub fn with_script_dir(dir: impl Into<PathBuf>) -> Self {
         Registry {
             script_dir: Some(dir.into()),
-            run: ScriptRun::default(),
+            ..Registry::default()
         }
     }
 
@@ -88,20 +88,15 @@ impl Registry {
             })
             .collect();
         for path in self.scripts() {
-            let name = path.display().to_string();
-            entries.push(match ScriptModel::load(&path) {
-                Ok(m) => ModelListing {
-                    name,
-                    summary: m.summary().to_string(),
-                    params: m.params().to_vec(),
-                    is_script: true,
-                },
-                Err(e) => ModelListing {
-                    name,
-                    summary: format!("(does not load: {e})"),
-                    params: Vec::new(),
-                    is_script: true,
-                },
+            let (summary, params) = match ScriptModel::load(&path) {
+                Ok(m) => (m.summary().to_string(), m.params().to_vec()),
+                Err(e) => (format!("(does not load: {e})"), Vec::new()),
+            };
+            entries.push(ModelListing {
+                name: path.display().to_string(),
+                summary,
+                params,
+                is_script: true,
             });
         }
         entries
@@ -109,10 +104,7 @@ impl Registry {
 
     /// The `*.rhai` files of the script directory, sorted.
     pub fn scripts(&self) -> Vec<PathBuf> {
-        let Some(dir) = &self.script_dir else {
-            return Vec::new();
-        };
-        let Ok(read) = std::fs::read_dir(dir) else {
+        let Some(Ok(read)) = self.script_dir.as_ref().map(std::fs::read_dir) else {
             return Vec::new();
         };
         let mut paths: Vec<PathBuf> = read

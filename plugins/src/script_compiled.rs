@@ -107,10 +107,7 @@ impl CompiledFn {
 
     /// Write an array result into `out` (all of it, lengths equal); `None`: use the VM.
     pub(crate) fn array(&self, p: &[f64], s: &ModelState, out: &mut [f64]) -> Option<()> {
-        match self.run(p, s, out)? {
-            Val::Written => Some(()),
-            _ => None,
-        }
+        (self.run(p, s, out)? == Val::Written).then_some(())
     }
 }
 
