@@ -233,7 +233,12 @@ fn store(slot: usize, value: Node) -> Node {
 }
 
 impl Translator<'_> {
-    fn lookup(&self, name: &str) -> Option<Binding> {
+    /// What a plain (un-namespaced) variable expression is bound to.
+    fn variable(&self, expr: &Expr) -> Option<Binding> {
+        let Expr::Variable(var, _, _) = expr else {
+            return None;
+        };
+        let name = var.2.is_empty().then_some(&var.1)?;
         self.names
             .iter()
             .rev()
@@ -284,13 +289,7 @@ impl Translator<'_> {
                 if op.is_op_assignment() {
                     return None;
                 }
-                let Expr::Variable(var, _, _) = &target.lhs else {
-                    return None;
-                };
-                if !var.2.is_empty() {
-                    return None;
-                }
-                let Binding::Local(slot) = self.lookup(&var.1)? else {
+                let Binding::Local(slot) = self.variable(&target.lhs)? else {
                     return None;
                 };
                 Some(store(slot, self.expr(&target.rhs, false)?))
@@ -350,17 +349,12 @@ impl Translator<'_> {
                 };
                 Some(constant(v))
             }
-            Expr::Variable(var, _, _) => {
-                if !var.2.is_empty() {
-                    return None;
-                }
-                match self.lookup(&var.1)? {
-                    Binding::Local(slot) => Some(Box::new(move |f| {
-                        f.locals.get(slot).copied().ok_or(Flow::Bail)
-                    })),
-                    Binding::Params | Binding::State => None,
-                }
-            }
+            Expr::Variable(..) => match self.variable(expr)? {
+                Binding::Local(slot) => Some(Box::new(move |f| {
+                    f.locals.get(slot).copied().ok_or(Flow::Bail)
+                })),
+                Binding::Params | Binding::State => None,
+            },
             Expr::Dot(bin, flags, _) | Expr::Index(bin, flags, _) => {
                 let is_dot = matches!(expr, Expr::Dot(..));
                 self.chain(&bin.lhs, is_dot, *flags, &bin.rhs)
@@ -400,10 +394,7 @@ impl Translator<'_> {
     /// (`?.`, `?[`) declines.
     fn chain(&mut self, base: &Expr, is_dot: bool, flags: ASTFlags, rest: &Expr) -> Option<Node> {
         let (step, next) = split_chain(flags, rest)?;
-        let binding = match base {
-            Expr::Variable(var, _, _) if var.2.is_empty() => self.lookup(&var.1),
-            _ => None,
-        };
+        let binding = self.variable(base);
         let head: Node = match (binding, is_dot, step) {
             (Some(Binding::Params), true, Expr::Property(prop, _)) => {
                 let index = self.params.iter().position(|n| *n == prop.2.as_str())?;
