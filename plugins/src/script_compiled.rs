@@ -311,10 +311,9 @@ impl Translator<'_> {
                 if !flags.is_empty() {
                     return None; // `throw`
                 }
-                let value = match value {
-                    Some(e) => self.expr(e, true)?,
-                    None => constant(Val::Unit),
-                };
+                let value = value
+                    .as_ref()
+                    .map_or(Some(constant(Val::Unit)), |e| self.expr(e, true))?;
                 Some(Box::new(move |f| Err(Flow::Return(value(f)?))))
             }
             _ => None,
@@ -363,10 +362,7 @@ impl Translator<'_> {
             Expr::Stmt(block) => self.statements(block.statements(), tail),
             Expr::And(items, _) | Expr::Or(items, _) => {
                 let stop_at = matches!(expr, Expr::Or(..));
-                let nodes = items
-                    .iter()
-                    .map(|e| self.expr(e, false))
-                    .collect::<Option<Vec<_>>>()?;
+                let nodes = self.exprs(items)?;
                 Some(Box::new(move |f| {
                     for node in &nodes {
                         match node(f)? {
@@ -378,15 +374,14 @@ impl Translator<'_> {
                     Ok(Val::Bool(!stop_at))
                 }))
             }
-            Expr::Array(items, _) if tail && self.arrays => {
-                let nodes = items
-                    .iter()
-                    .map(|e| self.expr(e, false))
-                    .collect::<Option<Vec<_>>>()?;
-                Some(write_array(nodes))
-            }
+            Expr::Array(items, _) if tail && self.arrays => Some(write_array(self.exprs(items)?)),
             _ => None,
         }
+    }
+
+    /// Expressions that are not the function's value (the items of a list, arguments).
+    fn exprs(&mut self, items: &[Expr]) -> Option<Vec<Node>> {
+        items.iter().map(|e| self.expr(e, false)).collect()
     }
 
     /// A chain `base.step…` or `base[step]…`: rhai nests the rest of the chain in the step.
@@ -441,9 +436,7 @@ impl Translator<'_> {
             return None;
         }
         let mut args: Vec<Node> = receiver.into_iter().collect();
-        for a in call.args.iter() {
-            args.push(self.expr(a, false)?);
-        }
+        args.extend(self.exprs(&call.args)?);
         if let Some(token) = &call.op_token {
             return operator(token, args);
         }

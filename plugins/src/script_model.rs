@@ -623,8 +623,7 @@ fn run_budget_message(limits: &ScriptLimits) -> String {
 
 /// A runtime error as line + message, from the innermost function call that failed; `used`
 /// is the operations the call performed.
-fn describe(err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
-    let mut err = err;
+fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
     let mut line = err.position().line();
     let mut callee = fname.to_string();
     while let EvalAltResult::ErrorInFunctionCall(name, _, inner, pos) = err {
