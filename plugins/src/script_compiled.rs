@@ -339,14 +339,11 @@ impl Translator<'_> {
                 Some(write_array(nodes))
             }
             Expr::DynamicConstant(d, _) => {
-                let v = if let Ok(i) = d.as_int() {
-                    Val::Int(i)
-                } else if let Ok(x) = d.as_float() {
-                    Val::Float(x)
-                } else {
-                    Val::Bool(d.as_bool().ok()?)
-                };
-                Some(constant(v))
+                let v = d
+                    .as_int()
+                    .map(Val::Int)
+                    .or_else(|_| d.as_float().map(Val::Float));
+                Some(constant(v.or_else(|_| d.as_bool().map(Val::Bool)).ok()?))
             }
             Expr::Variable(..) => match self.variable(expr)? {
                 Binding::Local(slot) => Some(Box::new(move |f| {
@@ -535,15 +532,12 @@ fn compare<T: PartialOrd>(op: &Token, x: T, y: T) -> Option<bool> {
 #[inline]
 #[allow(clippy::float_cmp)]
 fn float_op(op: &Token, x: f64, y: f64) -> Option<Val> {
-    let max = || {
-        if x * y == 0.0 {
+    let cmp = |zero: bool, test: fn(f64, f64, f64) -> bool| {
+        let m = if x * y == 0.0 {
             1.0
         } else {
             x.abs().max(y.abs())
-        }
-    };
-    let cmp = |zero: bool, test: fn(f64, f64, f64) -> bool| {
-        let m = max();
+        };
         Val::Bool(if m == 0.0 { zero } else { test(x, y, m) })
     };
     Some(match op {
