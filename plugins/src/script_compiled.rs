@@ -506,11 +506,10 @@ fn binary_node(
 fn binary(op: &Token, a: Val, b: Val) -> Option<Val> {
     match (a, b) {
         (Val::Float(x), Val::Float(y)) => float_op(op, x, y),
-        (Val::Float(x), Val::Int(y)) => float_op(op, x, y as f64),
-        (Val::Int(x), Val::Float(y)) => float_op(op, x as f64, y),
         (Val::Int(x), Val::Int(y)) => int_op(op, x, y),
         (Val::Bool(x), Val::Bool(y)) => compare(op, x, y).map(Val::Bool),
-        _ => None,
+        // An integer with a float is promoted; other types are not operands.
+        _ => float_op(op, a.number()?, b.number()?),
     }
 }
 
@@ -661,11 +660,7 @@ fn unary_fn(name: &str) -> Option<UnaryFn> {
             Val::Int(i) => Some(Val::Int(i.signum())),
             _ => None,
         },
-        "to_float" => |v| match v {
-            Val::Float(x) => Some(Val::Float(x)),
-            Val::Int(i) => Some(Val::Float(i as f64)),
-            _ => None,
-        },
+        "to_float" => |v| v.number().map(Val::Float),
         "to_int" => |v| match v {
             Val::Int(i) => Some(Val::Int(i)),
             Val::Float(x) if x > i64::MAX as f64 || x < i64::MIN as f64 => None,
@@ -691,12 +686,9 @@ fn binary_fn(name: &str) -> Option<BinaryFn> {
 /// rhai's `max`/`min`: `if keep_first(x, y) { x } else { y }`, integers mixed with floats
 /// converted to float first.
 fn pick(a: Val, b: Val, int: fn(i64, i64) -> bool, float: fn(f64, f64) -> bool) -> Option<Val> {
-    let (x, y) = match (a, b) {
-        (Val::Int(x), Val::Int(y)) => return Some(Val::Int(if int(x, y) { x } else { y })),
-        (Val::Float(x), Val::Float(y)) => (x, y),
-        (Val::Int(x), Val::Float(y)) => (x as f64, y),
-        (Val::Float(x), Val::Int(y)) => (x, y as f64),
-        _ => return None,
-    };
+    if let (Val::Int(x), Val::Int(y)) = (a, b) {
+        return Some(Val::Int(if int(x, y) { x } else { y }));
+    }
+    let (x, y) = (a.number()?, b.number()?);
     Some(Val::Float(if float(x, y) { x } else { y }))
 }
