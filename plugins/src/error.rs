@@ -26,10 +26,8 @@ impl ScriptLocation {
 
 impl fmt::Display for ScriptLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(line) => write!(f, "{}:{line}", self.path),
-            None => write!(f, "{}", self.path),
-        }
+        write!(f, "{}", self.path)?;
+        self.line.map_or(Ok(()), |line| write!(f, ":{line}"))
     }
 }
 

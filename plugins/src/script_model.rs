@@ -556,15 +556,11 @@ fn check_contract(
     at: impl Fn(Option<usize>) -> ScriptLocation,
 ) -> Result<(), ScriptError> {
     for &(fname, arity, signature, required) in CONTRACT {
-        let arities: Vec<usize> = defined
-            .iter()
-            .filter(|(n, _)| n == fname)
-            .map(|(_, a)| *a)
-            .collect();
-        if arities.contains(&arity) {
+        let mut arities = defined.iter().filter(|(n, _)| n == fname).map(|(_, a)| *a);
+        if arities.clone().any(|a| a == arity) {
             continue;
         }
-        if let Some(&wrong) = arities.first() {
+        if let Some(wrong) = arities.next() {
             return Err(ScriptError::Contract {
                 at: at(fn_line(source, fname)),
                 message: format!("fn {fname} takes {wrong} argument(s); it must be fn {signature}"),
