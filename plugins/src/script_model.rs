@@ -648,9 +648,8 @@ fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u6
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")
         }
         _ => {
-            let mut e = err;
-            let _ = e.take_position();
-            e.to_string()
+            let _ = err.take_position();
+            err.to_string()
         }
     };
     CallError {
