@@ -116,12 +116,6 @@ impl Registry {
     }
 }
 
-/// Load and check the script at `path` (for `stf-lab models --check`): its parameters, or
-/// the error naming the script and line.
-pub fn check_script(path: &Path) -> Result<Vec<ParamSpec>, ScriptError> {
-    ScriptModel::load(path).map(|m| m.params().to_vec())
-}
-
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
