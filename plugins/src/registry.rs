@@ -61,13 +61,11 @@ impl Registry {
     pub fn resolve(&self, spec: &str, base_dir: &Path) -> Result<Arc<dyn ForceModel>, ScriptError> {
         let spec = spec.trim();
         if spec.ends_with(".rhai") {
-            let path = Path::new(spec);
-            let path = if path.is_absolute() {
-                path.to_path_buf()
-            } else {
-                base_dir.join(path)
-            };
-            return Ok(Arc::new(ScriptModel::load_in(path, &self.run)?));
+            // `join` keeps an absolute path as it is.
+            return Ok(Arc::new(ScriptModel::load_in(
+                base_dir.join(spec),
+                &self.run,
+            )?));
         }
         stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
             name: spec.to_string(),
@@ -132,6 +130,15 @@ mod tests {
         for name in stf_models::names() {
             assert!(err.contains(name), "{err}");
         }
+    }
+
+    #[test]
+    fn absolute_script_paths_ignore_the_base_dir() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts/power_law.rhai");
+        let model = Registry::new()
+            .resolve(path.to_str().unwrap(), Path::new("/no/such/dir"))
+            .unwrap();
+        assert_eq!(model.name(), "power_law");
     }
 
     #[test]
