@@ -1,21 +1,11 @@
 //! The shape every built-in model shares, written once: [`builtin!`] declares a model's
-//! struct, its one-line `SUMMARY`, its parameter specs, `new`/`Default`, and the
-//! `name`/`summary`/`params` of its [`ForceModel`] impl; the model's file states only its
-//! name, summary, parameters and physics (`force`, `gradient`, …). [`Builtin`] gives the
-//! table in `lib.rs` the name and summary of each type.
+//! struct, its parameter specs, `new`/`Default`, its `ENTRY` in the table of `lib.rs`
+//! (name, summary, constructor), and the `name`/`summary`/`params` of its `ForceModel`
+//! impl; the model's file states only its name, summary, parameters and physics (`force`,
+//! `gradient`, …).
 //!
 //! A macro rather than a trait with default methods: `ForceModel` (in core) needs `params`
 //! to lend a slice the model owns, and a trait cannot add fields to a struct.
-
-use stf_core::physics::force_model::ForceModel;
-
-/// A built-in model: its name in experiment files and its one line for listings.
-pub trait Builtin: ForceModel + Default + 'static {
-    /// The name used in experiment files (docs/ARCHITECTURE.md §5).
-    const NAME: &'static str;
-    /// One line saying what the model is.
-    const SUMMARY: &'static str;
-}
 
 /// Declare a built-in model:
 ///
@@ -28,9 +18,8 @@ pub trait Builtin: ForceModel + Default + 'static {
 /// }
 /// ```
 ///
-/// makes `pub const SUMMARY`, `pub struct Viscous` with `new()` and `Default`, its
-/// [`Builtin`] impl and its `ForceModel` impl: `name`, `summary`, `params` and the methods in
-/// the `impl` block.
+/// makes `pub struct Viscous` with `new()`, `Default` and `ENTRY` (its [`crate::BuiltinEntry`])
+/// and its `ForceModel` impl: `name`, `summary`, `params` and the methods in the `impl` block.
 macro_rules! builtin {
     (
         $(#[$attr:meta])*
@@ -38,9 +27,6 @@ macro_rules! builtin {
         params [$($spec:expr),+ $(,)?];
         impl { $($body:tt)* }
     ) => {
-        /// One line for listings.
-        pub const SUMMARY: &str = $summary;
-
         $(#[$attr])*
         pub struct $ty {
             specs: Vec<stf_core::physics::param_spec::ParamSpec>,
@@ -51,6 +37,13 @@ macro_rules! builtin {
             pub fn new() -> Self {
                 $ty { specs: vec![$($spec),+] }
             }
+
+            /// Its entry in [`crate::BUILTINS`].
+            pub const ENTRY: $crate::BuiltinEntry = $crate::BuiltinEntry {
+                name: $name,
+                summary: $summary,
+                build: || std::sync::Arc::new($ty::new()),
+            };
         }
 
         impl Default for $ty {
@@ -59,17 +52,12 @@ macro_rules! builtin {
             }
         }
 
-        impl $crate::builtin::Builtin for $ty {
-            const NAME: &'static str = $name;
-            const SUMMARY: &'static str = SUMMARY;
-        }
-
         impl stf_core::physics::force_model::ForceModel for $ty {
             fn name(&self) -> &str {
                 $name
             }
             fn summary(&self) -> &str {
-                SUMMARY
+                $summary
             }
             fn params(&self) -> &[stf_core::physics::param_spec::ParamSpec] {
                 &self.specs

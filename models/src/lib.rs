@@ -28,8 +28,6 @@ use std::sync::Arc;
 
 use stf_core::physics::force_model::ForceModel;
 
-use builtin::Builtin;
-
 pub mod added_mass;
 mod builtin;
 pub mod cubic_stiffness;
@@ -51,28 +49,17 @@ pub struct BuiltinEntry {
     pub build: fn() -> Arc<dyn ForceModel>,
 }
 
-impl BuiltinEntry {
-    /// The entry of the built-in `M`.
-    const fn of<M: Builtin>() -> Self {
-        BuiltinEntry {
-            name: M::NAME,
-            summary: M::SUMMARY,
-            build: || Arc::new(M::default()),
-        }
-    }
-}
-
 /// Every built-in model, in the order they are listed to users. The names are those of the
 /// discovery vocabulary (docs/ARCHITECTURE.md §5).
 pub const BUILTINS: &[BuiltinEntry] = &[
-    BuiltinEntry::of::<viscous::Viscous>(),
-    BuiltinEntry::of::<power_law::PowerLaw>(),
-    BuiltinEntry::of::<added_mass::AddedMass>(),
-    BuiltinEntry::of::<yield_stress::Yield>(),
-    BuiltinEntry::of::<wall_impact::WallImpact>(),
-    BuiltinEntry::of::<cubic_stiffness::CubicStiffness>(),
-    BuiltinEntry::of::<maxwell::Maxwell>(),
-    BuiltinEntry::of::<jamming_on_off::JammingOnOff>(),
+    viscous::Viscous::ENTRY,
+    power_law::PowerLaw::ENTRY,
+    added_mass::AddedMass::ENTRY,
+    yield_stress::Yield::ENTRY,
+    wall_impact::WallImpact::ENTRY,
+    cubic_stiffness::CubicStiffness::ENTRY,
+    maxwell::Maxwell::ENTRY,
+    jamming_on_off::JammingOnOff::ENTRY,
 ];
 
 /// The built-in model called `name`, if there is one.

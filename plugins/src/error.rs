@@ -14,12 +14,20 @@ pub struct ScriptLocation {
     pub line: Option<usize>,
 }
 
+impl ScriptLocation {
+    /// `line` (when known) of the script at `path`.
+    pub fn new(path: &str, line: Option<usize>) -> Self {
+        ScriptLocation {
+            path: path.to_string(),
+            line,
+        }
+    }
+}
+
 impl fmt::Display for ScriptLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(line) => write!(f, "{}:{line}", self.path),
-            None => write!(f, "{}", self.path),
-        }
+        write!(f, "{}", self.path)?;
+        self.line.map_or(Ok(()), |line| write!(f, ":{line}"))
     }
 }
 

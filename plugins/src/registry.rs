@@ -43,8 +43,8 @@ impl Registry {
     /// The built-in models; scripts load in `run` (its limits and operation budgets).
     pub fn in_run(run: ScriptRun) -> Self {
         Registry {
-            script_dir: None,
             run,
+            ..Registry::default()
         }
     }
 
@@ -52,7 +52,7 @@ impl Registry {
     pub fn with_script_dir(dir: impl Into<PathBuf>) -> Self {
         Registry {
             script_dir: Some(dir.into()),
-            run: ScriptRun::default(),
+            ..Registry::default()
         }
     }
 
@@ -61,13 +61,11 @@ impl Registry {
     pub fn resolve(&self, spec: &str, base_dir: &Path) -> Result<Arc<dyn ForceModel>, ScriptError> {
         let spec = spec.trim();
         if spec.ends_with(".rhai") {
-            let path = Path::new(spec);
-            let path = if path.is_absolute() {
-                path.to_path_buf()
-            } else {
-                base_dir.join(path)
-            };
-            return Ok(Arc::new(ScriptModel::load_in(path, &self.run)?));
+            // `join` keeps an absolute path as it is.
+            return Ok(Arc::new(ScriptModel::load_in(
+                base_dir.join(spec),
+                &self.run,
+            )?));
         }
         stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
             name: spec.to_string(),
@@ -88,20 +86,15 @@ impl Registry {
             })
             .collect();
         for path in self.scripts() {
-            let name = path.display().to_string();
-            entries.push(match ScriptModel::load(&path) {
-                Ok(m) => ModelListing {
-                    name,
-                    summary: m.summary().to_string(),
-                    params: m.params().to_vec(),
-                    is_script: true,
-                },
-                Err(e) => ModelListing {
-                    name,
-                    summary: format!("(does not load: {e})"),
-                    params: Vec::new(),
-                    is_script: true,
-                },
+            let (summary, params) = match ScriptModel::load(&path) {
+                Ok(m) => (m.summary().to_string(), m.params().to_vec()),
+                Err(e) => (format!("(does not load: {e})"), Vec::new()),
+            };
+            entries.push(ModelListing {
+                name: path.display().to_string(),
+                summary,
+                params,
+                is_script: true,
             });
         }
         entries
@@ -109,10 +102,7 @@ impl Registry {
 
     /// The `*.rhai` files of the script directory, sorted.
     pub fn scripts(&self) -> Vec<PathBuf> {
-        let Some(dir) = &self.script_dir else {
-            return Vec::new();
-        };
-        let Ok(read) = std::fs::read_dir(dir) else {
+        let Some(Ok(read)) = self.script_dir.as_ref().map(std::fs::read_dir) else {
             return Vec::new();
         };
         let mut paths: Vec<PathBuf> = read
@@ -122,12 +112,6 @@ impl Registry {
         paths.sort();
         paths
     }
-}
-
-/// Load and check the script at `path` (for `stf-lab models --check`): its parameters, or
-/// the error naming the script and line.
-pub fn check_script(path: &Path) -> Result<Vec<ParamSpec>, ScriptError> {
-    ScriptModel::load(path).map(|m| m.params().to_vec())
 }
 
 #[cfg(test)]
@@ -146,6 +130,15 @@ mod tests {
         for name in stf_models::names() {
             assert!(err.contains(name), "{err}");
         }
+    }
+
+    #[test]
+    fn absolute_script_paths_ignore_the_base_dir() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/scripts/power_law.rhai");
+        let model = Registry::new()
+            .resolve(path.to_str().unwrap(), Path::new("/no/such/dir"))
+            .unwrap();
+        assert_eq!(model.name(), "power_law");
     }
 
     #[test]

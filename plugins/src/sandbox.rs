@@ -22,10 +22,6 @@ use rhai::grain::Vm;
 use rhai::module_resolvers::DummyModuleResolver;
 use rhai::{Dynamic, Engine};
 
-/// Operations one call of a script function may perform by default.
-pub const MAX_OPERATIONS: u64 = crate::limits::CALL_OPERATIONS;
-/// Wall-clock seconds one call of a script function may take by default (the last resort).
-pub const MAX_CALL_SECONDS: f64 = crate::limits::CALL_SECONDS;
 /// Operations between two looks at the clock. One look (≈ 20 ns) costs about as much as a
 /// simple operation, so this adds ≈ 1 % to a call; one operation on data at the size limits
 /// (`contains` or `sort` on a 10 000-element array) takes up to a few milliseconds, so the

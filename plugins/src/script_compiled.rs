@@ -22,7 +22,10 @@
 
 use std::collections::HashSet;
 
-use rhai::{ASTFlags, ASTNode, Expr, FnCallExpr, Position, Stmt, StmtBlock, Token, AST};
+use rhai::{ASTFlags, ASTNode, Expr, FnCallExpr, Position, Stmt, Token, AST};
+use stf_core::physics::force_model::ModelState;
+
+use crate::script_params::to_f64;
 
 /// A value inside a compiled call: the rhai types the subset can produce.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +38,17 @@ enum Val {
     Written,
 }
 
+impl Val {
+    /// A number as `f64` (an integer converted as the VM path does).
+    fn number(self) -> Option<f64> {
+        match self {
+            Val::Float(x) => Some(x),
+            Val::Int(i) => Some(i as f64),
+            _ => None,
+        }
+    }
+}
+
 /// Why evaluation left the normal flow.
 enum Flow {
     /// `return value`.
@@ -42,8 +56,6 @@ enum Flow {
     /// The VM must run this call (an error, or types outside the subset).
     Bail,
 }
-
-type Eval = Result<Val, Flow>;
 
 /// State of one compiled call.
 struct Frame<'a> {
@@ -55,7 +67,7 @@ struct Frame<'a> {
     out: &'a mut [f64],
 }
 
-type Node = Box<dyn Fn(&mut Frame<'_>) -> Eval + Send + Sync>;
+type Node = Box<dyn Fn(&mut Frame<'_>) -> Result<Val, Flow> + Send + Sync>;
 
 /// One script function translated to closures.
 pub(crate) struct CompiledFn {
@@ -68,7 +80,7 @@ const STACK_LOCALS: usize = 16;
 
 impl CompiledFn {
     /// Run with the arguments; `None` means "run this call on the VM".
-    fn run(&self, p: &[f64], t: f64, x: f64, v: f64, z: &[f64], out: &mut [f64]) -> Option<Val> {
+    fn run(&self, p: &[f64], s: &ModelState, out: &mut [f64]) -> Option<Val> {
         let mut stack = [Val::Unit; STACK_LOCALS];
         let mut heap = Vec::new();
         let locals: &mut [Val] = if self.n_locals <= STACK_LOCALS {
@@ -78,8 +90,9 @@ impl CompiledFn {
             &mut heap
         };
         if let [lt, lx, lv, ..] = locals {
-            (*lt, *lx, *lv) = (Val::Float(t), Val::Float(x), Val::Float(v));
+            (*lt, *lx, *lv) = (Val::Float(s.t), Val::Float(s.x), Val::Float(s.v));
         }
+        let z = s.z;
         let mut frame = Frame { p, z, locals, out };
         match (self.body)(&mut frame) {
             Ok(v) | Err(Flow::Return(v)) => Some(v),
@@ -88,28 +101,13 @@ impl CompiledFn {
     }
 
     /// A number result (float, or integer converted as the VM path does); `None`: use the VM.
-    pub(crate) fn number(&self, p: &[f64], t: f64, x: f64, v: f64, z: &[f64]) -> Option<f64> {
-        match self.run(p, t, x, v, z, &mut [])? {
-            Val::Float(f) => Some(f),
-            Val::Int(i) => Some(i as f64),
-            _ => None,
-        }
+    pub(crate) fn number(&self, p: &[f64], s: &ModelState) -> Option<f64> {
+        self.run(p, s, &mut [])?.number()
     }
 
     /// Write an array result into `out` (all of it, lengths equal); `None`: use the VM.
-    pub(crate) fn array(
-        &self,
-        p: &[f64],
-        t: f64,
-        x: f64,
-        v: f64,
-        z: &[f64],
-        out: &mut [f64],
-    ) -> Option<()> {
-        match self.run(p, t, x, v, z, out)? {
-            Val::Written => Some(()),
-            _ => None,
-        }
+    pub(crate) fn array(&self, p: &[f64], s: &ModelState, out: &mut [f64]) -> Option<()> {
+        (self.run(p, s, out)? == Val::Written).then_some(())
     }
 }
 
@@ -146,18 +144,15 @@ pub(crate) fn translate(
         .iter_fn_def()
         .find(|f| f.name == name && f.params.len() == 5)?;
     let body = body_of(ast, (def.body.start_position(), def.body.end_position()))?;
-    let arg = |i: usize| def.params.get(i).map(|s| s.to_string());
-    let names = vec![
-        (arg(0)?, Binding::Params),
-        (arg(1)?, Binding::Local(0)),
-        (arg(2)?, Binding::Local(1)),
-        (arg(3)?, Binding::Local(2)),
-        (arg(4)?, Binding::State),
-    ];
+    // p, then t, x, v in local slots 0, 1, 2, then z.
+    let bindings = std::iter::once(Binding::Params)
+        .chain((0..3).map(Binding::Local))
+        .chain([Binding::State]);
+    let names = def.params.iter().map(|s| s.to_string()).zip(bindings);
     let mut tr = Translator {
         params,
         script_fns: &script_fns,
-        names,
+        names: names.collect(),
         n_locals: 3,
         arrays,
     };
@@ -214,8 +209,36 @@ fn constant(v: Val) -> Node {
     Box::new(move |_| Ok(v))
 }
 
+/// The values of `nodes` written to the output slots (the value of `rates`; lengths equal).
+fn write_array(nodes: Vec<Node>) -> Node {
+    Box::new(move |f| {
+        if nodes.len() != f.out.len() {
+            return Err(Flow::Bail);
+        }
+        for (i, node) in nodes.iter().enumerate() {
+            let x = node(f)?.number().ok_or(Flow::Bail)?;
+            *f.out.get_mut(i).ok_or(Flow::Bail)? = x;
+        }
+        Ok(Val::Written)
+    })
+}
+
+/// `value` evaluated into local `slot`.
+fn store(slot: usize, value: Node) -> Node {
+    Box::new(move |f| {
+        let v = value(f)?;
+        *f.locals.get_mut(slot).ok_or(Flow::Bail)? = v;
+        Ok(Val::Unit)
+    })
+}
+
 impl Translator<'_> {
-    fn lookup(&self, name: &str) -> Option<Binding> {
+    /// What a plain (un-namespaced) variable expression is bound to.
+    fn variable(&self, expr: &Expr) -> Option<Binding> {
+        let Expr::Variable(var, _, _) = expr else {
+            return None;
+        };
+        let name = var.2.is_empty().then_some(&var.1)?;
         self.names
             .iter()
             .rev()
@@ -223,11 +246,7 @@ impl Translator<'_> {
             .map(|&(_, b)| b)
     }
 
-    /// A block: its own scope; its value is the last statement's.
-    fn block(&mut self, block: &StmtBlock, tail: bool) -> Option<Node> {
-        self.statements(block.statements(), tail)
-    }
-
+    /// Statements in a scope of their own; their value is the last one's.
     fn statements(&mut self, stmts: &[Stmt], tail: bool) -> Option<Node> {
         let mark = self.names.len();
         let mut nodes = Vec::with_capacity(stmts.len());
@@ -263,37 +282,22 @@ impl Translator<'_> {
                 self.n_locals += 1;
                 self.names
                     .push((ident.name.to_string(), Binding::Local(slot)));
-                Some(Box::new(move |f| {
-                    let value = init(f)?;
-                    *f.locals.get_mut(slot).ok_or(Flow::Bail)? = value;
-                    Ok(Val::Unit)
-                }))
+                Some(store(slot, init))
             }
             Stmt::Assignment(assign) => {
                 let (op, target) = &**assign;
                 if op.is_op_assignment() {
                     return None;
                 }
-                let Expr::Variable(var, _, _) = &target.lhs else {
+                let Binding::Local(slot) = self.variable(&target.lhs)? else {
                     return None;
                 };
-                if !var.2.is_empty() {
-                    return None;
-                }
-                let Binding::Local(slot) = self.lookup(&var.1)? else {
-                    return None;
-                };
-                let value = self.expr(&target.rhs, false)?;
-                Some(Box::new(move |f| {
-                    let v = value(f)?;
-                    *f.locals.get_mut(slot).ok_or(Flow::Bail)? = v;
-                    Ok(Val::Unit)
-                }))
+                Some(store(slot, self.expr(&target.rhs, false)?))
             }
             Stmt::If(flow, _) => {
                 let cond = self.expr(&flow.expr, false)?;
-                let then = self.block(&flow.body, tail)?;
-                let other = self.block(&flow.branch, tail)?;
+                let then = self.statements(flow.body.statements(), tail)?;
+                let other = self.statements(flow.branch.statements(), tail)?;
                 Some(Box::new(move |f| match cond(f)? {
                     Val::Bool(true) => then(f),
                     Val::Bool(false) => other(f),
@@ -302,15 +306,14 @@ impl Translator<'_> {
             }
             Stmt::Expr(e) => self.expr(e, tail),
             Stmt::FnCall(call, _) => self.call(call, None),
-            Stmt::Block(block) => self.block(block, tail),
+            Stmt::Block(block) => self.statements(block.statements(), tail),
             Stmt::Return(value, flags, _) => {
                 if !flags.is_empty() {
                     return None; // `throw`
                 }
-                let value = match value {
-                    Some(e) => self.expr(e, true)?,
-                    None => constant(Val::Unit),
-                };
+                let value = value
+                    .as_ref()
+                    .map_or(Some(constant(Val::Unit)), |e| self.expr(e, true))?;
                 Some(Box::new(move |f| Err(Flow::Return(value(f)?))))
             }
             _ => None,
@@ -329,55 +332,34 @@ impl Translator<'_> {
                 }
                 // A literal array the optimizer folded: numbers only, else decline.
                 let items = d.clone().into_array().ok()?;
-                let values = items
+                let nodes = items
                     .iter()
-                    .map(|item| {
-                        item.as_float()
-                            .ok()
-                            .or_else(|| item.as_int().ok().map(|i| i as f64))
-                    })
-                    .collect::<Option<Vec<f64>>>()?;
-                Some(Box::new(move |f| {
-                    if values.len() != f.out.len() {
-                        return Err(Flow::Bail);
-                    }
-                    f.out.copy_from_slice(&values);
-                    Ok(Val::Written)
-                }))
+                    .map(|item| Some(constant(Val::Float(to_f64(item)?))))
+                    .collect::<Option<Vec<_>>>()?;
+                Some(write_array(nodes))
             }
             Expr::DynamicConstant(d, _) => {
-                let v = if let Ok(i) = d.as_int() {
-                    Val::Int(i)
-                } else if let Ok(x) = d.as_float() {
-                    Val::Float(x)
-                } else {
-                    Val::Bool(d.as_bool().ok()?)
-                };
-                Some(constant(v))
+                let v = d
+                    .as_int()
+                    .map(Val::Int)
+                    .or_else(|_| d.as_float().map(Val::Float));
+                Some(constant(v.or_else(|_| d.as_bool().map(Val::Bool)).ok()?))
             }
-            Expr::Variable(var, _, _) => {
-                if !var.2.is_empty() {
-                    return None;
-                }
-                match self.lookup(&var.1)? {
-                    Binding::Local(slot) => Some(Box::new(move |f| {
-                        f.locals.get(slot).copied().ok_or(Flow::Bail)
-                    })),
-                    Binding::Params | Binding::State => None,
-                }
-            }
+            Expr::Variable(..) => match self.variable(expr)? {
+                Binding::Local(slot) => Some(Box::new(move |f| {
+                    f.locals.get(slot).copied().ok_or(Flow::Bail)
+                })),
+                Binding::Params | Binding::State => None,
+            },
             Expr::Dot(bin, flags, _) | Expr::Index(bin, flags, _) => {
                 let is_dot = matches!(expr, Expr::Dot(..));
                 self.chain(&bin.lhs, is_dot, *flags, &bin.rhs)
             }
             Expr::FnCall(call, _) => self.call(call, None),
-            Expr::Stmt(block) => self.block(block, tail),
+            Expr::Stmt(block) => self.statements(block.statements(), tail),
             Expr::And(items, _) | Expr::Or(items, _) => {
                 let stop_at = matches!(expr, Expr::Or(..));
-                let nodes = items
-                    .iter()
-                    .map(|e| self.expr(e, false))
-                    .collect::<Option<Vec<_>>>()?;
+                let nodes = self.exprs(items)?;
                 Some(Box::new(move |f| {
                     for node in &nodes {
                         match node(f)? {
@@ -389,28 +371,14 @@ impl Translator<'_> {
                     Ok(Val::Bool(!stop_at))
                 }))
             }
-            Expr::Array(items, _) if tail && self.arrays => {
-                let nodes = items
-                    .iter()
-                    .map(|e| self.expr(e, false))
-                    .collect::<Option<Vec<_>>>()?;
-                Some(Box::new(move |f| {
-                    if nodes.len() != f.out.len() {
-                        return Err(Flow::Bail);
-                    }
-                    for (i, node) in nodes.iter().enumerate() {
-                        let x = match node(f)? {
-                            Val::Float(x) => x,
-                            Val::Int(n) => n as f64,
-                            _ => return Err(Flow::Bail),
-                        };
-                        *f.out.get_mut(i).ok_or(Flow::Bail)? = x;
-                    }
-                    Ok(Val::Written)
-                }))
-            }
+            Expr::Array(items, _) if tail && self.arrays => Some(write_array(self.exprs(items)?)),
             _ => None,
         }
+    }
+
+    /// Expressions that are not the function's value (the items of a list, arguments).
+    fn exprs(&mut self, items: &[Expr]) -> Option<Vec<Node>> {
+        items.iter().map(|e| self.expr(e, false)).collect()
     }
 
     /// A chain `base.step…` or `base[step]…`: rhai nests the rest of the chain in the step.
@@ -418,10 +386,7 @@ impl Translator<'_> {
     /// (`?.`, `?[`) declines.
     fn chain(&mut self, base: &Expr, is_dot: bool, flags: ASTFlags, rest: &Expr) -> Option<Node> {
         let (step, next) = split_chain(flags, rest)?;
-        let binding = match base {
-            Expr::Variable(var, _, _) if var.2.is_empty() => self.lookup(&var.1),
-            _ => None,
-        };
+        let binding = self.variable(base);
         let head: Node = match (binding, is_dot, step) {
             (Some(Binding::Params), true, Expr::Property(prop, _)) => {
                 let index = self.params.iter().position(|n| *n == prop.2.as_str())?;
@@ -446,30 +411,20 @@ impl Translator<'_> {
             }
             _ => return None,
         };
-        match next {
-            None => Some(head),
-            Some((next_is_dot, next_flags, next_rest)) => {
-                self.chain_on(head, next_is_dot, next_flags, next_rest)
-            }
-        }
+        self.chain_on(head, next)
     }
 
     /// The rest of a chain applied to an already translated value (only method calls).
-    fn chain_on(&mut self, head: Node, is_dot: bool, flags: ASTFlags, rest: &Expr) -> Option<Node> {
-        if !is_dot {
-            return None;
+    fn chain_on(&mut self, mut head: Node, mut next: ChainRest<'_>) -> Option<Node> {
+        while let Some((is_dot, flags, rest)) = next {
+            let (step, after) = split_chain(flags, rest)?;
+            let (true, Expr::MethodCall(call, _)) = (is_dot, step) else {
+                return None;
+            };
+            head = self.call(call, Some(head))?;
+            next = after;
         }
-        let (step, next) = split_chain(flags, rest)?;
-        let Expr::MethodCall(call, _) = step else {
-            return None;
-        };
-        let node = self.call(call, Some(head))?;
-        match next {
-            None => Some(node),
-            Some((next_is_dot, next_flags, next_rest)) => {
-                self.chain_on(node, next_is_dot, next_flags, next_rest)
-            }
-        }
+        Some(head)
     }
 
     /// An operator or function call; `receiver` is the object of a method call.
@@ -478,9 +433,7 @@ impl Translator<'_> {
             return None;
         }
         let mut args: Vec<Node> = receiver.into_iter().collect();
-        for a in call.args.iter() {
-            args.push(self.expr(a, false)?);
-        }
+        args.extend(self.exprs(&call.args)?);
         if let Some(token) = &call.op_token {
             return operator(token, args);
         }
@@ -509,23 +462,6 @@ fn split_chain(flags: ASTFlags, rest: &Expr) -> Option<(&Expr, ChainRest<'_>)> {
     })
 }
 
-/// Binary operators rhai evaluates with its built-in fast path.
-#[derive(Clone, Copy)]
-enum BinOp {
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Rem,
-    Pow,
-    Eq,
-    Ne,
-    Lt,
-    Le,
-    Gt,
-    Ge,
-}
-
 fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
     if args.len() == 1 {
         let a = args.pop()?;
@@ -542,105 +478,95 @@ fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
             _ => None,
         };
     }
-    let op = match token {
-        Token::Plus => BinOp::Add,
-        Token::Minus => BinOp::Sub,
-        Token::Multiply => BinOp::Mul,
-        Token::Divide => BinOp::Div,
-        Token::Modulo => BinOp::Rem,
-        Token::PowerOf => BinOp::Pow,
-        Token::EqualsTo => BinOp::Eq,
-        Token::NotEqualsTo => BinOp::Ne,
-        Token::LessThan => BinOp::Lt,
-        Token::LessThanEqualsTo => BinOp::Le,
-        Token::GreaterThan => BinOp::Gt,
-        Token::GreaterThanEqualsTo => BinOp::Ge,
-        _ => return None,
-    };
-    if args.len() != 2 {
+    // The binary operators are those `float_op` knows.
+    if args.len() != 2 || float_op(token, 0.0, 0.0).is_none() {
         return None;
     }
-    let b = args.pop()?;
-    let a = args.pop()?;
-    Some(Box::new(move |f| {
-        let x = a(f)?;
-        let y = b(f)?;
-        binary(op, x, y)
-    }))
+    let (op, b) = (token.clone(), args.pop()?);
+    Some(binary_node(args.pop()?, b, move |x, y| binary(&op, x, y)))
 }
 
-/// rhai's built-in binary operators on the subset's types; `Bail` where rhai errs or
+/// A node applying `op` to the values of `a` and `b`; `None` from `op` bails out.
+#[inline]
+fn binary_node(
+    a: Node,
+    b: Node,
+    op: impl Fn(Val, Val) -> Option<Val> + Send + Sync + 'static,
+) -> Node {
+    Box::new(move |f| {
+        let x = a(f)?;
+        let y = b(f)?;
+        op(x, y).ok_or(Flow::Bail)
+    })
+}
+
+/// rhai's built-in binary operators on the subset's types; `None` where rhai errs or
 /// dispatches to a registered function.
 #[inline]
-fn binary(op: BinOp, a: Val, b: Val) -> Eval {
+fn binary(op: &Token, a: Val, b: Val) -> Option<Val> {
     match (a, b) {
-        (Val::Float(x), Val::Float(y)) => Ok(float_op(op, x, y)),
-        (Val::Float(x), Val::Int(y)) => Ok(float_op(op, x, y as f64)),
-        (Val::Int(x), Val::Float(y)) => Ok(float_op(op, x as f64, y)),
-        (Val::Int(x), Val::Int(y)) => int_op(op, x, y).ok_or(Flow::Bail),
-        (Val::Bool(x), Val::Bool(y)) => {
-            let r = match op {
-                BinOp::Eq => x == y,
-                BinOp::Ne => x != y,
-                BinOp::Lt => !x & y,
-                BinOp::Le => x <= y,
-                BinOp::Gt => x & !y,
-                BinOp::Ge => x >= y,
-                _ => return Err(Flow::Bail),
-            };
-            Ok(Val::Bool(r))
-        }
-        _ => Err(Flow::Bail),
+        (Val::Float(x), Val::Float(y)) => float_op(op, x, y),
+        (Val::Int(x), Val::Int(y)) => int_op(op, x, y),
+        (Val::Bool(x), Val::Bool(y)) => compare(op, x, y).map(Val::Bool),
+        // An integer with a float is promoted; other types are not operands.
+        _ => float_op(op, a.number()?, b.number()?),
     }
+}
+
+/// A comparison on integers or bools (`false < true`); `None` for any other `op`.
+#[inline]
+fn compare<T: PartialOrd>(op: &Token, x: T, y: T) -> Option<bool> {
+    Some(match op {
+        Token::EqualsTo => x == y,
+        Token::NotEqualsTo => x != y,
+        Token::LessThan => x < y,
+        Token::LessThanEqualsTo => x <= y,
+        Token::GreaterThan => x > y,
+        Token::GreaterThanEqualsTo => x >= y,
+        _ => return None,
+    })
 }
 
 /// rhai's float operators (checked build: comparisons with a relative epsilon).
 #[inline]
 #[allow(clippy::float_cmp)]
-fn float_op(op: BinOp, x: f64, y: f64) -> Val {
-    let max = || {
-        if x * y == 0.0 {
+fn float_op(op: &Token, x: f64, y: f64) -> Option<Val> {
+    let cmp = |zero: bool, test: fn(f64, f64, f64) -> bool| {
+        let m = if x * y == 0.0 {
             1.0
         } else {
             x.abs().max(y.abs())
-        }
-    };
-    let cmp = |zero: bool, test: fn(f64, f64, f64) -> bool| {
-        let m = max();
+        };
         Val::Bool(if m == 0.0 { zero } else { test(x, y, m) })
     };
-    match op {
-        BinOp::Add => Val::Float(x + y),
-        BinOp::Sub => Val::Float(x - y),
-        BinOp::Mul => Val::Float(x * y),
-        BinOp::Div => Val::Float(x / y),
-        BinOp::Rem => Val::Float(x % y),
-        BinOp::Pow => Val::Float(x.powf(y)),
-        BinOp::Eq => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
-        BinOp::Ne => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
-        BinOp::Gt => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
-        BinOp::Ge => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
-        BinOp::Lt => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
-        BinOp::Le => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
-    }
+    Some(match op {
+        Token::Plus => Val::Float(x + y),
+        Token::Minus => Val::Float(x - y),
+        Token::Multiply => Val::Float(x * y),
+        Token::Divide => Val::Float(x / y),
+        Token::Modulo => Val::Float(x % y),
+        Token::PowerOf => Val::Float(x.powf(y)),
+        Token::EqualsTo => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
+        Token::NotEqualsTo => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
+        Token::GreaterThan => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
+        Token::GreaterThanEqualsTo => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
+        Token::LessThan => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
+        Token::LessThanEqualsTo => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
+        _ => return None,
+    })
 }
 
 /// rhai's checked integer operators; `None` where rhai raises an error.
 #[inline]
-fn int_op(op: BinOp, x: i64, y: i64) -> Option<Val> {
+fn int_op(op: &Token, x: i64, y: i64) -> Option<Val> {
     Some(match op {
-        BinOp::Add => Val::Int(x.checked_add(y)?),
-        BinOp::Sub => Val::Int(x.checked_sub(y)?),
-        BinOp::Mul => Val::Int(x.checked_mul(y)?),
-        BinOp::Div => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
-        BinOp::Rem => Val::Int(x.checked_rem(y)?),
-        BinOp::Pow => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
-        BinOp::Eq => Val::Bool(x == y),
-        BinOp::Ne => Val::Bool(x != y),
-        BinOp::Lt => Val::Bool(x < y),
-        BinOp::Le => Val::Bool(x <= y),
-        BinOp::Gt => Val::Bool(x > y),
-        BinOp::Ge => Val::Bool(x >= y),
+        Token::Plus => Val::Int(x.checked_add(y)?),
+        Token::Minus => Val::Int(x.checked_sub(y)?),
+        Token::Multiply => Val::Int(x.checked_mul(y)?),
+        Token::Divide => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
+        Token::Modulo => Val::Int(x.checked_rem(y)?),
+        Token::PowerOf => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
+        _ => Val::Bool(compare(op, x, y)?),
     })
 }
 
@@ -656,19 +582,12 @@ fn function(name: &str, mut args: Vec<Node>) -> Option<Node> {
             Some(constant(Val::Float(v)))
         }
         1 => {
-            let a = args.pop()?;
-            let op = unary_fn(name)?;
+            let (a, op) = (args.pop()?, unary_fn(name)?);
             Some(Box::new(move |f| op(a(f)?).ok_or(Flow::Bail)))
         }
         2 => {
             let b = args.pop()?;
-            let a = args.pop()?;
-            let op = binary_fn(name)?;
-            Some(Box::new(move |f| {
-                let x = a(f)?;
-                let y = b(f)?;
-                op(x, y).ok_or(Flow::Bail)
-            }))
+            Some(binary_node(args.pop()?, b, binary_fn(name)?))
         }
         _ => None,
     }
@@ -677,12 +596,23 @@ fn function(name: &str, mut args: Vec<Node>) -> Option<Node> {
 type UnaryFn = fn(Val) -> Option<Val>;
 type BinaryFn = fn(Val, Val) -> Option<Val>;
 
+/// A float method as a function of the subset: `float_fn!(sin)` (a float result),
+/// `float_fn!(is_nan, Bool)` (another result type), `float_fn!(2 hypot)` (two floats).
 macro_rules! float_fn {
     ($method:ident) => {
+        float_fn!($method, Float)
+    };
+    ($method:ident, $result:ident) => {
         (|v| match v {
-            Val::Float(x) => Some(Val::Float(x.$method())),
+            Val::Float(x) => Some(Val::$result(x.$method())),
             _ => None,
         }) as UnaryFn
+    };
+    (2 $method:ident) => {
+        (|a, b| match (a, b) {
+            (Val::Float(x), Val::Float(y)) => Some(Val::Float(x.$method(y))),
+            _ => None,
+        }) as BinaryFn
     };
 }
 
@@ -713,18 +643,9 @@ fn unary_fn(name: &str) -> Option<UnaryFn> {
         "round" => float_fn!(round),
         "int" => float_fn!(trunc),
         "fraction" => float_fn!(fract),
-        "is_nan" => |v| match v {
-            Val::Float(x) => Some(Val::Bool(x.is_nan())),
-            _ => None,
-        },
-        "is_finite" => |v| match v {
-            Val::Float(x) => Some(Val::Bool(x.is_finite())),
-            _ => None,
-        },
-        "is_infinite" => |v| match v {
-            Val::Float(x) => Some(Val::Bool(x.is_infinite())),
-            _ => None,
-        },
+        "is_nan" => float_fn!(is_nan, Bool),
+        "is_finite" => float_fn!(is_finite, Bool),
+        "is_infinite" => float_fn!(is_infinite, Bool),
         "abs" => |v| match v {
             Val::Float(x) => Some(Val::Float(x.abs())),
             Val::Int(i) => i.checked_abs().map(Val::Int),
@@ -739,11 +660,7 @@ fn unary_fn(name: &str) -> Option<UnaryFn> {
             Val::Int(i) => Some(Val::Int(i.signum())),
             _ => None,
         },
-        "to_float" => |v| match v {
-            Val::Float(x) => Some(Val::Float(x)),
-            Val::Int(i) => Some(Val::Float(i as f64)),
-            _ => None,
-        },
+        "to_float" => |v| v.number().map(Val::Float),
         "to_int" => |v| match v {
             Val::Int(i) => Some(Val::Int(i)),
             Val::Float(x) if x > i64::MAX as f64 || x < i64::MIN as f64 => None,
@@ -757,18 +674,9 @@ fn unary_fn(name: &str) -> Option<UnaryFn> {
 /// Two-argument functions.
 fn binary_fn(name: &str) -> Option<BinaryFn> {
     Some(match name {
-        "atan" => |a, b| match (a, b) {
-            (Val::Float(x), Val::Float(y)) => Some(Val::Float(x.atan2(y))),
-            _ => None,
-        },
-        "hypot" => |a, b| match (a, b) {
-            (Val::Float(x), Val::Float(y)) => Some(Val::Float(x.hypot(y))),
-            _ => None,
-        },
-        "log" => |a, b| match (a, b) {
-            (Val::Float(x), Val::Float(y)) => Some(Val::Float(x.log(y))),
-            _ => None,
-        },
+        "atan" => float_fn!(2 atan2),
+        "hypot" => float_fn!(2 hypot),
+        "log" => float_fn!(2 log),
         "max" => |a, b| pick(a, b, |x, y| x >= y, |x, y| x >= y),
         "min" => |a, b| pick(a, b, |x, y| x <= y, |x, y| x <= y),
         _ => return None,
@@ -778,12 +686,9 @@ fn binary_fn(name: &str) -> Option<BinaryFn> {
 /// rhai's `max`/`min`: `if keep_first(x, y) { x } else { y }`, integers mixed with floats
 /// converted to float first.
 fn pick(a: Val, b: Val, int: fn(i64, i64) -> bool, float: fn(f64, f64) -> bool) -> Option<Val> {
-    let (x, y) = match (a, b) {
-        (Val::Int(x), Val::Int(y)) => return Some(Val::Int(if int(x, y) { x } else { y })),
-        (Val::Float(x), Val::Float(y)) => (x, y),
-        (Val::Int(x), Val::Float(y)) => (x as f64, y),
-        (Val::Float(x), Val::Int(y)) => (x, y as f64),
-        _ => return None,
-    };
+    if let (Val::Int(x), Val::Int(y)) = (a, b) {
+        return Some(Val::Int(if int(x, y) { x } else { y }));
+    }
+    let (x, y) = (a.number()?, b.number()?);
     Some(Val::Float(if float(x, y) { x } else { y }))
 }

@@ -100,7 +100,6 @@ pub struct ScriptModel {
     summary: String,
     specs: Vec<ParamSpec>,
     n_internal: usize,
-    has_rates: bool,
     has_added_mass: bool,
     has_initial: bool,
     program: SharedProgram,
@@ -219,10 +218,7 @@ impl ScriptModel {
         source: &str,
         run: &ScriptRun,
     ) -> Result<Self, ScriptError> {
-        let at = |line: Option<usize>| ScriptLocation {
-            path: path.clone(),
-            line,
-        };
+        let at = |line: Option<usize>| ScriptLocation::new(&path, line);
         let limits = run.limits();
         let ast = parse(source, &path, limits)?;
         let defined: Vec<(String, usize)> = ast
@@ -239,7 +235,6 @@ impl ScriptModel {
             summary: summary_of(source),
             specs: Vec::new(),
             n_internal: 0,
-            has_rates: has("rates", 5),
             has_added_mass: has("added_mass", 5),
             has_initial: has("initial", 1),
             program: Compiler::new().compile(&ast).into_shared(),
@@ -253,12 +248,8 @@ impl ScriptModel {
             run_used: run.counter(&path),
             force_operations: 0,
         };
-        let runtime = |e: CallError| ScriptError::Runtime {
-            at: at(e.line),
-            message: e.message,
-        };
-        let params_line = fn_line(source, "params");
-        let value = model.call("params", ()).map_err(runtime)?;
+        let params_line = model.line_of("params");
+        let value = model.call("params", ()).map_err(|e| model.load_error(e))?;
         model.specs = parse_params(value, &param_docs(source, params_line)).map_err(|message| {
             ScriptError::Params {
                 at: at(params_line),
@@ -266,11 +257,11 @@ impl ScriptModel {
             }
         })?;
         if has("n_internal", 0) {
-            model.n_internal = model.read_n_internal(source, at)?;
+            model.n_internal = model.read_n_internal()?;
         }
-        if model.n_internal > 0 && !model.has_rates {
+        if model.n_internal > 0 && !has("rates", 5) {
             return Err(ScriptError::Contract {
-                at: at(fn_line(source, "n_internal")),
+                at: at(model.line_of("n_internal")),
                 message: format!(
                     "n_internal() is {}, so the script must define fn rates(p, t, x, v, z)",
                     model.n_internal
@@ -278,30 +269,37 @@ impl ScriptModel {
             });
         }
         model.compiled = model.translate(&ast);
-        model.force_operations = model.check_at_defaults().map_err(runtime)?;
+        model.force_operations = model.check_at_defaults().map_err(|e| model.load_error(e))?;
         Ok(model)
     }
 
-    /// What `n_internal()` returns: an integer from 0 to [`MAX_INTERNAL`]; `at` places
-    /// an error.
-    fn read_n_internal(
-        &self,
-        source: &str,
-        at: impl Fn(Option<usize>) -> ScriptLocation,
-    ) -> Result<usize, ScriptError> {
+    /// The line where the script defines contract function `fname`.
+    fn line_of(&self, fname: &str) -> Option<usize> {
+        self.fn_lines
+            .iter()
+            .find_map(|(name, line)| (*name == fname).then_some(*line))
+    }
+
+    /// A call that failed while the script was loaded, placed in the script.
+    fn load_error(&self, e: CallError) -> ScriptError {
+        ScriptError::Runtime {
+            at: ScriptLocation::new(&self.path, e.line),
+            message: e.message,
+        }
+    }
+
+    /// What `n_internal()` returns: an integer from 0 to [`MAX_INTERNAL`].
+    fn read_n_internal(&self) -> Result<usize, ScriptError> {
         let value = self
             .call("n_internal", ())
-            .map_err(|e| ScriptError::Runtime {
-                at: at(e.line),
-                message: e.message,
-            })?;
+            .map_err(|e| self.load_error(e))?;
         value
             .as_int()
             .ok()
             .and_then(|n| usize::try_from(n).ok())
             .filter(|&n| n <= MAX_INTERNAL)
             .ok_or_else(|| ScriptError::Contract {
-                at: at(fn_line(source, "n_internal")),
+                at: ScriptLocation::new(&self.path, self.line_of("n_internal")),
                 message: format!(
                     "n_internal() must return an integer from 0 to {MAX_INTERNAL}, not {value}"
                 ),
@@ -311,26 +309,15 @@ impl ScriptModel {
     /// Translate the hot functions to closures; `None` if any is outside the subset.
     fn translate(&self, ast: &rhai::AST) -> Option<Compiled> {
         let names: Vec<String> = self.specs.iter().map(|s| s.name.clone()).collect();
-        let force = script_compiled::translate(ast, "force", &names, false)?;
-        let rates = if self.n_internal > 0 {
-            Some(script_compiled::translate(ast, "rates", &names, true)?)
-        } else {
-            None
-        };
-        let added_mass = if self.has_added_mass {
-            Some(script_compiled::translate(
-                ast,
-                "added_mass",
-                &names,
-                false,
-            )?)
-        } else {
-            None
+        // `Some(None)`: a function the model does not use; `None`: outside the subset.
+        let optional = |used: bool, fname: &str, arrays: bool| {
+            used.then(|| script_compiled::translate(ast, fname, &names, arrays))
+                .map_or(Some(None), |compiled| compiled.map(Some))
         };
         Some(Compiled {
-            force,
-            rates,
-            added_mass,
+            force: script_compiled::translate(ast, "force", &names, false)?,
+            rates: optional(self.n_internal > 0, "rates", true)?,
+            added_mass: optional(self.has_added_mass, "added_mass", false)?,
         })
     }
 
@@ -393,15 +380,10 @@ impl ScriptModel {
             .run_used
             .fetch_add(used, Ordering::Relaxed)
             .saturating_add(used);
-        let fn_line = || {
-            self.fn_lines
-                .iter()
-                .find_map(|(name, line)| (*name == fname).then_some(*line))
-        };
         let value = result
             .map_err(|e| describe(*e, fname, &self.limits, used))
             .map_err(|e| CallError {
-                line: e.line.or_else(fn_line),
+                line: e.line.or_else(|| self.line_of(fname)),
                 message: e.message,
             })?;
         // Calls running in parallel each stay within what was left when they started; the
@@ -409,7 +391,7 @@ impl ScriptModel {
         // its calls need more than the budget.
         if total > self.limits.run_operations {
             return Err(CallError {
-                line: fn_line(),
+                line: self.line_of(fname),
                 message: format!("{} (in fn {fname})", run_budget_message(&self.limits)),
             });
         }
@@ -452,7 +434,7 @@ impl ScriptModel {
             (Some(c), "added_mass") => c.added_mass.as_ref(),
             _ => None,
         };
-        if let Some(f) = compiled.and_then(|c| c.number(p, s.t, s.x, s.v, s.z)) {
+        if let Some(f) = compiled.and_then(|c| c.number(p, s)) {
             return Ok(f);
         }
         let value = self.call(fname, self.args(p, s))?;
@@ -469,7 +451,7 @@ impl ScriptModel {
         let f = self.eval_number("force", p, s)?;
         if self.n_internal > 0 {
             let rates = self.compiled.as_ref().and_then(|c| c.rates.as_ref());
-            if rates.is_some_and(|r| r.array(p, s.t, s.x, s.v, s.z, dz).is_some()) {
+            if rates.is_some_and(|r| r.array(p, s, dz).is_some()) {
                 return Ok(f);
             }
             let value = self.call("rates", self.args(p, s))?;
@@ -558,10 +540,7 @@ fn parse(source: &str, path: &str, limits: &ScriptLimits) -> Result<rhai::AST, S
     let mut ast = sandbox::engine()
         .compile(source)
         .map_err(|e| ScriptError::Syntax {
-            at: ScriptLocation {
-                path: path.to_string(),
-                line: e.1.line(),
-            },
+            at: ScriptLocation::new(path, e.1.line()),
             message: e.0.to_string(),
         })?;
     script_size::check_ast(&ast, limits).map_err(too_large)?;
@@ -577,15 +556,11 @@ fn check_contract(
     at: impl Fn(Option<usize>) -> ScriptLocation,
 ) -> Result<(), ScriptError> {
     for &(fname, arity, signature, required) in CONTRACT {
-        let arities: Vec<usize> = defined
-            .iter()
-            .filter(|(n, _)| n == fname)
-            .map(|(_, a)| *a)
-            .collect();
-        if arities.contains(&arity) {
+        let mut arities = defined.iter().filter(|(n, _)| n == fname).map(|(_, a)| *a);
+        if arities.clone().any(|a| a == arity) {
             continue;
         }
-        if let Some(&wrong) = arities.first() {
+        if let Some(wrong) = arities.next() {
             return Err(ScriptError::Contract {
                 at: at(fn_line(source, fname)),
                 message: format!("fn {fname} takes {wrong} argument(s); it must be fn {signature}"),
@@ -644,8 +619,7 @@ fn run_budget_message(limits: &ScriptLimits) -> String {
 
 /// A runtime error as line + message, from the innermost function call that failed; `used`
 /// is the operations the call performed.
-fn describe(err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
-    let mut err = err;
+fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
     let mut line = err.position().line();
     let mut callee = fname.to_string();
     while let EvalAltResult::ErrorInFunctionCall(name, _, inner, pos) = err {
@@ -674,9 +648,8 @@ fn describe(err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")
         }
         _ => {
-            let mut e = err;
-            let _ = e.take_position();
-            e.to_string()
+            let _ = err.take_position();
+            err.to_string()
         }
     };
     CallError {

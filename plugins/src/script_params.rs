@@ -29,11 +29,9 @@ pub(crate) fn parse_params(
             "must return an object map #{{ name: [default, min, max, unit] }}, not {type_name}"
         ));
     };
-    let mut specs = Vec::with_capacity(map.len());
-    for (name, entry) in map {
-        specs.push(parse_entry(&name, entry, docs)?);
-    }
-    Ok(specs)
+    map.into_iter()
+        .map(|(name, entry)| parse_entry(&name, entry, docs))
+        .collect()
 }
 
 fn parse_entry(
@@ -48,19 +46,17 @@ fn parse_entry(
     if !(4..=5).contains(&items.len()) {
         return Err(format!("`{name}` has {} elements; {shape}", items.len()));
     }
-    let mut numbers = [0.0; 3];
-    for (slot, (item, what)) in numbers
-        .iter_mut()
-        .zip(items.iter().zip(["default", "min", "max"]))
-    {
-        *slot = to_f64(item).filter(|v| !v.is_nan()).ok_or_else(|| {
+    // `items` has four or five elements (checked above).
+    let number = |i: usize, what: &str| {
+        let item = &items[i];
+        to_f64(item).filter(|v| !v.is_nan()).ok_or_else(|| {
             format!(
                 "`{name}`: {what} must be a number, not {}",
                 item.type_name()
             )
-        })?;
-    }
-    let [default, min, max] = numbers;
+        })
+    };
+    let (default, min, max) = (number(0, "default")?, number(1, "min")?, number(2, "max")?);
     if !(min <= default && default <= max) {
         return Err(format!(
             "`{name}`: need min <= default <= max, got default {default}, min {min}, max {max}"

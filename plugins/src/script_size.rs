@@ -35,8 +35,17 @@ pub(crate) fn check_ast(ast: &AST, limits: &ScriptLimits) -> Result<(), String> 
     let (mut nodes, mut constants) = (0usize, 0usize);
     ast.walk(&mut |path: &[ASTNode]| {
         nodes += 1;
-        if let Some(ASTNode::Expr(e)) = path.last() {
-            constants += usize::from(is_constant(e));
+        // A literal constant: each one is a search of the compiler's pool.
+        if let Some(ASTNode::Expr(
+            Expr::DynamicConstant(..)
+            | Expr::BoolConstant(..)
+            | Expr::IntegerConstant(..)
+            | Expr::FloatConstant(..)
+            | Expr::CharConstant(..)
+            | Expr::StringConstant(..),
+        )) = path.last()
+        {
+            constants += 1;
         }
         nodes <= limits.max_nodes && constants <= limits.max_constants
     });
@@ -53,17 +62,4 @@ pub(crate) fn check_ast(ast: &AST, limits: &ScriptLimits) -> Result<(), String> 
         ));
     }
     Ok(())
-}
-
-/// Whether an expression is a literal constant (each one is a search of the compiler's pool).
-fn is_constant(e: &Expr) -> bool {
-    matches!(
-        e,
-        Expr::DynamicConstant(..)
-            | Expr::BoolConstant(..)
-            | Expr::IntegerConstant(..)
-            | Expr::FloatConstant(..)
-            | Expr::CharConstant(..)
-            | Expr::StringConstant(..)
-    )
 }

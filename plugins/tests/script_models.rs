@@ -11,7 +11,7 @@ use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::physics::param_spec::defaults;
 use stf_core::simulate::{Simulation, Trajectory};
-use stf_plugins::registry::{check_script, Registry};
+use stf_plugins::registry::Registry;
 use stf_plugins::{ScriptError, ScriptLimits, ScriptModel, ScriptRun};
 
 mod support;
@@ -520,9 +520,9 @@ fn check_script_gives_params_or_the_error() {
         format!("{PARAMS}fn force(p, t, x, v, z) {{ p.c * v }}"),
     )
     .unwrap();
-    assert_eq!(check_script(&good).unwrap()[0].name, "c");
+    assert_eq!(ScriptModel::load(&good).unwrap().params()[0].name, "c");
     let bad = dir.path().join("bad.rhai");
     std::fs::write(&bad, format!("{PARAMS}fn force(p, t, x) {{ 0.0 }}")).unwrap();
-    let e = check_script(&bad).unwrap_err().to_string();
+    let e = ScriptModel::load(&bad).unwrap_err().to_string();
     assert!(e.contains("bad.rhai:2"), "{e}");
 }
