@@ -462,6 +462,23 @@ fn split_chain(flags: ASTFlags, rest: &Expr) -> Option<(&Expr, ChainRest<'_>)> {
     })
 }
 
+/// Binary operators rhai evaluates with its built-in fast path.
+#[derive(Clone, Copy)]
+enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Rem,
+    Pow,
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
 fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
     if args.len() == 1 {
         let a = args.pop()?;
@@ -478,12 +495,26 @@ fn operator(token: &Token, mut args: Vec<Node>) -> Option<Node> {
             _ => None,
         };
     }
-    // The binary operators are those `float_op` knows.
-    if args.len() != 2 || float_op(token, 0.0, 0.0).is_none() {
+    let op = match token {
+        Token::Plus => BinOp::Add,
+        Token::Minus => BinOp::Sub,
+        Token::Multiply => BinOp::Mul,
+        Token::Divide => BinOp::Div,
+        Token::Modulo => BinOp::Rem,
+        Token::PowerOf => BinOp::Pow,
+        Token::EqualsTo => BinOp::Eq,
+        Token::NotEqualsTo => BinOp::Ne,
+        Token::LessThan => BinOp::Lt,
+        Token::LessThanEqualsTo => BinOp::Le,
+        Token::GreaterThan => BinOp::Gt,
+        Token::GreaterThanEqualsTo => BinOp::Ge,
+        _ => return None,
+    };
+    if args.len() != 2 {
         return None;
     }
-    let (op, b) = (token.clone(), args.pop()?);
-    Some(binary_node(args.pop()?, b, move |x, y| binary(&op, x, y)))
+    let b = args.pop()?;
+    Some(binary_node(args.pop()?, b, move |x, y| binary(op, x, y)))
 }
 
 /// A node applying `op` to the values of `a` and `b`; `None` from `op` bails out.
@@ -503,7 +534,7 @@ fn binary_node(
 /// rhai's built-in binary operators on the subset's types; `None` where rhai errs or
 /// dispatches to a registered function.
 #[inline]
-fn binary(op: &Token, a: Val, b: Val) -> Option<Val> {
+fn binary(op: BinOp, a: Val, b: Val) -> Option<Val> {
     match (a, b) {
         (Val::Float(x), Val::Float(y)) => float_op(op, x, y),
         (Val::Int(x), Val::Int(y)) => int_op(op, x, y),
@@ -513,16 +544,16 @@ fn binary(op: &Token, a: Val, b: Val) -> Option<Val> {
     }
 }
 
-/// A comparison on integers or bools (`false < true`); `None` for any other `op`.
+/// A comparison on integers or bools (`false < true`); `None` for an arithmetic `op`.
 #[inline]
-fn compare<T: PartialOrd>(op: &Token, x: T, y: T) -> Option<bool> {
+fn compare<T: PartialOrd>(op: BinOp, x: T, y: T) -> Option<bool> {
     Some(match op {
-        Token::EqualsTo => x == y,
-        Token::NotEqualsTo => x != y,
-        Token::LessThan => x < y,
-        Token::LessThanEqualsTo => x <= y,
-        Token::GreaterThan => x > y,
-        Token::GreaterThanEqualsTo => x >= y,
+        BinOp::Eq => x == y,
+        BinOp::Ne => x != y,
+        BinOp::Lt => x < y,
+        BinOp::Le => x <= y,
+        BinOp::Gt => x > y,
+        BinOp::Ge => x >= y,
         _ => return None,
     })
 }
@@ -530,7 +561,7 @@ fn compare<T: PartialOrd>(op: &Token, x: T, y: T) -> Option<bool> {
 /// rhai's float operators (checked build: comparisons with a relative epsilon).
 #[inline]
 #[allow(clippy::float_cmp)]
-fn float_op(op: &Token, x: f64, y: f64) -> Option<Val> {
+fn float_op(op: BinOp, x: f64, y: f64) -> Option<Val> {
     let cmp = |zero: bool, test: fn(f64, f64, f64) -> bool| {
         let m = if x * y == 0.0 {
             1.0
@@ -540,32 +571,31 @@ fn float_op(op: &Token, x: f64, y: f64) -> Option<Val> {
         Val::Bool(if m == 0.0 { zero } else { test(x, y, m) })
     };
     Some(match op {
-        Token::Plus => Val::Float(x + y),
-        Token::Minus => Val::Float(x - y),
-        Token::Multiply => Val::Float(x * y),
-        Token::Divide => Val::Float(x / y),
-        Token::Modulo => Val::Float(x % y),
-        Token::PowerOf => Val::Float(x.powf(y)),
-        Token::EqualsTo => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
-        Token::NotEqualsTo => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
-        Token::GreaterThan => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
-        Token::GreaterThanEqualsTo => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
-        Token::LessThan => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
-        Token::LessThanEqualsTo => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
-        _ => return None,
+        BinOp::Add => Val::Float(x + y),
+        BinOp::Sub => Val::Float(x - y),
+        BinOp::Mul => Val::Float(x * y),
+        BinOp::Div => Val::Float(x / y),
+        BinOp::Rem => Val::Float(x % y),
+        BinOp::Pow => Val::Float(x.powf(y)),
+        BinOp::Eq => cmp(true, |x, y, m| (x - y).abs() / m <= f64::EPSILON),
+        BinOp::Ne => cmp(false, |x, y, m| (x - y).abs() / m > f64::EPSILON),
+        BinOp::Gt => cmp(false, |x, y, m| (x - y) / m > f64::EPSILON),
+        BinOp::Ge => cmp(true, |x, y, m| (x - y) / m > -f64::EPSILON),
+        BinOp::Lt => cmp(false, |x, y, m| (y - x) / m > f64::EPSILON),
+        BinOp::Le => cmp(true, |x, y, m| (y - x) / m > -f64::EPSILON),
     })
 }
 
 /// rhai's checked integer operators; `None` where rhai raises an error.
 #[inline]
-fn int_op(op: &Token, x: i64, y: i64) -> Option<Val> {
+fn int_op(op: BinOp, x: i64, y: i64) -> Option<Val> {
     Some(match op {
-        Token::Plus => Val::Int(x.checked_add(y)?),
-        Token::Minus => Val::Int(x.checked_sub(y)?),
-        Token::Multiply => Val::Int(x.checked_mul(y)?),
-        Token::Divide => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
-        Token::Modulo => Val::Int(x.checked_rem(y)?),
-        Token::PowerOf => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
+        BinOp::Add => Val::Int(x.checked_add(y)?),
+        BinOp::Sub => Val::Int(x.checked_sub(y)?),
+        BinOp::Mul => Val::Int(x.checked_mul(y)?),
+        BinOp::Div => Val::Int(if y == 0 { None } else { x.checked_div(y) }?),
+        BinOp::Rem => Val::Int(x.checked_rem(y)?),
+        BinOp::Pow => Val::Int(x.checked_pow(u32::try_from(y).ok()?)?),
         _ => Val::Bool(compare(op, x, y)?),
     })
 }
