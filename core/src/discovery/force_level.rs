@@ -21,10 +21,8 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
-use super::force_subset_fit::{fit_subset, residuals};
 use super::holdout::HoldoutSplit;
 use super::level::Level;
-use super::progress::DiscoveryEvent;
 use super::score::CandidateScore;
 use super::search;
 use super::search_model::SearchModel;
@@ -35,13 +33,14 @@ use crate::physics::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
 impl SearchModel {
-    /// The force fit of this stage starting from its values (clamped into the bounds).
+    /// The force fit of this stage starting from its values, clamped into the bounds. A value
+    /// on a bound is moved inside by the fit's bound transform; any other value is the start
+    /// as it is. (This used to move values 1 % of the width below an upper bound, so a refit
+    /// from a training fit with `p` = 3 started elsewhere; the stall it worked around was the
+    /// transform moving interior starts, now fixed.)
     fn force_fit(&self, settings: &DiscoverySettings) -> Result<ForceFit, DiscoveryError> {
         let model = self.model()?;
-        let mut fit = ForceFit::new(model.clone()).settings(settings.fit.clone());
-        for (spec, &v) in model.params().iter().zip(&self.values) {
-            fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
-        }
+        let mut fit = started_fit(&model, &self.values).settings(settings.fit.clone());
         if settings.fit_offset {
             let start = self
                 .values
@@ -53,31 +52,15 @@ impl SearchModel {
         Ok(fit)
     }
 
-    /// Fit on `subset`; the stage with the fitted values, and the fit.
-    fn fit(
-        &self,
-        data: &ForceData,
-        subset: &[usize],
-        settings: &DiscoverySettings,
-    ) -> Result<(SearchModel, ForceFit, FitResult), DiscoveryError> {
-        let fit = self.force_fit(settings)?;
-        let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
-        Ok((stage, fit, result))
-    }
-
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
     /// restarted from its default, or `None` when none does. A parameter pinned on a bound by
     /// the fit of a model that lacked an effect (n = 1 for a power law absorbing a yield
     /// force) hardly leaves it when the effect is added: the bound map is flat there.
     fn released(&self) -> Option<SearchModel> {
-        let specs: Vec<crate::physics::param_spec::ParamSpec> = self
-            .parts
-            .iter()
-            .flat_map(|p| p.params().to_vec())
-            .collect();
+        let specs = self.parts.iter().flat_map(|p| p.params());
         let mut values = self.values.clone();
         let mut any = false;
-        for (spec, v) in specs.iter().zip(values.iter_mut()) {
+        for (spec, v) in specs.zip(values.iter_mut()) {
             let tol = 1e-9 * (spec.max - spec.min).abs();
             let pinned = (*v - spec.min).abs() <= tol || (*v - spec.max).abs() <= tol;
             if pinned && *v != spec.default {
@@ -90,32 +73,18 @@ impl SearchModel {
             values,
         })
     }
+}
 
-    /// The force noise floor of this stage at its values: the sensor's `sensor` (N) with the
-    /// kinematics' noise of `settings.motion_noise` propagated through the model.
-    fn noise_floor(
-        &self,
-        data: &ForceData,
-        sensor: f64,
-        settings: &DiscoverySettings,
-    ) -> Result<NoiseFloor, DiscoveryError> {
-        let Some(motion) = settings.motion_noise else {
-            return Ok(NoiseFloor::force(sensor, 0.0));
-        };
-        let fit = self.force_fit(settings)?;
-        fit.noise_floor(data, &self.values, sensor, motion)
-            .map_err(|e| self.fit_error(e))
-    }
-
-    /// Measured minus modelled force at every sample.
-    fn residuals(
-        &self,
-        data: &ForceData,
-        settings: &DiscoverySettings,
-    ) -> Result<Vec<f64>, DiscoveryError> {
-        let fit = self.force_fit(settings)?;
-        residuals(&fit, data, &self.values).map_err(|e| self.fit_error(e))
-    }
+/// The force fit of `model` from `values` (its parameters', each clamped into its bounds).
+pub(super) fn started_fit(model: &Arc<dyn ForceModel>, values: &[f64]) -> ForceFit {
+    let fit = ForceFit::new(model.clone());
+    model
+        .params()
+        .iter()
+        .zip(values)
+        .fold(fit, |fit, (spec, &v)| {
+            fit.param(FitParam::from_spec(spec).value(v.clamp(spec.min, spec.max)))
+        })
 }
 
 /// The start values of `model`'s parameters for adding it to a model whose residual over
@@ -405,9 +374,10 @@ impl<'a> ForceLevel<'a> {
 }
 
 impl Level for ForceLevel<'_> {
-    fn said(&self) -> &'static Said {
-        &choice::FORCE
-    }
+    const SAID: &'static Said = &choice::FORCE;
+    /// From the defaults: the training fit of the base as it stood.
+    const FIRST_FROM_FIT: bool = false;
+    const RECHECK: bool = true;
 
     fn settings(&self) -> &DiscoverySettings {
         self.settings
@@ -435,12 +405,23 @@ impl Level for ForceLevel<'_> {
         subset: &[usize],
         settings: &DiscoverySettings,
     ) -> Result<(SearchModel, FitResult), DiscoveryError> {
-        let (stage, _, result) = stage.fit(self.data, subset, settings)?;
-        Ok((stage, result))
+        let fit = stage.force_fit(settings)?;
+        stage.fitted(fit.fit_rows(self.data, Some(subset), &settings.fit, None))
     }
 
+    /// Measured minus modelled force at every sample.
     fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError> {
-        stage.residuals(self.data, self.settings)
+        let fit = stage.force_fit(self.settings)?;
+        let predicted = fit
+            .predict(self.data, &stage.values)
+            .map_err(|e| stage.fit_error(e))?;
+        Ok(self
+            .data
+            .f
+            .iter()
+            .zip(&predicted)
+            .map(|(m, p)| m - p)
+            .collect())
     }
 
     /// The held-out samples' residuals.
@@ -448,14 +429,15 @@ impl Level for ForceLevel<'_> {
         self.split.holdout.iter().map(|&i| r[i]).collect()
     }
 
-    /// From the defaults: the training fit of the base as it stood.
-    fn first_trial(&self, start: &SearchModel, _: &SearchModel) -> Result<Trial, DiscoveryError> {
-        self.trial(start, self.settings)
-    }
-
-    /// The force sensor's noise with the kinematics' propagated through the model.
+    /// The force sensor's noise with the kinematics' noise of `settings.motion_noise`
+    /// propagated through the model at its values.
     fn floor(&self, stage: &SearchModel) -> Result<NoiseFloor, DiscoveryError> {
-        stage.noise_floor(self.data, self.sensor, self.settings)
+        let Some(motion) = self.settings.motion_noise else {
+            return Ok(NoiseFloor::force(self.sensor, 0.0));
+        };
+        let fit = stage.force_fit(self.settings)?;
+        fit.noise_floor(self.data, &stage.values, self.sensor, motion)
+            .map_err(|e| stage.fit_error(e))
     }
 
     fn gap(
@@ -534,7 +516,7 @@ impl Level for ForceLevel<'_> {
                 });
                 let n_own = c.model.params().len();
                 let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
-                emit_scored(settings, step, Some(&s));
+                settings.observer.scored(step, &s.0);
                 s
             })
             .collect())
@@ -558,10 +540,6 @@ impl Level for ForceLevel<'_> {
         best_trial(self, &starts, |start| {
             rest.inserting(part, 0, &c.model, start)
         })
-    }
-
-    fn recheck_default(&self) -> bool {
-        true
     }
 
     fn closing_notes(
@@ -625,30 +603,6 @@ fn floor_doubts(floor: &NoiseFloor, gap_after: f64, settings: &DiscoverySettings
         ));
     }
     doubts
-}
-
-/// Report the score of the candidate just tried.
-pub(super) fn emit_scored(
-    settings: &DiscoverySettings,
-    step: usize,
-    last: Option<&(CandidateScore, Option<Trial>)>,
-) {
-    if let Some((score, _)) = last {
-        settings.observer.emit(DiscoveryEvent::Scored {
-            step,
-            name: score.name.clone(),
-            holdout_rms: score.holdout_rms,
-            gain_z: score.gain_z,
-        });
-    }
-}
-
-/// `v` clamped into `[min, max]`. A value on a bound is moved inside by the fit's bound
-/// transform; any other value is the start as it is. (This used to move values 1 % of the
-/// width below an upper bound, so a refit from a training fit with `p` = 3 started elsewhere;
-/// the stall it worked around was the transform moving interior starts, now fixed.)
-pub(super) fn inside(v: f64, min: f64, max: f64) -> f64 {
-    v.clamp(min, max)
 }
 
 #[cfg(test)]

@@ -76,6 +76,23 @@ pub(super) fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
     out
 }
 
+/// RMS of `r` over the samples `subset` (0 for an empty subset).
+pub(crate) fn rms_over(r: &[f64], subset: &[usize]) -> f64 {
+    if subset.is_empty() {
+        return 0.0;
+    }
+    let ss: f64 = subset.iter().map(|&i| r[i] * r[i]).sum();
+    (ss / subset.len() as f64).sqrt()
+}
+
+/// RMS of all of `r` (0 when empty).
+pub(crate) fn rms(r: &[f64]) -> f64 {
+    if r.is_empty() {
+        return 0.0;
+    }
+    (r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

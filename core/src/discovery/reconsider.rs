@@ -127,7 +127,7 @@ impl<L: Level> Recheck<'_, L> {
             &step,
             [&old_name, &new_name, with],
             (&score, tie),
-            self.level.said(),
+            L::SAID,
             settings,
         );
         step.accepted = Some(new_name.clone());

@@ -4,7 +4,7 @@
 //! continues on the whole record ([`scouted`]).
 
 use super::choice::Trial;
-use super::force_subset_fit::rms_over;
+use super::holdout::rms_over;
 use super::scout::Scout;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;

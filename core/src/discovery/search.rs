@@ -17,7 +17,7 @@ use super::candidate::{self, Candidate};
 use super::choice::{self, Trial};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
-use super::force_subset_fit::rms;
+use super::holdout::rms;
 use super::level::Level;
 use super::progress::DiscoveryEvent;
 use super::reconsider::reconsider;
@@ -67,14 +67,14 @@ pub(super) fn discover<L: Level>(
             Ok::<_, DiscoveryError>(choice::decide(
                 &current,
                 scored,
-                level.said(),
+                L::SAID,
                 yardstick,
                 settings,
             ))
         })??;
         notes.push(step.verdict.clone());
-        if level.warns_unresolved() {
-            notes.extend(choice::unresolved(&step, level.said()));
+        if L::WARNS_UNRESOLVED {
+            notes.extend(choice::unresolved(&step, L::SAID));
         }
         effects.extend(step.accepted.clone());
         steps.push(step);
@@ -116,7 +116,7 @@ fn base_fit<L: Level>(
     let (stage, result) = level.fit(&start, &all, settings)?;
     let floor = level.floor(&stage)?;
     let (residual, location) = level.gap(&stage, &floor)?;
-    let current = level.first_trial(&start, &stage)?;
+    let current = level.trial(if L::FIRST_FROM_FIT { &stage } else { &start }, settings)?;
     let base_excess = level.base_excess(&current, &floor)?;
     Ok(BaseFit {
         stage,
@@ -222,7 +222,7 @@ fn final_refit<L: Level>(
     let refit_rms = rms(&level.residual(&refit)?);
     let start_rms = rms(&level.residual(&current.stage)?);
     if start_rms < refit_rms {
-        let said = level.said();
+        let said = L::SAID;
         notes.push(format!(
             "the whole-record refit ended worse ({:.4} {}) than the training fit it started \
              from ({:.4} {}); the training fit's values are kept",

@@ -36,8 +36,7 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::{Discovery, TrajectoryPart};
 use super::force_gap::GapLocation;
-use super::force_subset_fit::rms;
-use super::holdout::{cycle_rms, HoldoutSplit};
+use super::holdout::{cycle_rms, rms, HoldoutSplit};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout::Scout;
@@ -154,9 +153,12 @@ impl<'a> TrajectoryLevel<'a> {
 }
 
 impl Level for TrajectoryLevel<'_> {
-    fn said(&self) -> &'static Said {
-        &choice::DISPLACEMENT
-    }
+    const SAID: &'static Said = &choice::DISPLACEMENT;
+    /// From the base's whole-record fit: from the defaults it can end in a basin of its
+    /// own, and every candidate would then be scored against that.
+    const FIRST_FROM_FIT: bool = true;
+    const POLISH: bool = true;
+    const WARNS_UNRESOLVED: bool = true;
 
     fn n_before(&self) -> usize {
         self.setup.fit.free.len()
@@ -241,16 +243,6 @@ impl Level for TrajectoryLevel<'_> {
     /// Each held-out cycle's RMS: the cycle is the unit of evidence.
     fn held_out(&self, r: &[f64]) -> Vec<f64> {
         cycle_rms(r, &self.split.holdout)
-    }
-
-    /// From the base's whole-record fit: from the defaults it can end in a basin of its
-    /// own, and every candidate would then be scored against that.
-    fn first_trial(
-        &self,
-        _: &SearchModel,
-        base_full: &SearchModel,
-    ) -> Result<Trial, DiscoveryError> {
-        self.trial(base_full, self.settings)
     }
 
     /// The displacement noise, whatever the model.
@@ -342,14 +334,6 @@ impl Level for TrajectoryLevel<'_> {
         let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
         let stage = rest.inserting(part, self.n_before(), &c.model, &defaults);
         self.trial(&stage, &trial_settings(self.settings))
-    }
-
-    fn polish_default(&self) -> bool {
-        true
-    }
-
-    fn warns_unresolved(&self) -> bool {
-        true
     }
 
     /// Levenberg–Marquardt alone, from the training fit (near the optimum).

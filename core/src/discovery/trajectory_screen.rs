@@ -7,14 +7,13 @@
 use rayon::prelude::*;
 
 use super::choice::Trial;
-use super::force_level::inside;
-use super::force_subset_fit::fit_subset;
+use super::force_level::started_fit;
 use super::search_model::SearchModel;
 use super::trajectory_setup::ForceHint;
 use super::trajectory_subset_fit::Rig;
 use super::trajectory_trials::Trials;
 use crate::data::force_data::ForceData;
-use crate::fit::{FitParam, FitSettings, ForceFit, Solver};
+use crate::fit::{FitSettings, Solver};
 
 impl SearchModel {
     /// This stage with its model's parameters fitted at force level to the recovered force of
@@ -56,14 +55,11 @@ impl SearchModel {
         // model's own, so the screen's gains are not lost to a poor start.
         let mut nested = current.to_vec();
         if let Some((i, spec)) = self.amplitude(n_osc) {
-            nested[i - n_osc] = inside(1e-3 * spec.default, spec.min, spec.max);
+            nested[i - n_osc] = (1e-3 * spec.default).clamp(spec.min, spec.max);
         }
         for start in [current, nested.as_slice(), defaults.as_slice()] {
-            let mut fit = ForceFit::new(model.clone());
-            for (spec, &v) in model.params().iter().zip(start) {
-                fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
-            }
-            let Ok(r) = fit_subset(&fit, &data, &subset, &settings) else {
+            let fit = started_fit(&model, start);
+            let Ok(r) = fit.fit_rows(&data, Some(&subset), &settings, None) else {
                 continue;
             };
             if best.as_ref().is_none_or(|(rms, _)| r.rms < *rms) {

@@ -2,8 +2,7 @@
 //! effect's amplitude on three bases, the best after a short fit
 //! ([`SearchModel::starts`], [`SearchModel::started`]).
 
-use super::force_level::inside;
-use super::force_subset_fit::rms_over;
+use super::holdout::rms_over;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_setup::TrajectorySetup;
@@ -63,7 +62,7 @@ impl SearchModel {
             if let Some(((i, spec), model)) = &screen {
                 let mut values = values;
                 for f in SCREEN {
-                    values[*i] = inside(spec.default * f, spec.min, spec.max);
+                    values[*i] = (spec.default * f).clamp(spec.min, spec.max);
                     if let Ok(residual) = track.residual(model, &values) {
                         let s = rms_over(&residual, train);
                         if s < best.0 {

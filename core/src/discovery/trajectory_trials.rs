@@ -9,7 +9,6 @@ use rayon::prelude::*;
 use super::candidate::Candidate;
 use super::choice::{self, Trial, Yardstick};
 use super::error::DiscoveryError;
-use super::force_level::{emit_scored, inside};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout_ranking::{left_out, scouted};
@@ -33,11 +32,11 @@ impl SearchModel {
         let mut values = self.values.iter().copied();
         for p in &setup.fit.free {
             let v = values.next().unwrap_or(p.value);
-            out.push(p.clone().value(inside(v, p.min, p.max)));
+            out.push(p.clone().value(v.clamp(p.min, p.max)));
         }
         for spec in model.params() {
             let v = values.next().unwrap_or(spec.default);
-            out.push(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
+            out.push(FitParam::from_spec(spec).value(v.clamp(spec.min, spec.max)));
         }
         if let Some(v) = values.next() {
             out.push(
@@ -171,7 +170,7 @@ impl Trials<'_, '_> {
                     return (choice::failed(&c.name, why), None);
                 }
                 let s = self.scored(c, stage.clone(), current);
-                emit_scored(self.level.settings, step, Some(&s));
+                self.level.settings.observer.scored(step, &s.0);
                 s
             })
             .collect()
