@@ -1,5 +1,5 @@
 //! Which scouted candidates are tried on the whole record ([`super::scout`]): each ranked by
-//! the gain of its scout fit ([`Trials::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
+//! the gain of its scout fit ([`TrajectoryLevel::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
 //! their gain is a small share of the best one's ([`left_out`]); and where a scouted fit
 //! continues on the whole record ([`scouted`]).
 
@@ -8,17 +8,17 @@ use super::holdout::rms_over;
 use super::scout::Scout;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
+use super::trajectory_level::TrajectoryLevel;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::{Rig, Track};
-use super::trajectory_trials::Trials;
 use crate::regimes::Cycle;
 
 /// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
-/// out by their fits on the scout (see [`Trials::step`]).
+/// out by their fits on the scout (see [`TrajectoryLevel::scores`]).
 pub(super) const SCOUT_KEEP: usize = 3;
 
 /// The least share of the best candidate's gain on the scout for a candidate to be tried on
-/// the whole record in a scouted step (see [`Trials::step`]). A candidate that lowers the
+/// the whole record in a scouted step (see [`TrajectoryLevel::scores`]). A candidate that lowers the
 /// scout's mean square by a fraction of what the best one does cannot win the step unless
 /// the best one fails on the whole record; on Silverbox's 100 000 samples `jamming_on_off`
 /// (5 % of the excess explained) cost more than the two cubic springs' trials together.
@@ -78,7 +78,7 @@ pub(super) fn scout_of<'r>(
     Scout::new(rig, cycles, train)
 }
 
-impl Trials<'_, '_> {
+impl TrajectoryLevel<'_> {
     /// Each searched candidate's rank among them by the gain of its scout fit over the
     /// current model on the scout, their number and the gain (mean square, m²); all `None`
     /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
@@ -89,7 +89,7 @@ impl Trials<'_, '_> {
     ) -> Vec<Option<(usize, usize, f64)>> {
         let mut out = vec![None; searched.len()];
         let of = searched.iter().flatten().count();
-        let Some(scout) = self.level.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
+        let Some(scout) = self.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
             return out;
         };
         let Ok(model) = current.stage.model() else {

@@ -48,7 +48,7 @@ use super::trajectory_gap::locate_x_gap;
 use super::trajectory_screen::SCREEN_MIN_SAMPLES;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::Rig;
-use super::trajectory_trials::{trial_settings, Trials};
+use super::trajectory_trials::trial_settings;
 use crate::fit::{check_same_terms, FitResult, NoiseFloor, TrajectoryData};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::physics::oscillator_params::{OscParam, OscillatorParams};
@@ -316,11 +316,7 @@ impl Level for TrajectoryLevel<'_> {
         current: &Trial,
         yardstick: &Yardstick,
     ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
-        let trials = Trials {
-            level: self,
-            yardstick,
-        };
-        Ok(trials.step(step, tried, current))
+        Ok(self.scores(step, tried, current, yardstick))
     }
 
     /// From the candidate's defaults, at most `TRIAL_ITERS` iterations.

@@ -1,6 +1,6 @@
 //! A trajectory-level step's trials: a stage simulated and fitted on a [`Track`] (the whole
 //! record or the scout), and every candidate of a step searched, screened and scored
-//! ([`Trials::step`]); the trial itself is the one of [`Level::trial`].
+//! ([`TrajectoryLevel::scores`]); the trial itself is the one of [`Level::trial`].
 
 use std::sync::Arc;
 
@@ -88,13 +88,7 @@ pub(super) const TRIAL_ITERS: u64 = 60;
 /// scout (see [`super::scout`]).
 pub(super) const SCOUTED_TRIAL_ITERS: u64 = 15;
 
-/// What every candidate trial of a step shares: the level and the step's yardstick.
-pub(super) struct Trials<'a, 'r> {
-    pub level: &'a TrajectoryLevel<'r>,
-    pub yardstick: &'a Yardstick<'a>,
-}
-
-impl Trials<'_, '_> {
+impl TrajectoryLevel<'_> {
     /// The scores of the candidates `tried` against `current` in `step`, in their order.
     ///
     /// A screen first (when the setup has a force hint): each candidate, added to the current
@@ -107,13 +101,14 @@ impl Trials<'_, '_> {
     /// hundreds of simulations. On a scouted record each candidate's values are searched on
     /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
     /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
-    pub(super) fn step(
+    pub(super) fn scores(
         &self,
         step: usize,
         tried: &[&Candidate],
         current: &Trial,
+        yardstick: &Yardstick,
     ) -> Vec<(CandidateScore, Option<Trial>)> {
-        let n_osc = self.level.rig.oscillator.len();
+        let n_osc = self.rig.oscillator.len();
         let withs: Vec<SearchModel> = tried
             .iter()
             .map(|c| {
@@ -133,8 +128,7 @@ impl Trials<'_, '_> {
                 if screened && rank[i] >= SCREEN_KEEP {
                     return None;
                 }
-                self.level
-                    .settings
+                self.settings
                     .observer
                     .candidate(step, i, tried.len(), &tried[i].name);
                 let h = hinted[i].as_ref().map(|(s, _)| s);
@@ -169,8 +163,8 @@ impl Trials<'_, '_> {
                 ) {
                     return (choice::failed(&c.name, why), None);
                 }
-                let s = self.scored(c, stage.clone(), current);
-                self.level.settings.observer.scored(step, &s.0);
+                let s = self.scored(c, stage.clone(), current, yardstick);
+                self.settings.observer.scored(step, &s.0);
                 s
             })
             .collect()
@@ -186,22 +180,17 @@ impl Trials<'_, '_> {
         with: SearchModel,
         hinted: Option<&SearchModel>,
     ) -> (SearchModel, f64, f64) {
-        let (track, train): (&dyn Track, &[usize]) = match self.level.scout.as_ref() {
+        let (track, train): (&dyn Track, &[usize]) = match self.scout.as_ref() {
             Some(scout) => (scout, &scout.train),
-            None => (&self.level.rig, &self.level.split.train),
+            None => (&self.rig, &self.split.train),
         };
-        let starts = with.starts(track, train, &self.level.osc_start, hinted);
+        let starts = with.starts(track, train, &self.osc_start, hinted);
         let stage =
-            SearchModel::started(starts, track, self.level.setup, train, self.level.settings)
-                .unwrap_or(with);
-        match self.level.scout.as_ref() {
+            SearchModel::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
+        match self.scout.as_ref() {
             Some(scout) => {
-                let on = (
-                    &self.level.rig,
-                    self.level.setup,
-                    self.level.split.train.as_slice(),
-                );
-                scouted(stage, scout, on, &trial_settings(self.level.settings))
+                let on = (&self.rig, self.setup, self.split.train.as_slice());
+                scouted(stage, scout, on, &trial_settings(self.settings))
             }
             None => (stage, f64::INFINITY, f64::NAN),
         }
@@ -216,19 +205,20 @@ impl Trials<'_, '_> {
         c: &Candidate,
         stage: SearchModel,
         current: &Trial,
+        yardstick: &Yardstick,
     ) -> (CandidateScore, Option<Trial>) {
-        let mut settings = trial_settings(self.level.settings);
-        if self.level.scout.as_ref().is_some() {
+        let mut settings = trial_settings(self.settings);
+        if self.scout.as_ref().is_some() {
             let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
             settings.fit = settings.fit.max_iters(iters);
         }
         choice::scored(
             &c.name,
             c.model.params().len(),
-            self.level.trial(&stage, &settings),
+            self.trial(&stage, &settings),
             current,
-            self.yardstick,
-            self.level.settings,
+            yardstick,
+            self.settings,
         )
     }
 }
