@@ -122,7 +122,7 @@ impl<L: Level> Recheck<'_, L> {
         let old_name = effects[j].clone();
         let new_name = self.candidates[k].name.clone();
         let with = effects.last().map_or("", String::as_str);
-        let settings = self.level_settings();
+        let settings = self.level.settings();
         step.verdict = replaced_verdict(
             &step,
             [&old_name, &new_name, with],
@@ -139,11 +139,6 @@ impl<L: Level> Recheck<'_, L> {
         Ok(Some(step))
     }
 
-    /// The settings the step is measured with.
-    fn level_settings(&self) -> &DiscoverySettings {
-        self.level.settings()
-    }
-
     /// The candidate `c` put in the place of `replaced`, fitted and scored against `current`
     /// as `label`: its score (significant when it wins, or ties with fewer parameters and a
     /// lower BIC), its trial, and whether it is a tie rather than a win.
@@ -154,9 +149,8 @@ impl<L: Level> Recheck<'_, L> {
         current: &Trial,
         replaced: &Replaced,
     ) -> (CandidateScore, Option<Trial>, bool) {
-        let settings = self.level_settings();
-        let rest = replaced.rest;
-        let part = replaced.part;
+        let settings = self.level.settings();
+        let Replaced { rest, part, .. } = *replaced;
         let trial = match self
             .level
             .replacement_trial(c, rest, part, replaced.residual)
@@ -165,11 +159,7 @@ impl<L: Level> Recheck<'_, L> {
             Err(e) => return (choice::failed(label, e.to_string()), None, false),
         };
         // Its own parameters are not last here: take them by position.
-        let from: usize = self.level.n_before()
-            + rest.parts[..part.min(rest.parts.len())]
-                .iter()
-                .map(|p| p.params().len())
-                .sum::<usize>();
+        let from = rest.start_of(part, self.level.n_before());
         let n_own = c.model.params().len();
         let mut score = choice::score(label, 0, &trial, current, self.yardstick, settings);
         score.params = trial

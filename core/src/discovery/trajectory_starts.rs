@@ -110,8 +110,7 @@ impl SearchModel {
     pub(super) fn amplitude(&self, n_osc: usize) -> Option<(usize, ParamSpec)> {
         let extra = self.parts.last()?;
         let spec = extra.params().first()?;
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let i = (n_osc + n_model).checked_sub(extra.params().len())?;
+        let i = self.start_of(self.parts.len() - 1, n_osc);
         (spec.min >= 0.0 && spec.default > 0.0 && i < self.values.len()).then(|| (i, spec.clone()))
     }
 
