@@ -1,7 +1,7 @@
 //! The force level of discovery ([`ForceLevel`], a [`Level`] for the loop of
 //! [`super::search`]): records with a measured F_STF and kinematics, every model fitted to
 //! the force along them. Its candidates start from a small multi-start ([`candidate_starts`],
-//! [`best_trial`]); by default earlier effects are re-checked after each
+//! [`ForceLevel::best_trial`]); by default earlier effects are re-checked after each
 //! acceptance ([`super::reconsider`]) and an accepted model is not polished.
 //!
 //! Each step cuts the held-out cycles into blocks at least as long as the residual's
@@ -28,7 +28,7 @@ use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use crate::data::force_data::ForceData;
-use crate::fit::{FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
+use crate::fit::{Convergence, FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
@@ -189,7 +189,7 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
     while per > 1 && (per + 1).pow(specs.len() as u32) > GRID_MAX {
         per -= 1;
     }
-    let axes: Vec<Vec<f64>> = specs
+    specs
         .iter()
         .map(|s| {
             let lo = if s.min > 0.0 { s.min } else { 1e-4 * s.max };
@@ -208,73 +208,11 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
             }
             axis
         })
-        .collect();
-    let mut grid: Vec<Vec<f64>> = vec![Vec::new()];
-    for axis in &axes {
-        grid = grid
-            .into_iter()
-            .flat_map(|point| {
-                axis.iter().map(move |&v| {
-                    let mut p = point.clone();
-                    p.push(v);
-                    p
-                })
-            })
-            .collect();
-    }
-    grid
-}
-
-/// The trial with the lowest training RMS (a converged fit before a failed one) among those
-/// run from the stages `stage(start)` for each of the candidate's `starts`, and from the
-/// first of them [`SearchModel::released`] when a parameter of it sits on a bound: the multi-start
-/// of a candidate. Its evaluations and wall time are those of all the runs; the first run's
-/// error if every run fails.
-fn best_trial(
-    level: &ForceLevel,
-    starts: &[Vec<f64>],
-    stage: impl Fn(&[f64]) -> SearchModel,
-) -> Result<Trial, DiscoveryError> {
-    let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
-    if let Some(released) = stages.first().and_then(SearchModel::released) {
-        stages.push(released);
-    }
-    let mut best: Option<Trial> = None;
-    let mut first_error = None;
-    let (mut evaluations, mut wall) = (0, 0.0);
-    for stage in &stages {
-        match level.trial(stage, level.settings) {
-            Ok(trial) => {
-                evaluations += trial.train.evaluations;
-                wall += trial.train.wall_seconds;
-                let failed = |t: &Trial| {
-                    matches!(t.train.convergence, crate::fit::Convergence::Failed { .. })
-                };
-                let better = match &best {
-                    None => true,
-                    Some(b) => {
-                        (failed(b) && !failed(&trial))
-                            || (failed(b) == failed(&trial) && trial.train.rms < b.train.rms)
-                    }
-                };
-                if better {
-                    best = Some(trial);
-                }
-            }
-            Err(e) => {
-                first_error.get_or_insert(e);
-            }
-        }
-    }
-    match (best, first_error) {
-        (Some(mut t), _) => {
-            t.train.evaluations = evaluations;
-            t.train.wall_seconds = wall;
-            Ok(t)
-        }
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(DiscoveryError::BadSettings("no start to fit from".into())),
-    }
+        .fold(vec![Vec::new()], |grid, axis| {
+            grid.iter()
+                .flat_map(|point| axis.iter().map(|&v| [point.as_slice(), &[v]].concat()))
+                .collect()
+        })
 }
 
 /// Find the effects missing from `base` among `candidates`, at force level.
@@ -362,6 +300,46 @@ impl<'a> ForceLevel<'a> {
             sensor,
             settings,
         })
+    }
+
+    /// The trial with the lowest training RMS (a converged fit before a failed one) among
+    /// those run from the stages `stage(start)` for each of candidate `c`'s starts
+    /// ([`candidate_starts`] against the residual `r`), and from the first of them
+    /// [`SearchModel::released`] when a parameter of it sits on a bound: the multi-start of a
+    /// candidate. Its evaluations and wall time are those of all the runs; the first run's
+    /// error if every run fails.
+    fn best_trial(
+        &self,
+        c: &Candidate,
+        r: &[f64],
+        stage: impl Fn(&[f64]) -> SearchModel,
+    ) -> Result<Trial, DiscoveryError> {
+        let train = &self.split.train;
+        let starts = candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
+        let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
+        if let Some(released) = stages.first().and_then(SearchModel::released) {
+            stages.push(released);
+        }
+        let trials: Vec<Result<Trial, DiscoveryError>> = stages
+            .iter()
+            .map(|s| self.trial(s, self.settings))
+            .collect();
+        let (evaluations, wall) = trials.iter().flatten().fold((0, 0.0), |(e, w), t| {
+            (e + t.train.evaluations, w + t.train.wall_seconds)
+        });
+        let failed = |t: &Trial| matches!(t.train.convergence, Convergence::Failed { .. });
+        let best = trials
+            .into_iter()
+            .reduce(|best, next| match (&best, &next) {
+                (Err(_), Ok(_)) => next,
+                (Ok(b), Ok(t)) if (failed(t), t.train.rms) < (failed(b), b.train.rms) => next,
+                _ => best,
+            });
+        let mut best = best
+            .unwrap_or_else(|| Err(DiscoveryError::BadSettings("no start to fit from".into())))?;
+        best.train.evaluations = evaluations;
+        best.train.wall_seconds = wall;
+        Ok(best)
     }
 
     /// The blocks of the paired test for a model whose residual is `r` (every sample).
@@ -485,7 +463,7 @@ impl Level for ForceLevel<'_> {
         }))
     }
 
-    /// Each candidate a small multi-start ([`candidate_starts`], [`best_trial`]); the
+    /// Each candidate a small multi-start ([`candidate_starts`], [`ForceLevel::best_trial`]); the
     /// candidates are independent trials against the same current model: fitted in
     /// parallel, scored in their order.
     fn score_step(
@@ -495,7 +473,7 @@ impl Level for ForceLevel<'_> {
         current: &Trial,
         yardstick: &Yardstick,
     ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
-        let (data, split, settings) = (self.data, &self.split, self.settings);
+        let settings = self.settings;
         let current_residual = self.residual(&current.stage)?;
         Ok(tried
             .par_iter()
@@ -504,14 +482,7 @@ impl Level for ForceLevel<'_> {
                 settings
                     .observer
                     .candidate(step, index, tried.len(), &c.name);
-                let starts = candidate_starts(
-                    &c.model,
-                    data,
-                    &split.train,
-                    &current_residual,
-                    settings.extra_starts,
-                );
-                let best = best_trial(self, &starts, |start| {
+                let best = self.best_trial(c, &current_residual, |start| {
                     current.stage.with(&c.model, start, 0)
                 });
                 let n_own = c.model.params().len();
@@ -529,15 +500,7 @@ impl Level for ForceLevel<'_> {
         part: usize,
         residual: &[f64],
     ) -> Result<Trial, DiscoveryError> {
-        let settings = self.settings;
-        let starts = candidate_starts(
-            &c.model,
-            self.data,
-            &self.split.train,
-            residual,
-            settings.extra_starts,
-        );
-        best_trial(self, &starts, |start| {
+        self.best_trial(c, residual, |start| {
             rest.inserting(part, 0, &c.model, start)
         })
     }
