@@ -11,7 +11,6 @@ use super::settings::DiscoverySettings;
 use super::trajectory_level::TrajectoryLevel;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::{Rig, Track};
-use crate::regimes::Cycle;
 
 /// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
 /// out by their fits on the scout (see [`TrajectoryLevel::scores`]).
@@ -62,20 +61,6 @@ pub(super) fn left_out(
             current * 1e3
         )
     })
-}
-
-/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples; `None` for a
-/// shorter record, or when the record makes no scout.
-pub(super) fn scout_of<'r>(
-    rig: &Rig<'r>,
-    cycles: &[Cycle],
-    train: &[usize],
-    settings: &DiscoverySettings,
-) -> Option<Scout<'r>> {
-    if settings.scout_from == 0 || rig.t.len() < settings.scout_from {
-        return None;
-    }
-    Scout::new(rig, cycles, train)
 }
 
 impl TrajectoryLevel<'_> {
@@ -133,17 +118,14 @@ pub(super) fn scouted(
             .map_or(f64::INFINITY, |r| rms_over(&r, train))
     };
     let before = train_rms(&stage);
-    let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) else {
-        let ms = on_scout(&stage);
-        return (stage, ms, before);
-    };
-    let after = train_rms(&fitted);
-    if after < before {
-        (fitted, fit.rms * fit.rms, after)
-    } else {
-        let ms = on_scout(&stage);
-        (stage, ms, before)
+    if let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) {
+        let after = train_rms(&fitted);
+        if after < before {
+            return (fitted, fit.rms * fit.rms, after);
+        }
     }
+    let ms = on_scout(&stage);
+    (stage, ms, before)
 }
 
 #[cfg(test)]

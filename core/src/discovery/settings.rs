@@ -155,10 +155,7 @@ impl DiscoverySettings {
         self.fit
             .validate()
             .map_err(|e| DiscoveryError::BadSettings(e.to_string()))?;
-        let sigma_ok = match self.noise_sigma {
-            Some(s) => s > 0.0 && s.is_finite(),
-            None => true,
-        };
+        let sigma_ok = self.noise_sigma.is_none_or(|s| s > 0.0 && s.is_finite());
         let ok = self.holdout_every >= 2
             && self.min_gain_sigma >= 0.0
             && self.min_gain_sigma.is_finite()

@@ -40,7 +40,7 @@ use super::holdout::{cycle_rms, rms, HoldoutSplit};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout::Scout;
-use super::scout_ranking::{scout_of, scouted};
+use super::scout_ranking::scouted;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
@@ -136,7 +136,12 @@ impl<'a> TrajectoryLevel<'a> {
             x: data.x,
         };
         let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
-        let scout = scout_of(&rig, cycles, &split.train, settings);
+        // A scout only on a record of at least `scout_from` samples (none when 0), and when
+        // the record makes one.
+        let scouts = settings.scout_from > 0 && n >= settings.scout_from;
+        let scout = scouts
+            .then(|| Scout::new(&rig, cycles, &split.train))
+            .flatten();
         Ok(TrajectoryLevel {
             data,
             cycles,

@@ -56,14 +56,12 @@ impl SearchModel {
                 });
             }
         }
-        let screen = self.amplitude(osc_start.len()).zip(self.model().ok());
         let mut best = (f64::INFINITY, self.values.clone());
-        for values in self.bases(osc_start) {
-            if let Some(((i, spec), model)) = &screen {
-                let mut values = values;
+        if let Some(((i, spec), model)) = self.amplitude(osc_start.len()).zip(self.model().ok()) {
+            for mut values in self.bases(osc_start) {
                 for f in SCREEN {
-                    values[*i] = (spec.default * f).clamp(spec.min, spec.max);
-                    if let Ok(residual) = track.residual(model, &values) {
+                    values[i] = (spec.default * f).clamp(spec.min, spec.max);
+                    if let Ok(residual) = track.residual(&model, &values) {
                         let s = rms_over(&residual, train);
                         if s < best.0 {
                             best = (s, values.clone());

@@ -61,14 +61,6 @@ impl Track for Rig<'_> {
     }
 }
 
-/// The oscillator of one evaluation, its initial state and the displacement offset.
-struct RigSetup {
-    osc: Oscillator,
-    x0: f64,
-    v0: f64,
-    offset: f64,
-}
-
 /// One evaluation: the model's simulated motion and the displacement residual.
 pub(super) struct Run {
     pub sim: Trajectory,
@@ -80,13 +72,13 @@ impl Rig<'_> {
     /// Simulate `model` on the rig with the full parameter vector `values` (oscillator's,
     /// model's, offset): the whole motion and the displacement residual.
     pub fn run(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Run, String> {
-        let setup = self.setup(model, values)?;
-        let sim = Simulation::new(&setup.osc)
+        let (osc, [x0, v0], offset) = self.setup(model, values)?;
+        let sim = Simulation::new(&osc)
             .settings(self.sim.clone())
-            .initial(setup.x0, setup.v0)
+            .initial(x0, v0)
             .run_at(self.t)
             .map_err(|e| e.to_string())?;
-        let residual = self.residual_of(&sim.x, setup.offset)?;
+        let residual = self.residual_of(&sim.x, offset)?;
         Ok(Run { sim, residual })
     }
 
@@ -97,25 +89,29 @@ impl Rig<'_> {
         model: &Arc<dyn ForceModel>,
         values: &[f64],
     ) -> Result<Vec<f64>, String> {
-        let setup = self.setup(model, values)?;
+        let (osc, [x0, v0], offset) = self.setup(model, values)?;
         let Some(&t0) = self.t.first() else {
             return Ok(Vec::new());
         };
-        let y0 = setup.osc.initial_state(setup.x0, setup.v0);
-        let sol = integrate(&setup.osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
+        let y0 = osc.initial_state(x0, v0);
+        let sol = integrate(&osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
         let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
-        self.residual_of(&x, setup.offset)
+        self.residual_of(&x, offset)
     }
 
     /// The state (x0 m, v0 m/s) a simulation with `values` starts from: fitted, or the
     /// setup's estimate less the offset.
     pub fn start(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<[f64; 2], String> {
-        let setup = self.setup(model, values)?;
-        Ok([setup.x0, setup.v0])
+        Ok(self.setup(model, values)?.1)
     }
 
-    /// The oscillator with `values` set, its initial state and the offset.
-    fn setup(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<RigSetup, String> {
+    /// The oscillator with `values` set, its initial state (x0, v0) and the displacement
+    /// offset.
+    fn setup(
+        &self,
+        model: &Arc<dyn ForceModel>,
+        values: &[f64],
+    ) -> Result<(Oscillator, [f64; 2], f64), String> {
         let n_osc = self.oscillator.len();
         let n_model = model.params().len();
         if values.len() != n_osc + n_model + usize::from(self.fit_offset) {
@@ -148,12 +144,8 @@ impl Rig<'_> {
         let (x0, v0) = self
             .initial
             .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
-        Ok(RigSetup {
-            osc,
-            x0: initial[0].unwrap_or(x0 - offset),
-            v0: initial[1].unwrap_or(v0),
-            offset,
-        })
+        let start = [initial[0].unwrap_or(x0 - offset), initial[1].unwrap_or(v0)];
+        Ok((osc, start, offset))
     }
 
     /// Measured − simulated − offset, checked for length and finiteness.
