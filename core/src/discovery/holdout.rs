@@ -78,19 +78,22 @@ pub(super) fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
 
 /// RMS of `r` over the samples `subset` (0 for an empty subset).
 pub(crate) fn rms_over(r: &[f64], subset: &[usize]) -> f64 {
-    if subset.is_empty() {
-        return 0.0;
-    }
-    let ss: f64 = subset.iter().map(|&i| r[i] * r[i]).sum();
-    (ss / subset.len() as f64).sqrt()
+    rms_of(subset.iter().map(|&i| r[i])).0
 }
 
 /// RMS of all of `r` (0 when empty).
 pub(crate) fn rms(r: &[f64]) -> f64 {
-    if r.is_empty() {
-        return 0.0;
+    rms_of(r.iter().copied()).0
+}
+
+/// The RMS of `values` and how many there are ((0, 0) when there are none).
+pub(crate) fn rms_of(values: impl Iterator<Item = f64>) -> (f64, usize) {
+    let (ss, n) = values.fold((0.0, 0usize), |(ss, n), v| (ss + v * v, n + 1));
+    if n == 0 {
+        (0.0, 0)
+    } else {
+        ((ss / n as f64).sqrt(), n)
     }
-    (r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64).sqrt()
 }
 
 #[cfg(test)]

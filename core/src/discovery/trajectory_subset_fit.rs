@@ -50,8 +50,17 @@ pub(super) trait Track: Sync {
 }
 
 impl Track for Rig<'_> {
+    /// The displacement residual alone, at the cost of the integration only: what a fit
+    /// evaluates.
     fn residual(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String> {
-        Rig::residual(self, model, values)
+        let (osc, [x0, v0], offset) = self.setup(model, values)?;
+        let Some(&t0) = self.t.first() else {
+            return Ok(Vec::new());
+        };
+        let y0 = osc.initial_state(x0, v0);
+        let sol = integrate(&osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
+        let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
+        self.residual_of(&x, offset)
     }
     fn rtol(&self) -> f64 {
         self.sim.rtol
@@ -80,23 +89,6 @@ impl Rig<'_> {
             .map_err(|e| e.to_string())?;
         let residual = self.residual_of(&sim.x, offset)?;
         Ok(Run { sim, residual })
-    }
-
-    /// The displacement residual alone (measured − simulated − offset at every sample, m), at
-    /// the cost of the integration only: what a fit evaluates.
-    pub fn residual(
-        &self,
-        model: &Arc<dyn ForceModel>,
-        values: &[f64],
-    ) -> Result<Vec<f64>, String> {
-        let (osc, [x0, v0], offset) = self.setup(model, values)?;
-        let Some(&t0) = self.t.first() else {
-            return Ok(Vec::new());
-        };
-        let y0 = osc.initial_state(x0, v0);
-        let sol = integrate(&osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
-        let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
-        self.residual_of(&x, offset)
     }
 
     /// The state (x0 m, v0 m/s) a simulation with `values` starts from: fitted, or the
