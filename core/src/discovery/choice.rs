@@ -205,14 +205,10 @@ pub(super) fn failed(name: &str, why: String) -> CandidateScore {
         delta_bic: f64::NAN,
         holdout_gain: f64::NAN,
         gain_z: f64::NAN,
-        effective_n: 0,
         explained_fraction: f64::NAN,
         explained_share: f64::NAN,
-        params: Vec::new(),
-        significant: false,
         failure: Some(why),
-        evaluations: 0,
-        wall_seconds: 0.0,
+        ..CandidateScore::default()
     }
 }
 

@@ -288,7 +288,7 @@ impl Level for TrajectoryLevel<'_> {
             notes.push(format!(
                 "scouted: each candidate's values are searched on {} pieces of the record \
                  ({} samples of {n}), then fitted on the whole record from there",
-                s.pieces(),
+                s.pieces.len(),
                 s.samples
             ));
         }
