@@ -94,17 +94,16 @@ pub(super) const SCREEN_MIN_GAIN: f64 = 0.01;
 /// oscillator at 9 samples a period the screen ranked the true cubic spring 5th of 6).
 pub(super) const SCREEN_MIN_SAMPLES: usize = 20;
 
-/// The force-level screen of a step's candidates ([`TrajectoryLevel::force_screen`]).
-pub(super) struct ForceScreen {
-    /// Each candidate's force-level start and that fit's RMS (N).
-    pub hinted: Vec<Option<(SearchModel, f64)>>,
-    /// Each one's gain over the current model's mean square (N²).
-    pub gains: Vec<Option<f64>>,
-    /// Each one's rank by its gain (0 the best).
-    pub rank: Vec<usize>,
-    /// Whether the screen ranks out all but [`SCREEN_KEEP`].
-    pub screened: bool,
-}
+/// The force-level screen of a step's candidates ([`TrajectoryLevel::force_screen`]): each
+/// candidate's force-level start and that fit's RMS (N), its gain over the current model's
+/// mean square (N²), its rank by the gain (0 the best), and whether the screen ranks out all
+/// but [`SCREEN_KEEP`].
+pub(super) type ForceScreen = (
+    Vec<Option<(SearchModel, f64)>>,
+    Vec<Option<f64>>,
+    Vec<usize>,
+    bool,
+);
 
 impl TrajectoryLevel<'_> {
     /// The force-level screen of the candidates `withs` (each added to `current`): each one's
@@ -144,11 +143,6 @@ impl TrajectoryLevel<'_> {
         let screened = self.screen
             && withs.len() > SCREEN_KEEP
             && reference.is_some_and(|r| best_gain > SCREEN_MIN_GAIN * r * r);
-        ForceScreen {
-            hinted,
-            gains,
-            rank,
-            screened,
-        }
+        (hinted, gains, rank, screened)
     }
 }

@@ -15,7 +15,7 @@ use super::scout_ranking::{left_out, scouted};
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_level::TrajectoryLevel;
-use super::trajectory_screen::{ForceScreen, SCREEN_KEEP};
+use super::trajectory_screen::SCREEN_KEEP;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
 use crate::fit::{FitParam, FitResult, DISPLACEMENT_OFFSET};
@@ -116,12 +116,7 @@ impl TrajectoryLevel<'_> {
                 current.stage.with(&c.model, &defaults, n_osc)
             })
             .collect();
-        let ForceScreen {
-            hinted,
-            gains,
-            rank,
-            screened,
-        } = self.force_screen(&withs, current);
+        let (hinted, gains, rank, screened) = self.force_screen(&withs, current);
         let searched: Vec<Option<(SearchModel, f64, f64)>> = (0..tried.len())
             .into_par_iter()
             .map(|i| {
@@ -207,11 +202,11 @@ impl TrajectoryLevel<'_> {
         current: &Trial,
         yardstick: &Yardstick,
     ) -> (CandidateScore, Option<Trial>) {
-        let mut settings = trial_settings(self.settings);
-        if self.scout.as_ref().is_some() {
-            let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
-            settings.fit = settings.fit.max_iters(iters);
-        }
+        let iters = match self.scout {
+            Some(_) => SCOUTED_TRIAL_ITERS,
+            None => TRIAL_ITERS,
+        };
+        let settings = self.settings.levenberg_marquardt(Some(iters));
         choice::scored(
             &c.name,
             c.model.params().len(),
