@@ -365,18 +365,6 @@ impl Level for ForceLevel<'_> {
         &self.split
     }
 
-    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
-        SearchModel {
-            values: base
-                .params()
-                .iter()
-                .map(|s| s.default)
-                .chain(self.settings.fit_offset.then_some(0.0))
-                .collect(),
-            parts: vec![base.clone()],
-        }
-    }
-
     fn fit(
         &self,
         stage: &SearchModel,

@@ -73,8 +73,10 @@ pub(super) trait Level: Sync {
 
     /// Where the base's whole-record fit starts from: the level's own start values, the
     /// base's defaults and the offset (0) if fitted, improved as far as the level can before
-    /// the fit.
-    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel;
+    /// the fit (by default the base's defaults and the offset, nothing improved).
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
+        SearchModel::at_defaults(base, &[], self.settings().fit_offset)
+    }
 
     /// Fit `stage` on the samples `subset`: the stage with the fitted values, and the fit.
     fn fit(

@@ -26,6 +26,17 @@ pub(super) struct SearchModel {
 }
 
 impl SearchModel {
+    /// `base` alone at its defaults, after the level's own start values `own`, with the
+    /// offset (0) if `offset` is fitted.
+    pub fn at_defaults(base: &Arc<dyn ForceModel>, own: &[f64], offset: bool) -> SearchModel {
+        let values = own.iter().copied();
+        let values = values.chain(base.params().iter().map(|s| s.default));
+        SearchModel {
+            values: values.chain(offset.then_some(0.0)).collect(),
+            parts: vec![base.clone()],
+        }
+    }
+
     /// The model: the one part, or the sum of the parts.
     pub fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
         Ok(match self.parts.as_slice() {

@@ -206,16 +206,7 @@ impl Level for TrajectoryLevel<'_> {
     /// if any, then on the scout if any.
     fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
         let settings = self.settings;
-        let start = SearchModel {
-            values: self
-                .osc_start
-                .iter()
-                .copied()
-                .chain(base.params().iter().map(|s| s.default))
-                .chain(settings.fit_offset.then_some(0.0))
-                .collect(),
-            parts: vec![base.clone()],
-        };
+        let start = SearchModel::at_defaults(base, &self.osc_start, settings.fit_offset);
         let all: Vec<usize> = (0..self.samples()).collect();
         let start = match &self.setup.force_hint {
             Some(h) => start
