@@ -50,16 +50,23 @@ pub fn paired_z(reference: &[f64], new: &[f64]) -> f64 {
     mean_z(&d)
 }
 
-/// The z of the mean of paired differences `d`: mean over its standard error. +∞ for a
-/// consistent gain without spread, 0 for fewer than two pairs or no difference.
-pub fn mean_z(d: &[f64]) -> f64 {
+/// The mean of `d` and its standard error (`None` for fewer than two values).
+pub(super) fn mean_se(d: &[f64]) -> Option<(f64, f64)> {
     let n = d.len();
     if n < 2 {
-        return 0.0;
+        return None;
     }
     let mean = d.iter().sum::<f64>() / n as f64;
     let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
-    let se = (var / n as f64).sqrt();
+    Some((mean, (var / n as f64).sqrt()))
+}
+
+/// The z of the mean of paired differences `d`: mean over its standard error. +∞ for a
+/// consistent gain without spread, 0 for fewer than two pairs or no difference.
+pub fn mean_z(d: &[f64]) -> f64 {
+    let Some((mean, se)) = mean_se(d) else {
+        return 0.0;
+    };
     if se > 0.0 {
         mean / se
     } else if mean > 0.0 {
