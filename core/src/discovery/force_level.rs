@@ -165,10 +165,7 @@ fn candidate_starts(
         .collect();
     scored.sort_by(|a, b| a.1.total_cmp(&b.1));
     for (start, _) in scored {
-        if starts.len() > extra {
-            break;
-        }
-        if starts.iter().all(|s| s[1..] != start[1..]) {
+        if starts.len() <= extra && starts.iter().all(|s| s[1..] != start[1..]) {
             starts.push(start);
         }
     }

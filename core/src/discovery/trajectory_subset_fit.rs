@@ -106,10 +106,10 @@ impl Rig<'_> {
     ) -> Result<(Oscillator, [f64; 2], f64), String> {
         let n_osc = self.oscillator.len();
         let n_model = model.params().len();
-        if values.len() != n_osc + n_model + usize::from(self.fit_offset) {
+        let expected = n_osc + n_model + usize::from(self.fit_offset);
+        if values.len() != expected {
             return Err(format!(
-                "expected {} parameter values, got {}",
-                n_osc + n_model + usize::from(self.fit_offset),
+                "expected {expected} parameter values, got {}",
                 values.len()
             ));
         }
@@ -125,11 +125,8 @@ impl Rig<'_> {
                 system[param] = v;
             }
         }
-        let offset = if self.fit_offset {
-            values[n_osc + n_model]
-        } else {
-            0.0
-        };
+        // Checked above: a value after the model's is the offset, fitted.
+        let offset = values.get(n_osc + n_model).copied().unwrap_or(0.0);
         let osc = Oscillator::with_shared_excitation(system, self.excitation.clone())
             .with_model(model.clone(), values[n_osc..n_osc + n_model].to_vec())
             .map_err(|e| e.to_string())?;
