@@ -63,6 +63,15 @@ pub(super) fn left_out(
     })
 }
 
+impl Scout<'_> {
+    /// The mean square of `stage`'s residual over the scout's training samples (`None` when
+    /// it cannot be simulated).
+    fn mean_square(&self, stage: &SearchModel) -> Option<f64> {
+        let r = self.residual(&stage.model().ok()?, &stage.values).ok()?;
+        Some(rms_over(&r, &self.train).powi(2))
+    }
+}
+
 impl TrajectoryLevel<'_> {
     /// Each searched candidate's rank among them by the gain of its scout fit over the
     /// current model on the scout, their number and the gain (mean square, m²); all `None`
@@ -77,13 +86,9 @@ impl TrajectoryLevel<'_> {
         let Some(scout) = self.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
             return out;
         };
-        let Ok(model) = current.stage.model() else {
+        let Some(reference) = scout.mean_square(&current.stage) else {
             return out;
         };
-        let Ok(r) = scout.residual(&model, &current.stage.values) else {
-            return out;
-        };
-        let reference = rms_over(&r, &scout.train).powi(2);
         let mut order: Vec<(usize, f64)> = searched
             .iter()
             .enumerate()
@@ -107,12 +112,6 @@ pub(super) fn scouted(
     (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),
     settings: &DiscoverySettings,
 ) -> (SearchModel, f64, f64) {
-    let on_scout = |s: &SearchModel| {
-        s.model()
-            .ok()
-            .and_then(|m| scout.residual(&m, &s.values).ok())
-            .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
-    };
     let train_rms = |s: &SearchModel| {
         s.residual(rig)
             .map_or(f64::INFINITY, |r| rms_over(&r, train))
@@ -124,7 +123,7 @@ pub(super) fn scouted(
             return (fitted, fit.rms * fit.rms, after);
         }
     }
-    let ms = on_scout(&stage);
+    let ms = scout.mean_square(&stage).unwrap_or(f64::INFINITY);
     (stage, ms, before)
 }
 

@@ -45,12 +45,11 @@ pub(super) fn discover<L: Level>(
     settings: &DiscoverySettings,
 ) -> Result<Discovery, DiscoveryError> {
     candidate::distinct(candidates)?;
-    let base_name = base.name().to_string();
     let in_base: Vec<String> = base.terms().into_iter().map(str::to_string).collect();
-    let (kept, mut notes) = level.admitted(candidates);
-    let candidates = kept.as_slice();
+    let (candidates, mut notes) = level.admitted(candidates);
     settings.observer.emit(DiscoveryEvent::Base);
     let first = base_fit(level, &base, settings)?;
+    let base_name = base.name();
     notes.push(format!("base `{base_name}`: {}", first.location.summary));
     notes.extend(level.search_notes());
 
@@ -58,7 +57,7 @@ pub(super) fn discover<L: Level>(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
-        let tried = current.stage.to_try(candidates, &in_base, &effects);
+        let tried = current.stage.to_try(&candidates, &in_base, &effects);
         if tried.is_empty() {
             break;
         }
@@ -87,7 +86,7 @@ pub(super) fn discover<L: Level>(
             trial
         };
         if level.reconsiders() && effects.len() >= 2 {
-            let re = (candidates, in_base.as_slice(), first.base_excess);
+            let re = (candidates.as_slice(), in_base.as_slice(), first.base_excess);
             if let Some(step) = reconsider(level, &mut current, &mut effects, re)? {
                 notes.push(step.verdict.clone());
                 steps.push(step);

@@ -191,10 +191,8 @@ impl DiscoverySettings {
         what: &str,
         unit: &str,
     ) -> Result<f64, DiscoveryError> {
-        let floor = match self.noise_sigma {
-            Some(s) => s,
-            None => crate::regimes::noise_floor(signal)?,
-        };
+        let estimated = || crate::regimes::noise_floor(signal);
+        let floor = self.noise_sigma.map_or_else(estimated, Ok)?;
         if !(floor > 0.0 && floor.is_finite()) {
             return Err(DiscoveryError::BadData(format!(
                 "the noise floor of the measured {what} is {floor} {unit}; give `noise_sigma`"
