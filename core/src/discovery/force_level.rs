@@ -435,11 +435,9 @@ impl Level for ForceLevel<'_> {
     ) -> Result<T, DiscoveryError> {
         let blocks = self.blocks(&self.residual(&current.stage)?);
         let floor = self.floor(&current.stage)?;
-        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let units = |h: &[f64]| blocks.rms(h);
         Ok(then(&Yardstick {
-            gain_z: &gain_z,
-            units: &units,
+            gain_z: &|a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks),
+            units: &|h: &[f64]| blocks.rms(h),
             base_excess,
             floor,
             floor_band: self.settings.floor_band(floor.propagated),

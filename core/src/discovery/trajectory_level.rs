@@ -182,24 +182,21 @@ impl Level for TrajectoryLevel<'_> {
     /// a note saying why.
     fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
         let refitted = &self.rig.oscillator;
-        let mut kept = Vec::new();
         let mut notes = Vec::new();
-        for c in candidates {
-            match c
-                .model
-                .params()
-                .iter()
-                .find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)))
-            {
-                Some((spec, osc)) => notes.push(format!(
+        let kept = candidates.iter().filter(|c| {
+            let mut params = c.model.params().iter();
+            let same =
+                params.find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)));
+            if let Some((spec, osc)) = same {
+                notes.push(format!(
                     "`{}` not tried: its `{}` is the same term as the refitted oscillator's \
                      `{osc}`",
                     c.name, spec.name
-                )),
-                None => kept.push(c.clone()),
+                ));
             }
-        }
-        (kept, notes)
+            same.is_none()
+        });
+        (kept.cloned().collect(), notes)
     }
 
     /// The oscillator's start, the base's defaults: fitted at force level to the force hint
@@ -293,9 +290,8 @@ impl Level for TrajectoryLevel<'_> {
         base_excess: f64,
         then: impl FnOnce(&Yardstick) -> T,
     ) -> Result<T, DiscoveryError> {
-        let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
         Ok(then(&Yardstick {
-            gain_z: &test,
+            gain_z: &|a: &[f64], b: &[f64]| (cycle_gain_z(a, b), a.len()),
             units: &|h: &[f64]| h.to_vec(),
             base_excess,
             floor: NoiseFloor::displacement(self.floor),
