@@ -96,11 +96,8 @@ impl SearchModel {
 
     /// This stage's values with the oscillator's (the first ones) set to `osc`.
     pub(super) fn on_oscillator(&self, osc: &[f64]) -> Vec<f64> {
-        let mut values = self.values.clone();
-        for (v, &s) in values.iter_mut().zip(osc) {
-            *v = s;
-        }
-        values
+        let n = osc.len().min(self.values.len());
+        [&osc[..n], &self.values[n..]].concat()
     }
 
     /// The last part's first parameter and its index in `values` (after `n_osc` oscillator
