@@ -495,13 +495,12 @@ impl Level for ForceLevel<'_> {
         final_name: &str,
         where_after: &str,
     ) -> Vec<String> {
-        let mut notes = vec![format!(
+        let gap = format!(
             "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {:.4} N: force sensor {:.4} \
              N, kinematics through the model {:.4} N); final `{final_name}`: {where_after}",
             floor.sigma, floor.measured, floor.propagated,
-        )];
-        notes.extend(floor_doubts(floor, gap_after, self.settings));
-        notes
+        );
+        [vec![gap], floor_doubts(floor, gap_after, self.settings)].concat()
     }
 }
 

@@ -202,22 +202,16 @@ impl Level for TrajectoryLevel<'_> {
     /// The oscillator's start, the base's defaults: fitted at force level to the force hint
     /// if any, then on the scout if any.
     fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
-        let settings = self.settings;
-        let start = SearchModel::at_defaults(base, &self.osc_start, settings.fit_offset);
+        let start = SearchModel::at_defaults(base, &self.osc_start, self.settings.fit_offset);
         let all: Vec<usize> = (0..self.samples()).collect();
-        let start = match &self.setup.force_hint {
-            Some(h) => start
-                .force_started(&self.rig, h, &all)
-                .map_or(start, |(s, _)| s),
-            None => start,
+        let hint = self.setup.force_hint.as_ref();
+        let hinted = hint.and_then(|h| start.force_started(&self.rig, h, &all));
+        let start = hinted.map_or(start, |(s, _)| s);
+        let Some(scout) = &self.scout else {
+            return start;
         };
-        match &self.scout {
-            Some(s) => {
-                let lm = settings.levenberg_marquardt(None);
-                scouted(start, s, (&self.rig, self.setup, &all), &lm).0
-            }
-            None => start,
-        }
+        let lm = self.settings.levenberg_marquardt(None);
+        scouted(start, scout, (&self.rig, self.setup, &all), &lm).0
     }
 
     fn fit(
