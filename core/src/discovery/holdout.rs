@@ -4,6 +4,9 @@
 //! samples, including the partial cycles at both ends, train. Whole cycles keep the held-out
 //! samples independent of the training ones at the scale of the motion: a model cannot score
 //! well on them by interpolating between neighbouring samples.
+//!
+//! Beside the split: the RMS of a residual over a set of samples, over the whole record, and
+//! over each run of consecutive held-out samples (each held-out cycle), used by both levels.
 
 use super::error::DiscoveryError;
 use crate::regimes::Cycle;
