@@ -50,19 +50,29 @@ pub fn paired_z(reference: &[f64], new: &[f64]) -> f64 {
     mean_z(&d)
 }
 
-/// The z of the mean of paired differences `d`: mean over its standard error. +∞ for a
-/// consistent gain without spread, 0 for fewer than two pairs or no difference.
-pub fn mean_z(d: &[f64]) -> f64 {
+/// The mean of `d` and its standard error (`None` for fewer than two values).
+pub(super) fn mean_se(d: &[f64]) -> Option<(f64, f64)> {
     let n = d.len();
     if n < 2 {
-        return 0.0;
+        return None;
     }
     let mean = d.iter().sum::<f64>() / n as f64;
     let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
-    let se = (var / n as f64).sqrt();
+    Some((mean, (var / n as f64).sqrt()))
+}
+
+/// The z of the mean of paired differences `d`: mean over its standard error. +∞ for a
+/// consistent gain without spread, 0 for fewer than two pairs or no difference.
+pub fn mean_z(d: &[f64]) -> f64 {
+    mean_se(d).map_or(0.0, |(mean, se)| z_of(mean, se))
+}
+
+/// `value` over its standard error `se`: +∞ for a positive value without spread, else 0
+/// without spread.
+fn z_of(value: f64, se: f64) -> f64 {
     if se > 0.0 {
-        mean / se
-    } else if mean > 0.0 {
+        value / se
+    } else if value > 0.0 {
         f64::INFINITY
     } else {
         0.0
@@ -94,12 +104,8 @@ pub fn block_gain_z(reference: &[f64], new: &[f64], blocks: &Blocks) -> (f64, us
         var += u * u;
     }
     let n = blocks.count();
-    let z = if !(gain.is_finite() && var.is_finite()) {
-        0.0
-    } else if var > 0.0 {
-        gain / var.sqrt()
-    } else if gain > 0.0 {
-        f64::INFINITY
+    let z = if gain.is_finite() && var.is_finite() {
+        z_of(gain, var.sqrt())
     } else {
         0.0
     };

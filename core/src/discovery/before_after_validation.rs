@@ -15,7 +15,7 @@ use super::error::DiscoveryError;
 use super::findings::Discovery;
 use crate::data::force_data::ForceData;
 use crate::fit::{
-    FitParam, FittedParam, ForceFit, TrajectoryData, TrajectoryFit, Validation,
+    FitError, FitParam, FittedParam, ForceFit, TrajectoryData, TrajectoryFit, Validation,
     DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
 };
 use crate::physics::force_model::ForceModel;
@@ -30,18 +30,16 @@ pub struct DiscoveryValidation {
     pub after: Validation,
 }
 
+/// A model as fitted by the discovery: the model, its values and its fitted parameters.
+type Fitted<'a> = (&'a Arc<dyn ForceModel>, &'a [f64], &'a [FittedParam]);
+
 /// The value of `name` among a fit's parameters.
 fn value_of(params: &[FittedParam], name: &str) -> Option<f64> {
     params.iter().find(|p| p.name == name).map(|p| p.value)
 }
 
 /// The error of `model` with `values` and the offset of `params` on `data`.
-fn force_score(
-    model: &Arc<dyn ForceModel>,
-    values: &[f64],
-    params: &[FittedParam],
-    data: &ForceData,
-) -> Result<Validation, DiscoveryError> {
+fn force_score((model, values, params): Fitted, data: &ForceData) -> Result<Validation, FitError> {
     let mut fit = ForceFit::new(model.clone());
     let mut all = values.to_vec();
     if let Some(offset) = value_of(params, FORCE_OFFSET) {
@@ -49,36 +47,16 @@ fn force_score(
         all.push(offset);
     }
     fit.validate(data, &all)
-        .map_err(|source| DiscoveryError::Fit {
-            model: model.name().to_string(),
-            source,
-        })
-}
-
-impl Discovery {
-    /// The base's and the final model's errors on another record's kinematics and force
-    /// (force-level discovery).
-    pub fn validate(&self, data: &ForceData) -> Result<DiscoveryValidation, DiscoveryError> {
-        Ok(DiscoveryValidation {
-            before: force_score(&self.base_model, &self.base_values, &self.base_params, data)?,
-            after: force_score(
-                &self.final_model,
-                &self.final_values,
-                &self.final_params,
-                data,
-            )?,
-        })
-    }
 }
 
 /// The error on `data` of `model` with `values` on the oscillator `system`, with the offset
 /// and (refitted) initial state of `params`.
 fn trajectory_score(
-    (model, values, system): (&Arc<dyn ForceModel>, &[f64], OscillatorParams),
-    params: &[FittedParam],
+    (model, values, params): Fitted,
+    system: OscillatorParams,
     on: &TrajectoryFit,
     data: &TrajectoryData,
-) -> Result<Validation, DiscoveryError> {
+) -> Result<Validation, FitError> {
     let mut fit = TrajectoryFit::new(system, on.excitation.clone())
         .model(model.clone(), values.to_vec())
         .sim_settings(on.sim.clone());
@@ -98,13 +76,15 @@ fn trajectory_score(
         }
     }
     fit.validate(data, &held)
-        .map_err(|source| DiscoveryError::Fit {
-            model: model.name().to_string(),
-            source,
-        })
 }
 
 impl Discovery {
+    /// The base's and the final model's errors on another record's kinematics and force
+    /// (force-level discovery).
+    pub fn validate(&self, data: &ForceData) -> Result<DiscoveryValidation, DiscoveryError> {
+        self.before_after(|fitted, _| force_score(fitted, data))
+    }
+
     /// The base's and the final model's errors on another record's displacement `data`
     /// (trajectory-level discovery; an error for a force-level one). `on` gives that
     /// record's drive, its initial-state estimate and the integrator; its oscillator, model
@@ -114,24 +94,33 @@ impl Discovery {
         on: &TrajectoryFit,
         data: &TrajectoryData,
     ) -> Result<DiscoveryValidation, DiscoveryError> {
-        let (d, Some(part)) = (self, &self.trajectory) else {
+        let Some(part) = &self.trajectory else {
             return Err(DiscoveryError::BadSettings(
                 "a force-level discovery has no oscillator to simulate".into(),
             ));
         };
+        let systems = [part.system_before, part.system_after];
+        self.before_after(|fitted, i| trajectory_score(fitted, systems[i], on, data))
+    }
+
+    /// `score` of the base model (0) and of the final one (1), an error naming the model.
+    fn before_after(
+        &self,
+        score: impl Fn(Fitted, usize) -> Result<Validation, FitError>,
+    ) -> Result<DiscoveryValidation, DiscoveryError> {
+        let fitted: [Fitted; 2] = [
+            (&self.base_model, &self.base_values, &self.base_params),
+            (&self.final_model, &self.final_values, &self.final_params),
+        ];
+        let [before, after] = [0, 1].map(|i| {
+            score(fitted[i], i).map_err(|source| DiscoveryError::Fit {
+                model: fitted[i].0.name().to_string(),
+                source,
+            })
+        });
         Ok(DiscoveryValidation {
-            before: trajectory_score(
-                (&d.base_model, &d.base_values, part.system_before),
-                &d.base_params,
-                on,
-                data,
-            )?,
-            after: trajectory_score(
-                (&d.final_model, &d.final_values, part.system_after),
-                &d.final_params,
-                on,
-                data,
-            )?,
+            before: before?,
+            after: after?,
         })
     }
 }

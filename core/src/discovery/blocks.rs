@@ -16,7 +16,7 @@
 //! last block; a cycle shorter than the length is one block. The number of blocks is the
 //! test's effective sample size.
 
-use super::holdout::HoldoutSplit;
+use super::holdout::{rms_in, runs, HoldoutSplit};
 
 /// The autocorrelation below which residuals a lag apart count as uncorrelated.
 pub const DECORRELATED: f64 = 0.1;
@@ -29,22 +29,6 @@ pub struct Blocks {
     pub length: usize,
     /// Each block's first position and one past its last.
     pub ranges: Vec<(usize, usize)>,
-}
-
-/// The runs of consecutive indices of `holdout` (increasing) — its held-out cycles — as
-/// ranges of record indices and of positions in `holdout`.
-fn runs(holdout: &[usize]) -> Vec<((usize, usize), (usize, usize))> {
-    let mut out: Vec<((usize, usize), (usize, usize))> = Vec::new();
-    for (k, &i) in holdout.iter().enumerate() {
-        match out.last_mut() {
-            Some((index, at)) if index.1 == i => {
-                index.1 = i + 1;
-                at.1 = k + 1;
-            }
-            _ => out.push(((i, i + 1), (k, k + 1))),
-        }
-    }
-    out
 }
 
 /// The length of the test's blocks, samples: twice the filter `window` when known, else twice
@@ -105,12 +89,7 @@ impl Blocks {
     pub fn rms(&self, r: &[f64]) -> Vec<f64> {
         self.ranges
             .iter()
-            .map(|&(from, to)| {
-                let s: f64 = (from..to)
-                    .map(|i| r.get(i).map_or(f64::NAN, |v| v * v))
-                    .sum();
-                (s / (to - from) as f64).sqrt()
-            })
+            .map(|&(from, to)| rms_in(r, from, to))
             .collect()
     }
 

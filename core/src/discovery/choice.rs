@@ -99,14 +99,7 @@ pub(super) fn excess(
 ) -> f64 {
     let bar = acceptance::EXCESS_UNIT * sigma * sigma;
     let ms: Vec<f64> = units.iter().map(|r| r * r).filter(|&m| m < bar).collect();
-    let n = ms.len();
-    let resolved = if n < 2 {
-        0.0
-    } else {
-        let mean = ms.iter().sum::<f64>() / n as f64;
-        let var = ms.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-        settings.min_gain_sigma * (var / n as f64).sqrt()
-    };
+    let resolved = acceptance::mean_se(&ms).map_or(0.0, |(_, se)| settings.min_gain_sigma * se);
     (mse - sigma * sigma).max(band).max(resolved).max(0.0)
 }
 
@@ -205,14 +198,10 @@ pub(super) fn failed(name: &str, why: String) -> CandidateScore {
         delta_bic: f64::NAN,
         holdout_gain: f64::NAN,
         gain_z: f64::NAN,
-        effective_n: 0,
         explained_fraction: f64::NAN,
         explained_share: f64::NAN,
-        params: Vec::new(),
-        significant: false,
         failure: Some(why),
-        evaluations: 0,
-        wall_seconds: 0.0,
+        ..CandidateScore::default()
     }
 }
 

@@ -9,6 +9,7 @@
 
 use serde::Serialize;
 
+use super::holdout::{rms, rms_of};
 use crate::data::force_data::ForceData;
 use crate::regimes::{classify, Cycle, RegimeThresholds};
 
@@ -69,7 +70,7 @@ impl GapLocation {
 /// breakdown by regime is left out.
 pub fn locate_gap(r: &[f64], data: &ForceData, cycles: &[Cycle], floor: f64) -> GapLocation {
     let n = r.len();
-    let total = rms_of(r.iter().copied()).0;
+    let total = rms(r);
     let group = |label: String, idx: &mut dyn Iterator<Item = usize>| {
         let (rms, count) = rms_of(idx.filter(|&i| i < n).map(|i| r[i]));
         GapGroup {
@@ -145,15 +146,6 @@ pub fn locate_gap(r: &[f64], data: &ForceData, cycles: &[Cycle], floor: f64) -> 
         noise_floor: floor,
         breakdowns,
         summary,
-    }
-}
-
-fn rms_of(values: impl Iterator<Item = f64>) -> (f64, usize) {
-    let (ss, n) = values.fold((0.0, 0usize), |(ss, n), v| (ss + v * v, n + 1));
-    if n == 0 {
-        (0.0, 0)
-    } else {
-        ((ss / n as f64).sqrt(), n)
     }
 }
 

@@ -1,7 +1,7 @@
 //! The force level of discovery ([`ForceLevel`], a [`Level`] for the loop of
 //! [`super::search`]): records with a measured F_STF and kinematics, every model fitted to
 //! the force along them. Its candidates start from a small multi-start ([`candidate_starts`],
-//! [`best_trial`]); by default earlier effects are re-checked after each
+//! [`ForceLevel::best_trial`]); by default earlier effects are re-checked after each
 //! acceptance ([`super::reconsider`]) and an accepted model is not polished.
 //!
 //! Each step cuts the held-out cycles into blocks at least as long as the residual's
@@ -21,27 +21,26 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
-use super::force_subset_fit::{fit_subset, residuals};
 use super::holdout::HoldoutSplit;
 use super::level::Level;
-use super::progress::DiscoveryEvent;
 use super::score::CandidateScore;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use crate::data::force_data::ForceData;
-use crate::fit::{FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
+use crate::fit::{Convergence, FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::regimes::Cycle;
 
 impl SearchModel {
-    /// The force fit of this stage starting from its values (clamped into the bounds).
+    /// The force fit of this stage starting from its values, clamped into the bounds. A value
+    /// on a bound is moved inside by the fit's bound transform; any other value is the start
+    /// as it is. (This used to move values 1 % of the width below an upper bound, so a refit
+    /// from a training fit with `p` = 3 started elsewhere; the stall it worked around was the
+    /// transform moving interior starts, now fixed.)
     fn force_fit(&self, settings: &DiscoverySettings) -> Result<ForceFit, DiscoveryError> {
         let model = self.model()?;
-        let mut fit = ForceFit::new(model.clone()).settings(settings.fit.clone());
-        for (spec, &v) in model.params().iter().zip(&self.values) {
-            fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
-        }
+        let mut fit = started_fit(&model, &self.values).settings(settings.fit.clone());
         if settings.fit_offset {
             let start = self
                 .values
@@ -53,31 +52,15 @@ impl SearchModel {
         Ok(fit)
     }
 
-    /// Fit on `subset`; the stage with the fitted values, and the fit.
-    fn fit(
-        &self,
-        data: &ForceData,
-        subset: &[usize],
-        settings: &DiscoverySettings,
-    ) -> Result<(SearchModel, ForceFit, FitResult), DiscoveryError> {
-        let fit = self.force_fit(settings)?;
-        let (stage, result) = self.fitted(fit_subset(&fit, data, subset, &settings.fit))?;
-        Ok((stage, fit, result))
-    }
-
     /// This stage with every model parameter that sits on a bound (within 1e-9 of the width)
     /// restarted from its default, or `None` when none does. A parameter pinned on a bound by
     /// the fit of a model that lacked an effect (n = 1 for a power law absorbing a yield
     /// force) hardly leaves it when the effect is added: the bound map is flat there.
     fn released(&self) -> Option<SearchModel> {
-        let specs: Vec<crate::physics::param_spec::ParamSpec> = self
-            .parts
-            .iter()
-            .flat_map(|p| p.params().to_vec())
-            .collect();
+        let specs = self.parts.iter().flat_map(|p| p.params());
         let mut values = self.values.clone();
         let mut any = false;
-        for (spec, v) in specs.iter().zip(values.iter_mut()) {
+        for (spec, v) in specs.zip(values.iter_mut()) {
             let tol = 1e-9 * (spec.max - spec.min).abs();
             let pinned = (*v - spec.min).abs() <= tol || (*v - spec.max).abs() <= tol;
             if pinned && *v != spec.default {
@@ -90,32 +73,18 @@ impl SearchModel {
             values,
         })
     }
+}
 
-    /// The force noise floor of this stage at its values: the sensor's `sensor` (N) with the
-    /// kinematics' noise of `settings.motion_noise` propagated through the model.
-    fn noise_floor(
-        &self,
-        data: &ForceData,
-        sensor: f64,
-        settings: &DiscoverySettings,
-    ) -> Result<NoiseFloor, DiscoveryError> {
-        let Some(motion) = settings.motion_noise else {
-            return Ok(NoiseFloor::force(sensor, 0.0));
-        };
-        let fit = self.force_fit(settings)?;
-        fit.noise_floor(data, &self.values, sensor, motion)
-            .map_err(|e| self.fit_error(e))
-    }
-
-    /// Measured minus modelled force at every sample.
-    fn residuals(
-        &self,
-        data: &ForceData,
-        settings: &DiscoverySettings,
-    ) -> Result<Vec<f64>, DiscoveryError> {
-        let fit = self.force_fit(settings)?;
-        residuals(&fit, data, &self.values).map_err(|e| self.fit_error(e))
-    }
+/// The force fit of `model` from `values` (its parameters', each clamped into its bounds).
+pub(super) fn started_fit(model: &Arc<dyn ForceModel>, values: &[f64]) -> ForceFit {
+    let fit = ForceFit::new(model.clone());
+    model
+        .params()
+        .iter()
+        .zip(values)
+        .fold(fit, |fit, (spec, &v)| {
+            fit.param(FitParam::from_spec(spec).value(v.clamp(spec.min, spec.max)))
+        })
 }
 
 /// The start values of `model`'s parameters for adding it to a model whose residual over
@@ -196,10 +165,7 @@ fn candidate_starts(
         .collect();
     scored.sort_by(|a, b| a.1.total_cmp(&b.1));
     for (start, _) in scored {
-        if starts.len() > extra {
-            break;
-        }
-        if starts.iter().all(|s| s[1..] != start[1..]) {
+        if starts.len() <= extra && starts.iter().all(|s| s[1..] != start[1..]) {
             starts.push(start);
         }
     }
@@ -220,7 +186,7 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
     while per > 1 && (per + 1).pow(specs.len() as u32) > GRID_MAX {
         per -= 1;
     }
-    let axes: Vec<Vec<f64>> = specs
+    specs
         .iter()
         .map(|s| {
             let lo = if s.min > 0.0 { s.min } else { 1e-4 * s.max };
@@ -239,73 +205,11 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
             }
             axis
         })
-        .collect();
-    let mut grid: Vec<Vec<f64>> = vec![Vec::new()];
-    for axis in &axes {
-        grid = grid
-            .into_iter()
-            .flat_map(|point| {
-                axis.iter().map(move |&v| {
-                    let mut p = point.clone();
-                    p.push(v);
-                    p
-                })
-            })
-            .collect();
-    }
-    grid
-}
-
-/// The trial with the lowest training RMS (a converged fit before a failed one) among those
-/// run from the stages `stage(start)` for each of the candidate's `starts`, and from the
-/// first of them [`SearchModel::released`] when a parameter of it sits on a bound: the multi-start
-/// of a candidate. Its evaluations and wall time are those of all the runs; the first run's
-/// error if every run fails.
-fn best_trial(
-    level: &ForceLevel,
-    starts: &[Vec<f64>],
-    stage: impl Fn(&[f64]) -> SearchModel,
-) -> Result<Trial, DiscoveryError> {
-    let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
-    if let Some(released) = stages.first().and_then(SearchModel::released) {
-        stages.push(released);
-    }
-    let mut best: Option<Trial> = None;
-    let mut first_error = None;
-    let (mut evaluations, mut wall) = (0, 0.0);
-    for stage in &stages {
-        match level.trial(stage, level.settings) {
-            Ok(trial) => {
-                evaluations += trial.train.evaluations;
-                wall += trial.train.wall_seconds;
-                let failed = |t: &Trial| {
-                    matches!(t.train.convergence, crate::fit::Convergence::Failed { .. })
-                };
-                let better = match &best {
-                    None => true,
-                    Some(b) => {
-                        (failed(b) && !failed(&trial))
-                            || (failed(b) == failed(&trial) && trial.train.rms < b.train.rms)
-                    }
-                };
-                if better {
-                    best = Some(trial);
-                }
-            }
-            Err(e) => {
-                first_error.get_or_insert(e);
-            }
-        }
-    }
-    match (best, first_error) {
-        (Some(mut t), _) => {
-            t.train.evaluations = evaluations;
-            t.train.wall_seconds = wall;
-            Ok(t)
-        }
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(DiscoveryError::BadSettings("no start to fit from".into())),
-    }
+        .fold(vec![Vec::new()], |grid, axis| {
+            grid.iter()
+                .flat_map(|point| axis.iter().map(|&v| [point.as_slice(), &[v]].concat()))
+                .collect()
+        })
 }
 
 /// Find the effects missing from `base` among `candidates`, at force level.
@@ -395,6 +299,46 @@ impl<'a> ForceLevel<'a> {
         })
     }
 
+    /// The trial with the lowest training RMS (a converged fit before a failed one) among
+    /// those run from the stages `stage(start)` for each of candidate `c`'s starts
+    /// ([`candidate_starts`] against the residual `r`), and from the first of them
+    /// [`SearchModel::released`] when a parameter of it sits on a bound: the multi-start of a
+    /// candidate. Its evaluations and wall time are those of all the runs; the first run's
+    /// error if every run fails.
+    fn best_trial(
+        &self,
+        c: &Candidate,
+        r: &[f64],
+        stage: impl Fn(&[f64]) -> SearchModel,
+    ) -> Result<Trial, DiscoveryError> {
+        let train = &self.split.train;
+        let starts = candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
+        let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
+        if let Some(released) = stages.first().and_then(SearchModel::released) {
+            stages.push(released);
+        }
+        let trials: Vec<Result<Trial, DiscoveryError>> = stages
+            .iter()
+            .map(|s| self.trial(s, self.settings))
+            .collect();
+        let (evaluations, wall) = trials.iter().flatten().fold((0, 0.0), |(e, w), t| {
+            (e + t.train.evaluations, w + t.train.wall_seconds)
+        });
+        let failed = |t: &Trial| matches!(t.train.convergence, Convergence::Failed { .. });
+        let best = trials
+            .into_iter()
+            .reduce(|best, next| match (&best, &next) {
+                (Err(_), Ok(_)) => next,
+                (Ok(b), Ok(t)) if (failed(t), t.train.rms) < (failed(b), b.train.rms) => next,
+                _ => best,
+            });
+        let mut best = best
+            .unwrap_or_else(|| Err(DiscoveryError::BadSettings("no start to fit from".into())))?;
+        best.train.evaluations = evaluations;
+        best.train.wall_seconds = wall;
+        Ok(best)
+    }
+
     /// The blocks of the paired test for a model whose residual is `r` (every sample).
     fn blocks(&self, r: &[f64]) -> Blocks {
         Blocks::new(
@@ -405,9 +349,10 @@ impl<'a> ForceLevel<'a> {
 }
 
 impl Level for ForceLevel<'_> {
-    fn said(&self) -> &'static Said {
-        &choice::FORCE
-    }
+    const SAID: &'static Said = &choice::FORCE;
+    /// From the defaults: the training fit of the base as it stood.
+    const FIRST_FROM_FIT: bool = false;
+    const RECHECK: bool = true;
 
     fn settings(&self) -> &DiscoverySettings {
         self.settings
@@ -417,30 +362,29 @@ impl Level for ForceLevel<'_> {
         &self.split
     }
 
-    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
-        SearchModel {
-            values: base
-                .params()
-                .iter()
-                .map(|s| s.default)
-                .chain(self.settings.fit_offset.then_some(0.0))
-                .collect(),
-            parts: vec![base.clone()],
-        }
-    }
-
     fn fit(
         &self,
         stage: &SearchModel,
         subset: &[usize],
         settings: &DiscoverySettings,
     ) -> Result<(SearchModel, FitResult), DiscoveryError> {
-        let (stage, _, result) = stage.fit(self.data, subset, settings)?;
-        Ok((stage, result))
+        let fit = stage.force_fit(settings)?;
+        stage.fitted(fit.fit_rows(self.data, Some(subset), &settings.fit, None))
     }
 
+    /// Measured minus modelled force at every sample.
     fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError> {
-        stage.residuals(self.data, self.settings)
+        let fit = stage.force_fit(self.settings)?;
+        let predicted = fit
+            .predict(self.data, &stage.values)
+            .map_err(|e| stage.fit_error(e))?;
+        Ok(self
+            .data
+            .f
+            .iter()
+            .zip(&predicted)
+            .map(|(m, p)| m - p)
+            .collect())
     }
 
     /// The held-out samples' residuals.
@@ -448,14 +392,15 @@ impl Level for ForceLevel<'_> {
         self.split.holdout.iter().map(|&i| r[i]).collect()
     }
 
-    /// From the defaults: the training fit of the base as it stood.
-    fn first_trial(&self, start: &SearchModel, _: &SearchModel) -> Result<Trial, DiscoveryError> {
-        self.trial(start, self.settings)
-    }
-
-    /// The force sensor's noise with the kinematics' propagated through the model.
+    /// The force sensor's noise with the kinematics' noise of `settings.motion_noise`
+    /// propagated through the model at its values.
     fn floor(&self, stage: &SearchModel) -> Result<NoiseFloor, DiscoveryError> {
-        stage.noise_floor(self.data, self.sensor, self.settings)
+        let Some(motion) = self.settings.motion_noise else {
+            return Ok(NoiseFloor::force(self.sensor, 0.0));
+        };
+        let fit = stage.force_fit(self.settings)?;
+        fit.noise_floor(self.data, &stage.values, self.sensor, motion)
+            .map_err(|e| stage.fit_error(e))
     }
 
     fn gap(
@@ -490,11 +435,9 @@ impl Level for ForceLevel<'_> {
     ) -> Result<T, DiscoveryError> {
         let blocks = self.blocks(&self.residual(&current.stage)?);
         let floor = self.floor(&current.stage)?;
-        let gain_z = |a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks);
-        let units = |h: &[f64]| blocks.rms(h);
         Ok(then(&Yardstick {
-            gain_z: &gain_z,
-            units: &units,
+            gain_z: &|a: &[f64], b: &[f64]| acceptance::block_gain_z(a, b, &blocks),
+            units: &|h: &[f64]| blocks.rms(h),
             base_excess,
             floor,
             floor_band: self.settings.floor_band(floor.propagated),
@@ -503,7 +446,7 @@ impl Level for ForceLevel<'_> {
         }))
     }
 
-    /// Each candidate a small multi-start ([`candidate_starts`], [`best_trial`]); the
+    /// Each candidate a small multi-start ([`candidate_starts`], [`ForceLevel::best_trial`]); the
     /// candidates are independent trials against the same current model: fitted in
     /// parallel, scored in their order.
     fn score_step(
@@ -513,7 +456,7 @@ impl Level for ForceLevel<'_> {
         current: &Trial,
         yardstick: &Yardstick,
     ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
-        let (data, split, settings) = (self.data, &self.split, self.settings);
+        let settings = self.settings;
         let current_residual = self.residual(&current.stage)?;
         Ok(tried
             .par_iter()
@@ -522,19 +465,12 @@ impl Level for ForceLevel<'_> {
                 settings
                     .observer
                     .candidate(step, index, tried.len(), &c.name);
-                let starts = candidate_starts(
-                    &c.model,
-                    data,
-                    &split.train,
-                    &current_residual,
-                    settings.extra_starts,
-                );
-                let best = best_trial(self, &starts, |start| {
+                let best = self.best_trial(c, &current_residual, |start| {
                     current.stage.with(&c.model, start, 0)
                 });
                 let n_own = c.model.params().len();
                 let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
-                emit_scored(settings, step, Some(&s));
+                settings.observer.scored(step, &s.0);
                 s
             })
             .collect())
@@ -547,21 +483,9 @@ impl Level for ForceLevel<'_> {
         part: usize,
         residual: &[f64],
     ) -> Result<Trial, DiscoveryError> {
-        let settings = self.settings;
-        let starts = candidate_starts(
-            &c.model,
-            self.data,
-            &self.split.train,
-            residual,
-            settings.extra_starts,
-        );
-        best_trial(self, &starts, |start| {
+        self.best_trial(c, residual, |start| {
             rest.inserting(part, 0, &c.model, start)
         })
-    }
-
-    fn recheck_default(&self) -> bool {
-        true
     }
 
     fn closing_notes(
@@ -571,13 +495,12 @@ impl Level for ForceLevel<'_> {
         final_name: &str,
         where_after: &str,
     ) -> Vec<String> {
-        let mut notes = vec![format!(
+        let gap = format!(
             "gap {gap_before:.4} N → {gap_after:.4} N (noise floor {:.4} N: force sensor {:.4} \
              N, kinematics through the model {:.4} N); final `{final_name}`: {where_after}",
             floor.sigma, floor.measured, floor.propagated,
-        )];
-        notes.extend(floor_doubts(floor, gap_after, self.settings));
-        notes
+        );
+        [vec![gap], floor_doubts(floor, gap_after, self.settings)].concat()
     }
 }
 
@@ -625,30 +548,6 @@ fn floor_doubts(floor: &NoiseFloor, gap_after: f64, settings: &DiscoverySettings
         ));
     }
     doubts
-}
-
-/// Report the score of the candidate just tried.
-pub(super) fn emit_scored(
-    settings: &DiscoverySettings,
-    step: usize,
-    last: Option<&(CandidateScore, Option<Trial>)>,
-) {
-    if let Some((score, _)) = last {
-        settings.observer.emit(DiscoveryEvent::Scored {
-            step,
-            name: score.name.clone(),
-            holdout_rms: score.holdout_rms,
-            gain_z: score.gain_z,
-        });
-    }
-}
-
-/// `v` clamped into `[min, max]`. A value on a bound is moved inside by the fit's bound
-/// transform; any other value is the start as it is. (This used to move values 1 % of the
-/// width below an upper bound, so a refit from a training fit with `p` = 3 started elsewhere;
-/// the stall it worked around was the transform moving interior starts, now fixed.)
-pub(super) fn inside(v: f64, min: f64, max: f64) -> f64 {
-    v.clamp(min, max)
 }
 
 #[cfg(test)]

@@ -4,6 +4,9 @@
 //! samples, including the partial cycles at both ends, train. Whole cycles keep the held-out
 //! samples independent of the training ones at the scale of the motion: a model cannot score
 //! well on them by interpolating between neighbouring samples.
+//!
+//! Beside the split: the RMS of a residual over a set of samples, over the whole record, and
+//! over each run of consecutive held-out samples (each held-out cycle), used by both levels.
 
 use super::error::DiscoveryError;
 use crate::regimes::Cycle;
@@ -61,19 +64,49 @@ impl HoldoutSplit {
 /// samples, never two neighbouring cycles (one in `holdout_every` ≥ 2 is held out), so each
 /// run of consecutive indices is one cycle.
 pub(super) fn cycle_rms(r: &[f64], holdout: &[usize]) -> Vec<f64> {
-    let mut out = Vec::new();
-    let (mut sum, mut count) = (0.0, 0usize);
+    let cycles = runs(holdout).into_iter();
+    cycles.map(|((from, to), _)| rms_in(r, from, to)).collect()
+}
+
+/// The runs of consecutive indices of `holdout` (increasing) — its held-out cycles — as
+/// ranges of record indices and of positions in `holdout`.
+pub(super) fn runs(holdout: &[usize]) -> Vec<((usize, usize), (usize, usize))> {
+    let mut out: Vec<((usize, usize), (usize, usize))> = Vec::new();
     for (k, &i) in holdout.iter().enumerate() {
-        let value = r.get(i).copied().unwrap_or(f64::NAN);
-        sum += value * value;
-        count += 1;
-        let ends = holdout.get(k + 1).is_none_or(|&next| next != i + 1);
-        if ends {
-            out.push((sum / count as f64).sqrt());
-            (sum, count) = (0.0, 0);
+        match out.last_mut() {
+            Some((index, at)) if index.1 == i => {
+                index.1 = i + 1;
+                at.1 = k + 1;
+            }
+            _ => out.push(((i, i + 1), (k, k + 1))),
         }
     }
     out
+}
+
+/// The RMS of `r` over the samples `from..to` (NaN where `r` has no sample).
+pub(super) fn rms_in(r: &[f64], from: usize, to: usize) -> f64 {
+    rms_of((from..to).map(|i| r.get(i).copied().unwrap_or(f64::NAN))).0
+}
+
+/// RMS of `r` over the samples `subset` (0 for an empty subset).
+pub(crate) fn rms_over(r: &[f64], subset: &[usize]) -> f64 {
+    rms_of(subset.iter().map(|&i| r[i])).0
+}
+
+/// RMS of all of `r` (0 when empty).
+pub(crate) fn rms(r: &[f64]) -> f64 {
+    rms_of(r.iter().copied()).0
+}
+
+/// The RMS of `values` and how many there are ((0, 0) when there are none).
+pub(crate) fn rms_of(values: impl Iterator<Item = f64>) -> (f64, usize) {
+    let (ss, n) = values.fold((0.0, 0usize), |(ss, n), v| (ss + v * v, n + 1));
+    if n == 0 {
+        (0.0, 0)
+    } else {
+        ((ss / n as f64).sqrt(), n)
+    }
 }
 
 #[cfg(test)]

@@ -9,8 +9,7 @@
 //! earlier effects, polish, final refit — is written once, in [`super::search`], over this
 //! trait, and so is the trial of a stage ([`Level::trial`]: fit on the training samples,
 //! score on the held-out ones). The re-check and the polish run at either level, as the
-//! settings say, each level having its default ([`Level::recheck_default`],
-//! [`Level::polish_default`]). Where one level has nothing of its own (notes, admitted
+//! settings say, each level having its default ([`Level::RECHECK`], [`Level::POLISH`]). Where one level has nothing of its own (notes, admitted
 //! candidates, parameters, a part of the result) the trait's default serves.
 
 use std::sync::Arc;
@@ -20,8 +19,7 @@ use super::choice::{Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::TrajectoryPart;
 use super::force_gap::GapLocation;
-use super::force_subset_fit::rms_over;
-use super::holdout::HoldoutSplit;
+use super::holdout::{rms_over, HoldoutSplit};
 use super::score::CandidateScore;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
@@ -31,7 +29,23 @@ use crate::physics::force_model::ForceModel;
 /// A fit level: its data, fits, residuals, unit and evidence.
 pub(super) trait Level: Sync {
     /// How the level's verdicts say its residual (quantity, unit, scale from SI).
-    fn said(&self) -> &'static Said;
+    const SAID: &'static Said;
+
+    /// Whether the trial every candidate of the first step is measured against is that of
+    /// the base from its whole-record fit (else from its defaults, the level's `start`).
+    const FIRST_FROM_FIT: bool;
+
+    /// Whether earlier effects are re-checked after each acceptance when the settings do not
+    /// say ([`DiscoverySettings::recheck`]; not by default).
+    const RECHECK: bool = false;
+
+    /// Whether an accepted trial is polished when the settings do not say
+    /// ([`DiscoverySettings::polish`]; not by default).
+    const POLISH: bool = false;
+
+    /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted
+    /// (not by default).
+    const WARNS_UNRESOLVED: bool = false;
 
     /// The level's own parameters, fitted before the model's (the refitted oscillator's at
     /// trajectory level; none by default).
@@ -59,8 +73,10 @@ pub(super) trait Level: Sync {
 
     /// Where the base's whole-record fit starts from: the level's own start values, the
     /// base's defaults and the offset (0) if fitted, improved as far as the level can before
-    /// the fit.
-    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel;
+    /// the fit (by default the base's defaults and the offset, nothing improved).
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
+        SearchModel::at_defaults(base, &[], self.settings().fit_offset)
+    }
 
     /// Fit `stage` on the samples `subset`: the stage with the fitted values, and the fit.
     fn fit(
@@ -95,14 +111,6 @@ pub(super) trait Level: Sync {
             holdout_mse: h * h,
         })
     }
-
-    /// The trial every candidate of the first step is measured against: of the base from
-    /// its defaults (`start`) or from its whole-record fit (`base_full`).
-    fn first_trial(
-        &self,
-        start: &SearchModel,
-        base_full: &SearchModel,
-    ) -> Result<Trial, DiscoveryError>;
 
     /// The noise floor of `stage` at its values.
     fn floor(&self, stage: &SearchModel) -> Result<NoiseFloor, DiscoveryError>;
@@ -152,34 +160,16 @@ pub(super) trait Level: Sync {
         residual: &[f64],
     ) -> Result<Trial, DiscoveryError>;
 
-    /// Whether earlier effects are re-checked after each acceptance when the settings do not
-    /// say ([`DiscoverySettings::recheck`]; not by default).
-    fn recheck_default(&self) -> bool {
-        false
-    }
-
-    /// Whether an accepted trial is polished when the settings do not say
-    /// ([`DiscoverySettings::polish`]; not by default).
-    fn polish_default(&self) -> bool {
-        false
-    }
-
     /// Whether earlier effects are re-checked after each acceptance ([`super::reconsider`]):
     /// as the settings say, else the level's default.
     fn reconsiders(&self) -> bool {
-        self.settings().recheck.unwrap_or(self.recheck_default())
+        self.settings().recheck.unwrap_or(Self::RECHECK)
     }
 
     /// Whether an accepted trial is polished at the final fit's tolerance before the next
     /// step ([`super::search`]): as the settings say, else the level's default.
     fn polishes(&self) -> bool {
-        self.settings().polish.unwrap_or(self.polish_default())
-    }
-
-    /// Whether a step that accepts nothing above 1.2× the floor says it is not to be trusted
-    /// (not by default).
-    fn warns_unresolved(&self) -> bool {
-        false
+        self.settings().polish.unwrap_or(Self::POLISH)
     }
 
     /// The settings of the final whole-record refit, from the training fit's values, which

@@ -34,7 +34,6 @@ pub mod error;
 pub mod findings;
 pub mod force_gap;
 pub mod force_level;
-mod force_subset_fit;
 pub mod holdout;
 mod level;
 pub mod progress;

@@ -5,6 +5,8 @@
 use std::fmt;
 use std::sync::Arc;
 
+use super::score::CandidateScore;
+
 /// Something a discovery run has just done.
 #[derive(Clone, Debug, PartialEq)]
 pub enum DiscoveryEvent {
@@ -55,6 +57,16 @@ impl Observer {
             index,
             of,
             name: name.to_string(),
+        });
+    }
+
+    /// Report the score of the candidate just tried.
+    pub(crate) fn scored(&self, step: usize, score: &CandidateScore) {
+        self.emit(DiscoveryEvent::Scored {
+            step,
+            name: score.name.clone(),
+            holdout_rms: score.holdout_rms,
+            gain_z: score.gain_z,
         });
     }
 

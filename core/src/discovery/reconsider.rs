@@ -53,21 +53,14 @@ struct Recheck<'a, L> {
     yardstick: &'a Yardstick<'a>,
 }
 
-/// A model with one of its effects taken out, for a replacement to be inserted in its place.
-struct Replaced<'a> {
-    /// The model without the effect.
-    rest: &'a SearchModel,
-    /// Its residual at every sample.
-    residual: &'a [f64],
-    /// The index of the part taken out.
-    part: usize,
-    /// How many parameters the part taken out had.
-    old_len: usize,
-}
+/// A model with one of its effects taken out, for a replacement to be inserted in its place:
+/// the model without the effect, its residual at every sample, the index of the part taken
+/// out and how many parameters it had.
+type Replaced<'a> = (&'a SearchModel, &'a [f64], usize, usize);
 
-/// A replacement tried: its score, its trial, the effect index, the candidate index, and
-/// whether it is a tie rather than a win.
-type Tried = (CandidateScore, Option<Trial>, usize, usize, bool);
+/// A replacement tried: its score, its trial, the effect index, the candidate, and whether it
+/// is a tie rather than a win.
+type Tried<'a> = (CandidateScore, Option<Trial>, usize, &'a Candidate, bool);
 
 impl<L: Level> Recheck<'_, L> {
     /// Try every candidate in the place of every earlier effect; make the best replacement
@@ -87,23 +80,15 @@ impl<L: Level> Recheck<'_, L> {
             };
             let rest = current.stage.without(part, self.level.n_before());
             let rest_residual = self.level.residual(&rest)?;
-            let replaced = Replaced {
-                rest: &rest,
-                residual: &rest_residual,
-                part,
-                old_len: old.params().len(),
-            };
-            let to_try: Vec<usize> = (0..self.candidates.len())
-                .filter(|&k| !current.stage.holds(&self.candidates[k], self.in_base, &[]))
-                .collect();
+            let replaced = (&rest, rest_residual.as_slice(), part, old.params().len());
+            let to_try = current.stage.to_try(self.candidates, self.in_base, &[]);
             // Independent trials against the same current model: fitted in parallel, kept in
             // their order.
             let current = &*current;
-            tried.par_extend(to_try.par_iter().map(|&k| {
-                let c = &self.candidates[k];
+            tried.par_extend(to_try.par_iter().map(|&c| {
                 let label = format!("{} for {effect}", c.name);
-                let (score, trial, tie) = self.replacement(c, &label, current, &replaced);
-                (score, trial, j, k, tie)
+                let (score, trial, tie) = self.replacement(c, &label, current, replaced);
+                (score, trial, j, c, tie)
             }));
         }
         if tried.is_empty() {
@@ -115,21 +100,16 @@ impl<L: Level> Recheck<'_, L> {
         };
         let scores = tried.iter().map(|t| t.0.clone()).collect();
         let mut step = choice::step_on(current, scores, self.yardstick);
-        let (score, trial, j, k, tie) = tried.swap_remove(i);
+        let (score, trial, j, c, tie) = tried.swap_remove(i);
         let Some(trial) = trial else {
             return Ok(None);
         };
         let old_name = effects[j].clone();
-        let new_name = self.candidates[k].name.clone();
+        let new_name = c.name.clone();
         let with = effects.last().map_or("", String::as_str);
-        let settings = self.level_settings();
-        step.verdict = replaced_verdict(
-            &step,
-            [&old_name, &new_name, with],
-            (&score, tie),
-            self.level.said(),
-            settings,
-        );
+        let names = [old_name.as_str(), &new_name, with];
+        let settings = self.level.settings();
+        step.verdict = replaced_verdict(&step, names, (&score, tie), L::SAID, settings);
         step.accepted = Some(new_name.clone());
         if tie {
             step.tie_with = vec![old_name];
@@ -137,11 +117,6 @@ impl<L: Level> Recheck<'_, L> {
         effects[j] = new_name;
         *current = trial;
         Ok(Some(step))
-    }
-
-    /// The settings the step is measured with.
-    fn level_settings(&self) -> &DiscoverySettings {
-        self.level.settings()
     }
 
     /// The candidate `c` put in the place of `replaced`, fitted and scored against `current`
@@ -152,24 +127,15 @@ impl<L: Level> Recheck<'_, L> {
         c: &Candidate,
         label: &str,
         current: &Trial,
-        replaced: &Replaced,
+        (rest, residual, part, old_len): Replaced,
     ) -> (CandidateScore, Option<Trial>, bool) {
-        let settings = self.level_settings();
-        let rest = replaced.rest;
-        let part = replaced.part;
-        let trial = match self
-            .level
-            .replacement_trial(c, rest, part, replaced.residual)
-        {
+        let settings = self.level.settings();
+        let trial = match self.level.replacement_trial(c, rest, part, residual) {
             Ok(trial) => trial,
             Err(e) => return (choice::failed(label, e.to_string()), None, false),
         };
         // Its own parameters are not last here: take them by position.
-        let from: usize = self.level.n_before()
-            + rest.parts[..part.min(rest.parts.len())]
-                .iter()
-                .map(|p| p.params().len())
-                .sum::<usize>();
+        let from = rest.start_of(part, self.level.n_before());
         let n_own = c.model.params().len();
         let mut score = choice::score(label, 0, &trial, current, self.yardstick, settings);
         score.params = trial
@@ -182,7 +148,7 @@ impl<L: Level> Recheck<'_, L> {
         let tie = !wins
             && score.failure.is_none()
             && score.gain_z >= -settings.min_gain_sigma
-            && n_own < replaced.old_len
+            && n_own < old_len
             && score.delta_bic < 0.0;
         score.significant = wins || tie;
         (score, Some(trial), tie)

@@ -5,7 +5,7 @@ use serde::Serialize;
 use crate::fit::{FittedParam, NoiseFloor};
 
 /// How a candidate added to the current model scored.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct CandidateScore {
     /// The effect's name.
     pub name: String,

@@ -51,7 +51,8 @@ const MIN_PIECES: usize = 3;
 /// Short pieces of a record, each a rig of its own, that stand in for it while a candidate's
 /// values are searched for.
 pub(super) struct Scout<'a> {
-    pieces: Vec<Rig<'a>>,
+    /// The pieces, each simulated from the measured state at its start.
+    pub pieces: Vec<Rig<'a>>,
     /// Positions, in the pieces' joined residual, of the samples that train: training samples
     /// of the record past each piece's first quarter.
     pub train: Vec<usize>,
@@ -108,13 +109,6 @@ impl<'a> Scout<'a> {
             train: positions,
             samples: joined,
         })
-    }
-}
-
-impl Scout<'_> {
-    /// Number of pieces.
-    pub fn pieces(&self) -> usize {
-        self.pieces.len()
     }
 }
 
@@ -207,7 +201,7 @@ mod tests {
             let train: Vec<usize> = (0..n).collect();
             let scout = Scout::new(&rig(&t, &x), &cycles, &train).unwrap();
             assert_eq!(
-                (scout.samples, scout.pieces()),
+                (scout.samples, scout.pieces.len()),
                 (samples, pieces),
                 "{n} samples, {per} a cycle"
             );

@@ -1,24 +1,23 @@
 //! Which scouted candidates are tried on the whole record ([`super::scout`]): each ranked by
-//! the gain of its scout fit ([`Trials::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
+//! the gain of its scout fit ([`TrajectoryLevel::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
 //! their gain is a small share of the best one's ([`left_out`]); and where a scouted fit
 //! continues on the whole record ([`scouted`]).
 
 use super::choice::Trial;
-use super::force_subset_fit::rms_over;
+use super::holdout::rms_over;
 use super::scout::Scout;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
+use super::trajectory_level::TrajectoryLevel;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::{Rig, Track};
-use super::trajectory_trials::Trials;
-use crate::regimes::Cycle;
 
 /// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
-/// out by their fits on the scout (see [`Trials::step`]).
+/// out by their fits on the scout (see [`TrajectoryLevel::scores`]).
 pub(super) const SCOUT_KEEP: usize = 3;
 
 /// The least share of the best candidate's gain on the scout for a candidate to be tried on
-/// the whole record in a scouted step (see [`Trials::step`]). A candidate that lowers the
+/// the whole record in a scouted step (see [`TrajectoryLevel::scores`]). A candidate that lowers the
 /// scout's mean square by a fraction of what the best one does cannot win the step unless
 /// the best one fails on the whole record; on Silverbox's 100 000 samples `jamming_on_off`
 /// (5 % of the excess explained) cost more than the two cubic springs' trials together.
@@ -64,21 +63,16 @@ pub(super) fn left_out(
     })
 }
 
-/// The scout of a record of at least [`DiscoverySettings::scout_from`] samples; `None` for a
-/// shorter record, or when the record makes no scout.
-pub(super) fn scout_of<'r>(
-    rig: &Rig<'r>,
-    cycles: &[Cycle],
-    train: &[usize],
-    settings: &DiscoverySettings,
-) -> Option<Scout<'r>> {
-    if settings.scout_from == 0 || rig.t.len() < settings.scout_from {
-        return None;
+impl Scout<'_> {
+    /// The mean square of `stage`'s residual over the scout's training samples (`None` when
+    /// it cannot be simulated).
+    fn mean_square(&self, stage: &SearchModel) -> Option<f64> {
+        let r = self.residual(&stage.model().ok()?, &stage.values).ok()?;
+        Some(rms_over(&r, &self.train).powi(2))
     }
-    Scout::new(rig, cycles, train)
 }
 
-impl Trials<'_, '_> {
+impl TrajectoryLevel<'_> {
     /// Each searched candidate's rank among them by the gain of its scout fit over the
     /// current model on the scout, their number and the gain (mean square, m²); all `None`
     /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
@@ -89,16 +83,12 @@ impl Trials<'_, '_> {
     ) -> Vec<Option<(usize, usize, f64)>> {
         let mut out = vec![None; searched.len()];
         let of = searched.iter().flatten().count();
-        let Some(scout) = self.level.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
+        let Some(scout) = self.scout.as_ref().filter(|_| of > SCOUT_KEEP) else {
             return out;
         };
-        let Ok(model) = current.stage.model() else {
+        let Some(reference) = scout.mean_square(&current.stage) else {
             return out;
         };
-        let Ok(r) = scout.residual(&model, &current.stage.values) else {
-            return out;
-        };
-        let reference = rms_over(&r, &scout.train).powi(2);
         let mut order: Vec<(usize, f64)> = searched
             .iter()
             .enumerate()
@@ -122,28 +112,19 @@ pub(super) fn scouted(
     (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),
     settings: &DiscoverySettings,
 ) -> (SearchModel, f64, f64) {
-    let on_scout = |s: &SearchModel| {
-        s.model()
-            .ok()
-            .and_then(|m| scout.residual(&m, &s.values).ok())
-            .map_or(f64::INFINITY, |r| rms_over(&r, &scout.train).powi(2))
-    };
     let train_rms = |s: &SearchModel| {
         s.residual(rig)
             .map_or(f64::INFINITY, |r| rms_over(&r, train))
     };
     let before = train_rms(&stage);
-    let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) else {
-        let ms = on_scout(&stage);
-        return (stage, ms, before);
-    };
-    let after = train_rms(&fitted);
-    if after < before {
-        (fitted, fit.rms * fit.rms, after)
-    } else {
-        let ms = on_scout(&stage);
-        (stage, ms, before)
+    if let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) {
+        let after = train_rms(&fitted);
+        if after < before {
+            return (fitted, fit.rms * fit.rms, after);
+        }
     }
+    let ms = scout.mean_square(&stage).unwrap_or(f64::INFINITY);
+    (stage, ms, before)
 }
 
 #[cfg(test)]

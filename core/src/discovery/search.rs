@@ -17,7 +17,7 @@ use super::candidate::{self, Candidate};
 use super::choice::{self, Trial};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
-use super::force_subset_fit::rms;
+use super::holdout::rms;
 use super::level::Level;
 use super::progress::DiscoveryEvent;
 use super::reconsider::reconsider;
@@ -45,12 +45,11 @@ pub(super) fn discover<L: Level>(
     settings: &DiscoverySettings,
 ) -> Result<Discovery, DiscoveryError> {
     candidate::distinct(candidates)?;
-    let base_name = base.name().to_string();
     let in_base: Vec<String> = base.terms().into_iter().map(str::to_string).collect();
-    let (kept, mut notes) = level.admitted(candidates);
-    let candidates = kept.as_slice();
+    let (candidates, mut notes) = level.admitted(candidates);
     settings.observer.emit(DiscoveryEvent::Base);
     let first = base_fit(level, &base, settings)?;
+    let base_name = base.name();
     notes.push(format!("base `{base_name}`: {}", first.location.summary));
     notes.extend(level.search_notes());
 
@@ -58,7 +57,7 @@ pub(super) fn discover<L: Level>(
     let mut effects: Vec<String> = Vec::new();
     let mut steps = Vec::new();
     for step in 1..=settings.max_effects {
-        let tried = current.stage.to_try(candidates, &in_base, &effects);
+        let tried = current.stage.to_try(&candidates, &in_base, &effects);
         if tried.is_empty() {
             break;
         }
@@ -67,14 +66,14 @@ pub(super) fn discover<L: Level>(
             Ok::<_, DiscoveryError>(choice::decide(
                 &current,
                 scored,
-                level.said(),
+                L::SAID,
                 yardstick,
                 settings,
             ))
         })??;
         notes.push(step.verdict.clone());
-        if level.warns_unresolved() {
-            notes.extend(choice::unresolved(&step, level.said()));
+        if L::WARNS_UNRESOLVED {
+            notes.extend(choice::unresolved(&step, L::SAID));
         }
         effects.extend(step.accepted.clone());
         steps.push(step);
@@ -87,7 +86,7 @@ pub(super) fn discover<L: Level>(
             trial
         };
         if level.reconsiders() && effects.len() >= 2 {
-            let re = (candidates, in_base.as_slice(), first.base_excess);
+            let re = (candidates.as_slice(), in_base.as_slice(), first.base_excess);
             if let Some(step) = reconsider(level, &mut current, &mut effects, re)? {
                 notes.push(step.verdict.clone());
                 steps.push(step);
@@ -116,7 +115,7 @@ fn base_fit<L: Level>(
     let (stage, result) = level.fit(&start, &all, settings)?;
     let floor = level.floor(&stage)?;
     let (residual, location) = level.gap(&stage, &floor)?;
-    let current = level.first_trial(&start, &stage)?;
+    let current = level.trial(if L::FIRST_FROM_FIT { &stage } else { &start }, settings)?;
     let base_excess = level.base_excess(&current, &floor)?;
     Ok(BaseFit {
         stage,
@@ -222,7 +221,7 @@ fn final_refit<L: Level>(
     let refit_rms = rms(&level.residual(&refit)?);
     let start_rms = rms(&level.residual(&current.stage)?);
     if start_rms < refit_rms {
-        let said = level.said();
+        let said = L::SAID;
         notes.push(format!(
             "the whole-record refit ended worse ({:.4} {}) than the training fit it started \
              from ({:.4} {}); the training fit's values are kept",

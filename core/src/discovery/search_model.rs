@@ -26,6 +26,17 @@ pub(super) struct SearchModel {
 }
 
 impl SearchModel {
+    /// `base` alone at its defaults, after the level's own start values `own`, with the
+    /// offset (0) if `offset` is fitted.
+    pub fn at_defaults(base: &Arc<dyn ForceModel>, own: &[f64], offset: bool) -> SearchModel {
+        let values = own.iter().copied();
+        let values = values.chain(base.params().iter().map(|s| s.default));
+        SearchModel {
+            values: values.chain(offset.then_some(0.0)).collect(),
+            parts: vec![base.clone()],
+        }
+    }
+
     /// The model: the one part, or the sum of the parts.
     pub fn model(&self) -> Result<Arc<dyn ForceModel>, DiscoveryError> {
         Ok(match self.parts.as_slice() {
@@ -88,22 +99,21 @@ impl SearchModel {
     /// This stage with `extra` added last, its parameters at `start`, after the sum's
     /// parameters (which follow the level's `n_before` own) and before the offset.
     pub fn with(&self, extra: &Arc<dyn ForceModel>, start: &[f64], n_before: usize) -> SearchModel {
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let cut = (n_before + n_model).min(self.values.len());
-        let mut values = self.values[..cut].to_vec();
-        values.extend_from_slice(start);
-        values.extend_from_slice(&self.values[cut..]);
-        let mut parts = self.parts.clone();
-        parts.push(extra.clone());
-        SearchModel { parts, values }
+        self.inserting(self.parts.len(), n_before, extra, start)
+    }
+
+    /// Where the parameters of part `index` start among the values: after the level's
+    /// `n_before` own and those of the parts before it.
+    pub fn start_of(&self, index: usize, n_before: usize) -> usize {
+        let before = &self.parts[..index.min(self.parts.len())];
+        n_before + before.iter().map(|p| p.params().len()).sum::<usize>()
     }
 
     /// This stage without its part `index` (its parameters, which follow the level's
     /// `n_before` own, dropped).
     pub fn without(&self, index: usize, n_before: usize) -> SearchModel {
-        let sizes: Vec<usize> = self.parts.iter().map(|p| p.params().len()).collect();
-        let from: usize = n_before + sizes[..index.min(sizes.len())].iter().sum::<usize>();
-        let to = from + sizes.get(index).copied().unwrap_or(0);
+        let from = self.start_of(index, n_before);
+        let to = from + self.parts.get(index).map_or(0, |p| p.params().len());
         let mut values = self.values.clone();
         if to <= values.len() {
             values.drain(from..to);
@@ -125,13 +135,8 @@ impl SearchModel {
         start: &[f64],
     ) -> SearchModel {
         let index = index.min(self.parts.len());
-        let at: usize = n_before
-            + self.parts[..index]
-                .iter()
-                .map(|p| p.params().len())
-                .sum::<usize>();
+        let at = self.start_of(index, n_before).min(self.values.len());
         let mut values = self.values.clone();
-        let at = at.min(values.len());
         values.splice(at..at, start.iter().copied());
         let mut parts = self.parts.clone();
         parts.insert(index, extra.clone());

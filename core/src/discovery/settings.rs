@@ -155,10 +155,7 @@ impl DiscoverySettings {
         self.fit
             .validate()
             .map_err(|e| DiscoveryError::BadSettings(e.to_string()))?;
-        let sigma_ok = match self.noise_sigma {
-            Some(s) => s > 0.0 && s.is_finite(),
-            None => true,
-        };
+        let sigma_ok = self.noise_sigma.is_none_or(|s| s > 0.0 && s.is_finite());
         let ok = self.holdout_every >= 2
             && self.min_gain_sigma >= 0.0
             && self.min_gain_sigma.is_finite()
@@ -194,10 +191,8 @@ impl DiscoverySettings {
         what: &str,
         unit: &str,
     ) -> Result<f64, DiscoveryError> {
-        let floor = match self.noise_sigma {
-            Some(s) => s,
-            None => crate::regimes::noise_floor(signal)?,
-        };
+        let estimated = || crate::regimes::noise_floor(signal);
+        let floor = self.noise_sigma.map_or_else(estimated, Ok)?;
         if !(floor > 0.0 && floor.is_finite()) {
             return Err(DiscoveryError::BadData(format!(
                 "the noise floor of the measured {what} is {floor} {unit}; give `noise_sigma`"

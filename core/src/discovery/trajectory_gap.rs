@@ -7,7 +7,7 @@
 //! measured STF force, which a trajectory-level record does not have (ω bands stand in for
 //! them on a sweep).
 
-use super::force_gap::{locate_gap, summary, GapBreakdown, GapLocation};
+use super::force_gap::{locate_gap, summary, GapLocation};
 use super::trajectory_subset_fit::Run;
 use crate::data::force_data::ForceData;
 use crate::regimes::Cycle;
@@ -19,23 +19,18 @@ pub(super) fn locate_x_gap(run: &Run, cycles: &[Cycle], floor: f64) -> GapLocati
     let data = ForceData::new(&s.t, &s.x, &s.v, &s.a, &s.f_stf);
     let mut g = locate_gap(&run.residual, &data, cycles, floor);
     g.breakdowns.retain(|b| b.by != "regime");
-    g.summary = summarise_mm(g.rms, floor, &g.breakdowns);
-    g
-}
-
-/// The one-line description of where an x residual lives, in mm.
-fn summarise_mm(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
+    // The summary in mm.
     let mm = |v: f64| v * 1e3;
     let head = format!(
         "x residual {:.4} mm RMS (S = {:.4} mm²) against a noise floor of {:.4} mm ({:.1}×)",
-        mm(total),
-        mm(total) * mm(total),
+        mm(g.rms),
+        mm(g.rms) * mm(g.rms),
         mm(floor),
-        total / floor
+        g.rms / floor
     );
-    summary(head, total, floor, breakdowns, "ω and states", |v| {
-        format!("{:.4} mm", mm(v))
-    })
+    let say = |v: f64| format!("{:.4} mm", mm(v));
+    g.summary = summary(head, g.rms, floor, &g.breakdowns, "ω and states", say);
+    g
 }
 
 #[cfg(test)]

@@ -36,12 +36,11 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::{Discovery, TrajectoryPart};
 use super::force_gap::GapLocation;
-use super::force_subset_fit::rms;
-use super::holdout::{cycle_rms, HoldoutSplit};
+use super::holdout::{cycle_rms, rms, HoldoutSplit};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout::Scout;
-use super::scout_ranking::{scout_of, scouted};
+use super::scout_ranking::scouted;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
@@ -49,7 +48,7 @@ use super::trajectory_gap::locate_x_gap;
 use super::trajectory_screen::SCREEN_MIN_SAMPLES;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::Rig;
-use super::trajectory_trials::{trial_settings, Trials};
+use super::trajectory_trials::trial_settings;
 use crate::fit::{check_same_terms, FitResult, NoiseFloor, TrajectoryData};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::physics::oscillator_params::{OscParam, OscillatorParams};
@@ -137,7 +136,12 @@ impl<'a> TrajectoryLevel<'a> {
             x: data.x,
         };
         let split = HoldoutSplit::new(n, cycles, settings.holdout_every)?;
-        let scout = scout_of(&rig, cycles, &split.train, settings);
+        // A scout only on a record of at least `scout_from` samples (none when 0), and when
+        // the record makes one.
+        let scouts = settings.scout_from > 0 && n >= settings.scout_from;
+        let scout = scouts
+            .then(|| Scout::new(&rig, cycles, &split.train))
+            .flatten();
         Ok(TrajectoryLevel {
             data,
             cycles,
@@ -154,9 +158,12 @@ impl<'a> TrajectoryLevel<'a> {
 }
 
 impl Level for TrajectoryLevel<'_> {
-    fn said(&self) -> &'static Said {
-        &choice::DISPLACEMENT
-    }
+    const SAID: &'static Said = &choice::DISPLACEMENT;
+    /// From the base's whole-record fit: from the defaults it can end in a basin of its
+    /// own, and every candidate would then be scored against that.
+    const FIRST_FROM_FIT: bool = true;
+    const POLISH: bool = true;
+    const WARNS_UNRESOLVED: bool = true;
 
     fn n_before(&self) -> usize {
         self.setup.fit.free.len()
@@ -175,54 +182,36 @@ impl Level for TrajectoryLevel<'_> {
     /// a note saying why.
     fn admitted(&self, candidates: &[Candidate]) -> (Vec<Candidate>, Vec<String>) {
         let refitted = &self.rig.oscillator;
-        let mut kept = Vec::new();
         let mut notes = Vec::new();
-        for c in candidates {
-            match c
-                .model
-                .params()
-                .iter()
-                .find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)))
-            {
-                Some((spec, osc)) => notes.push(format!(
+        let kept = candidates.iter().filter(|c| {
+            let mut params = c.model.params().iter();
+            let same =
+                params.find_map(|s| s.same_as.filter(|o| refitted.contains(o)).map(|o| (s, o)));
+            if let Some((spec, osc)) = same {
+                notes.push(format!(
                     "`{}` not tried: its `{}` is the same term as the refitted oscillator's \
                      `{osc}`",
                     c.name, spec.name
-                )),
-                None => kept.push(c.clone()),
+                ));
             }
-        }
-        (kept, notes)
+            same.is_none()
+        });
+        (kept.cloned().collect(), notes)
     }
 
     /// The oscillator's start, the base's defaults: fitted at force level to the force hint
     /// if any, then on the scout if any.
     fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
-        let settings = self.settings;
-        let start = SearchModel {
-            values: self
-                .osc_start
-                .iter()
-                .copied()
-                .chain(base.params().iter().map(|s| s.default))
-                .chain(settings.fit_offset.then_some(0.0))
-                .collect(),
-            parts: vec![base.clone()],
-        };
+        let start = SearchModel::at_defaults(base, &self.osc_start, self.settings.fit_offset);
         let all: Vec<usize> = (0..self.samples()).collect();
-        let start = match &self.setup.force_hint {
-            Some(h) => start
-                .force_started(&self.rig, h, &all)
-                .map_or(start, |(s, _)| s),
-            None => start,
+        let hint = self.setup.force_hint.as_ref();
+        let hinted = hint.and_then(|h| start.force_started(&self.rig, h, &all));
+        let start = hinted.map_or(start, |(s, _)| s);
+        let Some(scout) = &self.scout else {
+            return start;
         };
-        match &self.scout {
-            Some(s) => {
-                let lm = settings.levenberg_marquardt(None);
-                scouted(start, s, (&self.rig, self.setup, &all), &lm).0
-            }
-            None => start,
-        }
+        let lm = self.settings.levenberg_marquardt(None);
+        scouted(start, scout, (&self.rig, self.setup, &all), &lm).0
     }
 
     fn fit(
@@ -241,16 +230,6 @@ impl Level for TrajectoryLevel<'_> {
     /// Each held-out cycle's RMS: the cycle is the unit of evidence.
     fn held_out(&self, r: &[f64]) -> Vec<f64> {
         cycle_rms(r, &self.split.holdout)
-    }
-
-    /// From the base's whole-record fit: from the defaults it can end in a basin of its
-    /// own, and every candidate would then be scored against that.
-    fn first_trial(
-        &self,
-        _: &SearchModel,
-        base_full: &SearchModel,
-    ) -> Result<Trial, DiscoveryError> {
-        self.trial(base_full, self.settings)
     }
 
     /// The displacement noise, whatever the model.
@@ -291,7 +270,7 @@ impl Level for TrajectoryLevel<'_> {
             notes.push(format!(
                 "scouted: each candidate's values are searched on {} pieces of the record \
                  ({} samples of {n}), then fitted on the whole record from there",
-                s.pieces(),
+                s.pieces.len(),
                 s.samples
             ));
         }
@@ -305,9 +284,8 @@ impl Level for TrajectoryLevel<'_> {
         base_excess: f64,
         then: impl FnOnce(&Yardstick) -> T,
     ) -> Result<T, DiscoveryError> {
-        let test = |reference: &[f64], new: &[f64]| (cycle_gain_z(reference, new), reference.len());
         Ok(then(&Yardstick {
-            gain_z: &test,
+            gain_z: &|a: &[f64], b: &[f64]| (cycle_gain_z(a, b), a.len()),
             units: &|h: &[f64]| h.to_vec(),
             base_excess,
             floor: NoiseFloor::displacement(self.floor),
@@ -324,11 +302,7 @@ impl Level for TrajectoryLevel<'_> {
         current: &Trial,
         yardstick: &Yardstick,
     ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
-        let trials = Trials {
-            level: self,
-            yardstick,
-        };
-        Ok(trials.step(step, tried, current))
+        Ok(self.scores(step, tried, current, yardstick))
     }
 
     /// From the candidate's defaults, at most `TRIAL_ITERS` iterations.
@@ -342,14 +316,6 @@ impl Level for TrajectoryLevel<'_> {
         let defaults: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
         let stage = rest.inserting(part, self.n_before(), &c.model, &defaults);
         self.trial(&stage, &trial_settings(self.settings))
-    }
-
-    fn polish_default(&self) -> bool {
-        true
-    }
-
-    fn warns_unresolved(&self) -> bool {
-        true
     }
 
     /// Levenberg–Marquardt alone, from the training fit (near the optimum).

@@ -2,19 +2,18 @@
 //! the force recovered from the record's kinematics ([`SearchModel::force_started`], also the
 //! start of its trajectory fit), ranked by how much it lowers that force's mean square; when
 //! the recovered force asks for something, only the best [`SCREEN_KEEP`] are fitted at
-//! trajectory level ([`Trials::force_screen`]).
+//! trajectory level ([`TrajectoryLevel::force_screen`]).
 
 use rayon::prelude::*;
 
 use super::choice::Trial;
-use super::force_level::inside;
-use super::force_subset_fit::fit_subset;
+use super::force_level::started_fit;
 use super::search_model::SearchModel;
+use super::trajectory_level::TrajectoryLevel;
 use super::trajectory_setup::ForceHint;
 use super::trajectory_subset_fit::Rig;
-use super::trajectory_trials::Trials;
 use crate::data::force_data::ForceData;
-use crate::fit::{FitParam, FitSettings, ForceFit, Solver};
+use crate::fit::{FitSettings, Solver};
 
 impl SearchModel {
     /// This stage with its model's parameters fitted at force level to the recovered force of
@@ -56,14 +55,11 @@ impl SearchModel {
         // model's own, so the screen's gains are not lost to a poor start.
         let mut nested = current.to_vec();
         if let Some((i, spec)) = self.amplitude(n_osc) {
-            nested[i - n_osc] = inside(1e-3 * spec.default, spec.min, spec.max);
+            nested[i - n_osc] = (1e-3 * spec.default).clamp(spec.min, spec.max);
         }
         for start in [current, nested.as_slice(), defaults.as_slice()] {
-            let mut fit = ForceFit::new(model.clone());
-            for (spec, &v) in model.params().iter().zip(start) {
-                fit = fit.param(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
-            }
-            let Ok(r) = fit_subset(&fit, &data, &subset, &settings) else {
+            let fit = started_fit(&model, start);
+            let Ok(r) = fit.fit_rows(&data, Some(&subset), &settings, None) else {
                 continue;
             };
             if best.as_ref().is_none_or(|(rms, _)| r.rms < *rms) {
@@ -86,43 +82,42 @@ impl SearchModel {
 pub(super) const HINT_SAMPLES: usize = 20_000;
 
 /// Candidates fitted at trajectory level in a step, at most: the others are ranked out by the
-/// screen of [`Trials::step`].
+/// screen of [`TrajectoryLevel::scores`].
 pub(super) const SCREEN_KEEP: usize = 3;
 
 /// The least gain, as a share of the current model's mean square at force level, for the
-/// screen of [`Trials::step`] to rank.
+/// screen of [`TrajectoryLevel::scores`] to rank.
 pub(super) const SCREEN_MIN_GAIN: f64 = 0.01;
 
-/// Fewest samples a cycle for the force-level screen of [`Trials::step`] to rank: below it the
+/// Fewest samples a cycle for the force-level screen of [`TrajectoryLevel::scores`] to rank: below it the
 /// derivative filter's ẍ, and with it the recovered force, is mostly bias (on an electronic
 /// oscillator at 9 samples a period the screen ranked the true cubic spring 5th of 6).
 pub(super) const SCREEN_MIN_SAMPLES: usize = 20;
 
-/// The force-level screen of a step's candidates ([`Trials::force_screen`]).
-pub(super) struct ForceScreen {
-    /// Each candidate's force-level start and that fit's RMS (N).
-    pub hinted: Vec<Option<(SearchModel, f64)>>,
-    /// Each one's gain over the current model's mean square (N²).
-    pub gains: Vec<Option<f64>>,
-    /// Each one's rank by its gain (0 the best).
-    pub rank: Vec<usize>,
-    /// Whether the screen ranks out all but [`SCREEN_KEEP`].
-    pub screened: bool,
-}
+/// The force-level screen of a step's candidates ([`TrajectoryLevel::force_screen`]): each
+/// candidate's force-level start and that fit's RMS (N), its gain over the current model's
+/// mean square (N²), its rank by the gain (0 the best), and whether the screen ranks out all
+/// but [`SCREEN_KEEP`].
+pub(super) type ForceScreen = (
+    Vec<Option<(SearchModel, f64)>>,
+    Vec<Option<f64>>,
+    Vec<usize>,
+    bool,
+);
 
-impl Trials<'_, '_> {
+impl TrajectoryLevel<'_> {
     /// The force-level screen of the candidates `withs` (each added to `current`): each one's
     /// force-level start and its RMS, its gain over `current` (N²), its rank by the gain, and
     /// whether the screen ranks out all but [`SCREEN_KEEP`].
     pub(super) fn force_screen(&self, withs: &[SearchModel], current: &Trial) -> ForceScreen {
-        let train = &self.level.split.train;
-        let hint = self.level.setup.force_hint.as_ref();
+        let train = &self.split.train;
+        let hint = self.setup.force_hint.as_ref();
         let hinted: Vec<Option<(SearchModel, f64)>> = withs
             .par_iter()
-            .map(|w| hint.and_then(|h| w.force_started(&self.level.rig, h, train)))
+            .map(|w| hint.and_then(|h| w.force_started(&self.rig, h, train)))
             .collect();
         let reference = hint
-            .and_then(|h| current.stage.force_started(&self.level.rig, h, train))
+            .and_then(|h| current.stage.force_started(&self.rig, h, train))
             .map(|(_, rms)| rms);
         let gains: Vec<Option<f64>> = hinted
             .iter()
@@ -145,14 +140,9 @@ impl Trials<'_, '_> {
             .iter()
             .flatten()
             .fold(f64::NEG_INFINITY, |a, &b| a.max(b));
-        let screened = self.level.screen
+        let screened = self.screen
             && withs.len() > SCREEN_KEEP
             && reference.is_some_and(|r| best_gain > SCREEN_MIN_GAIN * r * r);
-        ForceScreen {
-            hinted,
-            gains,
-            rank,
-            screened,
-        }
+        (hinted, gains, rank, screened)
     }
 }

@@ -2,8 +2,7 @@
 //! effect's amplitude on three bases, the best after a short fit
 //! ([`SearchModel::starts`], [`SearchModel::started`]).
 
-use super::force_level::inside;
-use super::force_subset_fit::rms_over;
+use super::holdout::rms_over;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_setup::TrajectorySetup;
@@ -57,14 +56,12 @@ impl SearchModel {
                 });
             }
         }
-        let screen = self.amplitude(osc_start.len()).zip(self.model().ok());
         let mut best = (f64::INFINITY, self.values.clone());
-        for values in self.bases(osc_start) {
-            if let Some(((i, spec), model)) = &screen {
-                let mut values = values;
+        if let Some(((i, spec), model)) = self.amplitude(osc_start.len()).zip(self.model().ok()) {
+            for mut values in self.bases(osc_start) {
                 for f in SCREEN {
-                    values[*i] = inside(spec.default * f, spec.min, spec.max);
-                    if let Ok(residual) = track.residual(model, &values) {
+                    values[i] = (spec.default * f).clamp(spec.min, spec.max);
+                    if let Ok(residual) = track.residual(&model, &values) {
                         let s = rms_over(&residual, train);
                         if s < best.0 {
                             best = (s, values.clone());
@@ -99,11 +96,8 @@ impl SearchModel {
 
     /// This stage's values with the oscillator's (the first ones) set to `osc`.
     pub(super) fn on_oscillator(&self, osc: &[f64]) -> Vec<f64> {
-        let mut values = self.values.clone();
-        for (v, &s) in values.iter_mut().zip(osc) {
-            *v = s;
-        }
-        values
+        let n = osc.len().min(self.values.len());
+        [&osc[..n], &self.values[n..]].concat()
     }
 
     /// The last part's first parameter and its index in `values` (after `n_osc` oscillator
@@ -111,8 +105,7 @@ impl SearchModel {
     pub(super) fn amplitude(&self, n_osc: usize) -> Option<(usize, ParamSpec)> {
         let extra = self.parts.last()?;
         let spec = extra.params().first()?;
-        let n_model: usize = self.parts.iter().map(|p| p.params().len()).sum();
-        let i = (n_osc + n_model).checked_sub(extra.params().len())?;
+        let i = self.start_of(self.parts.len() - 1, n_osc);
         (spec.min >= 0.0 && spec.default > 0.0 && i < self.values.len()).then(|| (i, spec.clone()))
     }
 

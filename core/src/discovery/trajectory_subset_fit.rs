@@ -50,8 +50,17 @@ pub(super) trait Track: Sync {
 }
 
 impl Track for Rig<'_> {
+    /// The displacement residual alone, at the cost of the integration only: what a fit
+    /// evaluates.
     fn residual(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String> {
-        Rig::residual(self, model, values)
+        let (osc, [x0, v0], offset) = self.setup(model, values)?;
+        let Some(&t0) = self.t.first() else {
+            return Ok(Vec::new());
+        };
+        let y0 = osc.initial_state(x0, v0);
+        let sol = integrate(&osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
+        let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
+        self.residual_of(&x, offset)
     }
     fn rtol(&self) -> f64 {
         self.sim.rtol
@@ -59,14 +68,6 @@ impl Track for Rig<'_> {
     fn fixes_start(&self) -> bool {
         self.fixed_start
     }
-}
-
-/// The oscillator of one evaluation, its initial state and the displacement offset.
-struct RigSetup {
-    osc: Oscillator,
-    x0: f64,
-    v0: f64,
-    offset: f64,
 }
 
 /// One evaluation: the model's simulated motion and the displacement residual.
@@ -80,48 +81,35 @@ impl Rig<'_> {
     /// Simulate `model` on the rig with the full parameter vector `values` (oscillator's,
     /// model's, offset): the whole motion and the displacement residual.
     pub fn run(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Run, String> {
-        let setup = self.setup(model, values)?;
-        let sim = Simulation::new(&setup.osc)
+        let (osc, [x0, v0], offset) = self.setup(model, values)?;
+        let sim = Simulation::new(&osc)
             .settings(self.sim.clone())
-            .initial(setup.x0, setup.v0)
+            .initial(x0, v0)
             .run_at(self.t)
             .map_err(|e| e.to_string())?;
-        let residual = self.residual_of(&sim.x, setup.offset)?;
+        let residual = self.residual_of(&sim.x, offset)?;
         Ok(Run { sim, residual })
-    }
-
-    /// The displacement residual alone (measured − simulated − offset at every sample, m), at
-    /// the cost of the integration only: what a fit evaluates.
-    pub fn residual(
-        &self,
-        model: &Arc<dyn ForceModel>,
-        values: &[f64],
-    ) -> Result<Vec<f64>, String> {
-        let setup = self.setup(model, values)?;
-        let Some(&t0) = self.t.first() else {
-            return Ok(Vec::new());
-        };
-        let y0 = setup.osc.initial_state(setup.x0, setup.v0);
-        let sol = integrate(&setup.osc, t0, &y0, self.t, &self.sim).map_err(|e| e.to_string())?;
-        let x: Vec<f64> = sol.states.iter().step_by(sol.dim).copied().collect();
-        self.residual_of(&x, setup.offset)
     }
 
     /// The state (x0 m, v0 m/s) a simulation with `values` starts from: fitted, or the
     /// setup's estimate less the offset.
     pub fn start(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<[f64; 2], String> {
-        let setup = self.setup(model, values)?;
-        Ok([setup.x0, setup.v0])
+        Ok(self.setup(model, values)?.1)
     }
 
-    /// The oscillator with `values` set, its initial state and the offset.
-    fn setup(&self, model: &Arc<dyn ForceModel>, values: &[f64]) -> Result<RigSetup, String> {
+    /// The oscillator with `values` set, its initial state (x0, v0) and the displacement
+    /// offset.
+    fn setup(
+        &self,
+        model: &Arc<dyn ForceModel>,
+        values: &[f64],
+    ) -> Result<(Oscillator, [f64; 2], f64), String> {
         let n_osc = self.oscillator.len();
         let n_model = model.params().len();
-        if values.len() != n_osc + n_model + usize::from(self.fit_offset) {
+        let expected = n_osc + n_model + usize::from(self.fit_offset);
+        if values.len() != expected {
             return Err(format!(
-                "expected {} parameter values, got {}",
-                n_osc + n_model + usize::from(self.fit_offset),
+                "expected {expected} parameter values, got {}",
                 values.len()
             ));
         }
@@ -137,23 +125,16 @@ impl Rig<'_> {
                 system[param] = v;
             }
         }
-        let offset = if self.fit_offset {
-            values[n_osc + n_model]
-        } else {
-            0.0
-        };
+        // Checked above: a value after the model's is the offset, fitted.
+        let offset = values.get(n_osc + n_model).copied().unwrap_or(0.0);
         let osc = Oscillator::with_shared_excitation(system, self.excitation.clone())
             .with_model(model.clone(), values[n_osc..n_osc + n_model].to_vec())
             .map_err(|e| e.to_string())?;
         let (x0, v0) = self
             .initial
             .unwrap_or((self.x.first().copied().unwrap_or(0.0), 0.0));
-        Ok(RigSetup {
-            osc,
-            x0: initial[0].unwrap_or(x0 - offset),
-            v0: initial[1].unwrap_or(v0),
-            offset,
-        })
+        let start = [initial[0].unwrap_or(x0 - offset), initial[1].unwrap_or(v0)];
+        Ok((osc, start, offset))
     }
 
     /// Measured − simulated − offset, checked for length and finiteness.

@@ -1,6 +1,6 @@
 //! A trajectory-level step's trials: a stage simulated and fitted on a [`Track`] (the whole
 //! record or the scout), and every candidate of a step searched, screened and scored
-//! ([`Trials::step`]); the trial itself is the one of [`Level::trial`].
+//! ([`TrajectoryLevel::scores`]); the trial itself is the one of [`Level::trial`].
 
 use std::sync::Arc;
 
@@ -9,14 +9,13 @@ use rayon::prelude::*;
 use super::candidate::Candidate;
 use super::choice::{self, Trial, Yardstick};
 use super::error::DiscoveryError;
-use super::force_level::{emit_scored, inside};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout_ranking::{left_out, scouted};
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_level::TrajectoryLevel;
-use super::trajectory_screen::{ForceScreen, SCREEN_KEEP};
+use super::trajectory_screen::SCREEN_KEEP;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
 use crate::fit::{FitParam, FitResult, DISPLACEMENT_OFFSET};
@@ -33,11 +32,11 @@ impl SearchModel {
         let mut values = self.values.iter().copied();
         for p in &setup.fit.free {
             let v = values.next().unwrap_or(p.value);
-            out.push(p.clone().value(inside(v, p.min, p.max)));
+            out.push(p.clone().value(v.clamp(p.min, p.max)));
         }
         for spec in model.params() {
             let v = values.next().unwrap_or(spec.default);
-            out.push(FitParam::from_spec(spec).value(inside(v, spec.min, spec.max)));
+            out.push(FitParam::from_spec(spec).value(v.clamp(spec.min, spec.max)));
         }
         if let Some(v) = values.next() {
             out.push(
@@ -89,13 +88,7 @@ pub(super) const TRIAL_ITERS: u64 = 60;
 /// scout (see [`super::scout`]).
 pub(super) const SCOUTED_TRIAL_ITERS: u64 = 15;
 
-/// What every candidate trial of a step shares: the level and the step's yardstick.
-pub(super) struct Trials<'a, 'r> {
-    pub level: &'a TrajectoryLevel<'r>,
-    pub yardstick: &'a Yardstick<'a>,
-}
-
-impl Trials<'_, '_> {
+impl TrajectoryLevel<'_> {
     /// The scores of the candidates `tried` against `current` in `step`, in their order.
     ///
     /// A screen first (when the setup has a force hint): each candidate, added to the current
@@ -108,13 +101,14 @@ impl Trials<'_, '_> {
     /// hundreds of simulations. On a scouted record each candidate's values are searched on
     /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
     /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
-    pub(super) fn step(
+    pub(super) fn scores(
         &self,
         step: usize,
         tried: &[&Candidate],
         current: &Trial,
+        yardstick: &Yardstick,
     ) -> Vec<(CandidateScore, Option<Trial>)> {
-        let n_osc = self.level.rig.oscillator.len();
+        let n_osc = self.rig.oscillator.len();
         let withs: Vec<SearchModel> = tried
             .iter()
             .map(|c| {
@@ -122,20 +116,14 @@ impl Trials<'_, '_> {
                 current.stage.with(&c.model, &defaults, n_osc)
             })
             .collect();
-        let ForceScreen {
-            hinted,
-            gains,
-            rank,
-            screened,
-        } = self.force_screen(&withs, current);
+        let (hinted, gains, rank, screened) = self.force_screen(&withs, current);
         let searched: Vec<Option<(SearchModel, f64, f64)>> = (0..tried.len())
             .into_par_iter()
             .map(|i| {
                 if screened && rank[i] >= SCREEN_KEEP {
                     return None;
                 }
-                self.level
-                    .settings
+                self.settings
                     .observer
                     .candidate(step, i, tried.len(), &tried[i].name);
                 let h = hinted[i].as_ref().map(|(s, _)| s);
@@ -170,8 +158,8 @@ impl Trials<'_, '_> {
                 ) {
                     return (choice::failed(&c.name, why), None);
                 }
-                let s = self.scored(c, stage.clone(), current);
-                emit_scored(self.level.settings, step, Some(&s));
+                let s = self.scored(c, stage.clone(), current, yardstick);
+                self.settings.observer.scored(step, &s.0);
                 s
             })
             .collect()
@@ -187,22 +175,17 @@ impl Trials<'_, '_> {
         with: SearchModel,
         hinted: Option<&SearchModel>,
     ) -> (SearchModel, f64, f64) {
-        let (track, train): (&dyn Track, &[usize]) = match self.level.scout.as_ref() {
+        let (track, train): (&dyn Track, &[usize]) = match self.scout.as_ref() {
             Some(scout) => (scout, &scout.train),
-            None => (&self.level.rig, &self.level.split.train),
+            None => (&self.rig, &self.split.train),
         };
-        let starts = with.starts(track, train, &self.level.osc_start, hinted);
+        let starts = with.starts(track, train, &self.osc_start, hinted);
         let stage =
-            SearchModel::started(starts, track, self.level.setup, train, self.level.settings)
-                .unwrap_or(with);
-        match self.level.scout.as_ref() {
+            SearchModel::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
+        match self.scout.as_ref() {
             Some(scout) => {
-                let on = (
-                    &self.level.rig,
-                    self.level.setup,
-                    self.level.split.train.as_slice(),
-                );
-                scouted(stage, scout, on, &trial_settings(self.level.settings))
+                let on = (&self.rig, self.setup, self.split.train.as_slice());
+                scouted(stage, scout, on, &trial_settings(self.settings))
             }
             None => (stage, f64::INFINITY, f64::NAN),
         }
@@ -217,19 +200,20 @@ impl Trials<'_, '_> {
         c: &Candidate,
         stage: SearchModel,
         current: &Trial,
+        yardstick: &Yardstick,
     ) -> (CandidateScore, Option<Trial>) {
-        let mut settings = trial_settings(self.level.settings);
-        if self.level.scout.as_ref().is_some() {
-            let iters = settings.fit.max_iters.min(SCOUTED_TRIAL_ITERS);
-            settings.fit = settings.fit.max_iters(iters);
-        }
+        let iters = match self.scout {
+            Some(_) => SCOUTED_TRIAL_ITERS,
+            None => TRIAL_ITERS,
+        };
+        let settings = self.settings.levenberg_marquardt(Some(iters));
         choice::scored(
             &c.name,
             c.model.params().len(),
-            self.level.trial(&stage, &settings),
+            self.trial(&stage, &settings),
             current,
-            self.yardstick,
-            self.level.settings,
+            yardstick,
+            self.settings,
         )
     }
 }
