@@ -22,7 +22,7 @@ use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory as SimRun};
 
 use crate::experiment::{Drive, Experiment};
-use crate::model_config::configure;
+use crate::model_config::configure_for;
 use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
 use crate::output_lock::OutputLock;
 use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
@@ -49,7 +49,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
     if !spec.truth.is_empty() {
-        let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
+        let truth = configure_for(&spec.truth, &exp.path, &exp.dir, &exp.scripts, None)?;
         truth_json.push(Truth {
             model: truth.model.name().to_string(),
             params: truth
