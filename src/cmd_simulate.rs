@@ -166,7 +166,7 @@ fn summary(run: &SimRun, free: bool) -> Summary {
     Summary {
         peak_x_m: pk.map(|p| p.amplitude),
         peak_t_s: pk.map(|p| p.t),
-        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
+        peak_omega_rad_s: pk.map(|p| p.omega),
         breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
         motion_stops_t_s: if free {
             stop(&run.v, MOVING_SPEED).map(|i| run.t[i])

@@ -94,7 +94,7 @@ pub struct FinalModelJson<'a> {
     /// The model's fitted values by name (SI units; no offsets or initial state).
     pub params: BTreeMap<String, f64>,
     /// Standard errors of every fitted value by name; null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
+    pub std_errors: BTreeMap<String, f64>,
     /// The model as a `[[models]]` entry (TOML).
     pub experiment_entry: String,
     /// The refitted oscillator (trajectory level; absent at force level).

@@ -10,7 +10,7 @@ use stf_core::numerics::derivative::NoiseEstimate;
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{errors_by_name, finite, level_name, values_by_name};
+use super::{errors_by_name, level_name, values_by_name};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::validation::ModelValidation;
@@ -83,9 +83,9 @@ pub struct ModelFitJson<'a> {
     /// Fitted (or held) values by parameter name, SI units.
     pub params: BTreeMap<String, f64>,
     /// Block-robust standard errors by name, SI units; null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
+    pub std_errors: BTreeMap<String, f64>,
     /// Standard errors as if the residuals were independent, by name; null where unknown.
-    pub naive_std_errors: BTreeMap<String, Option<f64>>,
+    pub naive_std_errors: BTreeMap<String, f64>,
     /// The blocks the robust errors were computed over.
     pub error_blocks: Option<ErrorBlocks>,
     /// Names of the parameters held at their values.
@@ -97,9 +97,9 @@ pub struct ModelFitJson<'a> {
     /// Mean squared displacement error, mm² (trajectory level).
     pub s_mm2: Option<f64>,
     /// Akaike information criterion; null if not finite.
-    pub aic: Option<f64>,
+    pub aic: f64,
     /// Bayesian information criterion; null if not finite.
-    pub bic: Option<f64>,
+    pub bic: f64,
     /// Samples fitted.
     pub n_points: usize,
     /// Free parameters.
@@ -115,7 +115,7 @@ pub struct ModelFitJson<'a> {
     /// The oscillator after the fit (trajectory level; null at force level).
     pub system: Option<OscillatorParams>,
     /// Correlation matrix of the free parameters; null where not finite.
-    pub correlation: Vec<Vec<Option<f64>>>,
+    pub correlation: &'a [Vec<f64>],
     /// The record's noise floor for this fit (same unit as `rms`).
     pub noise_floor: Option<NoiseFloor>,
     /// Why the fit is not to be trusted as it stands (`kind`, `message`, data).
@@ -155,8 +155,8 @@ impl<'a> ModelFitJson<'a> {
             rms: r.rms,
             rms_unit: level.signal().si_unit,
             s_mm2: r.s_mm2,
-            aic: finite(r.aic),
-            bic: finite(r.bic),
+            aic: r.aic,
+            bic: r.bic,
             n_points: r.n_points,
             n_free: r.n_free,
             evaluations: r.evaluations,
@@ -164,11 +164,7 @@ impl<'a> ModelFitJson<'a> {
             converged: r.convergence.converged(),
             convergence: &r.convergence,
             system: (level == FitLevel::Trajectory).then_some(fit.system),
-            correlation: r
-                .correlation
-                .iter()
-                .map(|row| row.iter().map(|&c| finite(c)).collect())
-                .collect(),
+            correlation: &r.correlation,
             noise_floor: fit.floor,
             warnings: fit.warnings.iter().map(FitWarning::stated).collect(),
             validation: fit.validation.as_ref().map(|v| ValidationJson {

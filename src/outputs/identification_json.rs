@@ -8,7 +8,7 @@ use serde::Serialize;
 use stf_core::fit::{Convergence, FitResult, FitWarning, NoiseFloor, StatedWarning};
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{errors_by_name, finite, values_by_name};
+use super::{errors_by_name, values_by_name};
 
 /// The whole of the identification's `fit.json`.
 #[derive(Serialize)]
@@ -50,7 +50,7 @@ impl<'a> IdentificationJson<'a> {
             models: [IdentifiedJson {
                 name: "none",
                 params: system,
-                rms: stages.last().and_then(|s| finite(s.rms)),
+                rms: stages.last().map(|s| s.rms),
                 warnings,
             }],
         }
@@ -67,15 +67,15 @@ pub struct StageJson {
     /// Fitted values by name (SI units).
     pub params: BTreeMap<String, f64>,
     /// Standard errors by name (SI units); null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
+    pub std_errors: BTreeMap<String, f64>,
     /// Mean squared displacement error S(μ), mm².
     pub s_mm2: Option<f64>,
     /// RMS displacement residual, m.
     pub rms: f64,
     /// Akaike information criterion; null if not finite.
-    pub aic: Option<f64>,
+    pub aic: f64,
     /// Bayesian information criterion; null if not finite.
-    pub bic: Option<f64>,
+    pub bic: f64,
     /// Simulations run.
     pub evaluations: u64,
     /// Whether the optimiser converged.
@@ -105,8 +105,8 @@ impl StageJson {
             std_errors: errors_by_name(&result.params, |p| p.std_error),
             s_mm2: result.s_mm2,
             rms: result.rms,
-            aic: finite(result.aic),
-            bic: finite(result.bic),
+            aic: result.aic,
+            bic: result.bic,
             evaluations: result.evaluations,
             converged: result.convergence.converged(),
             convergence: result.convergence.clone(),
