@@ -32,7 +32,7 @@ use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::write_json;
-use crate::outputs::discovery_json::{Common, DiscoveryJson};
+use crate::outputs::discovery_json::{DiscoveryJson, FinalSystemJson};
 use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::progress::{discovery_observer, Progress};
 use crate::report::{
@@ -52,26 +52,6 @@ fn model_from(terms: &[String], dir: &Path, run: &ScriptRun) -> Result<Arc<dyn F
         .map(|s| resolve(s, dir, run))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
-}
-
-/// The final `model` with the values of `params` as an experiment's `[[models]]` entry that
-/// `fit` and `compare` accept as it is (TOML).
-fn models_entry<'a>(
-    model: &dyn ForceModel,
-    params: impl Iterator<Item = &'a FittedParam>,
-) -> Result<String> {
-    ModelsEntry::new(&model.terms(), params)
-        .to_toml()
-        .context("cannot write the final model as an experiment entry")
-}
-
-/// The effects named, or `none`.
-fn named(effects: &[String]) -> String {
-    if effects.is_empty() {
-        "none".to_string()
-    } else {
-        effects.join(", ")
-    }
 }
 
 /// The fit settings of force-level discovery: discovery's own stopping rule
@@ -223,19 +203,17 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
         FitLevel::Force => force_fit_settings(&exp.fit.settings),
         FitLevel::Trajectory => exp.fit.settings.clone(),
     };
-    let mut settings = DiscoverySettings::default()
-        .fit(fit)
-        .fit_offset(exp.fit.offset);
-    if let Some(n) = spec.max_effects {
-        settings = settings.max_effects(n);
+    let d = DiscoverySettings::default();
+    DiscoverySettings {
+        max_effects: spec.max_effects.unwrap_or(d.max_effects),
+        holdout_every: spec.holdout_every.unwrap_or(d.holdout_every),
+        scout_from: spec.scout_from.unwrap_or(d.scout_from),
+        recheck: spec.recheck,
+        polish: spec.polish,
+        fit,
+        fit_offset: exp.fit.offset,
+        ..d
     }
-    if let Some(n) = spec.holdout_every {
-        settings = settings.holdout_every(n);
-    }
-    if let Some(n) = spec.scout_from {
-        settings = settings.scout_from(n);
-    }
-    settings.recheck(spec.recheck).polish(spec.polish)
 }
 
 /// The terminal summary of a discovery; `entries` are the final model's `[[models]]` and
@@ -248,7 +226,11 @@ fn print_summary(
     (entries, wall): (&(String, String), f64),
 ) {
     let (unit, scale) = data.level.shown();
-    let effects = named(&found.effects);
+    let effects = if found.effects.is_empty() {
+        "none".to_string()
+    } else {
+        found.effects.join(", ")
+    };
     let summary = match &found.trajectory {
         None => {
             say!(
@@ -319,32 +301,47 @@ fn write_results(
             || INITIAL_STATE.contains(&p.name.as_str())
     };
     let model_params: Vec<&FittedParam> = found.final_params.iter().filter(|p| !own(p)).collect();
-    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
-    let common = Common {
-        exp,
-        data,
-        found,
-        score,
-    };
+    // The final model as an experiment's `[[models]]` entry that `fit` and `compare` accept
+    // as it is (TOML).
+    let toml_entry = ModelsEntry::new(&found.final_model.terms(), model_params.iter().copied())
+        .to_toml()
+        .context("cannot write the final model as an experiment entry")?;
     let (doc, system_entry) = match &found.trajectory {
         None => {
             let all: Vec<&FittedParam> = found.final_params.iter().collect();
             let curves = crate::discovery_curves::force_curves(found, exp.system);
-            let doc = DiscoveryJson::new(common, &all, toml_entry.clone(), curves);
+            let doc = DiscoveryJson::new(
+                (exp, data),
+                (found, score),
+                &all,
+                toml_entry.clone(),
+                curves,
+            );
             (doc, String::new())
         }
         Some(tf) => {
-            let system_entry = SystemEntry {
+            let refitted = SystemEntry {
                 system: names
                     .iter()
                     .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
                     .collect(),
-            }
-            .to_toml()
-            .context("cannot write the refitted oscillator as a [system] entry")?;
+            };
+            let system_entry = refitted
+                .to_toml()
+                .context("cannot write the refitted oscillator as a [system] entry")?;
+            let system = FinalSystemJson {
+                refitted,
+                system_entry: system_entry.clone(),
+            };
             let curves = crate::discovery_curves::trajectory_curves(found, tf);
-            let doc = DiscoveryJson::new(common, &model_params, toml_entry.clone(), curves)
-                .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
+            let doc = DiscoveryJson::new(
+                (exp, data),
+                (found, score),
+                &model_params,
+                toml_entry.clone(),
+                curves,
+            )
+            .with_trajectory(tf, names, system, wall, data.system_estimate);
             (doc, system_entry)
         }
     };
