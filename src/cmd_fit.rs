@@ -23,7 +23,7 @@ use crate::identify_report::{system_line, write_identification_report, StageOutc
 use crate::output::write_json;
 use crate::outputs::columns_csv::Columns;
 use crate::outputs::fit_json::FitJson;
-use crate::outputs::identification_json::{IdentificationJson, StageJson};
+use crate::outputs::identification_json::IdentificationJson;
 use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
@@ -297,8 +297,6 @@ fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
 /// record's displacement, starting from the previous stage's values.
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
-    let mut stages = Vec::new();
-    let mut rows = Vec::new();
     let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         stage_start(exp, i, &mut system);
@@ -323,22 +321,18 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         }
         let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
-        let result = fit
-            .fit(
-                &TrajectoryData {
-                    t: &record.t,
-                    x: &record.x,
-                },
-                Some(&observer),
+        let data = TrajectoryData {
+            t: &record.t,
+            x: &record.x,
+        };
+        let result = fit.fit(&data, Some(&observer)).with_context(|| {
+            format!(
+                "{}:{}: identification stage {} failed",
+                exp.path.display(),
+                stage.line,
+                i + 1
             )
-            .with_context(|| {
-                format!(
-                    "{}:{}: identification stage {} failed",
-                    exp.path.display(),
-                    stage.line,
-                    i + 1
-                )
-            })?;
+        })?;
         bar.finish_and_clear();
         crate::interrupt::finished_step(format!("identification stage {}", i + 1));
         for &param in &stage.free {
@@ -349,19 +343,6 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let floor = NoiseFloor::displacement(k.sigma_x);
         let warnings = fit_warnings(&result, &free, Some(&floor));
         print_stage(i, stage, &result, &warnings);
-        let label = format!("stage {}", i + 1);
-        rows.extend(rows_of(&label, &result, None, &warnings));
-        stages.push(StageJson::new(
-            stage.data.display().to_string(),
-            stage.free.iter().map(OscParam::to_string).collect(),
-            &result,
-            floor,
-            warnings.clone(),
-        ));
-        let data = TrajectoryData {
-            t: &record.t,
-            x: &record.x,
-        };
         let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
         outcomes.push(StageOutcome {
             record: stage.data.display().to_string(),
@@ -373,7 +354,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             warnings,
         });
     }
-    finish_identification(exp, out, &system, &stages, &rows, &outcomes)
+    finish_identification(exp, out, &system, &outcomes)
 }
 
 /// Write the identification's fit.json, params.csv and report into `out`.
@@ -381,13 +362,16 @@ fn finish_identification(
     exp: &Experiment,
     out: &Path,
     system: &OscillatorParams,
-    stages: &[StageJson],
-    rows: &[ParamRow],
     outcomes: &[StageOutcome],
 ) -> Result<()> {
-    let doc = IdentificationJson::new(&exp.path, stages, *system);
+    let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system);
     write_json(&out.join("fit.json"), &doc)?;
-    write_params_csv(&out.join("params.csv"), rows)?;
+    let rows: Vec<ParamRow> = outcomes
+        .iter()
+        .enumerate()
+        .flat_map(|(i, o)| rows_of(&format!("stage {}", i + 1), &o.result, None, &o.warnings))
+        .collect();
+    write_params_csv(&out.join("params.csv"), &rows)?;
     say!("identified system: {}", system_line(system));
     if exp.output.report {
         write_identification_report(&exp.path, outcomes, system, out)?;
