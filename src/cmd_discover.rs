@@ -21,7 +21,9 @@ use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoveryError, DiscoverySettings,
     TrajectorySetup,
 };
-use stf_core::fit::{FitSettings, FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
+use stf_core::fit::{
+    FitSettings, FittedParam, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
+};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::oscillator_params::OscParam;
@@ -552,14 +554,15 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
 /// unless `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
 fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> TrajectorySetup {
     let k = &data.kinematics;
-    let mut fit = oscillator_fit(exp, data);
-    for &param in names {
-        fit = fit.free(system_param(param, &exp.system, k));
-    }
+    let params = names
+        .iter()
+        .map(|&param| system_param(param, &exp.system, k));
+    let mut fit = params.fold(oscillator_fit(exp, data), TrajectoryFit::free);
     if exp.fit.fit_initial {
-        for p in k.initial_state_params() {
-            fit = fit.free(p);
-        }
+        fit = k
+            .initial_state_params()
+            .into_iter()
+            .fold(fit, TrajectoryFit::free);
     }
     TrajectorySetup::new(fit).force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),

@@ -316,9 +316,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
         }
-        for p in &free {
-            fit = fit.free(p.clone());
-        }
+        fit = free.iter().cloned().fold(fit, TrajectoryFit::free);
         let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
         let data = TrajectoryData {

@@ -80,13 +80,14 @@ impl FitData {
 
     /// The force-level data (f_stf must be present).
     pub fn force_data(&self) -> ForceData<'_> {
-        ForceData {
-            t: &self.kinematics.t,
-            x: &self.kinematics.x,
-            v: &self.kinematics.v,
-            a: &self.kinematics.a,
-            f: self.record.f_stf.as_deref().unwrap_or(&[]),
-        }
+        let k = &self.kinematics;
+        ForceData::new(
+            &k.t,
+            &k.x,
+            &k.v,
+            &k.a,
+            self.record.f_stf.as_deref().unwrap_or(&[]),
+        )
     }
 }
 
@@ -387,10 +388,8 @@ impl Predictor {
     ) -> Result<Predictor> {
         if data.level == FitLevel::Force {
             let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
-            let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-            for p in &c.params {
-                fit = fit.param(p.clone());
-            }
+            let fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+            let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
                 fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
             }
@@ -412,10 +411,9 @@ impl Predictor {
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
         }
-        for p in free {
-            fit = fit.free(p);
-        }
-        Ok(Predictor::Trajectory(fit))
+        Ok(Predictor::Trajectory(
+            free.into_iter().fold(fit, TrajectoryFit::free),
+        ))
     }
 
     /// The parameters fitted (or held), in the order of the fit's values.
@@ -457,10 +455,10 @@ impl Predictor {
             return Ok(Some(NoiseFloor::displacement(k.sigma_x)));
         };
         let fd = data.force_data();
-        let sensor = match exp.regimes.noise_sigma {
-            Some(s) => Some(s),
-            None => stf_core::regimes::noise_floor(fd.f).ok(),
-        };
+        let sensor = exp
+            .regimes
+            .noise_sigma
+            .or_else(|| stf_core::regimes::noise_floor(fd.f).ok());
         sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
             .transpose()
