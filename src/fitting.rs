@@ -56,12 +56,6 @@ impl FitData {
         DataScales::of(&force, &k.x, &k.v, &k.a)
     }
 
-    /// How the noise of the signal fits aim at was estimated (both estimates and the one
-    /// taken: [`stf_core::numerics::derivative::noise_estimate`]).
-    pub fn noise_estimate(&self) -> stf_core::numerics::derivative::NoiseEstimate {
-        stf_core::numerics::derivative::noise_estimate(self.target())
-    }
-
     /// The measured signal fits aim at: `f_stf` (force level) or `x` (trajectory level).
     pub fn target(&self) -> &[f64] {
         match self.level {

@@ -8,7 +8,7 @@ use serde::Serialize;
 use stf_core::data::estimate::LinearEstimate;
 use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryPart};
 use stf_core::fit::{FittedParam, NoiseFloor};
-use stf_core::numerics::derivative::NoiseEstimate;
+use stf_core::numerics::derivative::{noise_estimate, NoiseEstimate};
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
@@ -128,7 +128,7 @@ impl<'a> DiscoveryJson<'a> {
             experiment: exp.path.display().to_string(),
             record: &data.record.source,
             drive: &data.kinematics.drive,
-            noise_estimate: data.noise_estimate(),
+            noise_estimate: noise_estimate(data.target()),
             base: exp
                 .discover
                 .as_ref()

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 use stf_core::data::estimate::LinearEstimate;
 use stf_core::fit::{Convergence, ErrorBlocks, FitResult, FitWarning, NoiseFloor, StatedWarning};
-use stf_core::numerics::derivative::NoiseEstimate;
+use stf_core::numerics::derivative::{noise_estimate, NoiseEstimate};
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
@@ -52,7 +52,7 @@ impl<'a> FitJson<'a> {
                 window: filter.window(),
             },
             drive: &data.kinematics.drive,
-            noise_estimate: data.noise_estimate(),
+            noise_estimate: noise_estimate(data.target()),
             system_estimate: data.system_estimate,
             models: fits
                 .iter()

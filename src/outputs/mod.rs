@@ -28,8 +28,22 @@ pub mod models_entry;
 pub mod simulate_json;
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
+use anyhow::{Context, Result};
 use stf_core::fit::FittedParam;
+
+/// `rows` as the CSV text of `path`, under the header the csv crate derives from `T`'s
+/// fields (written with the first row: no rows, no header).
+pub fn csv_rows<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        w.serialize(row)
+            .with_context(|| format!("cannot write a row of {}", path.display()))?;
+    }
+    w.into_inner()
+        .with_context(|| format!("cannot write {}", path.display()))
+}
 
 /// Parameters by name: each one's value.
 pub fn values_by_name<'a>(
