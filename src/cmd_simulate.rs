@@ -148,7 +148,7 @@ fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
         Drive::Free => (Excitation::None, false),
         Drive::Force(chirp) => {
             let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held {
+            let held = if chirp.held() {
                 Linear::held(times.to_vec(), u)
             } else {
                 Linear::new(times.to_vec(), u)
