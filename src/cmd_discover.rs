@@ -437,29 +437,23 @@ fn report(
             .map(|(i, step)| step_table(i, step));
         s.tables.extend(tables);
     }
-    let (name, quantity, caption) = drawn.signal;
-    let (b, a) = (shown(&before), shown(&after));
-    let curves = [("base", b.as_slice()), ("final", a.as_slice())];
-    let fig = measured_vs_model(
-        &dir,
-        name,
-        quantity,
-        &data.record.t,
-        &shown(target),
-        &curves,
-    )?;
-    s.figures.push(FigureRef::new(fig, caption));
-    let (name, quantity, caption) = drawn.residual;
-    let r_after = shown(&found.residual_after);
-    let fig = measured_vs_model(
-        &dir,
-        name,
-        quantity,
-        &data.record.t,
-        &shown(&found.residual_before),
-        &[("final", &r_after)],
-    )?;
-    s.figures.push(FigureRef::new(fig, caption));
+    let (b, a, r_after) = (shown(&before), shown(&after), shown(&found.residual_after));
+    let figures = [
+        (
+            drawn.signal,
+            shown(target),
+            vec![("base", &b[..]), ("final", &a[..])],
+        ),
+        (
+            drawn.residual,
+            shown(&found.residual_before),
+            vec![("final", &r_after[..])],
+        ),
+    ];
+    for ((name, quantity, caption), measured, curves) in figures {
+        let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
+        s.figures.push(FigureRef::new(fig, caption));
+    }
     let mut sections = vec![s];
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];
