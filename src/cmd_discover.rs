@@ -551,7 +551,7 @@ fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> Tra
     let params = names
         .iter()
         .map(|&param| system_param(param, &exp.system, k));
-    let mut fit = params.fold(oscillator_fit(exp, data), TrajectoryFit::free);
+    let mut fit = params.fold(oscillator_fit(exp, exp.system, k), TrajectoryFit::free);
     if exp.fit.fit_initial {
         fit = k
             .initial_state_params()

@@ -9,7 +9,6 @@
 //! parameter on a bound or not determined, two parameters not told apart).
 
 use std::path::Path;
-use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use stf_core::data::kinematics::Kinematics;
@@ -18,7 +17,9 @@ use stf_core::fit::{
 };
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
-use crate::fitting::{estimate_line, fit_all, load_data, system_param, FitData, ModelFit};
+use crate::fitting::{
+    estimate_line, fit_all, load_data, oscillator_fit, system_param, FitData, ModelFit,
+};
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
 use crate::output::write_json;
 use crate::outputs::columns_csv::Columns;
@@ -37,33 +38,25 @@ use stf_core::regimes::Regime;
 /// folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let progress = Progress::new(quiet);
-    if !exp.identify.is_empty() {
+    let mut files = vec!["fit.json", "params.csv"];
+    let results = if !exp.identify.is_empty() {
         if let Some(spec) = &exp.validate {
             let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
             return Err(spec.error("validate", msg));
         }
         let results = ResultsDir::begin(out, force)?;
         identify(&exp, results.path(), &progress)?;
-        results.commit()?;
-        say!(
-            "{}",
-            wrote_line(out, &["fit.json", "params.csv"], exp.output.report)
-        );
-        return Ok(());
-    }
-    let data = load_data(&mut exp)?;
-    let validation = crate::validation::load(&exp, &data)?;
-    let results = ResultsDir::begin(out, force)?;
-    write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+        results
+    } else {
+        let data = load_data(&mut exp)?;
+        let validation = crate::validation::load(&exp, &data)?;
+        let results = ResultsDir::begin(out, force)?;
+        write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+        files.push("fitted.csv");
+        results
+    };
     results.commit()?;
-    say!(
-        "{}",
-        wrote_line(
-            out,
-            &["fit.json", "params.csv", "fitted.csv"],
-            exp.output.report
-        )
-    );
+    say!("{}", wrote_line(out, &files, exp.output.report));
     Ok(())
 }
 
@@ -303,11 +296,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let record = crate::fitting::read_record(exp, &stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
-        let (x0, v0) = k.initial_state();
-        let mut fit = TrajectoryFit::new(system, Arc::new(k.excitation()))
-            .sim_settings(exp.integrator.clone())
-            .settings(exp.fit.settings.clone())
-            .initial(x0, v0);
+        let mut fit = oscillator_fit(exp, system, &k).settings(exp.fit.settings.clone());
         let mut free: Vec<_> = stage
             .free
             .iter()

@@ -390,7 +390,7 @@ impl Predictor {
             return Ok(Predictor::Force(fit));
         }
         let k = &data.kinematics;
-        let mut fit = oscillator_fit(exp, data).settings(exp.fit.settings.clone());
+        let mut fit = oscillator_fit(exp, exp.system, k).settings(exp.fit.settings.clone());
         let mut free: Vec<FitParam> = Vec::new();
         if let Some(c) = configured {
             fit = fit.model(c.model.clone(), c.values());
@@ -459,12 +459,12 @@ impl Predictor {
     }
 }
 
-/// The oscillator of a trajectory-level fit or discovery: the experiment's, driven as in the
-/// record, from the record's initial state, simulated with the experiment's integrator.
-pub fn oscillator_fit(exp: &Experiment, data: &FitData) -> TrajectoryFit {
-    let k = &data.kinematics;
+/// The oscillator `system` of a trajectory-level fit, discovery or identification stage,
+/// driven as in the record of kinematics `k`, from its initial state, simulated with the
+/// experiment's integrator.
+pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics) -> TrajectoryFit {
     let (x0, v0) = k.initial_state();
-    TrajectoryFit::new(exp.system, Arc::new(k.excitation()))
+    TrajectoryFit::new(system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0)
 }
