@@ -323,7 +323,7 @@ mod tests {
                 .unwrap()
                 .simulate
                 .unwrap();
-            assert!(matches!(s.drive, Drive::Force(c) if c.held == held));
+            assert!(matches!(s.drive, Drive::Force(c) if c.held() == held));
             assert_eq!(s.as_json["chirp"]["hold"], hold);
         }
         let msg = format!(
