@@ -16,7 +16,7 @@ use stf_core::data::response::{local_maxima, peak, Peak};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare, rank_models, rank_on_loops, Classification, Comparison, MetricRanking,
-    Ranking, Regime,
+    Ranking, Regime, RegimeMetrics,
 };
 use stf_core::simulate::Simulation;
 
@@ -296,23 +296,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         &c.labels(),
         &c.comparisons,
     ));
-    let bars: Vec<(&str, Vec<f64>)> = c
-        .fits
-        .iter()
-        .zip(&c.comparisons)
-        .map(|(f, cmp)| {
-            let mut v: Vec<f64> = Regime::ALL
-                .iter()
-                .map(|&r| {
-                    cmp.per_regime
-                        .get(r)
-                        .map_or(f64::NAN, |m| m.relative_rms_error)
-                })
-                .collect();
-            v.push(cmp.overall.relative_rms_error);
-            (f.label.as_str(), v)
-        })
-        .collect();
+    let bars = per_regime(c, |m| m.map_or(f64::NAN, |m| m.relative_rms_error));
     let fig = regime_errors(
         &out.join("figures"),
         "regime_errors",
@@ -329,9 +313,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
 
 /// The relative force RMS error (duty error) of each model per regime and overall.
 fn errors_table(c: &Compared) -> Table {
-    let cell = |m: &stf_core::regimes::RegimeMetrics| {
-        format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error)
-    };
+    let cell = |m: &RegimeMetrics| format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error);
     let caption =
         "Relative force RMS error per regime (on–off duty error in brackets); lower is better.";
     let columns = [
@@ -341,13 +323,22 @@ fn errors_table(c: &Compared) -> Table {
         "post-resonance",
         "overall",
     ];
-    let rows = c.fits.iter().zip(&c.comparisons).map(|(f, cmp)| {
-        let mut row = vec![f.label.clone()];
-        for r in Regime::ALL {
-            row.push(cmp.per_regime.get(r).map_or("—".to_string(), cell));
-        }
-        row.push(cell(&cmp.overall));
-        row
-    });
+    let rows = per_regime(c, |m| m.map_or("—".to_string(), cell));
+    let rows = rows
+        .into_iter()
+        .map(|(label, cells)| [vec![label.to_string()], cells].concat());
     Table::new(caption, &columns).with_rows(rows.collect())
+}
+
+/// Each model's label with `value` of its metrics in each regime (`None`: no cycle there),
+/// then overall.
+fn per_regime<T>(c: &Compared, value: impl Fn(Option<&RegimeMetrics>) -> T) -> Vec<(&str, Vec<T>)> {
+    let values = |cmp: &Comparison| {
+        let regimes = Regime::ALL.iter().map(|&r| value(cmp.per_regime.get(r)));
+        regimes.chain([value(Some(&cmp.overall))]).collect()
+    };
+    let models = c.fits.iter().zip(&c.comparisons);
+    models
+        .map(|(f, cmp)| (f.label.as_str(), values(cmp)))
+        .collect()
 }

@@ -21,7 +21,9 @@ use stf_core::discovery::{
     discover_force, discover_trajectory, Candidate, Discovery, DiscoveryError, DiscoverySettings,
     TrajectorySetup,
 };
-use stf_core::fit::{FitSettings, FittedParam, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
+use stf_core::fit::{
+    FitSettings, FittedParam, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
+};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::oscillator_params::OscParam;
@@ -32,7 +34,7 @@ use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
 use crate::output::write_json;
-use crate::outputs::discovery_json::{Common, DiscoveryJson};
+use crate::outputs::discovery_json::{DiscoveryJson, FinalSystemJson};
 use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::progress::{discovery_observer, Progress};
 use crate::report::{
@@ -52,26 +54,6 @@ fn model_from(terms: &[String], dir: &Path, run: &ScriptRun) -> Result<Arc<dyn F
         .map(|s| resolve(s, dir, run))
         .collect::<Result<Vec<_>>>()?;
     Ok(Arc::new(ModelSum::new(parts)?))
-}
-
-/// The final `model` with the values of `params` as an experiment's `[[models]]` entry that
-/// `fit` and `compare` accept as it is (TOML).
-fn models_entry<'a>(
-    model: &dyn ForceModel,
-    params: impl Iterator<Item = &'a FittedParam>,
-) -> Result<String> {
-    ModelsEntry::new(&model.terms(), params)
-        .to_toml()
-        .context("cannot write the final model as an experiment entry")
-}
-
-/// The effects named, or `none`.
-fn named(effects: &[String]) -> String {
-    if effects.is_empty() {
-        "none".to_string()
-    } else {
-        effects.join(", ")
-    }
 }
 
 /// The fit settings of force-level discovery: discovery's own stopping rule
@@ -223,19 +205,17 @@ fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> Discov
         FitLevel::Force => force_fit_settings(&exp.fit.settings),
         FitLevel::Trajectory => exp.fit.settings.clone(),
     };
-    let mut settings = DiscoverySettings::default()
-        .fit(fit)
-        .fit_offset(exp.fit.offset);
-    if let Some(n) = spec.max_effects {
-        settings = settings.max_effects(n);
+    let d = DiscoverySettings::default();
+    DiscoverySettings {
+        max_effects: spec.max_effects.unwrap_or(d.max_effects),
+        holdout_every: spec.holdout_every.unwrap_or(d.holdout_every),
+        scout_from: spec.scout_from.unwrap_or(d.scout_from),
+        recheck: spec.recheck,
+        polish: spec.polish,
+        fit,
+        fit_offset: exp.fit.offset,
+        ..d
     }
-    if let Some(n) = spec.holdout_every {
-        settings = settings.holdout_every(n);
-    }
-    if let Some(n) = spec.scout_from {
-        settings = settings.scout_from(n);
-    }
-    settings.recheck(spec.recheck).polish(spec.polish)
 }
 
 /// The terminal summary of a discovery; `entries` are the final model's `[[models]]` and
@@ -248,7 +228,11 @@ fn print_summary(
     (entries, wall): (&(String, String), f64),
 ) {
     let (unit, scale) = data.level.shown();
-    let effects = named(&found.effects);
+    let effects = if found.effects.is_empty() {
+        "none".to_string()
+    } else {
+        found.effects.join(", ")
+    };
     let summary = match &found.trajectory {
         None => {
             say!(
@@ -319,32 +303,47 @@ fn write_results(
             || INITIAL_STATE.contains(&p.name.as_str())
     };
     let model_params: Vec<&FittedParam> = found.final_params.iter().filter(|p| !own(p)).collect();
-    let toml_entry = models_entry(found.final_model.as_ref(), model_params.iter().copied())?;
-    let common = Common {
-        exp,
-        data,
-        found,
-        score,
-    };
+    // The final model as an experiment's `[[models]]` entry that `fit` and `compare` accept
+    // as it is (TOML).
+    let toml_entry = ModelsEntry::new(&found.final_model.terms(), model_params.iter().copied())
+        .to_toml()
+        .context("cannot write the final model as an experiment entry")?;
     let (doc, system_entry) = match &found.trajectory {
         None => {
             let all: Vec<&FittedParam> = found.final_params.iter().collect();
             let curves = crate::discovery_curves::force_curves(found, exp.system);
-            let doc = DiscoveryJson::new(common, &all, toml_entry.clone(), curves);
+            let doc = DiscoveryJson::new(
+                (exp, data),
+                (found, score),
+                &all,
+                toml_entry.clone(),
+                curves,
+            );
             (doc, String::new())
         }
         Some(tf) => {
-            let system_entry = SystemEntry {
+            let refitted = SystemEntry {
                 system: names
                     .iter()
                     .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
                     .collect(),
-            }
-            .to_toml()
-            .context("cannot write the refitted oscillator as a [system] entry")?;
+            };
+            let system_entry = refitted
+                .to_toml()
+                .context("cannot write the refitted oscillator as a [system] entry")?;
+            let system = FinalSystemJson {
+                refitted,
+                system_entry: system_entry.clone(),
+            };
             let curves = crate::discovery_curves::trajectory_curves(found, tf);
-            let doc = DiscoveryJson::new(common, &model_params, toml_entry.clone(), curves)
-                .with_trajectory(tf, names, system_entry.clone(), wall, data.system_estimate);
+            let doc = DiscoveryJson::new(
+                (exp, data),
+                (found, score),
+                &model_params,
+                toml_entry.clone(),
+                curves,
+            )
+            .with_trajectory(tf, names, system, wall, data.system_estimate);
             (doc, system_entry)
         }
     };
@@ -438,29 +437,23 @@ fn report(
             .map(|(i, step)| step_table(i, step));
         s.tables.extend(tables);
     }
-    let (name, quantity, caption) = drawn.signal;
-    let (b, a) = (shown(&before), shown(&after));
-    let curves = [("base", b.as_slice()), ("final", a.as_slice())];
-    let fig = measured_vs_model(
-        &dir,
-        name,
-        quantity,
-        &data.record.t,
-        &shown(target),
-        &curves,
-    )?;
-    s.figures.push(FigureRef::new(fig, caption));
-    let (name, quantity, caption) = drawn.residual;
-    let r_after = shown(&found.residual_after);
-    let fig = measured_vs_model(
-        &dir,
-        name,
-        quantity,
-        &data.record.t,
-        &shown(&found.residual_before),
-        &[("final", &r_after)],
-    )?;
-    s.figures.push(FigureRef::new(fig, caption));
+    let (b, a, r_after) = (shown(&before), shown(&after), shown(&found.residual_after));
+    let figures = [
+        (
+            drawn.signal,
+            shown(target),
+            vec![("base", &b[..]), ("final", &a[..])],
+        ),
+        (
+            drawn.residual,
+            shown(&found.residual_before),
+            vec![("final", &r_after[..])],
+        ),
+    ];
+    for ((name, quantity, caption), measured, curves) in figures {
+        let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
+        s.figures.push(FigureRef::new(fig, caption));
+    }
     let mut sections = vec![s];
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];
@@ -555,14 +548,15 @@ fn refitted(exp: &Experiment, data: &FitData, base: &dyn ForceModel, quiet: bool
 /// unless `[fit] initial = "record"`), the force recovered from the kinematics as a hint.
 fn trajectory_setup(exp: &Experiment, data: &FitData, names: &[OscParam]) -> TrajectorySetup {
     let k = &data.kinematics;
-    let mut fit = oscillator_fit(exp, data);
-    for &param in names {
-        fit = fit.free(system_param(param, &exp.system, k));
-    }
+    let params = names
+        .iter()
+        .map(|&param| system_param(param, &exp.system, k));
+    let mut fit = params.fold(oscillator_fit(exp, exp.system, k), TrajectoryFit::free);
     if exp.fit.fit_initial {
-        for p in k.initial_state_params() {
-            fit = fit.free(p);
-        }
+        fit = k
+            .initial_state_params()
+            .into_iter()
+            .fold(fit, TrajectoryFit::free);
     }
     TrajectorySetup::new(fit).force_hint(stf_core::discovery::ForceHint {
         v: k.v.clone(),

@@ -9,7 +9,6 @@
 //! parameter on a bound or not determined, two parameters not told apart).
 
 use std::path::Path;
-use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use stf_core::data::kinematics::Kinematics;
@@ -18,12 +17,14 @@ use stf_core::fit::{
 };
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
-use crate::fitting::{estimate_line, fit_all, load_data, system_param, FitData, ModelFit};
+use crate::fitting::{
+    estimate_line, fit_all, load_data, oscillator_fit, system_param, FitData, ModelFit,
+};
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
 use crate::output::write_json;
 use crate::outputs::columns_csv::Columns;
 use crate::outputs::fit_json::FitJson;
-use crate::outputs::identification_json::{IdentificationJson, StageJson};
+use crate::outputs::identification_json::IdentificationJson;
 use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
 use crate::results_dir::{wrote_line, ResultsDir};
@@ -37,33 +38,25 @@ use stf_core::regimes::Regime;
 /// folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let progress = Progress::new(quiet);
-    if !exp.identify.is_empty() {
+    let mut files = vec!["fit.json", "params.csv"];
+    let results = if !exp.identify.is_empty() {
         if let Some(spec) = &exp.validate {
             let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
             return Err(spec.error("validate", msg));
         }
         let results = ResultsDir::begin(out, force)?;
         identify(&exp, results.path(), &progress)?;
-        results.commit()?;
-        say!(
-            "{}",
-            wrote_line(out, &["fit.json", "params.csv"], exp.output.report)
-        );
-        return Ok(());
-    }
-    let data = load_data(&mut exp)?;
-    let validation = crate::validation::load(&exp, &data)?;
-    let results = ResultsDir::begin(out, force)?;
-    write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+        results
+    } else {
+        let data = load_data(&mut exp)?;
+        let validation = crate::validation::load(&exp, &data)?;
+        let results = ResultsDir::begin(out, force)?;
+        write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+        files.push("fitted.csv");
+        results
+    };
     results.commit()?;
-    say!(
-        "{}",
-        wrote_line(
-            out,
-            &["fit.json", "params.csv", "fitted.csv"],
-            exp.output.report
-        )
-    );
+    say!("{}", wrote_line(out, &files, exp.output.report));
     Ok(())
 }
 
@@ -297,19 +290,13 @@ fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
 /// record's displacement, starting from the previous stage's values.
 fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
     let mut system = exp.system;
-    let mut stages = Vec::new();
-    let mut rows = Vec::new();
     let mut outcomes = Vec::new();
     for (i, stage) in exp.identify.iter().enumerate() {
         stage_start(exp, i, &mut system);
         let record = crate::fitting::read_record(exp, &stage.data)?;
         let k = Kinematics::from_record(&record, &exp.kinematics)
             .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
-        let (x0, v0) = k.initial_state();
-        let mut fit = TrajectoryFit::new(system, Arc::new(k.excitation()))
-            .sim_settings(exp.integrator.clone())
-            .settings(exp.fit.settings.clone())
-            .initial(x0, v0);
+        let mut fit = oscillator_fit(exp, system, &k).settings(exp.fit.settings.clone());
         let mut free: Vec<_> = stage
             .free
             .iter()
@@ -318,27 +305,21 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
         }
-        for p in &free {
-            fit = fit.free(p.clone());
-        }
+        fit = free.iter().cloned().fold(fit, TrajectoryFit::free);
         let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
         let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
-        let result = fit
-            .fit(
-                &TrajectoryData {
-                    t: &record.t,
-                    x: &record.x,
-                },
-                Some(&observer),
+        let data = TrajectoryData {
+            t: &record.t,
+            x: &record.x,
+        };
+        let result = fit.fit(&data, Some(&observer)).with_context(|| {
+            format!(
+                "{}:{}: identification stage {} failed",
+                exp.path.display(),
+                stage.line,
+                i + 1
             )
-            .with_context(|| {
-                format!(
-                    "{}:{}: identification stage {} failed",
-                    exp.path.display(),
-                    stage.line,
-                    i + 1
-                )
-            })?;
+        })?;
         bar.finish_and_clear();
         crate::interrupt::finished_step(format!("identification stage {}", i + 1));
         for &param in &stage.free {
@@ -349,19 +330,6 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
         let floor = NoiseFloor::displacement(k.sigma_x);
         let warnings = fit_warnings(&result, &free, Some(&floor));
         print_stage(i, stage, &result, &warnings);
-        let label = format!("stage {}", i + 1);
-        rows.extend(rows_of(&label, &result, None, &warnings));
-        stages.push(StageJson::new(
-            stage.data.display().to_string(),
-            stage.free.iter().map(OscParam::to_string).collect(),
-            &result,
-            floor,
-            warnings.clone(),
-        ));
-        let data = TrajectoryData {
-            t: &record.t,
-            x: &record.x,
-        };
         let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
         outcomes.push(StageOutcome {
             record: stage.data.display().to_string(),
@@ -373,7 +341,7 @@ fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
             warnings,
         });
     }
-    finish_identification(exp, out, &system, &stages, &rows, &outcomes)
+    finish_identification(exp, out, &system, &outcomes)
 }
 
 /// Write the identification's fit.json, params.csv and report into `out`.
@@ -381,13 +349,16 @@ fn finish_identification(
     exp: &Experiment,
     out: &Path,
     system: &OscillatorParams,
-    stages: &[StageJson],
-    rows: &[ParamRow],
     outcomes: &[StageOutcome],
 ) -> Result<()> {
-    let doc = IdentificationJson::new(&exp.path, stages, *system);
+    let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system);
     write_json(&out.join("fit.json"), &doc)?;
-    write_params_csv(&out.join("params.csv"), rows)?;
+    let rows: Vec<ParamRow> = outcomes
+        .iter()
+        .enumerate()
+        .flat_map(|(i, o)| rows_of(&format!("stage {}", i + 1), &o.result, None, &o.warnings))
+        .collect();
+    write_params_csv(&out.join("params.csv"), &rows)?;
     say!("identified system: {}", system_line(system));
     if exp.output.report {
         write_identification_report(&exp.path, outcomes, system, out)?;

@@ -28,10 +28,7 @@ fn print_params(params: &[ParamSpec]) {
 pub fn list(script_dir: Option<&Path>) -> Result<()> {
     let default_dir = PathBuf::from("models/scripts");
     let dir = script_dir.or_else(|| default_dir.is_dir().then_some(default_dir.as_path()));
-    let registry = match dir {
-        Some(d) => Registry::with_script_dir(d),
-        None => Registry::new(),
-    };
+    let registry = dir.map_or_else(Registry::new, Registry::with_script_dir);
     for entry in registry.list() {
         crate::say!(
             "{}{}  —  {}",

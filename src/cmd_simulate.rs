@@ -22,7 +22,7 @@ use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory as SimRun};
 
 use crate::experiment::{Drive, Experiment};
-use crate::model_config::configure;
+use crate::model_config::configure_for;
 use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
 use crate::output_lock::OutputLock;
 use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
@@ -49,7 +49,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
     if !spec.truth.is_empty() {
-        let truth = configure(&spec.truth, &exp.path, &exp.dir, &exp.scripts)?;
+        let truth = configure_for(&spec.truth, &exp.path, &exp.dir, &exp.scripts, None)?;
         truth_json.push(Truth {
             model: truth.model.name().to_string(),
             params: truth
@@ -148,7 +148,7 @@ fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
         Drive::Free => (Excitation::None, false),
         Drive::Force(chirp) => {
             let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held {
+            let held = if chirp.held() {
                 Linear::held(times.to_vec(), u)
             } else {
                 Linear::new(times.to_vec(), u)
@@ -166,7 +166,7 @@ fn summary(run: &SimRun, free: bool) -> Summary {
     Summary {
         peak_x_m: pk.map(|p| p.amplitude),
         peak_t_s: pk.map(|p| p.t),
-        peak_omega_rad_s: pk.and_then(|p| p.omega.is_finite().then_some(p.omega)),
+        peak_omega_rad_s: pk.map(|p| p.omega),
         breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
         motion_stops_t_s: if free {
             stop(&run.v, MOVING_SPEED).map(|i| run.t[i])

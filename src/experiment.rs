@@ -59,13 +59,14 @@ struct RawExperiment {
     #[serde(default)]
     models: Vec<Spanned<models::RawModel>>,
     simulate: Option<Spanned<simulate::RawSimulate>>,
-    discover: Option<discover::RawDiscover>,
+    discover: Option<DiscoverSpec>,
     fit: Option<Spanned<fit::RawFit>>,
     filter: Option<Spanned<filter::RawFilter>>,
     #[serde(default)]
     identify: Vec<Spanned<identify::RawStage>>,
     regimes: Option<Spanned<toml::Value>>,
-    output: Option<output::RawOutput>,
+    #[serde(default)]
+    output: OutputSpec,
     validate: Option<Spanned<validate::RawValidate>>,
     scripts: Option<Spanned<scripts::RawScripts>>,
 }
@@ -201,7 +202,7 @@ impl Experiment {
             kinematics,
             identify,
             regimes,
-            output: raw.output.as_ref().into(),
+            output: raw.output,
             data_file: data.file,
             data_line: data.line,
             dir,
@@ -210,7 +211,7 @@ impl Experiment {
             integrator,
             models,
             simulate,
-            discover: raw.discover.map(DiscoverSpec::from),
+            discover: raw.discover,
         })
     }
 }

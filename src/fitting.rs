@@ -56,12 +56,6 @@ impl FitData {
         DataScales::of(&force, &k.x, &k.v, &k.a)
     }
 
-    /// How the noise of the signal fits aim at was estimated (both estimates and the one
-    /// taken: [`stf_core::numerics::derivative::noise_estimate`]).
-    pub fn noise_estimate(&self) -> stf_core::numerics::derivative::NoiseEstimate {
-        stf_core::numerics::derivative::noise_estimate(self.target())
-    }
-
     /// The measured signal fits aim at: `f_stf` (force level) or `x` (trajectory level).
     pub fn target(&self) -> &[f64] {
         match self.level {
@@ -80,13 +74,14 @@ impl FitData {
 
     /// The force-level data (f_stf must be present).
     pub fn force_data(&self) -> ForceData<'_> {
-        ForceData {
-            t: &self.kinematics.t,
-            x: &self.kinematics.x,
-            v: &self.kinematics.v,
-            a: &self.kinematics.a,
-            f: self.record.f_stf.as_deref().unwrap_or(&[]),
-        }
+        let k = &self.kinematics;
+        ForceData::new(
+            &k.t,
+            &k.x,
+            &k.v,
+            &k.a,
+            self.record.f_stf.as_deref().unwrap_or(&[]),
+        )
     }
 }
 
@@ -387,17 +382,15 @@ impl Predictor {
     ) -> Result<Predictor> {
         if data.level == FitLevel::Force {
             let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
-            let mut fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
-            for p in &c.params {
-                fit = fit.param(p.clone());
-            }
+            let fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+            let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
                 fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
             }
             return Ok(Predictor::Force(fit));
         }
         let k = &data.kinematics;
-        let mut fit = oscillator_fit(exp, data).settings(exp.fit.settings.clone());
+        let mut fit = oscillator_fit(exp, exp.system, k).settings(exp.fit.settings.clone());
         let mut free: Vec<FitParam> = Vec::new();
         if let Some(c) = configured {
             fit = fit.model(c.model.clone(), c.values());
@@ -412,10 +405,9 @@ impl Predictor {
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
         }
-        for p in free {
-            fit = fit.free(p);
-        }
-        Ok(Predictor::Trajectory(fit))
+        Ok(Predictor::Trajectory(
+            free.into_iter().fold(fit, TrajectoryFit::free),
+        ))
     }
 
     /// The parameters fitted (or held), in the order of the fit's values.
@@ -457,22 +449,22 @@ impl Predictor {
             return Ok(Some(NoiseFloor::displacement(k.sigma_x)));
         };
         let fd = data.force_data();
-        let sensor = match exp.regimes.noise_sigma {
-            Some(s) => Some(s),
-            None => stf_core::regimes::noise_floor(fd.f).ok(),
-        };
+        let sensor = exp
+            .regimes
+            .noise_sigma
+            .or_else(|| stf_core::regimes::noise_floor(fd.f).ok());
         sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
             .transpose()
     }
 }
 
-/// The oscillator of a trajectory-level fit or discovery: the experiment's, driven as in the
-/// record, from the record's initial state, simulated with the experiment's integrator.
-pub fn oscillator_fit(exp: &Experiment, data: &FitData) -> TrajectoryFit {
-    let k = &data.kinematics;
+/// The oscillator `system` of a trajectory-level fit, discovery or identification stage,
+/// driven as in the record of kinematics `k`, from its initial state, simulated with the
+/// experiment's integrator.
+pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics) -> TrajectoryFit {
     let (x0, v0) = k.initial_state();
-    TrajectoryFit::new(exp.system, Arc::new(k.excitation()))
+    TrajectoryFit::new(system, Arc::new(k.excitation()))
         .sim_settings(exp.integrator.clone())
         .initial(x0, v0)
 }

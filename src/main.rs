@@ -13,10 +13,11 @@
 
 #![deny(clippy::unwrap_used)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
 use stf_lab::campaign::slurm_script::SlurmOptions;
 use stf_lab::{
     cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate,
@@ -46,91 +47,94 @@ enum Command {
         scripts: Option<PathBuf>,
     },
     /// Write a synthetic record from the experiment's [simulate] section.
-    Simulate {
-        /// The experiment file.
-        experiment: PathBuf,
-        /// The record to write (CSV); a JSON sidecar is written beside it.
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Replace existing output files.
-        #[arg(short, long)]
-        force: bool,
-    },
+    ///
+    /// `--out` is the record to write (CSV); a JSON sidecar is written beside it.
+    Simulate(Run),
     /// Calibrate every model of the experiment against its record.
-    Fit {
-        /// The experiment file.
-        experiment: PathBuf,
-        /// Folder for fit.json and fitted.csv (replaced as a whole).
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Replace the results of an existing folder.
-        #[arg(short, long)]
-        force: bool,
-    },
+    ///
+    /// `--out` is the folder for fit.json and fitted.csv (replaced as a whole).
+    Fit(Run),
     /// Fit every model, then compare them regime by regime.
-    Compare {
-        /// The experiment file.
-        experiment: PathBuf,
-        /// Folder for compare.json, compare.md, compare.csv and the fit results (replaced as
-        /// a whole).
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Replace the results of an existing folder.
-        #[arg(short, long)]
-        force: bool,
-    },
+    ///
+    /// `--out` is the folder for compare.json, compare.md, compare.csv and the fit results
+    /// (replaced as a whole).
+    Compare(Run),
     /// Find, name and add the effect the base model misses; show the gap shrink.
-    Discover {
-        /// The experiment file (with a [discover] section).
-        experiment: PathBuf,
-        /// Folder for discovery.json, the report and figures (replaced as a whole).
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Replace the results of an existing folder.
-        #[arg(short, long)]
-        force: bool,
-    },
+    ///
+    /// The experiment needs a [discover] section; `--out` is the folder for discovery.json,
+    /// the report and figures (replaced as a whole).
+    Discover(Run),
     /// Run fit, compare or discover on every record of a campaign file, then tabulate.
-    Campaign {
-        /// The campaign file ([campaign] and [[records]]).
-        campaign: PathBuf,
-        /// Folder for the units' results, campaign.csv, campaign.json and the report (a rerun
-        /// into it resumes: units whose inputs have not changed are skipped).
-        #[arg(short, long)]
-        out: PathBuf,
-        /// Rerun every unit, finished or not.
-        #[arg(short, long)]
-        force: bool,
-        /// Units run at once (default: the number of cores).
-        #[arg(short, long, value_name = "N")]
-        jobs: Option<usize>,
-        /// Run unit N (the N-th record, from 1) alone, in this process, into DIR/units/.
-        #[arg(long, value_name = "N")]
-        unit: Option<usize>,
-        /// Only build the table, report and [global] fit from the finished units (what the
-        /// Slurm collect job runs); fails naming the units missing or failed.
-        #[arg(long, conflicts_with_all = ["unit", "jobs", "force", "slurm"])]
-        collect: bool,
-        /// Submit the units not finished to Slurm as a job array, and a collect job after it;
-        /// scripts and logs go to DIR/slurm/.
-        #[arg(long, conflicts_with_all = ["unit", "jobs"])]
-        slurm: bool,
-        /// Slurm partition of the jobs (default: the cluster's).
-        #[arg(long, value_name = "P", requires = "slurm")]
-        partition: Option<String>,
-        /// Slurm time limit per unit, e.g. 01:00:00 (default: the partition's).
-        #[arg(long, value_name = "HH:MM:SS", requires = "slurm")]
-        time: Option<String>,
-        /// Slurm memory per unit, e.g. 2G (default: the cluster's).
-        #[arg(long, value_name = "SIZE", requires = "slurm")]
-        mem: Option<String>,
-        /// Slurm account to charge (default: the user's).
-        #[arg(long, value_name = "A", requires = "slurm")]
-        account: Option<String>,
-        /// With --slurm: print the batch scripts and sbatch commands; submit and write nothing.
-        #[arg(long, requires = "slurm")]
-        dry_run: bool,
-    },
+    Campaign(CampaignArgs),
+}
+
+/// What `simulate`, `fit`, `compare` and `discover` take.
+#[derive(Args)]
+struct Run {
+    /// The experiment file.
+    experiment: PathBuf,
+    /// Where the results go: simulate's record, or the command's results folder (replaced as
+    /// a whole).
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Replace existing results.
+    #[arg(short, long)]
+    force: bool,
+}
+
+impl Run {
+    /// Load the experiment and run `command` on it.
+    fn with(
+        self,
+        quiet: bool,
+        command: fn(Experiment, &Path, bool, bool) -> Result<()>,
+    ) -> Result<()> {
+        Experiment::load(&self.experiment)
+            .and_then(|exp| command(exp, &self.out, self.force, quiet))
+    }
+}
+
+/// What `campaign` takes.
+#[derive(Args)]
+struct CampaignArgs {
+    /// The campaign file ([campaign] and [[records]]).
+    campaign: PathBuf,
+    /// Folder for the units' results, campaign.csv, campaign.json and the report (a rerun
+    /// into it resumes: units whose inputs have not changed are skipped).
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Rerun every unit, finished or not.
+    #[arg(short, long)]
+    force: bool,
+    /// Units run at once (default: the number of cores).
+    #[arg(short, long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Run unit N (the N-th record, from 1) alone, in this process, into DIR/units/.
+    #[arg(long, value_name = "N")]
+    unit: Option<usize>,
+    /// Only build the table, report and [global] fit from the finished units (what the
+    /// Slurm collect job runs); fails naming the units missing or failed.
+    #[arg(long, conflicts_with_all = ["unit", "jobs", "force", "slurm"])]
+    collect: bool,
+    /// Submit the units not finished to Slurm as a job array, and a collect job after it;
+    /// scripts and logs go to DIR/slurm/.
+    #[arg(long, conflicts_with_all = ["unit", "jobs"])]
+    slurm: bool,
+    /// Slurm partition of the jobs (default: the cluster's).
+    #[arg(long, value_name = "P", requires = "slurm")]
+    partition: Option<String>,
+    /// Slurm time limit per unit, e.g. 01:00:00 (default: the partition's).
+    #[arg(long, value_name = "HH:MM:SS", requires = "slurm")]
+    time: Option<String>,
+    /// Slurm memory per unit, e.g. 2G (default: the cluster's).
+    #[arg(long, value_name = "SIZE", requires = "slurm")]
+    mem: Option<String>,
+    /// Slurm account to charge (default: the user's).
+    #[arg(long, value_name = "A", requires = "slurm")]
+    account: Option<String>,
+    /// With --slurm: print the batch scripts and sbatch commands; submit and write nothing.
+    #[arg(long, requires = "slurm")]
+    dry_run: bool,
 }
 
 fn main() -> ExitCode {
@@ -142,59 +146,27 @@ fn main() -> ExitCode {
             Some(path) => cmd_models::check(&path),
             None => cmd_models::list(scripts.as_deref()),
         },
-        Command::Simulate {
-            experiment,
-            out,
-            force,
-        } => cmd_simulate::run(&experiment, &out, force),
-        Command::Fit {
-            experiment,
-            out,
-            force,
-        } => Experiment::load(&experiment)
-            .and_then(|exp| cmd_fit::run_experiment(exp, &out, force, quiet)),
-        Command::Compare {
-            experiment,
-            out,
-            force,
-        } => Experiment::load(&experiment)
-            .and_then(|exp| cmd_compare::run_experiment(exp, &out, force, quiet)),
-        Command::Discover {
-            experiment,
-            out,
-            force,
-        } => Experiment::load(&experiment)
-            .and_then(|exp| cmd_discover::run_experiment(exp, &out, force, quiet)),
-        Command::Campaign {
-            campaign,
-            out,
-            force,
-            jobs,
-            unit,
-            collect,
-            slurm,
-            partition,
-            time,
-            mem,
-            account,
-            dry_run,
-        } => cmd_campaign::run(
-            &campaign,
-            &out,
+        Command::Simulate(run) => cmd_simulate::run(&run.experiment, &run.out, run.force),
+        Command::Fit(run) => run.with(quiet, cmd_fit::run_experiment),
+        Command::Compare(run) => run.with(quiet, cmd_compare::run_experiment),
+        Command::Discover(run) => run.with(quiet, cmd_discover::run_experiment),
+        Command::Campaign(c) => cmd_campaign::run(
+            &c.campaign,
+            &c.out,
             &cmd_campaign::Settings {
-                force,
+                force: c.force,
                 quiet,
-                jobs,
-                unit,
-                collect,
-                slurm: slurm.then_some(cmd_campaign::SlurmSettings {
+                jobs: c.jobs,
+                unit: c.unit,
+                collect: c.collect,
+                slurm: c.slurm.then_some(cmd_campaign::SlurmSettings {
                     options: SlurmOptions {
-                        partition,
-                        time,
-                        mem,
-                        account,
+                        partition: c.partition,
+                        time: c.time,
+                        mem: c.mem,
+                        account: c.account,
                     },
-                    dry_run,
+                    dry_run: c.dry_run,
                 }),
             },
         ),

@@ -16,7 +16,7 @@ use stf_core::physics::model_sum::ModelSum;
 
 use stf_plugins::ScriptRun;
 
-use crate::experiment::{ModelEntry, ParamGiven};
+use crate::experiment::{error_at, ModelEntry, ParamGiven};
 
 /// A model ready to plug into the oscillator.
 #[derive(Clone)]
@@ -43,17 +43,8 @@ pub fn resolve(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceM
 /// Build one model from experiment entries: the parts of every entry are summed (one entry
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
 /// are applied. `file` is the experiment file, `dir` its folder, `run` where scripts load.
-pub fn configure(
-    entries: &[ModelEntry],
-    file: &Path,
-    dir: &Path,
-    run: &ScriptRun,
-) -> Result<ConfiguredModel> {
-    configure_for(entries, file, dir, run, None)
-}
-
-/// [`configure`] for a record of sizes `scales`: each model's bounds are widened where the
-/// record needs it ([`widened`]) before the entries' own values and bounds apply.
+/// For a record of sizes `scales`, each model's bounds are widened where the record needs it
+/// ([`widened`]) before the entries' own values and bounds apply.
 pub fn configure_for(
     entries: &[ModelEntry],
     file: &Path,
@@ -63,15 +54,7 @@ pub fn configure_for(
 ) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
-        let at = |msg: String| {
-            anyhow!(
-                "{}:{}: `{}`: {}",
-                file.display(),
-                entry.line,
-                entry.key,
-                msg
-            )
-        };
+        let at = |msg: String| error_at(file, entry.line, &entry.key, msg);
         for spec in entry.specs() {
             let model = resolve(spec, dir, run).map_err(|e| at(format!("{e:#}")))?;
             parts.push(match scales {
@@ -107,13 +90,11 @@ fn apply(
 ) -> Result<()> {
     let name = &given.name;
     let at = |msg: String| {
-        anyhow!(
-            "{}:{}: `{}.params.{}`: {}",
-            file.display(),
+        error_at(
+            file,
             given.line,
-            entry.key,
-            name,
-            msg
+            &format!("{}.params.{name}", entry.key),
+            msg,
         )
     };
     let i = sum.param_index(name).ok_or_else(|| {
@@ -141,7 +122,7 @@ mod tests {
 
     fn models_of(text: &str) -> Result<ConfiguredModel> {
         let exp = crate::experiment::parse_exp(text)?;
-        configure(&exp.models, &exp.path, &exp.dir, &exp.scripts)
+        configure_for(&exp.models, &exp.path, &exp.dir, &exp.scripts, None)
     }
 
     #[test]

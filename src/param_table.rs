@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
 use stf_core::fit::{FitResult, FitWarning};
 use stf_core::physics::force_model::ForceModel;
@@ -99,14 +99,5 @@ pub fn rows_of_fits(fits: &[ModelFit]) -> Vec<ParamRow> {
 
 /// Write `rows` as CSV to `path`, atomically.
 pub fn write_params_csv(path: &Path, rows: &[ParamRow]) -> Result<()> {
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    for row in rows {
-        writer
-            .serialize(row)
-            .with_context(|| format!("cannot write a row of {}", path.display()))?;
-    }
-    let bytes = writer
-        .into_inner()
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    write_atomic(path, &bytes)
+    write_atomic(path, &crate::outputs::csv_rows(path, rows)?)
 }

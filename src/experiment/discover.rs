@@ -1,33 +1,20 @@
 //! The `[discover]` section of an experiment file: the base model, the candidate effects,
 //! how many may be added, the held-out cycles, the scouting threshold, the fit level and
 //! whether earlier effects are re-checked and accepted models polished.
-//! Every key's shape is its serde type, so the checked section is a plain conversion; the
+//! Every key's shape is its serde type, so the section is read as it is checked; the
 //! base `a + b` is split into its terms as it is read ([`base_terms`]), once.
 
 use serde::{Deserialize, Deserializer};
 
 use super::FitLevel;
 
-/// `[discover]` as written.
-#[derive(Debug, Deserialize)]
+/// A validated `[discover]` section: every key's shape is its serde type.
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(super) struct RawDiscover {
-    #[serde(deserialize_with = "base_terms")]
-    base: Vec<String>,
-    candidates: Option<Vec<String>>,
-    max_effects: Option<usize>,
-    holdout_every: Option<usize>,
-    level: Option<FitLevel>,
-    scout_from: Option<usize>,
-    recheck: Option<bool>,
-    polish: Option<bool>,
-}
-
-/// A validated `[discover]` section.
-#[derive(Clone, Debug)]
 pub struct DiscoverSpec {
     /// The base model's terms, in order: names or script paths (`base = "a + b"` as written;
     /// `none` is the zero force).
+    #[serde(deserialize_with = "base_terms")]
     pub base: Vec<String>,
     /// Candidate effects (default: the vocabulary of docs/ARCHITECTURE.md §5).
     pub candidates: Option<Vec<String>>,
@@ -35,11 +22,11 @@ pub struct DiscoverSpec {
     pub max_effects: Option<usize>,
     /// Every k-th cycle is held out for scoring.
     pub holdout_every: Option<usize>,
-    /// Records of at least this many samples are scouted at trajectory level (0: never).
-    pub scout_from: Option<usize>,
     /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
     /// `f_stf`.
     pub level: Option<FitLevel>,
+    /// Records of at least this many samples are scouted at trajectory level (0: never).
+    pub scout_from: Option<usize>,
     /// Re-check earlier effects after each acceptance; `None`: the level's default (on at
     /// force level, off at trajectory level).
     pub recheck: Option<bool>,
@@ -64,21 +51,6 @@ impl DiscoverSpec {
     /// The base as shown: its terms joined by ` + `.
     pub fn base_text(&self) -> String {
         self.base.join(" + ")
-    }
-}
-
-impl From<RawDiscover> for DiscoverSpec {
-    fn from(d: RawDiscover) -> DiscoverSpec {
-        DiscoverSpec {
-            base: d.base,
-            candidates: d.candidates,
-            max_effects: d.max_effects,
-            holdout_every: d.holdout_every,
-            scout_from: d.scout_from,
-            level: d.level,
-            recheck: d.recheck,
-            polish: d.polish,
-        }
     }
 }
 

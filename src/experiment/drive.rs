@@ -25,8 +25,10 @@ pub enum Drive {
 }
 
 /// A linear chirp force `u = A·sin(2π·(f0·s + (f1 − f0)·s²/(2·(t1 − t0))))`, `s = t − t0`:
-/// the frequency sweeps linearly from `f0` at `t0` to `f1` at `t1`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// the frequency sweeps linearly from `f0` at `t0` to `f1` at `t1`. Read as written (`chirp =
+/// { f0, f1, amplitude, t0, t1, hold }`), then checked ([`Chirp::check`]).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
 pub struct Chirp {
     /// Frequency at `t0`, Hz.
     pub f0: f64,
@@ -35,12 +37,13 @@ pub struct Chirp {
     /// Force amplitude A, N.
     pub amplitude: f64,
     /// Start time, s.
+    #[serde(default)]
     pub t0: f64,
     /// End time, s.
     pub t1: f64,
-    /// The force is held from each sample to the next (a DAC's zero-order hold), instead of
-    /// varying linearly between them.
-    pub held: bool,
+    /// `"linear"` (default) or `"zoh"` ([`Chirp::held`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hold: Option<Hold>,
 }
 
 impl Chirp {
@@ -49,6 +52,12 @@ impl Chirp {
         let s = t - self.t0;
         let rate = (self.f1 - self.f0) / (self.t1 - self.t0);
         self.amplitude * (std::f64::consts::TAU * (self.f0 * s + 0.5 * rate * s * s)).sin()
+    }
+
+    /// The force is held from each sample to the next (a DAC's zero-order hold), instead of
+    /// varying linearly between them.
+    pub fn held(&self) -> bool {
+        self.hold == Some(Hold::Zoh)
     }
 }
 
@@ -182,25 +191,10 @@ enum Hold {
     Zoh,
 }
 
-/// `chirp = { f0, f1, amplitude, t0, t1, hold }`.
-#[derive(Debug, Deserialize, Serialize, Clone)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawChirp {
-    f0: f64,
-    f1: f64,
-    amplitude: f64,
-    #[serde(default)]
-    t0: f64,
-    t1: f64,
-    /// `"linear"` (default) or `"zoh"`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    hold: Option<Hold>,
-}
-
-impl RawChirp {
+impl Chirp {
     /// Frequencies not negative, a positive amplitude (every number is finite: `finite.rs`);
     /// errors point at the table's line.
-    pub(super) fn check(raw: &Spanned<RawChirp>, cx: &Ctx) -> Result<Checked> {
+    pub(super) fn check(raw: &Spanned<Chirp>, cx: &Ctx) -> Result<Checked> {
         let (at, c) = (raw.span(), raw.get_ref());
         for (name, v) in [("f0", c.f0), ("f1", c.f1)] {
             let key = format!("simulate.chirp.{name}");
@@ -217,16 +211,8 @@ impl RawChirp {
             "simulate.chirp.amplitude",
             format!("{} must be a positive force, N", c.amplitude),
         )?;
-        let chirp = Chirp {
-            f0: c.f0,
-            f1: c.f1,
-            amplitude: c.amplitude,
-            t0: c.t0,
-            t1: c.t1,
-            held: c.hold == Some(Hold::Zoh),
-        };
         Ok(Checked {
-            drive: Drive::Force(chirp),
+            drive: Drive::Force(*c),
             t0: c.t0,
             t1: c.t1,
             as_json: json!({ "chirp": c }),

@@ -61,14 +61,6 @@ pub(crate) enum RawDrive {
     Filter(RawFilterSpec),
 }
 
-/// The kinematics settings of `[filter]` (absent: the defaults).
-pub(super) fn check(filter: Option<&Spanned<RawFilter>>, cx: &Ctx) -> Result<KinematicsSettings> {
-    match filter {
-        None => Ok(KinematicsSettings::default()),
-        Some(f) => filters(f, cx),
-    }
-}
-
 /// `kinematics` with the drive reconstruction `[data] drive` asks for, if it does; `[filter]
 /// omega`, the same setting, must then be absent.
 pub(super) fn with_drive(
@@ -92,8 +84,12 @@ pub(super) fn with_drive(
     Ok(kinematics)
 }
 
-/// `[filter]`: the defaults (or the paper's), its filters, and the boundary on every filter.
-fn filters(raw: &Spanned<RawFilter>, cx: &Ctx) -> Result<KinematicsSettings> {
+/// The kinematics settings of `[filter]` (absent: the defaults): the defaults (or the
+/// paper's), its filters, and the boundary on every filter.
+pub(super) fn check(filter: Option<&Spanned<RawFilter>>, cx: &Ctx) -> Result<KinematicsSettings> {
+    let Some(raw) = filter else {
+        return Ok(KinematicsSettings::default());
+    };
     let (span, f) = (raw.span(), raw.get_ref());
     let mut kinematics = if f.paper {
         KinematicsSettings::paper()

@@ -3,25 +3,18 @@
 
 use serde::Deserialize;
 
-/// `[output]` as written.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawOutput {
-    report: Option<bool>,
-}
-
-/// What the commands write besides their JSON.
-#[derive(Clone, Debug)]
+/// What the commands write besides their JSON: `[output]` as written, the defaults where it
+/// or a key is absent.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct OutputSpec {
     /// Figures (SVG, PNG, CSV), report.html and report.md.
     pub report: bool,
 }
 
-impl From<Option<&RawOutput>> for OutputSpec {
-    fn from(raw: Option<&RawOutput>) -> OutputSpec {
-        OutputSpec {
-            report: raw.and_then(|o| o.report).unwrap_or(true),
-        }
+impl Default for OutputSpec {
+    fn default() -> OutputSpec {
+        OutputSpec { report: true }
     }
 }
 

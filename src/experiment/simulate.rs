@@ -10,7 +10,7 @@ use serde::Deserialize;
 use stf_core::simulate::{count_text, sample_count, DEFAULT_MAX_SAMPLES};
 use toml::Spanned;
 
-use super::drive::{self, Drive, RawChirp, RawConstant, RawFree, RawProfile, RawSweep};
+use super::drive::{self, Chirp, Drive, RawConstant, RawFree, RawProfile, RawSweep};
 use super::models::{self, ModelEntry, RawModel};
 use super::Ctx;
 
@@ -22,7 +22,7 @@ pub(super) struct RawSimulate {
     constant: Option<RawConstant>,
     profile: Option<RawProfile>,
     free: Option<RawFree>,
-    chirp: Option<Spanned<RawChirp>>,
+    chirp: Option<Spanned<Chirp>>,
     #[serde(default = "default_rate")]
     rate: f64,
     #[serde(default = "yes")]
@@ -82,12 +82,8 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
         return Ok(None);
     };
     let (span, s) = (s.span(), s.get_ref());
-    let drive::Checked {
-        drive,
-        t0,
-        t1,
-        mut as_json,
-    } = the_drive(s, cx, span.clone())?;
+    let checked = the_drive(s, cx, span.clone())?;
+    let (t0, t1, mut as_json) = (checked.t0, checked.t1, checked.as_json);
     let order = format!("t1 = {t1} must exceed t0 = {t0}");
     cx.ensure(t1 > t0, span.clone(), "simulate", order)?;
     cx.ensure(
@@ -103,7 +99,7 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
     as_json["x0"] = s.x0.into();
     as_json["v0"] = s.v0.into();
     Ok(Some(SimulateSpec {
-        drive,
+        drive: checked.drive,
         t0,
         t1,
         rate: s.rate,
@@ -124,7 +120,7 @@ fn the_drive(s: &RawSimulate, cx: &Ctx, span: Range<usize>) -> Result<drive::Che
         (None, Some(c), None, None, None) => Ok(c.check()),
         (None, None, Some(p), None, None) => p.check(cx, span),
         (None, None, None, Some(f), None) => Ok(f.check()),
-        (None, None, None, None, Some(c)) => RawChirp::check(c, cx),
+        (None, None, None, None, Some(c)) => Chirp::check(c, cx),
         _ => Err(cx.at(
             span,
             "simulate",
@@ -276,7 +272,7 @@ mod tests {
         let Drive::Force(chirp) = s.drive else {
             panic!("not a force drive: {:?}", s.drive)
         };
-        assert!(!chirp.held);
+        assert!(!chirp.held());
         // The frequency sweeps 0.5 → 1.5 Hz: the phase is 2π·(0.5·t + 0.025·t²).
         let t = 7.3;
         let expected = 2.0 * (std::f64::consts::TAU * (0.5 * t + 0.025 * t * t)).sin();
@@ -327,7 +323,7 @@ mod tests {
                 .unwrap()
                 .simulate
                 .unwrap();
-            assert!(matches!(s.drive, Drive::Force(c) if c.held == held));
+            assert!(matches!(s.drive, Drive::Force(c) if c.held() == held));
             assert_eq!(s.as_json["chirp"]["hold"], hold);
         }
         let msg = format!(

@@ -31,16 +31,12 @@ impl<'a> Columns<'a> {
         self
     }
 
-    /// Rows: the shortest column's length.
-    pub fn rows(&self) -> usize {
-        self.values.iter().map(|c| c.len()).min().unwrap_or(0)
-    }
-
     /// The CSV text: header, then one line per row.
     pub fn to_csv(&self) -> Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record(&self.names)?;
-        for i in 0..self.rows() {
+        let rows = self.values.iter().map(|c| c.len()).min().unwrap_or(0);
+        for i in 0..rows {
             w.write_record(self.values.iter().map(|c| carried(c[i]).to_string()))?;
         }
         w.into_inner().context("cannot build a CSV table")

@@ -5,10 +5,11 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::{Serialize, Serializer};
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 
+use super::csv_rows;
 use crate::output::write_atomic;
 
 /// One row: a model's errors in one regime.
@@ -102,33 +103,17 @@ pub fn rows<'a>(labels: &[&'a str], comparisons: &[Comparison]) -> Vec<CompareRo
 /// Write `rows` under their header to `path`, atomically (the header alone when no model
 /// was scored in any regime).
 pub fn write(path: &Path, rows: &[CompareRow]) -> Result<()> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for row in rows {
-        w.serialize(row)
-            .with_context(|| format!("cannot write a row of {}", path.display()))?;
+    if !rows.is_empty() {
+        return write_atomic(path, &csv_rows(path, rows)?);
     }
-    let mut bytes = w
-        .into_inner()
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    if rows.is_empty() {
-        bytes = header()?;
-    }
-    write_atomic(path, &bytes)
-}
-
-/// The header line, as the csv crate derives it from the fields of [`CompareRow`] (it
-/// writes a header with the first row only).
-fn header() -> Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.serialize(CompareRow::default())?;
-    let text = w
-        .into_inner()
-        .context("cannot build the header of compare.csv")?;
+    // The header line alone, as the csv crate derives it from the fields of [`CompareRow`]
+    // (it writes a header with the first row only).
+    let text = csv_rows(path, &[CompareRow::default()])?;
     let end = text
         .iter()
         .position(|b| *b == b'\n')
         .map_or(text.len(), |i| i + 1);
-    Ok(text[..end].to_vec())
+    write_atomic(path, &text[..end])
 }
 
 #[cfg(test)]

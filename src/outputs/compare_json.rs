@@ -7,7 +7,6 @@ use stf_core::regimes::{
     RegimeThresholds,
 };
 
-use super::finite;
 use super::fit_json::ModelFitJson;
 use crate::cmd_compare::Compared;
 use crate::compare_loops::BoundaryNote;
@@ -64,7 +63,7 @@ pub struct PeakJson {
     /// Largest |x|, m.
     pub peak_x_m: f64,
     /// ω at the peak, rad/s; null without a rotor speed.
-    pub peak_omega_rad_s: Option<f64>,
+    pub peak_omega_rad_s: f64,
 }
 
 /// One model compared with the record.
@@ -94,11 +93,11 @@ pub struct ModelPeak {
     /// Largest |x|, m.
     pub peak_x_m: f64,
     /// ω at the peak, rad/s; null if not finite.
-    pub peak_omega_rad_s: Option<f64>,
+    pub peak_omega_rad_s: f64,
     /// Simulated minus measured peak |x|, m.
     pub peak_x_error_m: f64,
     /// Simulated minus measured peak ω, rad/s; null if not finite.
-    pub peak_omega_error_rad_s: Option<f64>,
+    pub peak_omega_error_rad_s: f64,
 }
 
 /// The best model's label in each regime and overall.
@@ -137,7 +136,7 @@ impl<'a> CompareJson<'a> {
                 boundary_notes: crate::compare_loops::boundary_notes(measured),
                 resonance: PeakJson {
                     peak_x_m: peak.amplitude,
-                    peak_omega_rad_s: finite(peak.omega),
+                    peak_omega_rad_s: peak.omega,
                 },
             },
             thresholds: &exp.regimes,
@@ -174,9 +173,9 @@ fn models<'a>(data: &'a FitData, c: &'a Compared) -> Vec<ModelComparisonJson<'a>
                 let (x, w) = r.1;
                 ModelPeak {
                     peak_x_m: x,
-                    peak_omega_rad_s: finite(w),
+                    peak_omega_rad_s: w,
                     peak_x_error_m: x - measured.amplitude,
-                    peak_omega_error_rad_s: finite(w - measured.omega),
+                    peak_omega_error_rad_s: w - measured.omega,
                 }
             }),
         })

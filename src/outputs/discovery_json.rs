@@ -8,10 +8,11 @@ use serde::Serialize;
 use stf_core::data::estimate::LinearEstimate;
 use stf_core::discovery::{Discovery, GapLocation, Step, TrajectoryPart};
 use stf_core::fit::{FittedParam, NoiseFloor};
-use stf_core::numerics::derivative::NoiseEstimate;
+use stf_core::numerics::derivative::{noise_estimate, NoiseEstimate};
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
+use super::models_entry::SystemEntry;
 use super::{errors_by_name, values_by_name};
 use crate::discovery_curves::FittedCurves;
 use crate::experiment::Experiment;
@@ -94,7 +95,7 @@ pub struct FinalModelJson<'a> {
     /// The model's fitted values by name (SI units; no offsets or initial state).
     pub params: BTreeMap<String, f64>,
     /// Standard errors of every fitted value by name; null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
+    pub std_errors: BTreeMap<String, f64>,
     /// The model as a `[[models]]` entry (TOML).
     pub experiment_entry: String,
     /// The refitted oscillator (trajectory level; absent at force level).
@@ -105,39 +106,29 @@ pub struct FinalModelJson<'a> {
 /// The refitted oscillator of the final model.
 #[derive(Serialize)]
 pub struct FinalSystemJson {
-    /// The refitted parameters by name, SI units.
-    pub system: BTreeMap<String, f64>,
+    /// The refitted parameters by name, SI units (key `system`).
+    #[serde(flatten)]
+    pub refitted: SystemEntry,
     /// The same as a `[system]` table (TOML).
     pub system_entry: String,
 }
 
-/// What both levels share, from the experiment, the record and the discovery.
-pub struct Common<'a> {
-    /// The experiment.
-    pub exp: &'a Experiment,
-    /// The record and its kinematics.
-    pub data: &'a FitData,
-    /// The discovery.
-    pub found: &'a Discovery,
-    /// The score on the `[validate]` record.
-    pub score: Option<&'a DiscoveryScore>,
-}
-
 impl<'a> DiscoveryJson<'a> {
-    /// The document of a discovery: `model_params` are the final model's own values,
-    /// `experiment_entry` their `[[models]]` entry, `fitted` the curves' values.
+    /// The document of the discovery `found` of `exp` on `data` (`score`: on the `[validate]`
+    /// record): `model_params` are the final model's own values, `experiment_entry` their
+    /// `[[models]]` entry, `fitted` the curves' values.
     pub fn new(
-        c: Common<'a>,
+        (exp, data): (&'a Experiment, &'a FitData),
+        (found, score): (&'a Discovery, Option<&'a DiscoveryScore>),
         model_params: &[&FittedParam],
         experiment_entry: String,
         fitted: FittedCurves,
     ) -> Self {
-        let (exp, data, found) = (c.exp, c.data, c.found);
         DiscoveryJson {
             experiment: exp.path.display().to_string(),
             record: &data.record.source,
             drive: &data.kinematics.drive,
-            noise_estimate: data.noise_estimate(),
+            noise_estimate: noise_estimate(data.target()),
             base: exp
                 .discover
                 .as_ref()
@@ -162,28 +153,22 @@ impl<'a> DiscoveryJson<'a> {
             fitted,
             notes: data.record_warnings.iter().chain(&found.notes).collect(),
             trajectory: None,
-            validation: c.score,
+            validation: score,
         }
     }
 
-    /// The same at trajectory level: `tf` refitted `names` of the oscillator (the `[system]`
-    /// entry `system_entry`) in `wall` seconds.
+    /// The same at trajectory level: `tf` refitted `names` of the oscillator (`system`) in
+    /// `wall` seconds.
     pub fn with_trajectory(
         mut self,
         tf: &'a TrajectoryPart,
         names: &'a [String],
-        system_entry: String,
+        system: FinalSystemJson,
         wall: f64,
         system_estimate: Option<LinearEstimate>,
     ) -> Self {
         self.gap_unit = "m";
-        self.final_model.system = Some(FinalSystemJson {
-            system: names
-                .iter()
-                .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
-                .collect(),
-            system_entry,
-        });
+        self.final_model.system = Some(system);
         self.trajectory = Some(TrajectoryJson {
             system_estimate,
             level: "trajectory",

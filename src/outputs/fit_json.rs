@@ -5,12 +5,12 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 use stf_core::data::estimate::LinearEstimate;
-use stf_core::fit::{Convergence, ErrorBlocks, FitWarning, NoiseFloor, StatedWarning};
-use stf_core::numerics::derivative::NoiseEstimate;
+use stf_core::fit::{Convergence, ErrorBlocks, FitResult, FitWarning, NoiseFloor, StatedWarning};
+use stf_core::numerics::derivative::{noise_estimate, NoiseEstimate};
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{errors_by_name, finite, level_name, values_by_name};
+use super::{errors_by_name, level_name, values_by_name};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::validation::ModelValidation;
@@ -52,7 +52,7 @@ impl<'a> FitJson<'a> {
                 window: filter.window(),
             },
             drive: &data.kinematics.drive,
-            noise_estimate: data.noise_estimate(),
+            noise_estimate: noise_estimate(data.target()),
             system_estimate: data.system_estimate,
             models: fits
                 .iter()
@@ -80,46 +80,27 @@ pub struct ModelFitJson<'a> {
     pub label: &'a str,
     /// `force` or `trajectory`.
     pub level: &'static str,
-    /// Fitted (or held) values by parameter name, SI units.
-    pub params: BTreeMap<String, f64>,
-    /// Block-robust standard errors by name, SI units; null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
+    /// The values, errors, residual, criteria and warnings, as every fit states them.
+    #[serde(flatten)]
+    pub result: ResultJson<'a>,
     /// Standard errors as if the residuals were independent, by name; null where unknown.
-    pub naive_std_errors: BTreeMap<String, Option<f64>>,
+    pub naive_std_errors: BTreeMap<String, f64>,
     /// The blocks the robust errors were computed over.
     pub error_blocks: Option<ErrorBlocks>,
     /// Names of the parameters held at their values.
     pub fixed: Vec<&'a str>,
-    /// RMS residual, in `rms_unit`.
-    pub rms: f64,
-    /// `N` (force level) or `m` (trajectory level).
+    /// `N` (force level) or `m` (trajectory level): the unit of `rms`.
     pub rms_unit: &'static str,
-    /// Mean squared displacement error, mm² (trajectory level).
-    pub s_mm2: Option<f64>,
-    /// Akaike information criterion; null if not finite.
-    pub aic: Option<f64>,
-    /// Bayesian information criterion; null if not finite.
-    pub bic: Option<f64>,
     /// Samples fitted.
     pub n_points: usize,
     /// Free parameters.
     pub n_free: usize,
-    /// Model evaluations.
-    pub evaluations: u64,
     /// Evaluations that failed (a simulation that did not finish).
     pub failures: u64,
-    /// Whether the optimiser converged.
-    pub converged: bool,
-    /// How it ended.
-    pub convergence: &'a Convergence,
     /// The oscillator after the fit (trajectory level; null at force level).
     pub system: Option<OscillatorParams>,
     /// Correlation matrix of the free parameters; null where not finite.
-    pub correlation: Vec<Vec<Option<f64>>>,
-    /// The record's noise floor for this fit (same unit as `rms`).
-    pub noise_floor: Option<NoiseFloor>,
-    /// Why the fit is not to be trusted as it stands (`kind`, `message`, data).
-    pub warnings: Vec<StatedWarning<'a>>,
+    pub correlation: &'a [Vec<f64>],
     /// The error on the `[validate]` record (absent without one).
     #[serde(flatten)]
     pub validation: Option<ValidationJson<'a>>,
@@ -142,8 +123,7 @@ impl<'a> ModelFitJson<'a> {
             name: fit.name(),
             label: &fit.label,
             level: level_name(level),
-            params: values_by_name(&r.params),
-            std_errors: errors_by_name(&r.params, |p| p.std_error),
+            result: ResultJson::new(r, fit.floor, &fit.warnings),
             naive_std_errors: errors_by_name(&r.params, |p| p.naive_std_error),
             error_blocks: r.error_blocks,
             fixed: r
@@ -152,29 +132,63 @@ impl<'a> ModelFitJson<'a> {
                 .filter(|p| p.fixed)
                 .map(|p| p.name.as_str())
                 .collect(),
-            rms: r.rms,
             rms_unit: level.signal().si_unit,
-            s_mm2: r.s_mm2,
-            aic: finite(r.aic),
-            bic: finite(r.bic),
             n_points: r.n_points,
             n_free: r.n_free,
-            evaluations: r.evaluations,
             failures: r.failures,
-            converged: r.convergence.converged(),
-            convergence: &r.convergence,
             system: (level == FitLevel::Trajectory).then_some(fit.system),
-            correlation: r
-                .correlation
-                .iter()
-                .map(|row| row.iter().map(|&c| finite(c)).collect())
-                .collect(),
-            noise_floor: fit.floor,
-            warnings: fit.warnings.iter().map(FitWarning::stated).collect(),
+            correlation: &r.correlation,
             validation: fit.validation.as_ref().map(|v| ValidationJson {
                 validation_rms: v.rms(),
                 validation: v,
             }),
+        }
+    }
+}
+
+/// What every fit states of its result, in `fit.json`'s models and an identification's
+/// stages.
+#[derive(Serialize)]
+pub struct ResultJson<'a> {
+    /// Fitted (or held) values by parameter name, SI units.
+    pub params: BTreeMap<String, f64>,
+    /// Block-robust standard errors by name, SI units; null where not determined.
+    pub std_errors: BTreeMap<String, f64>,
+    /// RMS residual (N at force level, m at trajectory level).
+    pub rms: f64,
+    /// Mean squared displacement error, mm² (trajectory level).
+    pub s_mm2: Option<f64>,
+    /// Akaike information criterion; null if not finite.
+    pub aic: f64,
+    /// Bayesian information criterion; null if not finite.
+    pub bic: f64,
+    /// Model evaluations (simulations at trajectory level).
+    pub evaluations: u64,
+    /// Whether the optimiser converged.
+    pub converged: bool,
+    /// How it ended.
+    pub convergence: &'a Convergence,
+    /// The record's noise floor for this fit (same unit as `rms`).
+    pub noise_floor: Option<NoiseFloor>,
+    /// Why the fit is not to be trusted as it stands (`kind`, `message`, data).
+    pub warnings: Vec<StatedWarning<'a>>,
+}
+
+impl<'a> ResultJson<'a> {
+    /// The JSON of `r`, with its noise floor and warnings.
+    pub fn new(r: &'a FitResult, floor: Option<NoiseFloor>, warnings: &'a [FitWarning]) -> Self {
+        ResultJson {
+            params: values_by_name(&r.params),
+            std_errors: errors_by_name(&r.params, |p| p.std_error),
+            rms: r.rms,
+            s_mm2: r.s_mm2,
+            aic: r.aic,
+            bic: r.bic,
+            evaluations: r.evaluations,
+            converged: r.convergence.converged(),
+            convergence: &r.convergence,
+            noise_floor: floor,
+            warnings: warnings.iter().map(FitWarning::stated).collect(),
         }
     }
 }

@@ -2,13 +2,13 @@
 //! against each stage's record of displacement, and the result as the one model `none`, so
 //! that tools reading `models[].params` / `rms` of a plain fit read it too.
 
-use std::collections::BTreeMap;
-
 use serde::Serialize;
-use stf_core::fit::{Convergence, FitResult, FitWarning, NoiseFloor, StatedWarning};
-use stf_core::physics::oscillator_params::OscillatorParams;
+use stf_core::fit::StatedWarning;
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
-use super::{errors_by_name, finite, values_by_name};
+use super::fit_json::ResultJson;
+use crate::experiment::StageSpec;
+use crate::identify_report::StageOutcome;
 
 /// The whole of the identification's `fit.json`.
 #[derive(Serialize)]
@@ -18,7 +18,7 @@ pub struct IdentificationJson<'a> {
     /// Always `trajectory`.
     pub level: &'static str,
     /// Each stage, in order.
-    pub stages: &'a [StageJson],
+    pub stages: Vec<StageJson<'a>>,
     /// The oscillator after the last stage.
     pub system: OscillatorParams,
     /// One entry, `none`: the identified oscillator.
@@ -26,13 +26,15 @@ pub struct IdentificationJson<'a> {
 }
 
 impl<'a> IdentificationJson<'a> {
-    /// The document of `stages` that ended with `system`.
+    /// The document of the stages `specs` that came out as `outcomes` and ended with
+    /// `system`.
     pub fn new(
         experiment: &std::path::Path,
-        stages: &'a [StageJson],
+        specs: &[StageSpec],
+        outcomes: &'a [StageOutcome],
         system: OscillatorParams,
     ) -> Self {
-        let warnings = stages
+        let warnings = outcomes
             .iter()
             .enumerate()
             .flat_map(|(i, s)| {
@@ -42,15 +44,20 @@ impl<'a> IdentificationJson<'a> {
                 })
             })
             .collect();
+        let stages = specs.iter().zip(outcomes).map(|(spec, o)| StageJson {
+            record: &o.record,
+            free: spec.free.iter().map(OscParam::to_string).collect(),
+            result: ResultJson::new(&o.result, Some(o.floor), &o.warnings),
+        });
         IdentificationJson {
             experiment: experiment.display().to_string(),
             level: "trajectory",
-            stages,
+            stages: stages.collect(),
             system,
             models: [IdentifiedJson {
                 name: "none",
                 params: system,
-                rms: stages.last().and_then(|s| finite(s.rms)),
+                rms: outcomes.last().map(|s| s.result.rms),
                 warnings,
             }],
         }
@@ -59,66 +66,15 @@ impl<'a> IdentificationJson<'a> {
 
 /// One identification stage.
 #[derive(Serialize)]
-pub struct StageJson {
+pub struct StageJson<'a> {
     /// The stage's record (its path).
-    pub record: String,
+    pub record: &'a str,
     /// The oscillator parameters it fits.
     pub free: Vec<String>,
-    /// Fitted values by name (SI units).
-    pub params: BTreeMap<String, f64>,
-    /// Standard errors by name (SI units); null where not determined.
-    pub std_errors: BTreeMap<String, Option<f64>>,
-    /// Mean squared displacement error S(μ), mm².
-    pub s_mm2: Option<f64>,
-    /// RMS displacement residual, m.
-    pub rms: f64,
-    /// Akaike information criterion; null if not finite.
-    pub aic: Option<f64>,
-    /// Bayesian information criterion; null if not finite.
-    pub bic: Option<f64>,
-    /// Simulations run.
-    pub evaluations: u64,
-    /// Whether the optimiser converged.
-    pub converged: bool,
-    /// How it ended.
-    pub convergence: Convergence,
-    /// The position noise floor, m.
-    pub noise_floor: NoiseFloor,
-    /// Why the stage is not to be trusted as it stands (`kind`, `message`, data).
-    #[serde(serialize_with = "stated")]
-    pub warnings: Vec<FitWarning>,
-}
-
-impl StageJson {
-    /// The stage fitting `free` on `record` to `result`.
-    pub fn new(
-        record: String,
-        free: Vec<String>,
-        result: &FitResult,
-        noise_floor: NoiseFloor,
-        warnings: Vec<FitWarning>,
-    ) -> Self {
-        StageJson {
-            record,
-            free,
-            params: values_by_name(&result.params),
-            std_errors: errors_by_name(&result.params, |p| p.std_error),
-            s_mm2: result.s_mm2,
-            rms: result.rms,
-            aic: finite(result.aic),
-            bic: finite(result.bic),
-            evaluations: result.evaluations,
-            converged: result.convergence.converged(),
-            convergence: result.convergence.clone(),
-            noise_floor,
-            warnings,
-        }
-    }
-}
-
-/// Warnings as stated in JSON: `kind`, `message` and data.
-fn stated<S: serde::Serializer>(warnings: &[FitWarning], s: S) -> Result<S::Ok, S::Error> {
-    s.collect_seq(warnings.iter().map(FitWarning::stated))
+    /// Its values, errors, S(μ) (mm²), residual (m), criteria, position noise floor and
+    /// warnings, as every fit states them.
+    #[serde(flatten)]
+    pub result: ResultJson<'a>,
 }
 
 /// A warning of one stage, in the identified model's `warnings`.

@@ -28,12 +28,21 @@ pub mod models_entry;
 pub mod simulate_json;
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
+use anyhow::{Context, Result};
 use stf_core::fit::FittedParam;
 
-/// `v`, or `None` (JSON `null`) when it is not finite: JSON has no NaN or infinity.
-pub fn finite(v: f64) -> Option<f64> {
-    v.is_finite().then_some(v)
+/// `rows` as the CSV text of `path`, under the header the csv crate derives from `T`'s
+/// fields (written with the first row: no rows, no header).
+pub fn csv_rows<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        w.serialize(row)
+            .with_context(|| format!("cannot write a row of {}", path.display()))?;
+    }
+    w.into_inner()
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Parameters by name: each one's value.
@@ -46,16 +55,13 @@ pub fn values_by_name<'a>(
         .collect()
 }
 
-/// Parameters by name: each one's `error` (its standard error or another; `null` where the
-/// data do not give it).
+/// Parameters by name: each one's `error` (its standard error or another; NaN, JSON's
+/// `null`, where the data do not give it).
 pub fn errors_by_name(
     params: &[FittedParam],
     error: impl Fn(&FittedParam) -> f64,
-) -> BTreeMap<String, Option<f64>> {
-    params
-        .iter()
-        .map(|p| (p.name.clone(), finite(error(p))))
-        .collect()
+) -> BTreeMap<String, f64> {
+    params.iter().map(|p| (p.name.clone(), error(p))).collect()
 }
 
 /// The name of a fit level in JSON: `force` or `trajectory`.
@@ -63,5 +69,49 @@ pub fn level_name(level: crate::experiment::FitLevel) -> &'static str {
     match level {
         crate::experiment::FitLevel::Force => "force",
         crate::experiment::FitLevel::Trajectory => "trajectory",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The output types hold NaN where a value is not determined: what makes it JSON's `null`
+    /// is `write_json` (serde_json), for every f64 of every file.
+    #[test]
+    fn numbers_that_are_not_finite_are_written_as_null() {
+        #[derive(serde::Serialize)]
+        struct Doc {
+            aic: f64,
+            correlation: Vec<Vec<f64>>,
+            std_errors: BTreeMap<String, f64>,
+        }
+        let param = |name: &str, std_error| FittedParam {
+            name: name.into(),
+            value: 1.5,
+            std_error,
+            naive_std_error: f64::NAN,
+            fixed: false,
+        };
+        let doc = Doc {
+            aic: f64::NEG_INFINITY,
+            correlation: vec![vec![1.0, f64::NAN]],
+            std_errors: errors_by_name(&[param("K", 0.25), param("n", f64::INFINITY)], |p| {
+                p.std_error
+            }),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("doc.json");
+        crate::output::write_json(&path, &doc).unwrap();
+        let back: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(
+            back,
+            serde_json::json!({
+                "aic": null,
+                "correlation": [[1.0, null]],
+                "std_errors": { "K": 0.25, "n": null },
+            })
+        );
     }
 }
