@@ -1,5 +1,6 @@
 //! A parameter of a fit: start value, bounds, fixed or free, typical size.
 
+use derive_setters::Setters;
 use serde::Serialize;
 
 use super::error::FitError;
@@ -14,22 +15,26 @@ use crate::physics::param_spec::ParamSpec;
 /// let m = FitParam::new("m", 7.65).fixed(true);
 /// assert!(!k.fixed && m.fixed);
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Setters)]
 pub struct FitParam {
     /// Name: an oscillator parameter (`k`), a model parameter (`K`, `power_law.K`) or an
     /// offset (`x_off`, `f_off`).
+    #[setters(skip)]
     pub name: String,
     /// Start value (the value used if fixed).
     pub value: f64,
     /// Lower bound (`-inf`: none).
+    #[setters(skip)]
     pub min: f64,
     /// Upper bound (`inf`: none).
+    #[setters(skip)]
     pub max: f64,
     /// Held at `value`, not fitted.
     pub fixed: bool,
     /// Typical size of the parameter, for the initial simplex, the global search box and
     /// finite-difference steps; `None`: |value|, or a tenth of the bounds' width if the value
     /// is 0, or 1.
+    #[setters(strip_option)]
     pub scale: Option<f64>,
 }
 
@@ -80,24 +85,6 @@ impl FitParam {
     pub fn bounds(mut self, min: f64, max: f64) -> Self {
         self.min = min;
         self.max = max;
-        self
-    }
-
-    /// Start value.
-    pub fn value(mut self, value: f64) -> Self {
-        self.value = value;
-        self
-    }
-
-    /// Hold the parameter at its value.
-    pub fn fixed(mut self, fixed: bool) -> Self {
-        self.fixed = fixed;
-        self
-    }
-
-    /// Typical size (> 0).
-    pub fn scale(mut self, scale: f64) -> Self {
-        self.scale = Some(scale);
         self
     }
 

@@ -34,6 +34,7 @@
 
 use std::sync::Arc;
 
+use derive_setters::Setters;
 use nalgebra::DMatrix;
 
 use super::driver;
@@ -46,12 +47,15 @@ use crate::data::force_data::ForceData;
 use crate::physics::force_model::{ForceModel, ModelState};
 
 /// A force-level calibration of one STF model (a [`crate::physics::model_sum::ModelSum`] is one model).
-#[derive(Clone)]
+#[derive(Clone, Setters)]
+#[setters(generate = false)]
 pub struct ForceFit {
     model: Arc<dyn ForceModel>,
     params: Vec<FitParam>,
     unknown: Vec<String>,
     offset: Option<FitParam>,
+    /// Settings of the optimiser.
+    #[setters(generate)]
     settings: FitSettings,
 }
 
@@ -89,12 +93,6 @@ impl ForceFit {
             p.scale = Some(0.1);
         }
         self.offset = Some(p);
-        self
-    }
-
-    /// Settings of the optimiser.
-    pub fn settings(mut self, settings: FitSettings) -> Self {
-        self.settings = settings;
         self
     }
 

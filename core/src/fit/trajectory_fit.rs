@@ -24,6 +24,8 @@
 
 use std::sync::Arc;
 
+use derive_setters::Setters;
+
 use super::driver;
 use super::error::FitError;
 use super::fit_param::FitParam;
@@ -85,14 +87,23 @@ pub fn initial_state_params(x0: f64, v0: f64, x_span: f64, v_span: f64) -> [FitP
 }
 
 /// A trajectory-level fit of the oscillator and, optionally, an STF model.
-#[derive(Clone)]
+#[derive(Clone, Setters)]
+#[setters(generate = false)]
 pub struct TrajectoryFit {
     pub(crate) system: OscillatorParams,
+    /// The same fit driven by another excitation: another record's drive, for
+    /// [`TrajectoryFit::validate`] (set that record's initial estimate with
+    /// [`TrajectoryFit::initial`]).
+    #[setters(generate)]
     pub(crate) excitation: Arc<Excitation>,
     pub(crate) model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
     pub(crate) free: Vec<FitParam>,
     pub(crate) initial: Option<(f64, f64)>,
+    /// Integrator settings of the simulations.
+    #[setters(generate, rename = "sim_settings")]
     pub(crate) sim: Settings,
+    /// Settings of the optimiser.
+    #[setters(generate)]
     settings: FitSettings,
 }
 
@@ -143,18 +154,6 @@ impl TrajectoryFit {
         self
     }
 
-    /// Integrator settings of the simulations.
-    pub fn sim_settings(mut self, sim: Settings) -> Self {
-        self.sim = sim;
-        self
-    }
-
-    /// Settings of the optimiser.
-    pub fn settings(mut self, settings: FitSettings) -> Self {
-        self.settings = settings;
-        self
-    }
-
     fn resolve(&self, name: &str) -> Result<Slot, FitError> {
         if name == DISPLACEMENT_OFFSET {
             return Ok(Slot::Offset);
@@ -184,14 +183,6 @@ impl TrajectoryFit {
                 })
             }
         }
-    }
-
-    /// The same fit driven by another excitation: another record's drive, for
-    /// [`TrajectoryFit::validate`] (set that record's initial estimate with
-    /// [`TrajectoryFit::initial`]).
-    pub fn excitation(mut self, excitation: Arc<Excitation>) -> Self {
-        self.excitation = excitation;
-        self
     }
 
     /// The parameters given to [`TrajectoryFit::free`], in order.

@@ -13,6 +13,8 @@
 //! assert_eq!(run.x.len(), 51);
 //! ```
 
+use derive_setters::Setters;
+
 use crate::numerics::integrate::{integrate_states, Method, Settings, SimError, Stats};
 use crate::physics::oscillator::Oscillator;
 
@@ -53,12 +55,20 @@ pub struct Trajectory {
 }
 
 /// A simulation request: an oscillator, integrator settings and an initial state.
+#[derive(Setters)]
 pub struct Simulation<'a> {
+    #[setters(skip)]
     osc: &'a Oscillator,
+    /// Integrator settings.
     settings: Settings,
+    /// Output rate, samples per second (for [`Simulation::run`]).
     rate: f64,
+    /// Refuse a [`Simulation::run`] of more than this many samples (default
+    /// [`DEFAULT_MAX_SAMPLES`]).
     max_samples: u64,
+    #[setters(skip)]
     x0: f64,
+    #[setters(skip)]
     v0: f64,
 }
 
@@ -74,25 +84,9 @@ impl<'a> Simulation<'a> {
             v0: 0.0,
         }
     }
-    /// Integrator settings.
-    pub fn settings(mut self, settings: Settings) -> Self {
-        self.settings = settings;
-        self
-    }
     /// Integrator.
     pub fn method(mut self, method: Method) -> Self {
         self.settings.method = method;
-        self
-    }
-    /// Output rate, samples per second (for [`Simulation::run`]).
-    pub fn rate(mut self, rate: f64) -> Self {
-        self.rate = rate;
-        self
-    }
-    /// Refuse a [`Simulation::run`] of more than `samples` samples (default
-    /// [`DEFAULT_MAX_SAMPLES`]).
-    pub fn max_samples(mut self, samples: u64) -> Self {
-        self.max_samples = samples;
         self
     }
     /// Initial displacement (m) and velocity (m/s).
