@@ -18,7 +18,7 @@ use rand::SeedableRng;
 use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::fit_param::FitParam;
-use super::levenberg_marquardt::{self, BoundStop, MAX_FD_STEP, NOISE_PROBE};
+use super::levenberg_marquardt::{self, BoundStop, Refined, MAX_FD_STEP, NOISE_PROBE};
 use super::objective::{LnCost, Objective, Residuals};
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
 use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
@@ -57,17 +57,7 @@ pub fn run(
     };
     let (u, convergence) = chain.solve(&u0)?;
     let (u, convergence) = chain.no_worse_than(u0, u, convergence);
-    finish(
-        &obj,
-        params,
-        &u,
-        settings,
-        convergence,
-        chain.iterations,
-        chain.log,
-        trajectory,
-        clock,
-    )
+    chain.finish(params, &u, convergence, clock)
 }
 
 /// The free members of `params` after checking the settings, each parameter, that no name
@@ -155,6 +145,17 @@ impl Chain<'_> {
     /// parameter on a bound stops there; the parameter is then released (see
     /// [`release_pinned`]).
     fn lm(&mut self, start: &[f64]) -> (Vec<f64>, Convergence) {
+        let out = self.refine(start);
+        self.log.push(format!(
+            "levenberg_marquardt: {} iterations, {:?}",
+            out.iterations, out.convergence
+        ));
+        (out.u, out.convergence)
+    }
+
+    /// Levenberg–Marquardt from `start`, its iterations counted; in a trajectory fit it stops
+    /// where a parameter is pinned on a bound.
+    fn refine(&mut self, start: &[f64]) -> Refined {
         let (obj, free, settings) = (self.obj, self.free, self.settings);
         let at_bound = |u: &[f64]| !pinned(obj, free, u).is_empty();
         let stop_at_bound: BoundStop = self.trajectory.then_some(&at_bound);
@@ -168,11 +169,7 @@ impl Chain<'_> {
             stop_at_bound,
         );
         self.iterations += out.iterations;
-        self.log.push(format!(
-            "levenberg_marquardt: {} iterations, {:?}",
-            out.iterations, out.convergence
-        ));
-        (out.u, out.convergence)
+        out
     }
 
     /// Nelder–Mead from `start` to the simplex tolerance `tol`, logged.
@@ -247,7 +244,7 @@ fn release_pinned(
     u: Vec<f64>,
     convergence: Convergence,
 ) -> (Vec<f64>, Convergence) {
-    let (obj, free, settings) = (chain.obj, chain.free, chain.settings);
+    let (obj, free) = (chain.obj, chain.free);
     let stuck = pinned(obj, free, &u);
     if stuck.is_empty() {
         return (u, convergence);
@@ -259,16 +256,7 @@ fn release_pinned(
     for &j in &stuck {
         restart[j] = 0.0;
     }
-    obj.set_stage(SolverStage::LevenbergMarquardt);
-    let out = levenberg_marquardt::refine(
-        obj,
-        &restart,
-        settings.max_iters,
-        settings.tol,
-        settings.fd_step,
-        Some(&|u: &[f64]| !pinned(obj, free, u).is_empty()),
-    );
-    chain.iterations += out.iterations;
+    let out = chain.refine(&restart);
     let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
     match obj.cost(&out.u) {
         Some(c) if c < cost => {
@@ -357,75 +345,82 @@ fn particle_swarm(
     Ok((u, iters))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    obj: &Objective,
-    params: &[FitParam],
-    u: &[f64],
-    settings: &FitSettings,
-    mut convergence: Convergence,
-    iterations: u64,
-    mut log: Vec<String>,
-    trajectory: bool,
-    clock: Instant,
-) -> Result<FitResult, FitError> {
-    obj.set_stage(SolverStage::Errors);
-    let n = obj.len();
-    let x = obj.to_user(u);
-    let mut r0 = vec![0.0; n];
-    let Some(rss) = obj.residuals_user(&x, &mut r0) else {
-        return Err(FitError::Solver(format!(
-            "the best point cannot be re-evaluated: {}",
-            obj.last_failure().unwrap_or_default()
-        )));
-    };
-    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
-    let p = free.len();
-    let errors = if p > 0 {
-        let jac = jacobian(obj, &free, &x, &r0, settings);
-        Some(standard_errors(&jac, &r0, rss, &mut log))
-    } else {
-        None
-    };
-    let fitted = fitted_params(params, &x, errors.as_ref());
-    let nf = n as f64;
-    let mean = rss / nf;
-    let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
-    if obj.failures() > 0 {
-        log.push(format!(
-            "{} evaluations failed and were scored as penalties; last: {}",
-            obj.failures(),
-            obj.last_failure().unwrap_or_default()
-        ));
-    }
-    if !x.iter().all(|v| v.is_finite()) {
-        convergence = Convergence::Failed {
-            reason: "a parameter is not finite".into(),
+impl Chain<'_> {
+    /// The result at the chain's end `u`: residuals, standard errors and statistics, with
+    /// the chain's iterations and log.
+    fn finish(
+        self,
+        params: &[FitParam],
+        u: &[f64],
+        mut convergence: Convergence,
+        clock: Instant,
+    ) -> Result<FitResult, FitError> {
+        let Chain {
+            obj,
+            settings,
+            trajectory,
+            iterations,
+            mut log,
+            ..
+        } = self;
+        obj.set_stage(SolverStage::Errors);
+        let n = obj.len();
+        let x = obj.to_user(u);
+        let mut r0 = vec![0.0; n];
+        let Some(rss) = obj.residuals_user(&x, &mut r0) else {
+            return Err(FitError::Solver(format!(
+                "the best point cannot be re-evaluated: {}",
+                obj.last_failure().unwrap_or_default()
+            )));
         };
+        let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
+        let p = free.len();
+        let errors = if p > 0 {
+            let jac = jacobian(obj, &free, &x, &r0, settings);
+            Some(standard_errors(&jac, &r0, rss, &mut log))
+        } else {
+            None
+        };
+        let fitted = fitted_params(params, &x, errors.as_ref());
+        let nf = n as f64;
+        let mean = rss / nf;
+        let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
+        if obj.failures() > 0 {
+            log.push(format!(
+                "{} evaluations failed and were scored as penalties; last: {}",
+                obj.failures(),
+                obj.last_failure().unwrap_or_default()
+            ));
+        }
+        if !x.iter().all(|v| v.is_finite()) {
+            convergence = Convergence::Failed {
+                reason: "a parameter is not finite".into(),
+            };
+        }
+        let (correlation, error_blocks) = match errors {
+            Some(e) => (e.robust.correlation, Some(e.blocks)),
+            None => (vec![], None),
+        };
+        Ok(FitResult {
+            params: fitted,
+            correlation,
+            error_blocks,
+            n_points: n,
+            n_free: p,
+            rss,
+            rms: mean.sqrt(),
+            s_mm2: trajectory.then_some(mean * 1e6),
+            aic: ln_term + 2.0 * p as f64,
+            bic: ln_term + p as f64 * nf.ln(),
+            evaluations: obj.evaluations(),
+            failures: obj.failures(),
+            last_failure: obj.last_failure(),
+            iterations,
+            wall_seconds: clock.elapsed().as_secs_f64(),
+            convergence,
+            log,
+        })
     }
-    let (correlation, error_blocks) = match errors {
-        Some(e) => (e.robust.correlation, Some(e.blocks)),
-        None => (vec![], None),
-    };
-    Ok(FitResult {
-        params: fitted,
-        correlation,
-        error_blocks,
-        n_points: n,
-        n_free: p,
-        rss,
-        rms: mean.sqrt(),
-        s_mm2: trajectory.then_some(mean * 1e6),
-        aic: ln_term + 2.0 * p as f64,
-        bic: ln_term + p as f64 * nf.ln(),
-        evaluations: obj.evaluations(),
-        failures: obj.failures(),
-        last_failure: obj.last_failure(),
-        iterations,
-        wall_seconds: clock.elapsed().as_secs_f64(),
-        convergence,
-        log,
-    })
 }
 
 /// Every parameter as fitted: a fixed one at its value with no error, a free one at its entry

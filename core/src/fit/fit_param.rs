@@ -63,6 +63,24 @@ pub fn full_values(params: &[FitParam], free: &[f64]) -> Result<Vec<f64>, String
         .collect()
 }
 
+/// `params` held at `values` (one per parameter, in order): each fixed at its value; an
+/// error naming both counts if they differ.
+pub(crate) fn held(params: &[FitParam], values: &[f64]) -> Result<Vec<FitParam>, FitError> {
+    if values.len() != params.len() {
+        return Err(FitError::BadData(format!(
+            "{} values given for {} parameters",
+            values.len(),
+            params.len()
+        )));
+    }
+    let hold = |(p, &value): (&FitParam, &f64)| FitParam {
+        value,
+        fixed: true,
+        ..p.clone()
+    };
+    Ok(params.iter().zip(values).map(hold).collect())
+}
+
 impl FitParam {
     /// A free, unbounded parameter starting at `value`.
     pub fn new(name: impl Into<String>, value: f64) -> Self {

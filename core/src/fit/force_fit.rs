@@ -39,7 +39,7 @@ use nalgebra::DMatrix;
 
 use super::driver;
 use super::error::FitError;
-use super::fit_param::{full_values, FitParam};
+use super::fit_param::{full_values, held, FitParam};
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::solver::FitSettings;
@@ -160,18 +160,7 @@ impl ForceFit {
     /// vector `values` (the model's parameters, then the offset), along the kinematics.
     pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
         data.check_increasing()?;
-        let mut all = self.params();
-        if values.len() != all.len() {
-            return Err(FitError::BadData(format!(
-                "{} values given for {} parameters",
-                values.len(),
-                all.len()
-            )));
-        }
-        for (p, &v) in all.iter_mut().zip(values) {
-            p.value = v;
-            p.fixed = true;
-        }
+        let all = held(&self.params(), values)?;
         let problem = ForceResiduals {
             model: self.model.as_ref(),
             data: *data,

@@ -28,7 +28,7 @@ use derive_setters::Setters;
 
 use super::driver;
 use super::error::FitError;
-use super::fit_param::FitParam;
+use super::fit_param::{full_values, held, FitParam};
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::same_term::check_same_terms;
@@ -197,11 +197,6 @@ impl TrajectoryFit {
             .any(|p| !p.fixed && INITIAL_STATE.contains(&p.name.as_str()))
     }
 
-    /// The initial state given to [`TrajectoryFit::initial`], if any.
-    pub(super) fn initial_estimate(&self) -> Option<(f64, f64)> {
-        self.initial
-    }
-
     /// The same fit with the parameter list `free` instead.
     pub(super) fn with_free(&self, free: Vec<FitParam>) -> Self {
         TrajectoryFit {
@@ -224,24 +219,7 @@ impl TrajectoryFit {
         values: &[f64],
     ) -> Result<(Vec<f64>, [f64; 2]), FitError> {
         self.check(data)?;
-        if values.len() != self.free.len() {
-            return Err(FitError::BadData(format!(
-                "{} values given for {} parameters",
-                values.len(),
-                self.free.len()
-            )));
-        }
-        let held = self.with_free(
-            self.free
-                .iter()
-                .zip(values)
-                .map(|(p, &v)| FitParam {
-                    value: v,
-                    fixed: true,
-                    ..p.clone()
-                })
-                .collect(),
-        );
+        let held = self.with_free(held(&self.free, values)?);
         let problem = held.problem(data)?;
         let (sol, offset, initial) = problem.solve(&[]).map_err(FitError::BadData)?;
         let x = sol.states.iter().step_by(sol.dim).map(|x| x + offset);
@@ -356,13 +334,7 @@ impl TrajectoryResiduals<'_> {
         let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
         let mut offset = 0.0;
         let mut initial: [Option<f64>; 2] = [None, None];
-        let mut free = x.iter();
-        for (p, slot) in fit.free.iter().zip(&self.slots) {
-            let value = if p.fixed {
-                p.value
-            } else {
-                *free.next().ok_or("too few free values")?
-            };
+        for (value, slot) in full_values(&fit.free, x)?.into_iter().zip(&self.slots) {
             match *slot {
                 Slot::Oscillator(param) => system[param] = value,
                 Slot::Model(i) => {
