@@ -1,8 +1,9 @@
 //! Simulation of the oscillator: samples of x, v, a and F_STF at a rate or at given times.
 //!
 //! A run integrates the oscillator once and then evaluates the forces at every sample; from
-//! 20 000 samples on it uses a second thread for the drive (during the integration) and for half
-//! of the samples' forces (after it), which leaves the integration as the run's critical path.
+//! 20 000 samples on it uses a second thread (`rayon::join`) for the drive (during the
+//! integration) and for half of the samples' forces (after it), which leaves the integration
+//! as the run's critical path.
 //!
 //! ```
 //! use stf_core::physics::{excitation::{Excitation, RotorAngle}, oscillator::Oscillator,
@@ -137,14 +138,10 @@ impl<'a> Simulation<'a> {
         // on a second thread while the integration runs (one `sin` a sample is as much work as
         // the integration of a smooth sweep).
         let (integrated, drive) = if times.len() >= PARALLEL_SAMPLES {
-            std::thread::scope(|scope| {
-                let job = scope.spawn(|| DriveColumns::at(excitation, params, &times));
-                let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
-                let drive = job
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                (integrated, drive)
-            })
+            rayon::join(
+                || integrate_states(self.osc, t0, &y0, &times, &self.settings),
+                || DriveColumns::at(excitation, params, &times),
+            )
         } else {
             let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
             (integrated, DriveColumns::at(excitation, params, &times))
@@ -173,14 +170,11 @@ impl<'a> Simulation<'a> {
             let mid = n / 2;
             let (first, second) = (rows.window(0, mid), rows.window(mid, n));
             let (into_first, into_second) = columns.split_at(mid);
-            std::thread::scope(|scope| {
-                let job = scope.spawn(|| first.fill(self.osc, into_first));
-                let second = second.fill(self.osc, into_second);
-                let first = job
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                first.and(second)
-            })?;
+            let (first, second) = rayon::join(
+                || first.fill(self.osc, into_first),
+                || second.fill(self.osc, into_second),
+            );
+            first.and(second)?;
         } else {
             rows.fill(self.osc, columns)?;
         }
