@@ -355,14 +355,7 @@ impl Chain<'_> {
         mut convergence: Convergence,
         clock: Instant,
     ) -> Result<FitResult, FitError> {
-        let Chain {
-            obj,
-            settings,
-            trajectory,
-            iterations,
-            mut log,
-            ..
-        } = self;
+        let (obj, mut log) = (self.obj, self.log);
         obj.set_stage(SolverStage::Errors);
         let n = obj.len();
         let x = obj.to_user(u);
@@ -376,7 +369,7 @@ impl Chain<'_> {
         let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
         let p = free.len();
         let errors = if p > 0 {
-            let jac = jacobian(obj, &free, &x, &r0, settings);
+            let jac = jacobian(obj, &free, &x, &r0, self.settings);
             Some(standard_errors(&jac, &r0, rss, &mut log))
         } else {
             None
@@ -409,13 +402,13 @@ impl Chain<'_> {
             n_free: p,
             rss,
             rms: mean.sqrt(),
-            s_mm2: trajectory.then_some(mean * 1e6),
+            s_mm2: self.trajectory.then_some(mean * 1e6),
             aic: ln_term + 2.0 * p as f64,
             bic: ln_term + p as f64 * nf.ln(),
             evaluations: obj.evaluations(),
             failures: obj.failures(),
             last_failure: obj.last_failure(),
-            iterations,
+            iterations: self.iterations,
             wall_seconds: clock.elapsed().as_secs_f64(),
             convergence,
             log,
