@@ -153,10 +153,7 @@ impl Excitation {
     pub fn force(&self, t: f64, p: &OscillatorParams) -> f64 {
         match self {
             Excitation::None => 0.0,
-            Excitation::Rotor(angle) => {
-                let (phi, omega) = angle.at(t);
-                p.f0 * omega * omega * (phi - p.phi_off).sin()
-            }
+            Excitation::Rotor(_) => self.force_and_angle(t, p).0,
             Excitation::Force(u) => u.at(t) - p.u_off,
         }
     }

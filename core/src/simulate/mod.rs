@@ -152,13 +152,13 @@ impl<'a> Simulation<'a> {
         let (mut x, mut v, mut a, mut f_stf) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let mut z = vec![vec![0.0; n]; dim - 2];
-        let columns = Columns {
-            x: &mut x,
-            v: &mut v,
-            a: &mut a,
-            f_stf: &mut f_stf,
-            z: z.iter_mut().map(Vec::as_mut_slice).collect(),
-        };
+        let columns = Columns(
+            [&mut x, &mut v, &mut a, &mut f_stf]
+                .into_iter()
+                .chain(&mut z)
+                .map(Vec::as_mut_slice)
+                .collect(),
+        );
         let rows = Rows {
             states: &states,
             dim,
