@@ -86,19 +86,14 @@ impl DriveColumns {
                 omega: None,
             };
         }
-        let n = times.len();
-        let (mut force, mut phi, mut omega) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        );
-        for &t in times {
-            let (d, angle) = excitation.force_and_angle(t, p);
-            let (p, w) = angle.unwrap_or((0.0, 0.0));
-            force.push(d);
-            phi.push(p);
-            omega.push(w);
-        }
+        let ((force, phi), omega) = times
+            .iter()
+            .map(|&t| {
+                let (d, angle) = excitation.force_and_angle(t, p);
+                let (phi, w) = angle.unwrap_or((0.0, 0.0));
+                ((d, phi), w)
+            })
+            .unzip();
         DriveColumns {
             force,
             phi: Some(phi),
