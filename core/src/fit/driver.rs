@@ -366,10 +366,9 @@ impl Chain<'_> {
                 obj.last_failure().unwrap_or_default()
             )));
         };
-        let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
-        let p = free.len();
+        let p = self.free.len();
         let errors = if p > 0 {
-            let jac = jacobian(obj, &free, &x, &r0, self.settings);
+            let jac = jacobian(obj, self.free, &x, &r0, self.settings);
             Some(standard_errors(&jac, &r0, rss, &mut log))
         } else {
             None

@@ -32,16 +32,6 @@ impl Solver {
         Solver::LevenbergMarquardt,
         Solver::ParticleSwarm,
     ];
-
-    /// The name used in experiment files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Solver::Auto => "auto",
-            Solver::NelderMead => "nelder_mead",
-            Solver::LevenbergMarquardt => "levenberg_marquardt",
-            Solver::ParticleSwarm => "particle_swarm",
-        }
-    }
 }
 
 /// Settings of a fit, with named setters.
