@@ -86,8 +86,7 @@ impl ForceFit {
 
     /// Add a constant force offset `f_off` (N) to the model's force; fit it unless `fixed`.
     /// Its name is replaced by [`FORCE_OFFSET`].
-    pub fn offset(mut self, p: FitParam) -> Self {
-        let mut p = p;
+    pub fn offset(mut self, mut p: FitParam) -> Self {
         p.name = FORCE_OFFSET.to_string();
         if p.scale.is_none() && p.value == 0.0 {
             p.scale = Some(0.1);

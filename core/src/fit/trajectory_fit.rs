@@ -139,8 +139,7 @@ impl TrajectoryFit {
 
     /// A parameter to fit (or to hold, if `fixed`): an oscillator parameter, a model
     /// parameter, or `x_off` (the displacement offset, m, default scale 1 mm).
-    pub fn free(mut self, p: FitParam) -> Self {
-        let mut p = p;
+    pub fn free(mut self, mut p: FitParam) -> Self {
         if p.name == DISPLACEMENT_OFFSET && p.scale.is_none() && p.value == 0.0 {
             p.scale = Some(1e-3);
         }
