@@ -178,7 +178,37 @@ impl Chain<'_> {
         start: &[f64],
         tol: f64,
     ) -> Result<(Vec<f64>, Convergence), FitError> {
-        let (u, it, conv) = nelder_mead(self.obj, start, tol, self.settings)?;
+        self.obj.set_stage(SolverStage::NelderMead);
+        let p = start.len();
+        let mut simplex = vec![start.to_vec()];
+        for j in 0..p {
+            let mut v = start.to_vec();
+            v[j] += self.settings.simplex_step;
+            simplex.push(v);
+        }
+        let solver = NelderMead::new(simplex)
+            .with_sd_tolerance(tol)
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let res = Executor::new(LnCost(self.obj), solver)
+            .configure(|s| s.max_iters(self.settings.max_iters))
+            .timer(false)
+            .run()
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let state = res.state();
+        let u = state
+            .get_best_param()
+            .cloned()
+            .unwrap_or_else(|| start.to_vec());
+        let conv = match state.get_termination_reason() {
+            Some(TerminationReason::SolverConverged) => Convergence::Converged {
+                reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
+            },
+            Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
+            other => Convergence::Failed {
+                reason: format!("Nelder–Mead stopped: {other:?}"),
+            },
+        };
+        let it = state.get_iter();
         self.iterations += it;
         self.log
             .push(format!("nelder_mead: {it} iterations, {conv:?}"));
@@ -279,45 +309,6 @@ fn release_pinned(
             (u, convergence)
         }
     }
-}
-
-fn nelder_mead(
-    obj: &Objective,
-    u0: &[f64],
-    tol: f64,
-    settings: &FitSettings,
-) -> Result<(Vec<f64>, u64, Convergence), FitError> {
-    obj.set_stage(SolverStage::NelderMead);
-    let p = u0.len();
-    let mut simplex = vec![u0.to_vec()];
-    for j in 0..p {
-        let mut v = u0.to_vec();
-        v[j] += settings.simplex_step;
-        simplex.push(v);
-    }
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(tol)
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let res = Executor::new(LnCost(obj), solver)
-        .configure(|s| s.max_iters(settings.max_iters))
-        .timer(false)
-        .run()
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let state = res.state();
-    let u = state
-        .get_best_param()
-        .cloned()
-        .unwrap_or_else(|| u0.to_vec());
-    let conv = match state.get_termination_reason() {
-        Some(TerminationReason::SolverConverged) => Convergence::Converged {
-            reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
-        },
-        Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
-        other => Convergence::Failed {
-            reason: format!("Nelder–Mead stopped: {other:?}"),
-        },
-    };
-    Ok((u, state.get_iter(), conv))
 }
 
 fn particle_swarm(

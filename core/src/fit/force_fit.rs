@@ -152,9 +152,7 @@ impl ForceFit {
         };
         driver::run(&problem, &all, settings, observer, false)
     }
-}
 
-impl ForceFit {
     /// The modelled force (with the offset, if any) at every sample for the full parameter
     /// vector `values` (the model's parameters, then the offset), along the kinematics.
     pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {

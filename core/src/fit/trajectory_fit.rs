@@ -288,9 +288,7 @@ impl TrajectoryFit {
         let settings = self.settings.clone().for_simulation(self.sim.rtol);
         driver::run(&problem, &self.free, &settings, observer, true)
     }
-}
 
-impl TrajectoryFit {
     /// [`check_same_terms`] on the parameters this fit frees.
     fn check_same_terms(&self, slots: &[Slot]) -> Result<(), FitError> {
         let free = |i: usize| {
