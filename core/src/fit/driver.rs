@@ -128,9 +128,7 @@ impl Chain<'_> {
             }
             Solver::LevenbergMarquardt => self.lm(u0),
             Solver::ParticleSwarm => {
-                let (u, it) = particle_swarm(self.obj, u0, settings)?;
-                self.iterations += it;
-                self.log.push(format!("particle_swarm: {it} iterations"));
+                let u = self.particle_swarm(u0)?;
                 self.lm(&u)
             }
         };
@@ -311,32 +309,33 @@ fn release_pinned(
     }
 }
 
-fn particle_swarm(
-    obj: &Objective,
-    u0: &[f64],
-    settings: &FitSettings,
-) -> Result<(Vec<f64>, u64), FitError> {
-    obj.set_stage(SolverStage::ParticleSwarm);
-    let (lo, hi): (Vec<f64>, Vec<f64>) = obj.transforms().iter().map(|t| t.search_box()).unzip();
-    let solver = ParticleSwarm::new((lo, hi), settings.particles)
-        .with_rng_generator(StdRng::seed_from_u64(settings.seed));
-    let res = Executor::new(LnCost(obj), solver)
-        .configure(|s| s.max_iters(settings.max_iters))
-        .timer(false)
-        .run()
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let state = res.state();
-    let iters = state.get_iter();
-    // Keep the start if the swarm found nothing better.
-    let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
-    let u = match state.get_best_param() {
-        Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
-        _ => u0.to_vec(),
-    };
-    Ok((u, iters))
-}
-
 impl Chain<'_> {
+    /// The particle swarm over the whole box, logged: its best point, or `u0` if it found
+    /// nothing better.
+    fn particle_swarm(&mut self, u0: &[f64]) -> Result<Vec<f64>, FitError> {
+        let (obj, settings) = (self.obj, self.settings);
+        obj.set_stage(SolverStage::ParticleSwarm);
+        let (lo, hi): (Vec<f64>, Vec<f64>) =
+            obj.transforms().iter().map(|t| t.search_box()).unzip();
+        let solver = ParticleSwarm::new((lo, hi), settings.particles)
+            .with_rng_generator(StdRng::seed_from_u64(settings.seed));
+        let res = Executor::new(LnCost(obj), solver)
+            .configure(|s| s.max_iters(settings.max_iters))
+            .timer(false)
+            .run()
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let state = res.state();
+        let it = state.get_iter();
+        self.iterations += it;
+        self.log.push(format!("particle_swarm: {it} iterations"));
+        // Keep the start if the swarm found nothing better.
+        let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
+        Ok(match state.get_best_param() {
+            Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
+            _ => u0.to_vec(),
+        })
+    }
+
     /// The result at the chain's end `u`: residuals, standard errors and statistics, with
     /// the chain's iterations and log.
     fn finish(

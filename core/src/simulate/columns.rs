@@ -78,7 +78,7 @@ impl DriveColumns {
     pub(super) fn at(excitation: &Excitation, p: &OscillatorParams, times: &[f64]) -> Self {
         let rotor = times
             .first()
-            .is_some_and(|&t| excitation.omega(t).is_some());
+            .is_some_and(|&t| excitation.angle(t).is_some());
         if !rotor {
             return DriveColumns {
                 force: times.iter().map(|&t| excitation.force(t, p)).collect(),

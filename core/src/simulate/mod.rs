@@ -267,8 +267,8 @@ mod tests {
                 (run.a[i], run.f_stf[i], run.drive[i]),
                 (f.a, f.f_stf, f.drive)
             );
-            assert_eq!(phi[i], osc.excitation.phi(run.t[i]).unwrap());
-            assert_eq!(omega[i], osc.excitation.omega(run.t[i]).unwrap());
+            assert_eq!(phi[i], osc.excitation.angle(run.t[i]).unwrap().0);
+            assert_eq!(omega[i], osc.excitation.angle(run.t[i]).unwrap().1);
         }
         // A long run takes the drive from a second thread: the same columns.
         let long = Simulation::new(&osc).rate(1000.0).run(0.0, 25.0).unwrap();
@@ -278,8 +278,8 @@ mod tests {
             let t = long.t[i];
             let f = osc.forces(t, &[long.x[i], long.v[i]], &mut []).unwrap();
             assert_eq!((long.a[i], long.drive[i]), (f.a, f.drive));
-            assert_eq!(phi[i], osc.excitation.phi(t).unwrap());
-            assert_eq!(omega[i], osc.excitation.omega(t).unwrap());
+            assert_eq!(phi[i], osc.excitation.angle(t).unwrap().0);
+            assert_eq!(omega[i], osc.excitation.angle(t).unwrap().1);
         }
         let free = Oscillator::new(OscillatorParams::FREE, Excitation::None);
         let run = Simulation::new(&free)
