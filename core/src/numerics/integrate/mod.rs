@@ -226,9 +226,7 @@ pub(crate) fn integrate_states(
         Method::Auto => {
             switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::Switching)
         }
-        Method::Dopri5 => {
-            dopri5::integrate(sys, t0, y0, t_out, settings).map(|sol| (sol.states, sol.stats))
-        }
+        Method::Dopri5 => dopri5::integrate(sys, t0, y0, t_out, settings),
         Method::Rodas4 => {
             switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::StiffOnly)
         }
