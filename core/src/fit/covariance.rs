@@ -35,6 +35,8 @@ enum Column {
 
 /// JᵀJ scaled to unit diagonal (`C = D·JᵀJ·D`) and its inverse over the determined directions.
 struct Normal {
+    /// `JᵀJ` (entries of bad columns not finite, and unused).
+    a: DMatrix<f64>,
     /// The scaling `D` (0 for a zero or bad column).
     d: Vec<f64>,
     /// `C⁺`: the inverse of `C` over its determined eigen-directions.
@@ -47,30 +49,17 @@ fn normal_matrix(jac: &DMatrix<f64>) -> Normal {
     let bad: Vec<bool> = (0..p)
         .map(|j| jac.column(j).iter().any(|v| !v.is_finite()))
         .collect();
-    let mut a = DMatrix::<f64>::zeros(p, p);
-    for i in 0..p {
-        for j in i..p {
-            if bad[i] || bad[j] {
-                continue;
-            }
-            let v = jac.column(i).dot(&jac.column(j));
-            a[(i, j)] = v;
-            a[(j, i)] = v;
-        }
-    }
+    let a = jac.tr_mul(jac);
     // Scale to unit diagonal; zero or bad columns are held out of the inversion.
     let live: Vec<bool> = (0..p).map(|j| !bad[j] && a[(j, j)] > 0.0).collect();
     let d: Vec<f64> = (0..p)
         .map(|j| if live[j] { 1.0 / a[(j, j)].sqrt() } else { 0.0 })
         .collect();
-    let mut c = DMatrix::<f64>::identity(p, p);
-    for i in 0..p {
-        for j in 0..p {
-            if live[i] && live[j] {
-                c[(i, j)] = a[(i, j)] * d[i] * d[j];
-            }
-        }
-    }
+    let c = DMatrix::from_fn(p, p, |i, j| match (live[i] && live[j], i == j) {
+        (true, _) => a[(i, j)] * d[i] * d[j],
+        (false, true) => 1.0,
+        (false, false) => 0.0,
+    });
     let eig = SymmetricEigen::new(c);
     let lmax = eig.eigenvalues.iter().fold(0.0_f64, |m, &l| m.max(l));
     let cutoff = 1e-13 * lmax;
@@ -95,7 +84,7 @@ fn normal_matrix(jac: &DMatrix<f64>) -> Normal {
             }
         }
     }
-    Normal { d, pinv, status }
+    Normal { a, d, pinv, status }
 }
 
 /// Standard errors and correlations from `cov_scaled`, a covariance in the scaled
@@ -162,7 +151,7 @@ pub fn sandwich(jac: &DMatrix<f64>, r: &[f64], block: usize) -> Covariance {
         let cov = DMatrix::from_element(p, p, f64::NAN);
         return assemble(&nm, &cov);
     }
-    let c = normal_scaled(jac, &nm);
+    let c = normal_scaled(&nm);
     let mut cov = DMatrix::<f64>::zeros(p, p);
     let mut score = DVector::<f64>::zeros(p);
     let mut own = DMatrix::<f64>::zeros(p, p);
@@ -221,13 +210,13 @@ fn leverage(c: &DMatrix<f64>, own: &DMatrix<f64>) -> f64 {
 }
 
 /// `D·JᵀJ·D` in the scaled coordinates of `nm` (bad columns zeroed).
-fn normal_scaled(jac: &DMatrix<f64>, nm: &Normal) -> DMatrix<f64> {
-    let p = jac.ncols();
+fn normal_scaled(nm: &Normal) -> DMatrix<f64> {
+    let p = nm.d.len();
     DMatrix::from_fn(p, p, |i, j| {
         if nm.status[i] == Column::Bad || nm.status[j] == Column::Bad {
             0.0
         } else {
-            jac.column(i).dot(&jac.column(j)) * nm.d[i] * nm.d[j]
+            nm.a[(i, j)] * nm.d[i] * nm.d[j]
         }
     })
 }
@@ -288,14 +277,15 @@ pub fn blocks(jac: &DMatrix<f64>, r: &[f64]) -> ErrorBlocks {
             settled: false,
         };
     }
-    let mut scores = DMatrix::<f64>::zeros(n, p);
-    for j in 0..p {
-        if jac.column(j).iter().all(|v| v.is_finite()) {
-            for i in 0..n {
-                scores[(i, j)] = jac[(i, j)] * r[i];
-            }
-        }
-    }
+    let finite: Vec<bool> = jac
+        .column_iter()
+        .map(|c| c.iter().all(|v| v.is_finite()))
+        .collect();
+    let scores = DMatrix::from_fn(
+        n,
+        p,
+        |i, j| if finite[j] { jac[(i, j)] * r[i] } else { 0.0 },
+    );
     let mut lengths = vec![1];
     while let Some(&b) = lengths.last() {
         if n / (2 * b) < FEWEST_BLOCKS {

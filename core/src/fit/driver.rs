@@ -18,7 +18,7 @@ use rand::SeedableRng;
 use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::fit_param::FitParam;
-use super::levenberg_marquardt::{self, BoundStop, MAX_FD_STEP, NOISE_PROBE};
+use super::levenberg_marquardt::{self, BoundStop, Refined, MAX_FD_STEP, NOISE_PROBE};
 use super::objective::{LnCost, Objective, Residuals};
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
 use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
@@ -57,17 +57,7 @@ pub fn run(
     };
     let (u, convergence) = chain.solve(&u0)?;
     let (u, convergence) = chain.no_worse_than(u0, u, convergence);
-    finish(
-        &obj,
-        params,
-        &u,
-        settings,
-        convergence,
-        chain.iterations,
-        chain.log,
-        trajectory,
-        clock,
-    )
+    chain.finish(params, &u, convergence, clock)
 }
 
 /// The free members of `params` after checking the settings, each parameter, that no name
@@ -138,9 +128,7 @@ impl Chain<'_> {
             }
             Solver::LevenbergMarquardt => self.lm(u0),
             Solver::ParticleSwarm => {
-                let (u, it) = particle_swarm(self.obj, u0, settings)?;
-                self.iterations += it;
-                self.log.push(format!("particle_swarm: {it} iterations"));
+                let u = self.particle_swarm(u0)?;
                 self.lm(&u)
             }
         };
@@ -155,6 +143,17 @@ impl Chain<'_> {
     /// parameter on a bound stops there; the parameter is then released (see
     /// [`release_pinned`]).
     fn lm(&mut self, start: &[f64]) -> (Vec<f64>, Convergence) {
+        let out = self.refine(start);
+        self.log.push(format!(
+            "levenberg_marquardt: {} iterations, {:?}",
+            out.iterations, out.convergence
+        ));
+        (out.u, out.convergence)
+    }
+
+    /// Levenberg–Marquardt from `start`, its iterations counted; in a trajectory fit it stops
+    /// where a parameter is pinned on a bound.
+    fn refine(&mut self, start: &[f64]) -> Refined {
         let (obj, free, settings) = (self.obj, self.free, self.settings);
         let at_bound = |u: &[f64]| !pinned(obj, free, u).is_empty();
         let stop_at_bound: BoundStop = self.trajectory.then_some(&at_bound);
@@ -168,11 +167,7 @@ impl Chain<'_> {
             stop_at_bound,
         );
         self.iterations += out.iterations;
-        self.log.push(format!(
-            "levenberg_marquardt: {} iterations, {:?}",
-            out.iterations, out.convergence
-        ));
-        (out.u, out.convergence)
+        out
     }
 
     /// Nelder–Mead from `start` to the simplex tolerance `tol`, logged.
@@ -181,7 +176,37 @@ impl Chain<'_> {
         start: &[f64],
         tol: f64,
     ) -> Result<(Vec<f64>, Convergence), FitError> {
-        let (u, it, conv) = nelder_mead(self.obj, start, tol, self.settings)?;
+        self.obj.set_stage(SolverStage::NelderMead);
+        let p = start.len();
+        let mut simplex = vec![start.to_vec()];
+        for j in 0..p {
+            let mut v = start.to_vec();
+            v[j] += self.settings.simplex_step;
+            simplex.push(v);
+        }
+        let solver = NelderMead::new(simplex)
+            .with_sd_tolerance(tol)
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let res = Executor::new(LnCost(self.obj), solver)
+            .configure(|s| s.max_iters(self.settings.max_iters))
+            .timer(false)
+            .run()
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let state = res.state();
+        let u = state
+            .get_best_param()
+            .cloned()
+            .unwrap_or_else(|| start.to_vec());
+        let conv = match state.get_termination_reason() {
+            Some(TerminationReason::SolverConverged) => Convergence::Converged {
+                reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
+            },
+            Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
+            other => Convergence::Failed {
+                reason: format!("Nelder–Mead stopped: {other:?}"),
+            },
+        };
+        let it = state.get_iter();
         self.iterations += it;
         self.log
             .push(format!("nelder_mead: {it} iterations, {conv:?}"));
@@ -247,7 +272,7 @@ fn release_pinned(
     u: Vec<f64>,
     convergence: Convergence,
 ) -> (Vec<f64>, Convergence) {
-    let (obj, free, settings) = (chain.obj, chain.free, chain.settings);
+    let (obj, free) = (chain.obj, chain.free);
     let stuck = pinned(obj, free, &u);
     if stuck.is_empty() {
         return (u, convergence);
@@ -259,16 +284,7 @@ fn release_pinned(
     for &j in &stuck {
         restart[j] = 0.0;
     }
-    obj.set_stage(SolverStage::LevenbergMarquardt);
-    let out = levenberg_marquardt::refine(
-        obj,
-        &restart,
-        settings.max_iters,
-        settings.tol,
-        settings.fd_step,
-        Some(&|u: &[f64]| !pinned(obj, free, u).is_empty()),
-    );
-    chain.iterations += out.iterations;
+    let out = chain.refine(&restart);
     let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
     match obj.cost(&out.u) {
         Some(c) if c < cost => {
@@ -293,139 +309,100 @@ fn release_pinned(
     }
 }
 
-fn nelder_mead(
-    obj: &Objective,
-    u0: &[f64],
-    tol: f64,
-    settings: &FitSettings,
-) -> Result<(Vec<f64>, u64, Convergence), FitError> {
-    obj.set_stage(SolverStage::NelderMead);
-    let p = u0.len();
-    let mut simplex = vec![u0.to_vec()];
-    for j in 0..p {
-        let mut v = u0.to_vec();
-        v[j] += settings.simplex_step;
-        simplex.push(v);
+impl Chain<'_> {
+    /// The particle swarm over the whole box, logged: its best point, or `u0` if it found
+    /// nothing better.
+    fn particle_swarm(&mut self, u0: &[f64]) -> Result<Vec<f64>, FitError> {
+        let (obj, settings) = (self.obj, self.settings);
+        obj.set_stage(SolverStage::ParticleSwarm);
+        let (lo, hi): (Vec<f64>, Vec<f64>) =
+            obj.transforms().iter().map(|t| t.search_box()).unzip();
+        let solver = ParticleSwarm::new((lo, hi), settings.particles)
+            .with_rng_generator(StdRng::seed_from_u64(settings.seed));
+        let res = Executor::new(LnCost(obj), solver)
+            .configure(|s| s.max_iters(settings.max_iters))
+            .timer(false)
+            .run()
+            .map_err(|e| FitError::Solver(e.to_string()))?;
+        let state = res.state();
+        let it = state.get_iter();
+        self.iterations += it;
+        self.log.push(format!("particle_swarm: {it} iterations"));
+        // Keep the start if the swarm found nothing better.
+        let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
+        Ok(match state.get_best_param() {
+            Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
+            _ => u0.to_vec(),
+        })
     }
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(tol)
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let res = Executor::new(LnCost(obj), solver)
-        .configure(|s| s.max_iters(settings.max_iters))
-        .timer(false)
-        .run()
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let state = res.state();
-    let u = state
-        .get_best_param()
-        .cloned()
-        .unwrap_or_else(|| u0.to_vec());
-    let conv = match state.get_termination_reason() {
-        Some(TerminationReason::SolverConverged) => Convergence::Converged {
-            reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
-        },
-        Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
-        other => Convergence::Failed {
-            reason: format!("Nelder–Mead stopped: {other:?}"),
-        },
-    };
-    Ok((u, state.get_iter(), conv))
-}
 
-fn particle_swarm(
-    obj: &Objective,
-    u0: &[f64],
-    settings: &FitSettings,
-) -> Result<(Vec<f64>, u64), FitError> {
-    obj.set_stage(SolverStage::ParticleSwarm);
-    let (lo, hi): (Vec<f64>, Vec<f64>) = obj.transforms().iter().map(|t| t.search_box()).unzip();
-    let solver = ParticleSwarm::new((lo, hi), settings.particles)
-        .with_rng_generator(StdRng::seed_from_u64(settings.seed));
-    let res = Executor::new(LnCost(obj), solver)
-        .configure(|s| s.max_iters(settings.max_iters))
-        .timer(false)
-        .run()
-        .map_err(|e| FitError::Solver(e.to_string()))?;
-    let state = res.state();
-    let iters = state.get_iter();
-    // Keep the start if the swarm found nothing better.
-    let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
-    let u = match state.get_best_param() {
-        Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
-        _ => u0.to_vec(),
-    };
-    Ok((u, iters))
-}
-
-#[allow(clippy::too_many_arguments)]
-fn finish(
-    obj: &Objective,
-    params: &[FitParam],
-    u: &[f64],
-    settings: &FitSettings,
-    mut convergence: Convergence,
-    iterations: u64,
-    mut log: Vec<String>,
-    trajectory: bool,
-    clock: Instant,
-) -> Result<FitResult, FitError> {
-    obj.set_stage(SolverStage::Errors);
-    let n = obj.len();
-    let x = obj.to_user(u);
-    let mut r0 = vec![0.0; n];
-    let Some(rss) = obj.residuals_user(&x, &mut r0) else {
-        return Err(FitError::Solver(format!(
-            "the best point cannot be re-evaluated: {}",
-            obj.last_failure().unwrap_or_default()
-        )));
-    };
-    let free: Vec<&FitParam> = params.iter().filter(|p| !p.fixed).collect();
-    let p = free.len();
-    let errors = if p > 0 {
-        let jac = jacobian(obj, &free, &x, &r0, settings);
-        Some(standard_errors(&jac, &r0, rss, &mut log))
-    } else {
-        None
-    };
-    let fitted = fitted_params(params, &x, errors.as_ref());
-    let nf = n as f64;
-    let mean = rss / nf;
-    let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
-    if obj.failures() > 0 {
-        log.push(format!(
-            "{} evaluations failed and were scored as penalties; last: {}",
-            obj.failures(),
-            obj.last_failure().unwrap_or_default()
-        ));
-    }
-    if !x.iter().all(|v| v.is_finite()) {
-        convergence = Convergence::Failed {
-            reason: "a parameter is not finite".into(),
+    /// The result at the chain's end `u`: residuals, standard errors and statistics, with
+    /// the chain's iterations and log.
+    fn finish(
+        self,
+        params: &[FitParam],
+        u: &[f64],
+        mut convergence: Convergence,
+        clock: Instant,
+    ) -> Result<FitResult, FitError> {
+        let (obj, mut log) = (self.obj, self.log);
+        obj.set_stage(SolverStage::Errors);
+        let n = obj.len();
+        let x = obj.to_user(u);
+        let mut r0 = vec![0.0; n];
+        let Some(rss) = obj.residuals_user(&x, &mut r0) else {
+            return Err(FitError::Solver(format!(
+                "the best point cannot be re-evaluated: {}",
+                obj.last_failure().unwrap_or_default()
+            )));
         };
+        let p = self.free.len();
+        let errors = if p > 0 {
+            let jac = jacobian(obj, self.free, &x, &r0, self.settings);
+            Some(standard_errors(&jac, &r0, rss, &mut log))
+        } else {
+            None
+        };
+        let fitted = fitted_params(params, &x, errors.as_ref());
+        let nf = n as f64;
+        let mean = rss / nf;
+        let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
+        if obj.failures() > 0 {
+            log.push(format!(
+                "{} evaluations failed and were scored as penalties; last: {}",
+                obj.failures(),
+                obj.last_failure().unwrap_or_default()
+            ));
+        }
+        if !x.iter().all(|v| v.is_finite()) {
+            convergence = Convergence::Failed {
+                reason: "a parameter is not finite".into(),
+            };
+        }
+        let (correlation, error_blocks) = match errors {
+            Some(e) => (e.robust.correlation, Some(e.blocks)),
+            None => (vec![], None),
+        };
+        Ok(FitResult {
+            params: fitted,
+            correlation,
+            error_blocks,
+            n_points: n,
+            n_free: p,
+            rss,
+            rms: mean.sqrt(),
+            s_mm2: self.trajectory.then_some(mean * 1e6),
+            aic: ln_term + 2.0 * p as f64,
+            bic: ln_term + p as f64 * nf.ln(),
+            evaluations: obj.evaluations(),
+            failures: obj.failures(),
+            last_failure: obj.last_failure(),
+            iterations: self.iterations,
+            wall_seconds: clock.elapsed().as_secs_f64(),
+            convergence,
+            log,
+        })
     }
-    let (correlation, error_blocks) = match errors {
-        Some(e) => (e.robust.correlation, Some(e.blocks)),
-        None => (vec![], None),
-    };
-    Ok(FitResult {
-        params: fitted,
-        correlation,
-        error_blocks,
-        n_points: n,
-        n_free: p,
-        rss,
-        rms: mean.sqrt(),
-        s_mm2: trajectory.then_some(mean * 1e6),
-        aic: ln_term + 2.0 * p as f64,
-        bic: ln_term + p as f64 * nf.ln(),
-        evaluations: obj.evaluations(),
-        failures: obj.failures(),
-        last_failure: obj.last_failure(),
-        iterations,
-        wall_seconds: clock.elapsed().as_secs_f64(),
-        convergence,
-        log,
-    })
 }
 
 /// Every parameter as fitted: a fixed one at its value with no error, a free one at its entry

@@ -1,5 +1,6 @@
 //! A parameter of a fit: start value, bounds, fixed or free, typical size.
 
+use derive_setters::Setters;
 use serde::Serialize;
 
 use super::error::FitError;
@@ -14,22 +15,26 @@ use crate::physics::param_spec::ParamSpec;
 /// let m = FitParam::new("m", 7.65).fixed(true);
 /// assert!(!k.fixed && m.fixed);
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Setters)]
 pub struct FitParam {
     /// Name: an oscillator parameter (`k`), a model parameter (`K`, `power_law.K`) or an
     /// offset (`x_off`, `f_off`).
+    #[setters(skip)]
     pub name: String,
     /// Start value (the value used if fixed).
     pub value: f64,
     /// Lower bound (`-inf`: none).
+    #[setters(skip)]
     pub min: f64,
     /// Upper bound (`inf`: none).
+    #[setters(skip)]
     pub max: f64,
     /// Held at `value`, not fitted.
     pub fixed: bool,
     /// Typical size of the parameter, for the initial simplex, the global search box and
     /// finite-difference steps; `None`: |value|, or a tenth of the bounds' width if the value
     /// is 0, or 1.
+    #[setters(strip_option)]
     pub scale: Option<f64>,
 }
 
@@ -58,6 +63,24 @@ pub fn full_values(params: &[FitParam], free: &[f64]) -> Result<Vec<f64>, String
         .collect()
 }
 
+/// `params` held at `values` (one per parameter, in order): each fixed at its value; an
+/// error naming both counts if they differ.
+pub(crate) fn held(params: &[FitParam], values: &[f64]) -> Result<Vec<FitParam>, FitError> {
+    if values.len() != params.len() {
+        return Err(FitError::BadData(format!(
+            "{} values given for {} parameters",
+            values.len(),
+            params.len()
+        )));
+    }
+    let hold = |(p, &value): (&FitParam, &f64)| FitParam {
+        value,
+        fixed: true,
+        ..p.clone()
+    };
+    Ok(params.iter().zip(values).map(hold).collect())
+}
+
 impl FitParam {
     /// A free, unbounded parameter starting at `value`.
     pub fn new(name: impl Into<String>, value: f64) -> Self {
@@ -80,24 +103,6 @@ impl FitParam {
     pub fn bounds(mut self, min: f64, max: f64) -> Self {
         self.min = min;
         self.max = max;
-        self
-    }
-
-    /// Start value.
-    pub fn value(mut self, value: f64) -> Self {
-        self.value = value;
-        self
-    }
-
-    /// Hold the parameter at its value.
-    pub fn fixed(mut self, fixed: bool) -> Self {
-        self.fixed = fixed;
-        self
-    }
-
-    /// Typical size (> 0).
-    pub fn scale(mut self, scale: f64) -> Self {
-        self.scale = Some(scale);
         self
     }
 

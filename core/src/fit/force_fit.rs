@@ -34,11 +34,12 @@
 
 use std::sync::Arc;
 
+use derive_setters::Setters;
 use nalgebra::DMatrix;
 
 use super::driver;
 use super::error::FitError;
-use super::fit_param::{full_values, FitParam};
+use super::fit_param::{full_values, held, FitParam};
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::solver::FitSettings;
@@ -46,12 +47,15 @@ use crate::data::force_data::ForceData;
 use crate::physics::force_model::{ForceModel, ModelState};
 
 /// A force-level calibration of one STF model (a [`crate::physics::model_sum::ModelSum`] is one model).
-#[derive(Clone)]
+#[derive(Clone, Setters)]
+#[setters(generate = false)]
 pub struct ForceFit {
     model: Arc<dyn ForceModel>,
     params: Vec<FitParam>,
     unknown: Vec<String>,
     offset: Option<FitParam>,
+    /// Settings of the optimiser.
+    #[setters(generate)]
     settings: FitSettings,
 }
 
@@ -82,19 +86,12 @@ impl ForceFit {
 
     /// Add a constant force offset `f_off` (N) to the model's force; fit it unless `fixed`.
     /// Its name is replaced by [`FORCE_OFFSET`].
-    pub fn offset(mut self, p: FitParam) -> Self {
-        let mut p = p;
+    pub fn offset(mut self, mut p: FitParam) -> Self {
         p.name = FORCE_OFFSET.to_string();
         if p.scale.is_none() && p.value == 0.0 {
             p.scale = Some(0.1);
         }
         self.offset = Some(p);
-        self
-    }
-
-    /// Settings of the optimiser.
-    pub fn settings(mut self, settings: FitSettings) -> Self {
-        self.settings = settings;
         self
     }
 
@@ -155,25 +152,12 @@ impl ForceFit {
         };
         driver::run(&problem, &all, settings, observer, false)
     }
-}
 
-impl ForceFit {
     /// The modelled force (with the offset, if any) at every sample for the full parameter
     /// vector `values` (the model's parameters, then the offset), along the kinematics.
     pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
         data.check_increasing()?;
-        let mut all = self.params();
-        if values.len() != all.len() {
-            return Err(FitError::BadData(format!(
-                "{} values given for {} parameters",
-                values.len(),
-                all.len()
-            )));
-        }
-        for (p, &v) in all.iter_mut().zip(values) {
-            p.value = v;
-            p.fixed = true;
-        }
+        let all = held(&self.params(), values)?;
         let problem = ForceResiduals {
             model: self.model.as_ref(),
             data: *data,

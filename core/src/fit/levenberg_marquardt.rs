@@ -132,18 +132,10 @@ pub fn refine(
             )
         };
         if let Some(convergence) = end {
-            return Refined {
-                u: lm.u,
-                iterations: iter,
-                convergence,
-            };
+            return lm.refined(iter, convergence);
         }
     }
-    Refined {
-        u: lm.u,
-        iterations: max_iters,
-        convergence: Convergence::MaxIterations,
-    }
+    lm.refined(max_iters, Convergence::MaxIterations)
 }
 
 /// A refinement under way: the point, its residuals and cost, the damping, the Jacobian and
@@ -166,6 +158,15 @@ struct Lm<'a> {
 }
 
 impl Lm<'_> {
+    /// Where the refinement ended after `iterations`, and how.
+    fn refined(self, iterations: u64, convergence: Convergence) -> Refined {
+        Refined {
+            u: self.u,
+            iterations,
+            convergence,
+        }
+    }
+
     /// The Jacobian at `u`: exact where the problem gives one, else differences whose steps
     /// grow above the residuals' noise; non-finite entries zeroed. Whether it is all exact.
     fn jacobian(&mut self) -> bool {

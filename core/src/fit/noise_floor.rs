@@ -98,25 +98,22 @@ impl ForceFit {
     ) -> Result<NoiseFloor, FitError> {
         let n = data.t.len();
         let mut sum = vec![0.0; n];
-        let shifted = |column: &[f64], by: f64| -> Vec<f64> {
-            column.iter().map(|v| v + by).collect::<Vec<f64>>()
-        };
-        for (q, sigma) in [(0, motion.x), (1, motion.v), (2, motion.a)] {
+        for (q, sigma) in [motion.x, motion.v, motion.a].into_iter().enumerate() {
             if !(sigma > 0.0 && sigma.is_finite()) {
                 continue;
             }
-            let mut sides = Vec::with_capacity(2);
-            for by in [sigma, -sigma] {
-                let column = shifted([data.x, data.v, data.a][q], by);
+            let side = |by: f64| {
+                let column: Vec<f64> = [data.x, data.v, data.a][q].iter().map(|v| v + by).collect();
                 let mut d = *data;
                 match q {
                     0 => d.x = &column,
                     1 => d.v = &column,
                     _ => d.a = &column,
                 }
-                sides.push(self.predict(&d, values)?);
-            }
-            for (s, (up, down)) in sum.iter_mut().zip(sides[0].iter().zip(&sides[1])) {
+                self.predict(&d, values)
+            };
+            let (up, down) = (side(sigma)?, side(-sigma)?);
+            for (s, (up, down)) in sum.iter_mut().zip(up.iter().zip(&down)) {
                 *s += (0.5 * (up - down)).powi(2);
             }
         }

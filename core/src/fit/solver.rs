@@ -1,5 +1,6 @@
 //! Which optimiser a fit uses and when it stops.
 
+use derive_setters::Setters;
 use serde::{Deserialize, Serialize};
 
 use super::error::FitError;
@@ -31,16 +32,6 @@ impl Solver {
         Solver::LevenbergMarquardt,
         Solver::ParticleSwarm,
     ];
-
-    /// The name used in experiment files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Solver::Auto => "auto",
-            Solver::NelderMead => "nelder_mead",
-            Solver::LevenbergMarquardt => "levenberg_marquardt",
-            Solver::ParticleSwarm => "particle_swarm",
-        }
-    }
 }
 
 /// Settings of a fit, with named setters.
@@ -50,7 +41,7 @@ impl Solver {
 /// let s = FitSettings::default().solver(Solver::NelderMead).max_iters(200).seed(7);
 /// assert_eq!(s.max_iters, 200);
 /// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Setters)]
 pub struct FitSettings {
     /// The optimiser.
     pub solver: Solver,
@@ -118,52 +109,6 @@ impl FitSettings {
     pub fn for_simulation(mut self, rtol: f64) -> Self {
         self.fd_step = self.fd_step.max(rtol.sqrt());
         self.tol = self.tol.max(10.0 * rtol);
-        self
-    }
-
-    /// The optimiser.
-    pub fn solver(mut self, solver: Solver) -> Self {
-        self.solver = solver;
-        self
-    }
-    /// Most iterations of each stage.
-    pub fn max_iters(mut self, n: u64) -> Self {
-        self.max_iters = n;
-        self
-    }
-    /// Relative cost tolerance of Levenberg–Marquardt.
-    pub fn tol(mut self, tol: f64) -> Self {
-        self.tol = tol;
-        self
-    }
-    /// Nelder–Mead's tolerance on the spread of ln(cost).
-    pub fn simplex_tol(mut self, tol: f64) -> Self {
-        self.simplex_tol = tol;
-        self
-    }
-    /// Tolerance of the Nelder–Mead stage in [`Solver::Auto`].
-    pub fn presearch_tol(mut self, tol: f64) -> Self {
-        self.presearch_tol = tol;
-        self
-    }
-    /// Initial simplex edge, in scales.
-    pub fn simplex_step(mut self, step: f64) -> Self {
-        self.simplex_step = step;
-        self
-    }
-    /// Finite-difference step, in scales.
-    pub fn fd_step(mut self, step: f64) -> Self {
-        self.fd_step = step;
-        self
-    }
-    /// Particles of the swarm.
-    pub fn particles(mut self, n: usize) -> Self {
-        self.particles = n;
-        self
-    }
-    /// Random seed.
-    pub fn seed(mut self, seed: u64) -> Self {
-        self.seed = seed;
         self
     }
 

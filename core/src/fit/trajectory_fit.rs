@@ -24,9 +24,11 @@
 
 use std::sync::Arc;
 
+use derive_setters::Setters;
+
 use super::driver;
 use super::error::FitError;
-use super::fit_param::FitParam;
+use super::fit_param::{full_values, held, FitParam};
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::same_term::check_same_terms;
@@ -85,14 +87,23 @@ pub fn initial_state_params(x0: f64, v0: f64, x_span: f64, v_span: f64) -> [FitP
 }
 
 /// A trajectory-level fit of the oscillator and, optionally, an STF model.
-#[derive(Clone)]
+#[derive(Clone, Setters)]
+#[setters(generate = false)]
 pub struct TrajectoryFit {
     pub(crate) system: OscillatorParams,
+    /// The same fit driven by another excitation: another record's drive, for
+    /// [`TrajectoryFit::validate`] (set that record's initial estimate with
+    /// [`TrajectoryFit::initial`]).
+    #[setters(generate)]
     pub(crate) excitation: Arc<Excitation>,
     pub(crate) model: Option<(Arc<dyn ForceModel>, Vec<f64>)>,
     pub(crate) free: Vec<FitParam>,
     pub(crate) initial: Option<(f64, f64)>,
+    /// Integrator settings of the simulations.
+    #[setters(generate, rename = "sim_settings")]
     pub(crate) sim: Settings,
+    /// Settings of the optimiser.
+    #[setters(generate)]
     settings: FitSettings,
 }
 
@@ -128,8 +139,7 @@ impl TrajectoryFit {
 
     /// A parameter to fit (or to hold, if `fixed`): an oscillator parameter, a model
     /// parameter, or `x_off` (the displacement offset, m, default scale 1 mm).
-    pub fn free(mut self, p: FitParam) -> Self {
-        let mut p = p;
+    pub fn free(mut self, mut p: FitParam) -> Self {
         if p.name == DISPLACEMENT_OFFSET && p.scale.is_none() && p.value == 0.0 {
             p.scale = Some(1e-3);
         }
@@ -140,18 +150,6 @@ impl TrajectoryFit {
     /// Initial displacement (m) and velocity (m/s) of every simulation.
     pub fn initial(mut self, x0: f64, v0: f64) -> Self {
         self.initial = Some((x0, v0));
-        self
-    }
-
-    /// Integrator settings of the simulations.
-    pub fn sim_settings(mut self, sim: Settings) -> Self {
-        self.sim = sim;
-        self
-    }
-
-    /// Settings of the optimiser.
-    pub fn settings(mut self, settings: FitSettings) -> Self {
-        self.settings = settings;
         self
     }
 
@@ -186,14 +184,6 @@ impl TrajectoryFit {
         }
     }
 
-    /// The same fit driven by another excitation: another record's drive, for
-    /// [`TrajectoryFit::validate`] (set that record's initial estimate with
-    /// [`TrajectoryFit::initial`]).
-    pub fn excitation(mut self, excitation: Arc<Excitation>) -> Self {
-        self.excitation = excitation;
-        self
-    }
-
     /// The parameters given to [`TrajectoryFit::free`], in order.
     pub fn free_params(&self) -> &[FitParam] {
         &self.free
@@ -204,11 +194,6 @@ impl TrajectoryFit {
         self.free
             .iter()
             .any(|p| !p.fixed && INITIAL_STATE.contains(&p.name.as_str()))
-    }
-
-    /// The initial state given to [`TrajectoryFit::initial`], if any.
-    pub(super) fn initial_estimate(&self) -> Option<(f64, f64)> {
-        self.initial
     }
 
     /// The same fit with the parameter list `free` instead.
@@ -233,24 +218,7 @@ impl TrajectoryFit {
         values: &[f64],
     ) -> Result<(Vec<f64>, [f64; 2]), FitError> {
         self.check(data)?;
-        if values.len() != self.free.len() {
-            return Err(FitError::BadData(format!(
-                "{} values given for {} parameters",
-                values.len(),
-                self.free.len()
-            )));
-        }
-        let held = self.with_free(
-            self.free
-                .iter()
-                .zip(values)
-                .map(|(p, &v)| FitParam {
-                    value: v,
-                    fixed: true,
-                    ..p.clone()
-                })
-                .collect(),
-        );
+        let held = self.with_free(held(&self.free, values)?);
         let problem = held.problem(data)?;
         let (sol, offset, initial) = problem.solve(&[]).map_err(FitError::BadData)?;
         let x = sol.states.iter().step_by(sol.dim).map(|x| x + offset);
@@ -320,9 +288,7 @@ impl TrajectoryFit {
         let settings = self.settings.clone().for_simulation(self.sim.rtol);
         driver::run(&problem, &self.free, &settings, observer, true)
     }
-}
 
-impl TrajectoryFit {
     /// [`check_same_terms`] on the parameters this fit frees.
     fn check_same_terms(&self, slots: &[Slot]) -> Result<(), FitError> {
         let free = |i: usize| {
@@ -365,13 +331,7 @@ impl TrajectoryResiduals<'_> {
         let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
         let mut offset = 0.0;
         let mut initial: [Option<f64>; 2] = [None, None];
-        let mut free = x.iter();
-        for (p, slot) in fit.free.iter().zip(&self.slots) {
-            let value = if p.fixed {
-                p.value
-            } else {
-                *free.next().ok_or("too few free values")?
-            };
+        for (value, slot) in full_values(&fit.free, x)?.into_iter().zip(&self.slots) {
             match *slot {
                 Slot::Oscillator(param) => system[param] = value,
                 Slot::Model(i) => {

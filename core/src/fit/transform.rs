@@ -59,36 +59,15 @@ impl BoundTransform {
         } else {
             1.0
         };
-        let (lo, hi) = (min.is_finite(), max.is_finite());
-        match (lo, hi) {
-            (false, false) => BoundTransform {
-                min,
-                max,
-                x0,
-                scale,
-                shape: Shape::Free,
-            },
+        let (x0, scale, shape) = match (min.is_finite(), max.is_finite()) {
+            (false, false) => (x0, scale, Shape::Free),
             (true, false) => {
                 let x0 = x0.max(min + 1e-3 * scale);
-                let scale = scale.min(x0 - min);
-                BoundTransform {
-                    min,
-                    max,
-                    x0,
-                    scale,
-                    shape: Shape::Lower { d: x0 - min },
-                }
+                (x0, scale.min(x0 - min), Shape::Lower { d: x0 - min })
             }
             (false, true) => {
                 let x0 = x0.min(max - 1e-3 * scale);
-                let scale = scale.min(max - x0);
-                BoundTransform {
-                    min,
-                    max,
-                    x0,
-                    scale,
-                    shape: Shape::Upper { d: max - x0 },
-                }
+                (x0, scale.min(max - x0), Shape::Upper { d: max - x0 })
             }
             (true, true) => {
                 let width = max - min;
@@ -108,14 +87,15 @@ impl BoundTransform {
                 let s0 = (x0 - min) / width;
                 let w0 = (s0 / (1.0 - s0)).ln();
                 let c = scale / (width * s0 * (1.0 - s0));
-                BoundTransform {
-                    min,
-                    max,
-                    x0,
-                    scale,
-                    shape: Shape::Both { w0, c },
-                }
+                (x0, scale, Shape::Both { w0, c })
             }
+        };
+        BoundTransform {
+            min,
+            max,
+            x0,
+            scale,
+            shape,
         }
     }
 

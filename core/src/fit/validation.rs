@@ -38,6 +38,7 @@
 use serde::Serialize;
 
 use super::error::FitError;
+use super::fit_param::{held, FitParam};
 use super::force_fit::ForceFit;
 use super::trajectory_fit::{initial_state_params, TrajectoryData, TrajectoryFit, INITIAL_STATE};
 use crate::data::force_data::ForceData;
@@ -117,28 +118,18 @@ impl TrajectoryFit {
     /// doc of [`Validation`]. With `x0`, `v0` free, they are refitted from the estimate given to
     /// [`TrajectoryFit::initial`] (within a tenth of the record's range of x and v).
     pub fn validate(&self, data: &TrajectoryData, values: &[f64]) -> Result<Validation, FitError> {
-        let names: Vec<&str> = self.free_params().iter().map(|p| p.name.as_str()).collect();
-        if values.len() != names.len() {
-            return Err(FitError::BadData(format!(
-                "{} values given for {} parameters",
-                values.len(),
-                names.len()
-            )));
-        }
+        let given = held(self.free_params(), values)?;
         let refit = self.initial_is_free();
         let (x0, v0) = self
-            .initial_estimate()
+            .initial
             .unwrap_or((data.x.first().copied().unwrap_or(0.0), 0.0));
         let start = initial_state_params(x0, v0, x_span(data.x), v_span(data));
-        let held: Vec<_> = names
+        let held: Vec<_> = given
             .iter()
-            .zip(values)
-            .map(
-                |(&name, &value)| match INITIAL_STATE.iter().position(|n| *n == name) {
-                    Some(i) if refit => start[i].clone(),
-                    _ => super::FitParam::new(name, value).fixed(true),
-                },
-            )
+            .map(|p| match INITIAL_STATE.iter().position(|n| *n == p.name) {
+                Some(i) if refit => start[i].clone(),
+                _ => FitParam::new(&p.name, p.value).fixed(true),
+            })
             .collect();
         let held_fit = self.with_free(held.clone());
         let values: Vec<f64> = if refit {

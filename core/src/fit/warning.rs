@@ -14,9 +14,8 @@
 //! what to try; serialized, it is an object with a `kind` and the data
 //! ([`FitWarning::stated`] adds the `message`).
 
-use std::fmt;
-
 use serde::Serialize;
+use thiserror::Error;
 
 use super::fit_param::FitParam;
 use super::noise_floor::{NoiseFloor, Quantity};
@@ -50,15 +49,22 @@ pub enum BoundSide {
 }
 
 /// A reason not to trust a fit's result as it stands.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Error)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum FitWarning {
     /// The fit did not converge: the values may not be the optimum.
+    #[error("{}", not_converged(.convergence))]
     NotConverged {
         /// How the fit ended.
         convergence: Convergence,
     },
     /// The RMS residual is well above the noise floor: the model misses an effect.
+    #[error(
+        "the residual is {ratio:.1}× the noise floor (RMS {} against {}): the model \
+         misses an effect — try `stf-lab discover`",
+        .quantity.show(*.rms),
+        .quantity.show(*.floor)
+    )]
     AboveNoiseFloor {
         /// What the residuals measure.
         quantity: Quantity,
@@ -70,6 +76,11 @@ pub enum FitWarning {
         ratio: f64,
     },
     /// A free parameter ended on one of its bounds: the data push it there or beyond.
+    #[error(
+        "{param} ended on its {} bound ({value:.5} at {bound}): the data push it \
+         there or beyond — widen the bound of {param} or fix it",
+        .side.name()
+    )]
     OnBound {
         /// Parameter.
         param: String,
@@ -81,6 +92,7 @@ pub enum FitWarning {
         side: BoundSide,
     },
     /// A free parameter's standard error exceeds its |value| (or is not finite).
+    #[error("{}", undetermined(.param, *.value, *.std_error))]
     Undetermined {
         /// Parameter.
         param: String,
@@ -90,6 +102,10 @@ pub enum FitWarning {
         std_error: f64,
     },
     /// Two free parameters correlate so strongly that the data do not tell them apart.
+    #[error(
+        "{first} and {second} correlate at {correlation:.3}: the data do not tell them \
+         apart — fix one or fit a record with a wider velocity range"
+    )]
     Correlated {
         /// One parameter.
         first: String,
@@ -131,83 +147,45 @@ impl FitWarning {
     }
 }
 
-impl fmt::Display for FitWarning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl BoundSide {
+    /// `lower` or `upper`.
+    fn name(self) -> &'static str {
         match self {
-            FitWarning::NotConverged { convergence } => match convergence {
-                Convergence::Failed { reason } => write!(
-                    f,
-                    "the fit failed ({reason}): the values are not an optimum — check the start \
-                     values and bounds, or try another `fit.solver`"
-                ),
-                Convergence::Stalled { reason } => write!(
-                    f,
-                    "the fit stalled ({reason}): the values are not an optimum — start nearer \
-                     the optimum or try another `fit.solver`"
-                ),
-                _ => write!(
-                    f,
-                    "the fit ran out of iterations: the values may not be the optimum — raise \
-                     `fit.max_iters` or start nearer the optimum"
-                ),
-            },
-            FitWarning::AboveNoiseFloor {
-                quantity,
-                rms,
-                floor,
-                ratio,
-            } => write!(
-                f,
-                "the residual is {ratio:.1}× the noise floor (RMS {} against {}): the model \
-                 misses an effect — try `stf-lab discover`",
-                quantity.show(*rms),
-                quantity.show(*floor)
-            ),
-            FitWarning::OnBound {
-                param,
-                value,
-                bound,
-                side,
-            } => {
-                let side = match side {
-                    BoundSide::Lower => "lower",
-                    BoundSide::Upper => "upper",
-                };
-                write!(
-                    f,
-                    "{param} ended on its {side} bound ({value:.5} at {bound}): the data push it \
-                     there or beyond — widen the bound of {param} or fix it"
-                )
-            }
-            FitWarning::Undetermined {
-                param,
-                value,
-                std_error,
-            } => {
-                if std_error.is_finite() {
-                    write!(
-                        f,
-                        "{param} = {value:.4e} has a standard error of {std_error:.2e}, larger \
-                         than itself: the data do not determine {param} — fix it or drop its term"
-                    )
-                } else {
-                    write!(
-                        f,
-                        "{param} has no finite standard error: the data do not determine \
-                         {param} — fix it or drop its term"
-                    )
-                }
-            }
-            FitWarning::Correlated {
-                first,
-                second,
-                correlation,
-            } => write!(
-                f,
-                "{first} and {second} correlate at {correlation:.3}: the data do not tell them \
-                 apart — fix one or fit a record with a wider velocity range"
-            ),
+            BoundSide::Lower => "lower",
+            BoundSide::Upper => "upper",
         }
+    }
+}
+
+/// The sentence of [`FitWarning::NotConverged`]: what the end of the fit says, and what to try.
+fn not_converged(convergence: &Convergence) -> String {
+    match convergence {
+        Convergence::Failed { reason } => format!(
+            "the fit failed ({reason}): the values are not an optimum — check the start \
+             values and bounds, or try another `fit.solver`"
+        ),
+        Convergence::Stalled { reason } => format!(
+            "the fit stalled ({reason}): the values are not an optimum — start nearer \
+             the optimum or try another `fit.solver`"
+        ),
+        _ => "the fit ran out of iterations: the values may not be the optimum — raise \
+              `fit.max_iters` or start nearer the optimum"
+            .into(),
+    }
+}
+
+/// The sentence of [`FitWarning::Undetermined`], with the error if it is finite.
+fn undetermined(param: &str, value: f64, std_error: f64) -> String {
+    if std_error.is_finite() {
+        format!(
+            "{param} = {value:.4e} has a standard error of {std_error:.2e}, larger \
+             than itself: the data do not determine {param} — fix it or drop its term"
+        )
+    } else {
+        format!(
+            "{param} has no finite standard error: the data do not determine \
+             {param} — fix it or drop its term"
+        )
     }
 }
 

@@ -156,29 +156,26 @@ impl PolyFilter {
         if window <= order {
             return Err(FilterError::WindowTooSmall { window, order });
         }
-        Ok(PolyFilter {
-            order,
-            window,
-            boundary: Boundary::Shifted,
-        })
+        Ok(Self::checked(order, window))
     }
 
     /// The paper's filter for ω from φ: order 2 over 800 samples. Edges are
     /// [`Boundary::Shifted`]; add `.boundary(Boundary::Zero)` for the paper's zeroed edges.
     pub const fn paper_omega() -> Self {
-        PolyFilter {
-            order: PAPER_OMEGA_ORDER,
-            window: PAPER_OMEGA_WINDOW,
-            boundary: Boundary::Shifted,
-        }
+        Self::checked(PAPER_OMEGA_ORDER, PAPER_OMEGA_WINDOW)
     }
 
     /// The paper's filter for v and a from x: order 3 over 40 samples. Edges are
     /// [`Boundary::Shifted`]; add `.boundary(Boundary::Zero)` for the paper's zeroed edges.
     pub const fn paper_motion() -> Self {
+        Self::checked(PAPER_MOTION_ORDER, PAPER_MOTION_WINDOW)
+    }
+
+    /// A filter of an order and window already known to be valid, with shifted edges.
+    const fn checked(order: usize, window: usize) -> Self {
         PolyFilter {
-            order: PAPER_MOTION_ORDER,
-            window: PAPER_MOTION_WINDOW,
+            order,
+            window,
             boundary: Boundary::Shifted,
         }
     }
@@ -246,18 +243,13 @@ impl PolyFilter {
         if self.boundary == Boundary::Shifted {
             // One fit over the first and one over the last complete window; the polynomial
             // is evaluated at each edge sample.
-            let left = fit.coefficients(&y[..w]);
-            for i in 0..lead {
-                out.value[i] = fit.evaluate(&left, i, 0);
-                out.d1[i] = fit.evaluate(&left, i, 1) * s1;
-                out.d2[i] = fit.evaluate(&left, i, 2) * s2;
-            }
-            let right = fit.coefficients(&y[n - w..]);
-            for i in (n - w + lead + 1)..n {
-                let p = i - (n - w);
-                out.value[i] = fit.evaluate(&right, p, 0);
-                out.d1[i] = fit.evaluate(&right, p, 1) * s1;
-                out.d2[i] = fit.evaluate(&right, p, 2) * s2;
+            for (start, edge) in [(0, 0..lead), (n - w, (n - w + lead + 1)..n)] {
+                let c = fit.coefficients(&y[start..start + w]);
+                for i in edge {
+                    out.value[i] = fit.evaluate(&c, i - start, 0);
+                    out.d1[i] = fit.evaluate(&c, i - start, 1) * s1;
+                    out.d2[i] = fit.evaluate(&c, i - start, 2) * s2;
+                }
             }
         }
         Ok(out)

@@ -87,17 +87,12 @@ impl Linear {
     /// equivalent delay of 5e-4 of a step).
     pub fn held(t: Vec<f64>, y: Vec<f64>) -> Self {
         debug_assert_eq!(t.len(), y.len());
-        let n = t.len();
-        let mut times = Vec::with_capacity(2 * n);
-        let mut values = Vec::with_capacity(2 * n);
-        for i in 0..n {
-            if i > 0 {
-                times.push(t[i] - 1e-3 * (t[i] - t[i - 1]));
-                values.push(y[i - 1]);
-            }
-            times.push(t[i]);
-            values.push(y[i]);
-        }
+        let (times, values) = (0..t.len())
+            .flat_map(|i| {
+                let ramp = (i > 0).then(|| (t[i] - 1e-3 * (t[i] - t[i - 1]), y[i - 1]));
+                ramp.into_iter().chain([(t[i], y[i])])
+            })
+            .unzip();
         Linear::new(times, values)
     }
 

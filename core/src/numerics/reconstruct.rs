@@ -78,17 +78,6 @@ pub enum DriveMethod {
     Held,
 }
 
-impl std::fmt::Display for DriveMethod {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            DriveMethod::Auto => "auto",
-            DriveMethod::Set => "set",
-            DriveMethod::Samples => "samples",
-            DriveMethod::Held => "held",
-        })
-    }
-}
-
 /// What the reconstruction did, for reports.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DriveReport {
@@ -133,7 +122,7 @@ impl std::fmt::Display for DriveReport {
             DriveSignal::Phi => "rotor angle φ",
             DriveSignal::U => "drive force u",
         };
-        match (self.method, self.signal) {
+        let how = match (self.method, self.signal) {
             (DriveMethod::Held, _) => {
                 return write!(
                     f,
@@ -150,12 +139,13 @@ impl std::fmt::Display for DriveReport {
                     self.order, self.window
                 )
             }
-            _ => {}
-        }
+            (DriveMethod::Auto, _) => "auto",
+            (DriveMethod::Set, _) => "set",
+        };
         write!(
             f,
-            "{what} smoothed ({}): order {} over {} samples ({:.3} s)",
-            self.method, self.order, self.window, self.window_s
+            "{what} smoothed ({how}): order {} over {} samples ({:.3} s)",
+            self.order, self.window, self.window_s
         )?;
         match (self.counts_per_rev, self.residual_over_step) {
             (Some(counts), Some(ratio)) => write!(

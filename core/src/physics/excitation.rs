@@ -153,10 +153,7 @@ impl Excitation {
     pub fn force(&self, t: f64, p: &OscillatorParams) -> f64 {
         match self {
             Excitation::None => 0.0,
-            Excitation::Rotor(angle) => {
-                let (phi, omega) = angle.at(t);
-                p.f0 * omega * omega * (phi - p.phi_off).sin()
-            }
+            Excitation::Rotor(_) => self.force_and_angle(t, p).0,
             Excitation::Force(u) => u.at(t) - p.u_off,
         }
     }
@@ -190,18 +187,10 @@ impl Excitation {
         }
     }
 
-    /// Rotor speed ω at `t`, rad/s, if a rotor drives the oscillator.
-    pub fn omega(&self, t: f64) -> Option<f64> {
+    /// Rotor angle φ (rad) and speed ω (rad/s) at `t`, if a rotor drives the oscillator.
+    pub fn angle(&self, t: f64) -> Option<(f64, f64)> {
         match self {
-            Excitation::Rotor(angle) => Some(angle.at(t).1),
-            _ => None,
-        }
-    }
-
-    /// Rotor angle φ at `t`, rad, if a rotor drives the oscillator.
-    pub fn phi(&self, t: f64) -> Option<f64> {
-        match self {
-            Excitation::Rotor(angle) => Some(angle.at(t).0),
+            Excitation::Rotor(angle) => Some(angle.at(t)),
             _ => None,
         }
     }
@@ -228,10 +217,7 @@ mod tests {
         for t in [50.0, 77.7, 199.9] {
             let (drive, angle) = rotor.force_and_angle(t, &OscillatorParams::FORCED);
             assert_eq!(drive, rotor.force(t, &OscillatorParams::FORCED));
-            assert_eq!(
-                angle,
-                Some((rotor.phi(t).unwrap(), rotor.omega(t).unwrap()))
-            );
+            assert_eq!(angle, Some(rotor.angle(t).unwrap()));
         }
         let free = Excitation::None;
         assert_eq!(

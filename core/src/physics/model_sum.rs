@@ -21,7 +21,6 @@ pub struct ModelSum {
     param_offsets: Vec<usize>,
     /// Start of each part's internal states, then their end.
     state_offsets: Vec<usize>,
-    n_internal: usize,
 }
 
 impl ModelSum {
@@ -76,7 +75,6 @@ impl ModelSum {
             specs,
             param_offsets,
             state_offsets,
-            n_internal,
         })
     }
 
@@ -136,7 +134,7 @@ impl ForceModel for ModelSum {
     }
 
     fn n_internal(&self) -> usize {
-        self.n_internal
+        self.state_offsets[self.parts.len()]
     }
 
     fn initial_internal(&self, p: &[f64], z0: &mut [f64]) {

@@ -43,12 +43,7 @@ pub struct Oscillator {
 impl Oscillator {
     /// An oscillator without STF.
     pub fn new(params: OscillatorParams, excitation: Excitation) -> Self {
-        Oscillator {
-            params,
-            excitation: Arc::new(excitation),
-            model: None,
-            model_params: Vec::new(),
-        }
+        Oscillator::with_shared_excitation(params, Arc::new(excitation))
     }
 
     /// The same oscillator with a shared excitation (cheap to clone for fits).

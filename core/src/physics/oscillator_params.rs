@@ -65,16 +65,12 @@ impl OscillatorParams {
 
     /// The source study's identification from free vibration (no rotor, no static excess).
     pub const FREE: OscillatorParams = OscillatorParams {
-        m: 7.650,
         k: 267.9245,
         c: 4.3736,
         t_friction: 0.4190,
         delta_t: 0.0,
         f0: 0.0,
-        eta: 1e3,
-        f_off: 0.0,
-        phi_off: 0.0,
-        u_off: 0.0,
+        ..Self::FORCED
     };
 
     /// Names of the parameters, in the order of [`OscillatorParams::to_vec`].

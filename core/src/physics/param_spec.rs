@@ -4,10 +4,12 @@
 //! plain `&[f64]` in the order of the specs, resolved once when a model is configured, so the
 //! right-hand side of the ODE never looks a name up.
 
+use derive_setters::Setters;
 use serde::Serialize;
 
 /// One named parameter of a force model.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Setters)]
+#[setters(generate = false)]
 pub struct ParamSpec {
     /// Name used in experiment files and results (`K`, `n`, `power_law.K` in a sum).
     pub name: String,
@@ -23,6 +25,7 @@ pub struct ParamSpec {
     pub doc: String,
     /// The oscillator parameter this one duplicates, if any (a fluid's linear damping `c_s` is
     /// the same term as the oscillator's `c`): a fit may free one of the two, never both.
+    #[setters(generate, strip_option)]
     pub same_as: Option<&'static str>,
 }
 
@@ -38,12 +41,6 @@ impl ParamSpec {
             doc: doc.to_string(),
             same_as: None,
         }
-    }
-
-    /// The same parameter, marked as the same term as the oscillator's parameter `name`.
-    pub fn same_as(mut self, name: &'static str) -> Self {
-        self.same_as = Some(name);
-        self
     }
 
     /// Whether `value` lies within the bounds.

@@ -41,11 +41,8 @@ impl<'r> Rows<'r> {
             .zip(self.drive);
         for (i, ((y, &t), &d)) in rows.enumerate() {
             let f = osc.forces_with_drive(t, y, d, &mut dz)?;
-            out.x[i] = y[0];
-            out.v[i] = y[1];
-            out.a[i] = f.a;
-            out.f_stf[i] = f.f_stf;
-            for (column, &value) in out.z.iter_mut().zip(&y[2..]) {
+            let values = [y[0], y[1], f.a, f.f_stf].into_iter();
+            for (column, value) in out.0.iter_mut().zip(values.chain(y[2..].iter().copied())) {
                 column[i] = value;
             }
         }
@@ -53,39 +50,15 @@ impl<'r> Rows<'r> {
     }
 }
 
-/// The output columns of a window of samples.
-pub(super) struct Columns<'c> {
-    pub(super) x: &'c mut [f64],
-    pub(super) v: &'c mut [f64],
-    pub(super) a: &'c mut [f64],
-    pub(super) f_stf: &'c mut [f64],
-    pub(super) z: Vec<&'c mut [f64]>,
-}
+/// The output columns of a window of samples: x, v, a, F_STF, then the model's internal
+/// states.
+pub(super) struct Columns<'c>(pub(super) Vec<&'c mut [f64]>);
 
 impl<'c> Columns<'c> {
     /// Samples `..mid` and `mid..`.
     pub(super) fn split_at(self, mid: usize) -> (Columns<'c>, Columns<'c>) {
-        let (x0, x1) = self.x.split_at_mut(mid);
-        let (v0, v1) = self.v.split_at_mut(mid);
-        let (a0, a1) = self.a.split_at_mut(mid);
-        let (f0, f1) = self.f_stf.split_at_mut(mid);
-        let (z0, z1) = self.z.into_iter().map(|z| z.split_at_mut(mid)).unzip();
-        (
-            Columns {
-                x: x0,
-                v: v0,
-                a: a0,
-                f_stf: f0,
-                z: z0,
-            },
-            Columns {
-                x: x1,
-                v: v1,
-                a: a1,
-                f_stf: f1,
-                z: z1,
-            },
-        )
+        let (first, second) = self.0.into_iter().map(|c| c.split_at_mut(mid)).unzip();
+        (Columns(first), Columns(second))
     }
 }
 
@@ -105,7 +78,7 @@ impl DriveColumns {
     pub(super) fn at(excitation: &Excitation, p: &OscillatorParams, times: &[f64]) -> Self {
         let rotor = times
             .first()
-            .is_some_and(|&t| excitation.omega(t).is_some());
+            .is_some_and(|&t| excitation.angle(t).is_some());
         if !rotor {
             return DriveColumns {
                 force: times.iter().map(|&t| excitation.force(t, p)).collect(),
@@ -113,19 +86,14 @@ impl DriveColumns {
                 omega: None,
             };
         }
-        let n = times.len();
-        let (mut force, mut phi, mut omega) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        );
-        for &t in times {
-            let (d, angle) = excitation.force_and_angle(t, p);
-            let (p, w) = angle.unwrap_or((0.0, 0.0));
-            force.push(d);
-            phi.push(p);
-            omega.push(w);
-        }
+        let ((force, phi), omega) = times
+            .iter()
+            .map(|&t| {
+                let (d, angle) = excitation.force_and_angle(t, p);
+                let (phi, w) = angle.unwrap_or((0.0, 0.0));
+                ((d, phi), w)
+            })
+            .unzip();
         DriveColumns {
             force,
             phi: Some(phi),

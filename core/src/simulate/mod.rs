@@ -1,8 +1,9 @@
 //! Simulation of the oscillator: samples of x, v, a and F_STF at a rate or at given times.
 //!
 //! A run integrates the oscillator once and then evaluates the forces at every sample; from
-//! 20 000 samples on it uses a second thread for the drive (during the integration) and for half
-//! of the samples' forces (after it), which leaves the integration as the run's critical path.
+//! 20 000 samples on it uses a second thread (`rayon::join`) for the drive (during the
+//! integration) and for half of the samples' forces (after it), which leaves the integration
+//! as the run's critical path.
 //!
 //! ```
 //! use stf_core::physics::{excitation::{Excitation, RotorAngle}, oscillator::Oscillator,
@@ -12,6 +13,8 @@
 //! let run = Simulation::new(&osc).rate(50.0).run(0.0, 1.0).unwrap();
 //! assert_eq!(run.x.len(), 51);
 //! ```
+
+use derive_setters::Setters;
 
 use crate::numerics::integrate::{integrate_states, Method, Settings, SimError, Stats};
 use crate::physics::oscillator::Oscillator;
@@ -53,12 +56,20 @@ pub struct Trajectory {
 }
 
 /// A simulation request: an oscillator, integrator settings and an initial state.
+#[derive(Setters)]
 pub struct Simulation<'a> {
+    #[setters(skip)]
     osc: &'a Oscillator,
+    /// Integrator settings.
     settings: Settings,
+    /// Output rate, samples per second (for [`Simulation::run`]).
     rate: f64,
+    /// Refuse a [`Simulation::run`] of more than this many samples (default
+    /// [`DEFAULT_MAX_SAMPLES`]).
     max_samples: u64,
+    #[setters(skip)]
     x0: f64,
+    #[setters(skip)]
     v0: f64,
 }
 
@@ -74,25 +85,9 @@ impl<'a> Simulation<'a> {
             v0: 0.0,
         }
     }
-    /// Integrator settings.
-    pub fn settings(mut self, settings: Settings) -> Self {
-        self.settings = settings;
-        self
-    }
     /// Integrator.
     pub fn method(mut self, method: Method) -> Self {
         self.settings.method = method;
-        self
-    }
-    /// Output rate, samples per second (for [`Simulation::run`]).
-    pub fn rate(mut self, rate: f64) -> Self {
-        self.rate = rate;
-        self
-    }
-    /// Refuse a [`Simulation::run`] of more than `samples` samples (default
-    /// [`DEFAULT_MAX_SAMPLES`]).
-    pub fn max_samples(mut self, samples: u64) -> Self {
-        self.max_samples = samples;
         self
     }
     /// Initial displacement (m) and velocity (m/s).
@@ -143,14 +138,10 @@ impl<'a> Simulation<'a> {
         // on a second thread while the integration runs (one `sin` a sample is as much work as
         // the integration of a smooth sweep).
         let (integrated, drive) = if times.len() >= PARALLEL_SAMPLES {
-            std::thread::scope(|scope| {
-                let job = scope.spawn(|| DriveColumns::at(excitation, params, &times));
-                let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
-                let drive = job
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                (integrated, drive)
-            })
+            rayon::join(
+                || integrate_states(self.osc, t0, &y0, &times, &self.settings),
+                || DriveColumns::at(excitation, params, &times),
+            )
         } else {
             let integrated = integrate_states(self.osc, t0, &y0, &times, &self.settings);
             (integrated, DriveColumns::at(excitation, params, &times))
@@ -161,13 +152,13 @@ impl<'a> Simulation<'a> {
         let (mut x, mut v, mut a, mut f_stf) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let mut z = vec![vec![0.0; n]; dim - 2];
-        let columns = Columns {
-            x: &mut x,
-            v: &mut v,
-            a: &mut a,
-            f_stf: &mut f_stf,
-            z: z.iter_mut().map(Vec::as_mut_slice).collect(),
-        };
+        let columns = Columns(
+            [&mut x, &mut v, &mut a, &mut f_stf]
+                .into_iter()
+                .chain(&mut z)
+                .map(Vec::as_mut_slice)
+                .collect(),
+        );
         let rows = Rows {
             states: &states,
             dim,
@@ -179,14 +170,11 @@ impl<'a> Simulation<'a> {
             let mid = n / 2;
             let (first, second) = (rows.window(0, mid), rows.window(mid, n));
             let (into_first, into_second) = columns.split_at(mid);
-            std::thread::scope(|scope| {
-                let job = scope.spawn(|| first.fill(self.osc, into_first));
-                let second = second.fill(self.osc, into_second);
-                let first = job
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                first.and(second)
-            })?;
+            let (first, second) = rayon::join(
+                || first.fill(self.osc, into_first),
+                || second.fill(self.osc, into_second),
+            );
+            first.and(second)?;
         } else {
             rows.fill(self.osc, columns)?;
         }
@@ -279,8 +267,8 @@ mod tests {
                 (run.a[i], run.f_stf[i], run.drive[i]),
                 (f.a, f.f_stf, f.drive)
             );
-            assert_eq!(phi[i], osc.excitation.phi(run.t[i]).unwrap());
-            assert_eq!(omega[i], osc.excitation.omega(run.t[i]).unwrap());
+            assert_eq!(phi[i], osc.excitation.angle(run.t[i]).unwrap().0);
+            assert_eq!(omega[i], osc.excitation.angle(run.t[i]).unwrap().1);
         }
         // A long run takes the drive from a second thread: the same columns.
         let long = Simulation::new(&osc).rate(1000.0).run(0.0, 25.0).unwrap();
@@ -290,8 +278,8 @@ mod tests {
             let t = long.t[i];
             let f = osc.forces(t, &[long.x[i], long.v[i]], &mut []).unwrap();
             assert_eq!((long.a[i], long.drive[i]), (f.a, f.drive));
-            assert_eq!(phi[i], osc.excitation.phi(t).unwrap());
-            assert_eq!(omega[i], osc.excitation.omega(t).unwrap());
+            assert_eq!(phi[i], osc.excitation.angle(t).unwrap().0);
+            assert_eq!(omega[i], osc.excitation.angle(t).unwrap().1);
         }
         let free = Oscillator::new(OscillatorParams::FREE, Excitation::None);
         let run = Simulation::new(&free)

@@ -11,7 +11,7 @@ use ode_solvers::continuous_output_model::ContinuousOutputModel;
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dopri5, OutputType, System};
 
-use super::{OdeSystem, Settings, SimError, Solution, Stats};
+use super::{OdeSystem, Settings, SimError, Stats};
 
 struct Adapter<'a> {
     sys: &'a dyn OdeSystem,
@@ -57,13 +57,15 @@ fn uniform_step(t0: f64, outputs: &[f64]) -> Option<f64> {
     even.then_some(dx)
 }
 
+/// Integrate with Dormand–Prince 5(4) from `ode_solvers`: the sampled states, row after row,
+/// and the work.
 pub(super) fn integrate(
     sys: &dyn OdeSystem,
     t0: f64,
     y0: &[f64],
     t_out: &[f64],
     s: &Settings,
-) -> Result<Solution, SimError> {
+) -> Result<(Vec<f64>, Stats), SimError> {
     let dim = y0.len();
     let t_end = *t_out.last().unwrap_or(&t0);
     let mut states = Vec::with_capacity(t_out.len() * dim);
@@ -135,12 +137,7 @@ pub(super) fn integrate(
             }
         }
     }
-    Ok(Solution {
-        t: t_out.to_vec(),
-        states,
-        dim,
-        stats,
-    })
+    Ok((states, stats))
 }
 
 /// The solver's failure as the simulation's error.

@@ -32,6 +32,7 @@ mod switching;
 pub use error::SimError;
 pub(crate) use rhs_jacobian::fd_jacobian;
 
+use derive_setters::Setters;
 use serde::{Deserialize, Serialize};
 
 /// A first-order ODE system `dy/dt = f(t, y)`.
@@ -96,7 +97,7 @@ impl Method {
 }
 
 /// Tolerances and limits of an integration.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Setters)]
 pub struct Settings {
     /// The integrator.
     pub method: Method,
@@ -123,32 +124,6 @@ impl Default for Settings {
 }
 
 impl Settings {
-    /// Use `method`.
-    pub fn method(mut self, method: Method) -> Self {
-        self.method = method;
-        self
-    }
-    /// Relative tolerance.
-    pub fn rtol(mut self, rtol: f64) -> Self {
-        self.rtol = rtol;
-        self
-    }
-    /// Absolute tolerance.
-    pub fn atol(mut self, atol: f64) -> Self {
-        self.atol = atol;
-        self
-    }
-    /// Largest step, s.
-    pub fn h_max(mut self, h_max: f64) -> Self {
-        self.h_max = h_max;
-        self
-    }
-    /// Most steps.
-    pub fn max_steps(mut self, max_steps: u32) -> Self {
-        self.max_steps = max_steps;
-        self
-    }
-
     fn validate(&self) -> Result<(), SimError> {
         let ok = self.rtol > 0.0 && self.atol > 0.0 && self.h_max >= 0.0 && self.max_steps > 0;
         if ok && self.rtol.is_finite() && self.atol.is_finite() && self.h_max.is_finite() {
@@ -251,9 +226,7 @@ pub(crate) fn integrate_states(
         Method::Auto => {
             switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::Switching)
         }
-        Method::Dopri5 => {
-            dopri5::integrate(sys, t0, y0, t_out, settings).map(|sol| (sol.states, sol.stats))
-        }
+        Method::Dopri5 => dopri5::integrate(sys, t0, y0, t_out, settings),
         Method::Rodas4 => {
             switching::integrate(sys, t0, y0, t_out, settings, switching::Policy::StiffOnly)
         }
