@@ -11,6 +11,7 @@
 use std::f64::consts::{PI, TAU};
 use std::fmt;
 
+use derive_setters::Setters;
 use thiserror::Error;
 
 use super::{ColumnNames, RecordError};
@@ -393,8 +394,9 @@ impl LayoutError {
 /// assert_eq!(rec.x, [0.0, 0.0, 1e-3]);
 /// assert_eq!(rec.u.unwrap(), [2.5, 3.75, 5.0]);
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Setters)]
 pub struct ReadOptions {
+    #[setters(skip)]
     channels: [Channel; 6],
     /// Cell separator (CSV).
     pub separator: Separator,
@@ -405,10 +407,13 @@ pub struct ReadOptions {
     /// Whether a header row names the columns (CSV); without one, columns go by number.
     pub header: bool,
     /// Where the time comes from.
+    #[setters(skip)]
     pub time: TimeBase,
     /// The rest stretch `[t0, t1]`, s, over which `Offset::Rest` channels are averaged.
+    #[setters(skip)]
     pub rest: Option<(f64, f64)>,
     /// Calibration of `f_stf`.
+    #[setters(skip)]
     pub calibration: Option<Calibration>,
     /// The most bytes read from a record file, and the most a `.mat` file's compressed
     /// variables may inflate to ([`DEFAULT_MAX_BYTES`] unless set).
@@ -480,30 +485,6 @@ impl ReadOptions {
         self
     }
 
-    /// Cells are separated by `separator`.
-    pub fn separator(mut self, separator: Separator) -> Self {
-        self.separator = separator;
-        self
-    }
-
-    /// Numbers use `decimal` as the decimal mark.
-    pub fn decimal(mut self, decimal: DecimalMark) -> Self {
-        self.decimal = decimal;
-        self
-    }
-
-    /// `lines` lines come before the header row.
-    pub fn skip(mut self, lines: usize) -> Self {
-        self.skip = lines;
-        self
-    }
-
-    /// Whether a header row names the columns.
-    pub fn header(mut self, header: bool) -> Self {
-        self.header = header;
-        self
-    }
-
     /// Time from a sample rate (Hz), the first sample at `t0` s; no `t` column is read.
     pub fn rate(mut self, rate: f64, t0: f64) -> Self {
         self.time = TimeBase::Rate { rate, t0 };
@@ -519,12 +500,6 @@ impl ReadOptions {
     /// Calibrate `f_stf`: `F = a·signal + b`.
     pub fn calibration(mut self, a: f64, b: f64) -> Self {
         self.calibration = Some(Calibration { a, b });
-        self
-    }
-
-    /// Refuse a record file over `bytes` (a `.mat` file: whose variables inflate past it).
-    pub fn max_bytes(mut self, bytes: u64) -> Self {
-        self.max_bytes = bytes;
         self
     }
 
