@@ -23,7 +23,7 @@ use super::error::{check_len, RegimeError};
 use super::metrics::PerRegime;
 
 /// The error of a prediction over the cycles of one regime.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct RegimeRms {
     /// Cycles in the regime.
     pub cycles: usize,

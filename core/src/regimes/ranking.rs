@@ -49,7 +49,8 @@ impl Ranking {
     }
 }
 
-fn sorted(mut v: Vec<Score>) -> Vec<Score> {
+/// `v` best first (lowest score), NaN scores last.
+pub(super) fn sorted(mut v: Vec<Score>) -> Vec<Score> {
     v.sort_by(|a, b| match (a.score.is_nan(), b.score.is_nan()) {
         (false, false) => a.score.total_cmp(&b.score),
         (x, y) => x.cmp(&y),
