@@ -68,6 +68,13 @@ impl Classification {
     pub fn count(&self, regime: Regime) -> usize {
         self.labels.iter().filter(|&&r| r == regime).count()
     }
+
+    /// The indices of the cycles labelled `regime`.
+    pub fn cycles_in(&self, regime: Regime) -> Vec<usize> {
+        (0..self.labels.len())
+            .filter(|&i| self.labels[i] == regime)
+            .collect()
+    }
 }
 
 /// Raw labels of cycles with `features` (rules 2–4 of the [module doc](self)), given the

@@ -229,33 +229,25 @@ pub fn rank_on_loops(meas: &Classification, results: &[(&str, &Comparison)]) -> 
         .iter()
         .map(|&metric| {
             let mut per_regime = PerRegime::default();
-            let mut sums: Vec<(f64, usize)> = vec![(0.0, 0); results.len()];
             for r in Regime::ALL {
-                let idx: Vec<usize> = (0..meas.labels.len())
-                    .filter(|&i| meas.labels[i] == r)
-                    .collect();
-                if idx.is_empty() {
-                    continue;
+                let idx = meas.cycles_in(r);
+                if !idx.is_empty() {
+                    per_regime.set(r, Some(rank_regime(metric, &idx, meas, results)));
                 }
-                let rank = rank_regime(metric, &idx, meas, results);
-                for (k, (name, _)) in results.iter().enumerate() {
-                    let s = rank
-                        .scores
-                        .iter()
-                        .find(|s| s.model == *name)
-                        .map_or(f64::NAN, |s| s.score);
-                    if s.is_finite() {
-                        sums[k] = (sums[k].0 + s, sums[k].1 + 1);
-                    }
-                }
-                per_regime.set(r, Some(rank));
             }
+            // Each model's mean over the regimes where its score is finite.
             let overall = results
                 .iter()
-                .zip(&sums)
-                .map(|((name, _), &(s, n))| Score {
-                    model: name.to_string(),
-                    score: if n > 0 { s / n as f64 } else { f64::NAN },
+                .map(|(name, _)| {
+                    let ranks = Regime::ALL.into_iter().filter_map(|r| per_regime.get(r));
+                    let scores = ranks.map(|rank: &RegimeRank| {
+                        let mine = rank.scores.iter().find(|s| s.model == *name);
+                        mine.map_or(f64::NAN, |s| s.score)
+                    });
+                    Score {
+                        model: name.to_string(),
+                        score: finite_mean(scores),
+                    }
                 })
                 .collect();
             MetricRanking {

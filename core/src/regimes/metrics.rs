@@ -147,7 +147,7 @@ pub struct Comparison {
 }
 
 /// Mean of `x` (`empty` if it has no values).
-fn mean_or(x: impl Iterator<Item = f64>, empty: f64) -> f64 {
+pub(super) fn mean_or(x: impl Iterator<Item = f64>, empty: f64) -> f64 {
     let (s, n) = x.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     if n > 0 {
         s / n as f64
@@ -283,9 +283,7 @@ pub fn compare(
     )?;
     let mut per_regime = PerRegime::default();
     for r in Regime::ALL {
-        let idx: Vec<usize> = (0..measured.labels.len())
-            .filter(|&i| measured.labels[i] == r)
-            .collect();
+        let idx = measured.cycles_in(r);
         let m = (!idx.is_empty()).then(|| metrics_over(&idx, measured, &model, sig.f, model_force));
         per_regime.set(r, m);
     }
