@@ -54,18 +54,13 @@ pub(super) fn read<R: std::io::Read>(
             found = Some(resolve(source, opts, None, rows.width(), line)?);
         }
         let Some(found) = &found else { continue };
-        if lines.len() == 0 {
-            for p in &found.places {
-                raw[p.signal.index()] = Some(Vec::new());
-            }
-        }
         check_width(source, found, rows.width(), line)?;
         for p in &found.places {
             let cell = rows.cell(p.index).unwrap_or_default();
             let value = number(source, line, &p.label, cell, opts.decimal, &mut scratch)?;
-            if let Some(values) = raw[p.signal.index()].as_mut() {
-                values.push(value);
-            }
+            raw[p.signal.index()]
+                .get_or_insert_with(Vec::new)
+                .push(value);
         }
         lines.push(line);
     }
@@ -183,11 +178,7 @@ fn resolve(
     width: usize,
     line: usize,
 ) -> Result<Found, RecordError> {
-    let by = if header.is_some() {
-        "header"
-    } else {
-        "first row"
-    };
+    let by = header.map_or("first row", |_| "header");
     let mut places = Vec::new();
     for (signal, ch) in opts.wanted() {
         let place = match (&ch.column, header) {

@@ -65,8 +65,7 @@ pub(super) fn read_bytes(
         };
         labels[signal.index()].clone_from(name);
         raw[signal.index()] = vector(&source, &file, name)?;
-        let must = opts.needs(signal);
-        if must && raw[signal.index()].is_none() {
+        if opts.needs(signal) && raw[signal.index()].is_none() {
             return Err(missing(&source, &file, name, ""));
         }
     }
