@@ -13,7 +13,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::data::record::{Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit};
+use stf_core::data::record::{
+    Calibration, Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit,
+};
 use toml::{Spanned, Value};
 
 use crate::experiment::{Ctx, RawDrive};
@@ -45,18 +47,11 @@ pub(crate) struct RawData {
     /// The most bytes the record file may hold (a `.mat` file: inflate to).
     max_bytes: Option<Spanned<f64>>,
     /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
-    calibration: Option<Spanned<RawCalibration>>,
+    calibration: Option<Spanned<Calibration>>,
     /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
     pub drive: Option<RawDrive>,
     /// Refuse or flag implausible records (`crate::plausibility`); default true.
     plausibility: Option<bool>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawCalibration {
-    a: f64,
-    b: f64,
 }
 
 /// A validated `[data]` section.
@@ -120,13 +115,8 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
         }
         (None, None) => {}
     }
-    if let Some(rest) = &raw.rest {
-        let [a, b] = *rest.get_ref();
-        opts = opts.rest(a, b);
-    }
-    if let Some(c) = &raw.calibration {
-        opts = opts.calibration(c.get_ref().a, c.get_ref().b);
-    }
+    opts.rest = raw.rest.as_ref().map(|r| (r.get_ref()[0], r.get_ref()[1]));
+    opts.calibration = raw.calibration.as_ref().map(|c| *c.get_ref());
     if let Some(m) = &raw.max_bytes {
         let v = *m.get_ref();
         let what = format!("{v} is not a size in bytes (at least 1)");

@@ -12,6 +12,7 @@ use std::f64::consts::{PI, TAU};
 use std::fmt;
 
 use derive_setters::Setters;
+use serde::Deserialize;
 use thiserror::Error;
 
 use super::{ColumnNames, RecordError};
@@ -296,7 +297,8 @@ pub enum TimeBase {
 }
 
 /// A force sensor's calibration `F = a·signal + b`, applied to `f_stf` after its unit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Calibration {
     /// Slope.
     pub a: f64,
