@@ -138,34 +138,22 @@ impl<'s, R: Read> Rows<'s, R> {
                 }
                 continue;
             }
-            if at_end && !self.read_line()? {
-                // The input ended inside a quoted cell: the parser closes the row.
-                let (result, _, o, e) =
-                    self.parser
-                        .read_record(&[], &mut self.cells[out..], &mut self.ends[end..]);
-                (out, end) = (out + o, end + e);
-                match result {
-                    csv_core::ReadRecordResult::OutputFull => self.grow_cells(),
-                    csv_core::ReadRecordResult::OutputEndsFull => self.grow_ends(),
-                    csv_core::ReadRecordResult::Record => return self.row(end, start),
-                    _ => return Ok(None),
-                }
-                continue;
-            }
-            let first = *start.get_or_insert(self.number);
-            let (result, used, o, e) = self.parser.read_record(
-                &self.line[self.pos..],
-                &mut self.cells[out..],
-                &mut self.ends[end..],
-            );
+            // Where the input has ended (inside a quoted cell) the parser is fed nothing and
+            // closes the row.
+            let eof = at_end && !self.read_line()?;
+            let input: &[u8] = if eof { &[] } else { &self.line[self.pos..] };
+            start.get_or_insert(self.number); // a no-op at the end: the row has begun
+            let (result, used, o, e) =
+                self.parser
+                    .read_record(input, &mut self.cells[out..], &mut self.ends[end..]);
             self.pos += used;
             (out, end) = (out + o, end + e);
             match result {
                 csv_core::ReadRecordResult::OutputFull => self.grow_cells(),
                 csv_core::ReadRecordResult::OutputEndsFull => self.grow_ends(),
-                csv_core::ReadRecordResult::Record => return self.row(end, Some(first)),
-                csv_core::ReadRecordResult::End => return Ok(None),
-                csv_core::ReadRecordResult::InputEmpty => {}
+                csv_core::ReadRecordResult::Record => return self.row(end, start),
+                csv_core::ReadRecordResult::InputEmpty if !eof => {}
+                _ => return Ok(None),
             }
         }
     }

@@ -230,10 +230,10 @@ fn parameter(unit: &str, param: &'static str, value: Option<f64>) -> Result<f64,
     })?;
     let positive = param == "per_rev";
     if !value.is_finite() || value == 0.0 || (positive && value < 0.0) {
-        return Err(LayoutError::Invalid {
-            setting: "units",
-            message: format!("`{param}` = {value} must be a finite, non-zero number"),
-        });
+        return invalid(
+            "units",
+            format!("`{param}` = {value} must be a finite, non-zero number"),
+        );
     }
     Ok(value)
 }
@@ -532,7 +532,6 @@ impl ReadOptions {
 
     /// Check that the settings can work together.
     pub fn check(&self) -> Result<(), LayoutError> {
-        let invalid = |setting, message: String| Err(LayoutError::Invalid { setting, message });
         for (signal, ch) in Signal::ALL.map(|s| (s, self.channel(s))) {
             match &ch.column {
                 Column::Number(0) => {
@@ -561,7 +560,7 @@ impl ReadOptions {
             }
             match ch.offset {
                 Some(_) if signal == Signal::T => {
-                    return invalid("offsets", "`t` takes no offset (set `t0`)".into())
+                    return invalid("offsets", "`t` takes no offset (set `t0`)")
                 }
                 Some(Offset::Value(v)) if !v.is_finite() => {
                     return invalid(
@@ -593,7 +592,6 @@ impl ReadOptions {
         let TimeBase::Rate { rate, t0 } = self.time else {
             return Ok(());
         };
-        let invalid = |setting, message: String| Err(LayoutError::Invalid { setting, message });
         if !(rate.is_finite() && rate > 0.0) {
             return invalid("rate", format!("{rate} must be a positive sample rate, Hz"));
         }
@@ -604,13 +602,13 @@ impl ReadOptions {
         if t.required {
             return invalid(
                 "rate",
-                "give either a `t` column or a sample `rate`, not both".into(),
+                "give either a `t` column or a sample `rate`, not both",
             );
         }
         if t.unit != Unit::Second {
             return invalid(
                 "units",
-                "`t` has no unit when a sample `rate` gives the time".into(),
+                "`t` has no unit when a sample `rate` gives the time",
             );
         }
         Ok(())
@@ -621,31 +619,37 @@ impl ReadOptions {
             return Ok(());
         };
         if !(a.is_finite() && b.is_finite() && b > a) {
-            return Err(LayoutError::Invalid {
-                setting: "rest",
-                message: format!("[{a}, {b}] is not a stretch of time: need t0 < t1, in s"),
-            });
+            return invalid(
+                "rest",
+                format!("[{a}, {b}] is not a stretch of time: need t0 < t1, in s"),
+            );
         }
         if !self.channels.iter().any(|c| c.offset == Some(Offset::Rest)) {
-            return Err(LayoutError::Invalid {
-                setting: "rest",
-                message: "no channel's offset is \"rest\": name them, e.g. \
-                          offsets = { x = \"rest\" }"
-                    .into(),
-            });
+            return invalid(
+                "rest",
+                "no channel's offset is \"rest\": name them, e.g. offsets = { x = \"rest\" }",
+            );
         }
         Ok(())
     }
 
     fn check_text(&self) -> Result<(), LayoutError> {
         if self.decimal == DecimalMark::Comma && self.separator == Separator::Comma {
-            return Err(LayoutError::Invalid {
-                setting: "decimal",
-                message: "decimal commas need another separator (`;` or tab)".into(),
-            });
+            return invalid(
+                "decimal",
+                "decimal commas need another separator (`;` or tab)",
+            );
         }
         Ok(())
     }
+}
+
+/// A [`LayoutError::Invalid`] of `setting`.
+fn invalid<T>(setting: &'static str, message: impl Into<String>) -> Result<T, LayoutError> {
+    Err(LayoutError::Invalid {
+        setting,
+        message: message.into(),
+    })
 }
 
 /// The signals as recorded, by [`Signal`] index, before the layout is applied.
