@@ -12,7 +12,7 @@
 
 use super::csv_rows::{RowLines, Rows};
 use super::layout::{self, Raw};
-use super::{Column, Columns, DecimalMark, ReadOptions, Record, RecordError, Separator, Signal};
+use super::{Column, DecimalMark, ReadOptions, Record, RecordError, Separator, Signal};
 
 /// Where a wanted signal sits in a row (0-based) and the column name errors use.
 struct Place {
@@ -79,7 +79,7 @@ pub(super) fn read<R: std::io::Read>(
     }
     let row_of = |i: usize| lines.line(i);
     let raw = layout::apply(opts, raw, source, &labels, &row_of)?;
-    Columns(raw).into_record(source, &labels, &row_of)
+    super::into_record(raw, source, &labels, &row_of)
 }
 
 /// Pass over the `skip` lines before the header, whatever they hold.
@@ -150,10 +150,8 @@ fn read_header<R: std::io::Read>(
 ) -> Result<Found, RecordError> {
     let got = rows.next_row()?;
     let line = got.unwrap_or(rows.line_number() + 1);
-    let header = match got {
-        Some(line) => rows.texts(line)?,
-        None => Vec::new(),
-    };
+    let header = got.map(|line| rows.texts(line)).transpose()?;
+    let header = header.unwrap_or_default();
     if header.iter().all(String::is_empty) {
         let what = if opts.skip > 0 {
             format!("nothing after the {} skipped line(s)", opts.skip)
