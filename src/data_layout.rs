@@ -303,11 +303,7 @@ fn offset(cx: &Ctx, signal: Signal, value: &Value, at: Range<usize>) -> Result<O
 
 /// A TOML number (integer or float) as `f64`.
 fn number(value: &Value) -> Option<f64> {
-    match value {
-        Value::Float(v) => Some(*v),
-        Value::Integer(v) => Some(*v as f64),
-        _ => None,
-    }
+    value.as_float().or(value.as_integer().map(|v| v as f64))
 }
 
 /// Where a layout setting is written: the key if given, else the `[data]` header.

@@ -9,6 +9,8 @@
 
 use std::io::{BufRead, Read};
 
+use csv_core::ReadRecordResult;
+
 use super::RecordError;
 use crate::data::bounded::byte_size;
 
@@ -149,10 +151,10 @@ impl<'s, R: Read> Rows<'s, R> {
             self.pos += used;
             (out, end) = (out + o, end + e);
             match result {
-                csv_core::ReadRecordResult::OutputFull => self.grow_cells(),
-                csv_core::ReadRecordResult::OutputEndsFull => self.grow_ends(),
-                csv_core::ReadRecordResult::Record => return self.row(end, start),
-                csv_core::ReadRecordResult::InputEmpty if !eof => {}
+                ReadRecordResult::OutputFull => self.cells.resize(2 * self.cells.len(), 0),
+                ReadRecordResult::OutputEndsFull => self.ends.resize(2 * self.ends.len(), 0),
+                ReadRecordResult::Record => return self.row(end, start),
+                ReadRecordResult::InputEmpty if !eof => {}
                 _ => return Ok(None),
             }
         }
@@ -161,16 +163,6 @@ impl<'s, R: Read> Rows<'s, R> {
     fn row(&mut self, width: usize, start: Option<usize>) -> Result<Option<usize>, RecordError> {
         self.width = width;
         Ok(Some(start.unwrap_or(self.number)))
-    }
-
-    fn grow_cells(&mut self) {
-        let n = self.cells.len();
-        self.cells.resize(n * 2, 0);
-    }
-
-    fn grow_ends(&mut self) {
-        let n = self.ends.len();
-        self.ends.resize(n * 2, 0);
     }
 
     /// Cells in the current row.
