@@ -31,7 +31,7 @@
 //! looked for within `smoothing_cycles` (at least 3) cycles of the change, and at least the two
 //! cycles of the change itself (as in [`super::boundaries`]).
 
-use super::boundaries::{boundary_at, Boundaries, BoundaryRule};
+use super::boundaries::{boundary_at, Boundaries, Boundary, BoundaryRule};
 use super::classify::{median_filter, Regime};
 use super::features::CycleFeatures;
 use super::thresholds::RegimeThresholds;
@@ -115,35 +115,19 @@ pub fn place(features: &[CycleFeatures], th: &RegimeThresholds, negligible_level
     let b2 = c2.filter(|&(j, _)| j > 0);
     let forced: Vec<bool> = beh.iter().map(|&b| b != Behaviour::Negligible).collect();
     let not_on: Vec<bool> = beh.iter().map(|&b| b != Behaviour::On).collect();
-    let mut boundaries = Boundaries {
-        pre_resonance: b1.map(|j| {
-            boundary_at(
-                &omega,
-                j,
-                w,
-                BoundaryRule::ForceOnset,
-                |i| forced[i],
-                |i| !forced[i],
-            )
-        }),
+    // The boundary between sweep positions j − 1 and j; its `cycle` is the index of the cycle
+    // at position j.
+    let at = |j: usize, rule, side: &[bool]| Boundary {
+        cycle: order[j],
+        ..boundary_at(&omega, j, w, rule, |i| side[i], |i| !side[i])
+    };
+    let boundaries = Boundaries {
+        pre_resonance: b1.map(|j| at(j, BoundaryRule::ForceOnset, &forced)),
         resonance_post: b2.map(|(j, rule)| {
-            let side = if rule == BoundaryRule::OnOffFromOnset {
-                &forced
-            } else {
-                &not_on
-            };
-            boundary_at(&omega, j, w, rule, |i| side[i], |i| !side[i])
+            let on_off_from_onset = rule == BoundaryRule::OnOffFromOnset;
+            at(j, rule, if on_off_from_onset { &forced } else { &not_on })
         }),
     };
-    for b in [
-        &mut boundaries.pre_resonance,
-        &mut boundaries.resonance_post,
-    ]
-    .into_iter()
-    .flatten()
-    {
-        b.cycle = order[b.cycle];
-    }
     let mut labels = vec![Regime::PreResonance; n];
     let mut raw = vec![Regime::PreResonance; n];
     for (pos, &i) in order.iter().enumerate() {

@@ -452,17 +452,11 @@ impl Default for ReadOptions {
 
 impl ReadOptions {
     /// Read with these column names (each signal may still be absent, as by default).
-    pub fn columns(mut self, names: ColumnNames) -> Self {
-        let ColumnNames {
-            t,
-            x,
-            phi,
-            f_stf,
-            omega,
-            u,
-        } = names;
-        for (signal, name) in Signal::ALL.into_iter().zip([t, x, phi, f_stf, omega, u]) {
-            self.channels[signal.index()].column = Column::Name(name);
+    pub fn columns(mut self, n: ColumnNames) -> Self {
+        // The channels are in the order of `Signal::ALL`.
+        let names = [n.t, n.x, n.phi, n.f_stf, n.omega, n.u];
+        for (channel, name) in self.channels.iter_mut().zip(names) {
+            channel.column = Column::Name(name);
         }
         self
     }
