@@ -131,7 +131,7 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
     opts.check().map_err(|e| {
         let setting = e.setting();
         cx.at(
-            setting_span(raw, setting, span),
+            span_of(raw, setting).unwrap_or_else(|| span.clone()),
             &format!("data.{setting}"),
             e,
         )
@@ -147,14 +147,8 @@ fn text_settings(cx: &Ctx, raw: &RawData) -> Result<ReadOptions> {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("mat"))
     });
-    let text_spans = [
-        ("separator", raw.separator.as_ref().map(Spanned::span)),
-        ("decimal", raw.decimal.as_ref().map(Spanned::span)),
-        ("skip", raw.skip.as_ref().map(Spanned::span)),
-        ("header", raw.header.as_ref().map(Spanned::span)),
-    ];
-    for (key, at) in text_spans {
-        if let (true, Some(at)) = (is_mat, at) {
+    for key in ["separator", "decimal", "skip", "header"] {
+        if let (true, Some(at)) = (is_mat, span_of(raw, key)) {
             return Err(cx.at(
                 at,
                 &format!("data.{key}"),
@@ -306,10 +300,10 @@ fn number(value: &Value) -> Option<f64> {
     value.as_float().or(value.as_integer().map(|v| v as f64))
 }
 
-/// Where a layout setting is written: the key if given, else the `[data]` header.
-fn setting_span(raw: &RawData, setting: &str, data: &Range<usize>) -> Range<usize> {
+/// Where a layout setting is written, if it is (`columns` without columns: `header`).
+fn span_of(raw: &RawData, setting: &str) -> Option<Range<usize>> {
     let first = |map: &BTreeMap<String, Spanned<Value>>| map.values().next().map(Spanned::span);
-    let span = match setting {
+    match setting {
         "columns" => first(&raw.columns).or_else(|| raw.header.as_ref().map(Spanned::span)),
         "units" => first(&raw.units),
         "offsets" => first(&raw.offsets),
@@ -322,8 +316,7 @@ fn setting_span(raw: &RawData, setting: &str, data: &Range<usize>) -> Range<usiz
         "header" => raw.header.as_ref().map(Spanned::span),
         "calibration" => raw.calibration.as_ref().map(Spanned::span),
         _ => None,
-    };
-    span.unwrap_or_else(|| data.clone())
+    }
 }
 
 #[cfg(test)]
