@@ -13,7 +13,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde::Deserialize;
-use stf_core::data::record::{Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit};
+use stf_core::data::record::{
+    Calibration, Column, DecimalMark, Offset, ReadOptions, Separator, Signal, Unit,
+};
 use toml::{Spanned, Value};
 
 use crate::experiment::{Ctx, RawDrive};
@@ -45,18 +47,11 @@ pub(crate) struct RawData {
     /// The most bytes the record file may hold (a `.mat` file: inflate to).
     max_bytes: Option<Spanned<f64>>,
     /// Strain-gauge calibration of a force column recorded as a signal: F = a·signal + b.
-    calibration: Option<Spanned<RawCalibration>>,
+    calibration: Option<Spanned<Calibration>>,
     /// How the measured drive (φ or u) is reconstructed: `"auto"`, `"samples"` or a filter.
     pub drive: Option<RawDrive>,
     /// Refuse or flag implausible records (`crate::plausibility`); default true.
     plausibility: Option<bool>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawCalibration {
-    a: f64,
-    b: f64,
 }
 
 /// A validated `[data]` section.
@@ -120,13 +115,8 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
         }
         (None, None) => {}
     }
-    if let Some(rest) = &raw.rest {
-        let [a, b] = *rest.get_ref();
-        opts = opts.rest(a, b);
-    }
-    if let Some(c) = &raw.calibration {
-        opts = opts.calibration(c.get_ref().a, c.get_ref().b);
-    }
+    opts.rest = raw.rest.as_ref().map(|r| (r.get_ref()[0], r.get_ref()[1]));
+    opts.calibration = raw.calibration.as_ref().map(|c| *c.get_ref());
     if let Some(m) = &raw.max_bytes {
         let v = *m.get_ref();
         let what = format!("{v} is not a size in bytes (at least 1)");
@@ -141,7 +131,7 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
     opts.check().map_err(|e| {
         let setting = e.setting();
         cx.at(
-            setting_span(raw, setting, span),
+            span_of(raw, setting).unwrap_or_else(|| span.clone()),
             &format!("data.{setting}"),
             e,
         )
@@ -157,14 +147,8 @@ fn text_settings(cx: &Ctx, raw: &RawData) -> Result<ReadOptions> {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("mat"))
     });
-    let text_spans = [
-        ("separator", raw.separator.as_ref().map(Spanned::span)),
-        ("decimal", raw.decimal.as_ref().map(Spanned::span)),
-        ("skip", raw.skip.as_ref().map(Spanned::span)),
-        ("header", raw.header.as_ref().map(Spanned::span)),
-    ];
-    for (key, at) in text_spans {
-        if let (true, Some(at)) = (is_mat, at) {
+    for key in ["separator", "decimal", "skip", "header"] {
+        if let (true, Some(at)) = (is_mat, span_of(raw, key)) {
             return Err(cx.at(
                 at,
                 &format!("data.{key}"),
@@ -313,17 +297,13 @@ fn offset(cx: &Ctx, signal: Signal, value: &Value, at: Range<usize>) -> Result<O
 
 /// A TOML number (integer or float) as `f64`.
 fn number(value: &Value) -> Option<f64> {
-    match value {
-        Value::Float(v) => Some(*v),
-        Value::Integer(v) => Some(*v as f64),
-        _ => None,
-    }
+    value.as_float().or(value.as_integer().map(|v| v as f64))
 }
 
-/// Where a layout setting is written: the key if given, else the `[data]` header.
-fn setting_span(raw: &RawData, setting: &str, data: &Range<usize>) -> Range<usize> {
+/// Where a layout setting is written, if it is (`columns` without columns: `header`).
+fn span_of(raw: &RawData, setting: &str) -> Option<Range<usize>> {
     let first = |map: &BTreeMap<String, Spanned<Value>>| map.values().next().map(Spanned::span);
-    let span = match setting {
+    match setting {
         "columns" => first(&raw.columns).or_else(|| raw.header.as_ref().map(Spanned::span)),
         "units" => first(&raw.units),
         "offsets" => first(&raw.offsets),
@@ -336,8 +316,7 @@ fn setting_span(raw: &RawData, setting: &str, data: &Range<usize>) -> Range<usiz
         "header" => raw.header.as_ref().map(Spanned::span),
         "calibration" => raw.calibration.as_ref().map(Spanned::span),
         _ => None,
-    };
-    span.unwrap_or_else(|| data.clone())
+    }
 }
 
 #[cfg(test)]

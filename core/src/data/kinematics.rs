@@ -121,27 +121,18 @@ pub struct Kinematics {
     pub sigma_a: f64,
 }
 
-/// Robust σ of the position noise: [`noise_sigma`] of x.
-pub fn position_noise(x: &[f64]) -> f64 {
-    noise_sigma(x)
-}
-
 impl Kinematics {
     /// Derive the kinematics of `record`.
     pub fn from_record(record: &Record, s: &KinematicsSettings) -> Result<Self, FilterError> {
         let dt = sample_step(&record.t)?;
         let rate = 1.0 / dt;
         let (phi, omega, u, drive) = reconstruct_drive(record, dt, &s.drive)?;
-        let sigma_x = position_noise(&record.x);
+        let sigma_x = noise_sigma(&record.x);
         let motion = match &s.motion {
             Some(f) => *f,
             None => {
                 let f = dominant_frequency(omega.as_deref(), &record.x, dt);
-                let mean = record.x.iter().sum::<f64>() / record.x.len() as f64;
-                let x_amp = record
-                    .x
-                    .iter()
-                    .fold(0.0_f64, |m, x| m.max((x - mean).abs()));
+                let x_amp = largest_deviation(&record.x);
                 let window =
                     choose_motion_window(rate, f, x_amp, sigma_x, s.motion_order, record.t.len());
                 PolyFilter::new(s.motion_order, window)?.boundary(s.boundary)
@@ -179,10 +170,8 @@ impl Kinematics {
 
     /// The record's own range of x and v, (m, m/s): the largest |x − mean x| and |v|.
     pub fn state_span(&self) -> (f64, f64) {
-        let mean = self.x.iter().sum::<f64>() / self.x.len().max(1) as f64;
-        let x_span = self.x.iter().fold(0.0_f64, |m, x| m.max((x - mean).abs()));
         let v_span = self.v.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        (x_span, v_span)
+        (largest_deviation(&self.x), v_span)
     }
 
     /// The drive force at each sample, N: F0·ω²·sin(φ − phi_off) for a rotor, u − u_off for
@@ -248,6 +237,12 @@ impl Kinematics {
             _ => Excitation::None,
         }
     }
+}
+
+/// The largest |x − mean x| (0 without samples).
+fn largest_deviation(x: &[f64]) -> f64 {
+    let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    x.iter().fold(0.0_f64, |m, x| m.max((x - mean).abs()))
 }
 
 /// The state at the first sample, (x0 m, v0 m/s), from the longest opening stretch of the
@@ -393,7 +388,7 @@ mod tests {
         let x: Vec<f64> = (0..20000)
             .map(|i| 0.04 * (i as f64 * 1e-3 * 6.0).sin() + n.sample(&mut rng))
             .collect();
-        let s = position_noise(&x);
+        let s = noise_sigma(&x);
         assert!((s - 5e-5).abs() < 0.05 * 5e-5, "{s}");
     }
 }

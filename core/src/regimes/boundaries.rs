@@ -100,27 +100,49 @@ pub fn find_boundaries(
             (p == a && q == b) || (p == b && q == a)
         })?;
         let (old, new) = (smoothed[j - 1], smoothed[j]);
-        let w = window.max(3);
-        let (lo_n, hi_n) = (j.saturating_sub(w), (j + w).min(n));
-        let first_new = (lo_n..hi_n).find(|&i| raw[i] == new).unwrap_or(j);
-        let last_old = (lo_n..hi_n).rev().find(|&i| raw[i] == old).unwrap_or(j - 1);
-        let lo = first_new.min(j - 1);
-        let hi = last_old.max(j);
-        let span = omega[lo..=hi]
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| {
-                (a.min(w), b.max(w))
-            });
-        Some(Boundary {
-            omega: 0.5 * (omega[j - 1] + omega[j]),
-            uncertainty: 0.5 * (span.1 - span.0),
-            cycle: j,
-            rule: BoundaryRule::Amplitude,
-        })
+        Some(boundary_at(
+            &omega[..n],
+            j,
+            window,
+            BoundaryRule::Amplitude,
+            |i| raw[i] == new,
+            |i| raw[i] == old,
+        ))
     };
     Boundaries {
         pre_resonance: find(Regime::PreResonance, Regime::Resonance),
         resonance_post: find(Regime::Resonance, Regime::PostResonance),
+    }
+}
+
+/// The boundary between cycles `j − 1` and `j` (j ≥ 1), placed by `rule`: its ω is the mean
+/// of the two cycles' ω; its uncertainty half the ω span from the first cycle on the new side
+/// (`is_new`) to the last on the old side (`is_old`), looked for within `window` (at least 3)
+/// cycles of the change, and at least the two cycles of the change itself.
+pub(super) fn boundary_at(
+    omega: &[f64],
+    j: usize,
+    window: usize,
+    rule: BoundaryRule,
+    is_new: impl Fn(usize) -> bool,
+    is_old: impl Fn(usize) -> bool,
+) -> Boundary {
+    let n = omega.len();
+    let w = window.max(3);
+    let (lo_n, hi_n) = (j.saturating_sub(w), (j + w).min(n));
+    let first_new = (lo_n..hi_n).find(|&i| is_new(i)).unwrap_or(j);
+    let last_old = (lo_n..hi_n).rev().find(|&i| is_old(i)).unwrap_or(j - 1);
+    let (lo, hi) = (first_new.min(j - 1), last_old.max(j));
+    let (a, b) = omega[lo..=hi]
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| {
+            (a.min(w), b.max(w))
+        });
+    Boundary {
+        omega: 0.5 * (omega[j - 1] + omega[j]),
+        uncertainty: 0.5 * (b - a),
+        cycle: j,
+        rule,
     }
 }
 

@@ -68,6 +68,13 @@ impl Classification {
     pub fn count(&self, regime: Regime) -> usize {
         self.labels.iter().filter(|&&r| r == regime).count()
     }
+
+    /// The indices of the cycles labelled `regime`.
+    pub fn cycles_in(&self, regime: Regime) -> Vec<usize> {
+        (0..self.labels.len())
+            .filter(|&i| self.labels[i] == regime)
+            .collect()
+    }
 }
 
 /// Raw labels of cycles with `features` (rules 2–4 of the [module doc](self)), given the
@@ -104,17 +111,17 @@ pub fn label_cycles(
     (labels, no_stf, peak_omega)
 }
 
-/// Median filter of `labels` (ordered Pre < Resonance < Post) over `window` cycles (odd); the
-/// window shrinks symmetrically at the ends.
-pub fn median_filter(labels: &[Regime], window: usize) -> Vec<Regime> {
+/// Median filter of `labels` (regimes ordered Pre < Resonance < Post, booleans false < true)
+/// over `window` cycles (odd); the window shrinks symmetrically at the ends.
+pub fn median_filter<T: Copy + Ord>(labels: &[T], window: usize) -> Vec<T> {
     let n = labels.len();
     let h = window / 2;
     (0..n)
         .map(|i| {
             let hi = h.min(i).min(n - 1 - i);
-            let mut w: Vec<u8> = labels[i - hi..=i + hi].iter().map(|r| r.rank()).collect();
+            let mut w = labels[i - hi..=i + hi].to_vec();
             w.sort_unstable();
-            Regime::from_rank(w[w.len() / 2])
+            w[w.len() / 2]
         })
         .collect()
 }
@@ -233,6 +240,6 @@ mod tests {
             vec![Pre, Pre, Pre, Pre, Pre, Res, Res, Res, Res, Res, Post, Post, Post]
         );
         assert_eq!(median_filter(&l, 1), l.to_vec());
-        assert!(median_filter(&[], 5).is_empty());
+        assert!(median_filter::<Regime>(&[], 5).is_empty());
     }
 }

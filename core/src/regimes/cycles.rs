@@ -144,15 +144,14 @@ pub fn phase_from_omega(t: &[f64], omega: &[f64]) -> Result<Vec<f64>, RegimeErro
     check_len("omega", omega, t.len())?;
     check_time(t)?;
     check_finite("omega", omega)?;
-    let mut phi = Vec::with_capacity(t.len());
     let mut acc = 0.0;
-    for i in 0..t.len() {
+    let steps = (0..t.len()).map(|i| {
         if i > 0 {
             acc += 0.5 * (omega[i] + omega[i - 1]) * (t[i] - t[i - 1]);
         }
-        phi.push(acc);
-    }
-    Ok(phi)
+        acc
+    });
+    Ok(steps.collect())
 }
 
 #[cfg(test)]

@@ -89,15 +89,15 @@ pub(crate) fn check_finite(name: &'static str, x: &[f64]) -> Result<(), RegimeEr
     }
 }
 
-/// Check that `x` has `expected` samples.
-pub(crate) fn check_len(name: &'static str, x: &[f64], expected: usize) -> Result<(), RegimeError> {
-    if x.len() == expected {
+/// Check that `x` has `n` values (samples, or labels of `n` cycles).
+pub(crate) fn check_len<T>(name: &'static str, x: &[T], n: usize) -> Result<(), RegimeError> {
+    if x.len() == n {
         Ok(())
     } else {
         Err(RegimeError::LengthMismatch {
             name,
             len: x.len(),
-            expected,
+            expected: n,
         })
     }
 }

@@ -80,7 +80,9 @@ pub fn duty(f: &[f64], threshold: f64, min_off_fraction: f64) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let mut runs = circular_runs(f.iter().map(|x| x.abs() > threshold));
+    // One run a sample, merged into the runs of equal values (flipping none).
+    let samples = f.iter().map(|x| (x.abs() > threshold, 1)).collect();
+    let mut runs = flip_short(samples, true, 0);
     runs = flip_short(runs, true, 2);
     let min_off = (min_off_fraction * n as f64).ceil() as usize;
     runs = flip_short(runs, false, min_off);
@@ -88,18 +90,7 @@ pub fn duty(f: &[f64], threshold: f64, min_off_fraction: f64) -> f64 {
     on as f64 / n as f64
 }
 
-/// Runs of equal values, `(value, length)`, with the first and last merged when equal.
-fn circular_runs(mask: impl Iterator<Item = bool>) -> Vec<(bool, usize)> {
-    let mut runs: Vec<(bool, usize)> = Vec::new();
-    for m in mask {
-        match runs.last_mut() {
-            Some(r) if r.0 == m => r.1 += 1,
-            _ => runs.push((m, 1)),
-        }
-    }
-    merge_ends(runs)
-}
-
+/// The runs with the first and last merged when equal (the cycle is periodic).
 fn merge_ends(mut runs: Vec<(bool, usize)>) -> Vec<(bool, usize)> {
     if runs.len() > 1 && runs[0].0 == runs[runs.len() - 1].0 {
         if let Some(last) = runs.pop() {

@@ -26,8 +26,8 @@
 use serde::Serialize;
 
 use super::classify::{Classification, Regime};
-use super::metrics::{phase_error, Comparison, PerRegime};
-use super::ranking::Score;
+use super::metrics::{finite_mean, phase_error, Comparison, PerRegime};
+use super::ranking::{sorted, Score};
 
 /// A quantity read from the loops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -137,7 +137,7 @@ pub struct PairedTest {
 }
 
 /// Models ranked in one regime by one metric.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct RegimeRank {
     /// Scores, best first.
     pub scores: Vec<Score>,
@@ -156,14 +156,6 @@ pub struct MetricRanking {
     pub overall: Vec<Score>,
     /// Per measured regime.
     pub per_regime: PerRegime<RegimeRank>,
-}
-
-fn sorted(mut v: Vec<Score>) -> Vec<Score> {
-    v.sort_by(|a, b| match (a.score.is_nan(), b.score.is_nan()) {
-        (false, false) => a.score.total_cmp(&b.score),
-        (x, y) => x.cmp(&y),
-    });
-    v
 }
 
 fn paired(best: &str, runner: &str, errors: &[(Vec<f64>, &str)]) -> Option<PairedTest> {
@@ -208,15 +200,9 @@ fn rank_regime(
         })
         .collect();
     let scale = if metric.relative() {
-        let s: Vec<f64> = idx
-            .iter()
-            .map(|&i| {
-                results
-                    .first()
-                    .map_or(f64::NAN, |(_, c)| metric.cycle(i, meas, c).1)
-            })
-            .collect();
-        mean_finite(&s)
+        results.first().map_or(f64::NAN, |(_, c)| {
+            finite_mean(idx.iter().map(|&i| metric.cycle(i, meas, c).1))
+        })
     } else {
         1.0
     };
@@ -225,7 +211,7 @@ fn rank_regime(
             .iter()
             .map(|(e, name)| Score {
                 model: name.to_string(),
-                score: mean_finite(e) / scale,
+                score: finite_mean(e.iter().copied()) / scale,
             })
             .collect(),
     );
@@ -236,15 +222,6 @@ fn rank_regime(
     RegimeRank { scores, test }
 }
 
-fn mean_finite(x: &[f64]) -> f64 {
-    let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-    if f.is_empty() {
-        f64::NAN
-    } else {
-        f.iter().sum::<f64>() / f.len() as f64
-    }
-}
-
 /// Rank models on every [`LoopMetric`], per measured regime and overall, each with the paired
 /// test of the best against the runner-up (see the [module doc](self)).
 pub fn rank_on_loops(meas: &Classification, results: &[(&str, &Comparison)]) -> Vec<MetricRanking> {
@@ -252,33 +229,25 @@ pub fn rank_on_loops(meas: &Classification, results: &[(&str, &Comparison)]) -> 
         .iter()
         .map(|&metric| {
             let mut per_regime = PerRegime::default();
-            let mut sums: Vec<(f64, usize)> = vec![(0.0, 0); results.len()];
             for r in Regime::ALL {
-                let idx: Vec<usize> = (0..meas.labels.len())
-                    .filter(|&i| meas.labels[i] == r)
-                    .collect();
-                if idx.is_empty() {
-                    continue;
+                let idx = meas.cycles_in(r);
+                if !idx.is_empty() {
+                    per_regime.set(r, Some(rank_regime(metric, &idx, meas, results)));
                 }
-                let rank = rank_regime(metric, &idx, meas, results);
-                for (k, (name, _)) in results.iter().enumerate() {
-                    let s = rank
-                        .scores
-                        .iter()
-                        .find(|s| s.model == *name)
-                        .map_or(f64::NAN, |s| s.score);
-                    if s.is_finite() {
-                        sums[k] = (sums[k].0 + s, sums[k].1 + 1);
-                    }
-                }
-                per_regime.set(r, Some(rank));
             }
+            // Each model's mean over the regimes where its score is finite.
             let overall = results
                 .iter()
-                .zip(&sums)
-                .map(|((name, _), &(s, n))| Score {
-                    model: name.to_string(),
-                    score: if n > 0 { s / n as f64 } else { f64::NAN },
+                .map(|(name, _)| {
+                    let ranks = Regime::ALL.into_iter().filter_map(|r| per_regime.get(r));
+                    let scores = ranks.map(|rank: &RegimeRank| {
+                        let mine = rank.scores.iter().find(|s| s.model == *name);
+                        mine.map_or(f64::NAN, |s| s.score)
+                    });
+                    Score {
+                        model: name.to_string(),
+                        score: finite_mean(scores),
+                    }
                 })
                 .collect();
             MetricRanking {

@@ -35,7 +35,7 @@ use super::thresholds::RegimeThresholds;
 use crate::data::force_data::ForceData;
 
 /// One value per regime (`None`: the measurement has no cycle in that regime).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct PerRegime<T> {
     /// Pre-resonance.
     pub pre_resonance: Option<T>,
@@ -43,16 +43,6 @@ pub struct PerRegime<T> {
     pub resonance: Option<T>,
     /// Post-resonance.
     pub post_resonance: Option<T>,
-}
-
-impl<T> Default for PerRegime<T> {
-    fn default() -> Self {
-        PerRegime {
-            pre_resonance: None,
-            resonance: None,
-            post_resonance: None,
-        }
-    }
 }
 
 impl<T> PerRegime<T> {
@@ -76,7 +66,7 @@ impl<T> PerRegime<T> {
 }
 
 /// Errors of a model over a set of cycles; see the [module doc](self).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct RegimeMetrics {
     /// Number of cycles.
     pub cycles: usize,
@@ -156,12 +146,13 @@ pub struct Comparison {
     pub cycle_force_rms_error: Vec<f64>,
 }
 
-fn mean(x: impl Iterator<Item = f64>) -> f64 {
+/// Mean of `x` (`empty` if it has no values).
+pub(super) fn mean_or(x: impl Iterator<Item = f64>, empty: f64) -> f64 {
     let (s, n) = x.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     if n > 0 {
         s / n as f64
     } else {
-        0.0
+        empty
     }
 }
 
@@ -180,15 +171,8 @@ fn circular_mean(x: impl Iterator<Item = f64>) -> f64 {
 }
 
 /// Mean of the finite values (NaN if none).
-fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
-    let (s, n) = x
-        .filter(|v| v.is_finite())
-        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    if n > 0 {
-        s / n as f64
-    } else {
-        f64::NAN
-    }
+pub(super) fn finite_mean(x: impl Iterator<Item = f64>) -> f64 {
+    mean_or(x.filter(|v| v.is_finite()), f64::NAN)
 }
 
 /// |model − measured| of a phase, wrapped to [0°, 180°] (NaN when either is NaN).
@@ -196,33 +180,7 @@ pub fn phase_error(measured: f64, model: f64) -> f64 {
     wrap_deg(model - measured).abs()
 }
 
-/// Loop metrics of the cycles `idx`: measured and model means and mean |differences|.
-fn loop_metrics(
-    idx: &[usize],
-    meas: &[CycleFeatures],
-    model: &[CycleFeatures],
-    m: &mut RegimeMetrics,
-) {
-    let over = |g: &dyn Fn(&CycleFeatures, &CycleFeatures) -> f64| {
-        finite_mean(idx.iter().map(|&i| g(&meas[i], &model[i])))
-    };
-    let circ = |g: &dyn Fn(&CycleFeatures) -> f64, set: &[CycleFeatures]| {
-        circular_mean(idx.iter().map(|&i| g(&set[i])))
-    };
-    m.model_energy = over(&|_, b| b.energy);
-    m.measured_c_eq = over(&|a, _| a.c_eq);
-    m.model_c_eq = over(&|_, b| b.c_eq);
-    m.c_eq_error = over(&|a, b| (b.c_eq - a.c_eq).abs());
-    m.measured_phase_x = circ(&|f| f.phase_x, meas);
-    m.model_phase_x = circ(&|f| f.phase_x, model);
-    m.phase_x_error = over(&|a, b| phase_error(a.phase_x, b.phase_x));
-    m.measured_phase_v = circ(&|f| f.phase_v, meas);
-    m.model_phase_v = circ(&|f| f.phase_v, model);
-    m.phase_v_error = over(&|a, b| phase_error(a.phase_v, b.phase_v));
-    m.measured_peak_force = over(&|a, _| a.f_peak);
-    m.model_peak_force = over(&|_, b| b.f_peak);
-}
-
+/// The metrics of the cycles `idx`; see the [module doc](self).
 fn metrics_over(
     idx: &[usize],
     measured: &Classification,
@@ -243,16 +201,18 @@ fn metrics_over(
     }
     let rms = |s: f64| if n > 0 { (s / n as f64).sqrt() } else { 0.0 };
     let (err, meas) = (rms(e2), rms(m2));
-    let pair = |i: usize| -> (&CycleFeatures, &CycleFeatures) {
-        (&measured.features[i], &model.features[i])
-    };
+    let (mf, pf) = (&measured.features, &model.features);
+    let pairs = || idx.iter().map(|&i| (&mf[i], &pf[i]));
     let over = |g: &dyn Fn(&CycleFeatures, &CycleFeatures) -> f64| {
-        mean(idx.iter().map(|&i| {
-            let (a, b) = pair(i);
-            g(a, b)
-        }))
+        mean_or(pairs().map(|(a, b)| g(a, b)), 0.0)
     };
-    let mut m = RegimeMetrics {
+    let finite = |g: &dyn Fn(&CycleFeatures, &CycleFeatures) -> f64| {
+        finite_mean(pairs().map(|(a, b)| g(a, b)))
+    };
+    let circ = |g: &dyn Fn(&CycleFeatures) -> f64, set: &[CycleFeatures]| {
+        circular_mean(idx.iter().map(|&i| g(&set[i])))
+    };
+    RegimeMetrics {
         cycles: idx.len(),
         measured_rms: meas,
         model_rms: rms(p2),
@@ -264,25 +224,24 @@ fn metrics_over(
         model_duty: over(&|_, b| b.duty),
         duty_error: over(&|a, b| (b.duty - a.duty).abs()),
         peak_force_error: over(&|a, b| (b.f_peak - a.f_peak).abs()),
-        label_agreement: mean(
+        label_agreement: mean_or(
             idx.iter()
                 .map(|&i| f64::from(u8::from(measured.labels[i] == model.labels[i]))),
+            0.0,
         ),
-        model_energy: 0.0,
-        measured_c_eq: 0.0,
-        model_c_eq: 0.0,
-        c_eq_error: 0.0,
-        measured_phase_x: f64::NAN,
-        model_phase_x: f64::NAN,
-        phase_x_error: f64::NAN,
-        measured_phase_v: f64::NAN,
-        model_phase_v: f64::NAN,
-        phase_v_error: f64::NAN,
-        measured_peak_force: 0.0,
-        model_peak_force: 0.0,
-    };
-    loop_metrics(idx, &measured.features, &model.features, &mut m);
-    m
+        model_energy: finite(&|_, b| b.energy),
+        measured_c_eq: finite(&|a, _| a.c_eq),
+        model_c_eq: finite(&|_, b| b.c_eq),
+        c_eq_error: finite(&|a, b| (b.c_eq - a.c_eq).abs()),
+        measured_phase_x: circ(&|f| f.phase_x, mf),
+        model_phase_x: circ(&|f| f.phase_x, pf),
+        phase_x_error: finite(&|a, b| phase_error(a.phase_x, b.phase_x)),
+        measured_phase_v: circ(&|f| f.phase_v, mf),
+        model_phase_v: circ(&|f| f.phase_v, pf),
+        phase_v_error: finite(&|a, b| phase_error(a.phase_v, b.phase_v)),
+        measured_peak_force: finite(&|a, _| a.f_peak),
+        model_peak_force: finite(&|_, b| b.f_peak),
+    }
 }
 
 /// RMS of the force error in each measured cycle, N.
@@ -324,9 +283,7 @@ pub fn compare(
     )?;
     let mut per_regime = PerRegime::default();
     for r in Regime::ALL {
-        let idx: Vec<usize> = (0..measured.labels.len())
-            .filter(|&i| measured.labels[i] == r)
-            .collect();
+        let idx = measured.cycles_in(r);
         let m = (!idx.is_empty()).then(|| metrics_over(&idx, measured, &model, sig.f, model_force));
         per_regime.set(r, m);
     }

@@ -23,7 +23,7 @@ use super::error::{check_len, RegimeError};
 use super::metrics::PerRegime;
 
 /// The error of a prediction over the cycles of one regime.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct RegimeRms {
     /// Cycles in the regime.
     pub cycles: usize,
@@ -47,13 +47,7 @@ pub fn rms_by_regime(
 ) -> Result<PerRegime<RegimeRms>, RegimeError> {
     let n = measured.len();
     check_len("predicted", predicted, n)?;
-    if labels.len() != cycles.len() {
-        return Err(RegimeError::LengthMismatch {
-            name: "labels",
-            len: labels.len(),
-            expected: cycles.len(),
-        });
-    }
+    check_len("labels", labels, cycles.len())?;
     let mut out = PerRegime::default();
     for regime in Regime::ALL {
         let (mut cycles_in, mut samples, mut e2, mut m2) = (0, 0, 0.0, 0.0);

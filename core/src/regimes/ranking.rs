@@ -14,7 +14,7 @@
 use serde::Serialize;
 
 use super::classify::Regime;
-use super::metrics::{Comparison, PerRegime};
+use super::metrics::{mean_or, Comparison, PerRegime};
 
 /// A model's score (lower is better).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -49,7 +49,8 @@ impl Ranking {
     }
 }
 
-fn sorted(mut v: Vec<Score>) -> Vec<Score> {
+/// `v` best first (lowest score), NaN scores last.
+pub(super) fn sorted(mut v: Vec<Score>) -> Vec<Score> {
     v.sort_by(|a, b| match (a.score.is_nan(), b.score.is_nan()) {
         (false, false) => a.score.total_cmp(&b.score),
         (x, y) => x.cmp(&y),
@@ -74,20 +75,14 @@ pub fn rank_models(results: &[(&str, &Comparison)]) -> Ranking {
     }
     let overall = results
         .iter()
-        .map(|(name, c)| {
-            let s: Vec<f64> = Regime::ALL
-                .iter()
-                .filter_map(|&r| c.per_regime.get(r).map(|m| m.relative_rms_error))
-                .collect();
-            let score = if s.is_empty() {
-                f64::NAN
-            } else {
-                s.iter().sum::<f64>() / s.len() as f64
-            };
-            Score {
-                model: name.to_string(),
-                score,
-            }
+        .map(|(name, c)| Score {
+            model: name.to_string(),
+            score: mean_or(
+                Regime::ALL
+                    .iter()
+                    .filter_map(|&r| c.per_regime.get(r).map(|m| m.relative_rms_error)),
+                f64::NAN,
+            ),
         })
         .collect();
     Ranking {

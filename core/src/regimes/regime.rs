@@ -31,16 +31,4 @@ impl Regime {
             Regime::PostResonance => "post_resonance",
         }
     }
-
-    pub(crate) fn rank(self) -> u8 {
-        self as u8
-    }
-
-    pub(crate) fn from_rank(r: u8) -> Regime {
-        match r {
-            0 => Regime::PreResonance,
-            1 => Regime::Resonance,
-            _ => Regime::PostResonance,
-        }
-    }
 }

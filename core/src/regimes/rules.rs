@@ -31,8 +31,8 @@
 //! looked for within `smoothing_cycles` (at least 3) cycles of the change, and at least the two
 //! cycles of the change itself (as in [`super::boundaries`]).
 
-use super::boundaries::{Boundaries, Boundary, BoundaryRule};
-use super::classify::Regime;
+use super::boundaries::{boundary_at, Boundaries, Boundary, BoundaryRule};
+use super::classify::{median_filter, Regime};
 use super::features::CycleFeatures;
 use super::thresholds::RegimeThresholds;
 
@@ -68,52 +68,11 @@ pub struct Placed {
     pub boundaries: Boundaries,
 }
 
-/// Median filter of booleans over `window` cycles (the window shrinks at the ends).
-fn median_bool(x: &[bool], window: usize) -> Vec<bool> {
-    let n = x.len();
-    let h = window / 2;
-    (0..n)
-        .map(|i| {
-            let hi = h.min(i).min(n - 1 - i);
-            let on = x[i - hi..=i + hi].iter().filter(|&&b| b).count();
-            2 * on > 2 * hi + 1
-        })
-        .collect()
-}
-
-/// The boundary at position `j` of the sweep order (`j ≥ 1`), where `new_side` tells which
-/// unsmoothed cycles belong to the side after the change.
-fn boundary_at(
-    omega: &[f64],
-    new_side: &[bool],
-    j: usize,
-    window: usize,
-    rule: BoundaryRule,
-) -> Boundary {
-    let n = omega.len();
-    let w = window.max(3);
-    let (lo_n, hi_n) = (j.saturating_sub(w), (j + w).min(n));
-    let first_new = (lo_n..hi_n).find(|&i| new_side[i]).unwrap_or(j);
-    let last_old = (lo_n..hi_n).rev().find(|&i| !new_side[i]).unwrap_or(j - 1);
-    let (lo, hi) = (first_new.min(j - 1), last_old.max(j));
-    let (a, b) = omega[lo..=hi]
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &w| {
-            (a.min(w), b.max(w))
-        });
-    Boundary {
-        omega: 0.5 * (omega[j - 1] + omega[j]),
-        uncertainty: 0.5 * (b - a),
-        cycle: j,
-        rule,
-    }
-}
-
 /// Positions (in sweep order) of the two changes and the rule of the second.
 fn changes(beh: &[Behaviour], window: usize) -> (Option<usize>, Option<(usize, BoundaryRule)>) {
     let forced: Vec<bool> = beh.iter().map(|&b| b != Behaviour::Negligible).collect();
     let on: Vec<bool> = beh.iter().map(|&b| b == Behaviour::On).collect();
-    let (forced_s, on_s) = (median_bool(&forced, window), median_bool(&on, window));
+    let (forced_s, on_s) = (median_filter(&forced, window), median_filter(&on, window));
     let Some(b1) = forced_s.iter().position(|&f| f) else {
         return (None, None);
     };
@@ -156,26 +115,19 @@ pub fn place(features: &[CycleFeatures], th: &RegimeThresholds, negligible_level
     let b2 = c2.filter(|&(j, _)| j > 0);
     let forced: Vec<bool> = beh.iter().map(|&b| b != Behaviour::Negligible).collect();
     let not_on: Vec<bool> = beh.iter().map(|&b| b != Behaviour::On).collect();
-    let mut boundaries = Boundaries {
-        pre_resonance: b1.map(|j| boundary_at(&omega, &forced, j, w, BoundaryRule::ForceOnset)),
+    // The boundary between sweep positions j − 1 and j; its `cycle` is the index of the cycle
+    // at position j.
+    let at = |j: usize, rule, side: &[bool]| Boundary {
+        cycle: order[j],
+        ..boundary_at(&omega, j, w, rule, |i| side[i], |i| !side[i])
+    };
+    let boundaries = Boundaries {
+        pre_resonance: b1.map(|j| at(j, BoundaryRule::ForceOnset, &forced)),
         resonance_post: b2.map(|(j, rule)| {
-            let side = if rule == BoundaryRule::OnOffFromOnset {
-                &forced
-            } else {
-                &not_on
-            };
-            boundary_at(&omega, side, j, w, rule)
+            let on_off_from_onset = rule == BoundaryRule::OnOffFromOnset;
+            at(j, rule, if on_off_from_onset { &forced } else { &not_on })
         }),
     };
-    for b in [
-        &mut boundaries.pre_resonance,
-        &mut boundaries.resonance_post,
-    ]
-    .into_iter()
-    .flatten()
-    {
-        b.cycle = order[b.cycle];
-    }
     let mut labels = vec![Regime::PreResonance; n];
     let mut raw = vec![Regime::PreResonance; n];
     for (pos, &i) in order.iter().enumerate() {

@@ -93,12 +93,8 @@ impl RegimeThresholds {
         let bad = |name, value, why| Err(RegimeError::BadThreshold { name, value, why });
         let nonneg = |x: f64| x >= 0.0 && x.is_finite();
         let frac = |x: f64| (0.0..=1.0).contains(&x);
-        if let Some(s) = self.noise_sigma {
-            if !nonneg(s) {
-                return bad("noise_sigma", s, "must be finite and ≥ 0");
-            }
-        }
         for (name, value) in [
+            ("noise_sigma", self.noise_sigma.unwrap_or(0.0)), // absent: estimated
             ("on_k", self.on_k),
             ("on_min", self.on_min),
             ("negligible_force", self.negligible_force),

@@ -12,7 +12,7 @@
 
 use super::csv_rows::{RowLines, Rows};
 use super::layout::{self, Raw};
-use super::{Column, Columns, DecimalMark, ReadOptions, Record, RecordError, Separator, Signal};
+use super::{Column, DecimalMark, ReadOptions, Record, RecordError, Separator, Signal};
 
 /// Where a wanted signal sits in a row (0-based) and the column name errors use.
 struct Place {
@@ -54,18 +54,13 @@ pub(super) fn read<R: std::io::Read>(
             found = Some(resolve(source, opts, None, rows.width(), line)?);
         }
         let Some(found) = &found else { continue };
-        if lines.len() == 0 {
-            for p in &found.places {
-                raw[p.signal.index()] = Some(Vec::new());
-            }
-        }
         check_width(source, found, rows.width(), line)?;
         for p in &found.places {
             let cell = rows.cell(p.index).unwrap_or_default();
             let value = number(source, line, &p.label, cell, opts.decimal, &mut scratch)?;
-            if let Some(values) = raw[p.signal.index()].as_mut() {
-                values.push(value);
-            }
+            raw[p.signal.index()]
+                .get_or_insert_with(Vec::new)
+                .push(value);
         }
         lines.push(line);
     }
@@ -84,7 +79,7 @@ pub(super) fn read<R: std::io::Read>(
     }
     let row_of = |i: usize| lines.line(i);
     let raw = layout::apply(opts, raw, source, &labels, &row_of)?;
-    Columns(raw).into_record(source, &labels, &row_of)
+    super::into_record(raw, source, &labels, &row_of)
 }
 
 /// Pass over the `skip` lines before the header, whatever they hold.
@@ -155,10 +150,8 @@ fn read_header<R: std::io::Read>(
 ) -> Result<Found, RecordError> {
     let got = rows.next_row()?;
     let line = got.unwrap_or(rows.line_number() + 1);
-    let header = match got {
-        Some(line) => rows.texts(line)?,
-        None => Vec::new(),
-    };
+    let header = got.map(|line| rows.texts(line)).transpose()?;
+    let header = header.unwrap_or_default();
     if header.iter().all(String::is_empty) {
         let what = if opts.skip > 0 {
             format!("nothing after the {} skipped line(s)", opts.skip)
@@ -183,11 +176,7 @@ fn resolve(
     width: usize,
     line: usize,
 ) -> Result<Found, RecordError> {
-    let by = if header.is_some() {
-        "header"
-    } else {
-        "first row"
-    };
+    let by = header.map_or("first row", |_| "header");
     let mut places = Vec::new();
     for (signal, ch) in opts.wanted() {
         let place = match (&ch.column, header) {

@@ -9,6 +9,8 @@
 
 use std::io::{BufRead, Read};
 
+use csv_core::ReadRecordResult;
+
 use super::RecordError;
 use crate::data::bounded::byte_size;
 
@@ -138,34 +140,22 @@ impl<'s, R: Read> Rows<'s, R> {
                 }
                 continue;
             }
-            if at_end && !self.read_line()? {
-                // The input ended inside a quoted cell: the parser closes the row.
-                let (result, _, o, e) =
-                    self.parser
-                        .read_record(&[], &mut self.cells[out..], &mut self.ends[end..]);
-                (out, end) = (out + o, end + e);
-                match result {
-                    csv_core::ReadRecordResult::OutputFull => self.grow_cells(),
-                    csv_core::ReadRecordResult::OutputEndsFull => self.grow_ends(),
-                    csv_core::ReadRecordResult::Record => return self.row(end, start),
-                    _ => return Ok(None),
-                }
-                continue;
-            }
-            let first = *start.get_or_insert(self.number);
-            let (result, used, o, e) = self.parser.read_record(
-                &self.line[self.pos..],
-                &mut self.cells[out..],
-                &mut self.ends[end..],
-            );
+            // Where the input has ended (inside a quoted cell) the parser is fed nothing and
+            // closes the row.
+            let eof = at_end && !self.read_line()?;
+            let input: &[u8] = if eof { &[] } else { &self.line[self.pos..] };
+            start.get_or_insert(self.number); // a no-op at the end: the row has begun
+            let (result, used, o, e) =
+                self.parser
+                    .read_record(input, &mut self.cells[out..], &mut self.ends[end..]);
             self.pos += used;
             (out, end) = (out + o, end + e);
             match result {
-                csv_core::ReadRecordResult::OutputFull => self.grow_cells(),
-                csv_core::ReadRecordResult::OutputEndsFull => self.grow_ends(),
-                csv_core::ReadRecordResult::Record => return self.row(end, Some(first)),
-                csv_core::ReadRecordResult::End => return Ok(None),
-                csv_core::ReadRecordResult::InputEmpty => {}
+                ReadRecordResult::OutputFull => self.cells.resize(2 * self.cells.len(), 0),
+                ReadRecordResult::OutputEndsFull => self.ends.resize(2 * self.ends.len(), 0),
+                ReadRecordResult::Record => return self.row(end, start),
+                ReadRecordResult::InputEmpty if !eof => {}
+                _ => return Ok(None),
             }
         }
     }
@@ -173,16 +163,6 @@ impl<'s, R: Read> Rows<'s, R> {
     fn row(&mut self, width: usize, start: Option<usize>) -> Result<Option<usize>, RecordError> {
         self.width = width;
         Ok(Some(start.unwrap_or(self.number)))
-    }
-
-    fn grow_cells(&mut self) {
-        let n = self.cells.len();
-        self.cells.resize(n * 2, 0);
-    }
-
-    fn grow_ends(&mut self) {
-        let n = self.ends.len();
-        self.ends.resize(n * 2, 0);
     }
 
     /// Cells in the current row.

@@ -1,6 +1,7 @@
 //! Why a record could not be read or written: the file, the row and the column, and what is
 //! wrong there.
 
+use derive_setters::Setters;
 use thiserror::Error;
 
 /// A record could not be read, validated or written.
@@ -9,16 +10,20 @@ use thiserror::Error;
 /// For CSV files, `row` is the line number a user sees in an editor (the header is line 1,
 /// the first data row is line 2); for `.mat` files it is the 1-based element of the vector;
 /// for records in memory, the 1-based sample.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[derive(Debug, Clone, PartialEq, Eq, Error, Setters)]
 #[error("{file}{}{}: {message}", row_part(*row), column_part(column.as_deref()))]
 pub struct RecordError {
     /// File path, or `(memory)`.
+    #[setters(skip)]
     pub file: String,
-    /// Row (see above), if the problem has one.
+    /// Row (see above), if the problem has one; set by `at_row`.
+    #[setters(strip_option, rename = "at_row")]
     pub row: Option<usize>,
-    /// Column (or `.mat` variable) name, if the problem has one.
+    /// Column (or `.mat` variable) name, if the problem has one; set by `in_column`.
+    #[setters(strip_option, into, rename = "in_column")]
     pub column: Option<String>,
     /// What is wrong.
+    #[setters(skip)]
     pub message: String,
 }
 
@@ -31,18 +36,6 @@ impl RecordError {
             column: None,
             message: message.into(),
         }
-    }
-
-    /// The same error at `row`.
-    pub fn at_row(mut self, row: usize) -> Self {
-        self.row = Some(row);
-        self
-    }
-
-    /// The same error in `column`.
-    pub fn in_column(mut self, column: impl Into<String>) -> Self {
-        self.column = Some(column.into());
-        self
     }
 }
 

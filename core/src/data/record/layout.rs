@@ -11,6 +11,8 @@
 use std::f64::consts::{PI, TAU};
 use std::fmt;
 
+use derive_setters::Setters;
+use serde::Deserialize;
 use thiserror::Error;
 
 use super::{ColumnNames, RecordError};
@@ -228,10 +230,10 @@ fn parameter(unit: &str, param: &'static str, value: Option<f64>) -> Result<f64,
     })?;
     let positive = param == "per_rev";
     if !value.is_finite() || value == 0.0 || (positive && value < 0.0) {
-        return Err(LayoutError::Invalid {
-            setting: "units",
-            message: format!("`{param}` = {value} must be a finite, non-zero number"),
-        });
+        return invalid(
+            "units",
+            format!("`{param}` = {value} must be a finite, non-zero number"),
+        );
     }
     Ok(value)
 }
@@ -295,7 +297,8 @@ pub enum TimeBase {
 }
 
 /// A force sensor's calibration `F = a·signal + b`, applied to `f_stf` after its unit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Calibration {
     /// Slope.
     pub a: f64,
@@ -393,8 +396,9 @@ impl LayoutError {
 /// assert_eq!(rec.x, [0.0, 0.0, 1e-3]);
 /// assert_eq!(rec.u.unwrap(), [2.5, 3.75, 5.0]);
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Setters)]
 pub struct ReadOptions {
+    #[setters(skip)]
     channels: [Channel; 6],
     /// Cell separator (CSV).
     pub separator: Separator,
@@ -405,10 +409,13 @@ pub struct ReadOptions {
     /// Whether a header row names the columns (CSV); without one, columns go by number.
     pub header: bool,
     /// Where the time comes from.
+    #[setters(skip)]
     pub time: TimeBase,
     /// The rest stretch `[t0, t1]`, s, over which `Offset::Rest` channels are averaged.
+    #[setters(skip)]
     pub rest: Option<(f64, f64)>,
     /// Calibration of `f_stf`.
+    #[setters(skip)]
     pub calibration: Option<Calibration>,
     /// The most bytes read from a record file, and the most a `.mat` file's compressed
     /// variables may inflate to ([`DEFAULT_MAX_BYTES`] unless set).
@@ -445,17 +452,11 @@ impl Default for ReadOptions {
 
 impl ReadOptions {
     /// Read with these column names (each signal may still be absent, as by default).
-    pub fn columns(mut self, names: ColumnNames) -> Self {
-        let ColumnNames {
-            t,
-            x,
-            phi,
-            f_stf,
-            omega,
-            u,
-        } = names;
-        for (signal, name) in Signal::ALL.into_iter().zip([t, x, phi, f_stf, omega, u]) {
-            self.channels[signal.index()].column = Column::Name(name);
+    pub fn columns(mut self, n: ColumnNames) -> Self {
+        // The channels are in the order of `Signal::ALL`.
+        let names = [n.t, n.x, n.phi, n.f_stf, n.omega, n.u];
+        for (channel, name) in self.channels.iter_mut().zip(names) {
+            channel.column = Column::Name(name);
         }
         self
     }
@@ -480,30 +481,6 @@ impl ReadOptions {
         self
     }
 
-    /// Cells are separated by `separator`.
-    pub fn separator(mut self, separator: Separator) -> Self {
-        self.separator = separator;
-        self
-    }
-
-    /// Numbers use `decimal` as the decimal mark.
-    pub fn decimal(mut self, decimal: DecimalMark) -> Self {
-        self.decimal = decimal;
-        self
-    }
-
-    /// `lines` lines come before the header row.
-    pub fn skip(mut self, lines: usize) -> Self {
-        self.skip = lines;
-        self
-    }
-
-    /// Whether a header row names the columns.
-    pub fn header(mut self, header: bool) -> Self {
-        self.header = header;
-        self
-    }
-
     /// Time from a sample rate (Hz), the first sample at `t0` s; no `t` column is read.
     pub fn rate(mut self, rate: f64, t0: f64) -> Self {
         self.time = TimeBase::Rate { rate, t0 };
@@ -519,12 +496,6 @@ impl ReadOptions {
     /// Calibrate `f_stf`: `F = a·signal + b`.
     pub fn calibration(mut self, a: f64, b: f64) -> Self {
         self.calibration = Some(Calibration { a, b });
-        self
-    }
-
-    /// Refuse a record file over `bytes` (a `.mat` file: whose variables inflate past it).
-    pub fn max_bytes(mut self, bytes: u64) -> Self {
-        self.max_bytes = bytes;
         self
     }
 
@@ -555,7 +526,6 @@ impl ReadOptions {
 
     /// Check that the settings can work together.
     pub fn check(&self) -> Result<(), LayoutError> {
-        let invalid = |setting, message: String| Err(LayoutError::Invalid { setting, message });
         for (signal, ch) in Signal::ALL.map(|s| (s, self.channel(s))) {
             match &ch.column {
                 Column::Number(0) => {
@@ -584,7 +554,7 @@ impl ReadOptions {
             }
             match ch.offset {
                 Some(_) if signal == Signal::T => {
-                    return invalid("offsets", "`t` takes no offset (set `t0`)".into())
+                    return invalid("offsets", "`t` takes no offset (set `t0`)")
                 }
                 Some(Offset::Value(v)) if !v.is_finite() => {
                     return invalid(
@@ -616,7 +586,6 @@ impl ReadOptions {
         let TimeBase::Rate { rate, t0 } = self.time else {
             return Ok(());
         };
-        let invalid = |setting, message: String| Err(LayoutError::Invalid { setting, message });
         if !(rate.is_finite() && rate > 0.0) {
             return invalid("rate", format!("{rate} must be a positive sample rate, Hz"));
         }
@@ -627,13 +596,13 @@ impl ReadOptions {
         if t.required {
             return invalid(
                 "rate",
-                "give either a `t` column or a sample `rate`, not both".into(),
+                "give either a `t` column or a sample `rate`, not both",
             );
         }
         if t.unit != Unit::Second {
             return invalid(
                 "units",
-                "`t` has no unit when a sample `rate` gives the time".into(),
+                "`t` has no unit when a sample `rate` gives the time",
             );
         }
         Ok(())
@@ -644,31 +613,37 @@ impl ReadOptions {
             return Ok(());
         };
         if !(a.is_finite() && b.is_finite() && b > a) {
-            return Err(LayoutError::Invalid {
-                setting: "rest",
-                message: format!("[{a}, {b}] is not a stretch of time: need t0 < t1, in s"),
-            });
+            return invalid(
+                "rest",
+                format!("[{a}, {b}] is not a stretch of time: need t0 < t1, in s"),
+            );
         }
         if !self.channels.iter().any(|c| c.offset == Some(Offset::Rest)) {
-            return Err(LayoutError::Invalid {
-                setting: "rest",
-                message: "no channel's offset is \"rest\": name them, e.g. \
-                          offsets = { x = \"rest\" }"
-                    .into(),
-            });
+            return invalid(
+                "rest",
+                "no channel's offset is \"rest\": name them, e.g. offsets = { x = \"rest\" }",
+            );
         }
         Ok(())
     }
 
     fn check_text(&self) -> Result<(), LayoutError> {
         if self.decimal == DecimalMark::Comma && self.separator == Separator::Comma {
-            return Err(LayoutError::Invalid {
-                setting: "decimal",
-                message: "decimal commas need another separator (`;` or tab)".into(),
-            });
+            return invalid(
+                "decimal",
+                "decimal commas need another separator (`;` or tab)",
+            );
         }
         Ok(())
     }
+}
+
+/// A [`LayoutError::Invalid`] of `setting`.
+fn invalid<T>(setting: &'static str, message: impl Into<String>) -> Result<T, LayoutError> {
+    Err(LayoutError::Invalid {
+        setting,
+        message: message.into(),
+    })
 }
 
 /// The signals as recorded, by [`Signal`] index, before the layout is applied.

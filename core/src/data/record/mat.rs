@@ -11,7 +11,7 @@
 //! (`mat_inflate`).
 
 use super::layout::{self, Raw};
-use super::{Column, Columns, ReadOptions, Record, RecordError, Signal};
+use super::{Column, ReadOptions, Record, RecordError, Signal};
 use std::path::Path;
 
 const SAVE_HINT: &str = "save the signals as double vectors with `save(file, ..., '-v7')`";
@@ -34,12 +34,11 @@ pub(super) fn read_bytes(
     source: &str,
     opts: &ReadOptions,
 ) -> Result<Record, RecordError> {
-    let source = source.to_string();
-    check_header(&source, bytes)?;
-    let bytes = super::mat_inflate::inflate(bytes, &source, opts.max_bytes)?;
+    check_header(source, bytes)?;
+    let bytes = super::mat_inflate::inflate(bytes, source, opts.max_bytes)?;
     let file = matfile::MatFile::parse(&bytes[..]).map_err(|e| {
         RecordError::new(
-            &source,
+            source,
             format!(
                 "cannot parse the .mat file ({e}); the reader handles numeric double, single \
                  and (u)int8/16 arrays, and a single int32 variable makes the whole file \
@@ -54,7 +53,7 @@ pub(super) fn read_bytes(
             Column::Name(name) => name,
             Column::Number(k) => {
                 return Err(RecordError::new(
-                    &source,
+                    source,
                     format!(
                         "`{signal}` is given as column {k}: a .mat file names its variables, \
                          so give the variable's name"
@@ -64,10 +63,9 @@ pub(super) fn read_bytes(
             }
         };
         labels[signal.index()].clone_from(name);
-        raw[signal.index()] = vector(&source, &file, name)?;
-        let must = opts.needs(signal);
-        if must && raw[signal.index()].is_none() {
-            return Err(missing(&source, &file, name, ""));
+        raw[signal.index()] = vector(source, &file, name)?;
+        if opts.needs(signal) && raw[signal.index()].is_none() {
+            return Err(missing(source, &file, name, ""));
         }
     }
     if raw[Signal::Phi.index()].is_none() && raw[Signal::U.index()].is_none() {
@@ -75,15 +73,10 @@ pub(super) fn read_bytes(
             " (or `{}` for a force-driven rig)",
             labels[Signal::U.index()]
         );
-        return Err(missing(
-            &source,
-            &file,
-            &labels[Signal::Phi.index()],
-            &extra,
-        ));
+        return Err(missing(source, &file, &labels[Signal::Phi.index()], &extra));
     }
-    let raw = layout::apply(opts, raw, &source, &labels, &|i| i + 1)?;
-    Columns(raw).into_record(&source, &labels, &|i| i + 1)
+    let raw = layout::apply(opts, raw, source, &labels, &|i| i + 1)?;
+    super::into_record(raw, source, &labels, &|i| i + 1)
 }
 
 /// The variable `name` is not in the file (or not readable).

@@ -160,79 +160,74 @@ impl ReadOptions {
     }
 }
 
-/// The signals of a record while it is being assembled, before validation, by
-/// [`Signal`] index; `t` and `x` are present.
-pub(crate) struct Columns(pub layout::Raw);
-
-impl Columns {
-    /// Check the signals and make a record: equal lengths, at least one sample, finite
-    /// values, strictly increasing time, φ or u present. `labels` name the columns (by
-    /// [`Signal`] index) and `row_of` turns a 0-based sample index into the row a user sees.
-    pub(crate) fn into_record(
-        self,
-        source: &str,
-        labels: &[String; 6],
-        row_of: &dyn Fn(usize) -> usize,
-    ) -> Result<Record, RecordError> {
-        let [t, x, phi, f_stf, omega, u] = self.0;
-        let (t, x) = (t.unwrap_or_default(), x.unwrap_or_default());
-        let n = t.len();
-        let err = |message: String| RecordError::new(source, message);
-        let label = |s: Signal| labels[s.index()].as_str();
-        if n == 0 {
-            return Err(err("no data: the record has no samples".into()));
-        }
-        let named = [
-            (Signal::T, Some(&t)),
-            (Signal::X, Some(&x)),
-            (Signal::Phi, phi.as_ref()),
-            (Signal::FStf, f_stf.as_ref()),
-            (Signal::Omega, omega.as_ref()),
-            (Signal::U, u.as_ref()),
-        ];
-        for (signal, values) in named {
-            let Some(values) = values else { continue };
-            if values.len() != n {
-                return Err(err(format!(
-                    "has {} values but `{}` has {n}: all signals need the same length",
-                    values.len(),
-                    label(Signal::T)
-                ))
-                .in_column(label(signal)));
-            }
-            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-                return Err(err(format!("not a finite number: `{}`", values[i]))
-                    .at_row(row_of(i))
-                    .in_column(label(signal)));
-            }
-        }
-        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(err(format!(
-                "time is not strictly increasing: {} s follows {} s",
-                t[i + 1],
-                t[i]
-            ))
-            .at_row(row_of(i + 1))
-            .in_column(label(Signal::T)));
-        }
-        if phi.is_none() && u.is_none() {
-            return Err(err(format!(
-                "missing column `{}` (or `{}` for a force-driven rig)",
-                label(Signal::Phi),
-                label(Signal::U)
-            ))
-            .in_column(label(Signal::Phi)));
-        }
-        Ok(Record {
-            source: source.to_string(),
-            t,
-            x,
-            phi,
-            f_stf,
-            omega,
-            u,
-        })
+/// Check the signals of a record being assembled (by [`Signal`] index; `t` and `x` present)
+/// and make a record: equal lengths, at least one sample, finite values, strictly increasing
+/// time, φ or u present. `labels` name the columns (by [`Signal`] index) and `row_of` turns a
+/// 0-based sample index into the row a user sees.
+pub(crate) fn into_record(
+    raw: layout::Raw,
+    source: &str,
+    labels: &[String; 6],
+    row_of: &dyn Fn(usize) -> usize,
+) -> Result<Record, RecordError> {
+    let [t, x, phi, f_stf, omega, u] = raw;
+    let (t, x) = (t.unwrap_or_default(), x.unwrap_or_default());
+    let n = t.len();
+    let err = |message: String| RecordError::new(source, message);
+    let label = |s: Signal| labels[s.index()].as_str();
+    if n == 0 {
+        return Err(err("no data: the record has no samples".into()));
     }
+    let named = [
+        (Signal::T, Some(&t)),
+        (Signal::X, Some(&x)),
+        (Signal::Phi, phi.as_ref()),
+        (Signal::FStf, f_stf.as_ref()),
+        (Signal::Omega, omega.as_ref()),
+        (Signal::U, u.as_ref()),
+    ];
+    for (signal, values) in named {
+        let Some(values) = values else { continue };
+        if values.len() != n {
+            return Err(err(format!(
+                "has {} values but `{}` has {n}: all signals need the same length",
+                values.len(),
+                label(Signal::T)
+            ))
+            .in_column(label(signal)));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(err(format!("not a finite number: `{}`", values[i]))
+                .at_row(row_of(i))
+                .in_column(label(signal)));
+        }
+    }
+    if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(err(format!(
+            "time is not strictly increasing: {} s follows {} s",
+            t[i + 1],
+            t[i]
+        ))
+        .at_row(row_of(i + 1))
+        .in_column(label(Signal::T)));
+    }
+    if phi.is_none() && u.is_none() {
+        return Err(err(format!(
+            "missing column `{}` (or `{}` for a force-driven rig)",
+            label(Signal::Phi),
+            label(Signal::U)
+        ))
+        .in_column(label(Signal::Phi)));
+    }
+    Ok(Record {
+        source: source.to_string(),
+        t,
+        x,
+        phi,
+        f_stf,
+        omega,
+        u,
+    })
 }
 
 /// The contract's names of the signals, by [`Signal`] index (the labels of a record in
@@ -266,16 +261,15 @@ impl Record {
     /// at least one sample, finite values, strictly increasing `t`, `phi` or `u` present.
     /// Rows in errors are 1-based sample numbers.
     pub fn validate(&self) -> Result<(), RecordError> {
-        Columns([
+        let raw = [
             Some(self.t.clone()),
             Some(self.x.clone()),
             self.phi.clone(),
             self.f_stf.clone(),
             self.omega.clone(),
             self.u.clone(),
-        ])
-        .into_record(&self.source, &contract_labels(), &|i| i + 1)
-        .map(|_| ())
+        ];
+        into_record(raw, &self.source, &contract_labels(), &|i| i + 1).map(|_| ())
     }
 
     /// Write the record as CSV with columns `t, phi, x, f_stf, omega, u` (those present), each
