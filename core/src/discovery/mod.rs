@@ -40,17 +40,14 @@ pub mod progress;
 mod reconsider;
 pub mod score;
 mod scout;
-mod scout_ranking;
 mod search;
 mod search_model;
 pub mod settings;
 mod trajectory_gap;
 pub mod trajectory_level;
-mod trajectory_screen;
 pub mod trajectory_setup;
 mod trajectory_starts;
 mod trajectory_subset_fit;
-mod trajectory_trials;
 
 pub use before_after_validation::DiscoveryValidation;
 pub use candidate::Candidate;

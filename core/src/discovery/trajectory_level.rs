@@ -28,8 +28,15 @@
 //! level [`DiscoverySettings::noise_sigma`] is the displacement noise σ (m) and
 //! [`DiscoverySettings::fit_offset`] fits the displacement offset `x_off`.
 
+mod scout_ranking;
+mod screen;
+mod trials;
+
 use std::sync::Arc;
 
+use self::scout_ranking::scouted;
+use self::screen::SCREEN_MIN_SAMPLES;
+use self::trials::trial_settings;
 use super::acceptance::cycle_gain_z;
 use super::candidate::Candidate;
 use super::choice::{self, Said, Trial, Yardstick};
@@ -40,15 +47,12 @@ use super::holdout::{cycle_rms, rms, HoldoutSplit};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::scout::Scout;
-use super::scout_ranking::scouted;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_gap::locate_x_gap;
-use super::trajectory_screen::SCREEN_MIN_SAMPLES;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::Rig;
-use super::trajectory_trials::trial_settings;
 use crate::fit::{check_same_terms, FitResult, NoiseFloor, TrajectoryData};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::physics::oscillator_params::{OscParam, OscillatorParams};

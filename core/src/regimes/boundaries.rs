@@ -148,7 +148,7 @@ pub(super) fn boundary_at(
 
 #[cfg(test)]
 mod tests {
-    use super::super::classify::median_filter;
+    use super::super::median::median_filter;
     use super::*;
     use Regime::{PostResonance as Post, PreResonance as Pre, Resonance as Res};
 

@@ -28,6 +28,7 @@ use super::boundaries::{find_boundaries, Boundaries};
 use super::cycles::Cycle;
 use super::error::RegimeError;
 use super::features::{features, CycleFeatures};
+use super::median::median_filter;
 use super::noise::noise_floor;
 pub use super::regime::Regime;
 use super::rules::place;
@@ -109,21 +110,6 @@ pub fn label_cycles(
         })
         .collect();
     (labels, no_stf, peak_omega)
-}
-
-/// Median filter of `labels` (regimes ordered Pre < Resonance < Post, booleans false < true)
-/// over `window` cycles (odd); the window shrinks symmetrically at the ends.
-pub fn median_filter<T: Copy + Ord>(labels: &[T], window: usize) -> Vec<T> {
-    let n = labels.len();
-    let h = window / 2;
-    (0..n)
-        .map(|i| {
-            let hi = h.min(i).min(n - 1 - i);
-            let mut w = labels[i - hi..=i + hi].to_vec();
-            w.sort_unstable();
-            w[w.len() / 2]
-        })
-        .collect()
 }
 
 /// Classify the cycles of a record (see the [module doc](self) for the rules).
@@ -227,19 +213,5 @@ mod tests {
         let (l, no_stf, _) = label_cycles(&f, &th, 0.2);
         assert!(no_stf);
         assert!(l.iter().all(|&r| r == Pre));
-    }
-
-    #[test]
-    fn the_median_filter_removes_single_flips_and_keeps_changes() {
-        let l = [
-            Pre, Pre, Res, Pre, Pre, Res, Res, Post, Res, Res, Post, Post, Post,
-        ];
-        let m = median_filter(&l, 3);
-        assert_eq!(
-            m,
-            vec![Pre, Pre, Pre, Pre, Pre, Res, Res, Res, Res, Res, Post, Post, Post]
-        );
-        assert_eq!(median_filter(&l, 1), l.to_vec());
-        assert!(median_filter::<Regime>(&[], 5).is_empty());
     }
 }

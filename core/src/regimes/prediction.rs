@@ -17,10 +17,10 @@
 
 use serde::Serialize;
 
-use super::classify::Regime;
 use super::cycles::Cycle;
 use super::error::{check_len, RegimeError};
 use super::metrics::PerRegime;
+use super::regime::Regime;
 
 /// The error of a prediction over the cycles of one regime.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]

@@ -13,8 +13,8 @@
 
 use serde::Serialize;
 
-use super::classify::Regime;
 use super::metrics::{mean_or, Comparison, PerRegime};
+use super::regime::Regime;
 
 /// A model's score (lower is better).
 #[derive(Clone, Debug, PartialEq, Serialize)]

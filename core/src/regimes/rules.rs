@@ -32,8 +32,9 @@
 //! cycles of the change itself (as in [`super::boundaries`]).
 
 use super::boundaries::{boundary_at, Boundaries, Boundary, BoundaryRule};
-use super::classify::{median_filter, Regime};
 use super::features::CycleFeatures;
+use super::median::median_filter;
+use super::regime::Regime;
 use super::thresholds::RegimeThresholds;
 
 /// What a cycle's force does; see the [module doc](self).

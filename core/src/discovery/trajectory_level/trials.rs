@@ -6,24 +6,24 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::candidate::Candidate;
-use super::choice::{self, Trial, Yardstick};
-use super::error::DiscoveryError;
-use super::level::Level;
-use super::score::CandidateScore;
 use super::scout_ranking::{left_out, scouted};
-use super::search_model::SearchModel;
-use super::settings::DiscoverySettings;
-use super::trajectory_level::TrajectoryLevel;
-use super::trajectory_screen::SCREEN_KEEP;
-use super::trajectory_setup::TrajectorySetup;
-use super::trajectory_subset_fit::{fit_on, Rig, Run, Track};
+use super::screen::SCREEN_KEEP;
+use super::TrajectoryLevel;
+use crate::discovery::candidate::Candidate;
+use crate::discovery::choice::{self, Trial, Yardstick};
+use crate::discovery::error::DiscoveryError;
+use crate::discovery::level::Level;
+use crate::discovery::score::CandidateScore;
+use crate::discovery::search_model::SearchModel;
+use crate::discovery::settings::DiscoverySettings;
+use crate::discovery::trajectory_setup::TrajectorySetup;
+use crate::discovery::trajectory_subset_fit::{fit_on, Rig, Run, Track};
 use crate::fit::{FitParam, FitResult, DISPLACEMENT_OFFSET};
 use crate::physics::force_model::ForceModel;
 
 impl SearchModel {
     /// Every parameter of the fit, starting from this stage's values.
-    pub(super) fn params(
+    pub(in crate::discovery) fn params(
         &self,
         setup: &TrajectorySetup,
         model: &Arc<dyn ForceModel>,
@@ -49,7 +49,7 @@ impl SearchModel {
     }
 
     /// Fit on `subset`: the stage with the fitted values, and the fit.
-    pub(super) fn fit_simulated(
+    pub(in crate::discovery) fn fit_simulated(
         &self,
         track: &dyn Track,
         setup: &TrajectorySetup,
@@ -67,14 +67,14 @@ impl SearchModel {
     }
 
     /// The simulated run of this stage at its values.
-    pub(super) fn run(&self, rig: &Rig) -> Result<Run, DiscoveryError> {
+    pub(in crate::discovery) fn run(&self, rig: &Rig) -> Result<Run, DiscoveryError> {
         let model = self.model()?;
         rig.run(&model, &self.values)
             .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
     }
 
     /// The displacement residual of this stage at its values (the integration alone).
-    pub(super) fn residual(&self, rig: &Rig) -> Result<Vec<f64>, DiscoveryError> {
+    pub(in crate::discovery) fn residual(&self, rig: &Rig) -> Result<Vec<f64>, DiscoveryError> {
         let model = self.model()?;
         rig.residual(&model, &self.values)
             .map_err(|e| DiscoveryError::BadData(format!("simulating `{}`: {e}", self.name())))
@@ -82,11 +82,11 @@ impl SearchModel {
 }
 
 /// Most Levenberg–Marquardt iterations of a candidate's trial at trajectory level.
-pub(super) const TRIAL_ITERS: u64 = 60;
+pub(in crate::discovery) const TRIAL_ITERS: u64 = 60;
 
 /// Most Levenberg–Marquardt iterations of a candidate's trial on the whole record after its
-/// scout (see [`super::scout`]).
-pub(super) const SCOUTED_TRIAL_ITERS: u64 = 15;
+/// scout (see [`crate::discovery::scout`]).
+pub(in crate::discovery) const SCOUTED_TRIAL_ITERS: u64 = 15;
 
 impl TrajectoryLevel<'_> {
     /// The scores of the candidates `tried` against `current` in `step`, in their order.
@@ -101,7 +101,7 @@ impl TrajectoryLevel<'_> {
     /// hundreds of simulations. On a scouted record each candidate's values are searched on
     /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
     /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
-    pub(super) fn scores(
+    pub(in crate::discovery) fn scores(
         &self,
         step: usize,
         tried: &[&Candidate],
@@ -170,7 +170,7 @@ impl TrajectoryLevel<'_> {
     /// scout when there is one; its mean square on the scout's training samples (m²;
     /// infinite without a scout) and its RMS on the whole record's training samples (m; NaN
     /// without a scout).
-    pub(super) fn searched(
+    pub(in crate::discovery) fn searched(
         &self,
         with: SearchModel,
         hinted: Option<&SearchModel>,
@@ -195,7 +195,7 @@ impl TrajectoryLevel<'_> {
     /// `current`. Scouted, the search is done: the trial polishes, at most
     /// `SCOUTED_TRIAL_ITERS` iterations (a candidate still wandering then is scored where it
     /// stopped, as one wandering on the whole record is after `TRIAL_ITERS`).
-    pub(super) fn scored(
+    pub(in crate::discovery) fn scored(
         &self,
         c: &Candidate,
         stage: SearchModel,
@@ -221,6 +221,6 @@ impl TrajectoryLevel<'_> {
 /// Levenberg–Marquardt alone, at most `TRIAL_ITERS` iterations: a candidate whose fit does
 /// not settle by then (a stiff relaxation wandering through thousands of simulations) is
 /// scored where it stopped, not chased by Nelder–Mead.
-pub(super) fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
+pub(in crate::discovery) fn trial_settings(settings: &DiscoverySettings) -> DiscoverySettings {
     settings.levenberg_marquardt(Some(TRIAL_ITERS))
 }

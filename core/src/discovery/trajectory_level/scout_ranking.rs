@@ -1,34 +1,34 @@
-//! Which scouted candidates are tried on the whole record ([`super::scout`]): each ranked by
+//! Which scouted candidates are tried on the whole record ([`crate::discovery::scout`]): each ranked by
 //! the gain of its scout fit ([`TrajectoryLevel::scout_ranks`]), the best [`SCOUT_KEEP`] kept unless
 //! their gain is a small share of the best one's ([`left_out`]); and where a scouted fit
 //! continues on the whole record ([`scouted`]).
 
-use super::choice::Trial;
-use super::holdout::rms_over;
-use super::scout::Scout;
-use super::search_model::SearchModel;
-use super::settings::DiscoverySettings;
-use super::trajectory_level::TrajectoryLevel;
-use super::trajectory_setup::TrajectorySetup;
-use super::trajectory_subset_fit::{Rig, Track};
+use super::TrajectoryLevel;
+use crate::discovery::choice::Trial;
+use crate::discovery::holdout::rms_over;
+use crate::discovery::scout::Scout;
+use crate::discovery::search_model::SearchModel;
+use crate::discovery::settings::DiscoverySettings;
+use crate::discovery::trajectory_setup::TrajectorySetup;
+use crate::discovery::trajectory_subset_fit::{Rig, Track};
 
 /// Candidates fitted on the whole record in a scouted step, at most: the others are ranked
 /// out by their fits on the scout (see [`TrajectoryLevel::scores`]).
-pub(super) const SCOUT_KEEP: usize = 3;
+pub(in crate::discovery) const SCOUT_KEEP: usize = 3;
 
 /// The least share of the best candidate's gain on the scout for a candidate to be tried on
 /// the whole record in a scouted step (see [`TrajectoryLevel::scores`]). A candidate that lowers the
 /// scout's mean square by a fraction of what the best one does cannot win the step unless
 /// the best one fails on the whole record; on Silverbox's 100 000 samples `jamming_on_off`
 /// (5 % of the excess explained) cost more than the two cubic springs' trials together.
-pub(super) const SCOUT_SHARE: f64 = 0.2;
+pub(in crate::discovery) const SCOUT_SHARE: f64 = 0.2;
 
 /// Why a scouted candidate is not fitted on the whole record, if it is not: its scout rank
 /// (`rank` of `of`, gain in m²) is past [`SCOUT_KEEP`], its gain is under [`SCOUT_SHARE`] of
 /// the best candidate's `best`, or its scout fit (`start_rms`, m) is no better than the
 /// current model's training RMS `current` on the whole record — where the search failed, and
 /// a short polish does not climb out.
-pub(super) fn left_out(
+pub(in crate::discovery) fn left_out(
     scout_rank: Option<(usize, usize, f64)>,
     best: f64,
     start_rms: f64,
@@ -76,7 +76,7 @@ impl TrajectoryLevel<'_> {
     /// Each searched candidate's rank among them by the gain of its scout fit over the
     /// current model on the scout, their number and the gain (mean square, m²); all `None`
     /// without a scout, or when no more than [`SCOUT_KEEP`] were searched.
-    pub(super) fn scout_ranks(
+    pub(in crate::discovery) fn scout_ranks(
         &self,
         searched: &[Option<(SearchModel, f64, f64)>],
         current: &Trial,
@@ -106,7 +106,7 @@ impl TrajectoryLevel<'_> {
 /// if that lowers the whole record's RMS at the samples `train`, else `stage` (one
 /// simulation of each); with its mean square on the scout's training samples (m²) and its RMS
 /// at `train` (m).
-pub(super) fn scouted(
+pub(in crate::discovery) fn scouted(
     stage: SearchModel,
     scout: &Scout,
     (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),

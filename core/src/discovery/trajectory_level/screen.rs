@@ -6,13 +6,13 @@
 
 use rayon::prelude::*;
 
-use super::choice::Trial;
-use super::force_level::started_fit;
-use super::search_model::SearchModel;
-use super::trajectory_level::TrajectoryLevel;
-use super::trajectory_setup::ForceHint;
-use super::trajectory_subset_fit::Rig;
+use super::TrajectoryLevel;
 use crate::data::force_data::ForceData;
+use crate::discovery::choice::Trial;
+use crate::discovery::force_level::started_fit;
+use crate::discovery::search_model::SearchModel;
+use crate::discovery::trajectory_setup::ForceHint;
+use crate::discovery::trajectory_subset_fit::Rig;
 use crate::fit::{FitSettings, Solver};
 
 impl SearchModel {
@@ -20,7 +20,7 @@ impl SearchModel {
     /// `hint` on (every k-th of) the `train` samples — from its values, from them with the
     /// last part's amplitude near zero, and from the models' defaults, the best kept — and
     /// that fit's RMS residual; the oscillator's values are kept. `None` if no fit succeeds.
-    pub(super) fn force_started(
+    pub(in crate::discovery) fn force_started(
         &self,
         rig: &Rig,
         hint: &ForceHint,
@@ -79,26 +79,26 @@ impl SearchModel {
 
 /// Most samples of the force-level fit that starts a trajectory fit (see
 /// [`SearchModel::force_started`]).
-pub(super) const HINT_SAMPLES: usize = 20_000;
+pub(in crate::discovery) const HINT_SAMPLES: usize = 20_000;
 
 /// Candidates fitted at trajectory level in a step, at most: the others are ranked out by the
 /// screen of [`TrajectoryLevel::scores`].
-pub(super) const SCREEN_KEEP: usize = 3;
+pub(in crate::discovery) const SCREEN_KEEP: usize = 3;
 
 /// The least gain, as a share of the current model's mean square at force level, for the
 /// screen of [`TrajectoryLevel::scores`] to rank.
-pub(super) const SCREEN_MIN_GAIN: f64 = 0.01;
+pub(in crate::discovery) const SCREEN_MIN_GAIN: f64 = 0.01;
 
 /// Fewest samples a cycle for the force-level screen of [`TrajectoryLevel::scores`] to rank: below it the
 /// derivative filter's ẍ, and with it the recovered force, is mostly bias (on an electronic
 /// oscillator at 9 samples a period the screen ranked the true cubic spring 5th of 6).
-pub(super) const SCREEN_MIN_SAMPLES: usize = 20;
+pub(in crate::discovery) const SCREEN_MIN_SAMPLES: usize = 20;
 
 /// The force-level screen of a step's candidates ([`TrajectoryLevel::force_screen`]): each
 /// candidate's force-level start and that fit's RMS (N), its gain over the current model's
 /// mean square (N²), its rank by the gain (0 the best), and whether the screen ranks out all
 /// but [`SCREEN_KEEP`].
-pub(super) type ForceScreen = (
+pub(in crate::discovery) type ForceScreen = (
     Vec<Option<(SearchModel, f64)>>,
     Vec<Option<f64>>,
     Vec<usize>,
@@ -109,7 +109,11 @@ impl TrajectoryLevel<'_> {
     /// The force-level screen of the candidates `withs` (each added to `current`): each one's
     /// force-level start and its RMS, its gain over `current` (N²), its rank by the gain, and
     /// whether the screen ranks out all but [`SCREEN_KEEP`].
-    pub(super) fn force_screen(&self, withs: &[SearchModel], current: &Trial) -> ForceScreen {
+    pub(in crate::discovery) fn force_screen(
+        &self,
+        withs: &[SearchModel],
+        current: &Trial,
+    ) -> ForceScreen {
         let train = &self.split.train;
         let hint = self.setup.force_hint.as_ref();
         let hinted: Vec<Option<(SearchModel, f64)>> = withs
