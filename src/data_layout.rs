@@ -118,15 +118,7 @@ fn layout(cx: &Ctx, span: &Range<usize>, raw: &RawData) -> Result<ReadOptions> {
     opts.rest = raw.rest.as_ref().map(|r| (r.get_ref()[0], r.get_ref()[1]));
     opts.calibration = raw.calibration.as_ref().map(|c| *c.get_ref());
     if let Some(m) = &raw.max_bytes {
-        let v = *m.get_ref();
-        let what = format!("{v} is not a size in bytes (at least 1)");
-        cx.ensure(
-            v >= 1.0 && v <= u64::MAX as f64,
-            m.span(),
-            "data.max_bytes",
-            what,
-        )?;
-        opts = opts.max_bytes(v as u64);
+        opts = opts.max_bytes(cx.count(m, "data.max_bytes", 1, "size in bytes")?);
     }
     opts.check().map_err(|e| {
         let setting = e.setting();

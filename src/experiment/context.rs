@@ -59,6 +59,26 @@ impl<'a> Ctx<'a> {
         }
     }
 
+    /// A whole count read from a number: at least `least` and within `u64`, else the error
+    /// [`Ctx::at`] gives, "V is not a WHAT (at least LEAST)".
+    pub(crate) fn count(
+        &self,
+        value: &toml::Spanned<f64>,
+        key: &str,
+        least: u64,
+        what: &str,
+    ) -> anyhow::Result<u64> {
+        let v = *value.get_ref();
+        let msg = format!("{v} is not a {what} (at least {least})");
+        self.ensure(
+            v >= least as f64 && v <= u64::MAX as f64,
+            value.span(),
+            key,
+            msg,
+        )?;
+        Ok(v as u64)
+    }
+
     /// A deserialisation error of the file's text: its line, the key path of the value it is
     /// about (none for a key unknown at the top level) and serde's message.
     pub(crate) fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {

@@ -134,17 +134,7 @@ fn the_drive(s: &RawSimulate, cx: &Ctx, span: Range<usize>) -> Result<drive::Che
 fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64) -> Result<u64> {
     let limit = match &s.max_samples {
         None => DEFAULT_MAX_SAMPLES,
-        Some(m) => {
-            let v = *m.get_ref();
-            let what = format!("{v} is not a sample count (at least 2)");
-            cx.ensure(
-                v >= 2.0 && v <= u64::MAX as f64,
-                m.span(),
-                "simulate.max_samples",
-                what,
-            )?;
-            v as u64
-        }
+        Some(m) => cx.count(m, "simulate.max_samples", 2, "sample count")?,
     };
     let count = sample_count(t0, t1, s.rate);
     let asked = format!(
