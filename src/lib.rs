@@ -10,6 +10,11 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![deny(clippy::unwrap_used)]
 
+pub use stf_study::{
+    compare, data_layout, digits, discovery_curves, experiment, fitting, identify, model_config,
+    observer, outputs, param_table, plausibility, validation, verdict,
+};
+
 pub mod campaign;
 pub mod cmd_campaign;
 pub mod cmd_compare;
@@ -19,19 +24,10 @@ pub mod cmd_models;
 pub mod cmd_simulate;
 pub mod compare_loops;
 pub mod compare_markdown;
-pub mod data_layout;
-pub mod digits;
-pub mod discovery_curves;
-pub mod experiment;
-pub mod fitting;
 pub mod identify_report;
 pub mod interrupt;
-pub mod model_config;
 pub mod output;
 pub mod output_lock;
-pub mod outputs;
-pub mod param_table;
-pub mod plausibility;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;
@@ -39,5 +35,3 @@ pub mod results_dir;
 pub mod staged_files;
 pub mod standard_report;
 pub mod terminal;
-pub mod validation;
-pub mod verdict;

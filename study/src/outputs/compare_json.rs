@@ -8,8 +8,8 @@ use stf_core::regimes::{
 };
 
 use super::fit_json::ModelFitJson;
-use crate::cmd_compare::Compared;
-use crate::compare_loops::BoundaryNote;
+use crate::compare::BoundaryNote;
+use crate::compare::Compared;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 
@@ -133,7 +133,7 @@ impl<'a> CompareJson<'a> {
                 cycles: measured.labels.len(),
                 cycles_per_regime,
                 boundaries: &measured.boundaries,
-                boundary_notes: crate::compare_loops::boundary_notes(measured),
+                boundary_notes: crate::compare::boundary_notes(measured),
                 resonance: PeakJson {
                     peak_x_m: peak.amplitude,
                     peak_omega_rad_s: peak.omega,

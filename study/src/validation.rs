@@ -59,9 +59,6 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
     let mut record = read_record(exp, &spec.file).map_err(|e| spec.error(key, format!("{e:#}")))?;
     let record_warnings = crate::plausibility::check(exp, &spec.file, &record)
         .map_err(|e| spec.error(key, format!("{e:#}")))?;
-    for w in &record_warnings {
-        eprintln!("warning: {w}");
-    }
     check_columns(exp, spec, &record, estimation)?;
     if let Some((t0, t1)) = spec.window {
         record = record.slice_time(t0, t1);

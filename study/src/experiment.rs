@@ -37,11 +37,11 @@ mod simulate;
 mod system;
 mod validate;
 
-pub(crate) use context::Ctx;
+pub use context::Ctx;
 pub use context::{error_at, line_of};
 pub use discover::DiscoverSpec;
 pub use drive::{Chirp, Drive};
-pub(crate) use filter::RawDrive;
+pub use filter::RawDrive;
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
 pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
@@ -218,7 +218,7 @@ impl Experiment {
 
 /// `text` parsed as the experiment file `exp.toml`: what the tests of every section check.
 #[cfg(test)]
-pub(crate) fn parse_exp(text: &str) -> Result<Experiment> {
+pub fn parse_exp(text: &str) -> Result<Experiment> {
     Experiment::parse(Path::new("exp.toml"), text)
 }
 

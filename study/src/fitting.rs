@@ -25,7 +25,7 @@ use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
-use crate::progress::{fit_message, Progress};
+use crate::observer::{fit_message, jobs_message, Job, Observer};
 use stf_core::data::record_bounds::DataScales;
 
 /// A record with its kinematics, ready to fit.
@@ -113,9 +113,6 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let mut record = read_record(exp, file)?;
     let record_warnings = crate::plausibility::check(exp, file, &record)
         .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
-    for w in &record_warnings {
-        eprintln!("warning: {w}");
-    }
     if let Some((t0, t1)) = exp.data_window {
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
@@ -324,11 +321,10 @@ pub fn fit_model(
     exp: &Experiment,
     data: &FitData,
     configured: Option<&ConfiguredModel>,
-    progress: &indicatif::ProgressBar,
+    progress: &dyn Job,
 ) -> Result<ModelFit> {
     let (unit, scale) = data.level.shown();
-    let observer =
-        |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
+    let observer = |p: stf_core::fit::FitProgress| progress.message(&fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     let predictor = Predictor::build(exp, data, configured)?;
     let result = predictor
@@ -368,7 +364,7 @@ pub fn fit_model(
 }
 
 /// A progress observer.
-type Observer<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
+type FitObserver<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
 
 impl Predictor {
     /// The fit of `configured` (or the bare oscillator) at `data`'s level: the model's
@@ -419,7 +415,7 @@ impl Predictor {
     }
 
     /// Run the fit on `data`'s target signal.
-    fn fit(&self, data: &FitData, observer: &Observer) -> Result<FitResult, FitError> {
+    fn fit(&self, data: &FitData, observer: &FitObserver) -> Result<FitResult, FitError> {
         match self {
             Predictor::Force(f) => f.fit(&data.force_data(), Some(observer)),
             Predictor::Trajectory(f) => f.fit(&data.trajectory_data(), Some(observer)),
@@ -471,7 +467,7 @@ pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics
 
 /// Configure and fit every model of the experiment, in parallel (bounds widened where the
 /// record needs it: [`FitData::scales`]).
-pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<Vec<ModelFit>> {
+pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Result<Vec<ModelFit>> {
     let scales = data.scales(&exp.system);
     let configured: Vec<Option<ConfiguredModel>> = if exp.models.is_empty() {
         if data.level == FitLevel::Force {
@@ -500,7 +496,7 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             .collect::<Result<_>>()?
     };
     let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
-    overall.set_message(crate::progress::jobs_message(0, configured.len(), 0.0));
+    overall.message(&jobs_message(0, configured.len(), 0.0));
     let (started, done) = (
         std::time::Instant::now(),
         std::sync::atomic::AtomicUsize::new(0),
@@ -513,19 +509,19 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .par_iter()
         .zip(bars.par_iter())
         .map(|(c, bar)| {
-            let r = fit_model(exp, data, c.as_ref(), bar);
-            bar.finish_and_clear();
+            let r = fit_model(exp, data, c.as_ref(), bar.as_ref());
+            bar.finish();
             let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             let elapsed = started.elapsed().as_secs_f64();
-            overall.set_message(crate::progress::jobs_message(n, configured.len(), elapsed));
+            overall.message(&jobs_message(n, configured.len(), elapsed));
             if r.is_ok() {
                 let name = c.as_ref().map_or("the oscillator", |c| c.model.name());
-                crate::interrupt::finished_step(format!("the fit of `{name}`"));
+                progress.finished(&format!("the fit of `{name}`"));
             }
             r
         })
         .collect::<Result<_>>()?;
-    overall.finish_and_clear();
+    overall.finish();
     let names: Vec<String> = fits.iter().map(|f| f.label.replace(' ', "")).collect();
     for (i, f) in fits.iter_mut().enumerate() {
         let same = names[..i].iter().filter(|n| **n == names[i]).count();

@@ -20,7 +20,7 @@ use crate::data_layout::RawData;
 /// A filter as written: polynomial order and window (samples).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(crate) struct RawFilterSpec {
+pub struct RawFilterSpec {
     order: usize,
     window: usize,
 }
@@ -56,7 +56,7 @@ pub(super) struct RawFilter {
 /// A `[data] drive` value as written.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
-pub(crate) enum RawDrive {
+pub enum RawDrive {
     Named(String),
     Filter(RawFilterSpec),
 }
