@@ -509,6 +509,9 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Res
         .par_iter()
         .zip(bars.par_iter())
         .map(|(c, bar)| {
+            if progress.cancelled() {
+                return Err(crate::error::Interrupted.into());
+            }
             let r = fit_model(exp, data, c.as_ref(), bar.as_ref());
             bar.finish();
             let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;

@@ -9,6 +9,9 @@
 //! and the Python package only render and write these results. The results are the
 //! `Serialize` types of [`outputs`]: what a command writes as JSON is one of them.
 //!
+//! A researcher starts from [`prelude`]: `read_experiment`, then `fit`, `compare`, `discover`
+//! or `identify`, each returning a typed result or a [`error::StudyError`].
+//!
 //! Layers: `stf-lab` (program) → `stf-study` → `stf-plugins` → `stf-models` → `stf-core`.
 
 // `!(a > b)` is how this crate says "not greater, or NaN": the NaN case is meant.
@@ -20,6 +23,7 @@ pub mod data_layout;
 pub mod digits;
 pub mod discover;
 pub mod discovery_curves;
+pub mod error;
 pub mod experiment;
 pub mod fit;
 pub mod fitting;
@@ -29,5 +33,6 @@ pub mod observer;
 pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
+pub mod prelude;
 pub mod validation;
 pub mod verdict;
