@@ -20,7 +20,7 @@ use std::path::Path;
 
 use common::{csv_column, simulate_ok};
 use stf_core::regimes::{cycles_from_phase, duty, Boundary, BoundaryRule, RegimeThresholds};
-use stf_lab::cmd_compare::measured_regimes;
+use stf_study::compare::measured_regimes;
 use stf_lab::experiment::Experiment;
 use stf_lab::fitting::load_data;
 
