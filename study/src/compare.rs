@@ -20,7 +20,6 @@ use crate::experiment::{Experiment, FitLevel};
 use crate::fit::FitInputs;
 use crate::fitting::{fit_all, FitData, ModelFit};
 use crate::observer::Observer;
-use crate::outputs::compare_json::CompareJson;
 use crate::validation::ValidationRecord;
 
 /// A comparison with the records it was made on: what `compare.json`, `compare.md`,
@@ -65,13 +64,6 @@ impl FitInputs {
             validation: self.validation,
             compared,
         })
-    }
-}
-
-impl CompareResult {
-    /// `compare.json` of the experiment `exp`.
-    pub fn json<'a>(&'a self, exp: &'a Experiment) -> CompareJson<'a> {
-        CompareJson::new(exp, &self.data, &self.compared)
     }
 }
 

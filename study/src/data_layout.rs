@@ -18,7 +18,8 @@ use stf_core::data::record::{
 };
 use toml::{Spanned, Value};
 
-use crate::experiment::{Ctx, RawDrive};
+use crate::experiment::context::Ctx;
+use crate::experiment::raw_drive::RawDrive;
 
 /// `[data]` as written.
 #[derive(Debug, Deserialize)]

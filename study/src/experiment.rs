@@ -21,7 +21,7 @@ use toml::Spanned;
 
 use crate::data_layout::{self, RawData};
 
-mod context;
+pub mod context;
 mod discover;
 mod drive;
 mod filter;
@@ -31,6 +31,7 @@ mod identify;
 mod integrator;
 mod models;
 mod output;
+pub mod raw_drive;
 mod regimes;
 mod scripts;
 mod simulate;
@@ -41,11 +42,11 @@ pub use context::Ctx;
 pub use context::{error_at, line_of};
 pub use discover::DiscoverSpec;
 pub use drive::{Chirp, Drive};
-pub use filter::RawDrive;
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
 pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
 pub use output::OutputSpec;
+pub use raw_drive::RawDrive;
 pub use simulate::SimulateSpec;
 pub use validate::ValidateSpec;
 

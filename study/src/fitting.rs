@@ -13,15 +13,18 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
+use serde::Serialize;
 use stf_core::data::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
+use stf_core::fit::Validation;
 use stf_core::fit::{
     fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor, TrajectoryData,
     TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
+use stf_core::regimes::{PerRegime, RegimeRms};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
@@ -267,7 +270,7 @@ pub struct ModelFit {
     /// (force level), or the free parameters as listed (trajectory level).
     pub values: Vec<f64>,
     /// The model's error on the `[validate]` record, once scored.
-    pub validation: Option<crate::validation::ModelValidation>,
+    pub validation: Option<ModelValidation>,
 }
 
 impl ModelFit {
@@ -286,6 +289,30 @@ impl ModelFit {
                 .map(|p| self.result.value(&p.name).unwrap_or(p.value))
                 .collect()
         })
+    }
+}
+
+/// A fitted model's error on the validation record (fit.json's `validation`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelValidation {
+    /// The record, as the experiment names it.
+    pub file: String,
+    /// Unit of the errors: N (force level) or m (trajectory level).
+    pub unit: &'static str,
+    /// `rms`, `measured_rms`, `normalised`, `samples`, `initial`, `initial_fitted`.
+    #[serde(flatten)]
+    pub score: Option<Validation>,
+    /// The same per regime of the record's rotor cycles (none without a rotor).
+    pub per_regime: Option<PerRegime<RegimeRms>>,
+    /// Why the model could not be scored, if it could not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+impl ModelValidation {
+    /// The RMS error, if scored.
+    pub fn rms(&self) -> Option<f64> {
+        self.score.as_ref().map(|s| s.rms)
     }
 }
 

@@ -8,8 +8,7 @@ use stf_core::regimes::{
 };
 
 use super::fit_json::ModelFitJson;
-use crate::compare::BoundaryNote;
-use crate::compare::Compared;
+use crate::compare::{BoundaryNote, CompareResult, Compared};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 
@@ -180,4 +179,11 @@ fn models<'a>(data: &'a FitData, c: &'a Compared) -> Vec<ModelComparisonJson<'a>
             }),
         })
         .collect()
+}
+
+impl CompareResult {
+    /// `compare.json` of the experiment `exp`.
+    pub fn json<'a>(&'a self, exp: &'a Experiment) -> CompareJson<'a> {
+        CompareJson::new(exp, &self.data, &self.compared)
+    }
 }
