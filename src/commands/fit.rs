@@ -127,7 +127,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
     say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
-        crate::outputs::level_name(data.level),
+        data.level.name(),
         data.record.len(),
         data.record.source
     );
