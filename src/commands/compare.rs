@@ -108,13 +108,7 @@ fn write_compare_report(
     sections.extend(crate::regime_figures::regime_section(
         exp, data, &forces, out,
     )?);
-    let verdict = crate::verdict::compare_verdict(
-        &c.ranking,
-        &c.measured.cycles,
-        &c.measured.labels,
-        data.record.f_stf.as_deref().unwrap_or(&[]),
-        &forces,
-    );
+    let verdict = crate::verdict::compare_verdict(c);
     let record = format!(
         "{} cycles of {}; noise floor σ = {:.4} N.",
         c.measured.labels.len(),

@@ -233,20 +233,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         )?);
     }
     sections.extend(record_sections(data, &[], out)?);
-    let verdict = crate::verdict::discover_verdict(
-        &found.effects,
-        found.gap_before * scale,
-        found.gap_after * scale,
-        found.noise_floor * scale,
-        unit,
-    );
-    let mut intro = vec![match &found.trajectory {
-        None => verdict,
-        Some(tf) => format!(
-            "{verdict} S(μ) {:.4} → {:.4} mm².",
-            tf.s_before_mm2, tf.s_after_mm2
-        ),
-    }];
+    let mut intro = vec![discovered.verdict().text];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));
     write_report(
         &format!("Discovery: {}", exp.path.display()),

@@ -94,7 +94,7 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
         exp, data, &forces, out,
     )?);
     let mut intro = vec![
-        fitted.verdict(),
+        fitted.verdict().text,
         format!(
             "stf-lab fitted {} model(s) of {} to {}.",
             fits.len(),

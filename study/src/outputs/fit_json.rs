@@ -14,6 +14,7 @@ use super::{errors_by_name, values_by_name};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::validation::ModelValidation;
+use crate::verdict::FitVerdict;
 
 /// The whole of `fit.json`.
 #[derive(Serialize)]
@@ -36,6 +37,8 @@ pub struct FitJson<'a> {
     pub system_estimate: Option<LinearEstimate>,
     /// One entry per model, in the experiment's order.
     pub models: Vec<ModelFitJson<'a>>,
+    /// The best model, how far the others are behind, and the report's opening paragraph.
+    pub verdict: FitVerdict,
 }
 
 impl<'a> FitJson<'a> {
@@ -58,6 +61,7 @@ impl<'a> FitJson<'a> {
                 .iter()
                 .map(|f| ModelFitJson::new(f, data.level))
                 .collect(),
+            verdict: FitVerdict::new(fits, data.level),
         }
     }
 }
