@@ -89,7 +89,7 @@ pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
         .iter()
         .map(|m| {
             let mut line = format!(
-                "by {} ({}): best overall {}",
+                "by {} ({}): best over the regimes {}",
                 m.metric.name(),
                 m.criterion,
                 m.overall.first().map_or("—", |s| s.model.as_str())
