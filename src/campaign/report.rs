@@ -12,6 +12,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::global::GlobalJson;
+use super::labels::{axis_label, value_label};
 use super::table::{param_names, CampaignJson, CampaignRow};
 use crate::digits::{carried, with_error};
 use crate::report::{self, ErrorPoint, ErrorSeries, FigureRef, Report, Section, Table};
@@ -144,24 +145,6 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
         }
     }
     Ok(figures)
-}
-
-/// An axis's label: the name and its unit in brackets (`K [N·(s/m)ⁿ]`, `n [–]` for a
-/// dimensionless one), the name alone when the unit is not known.
-pub(super) fn axis_label(name: &str, unit: Option<&str>) -> String {
-    match unit.map(str::trim) {
-        None => name.to_string(),
-        Some("") => format!("{name} [–]"),
-        Some(u) => format!("{name} [{u}]"),
-    }
-}
-
-/// `name = value unit` (the unit where the campaign gives one) for a legend.
-pub(super) fn value_label(name: &str, value: f64, unit: Option<&String>) -> String {
-    match unit {
-        Some(u) => format!("{name} = {} {u}", carried(value)),
-        None => format!("{name} = {}", carried(value)),
-    }
 }
 
 /// How many different values `condition` takes over `rows`.

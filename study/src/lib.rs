@@ -28,6 +28,7 @@ pub mod experiment;
 pub mod fit;
 pub mod fitting;
 pub mod identify;
+pub mod joint;
 pub mod model_config;
 pub mod observer;
 pub mod outputs;
