@@ -15,7 +15,7 @@
 //! models running together each append their whole block):
 //!
 //! ```text
-//! # fit of 2 free parameters: K n
+//! # fit, free parameters: K n
 //! # levenberg_marquardt: iteration, mean square residual, the free parameters
 //! 0 0.0123 12 1.8
 //! 1 0.00456 14.2 1.71
@@ -101,11 +101,7 @@ impl Watch {
         (names, transforms): (&[&str], Vec<BoundTransform>),
     ) -> Self {
         let trace = trace.map(|path| {
-            let text = format!(
-                "# fit of {} free parameters: {}\n",
-                names.len(),
-                names.join(" ")
-            );
+            let text = format!("# fit, free parameters: {}\n", names.join(" "));
             Arc::new(Mutex::new(Trace {
                 path: path.to_path_buf(),
                 transforms,
