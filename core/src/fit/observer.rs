@@ -259,3 +259,75 @@ fn stage_name(stage: SolverStage) -> &'static str {
         SolverStage::Errors => "errors",
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    use crate::fit::{fit_residuals, FitParam, FitSettings, Residuals};
+
+    use super::*;
+
+    /// r_i = y_i − k·x_i.
+    struct Line;
+
+    impl Residuals for Line {
+        fn len(&self) -> usize {
+            40
+        }
+        fn residuals(&self, k: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+            for i in 0..40 {
+                let x = i as f64 * 0.1;
+                sink(
+                    i,
+                    3.0 * x + 0.01 * ((i * 7919 % 13) as f64 - 6.0) - k[0] * x,
+                );
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn one_observer_shows_every_iteration_and_appends_the_trace() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("trace.txt");
+        let params = [FitParam::new("k", 1.0).bounds(0.0, 10.0)];
+        let settings = FitSettings::default().trace(path.clone());
+        let seen = AtomicU64::new(0);
+        let show = |_: FitProgress| {
+            seen.fetch_add(1, Ordering::Relaxed);
+        };
+        let fit = fit_residuals(&Line, &params, &settings, Some(&show)).unwrap();
+        // The stage's start, each iteration, then the standard errors.
+        assert_eq!(seen.load(Ordering::Relaxed), fit.iterations + 2);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "# fit, free parameters: k");
+        assert!(lines[1].starts_with("# levenberg_marquardt: "), "{text}");
+        assert_eq!(lines.len() as u64, 2 + fit.iterations + 1, "{text}");
+        let last: Vec<f64> = lines[lines.len() - 1]
+            .split(' ')
+            .map(|w| w.parse().unwrap())
+            .collect();
+        assert_eq!(last[0], fit.iterations as f64);
+        assert!((last[1] - fit.rss / 40.0).abs() <= 1e-12 * last[1]);
+        assert_eq!(last[2], fit.value("k").unwrap());
+        // A second fit appends its own block; without a trace nothing is written.
+        fit_residuals(&Line, &params, &settings, None).unwrap();
+        let again = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(again, format!("{text}{text}"));
+        let quiet = FitSettings::default();
+        fit_residuals(&Line, &params, &quiet, None).unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), again);
+    }
+
+    #[test]
+    fn a_trace_that_cannot_be_written_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let settings = FitSettings::default().trace(dir.path().join("no/such/folder/t.txt"));
+        let params = [FitParam::new("k", 1.0).bounds(0.0, 10.0)];
+        let e = fit_residuals(&Line, &params, &settings, None).unwrap_err();
+        assert!(matches!(e, FitError::Trace { .. }), "{e}");
+    }
+}

@@ -146,3 +146,98 @@ pub(super) fn particle_swarm(
         iterations: state.get_iter(),
     })
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::fit::levenberg_marquardt::START_FAILS;
+    use crate::fit::objective::Residuals;
+    use crate::fit::transform::BoundTransform;
+
+    /// r_i = y_i − k·x_i, failing where k > `fails_above`.
+    struct Line {
+        fails_above: f64,
+    }
+
+    impl Residuals for Line {
+        fn len(&self) -> usize {
+            50
+        }
+        fn residuals(&self, k: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+            if k[0] > self.fails_above {
+                return Err("too steep".into());
+            }
+            for i in 0..50 {
+                let x = i as f64 * 0.1;
+                let y = 3.0 * x + 0.01 * ((i * 7919 % 13) as f64 - 6.0);
+                sink(i, y - k[0] * x);
+            }
+            Ok(())
+        }
+    }
+
+    fn refined(line: &Line, start: f64, max_iters: u64) -> StageEnd {
+        let obj = Objective::new(line, vec![BoundTransform::new(start, 0.0, 10.0, 1.0)]);
+        let watch = Watch::new(obj.tally(), None, None, (&["k"], obj.transforms().to_vec()));
+        let settings = FitSettings::default().max_iters(max_iters);
+        levenberg_marquardt(&obj, &[0.0], &settings, None, &watch).unwrap()
+    }
+
+    #[test]
+    fn argmin_s_reasons_become_the_fit_s_convergence() {
+        let words = || "the rule".to_string();
+        let c = |reason| convergence("LM", Some(&reason), words);
+        assert!(c(TerminationReason::SolverConverged).converged());
+        assert_eq!(
+            c(TerminationReason::MaxItersReached),
+            Convergence::MaxIterations
+        );
+        assert_eq!(
+            c(TerminationReason::SolverExit(STALLED.into())),
+            Convergence::Stalled {
+                reason: "the rule".into()
+            }
+        );
+        assert_eq!(
+            c(TerminationReason::SolverExit("no start".into())),
+            Convergence::Failed {
+                reason: "no start".into()
+            }
+        );
+        assert_eq!(
+            convergence("LM", None, words),
+            Convergence::Failed {
+                reason: "LM stopped: None".into()
+            }
+        );
+    }
+
+    #[test]
+    fn the_executor_counts_the_refinement_s_iterations_and_stops_it() {
+        let line = Line {
+            fails_above: f64::INFINITY,
+        };
+        let end = refined(&line, 1.0, 1);
+        assert_eq!(
+            (end.iterations, end.convergence),
+            (1, Convergence::MaxIterations)
+        );
+        let end = refined(&line, 1.0, 100);
+        assert!(end.convergence.converged(), "{:?}", end.convergence);
+        assert!(end.iterations > 1 && end.iterations < 100);
+        // Trial points that fail are rejected steps; a start that fails ends the stage.
+        let end = refined(&Line { fails_above: 3.5 }, 1.0, 100);
+        assert!(end.convergence.converged(), "{:?}", end.convergence);
+        let end = refined(&Line { fails_above: 0.5 }, 1.0, 100);
+        assert_eq!(
+            (end.iterations, end.convergence),
+            (
+                0,
+                Convergence::Failed {
+                    reason: START_FAILS.into()
+                }
+            )
+        );
+    }
+}
