@@ -79,8 +79,10 @@ fn run_watched(
         let (u, convergence) = chain.no_worse_than(u0, u, convergence);
         chain.finish(params, &u, convergence, clock)
     });
-    watch.write_trace()?;
-    fitted
+    // The trace is written whatever the end; the fit's own error comes first.
+    let written = watch.write_trace();
+    let fitted = fitted?;
+    written.map(|()| fitted)
 }
 
 /// The free members of `params` after checking the settings, each parameter, that no name
