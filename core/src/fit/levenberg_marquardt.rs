@@ -31,7 +31,7 @@
 //! - the stopping rules and the state. A small relative change of the cost, residuals
 //!   orthogonal to the Jacobian, no step at any damping, a parameter pinned on its bound, and
 //!   the stall rule ([`small_change`]) end a run with argmin's `SolverConverged` or, for a
-//!   stall, `SolverExit(`[`STALLED`]`)`, their numbers in words in the state
+//!   stall, its `SolverExit` with [`STALLED`], their numbers in words in the state
 //!   ([`LmState`]: argmin's `IterState` has no room for the residuals, the damping or the
 //!   words).
 
