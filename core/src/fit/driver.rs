@@ -1,4 +1,4 @@
-//! The driver shared by every kind of fit: validated parameters in, [`FitResult`] out.
+//! The driver shared by every kind of fit: checked parameters in, [`FitResult`] out.
 //!
 //! It runs the stages of the chosen [`Solver`] on an [`Objective`] — each stage one run of
 //! argmin's `Executor` ([`super::stages`]), watched by the fit's observer
@@ -92,9 +92,9 @@ fn checked<'p>(
     params: &'p [FitParam],
     settings: &FitSettings,
 ) -> Result<Vec<&'p FitParam>, FitError> {
-    settings.validate()?;
+    settings.check()?;
     for (i, p) in params.iter().enumerate() {
-        p.validate()?;
+        p.check()?;
         if params[..i].iter().any(|q| q.name == p.name) {
             return Err(FitError::DuplicateParam(p.name.clone()));
         }

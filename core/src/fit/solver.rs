@@ -121,7 +121,7 @@ impl FitSettings {
     }
 
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), FitError> {
+    pub fn check(&self) -> Result<(), FitError> {
         let pos = |v: f64| v > 0.0 && v.is_finite();
         let ok = self.max_iters > 0
             && pos(self.tol)

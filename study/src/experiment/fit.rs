@@ -97,7 +97,7 @@ pub(super) struct RawFit {
     trace: Option<PathBuf>,
 }
 
-/// A validated `[fit]` section.
+/// A checked `[fit]` section.
 #[derive(Clone, Debug)]
 pub struct FitSpec {
     /// Force or trajectory level; `None`: force when the record has `f_stf`.

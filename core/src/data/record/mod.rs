@@ -260,7 +260,7 @@ impl Record {
     /// Check a record (e.g. one built in memory) against the data contract: equal lengths,
     /// at least one sample, finite values, strictly increasing `t`, `phi` or `u` present.
     /// Rows in errors are 1-based sample numbers.
-    pub fn validate(&self) -> Result<(), RecordError> {
+    pub fn check(&self) -> Result<(), RecordError> {
         let raw = [
             Some(self.t.clone()),
             Some(self.x.clone()),
@@ -275,9 +275,9 @@ impl Record {
     /// Write the record as CSV with columns `t, phi, x, f_stf, omega, u` (those present), each
     /// number in the shortest form that reads back to the same `f64`. The file is written to
     /// a temporary file in the same directory and renamed into place, so a reader never sees
-    /// half a file. The record is validated first.
+    /// half a file. The record is checked first.
     pub fn write_csv(&self, path: &Path) -> Result<(), RecordError> {
-        self.validate()?;
+        self.check()?;
         csv_write::write(self, path)
     }
 
@@ -356,20 +356,20 @@ mod tests {
     }
 
     #[test]
-    fn validate_catches_length_mismatch_and_missing_drive() {
+    fn check_catches_length_mismatch_and_missing_drive() {
         let mut r = memory(5);
         r.x.pop();
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert_eq!(e.column.as_deref(), Some("x"));
         assert_eq!(e.file, MEMORY_SOURCE);
         let mut r = memory(5);
         r.phi = None;
         r.u = None;
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert!(e.message.contains("missing column `phi` (or `u`"), "{e}");
         let mut r = memory(5);
         r.t[3] = r.t[2];
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(4), Some("t")));
     }
 
