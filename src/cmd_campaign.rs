@@ -21,8 +21,8 @@ use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::campaign::{slurm, slurm_script};
-use crate::output::{resolve, write_json};
 use crate::say;
+use crate::writing::{resolve, write_json};
 
 /// The command line's settings.
 pub struct Settings {

@@ -23,14 +23,14 @@ use stf_core::simulate::Simulation;
 use crate::compare_markdown::{compare_markdown, duty_meaning};
 use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{fit_all, load_data, FitData, ModelFit};
-use crate::output::{write_atomic, write_json};
 use crate::outputs::compare_csv;
 use crate::outputs::compare_json::CompareJson;
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::standard_report::{frequency_section, record_sections, write_report};
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::{write_atomic, write_json};
 
 /// The measured record's regimes.
 pub fn measured_regimes(exp: &Experiment, data: &FitData) -> Result<Classification> {

@@ -33,7 +33,6 @@ use stf_plugins::ScriptRun;
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
-use crate::output::write_json;
 use crate::outputs::discovery_json::{DiscoveryJson, FinalSystemJson};
 use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::progress::{discovery_observer, Progress};
@@ -41,9 +40,10 @@ use crate::report::{
     measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
 };
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::standard_report::{record_sections, write_report};
 use crate::validation::DiscoveryScore;
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::write_json;
 use crate::{say, tell};
 
 /// The sum of `terms` (names or script paths; `none` is the zero force).

@@ -21,15 +21,15 @@ use crate::fitting::{
     estimate_line, fit_all, load_data, oscillator_fit, system_param, FitData, ModelFit,
 };
 use crate::identify_report::{system_line, write_identification_report, StageOutcome};
-use crate::output::write_json;
 use crate::outputs::columns_csv::Columns;
 use crate::outputs::fit_json::FitJson;
 use crate::outputs::identification_json::IdentificationJson;
 use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
 use crate::progress::{fit_message, Progress};
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::write_json;
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::Regime;
 

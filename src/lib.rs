@@ -1,7 +1,7 @@
 //! `stf_lab`: the library behind the `stf-lab` program of the shear-thickening fluid lab. It
 //! reads experiment files ([`experiment`]), runs the commands (`cmd_*`: simulate, fit,
 //! compare, discover, models, and [`campaign`]s of them over many records), scores fitted models on a second record ([`validation`]), and
-//! writes results ([`outputs`]: one `Serialize` type a file, written by [`output`]), figures
+//! writes results ([`outputs`]: one `Serialize` type a file, written by [`writing`]), figures
 //! and reports ([`report`], [`standard_report`],
 //! [`discovery_curves`]). The binary (`src/main.rs`) only parses the command line and
 //! calls one `cmd_*::run`; integration tests and fuzz targets use the same functions.
@@ -27,17 +27,14 @@ pub mod fitting;
 pub mod identify_report;
 pub mod interrupt;
 pub mod model_config;
-pub mod output;
-pub mod output_lock;
 pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;
-pub mod results_dir;
-pub mod staged_files;
 pub mod standard_report;
 pub mod terminal;
 pub mod validation;
 pub mod verdict;
+pub mod writing;

@@ -17,7 +17,7 @@ use stf_core::physics::force_model::ForceModel;
 
 use crate::digits::carried;
 use crate::fitting::ModelFit;
-use crate::output::write_atomic;
+use crate::writing::write_atomic;
 
 /// One row of the table.
 #[derive(Clone, Debug, PartialEq, Serialize)]

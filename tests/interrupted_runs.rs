@@ -68,7 +68,7 @@ fn a_killed_fit_leaves_whole_results() {
         let _ = child.wait();
         // A kill between the two renames of the folder swap leaves the old results beside
         // the folder's place; the next run puts them back first, as here.
-        stf_lab::results_dir::repair(&dir).unwrap();
+        stf_lab::writing::results_dir::repair(&dir).unwrap();
         assert_whole(&dir, rows);
         let strays: Vec<_> = std::fs::read_dir(out.path())
             .unwrap()

@@ -148,7 +148,7 @@ fn a_folder_being_written_by_another_run_is_refused() {
     let exp = fit_experiment(tmp.path(), "exp.toml", false);
     assert!(fit(&exp, &out, false).status.success());
     let before = std::fs::read(out.join("fit.json")).unwrap();
-    let held = stf_lab::output_lock::OutputLock::acquire(&out).unwrap();
+    let held = stf_lab::writing::lock::OutputLock::acquire(&out).unwrap();
     let second = fit(&exp, &out, true);
     assert!(!second.status.success());
     let msg = stderr(&second);

@@ -605,7 +605,7 @@ pub fn write(campaign: &Campaign, out: &Path) -> Result<GlobalJson> {
     let started = std::time::Instant::now();
     let mut json = run(campaign)?;
     json.wall_seconds = started.elapsed().as_secs_f64();
-    crate::output::write_json(&out.join(GLOBAL_JSON), &json)?;
+    crate::writing::write_json(&out.join(GLOBAL_JSON), &json)?;
     Ok(json)
 }
 

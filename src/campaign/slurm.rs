@@ -16,7 +16,7 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, Context, Result};
 
 use super::slurm_script::{Job, Scripts, COLLECT_SCRIPT, UNITS_SCRIPT};
-use crate::output::write_atomic;
+use crate::writing::write_atomic;
 
 /// The job ids Slurm gave.
 pub struct Submitted {

@@ -4,7 +4,7 @@
 //! cluster run and a local run give identical unit outputs.
 //!
 //! The command's usual outputs are written by the command itself (its folder swapped in whole
-//! and locked, `crate::results_dir`), then `unit.json` ([`UnitJson`]) beside them, atomically:
+//! and locked, `crate::writing::results_dir`), then `unit.json` ([`UnitJson`]) beside them, atomically:
 //! a unit killed midway leaves no `unit.json` that matches its inputs, so it is rerun. A unit
 //! whose command fails gets a folder holding only its `unit.json` (status `failed`, the
 //! error). Without `--force` a unit whose `unit.json` says `ok` with the same inputs' hash
@@ -20,8 +20,8 @@ use serde::{Deserialize, Serialize};
 use super::file::{Campaign, CommandName, Unit};
 use super::hash::unit_hash;
 use crate::experiment::Experiment;
-use crate::output::write_json;
-use crate::results_dir::ResultsDir;
+use crate::writing::results_dir::ResultsDir;
+use crate::writing::write_json;
 
 /// The folder of unit folders under the campaign's output.
 pub const UNITS: &str = "units";

@@ -9,7 +9,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use crate::digits::carried;
-use crate::output::write_atomic;
+use crate::writing::write_atomic;
 
 /// Columns of one table, left to right; rows as long as the shortest column.
 #[derive(Clone, Debug, Default)]

@@ -10,7 +10,7 @@ use serde::{Serialize, Serializer};
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 
 use super::csv_rows;
-use crate::output::write_atomic;
+use crate::writing::write_atomic;
 
 /// One row: a model's errors in one regime.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]

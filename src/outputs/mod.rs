@@ -1,6 +1,6 @@
 //! The results files, one type each: what a command writes is a value of one of these
 //! `Serialize` types, built from the command's results and then written — JSON through
-//! [`crate::output::write_json`] (numbers tidied by [`crate::digits`]), CSV through the `csv`
+//! [`crate::writing::write_json`] (numbers tidied by [`crate::digits`]), CSV through the `csv`
 //! crate, the experiment entry through `toml_edit`. A type's fields *are* the file's
 //! contract (docs/ARCHITECTURE.md §6): each carries its unit in its doc comment.
 //!
@@ -102,7 +102,7 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("doc.json");
-        crate::output::write_json(&path, &doc).unwrap();
+        crate::writing::write_json(&path, &doc).unwrap();
         let back: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
         assert_eq!(
