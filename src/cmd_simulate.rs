@@ -30,7 +30,8 @@ use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::say;
 use crate::writing::lock::OutputLock;
 use crate::writing::staged_files::{finish_commits, StagedFiles};
-use crate::writing::{check_distinct, check_overwrite, clean_stale, ensure_parent};
+use crate::writing::{check_distinct, check_overwrite, check_regular_or_new};
+use crate::writing::{clean_stale, ensure_parent};
 use crate::writing::{write_json, write_with};
 
 /// Run the `[simulate]` section of `exp_path` and write the record to `out`.
@@ -122,7 +123,8 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
 
 /// Check that the record `out` and its `sidecar` may be written (distinct, regular or new,
 /// replaced only with `force`), lock both, finish a commit a killed run left and clear its
-/// temporaries. (Checked before locking too: a refused run leaves no lock file.)
+/// temporaries — before a refusal to replace them, so that a rerun without `--force` puts
+/// right what a killed run left too.
 fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<[OutputLock; 2]> {
     if check_distinct(&[("the record", out), ("its JSON sidecar", sidecar)]).is_err() {
         bail!(
@@ -131,8 +133,8 @@ fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<[OutputLock;
             out.display()
         );
     }
-    check_overwrite(out, force)?;
-    check_overwrite(sidecar, force)?;
+    check_regular_or_new(out)?;
+    check_regular_or_new(sidecar)?;
     ensure_parent(out)?;
     let locks = [OutputLock::acquire(out)?, OutputLock::acquire(sidecar)?];
     for note in finish_commits(out)? {

@@ -1,6 +1,6 @@
-//! Ctrl-C (SIGINT) or SIGTERM during a run: the program removes the results it was building,
-//! stops the child processes it started, says what had finished and what was written, and
-//! exits with 130.
+//! Ctrl-C (SIGINT) or SIGTERM during a run: the program removes the results it was building
+//! and its lock files, stops the child processes it started, says what had finished and what
+//! was written, and exits with 130.
 //!
 //! Results are built apart (a staging folder, or staged files beside the outputs) and put in
 //! place only at the end. Every file write ([`crate::writing::atomic`]) and every commit's
@@ -107,6 +107,14 @@ pub fn child_started<T>(
         children.push(pid);
         child
     }))
+}
+
+/// When the run has been interrupted, wait here for the handler to end the process (a run
+/// whose children were stopped must not go on to write its tables).
+pub fn park_if_interrupted() {
+    while is_interrupted() {
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }
 
 /// The child `pid` has ended and what it did is recorded.
