@@ -253,7 +253,7 @@ mod tests {
             super::super::names::is_temporary_of(&name, "001-r.log"),
             "{name}"
         );
-        (&*staged.as_file()).write_all(b"this run\n").unwrap();
+        staged.as_file().write_all(b"this run\n").unwrap();
         assert_eq!(std::fs::read_to_string(&log).unwrap(), "last run\n");
         staged.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&log).unwrap(), "this run\n");
