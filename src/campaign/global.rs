@@ -29,6 +29,6 @@ pub fn write(campaign: &Campaign, out: &Path) -> Result<GlobalJson> {
         global: campaign.global.as_ref(),
     };
     let json = stf_study::joint::run(&inputs)?;
-    crate::output::write_json(&out.join(GLOBAL_JSON), &json)?;
+    crate::writing::write_json(&out.join(GLOBAL_JSON), &json)?;
     Ok(json)
 }

@@ -8,7 +8,10 @@
 //!
 //! The record and its sidecar are refused if they would be one file (`--out rec.json`) or
 //! replace something that is not a regular file; they are staged beside their targets and
-//! renamed into place together, the record locked for the run ([`crate::staged_files`]).
+//! renamed into place as one unit ([`crate::writing::staged_files`]: a commit cut short by a kill
+//! is finished by the next run). The record and the sidecar are both locked for the run, so
+//! two runs whose records differ but share a sidecar (`--out q.csv`, `--out q.CSV`) cannot
+//! write it at once.
 
 use std::path::Path;
 use std::time::Instant;
@@ -23,11 +26,13 @@ use stf_core::simulate::{Simulation, Trajectory as SimRun};
 
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure_for;
-use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
-use crate::output_lock::OutputLock;
 use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
 use crate::say;
-use crate::staged_files::{clean_stale, StagedFiles};
+use crate::writing::lock::OutputLock;
+use crate::writing::staged_files::{finish_commits, StagedFiles};
+use crate::writing::{check_distinct, check_overwrite, check_regular_or_new};
+use crate::writing::{clean_stale, ensure_parent};
+use crate::writing::{write_json, write_with};
 
 /// Run the `[simulate]` section of `exp_path` and write the record to `out`.
 pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
@@ -39,7 +44,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         );
     };
     let sidecar = out.with_extension("json");
-    let _lock = claim_outputs(out, &sidecar, force)?;
+    let _locks = claim_outputs(out, &sidecar, force)?;
 
     // The sample times, as `Simulation::run` makes them.
     let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
@@ -81,9 +86,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
     record.source = out.display().to_string();
 
     let mut staged = StagedFiles::new();
-    record
-        .write_csv(&staged.stage(out))
-        .with_context(|| format!("cannot write {}", out.display()))?;
+    write_with(&staged.stage(out)?, |w| {
+        record.write_csv(w).map_err(std::io::Error::other)
+    })
+    .with_context(|| format!("cannot write {}", out.display()))?;
     let meta = SimulateJson {
         generator: "stf-lab simulate",
         version: env!("CARGO_PKG_VERSION"),
@@ -99,7 +105,7 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         record: out.display().to_string(),
         summary: summary(&run, free),
     };
-    write_json(&staged.stage(&sidecar), &meta)
+    write_json(&staged.stage(&sidecar)?, &meta)
         .with_context(|| format!("cannot write {}", sidecar.display()))?;
     staged.commit()?;
 
@@ -116,8 +122,10 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
 }
 
 /// Check that the record `out` and its `sidecar` may be written (distinct, regular or new,
-/// replaced only with `force`), lock the record and clear what an interrupted run left.
-fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> {
+/// replaced only with `force`), lock both, finish a commit a killed run left and clear its
+/// temporaries — before a refusal to replace them, so that a rerun without `--force` puts
+/// right what a killed run left too.
+fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<[OutputLock; 2]> {
     if check_distinct(&[("the record", out), ("its JSON sidecar", sidecar)]).is_err() {
         bail!(
             "{}: the JSON sidecar is written to the record's path with the extension .json, \
@@ -125,10 +133,13 @@ fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> 
             out.display()
         );
     }
-    check_overwrite(out, force)?;
-    check_overwrite(sidecar, force)?;
+    check_regular_or_new(out)?;
+    check_regular_or_new(sidecar)?;
     ensure_parent(out)?;
-    let lock = OutputLock::acquire(out)?;
+    let locks = [OutputLock::acquire(out)?, OutputLock::acquire(sidecar)?];
+    for note in finish_commits(out)? {
+        crate::tell!("note: {note}");
+    }
     for target in [out, sidecar] {
         for name in clean_stale(target)? {
             crate::tell!(
@@ -137,7 +148,9 @@ fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> 
             );
         }
     }
-    Ok(lock)
+    check_overwrite(out, force)?;
+    check_overwrite(sidecar, force)?;
+    Ok(locks)
 }
 
 /// The excitation of `drive` at the sample `times`, and whether it is a rotor. A force is
