@@ -35,5 +35,6 @@ pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
 pub mod prelude;
+pub mod simulate;
 pub mod validation;
 pub mod verdict;
