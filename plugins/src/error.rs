@@ -82,6 +82,15 @@ pub enum ScriptError {
         /// What went wrong.
         message: String,
     },
+    /// A run would take a script longer than its time budget
+    /// ([`crate::ScriptLimits::run_seconds`]).
+    #[error("{path}: {message}")]
+    Budget {
+        /// The script's path.
+        path: String,
+        /// The cost of a call, the calls the run needs and the limit.
+        message: String,
+    },
     /// A name is neither a built-in model nor a script path.
     #[error(
         "unknown model `{name}`; built-in models: {known}; or give a script path ending in .rhai"
