@@ -499,6 +499,8 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             })
             .collect::<Result<_>>()?
     };
+    let calls = crate::script_plan::fit_calls(&configured, data.record.len(), data.level);
+    crate::script_plan::check(exp, calls, "this fit")?;
     let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
     overall.set_message(crate::progress::jobs_message(0, configured.len(), 0.0));
     let (started, done) = (

@@ -36,6 +36,7 @@ pub mod progress;
 pub mod regime_figures;
 pub mod report;
 pub mod results_dir;
+pub mod script_plan;
 pub mod staged_files;
 pub mod standard_report;
 pub mod terminal;
