@@ -102,12 +102,11 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let Some(file) = &exp.data_file else {
         bail!("{}: has no [data] file to fit", exp.path.display());
     };
-    if !file.is_file() {
+    if let Some(problem) = stf_core::data::bounded::record_path_problem(file) {
         bail!(
-            "{}:{}: `data.file`: no such record: {}",
+            "{}:{}: `data.file`: {problem}",
             exp.path.display(),
-            exp.data_line,
-            file.display()
+            exp.data_line
         );
     }
     let mut record = read_record(exp, file)?;
