@@ -22,6 +22,7 @@ use toml::Spanned;
 use crate::data_layout::{self, RawData};
 
 mod context;
+mod counts;
 mod discover;
 mod drive;
 mod filter;
