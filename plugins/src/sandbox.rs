@@ -137,9 +137,11 @@ pub(crate) fn clock_call(ast: &rhai::AST) -> Option<(&'static str, Option<usize>
     let own = |name: &str| ast.iter_functions().any(|f| f.name == name);
     let mut found = None;
     ast.walk(&mut |path: &[rhai::ASTNode]| {
-        if let Some(rhai::ASTNode::Expr(
-            rhai::Expr::FnCall(call, pos) | rhai::Expr::MethodCall(call, pos),
-        )) = path.last()
+        // A call is an expression, or a statement of its own (`sleep(12);`).
+        if let Some(
+            rhai::ASTNode::Expr(rhai::Expr::FnCall(call, pos) | rhai::Expr::MethodCall(call, pos))
+            | rhai::ASTNode::Stmt(rhai::Stmt::FnCall(call, pos)),
+        ) = path.last()
         {
             if let Some(name) = NO_CLOCK.iter().find(|n| call.name.as_str() == **n) {
                 if !own(name) {
