@@ -7,8 +7,8 @@
 //! evaluation one call a sample at force level, and at trajectory level six (one
 //! Dormand–Prince step a sample at the least).
 
-use anyhow::Result;
 use crate::experiment::FitLevel;
+use anyhow::Result;
 
 use crate::experiment::Experiment;
 use crate::model_config::ConfiguredModel;
@@ -35,15 +35,21 @@ pub fn fit_calls(models: &[Option<ConfiguredModel>], samples: usize, level: FitL
         .sum()
 }
 
-/// Say what the experiment's scripts will cost a run of `calls` calls (`what`: "this fit"),
-/// or refuse it when a script would take longer than its budget.
+/// Runs planned to take at least this long (s) are said before they start.
+const SAID_FROM: f64 = 1.0;
+
+/// Say what the experiment's scripts will cost a run of `calls` calls (`what`: "this fit")
+/// when that is a second or more, or refuse it when a script would take longer than its
+/// budget.
 pub fn check(exp: &Experiment, calls: f64, what: &str) -> Result<()> {
     let lines = exp
         .scripts
         .plan(calls, what)
         .map_err(|e| anyhow::anyhow!("{}: {e}", exp.path.display()))?;
-    for line in lines {
-        crate::say!("{line}");
+    for (line, seconds) in lines {
+        if seconds >= SAID_FROM {
+            crate::say!("{line}");
+        }
     }
     Ok(())
 }

@@ -132,14 +132,19 @@ impl ScriptRun {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         map.iter()
-            .map(|(path, u)| (path.clone(), u.call_nanos.load(Ordering::Relaxed) as f64 * 1e-9))
+            .map(|(path, u)| {
+                (
+                    path.clone(),
+                    u.call_nanos.load(Ordering::Relaxed) as f64 * 1e-9,
+                )
+            })
             .collect()
     }
 
-    /// What a run of `calls` force evaluations of every script loaded in it will cost, one
-    /// line a script (`what` names the run: "a fit"); an error if a script would take longer
-    /// than [`ScriptLimits::run_seconds`].
-    pub fn plan(&self, calls: f64, what: &str) -> Result<Vec<String>, crate::ScriptError> {
+    /// What a run of `calls` force evaluations of every script loaded in it will cost: one
+    /// line a script (`what` names the run: "a fit") with its seconds; an error if a script
+    /// would take longer than [`ScriptLimits::run_seconds`].
+    pub fn plan(&self, calls: f64, what: &str) -> Result<Vec<(String, f64)>, crate::ScriptError> {
         let mut lines = Vec::new();
         for (path, seconds) in self.call_costs() {
             let total = seconds * calls;
@@ -155,12 +160,13 @@ impl ScriptRun {
                     message: format!(
                         "{}; the limit is {} of script calls a run (`[scripts] run_seconds`: \
                          raise it to run anyway, or make the script faster)",
-                        line.split_once(": ").map_or(line.as_str(), |(_, rest)| rest),
+                        line.split_once(": ")
+                            .map_or(line.as_str(), |(_, rest)| rest),
                         duration_text(self.limits.run_seconds)
                     ),
                 });
             }
-            lines.push(line);
+            lines.push((line, total));
         }
         Ok(lines)
     }

@@ -110,9 +110,10 @@ fn build_engine() -> Engine {
         .register_fn("sleep", |_: rhai::INT| -> Result<(), Box<EvalAltResult>> {
             Err(no_clock("sleep"))
         })
-        .register_fn("sleep", |_: rhai::FLOAT| -> Result<(), Box<EvalAltResult>> {
-            Err(no_clock("sleep"))
-        })
+        .register_fn(
+            "sleep",
+            |_: rhai::FLOAT| -> Result<(), Box<EvalAltResult>> { Err(no_clock("sleep")) },
+        )
         .register_fn("timestamp", || -> Result<(), Box<EvalAltResult>> {
             Err(no_clock("timestamp"))
         });

@@ -623,9 +623,7 @@ impl ForceModel for ScriptModel {
         self.finite("added_mass", m, p, s)
     }
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
-        let f = self
-            .eval_force(p, s, dz)
-            .map_err(|e| self.model_error(e))?;
+        let f = self.eval_force(p, s, dz).map_err(|e| self.model_error(e))?;
         self.finite("force", f, p, s)
     }
 }
