@@ -31,7 +31,11 @@ fn ends(mut cmd: Command) -> Output {
 
 fn fifo(dir: &Path, name: &str) -> PathBuf {
     let path = dir.join(name);
-    assert!(Command::new("mkfifo").arg(&path).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&path)
+        .status()
+        .unwrap()
+        .success());
     path
 }
 
@@ -69,7 +73,12 @@ fn a_folder_fifo_or_device_as_the_record_is_named_as_such() {
             ),
         );
         let out = dir.path().join("out");
-        let msg = fails(&["fit".as_ref(), exp.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+        let msg = fails(&[
+            "fit".as_ref(),
+            exp.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
         assert!(
             msg.contains("exp.toml:1: `data.file`: ") && msg.contains(what),
             "{record:?}: {msg}"
@@ -83,11 +92,19 @@ fn a_fifo_as_the_experiment_or_the_script_fails_at_once() {
     let dir = tempfile::tempdir().unwrap();
     let pipe = fifo(dir.path(), "exp.toml");
     let out = dir.path().join("out");
-    let msg = fails(&["fit".as_ref(), pipe.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    let msg = fails(&[
+        "fit".as_ref(),
+        pipe.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(msg.contains("FIFO (named pipe)"), "{msg}");
     let script = fifo(dir.path(), "model.rhai");
     let msg = fails(&["models".as_ref(), "--check".as_ref(), script.as_os_str()]);
-    assert!(msg.contains("model.rhai") && msg.contains("FIFO (named pipe)"), "{msg}");
+    assert!(
+        msg.contains("model.rhai") && msg.contains("FIFO (named pipe)"),
+        "{msg}"
+    );
     let record = root().join("experiments/records/power_law_sweep.csv");
     let exp = dir.path().join("with_script.toml");
     std::fs::write(
@@ -98,8 +115,16 @@ fn a_fifo_as_the_experiment_or_the_script_fails_at_once() {
         ),
     )
     .unwrap();
-    let msg = fails(&["fit".as_ref(), exp.as_os_str(), "--out".as_ref(), out.as_os_str()]);
-    assert!(msg.contains("model.rhai") && msg.contains("FIFO (named pipe)"), "{msg}");
+    let msg = fails(&[
+        "fit".as_ref(),
+        exp.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(
+        msg.contains("model.rhai") && msg.contains("FIFO (named pipe)"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -111,7 +136,12 @@ fn a_sample_limit_raised_past_memory_is_refused_at_its_key_not_aborted() {
         "[simulate]\nconstant = { omega = 8.2, t1 = 1e4 }\nrate = 1e9\nmax_samples = 1e18\n",
     );
     let rec = dir.path().join("rec.csv");
-    let msg = fails(&["simulate".as_ref(), exp.as_os_str(), "--out".as_ref(), rec.as_os_str()]);
+    let msg = fails(&[
+        "simulate".as_ref(),
+        exp.as_os_str(),
+        "--out".as_ref(),
+        rec.as_os_str(),
+    ]);
     assert!(
         msg.contains("exp.toml:4: `simulate.max_samples`: ")
             && msg.contains("1.00e13 samples, which needs about")
@@ -133,7 +163,12 @@ fn a_window_of_three_values_is_refused() {
         ),
     );
     let out = dir.path().join("out");
-    let msg = fails(&["fit".as_ref(), exp.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    let msg = fails(&[
+        "fit".as_ref(),
+        exp.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(
         msg.contains("exp.toml:3: `data.window`: give two times"),
         "{msg}"

@@ -174,7 +174,10 @@ mod tests {
         assert!(msg.len() < 2_000, "{} bytes", msg.len());
         assert!(msg.starts_with("exp.toml:2: `system`: "), "{}", &msg[..200]);
         // The word shown cut is the key with its quotes and comma.
-        assert!(msg.contains("unknown field `kkkk") && msg.contains("…(5000003 bytes)…"), "{msg}");
+        assert!(
+            msg.contains("unknown field `kkkk") && msg.contains("…(5000003 bytes)…"),
+            "{msg}"
+        );
         // Short text is shown whole; multibyte text is cut on a character boundary.
         assert_eq!(super::shorten("a `b` c"), "a `b` c");
         let wide = "é".repeat(300);

@@ -83,8 +83,9 @@ mod tests {
             "exp.toml:3: `discover.holdout_every`: 0 is not a count of cycles (a whole number, \
              at least 2)"
         );
-        let e = parse("[fit]\nmax_iters = 1e3\n[discover]\nbase = \"viscous\"\nholdout_every = 4\n")
-            .unwrap();
+        let e =
+            parse("[fit]\nmax_iters = 1e3\n[discover]\nbase = \"viscous\"\nholdout_every = 4\n")
+                .unwrap();
         assert_eq!(e.fit.settings.max_iters, 1000);
         assert_eq!(e.discover.unwrap().holdout_every, Some(4));
     }

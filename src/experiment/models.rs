@@ -185,10 +185,16 @@ mod tests {
     #[test]
     fn more_models_than_a_run_takes_are_refused_at_the_first_past_the_limit() {
         let entries = |n: usize| "[[models]]\nname = \"viscous\"\n".repeat(n);
-        assert_eq!(parse(&entries(MAX_MODELS)).unwrap().models.len(), MAX_MODELS);
+        assert_eq!(
+            parse(&entries(MAX_MODELS)).unwrap().models.len(),
+            MAX_MODELS
+        );
         let msg = parse(&entries(2000)).unwrap_err().to_string();
         assert!(
-            msg.starts_with(&format!("exp.toml:{}: `models`: 2000 entries; a run takes at most 100", 2 * MAX_MODELS + 1)),
+            msg.starts_with(&format!(
+                "exp.toml:{}: `models`: 2000 entries; a run takes at most 100",
+                2 * MAX_MODELS + 1
+            )),
             "{msg}"
         );
     }

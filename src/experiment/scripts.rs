@@ -119,12 +119,18 @@ mod tests {
             ),
             ("[scripts]\nmax_bytes = 0\n", "scripts.max_bytes"),
             ("[scripts]\ncall_seconds = -1.0\n", "scripts.call_seconds"),
-            ("[scripts]\nrun_seconds = 0\n", "exp.toml:2: `scripts.run_seconds`: 0 must be"),
+            (
+                "[scripts]\nrun_seconds = 0\n",
+                "exp.toml:2: `scripts.run_seconds`: 0 must be",
+            ),
             (
                 "[scripts]\nrun_operations = -5\n",
                 "exp.toml:2: `scripts.run_operations`: -5 is not a count (at least 1)",
             ),
-            ("[scripts]\nrun_operations = 2.5e30\n", "`scripts.run_operations`: 2500000"),
+            (
+                "[scripts]\nrun_operations = 2.5e30\n",
+                "`scripts.run_operations`: 2500000",
+            ),
             ("[scripts]\ndeadline = 1.0\n", "deadline"),
         ] {
             let msg = format!("{:#}", parse(text).unwrap_err());

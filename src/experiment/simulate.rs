@@ -217,9 +217,10 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(
-            msg.starts_with("exp.toml:4: `simulate.max_samples`: 1000000000 samples/s from t0 = 0 \
-                             to t1 = 10000 s is 1.00e13 samples, which needs about")
-                && msg.contains("of memory this machine has available")
+            msg.starts_with(
+                "exp.toml:4: `simulate.max_samples`: 1000000000 samples/s from t0 = 0 \
+                             to t1 = 10000 s is 1.00e13 samples, which needs about"
+            ) && msg.contains("of memory this machine has available")
                 && msg.contains("lower `rate`"),
             "{msg}"
         );

@@ -221,8 +221,17 @@ mod tests {
             ),
             "{e}"
         );
-        assert!(e.to_string().starts_with("holds more than the 0 MB of memory"), "{e}");
-        assert_eq!(read_within(&[1u8; 5000][..], u64::MAX, Some(10_000)).unwrap().len(), 5000);
+        assert!(
+            e.to_string()
+                .starts_with("holds more than the 0 MB of memory"),
+            "{e}"
+        );
+        assert_eq!(
+            read_within(&[1u8; 5000][..], u64::MAX, Some(10_000))
+                .unwrap()
+                .len(),
+            5000
+        );
     }
 
     #[cfg(unix)]
@@ -230,18 +239,30 @@ mod tests {
     fn folders_fifos_and_devices_are_named_and_a_fifo_is_never_opened() {
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("pipe");
-        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
         assert!(made.success());
         // No writer: opening it would block this test forever.
         let e = read_file(&fifo, 1000).unwrap_err();
-        assert_eq!(e.to_string(), "cannot read: it is a FIFO (named pipe), not a file");
+        assert_eq!(
+            e.to_string(),
+            "cannot read: it is a FIFO (named pipe), not a file"
+        );
         let e = read_file(dir.path(), 1000).unwrap_err();
         assert_eq!(e.to_string(), "cannot read: it is a folder, not a file");
         let shown = |p: &Path| record_path_problem(p).unwrap();
         assert!(shown(&fifo).ends_with("pipe is a FIFO (named pipe), not a record file"));
         assert!(shown(dir.path()).ends_with(" is a folder, not a record file"));
-        assert_eq!(shown(Path::new("/dev/zero")), "/dev/zero is a device, not a record file");
-        assert_eq!(shown(Path::new("/no/such.csv")), "no such record: /no/such.csv");
+        assert_eq!(
+            shown(Path::new("/dev/zero")),
+            "/dev/zero is a device, not a record file"
+        );
+        assert_eq!(
+            shown(Path::new("/no/such.csv")),
+            "no such record: /no/such.csv"
+        );
         let file = dir.path().join("r.csv");
         std::fs::write(&file, "t,x\n").unwrap();
         assert_eq!(record_path_problem(&file), None);

@@ -188,7 +188,10 @@ mod tests {
                 f: &f,
             };
             for c in &segs {
-                assert!(c.end < n && c.omega.is_finite() && c.omega > 0.0, "{n}: {c:?}");
+                assert!(
+                    c.end < n && c.omega.is_finite() && c.omega > 0.0,
+                    "{n}: {c:?}"
+                );
                 crate::regimes::features::cycle_features(&sig, c, 0.1, 0.5).unwrap();
             }
         }

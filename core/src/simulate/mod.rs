@@ -122,7 +122,11 @@ impl<'a> Simulation<'a> {
                 self.max_samples
             )));
         }
-        let internal = self.osc.initial_state(self.x0, self.v0).len().saturating_sub(2);
+        let internal = self
+            .osc
+            .initial_state(self.x0, self.v0)
+            .len()
+            .saturating_sub(2);
         let bytes = count * bytes_per_sample(internal);
         crate::data::memory::check(bytes, crate::data::memory::available()).map_err(|why| {
             SimError::BadSettings(format!(

@@ -202,7 +202,13 @@ impl Walk<'_> {
 
     /// An element at `at` of its bytes that needs `wanted` bytes where `left` remain: in
     /// the file itself or `inside` an inflated variable.
-    fn truncated(&self, at: usize, wanted: usize, left: usize, inside: Option<usize>) -> RecordError {
+    fn truncated(
+        &self,
+        at: usize,
+        wanted: usize,
+        left: usize,
+        inside: Option<usize>,
+    ) -> RecordError {
         let message = match inside {
             None => format!(
                 "is truncated: the variable at byte {} needs {wanted} bytes but the file \
