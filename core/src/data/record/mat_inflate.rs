@@ -25,6 +25,18 @@ const HEADER: usize = 128;
 /// Compressed elements inside compressed elements that are followed (MATLAB writes none).
 const MAX_DEPTH: usize = 4;
 
+/// One element of a `.mat` file (or of an inflated variable).
+struct Element<'b> {
+    /// Its data type.
+    kind: u32,
+    /// Where its tag starts.
+    start: usize,
+    /// Its data.
+    body: &'b [u8],
+    /// Where the next element starts (past an uncompressed element's padding).
+    end: usize,
+}
+
 /// What the walk knows of the file: its name, byte order and what is left of the cap.
 struct Walk<'s> {
     source: &'s str,
@@ -70,15 +82,13 @@ impl Walk<'_> {
         })
     }
 
-    /// The elements of `bytes` as `(kind, start, body, end)`: `body` the element's data,
-    /// `end` where the next element starts (past an uncompressed element's padding). An
-    /// element the bytes end inside is an error; `inside` is the compressed element whose
+    /// The elements of `bytes`. An element the bytes end inside is an error; `inside` is the compressed element whose
     /// content `bytes` is, `None` for the file's own elements (after its header).
     fn elements<'b>(
         &self,
         bytes: &'b [u8],
         inside: Option<usize>,
-    ) -> Result<Vec<(u32, usize, &'b [u8], usize)>, RecordError> {
+    ) -> Result<Vec<Element<'b>>, RecordError> {
         let mut found = Vec::new();
         let mut at = 0;
         while at < bytes.len() {
@@ -87,7 +97,12 @@ impl Walk<'_> {
             };
             if tag >> 16 != 0 {
                 // The small data element format: type and size in one word, 4 bytes of data.
-                found.push((tag & 0xffff, at, &bytes[at + 4..at + 8], at + 8));
+                found.push(Element {
+                    kind: tag & 0xffff,
+                    start: at,
+                    body: &bytes[at + 4..at + 8],
+                    end: at + 8,
+                });
                 at += 8;
                 continue;
             }
@@ -100,7 +115,12 @@ impl Walk<'_> {
             } else {
                 (at + 8 + size).next_multiple_of(8).min(bytes.len())
             };
-            found.push((tag, at, body, end));
+            found.push(Element {
+                kind: tag,
+                start: at,
+                body,
+                end,
+            });
             at = end;
         }
         Ok(found)
@@ -109,7 +129,7 @@ impl Walk<'_> {
     /// Check the top-level elements are whole; whether any is compressed.
     fn check(&self, bytes: &[u8]) -> Result<bool, RecordError> {
         let elements = self.elements(bytes, None)?;
-        Ok(elements.iter().any(|e| e.0 == MI_COMPRESSED))
+        Ok(elements.iter().any(|e| e.kind == MI_COMPRESSED))
     }
 
     /// Append the elements of `bytes` to `out`, each compressed one inflated (and the
@@ -122,7 +142,13 @@ impl Walk<'_> {
         out: &mut Vec<u8>,
         depth: usize,
     ) -> Result<(), RecordError> {
-        for (kind, at, body, end) in self.elements(bytes, inside)? {
+        for Element {
+            kind,
+            start: at,
+            body,
+            end,
+        } in self.elements(bytes, inside)?
+        {
             // Where the element is in the file: nested content is placed at its outer element.
             let place = inside.unwrap_or(HEADER + at);
             if kind != MI_COMPRESSED {
