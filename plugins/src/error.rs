@@ -35,12 +35,13 @@ impl fmt::Display for ScriptLocation {
 #[derive(Debug, Error)]
 pub enum ScriptError {
     /// The file could not be read.
-    #[error("{path}: cannot read the script: {source}")]
+    #[error("{path}: cannot read the script: {error}")]
     Read {
         /// The script's path.
         path: String,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shown in the message, so not also a `source` that an error chain
+        /// would print a second time).
+        error: std::io::Error,
     },
     /// The script exceeds a size limit ([`crate::ScriptLimits`]); checked before it is compiled.
     #[error("{path}: the script is too large to load: {message}")]

@@ -163,9 +163,9 @@ impl ScriptModel {
         // read into memory).
         let limit = run.limits().max_bytes as u64;
         let source = read_file_to_string(path, limit).map_err(|e| match e {
-            BoundedError::Io(source) => ScriptError::Read {
+            BoundedError::Io(error) => ScriptError::Read {
                 path: shown.clone(),
-                source,
+                error,
             },
             too_large => ScriptError::TooLarge {
                 path: shown.clone(),
