@@ -124,3 +124,31 @@ fn the_amplitude_criterion_remains_as_an_option() {
     let md = std::fs::read_to_string(out.join("compare.md")).unwrap();
     assert!(md.contains("placed by `amplitude`"), "{md}");
 }
+
+/// The bundled chirp record (a shaker rig, no rotor: its cycles are equal stretches of the
+/// record) compared with a model: the last stretch once ended one sample past the record, and
+/// compare failed with "cycle 3875..4001 does not fit 4001 samples".
+#[test]
+fn compare_runs_on_the_bundled_chirp_record() {
+    let out = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("experiments/trajectory_discovery.toml"))
+        .unwrap()
+        .replace(
+            "records/trajectory_discovery.csv",
+            &root()
+                .join("experiments/records/trajectory_discovery.csv")
+                .display()
+                .to_string(),
+        )
+        + "\n[[models]]\nname = \"viscous\"\n";
+    let exp = out.path().join("chirp.toml");
+    std::fs::write(&exp, text).unwrap();
+    let dir = out.path().join("cmp");
+    let _ = run_ok("compare", &exp, &dir);
+    let doc = read_json(&dir.join("compare.json"));
+    let models = doc["models"].as_array().unwrap();
+    assert_eq!(models.len(), 1);
+    assert_eq!(models[0]["name"], "viscous");
+    let cycles = std::fs::read_to_string(dir.join("cycles.csv")).unwrap();
+    assert!(cycles.lines().count() > 2, "{cycles}");
+}

@@ -196,3 +196,48 @@ fn the_run_budget_stops_a_fit_with_a_clear_message() {
         "{msg}"
     );
 }
+
+/// A script that sleeps (the issue's hung `fit` and `models --check` for 12 s a call) is
+/// refused at load, before any run; one whose calls are slow is refused before the fit starts
+/// when its plan exceeds the time budget, with what a call costs and how many the fit needs.
+#[test]
+fn sleeping_scripts_and_runs_planned_past_the_time_budget_are_refused_before_the_run() {
+    let sleeper = format!("{PARAMS}fn force(p, t, x, v, z) {{\n  sleep(12);\n  p.K * v\n}}\n");
+    let msg = fit_fails(&sleeper);
+    assert!(
+        msg.contains("hostile.rhai:3:") && msg.contains("`sleep` is not available"),
+        "{msg}"
+    );
+    let held = tempfile::tempdir().unwrap();
+    let script = held.path().join("hostile.rhai");
+    std::fs::write(&script, &sleeper).unwrap();
+    let check = stf_lab()
+        .args(["models", "--check"])
+        .arg(&script)
+        .output()
+        .unwrap();
+    assert!(!check.status.success());
+    assert!(String::from_utf8_lossy(&check.stderr).contains("`sleep` is not available"));
+    // A sort of 2 000 numbers a call on the VM (tens of µs here) against a budget of 0.1 s:
+    // a fit of the 150 001-sample sweep needs millions of calls, far past it on any machine.
+    let slow = format!(
+        "{PARAMS}fn force(p, t, x, v, z) {{\n  let a = [];\n  a.pad(2000, 1.0);\n  a.sort();\n  \
+         p.K * v * a[0]\n}}\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let exp = experiment(
+        dir.path(),
+        &slow,
+        "[scripts]\nrun_seconds = 0.1\n\n[[models]]\nscript = \"hostile.rhai\"\n",
+    );
+    let out = run("fit", &exp, &dir.path().join("out"));
+    let msg = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(!dir.path().join("out").exists());
+    assert!(
+        msg.contains("hostile.rhai: this script costs ~")
+            && msg.contains(" a call: this fit needs ~")
+            && msg.contains("`[scripts] run_seconds`"),
+        "{msg}"
+    );
+}

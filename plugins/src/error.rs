@@ -35,12 +35,13 @@ impl fmt::Display for ScriptLocation {
 #[derive(Debug, Error)]
 pub enum ScriptError {
     /// The file could not be read.
-    #[error("{path}: cannot read the script: {source}")]
+    #[error("{path}: cannot read the script: {error}")]
     Read {
         /// The script's path.
         path: String,
-        /// The I/O error.
-        source: std::io::Error,
+        /// The I/O error (shown in the message, so not also a `source` that an error chain
+        /// would print a second time).
+        error: std::io::Error,
     },
     /// The script exceeds a size limit ([`crate::ScriptLimits`]); checked before it is compiled.
     #[error("{path}: the script is too large to load: {message}")]
@@ -80,6 +81,15 @@ pub enum ScriptError {
         /// Where.
         at: ScriptLocation,
         /// What went wrong.
+        message: String,
+    },
+    /// A run would take a script longer than its time budget
+    /// ([`crate::ScriptLimits::run_seconds`]).
+    #[error("{path}: {message}")]
+    Budget {
+        /// The script's path.
+        path: String,
+        /// The cost of a call, the calls the run needs and the limit.
         message: String,
     },
     /// A name is neither a built-in model nor a script path.

@@ -3,7 +3,9 @@
 //! One engine, built once, serves all scripts: rhai's standard packages (arithmetic, math,
 //! strings, arrays, maps: no file, network or process access exist in rhai), `import` and
 //! `eval` disabled with a module resolver that resolves nothing, `print`/`debug` discarded,
-//! strict variables (an undefined name is a compile error), and limits on call depth,
+//! strict variables (an undefined name is a compile error), no sleeping or clock functions
+//! (rhai's `sleep` and `timestamp` are replaced by errors, and a script that names them is
+//! refused at load: [`NO_CLOCK`]), and limits on call depth,
 //! expression depth, string, array and map sizes. Each call to a script function runs under a
 //! [`CallBudget`]: a number of operations — the call's own budget, or what is left of its
 //! script's budget for the run, whichever is smaller — that decides deterministically whether a
@@ -20,7 +22,7 @@ use std::time::{Duration, Instant};
 
 use rhai::grain::Vm;
 use rhai::module_resolvers::DummyModuleResolver;
-use rhai::{Dynamic, Engine};
+use rhai::{Dynamic, Engine, EvalAltResult};
 
 /// Operations between two looks at the clock. One look (≈ 20 ns) costs about as much as a
 /// simple operation, so this adds ≈ 1 % to a call; one operation on data at the size limits
@@ -37,6 +39,11 @@ pub const MAX_STRING_SIZE: usize = 10_000;
 pub const MAX_ARRAY_SIZE: usize = 10_000;
 /// Largest object map a script may build.
 pub const MAX_MAP_SIZE: usize = 1_000;
+
+/// rhai's functions that sleep or read the clock: a model's force depends on its arguments
+/// alone, and a script that sleeps hangs a run while using no operations. Calls to them fail,
+/// and a script that names them is refused at load ([`clock_call`]).
+pub const NO_CLOCK: [&str; 2] = ["sleep", "timestamp"];
 
 /// The token of the error raised when a call exceeds its operation budget.
 pub(crate) const BUDGET_TOKEN: &str = "operation budget exceeded";
@@ -98,7 +105,54 @@ fn build_engine() -> Engine {
         })
         .on_print(|_| {})
         .on_debug(|_, _, _| {});
+    // Registered in the engine's own namespace, these are found before rhai's packages.
     engine
+        .register_fn("sleep", |_: rhai::INT| -> Result<(), Box<EvalAltResult>> {
+            Err(no_clock("sleep"))
+        })
+        .register_fn(
+            "sleep",
+            |_: rhai::FLOAT| -> Result<(), Box<EvalAltResult>> { Err(no_clock("sleep")) },
+        )
+        .register_fn("timestamp", || -> Result<(), Box<EvalAltResult>> {
+            Err(no_clock("timestamp"))
+        });
+    engine
+}
+
+/// Why a script may not call `name`.
+pub(crate) fn no_clock_message(name: &str) -> String {
+    format!(
+        "`{name}` is not available to scripts: a model has no sleeping or clock functions \
+         (its force depends on its arguments alone)"
+    )
+}
+
+fn no_clock(name: &str) -> Box<EvalAltResult> {
+    no_clock_message(name).into()
+}
+
+/// The first call in `ast` of a function of [`NO_CLOCK`] that the script does not define
+/// itself, with its line.
+pub(crate) fn clock_call(ast: &rhai::AST) -> Option<(&'static str, Option<usize>)> {
+    let own = |name: &str| ast.iter_functions().any(|f| f.name == name);
+    let mut found = None;
+    ast.walk(&mut |path: &[rhai::ASTNode]| {
+        // A call is an expression, or a statement of its own (`sleep(12);`).
+        if let Some(
+            rhai::ASTNode::Expr(rhai::Expr::FnCall(call, pos) | rhai::Expr::MethodCall(call, pos))
+            | rhai::ASTNode::Stmt(rhai::Stmt::FnCall(call, pos)),
+        ) = path.last()
+        {
+            if let Some(name) = NO_CLOCK.iter().find(|n| call.name.as_str() == **n) {
+                if !own(name) {
+                    found = Some((*name, pos.line()));
+                }
+            }
+        }
+        found.is_none()
+    });
+    found
 }
 
 /// Whether the current call is past its deadline; looks at the clock only once every

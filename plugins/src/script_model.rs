@@ -56,6 +56,7 @@ use std::cell::RefCell;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 use rhai::grain::{Compiler, SharedProgram};
 use rhai::{CallFnOptions, Dynamic, EvalAltResult, Scope};
@@ -64,13 +65,18 @@ use stf_core::physics::force_model::{ForceModel, ModelError, ModelState};
 use stf_core::physics::param_spec::{defaults, ParamSpec};
 
 use crate::error::{ScriptError, ScriptLocation};
-use crate::limits::{ScriptLimits, ScriptRun};
+use crate::limits::{duration_text, ScriptLimits, ScriptRun, Usage};
 use crate::sandbox::{
     self, CallBudget, BUDGET_TOKEN, DEADLINE_TOKEN, MAX_CALL_LEVELS, RUN_BUDGET_TOKEN,
 };
 use crate::script_compiled::{self, CompiledFn};
 use crate::script_params::{param_docs, parse_params, to_f64};
 use crate::script_size;
+
+/// Most evaluations timed at load to measure a script's cost of a call.
+const TIMING_CALLS: u32 = 1000;
+/// Seconds after which no more evaluations are timed at load.
+const TIMING_SECONDS: f64 = 0.02;
 
 /// Most internal states a script may declare.
 pub const MAX_INTERNAL: usize = 64;
@@ -110,8 +116,9 @@ pub struct ScriptModel {
     compiled: Option<Compiled>,
     /// The limits its calls run under.
     limits: ScriptLimits,
-    /// Operations its calls have used in this run (shared by every load of the script).
-    run_used: Arc<AtomicU64>,
+    /// Operations and time its calls have used in this run (shared by every load of the
+    /// script).
+    run_used: Arc<Usage>,
     /// Operations of one `force` call at the defaults, from rest, on the VM.
     force_operations: u64,
 }
@@ -156,9 +163,9 @@ impl ScriptModel {
         // read into memory).
         let limit = run.limits().max_bytes as u64;
         let source = read_file_to_string(path, limit).map_err(|e| match e {
-            BoundedError::Io(source) => ScriptError::Read {
+            BoundedError::Io(error) => ScriptError::Read {
                 path: shown.clone(),
-                source,
+                error,
             },
             too_large => ScriptError::TooLarge {
                 path: shown.clone(),
@@ -190,6 +197,13 @@ impl ScriptModel {
     /// load-time check measured; deterministic).
     pub fn force_operations(&self) -> u64 {
         self.force_operations
+    }
+
+    /// Seconds one evaluation of the force (with the rates) took at the defaults when the
+    /// script was loaded, on the path its calls take (compiled or VM): what a run's plan
+    /// multiplies ([`ScriptRun::plan`]).
+    pub fn call_seconds(&self) -> f64 {
+        self.run_used.call_nanos.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     /// The script's path (or the name given to [`ScriptModel::from_source`]).
@@ -336,14 +350,40 @@ impl ScriptModel {
             z: &z,
         };
         let mut dz = vec![0.0; self.n_internal];
-        let before = self.run_used.load(Ordering::Relaxed);
+        let ops = &self.run_used.operations;
+        let before = ops.load(Ordering::Relaxed);
         let _ = self.call("force", self.args(&p, &s))?;
-        let force_operations = self.run_used.load(Ordering::Relaxed).saturating_sub(before);
-        self.eval_force(&p, &s, &mut dz)?;
+        let force_operations = ops.load(Ordering::Relaxed).saturating_sub(before);
+        self.time_force(&p, &s, &mut dz)?;
         if self.has_added_mass {
             self.eval_number("added_mass", &p, &s)?;
         }
         Ok(force_operations)
+    }
+
+    /// Time evaluations of the force (with the rates) at `p`, `s` on the path calls take:
+    /// one, or for a fast one as many as fit in [`TIMING_SECONDS`] (at most
+    /// [`TIMING_CALLS`]), their mean kept as the script's cost of a call. Only the first
+    /// counts against the run's operations, so what a load uses stays the same every time.
+    fn time_force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), CallError> {
+        let ops = &self.run_used.operations;
+        let clock = Instant::now();
+        self.eval_force(p, s, dz)?;
+        let after_first = ops.load(Ordering::Relaxed);
+        let mut calls = 1u32;
+        let mut spent = clock.elapsed().as_secs_f64();
+        while calls < TIMING_CALLS && spent < TIMING_SECONDS {
+            self.eval_force(p, s, dz)?;
+            calls += 1;
+            spent = clock.elapsed().as_secs_f64();
+        }
+        let _ = ops.fetch_sub(
+            ops.load(Ordering::Relaxed).saturating_sub(after_first),
+            Ordering::Relaxed,
+        );
+        let nanos = (spent * 1e9 / f64::from(calls)).round() as u64;
+        self.run_used.call_nanos.store(nanos, Ordering::Relaxed);
+        Ok(())
     }
 
     /// What the next call may use: its own budget, or what is left of the run's.
@@ -351,7 +391,7 @@ impl ScriptModel {
         let left = self
             .limits
             .run_operations
-            .saturating_sub(self.run_used.load(Ordering::Relaxed));
+            .saturating_sub(self.run_used.operations.load(Ordering::Relaxed));
         CallBudget {
             operations: left.min(self.limits.call_operations),
             from_run: left < self.limits.call_operations,
@@ -363,6 +403,7 @@ impl ScriptModel {
     fn call(&self, fname: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, CallError> {
         let options = CallFnOptions::new().eval_ast(false).rewind_scope(true);
         let budget = self.budget();
+        let clock = Instant::now();
         let (result, used) = sandbox::with_vm(budget, |vm| {
             vm.call_fn_with_options::<Dynamic>(
                 options,
@@ -376,8 +417,15 @@ impl ScriptModel {
             line: None,
             message: format!("fn {fname} called re-entrantly on one thread"),
         })?;
+        let nanos = u64::try_from(clock.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        let total_nanos = self
+            .run_used
+            .nanos
+            .fetch_add(nanos, Ordering::Relaxed)
+            .saturating_add(nanos);
         let total = self
             .run_used
+            .operations
             .fetch_add(used, Ordering::Relaxed)
             .saturating_add(used);
         let value = result
@@ -393,6 +441,17 @@ impl ScriptModel {
             return Err(CallError {
                 line: self.line_of(fname),
                 message: format!("{} (in fn {fname})", run_budget_message(&self.limits)),
+            });
+        }
+        if total_nanos as f64 * 1e-9 > self.limits.run_seconds {
+            return Err(CallError {
+                line: self.line_of(fname),
+                message: format!(
+                    "stopped by its run time budget: this script's calls in this run took \
+                     more than {} (`[scripts] run_seconds`); it is too slow for this run \
+                     (in fn {fname})",
+                    duration_text(self.limits.run_seconds)
+                ),
             });
         }
         Ok(value)
@@ -445,6 +504,42 @@ impl ScriptModel {
                 value.type_name()
             ),
         })
+    }
+
+    /// `f`, the value `fname` returned at `p`, `s`, if it is finite; else an error naming the
+    /// script, the function's line and the arguments (a NaN force would only show later as
+    /// a residual or a state that is not finite, far from its cause).
+    fn finite(&self, fname: &str, f: f64, p: &[f64], s: &ModelState) -> Result<f64, ModelError> {
+        if f.is_finite() {
+            Ok(f)
+        } else {
+            Err(self.model_error(self.not_finite(fname, f, p, s)))
+        }
+    }
+
+    /// `fname` returned `f`, not a finite number, at `p`, `s`: said with the arguments.
+    fn not_finite(&self, fname: &str, f: f64, p: &[f64], s: &ModelState) -> CallError {
+        let params: Vec<String> = self
+            .specs
+            .iter()
+            .zip(p)
+            .map(|(spec, v)| format!("{} = {v}", spec.name))
+            .collect();
+        CallError {
+            line: self.line_of(fname),
+            message: format!(
+                "fn {fname} returned {f}, not a finite number, at t = {}, x = {}, v = {} with \
+                 {}",
+                s.t,
+                s.x,
+                s.v,
+                if params.is_empty() {
+                    "no parameters".to_string()
+                } else {
+                    params.join(", ")
+                }
+            ),
+        }
     }
 
     fn eval_force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, CallError> {
@@ -522,11 +617,14 @@ impl ForceModel for ScriptModel {
         if !self.has_added_mass {
             return Ok(0.0);
         }
-        self.eval_number("added_mass", p, s)
-            .map_err(|e| self.model_error(e))
+        let m = self
+            .eval_number("added_mass", p, s)
+            .map_err(|e| self.model_error(e))?;
+        self.finite("added_mass", m, p, s)
     }
     fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
-        self.eval_force(p, s, dz).map_err(|e| self.model_error(e))
+        let f = self.eval_force(p, s, dz).map_err(|e| self.model_error(e))?;
+        self.finite("force", f, p, s)
     }
 }
 
@@ -544,6 +642,12 @@ fn parse(source: &str, path: &str, limits: &ScriptLimits) -> Result<rhai::AST, S
             message: e.0.to_string(),
         })?;
     script_size::check_ast(&ast, limits).map_err(too_large)?;
+    if let Some((name, line)) = sandbox::clock_call(&ast) {
+        return Err(ScriptError::Contract {
+            at: ScriptLocation::new(path, line),
+            message: sandbox::no_clock_message(name),
+        });
+    }
     ast.set_source(path);
     Ok(ast)
 }
@@ -643,6 +747,10 @@ fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u6
              (work on large arrays or strings?); unlike the operation budget, this limit \
              depends on the machine's speed and load (`[scripts] call_seconds`)",
             limits.call_seconds, limits.call_operations
+        ),
+        EvalAltResult::Exit(value, _) => format!(
+            "the script called exit({value}); a script cannot end the run: return a number \
+             from the function instead"
         ),
         EvalAltResult::ErrorStackOverflow(_) => {
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")

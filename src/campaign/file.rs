@@ -313,12 +313,8 @@ fn check_record(
         return Err(place.error(start, &key, "missing `file`: the record's path"));
     };
     let record = place.dir.join(&record_given);
-    if !record.is_file() {
-        return Err(place.error(
-            record_at,
-            &format!("{key}.file"),
-            format!("no such record: {}", record.display()),
-        ));
+    if let Some(problem) = stf_core::data::bounded::record_path_problem(&record) {
+        return Err(place.error(record_at, &format!("{key}.file"), problem));
     }
     let (experiment_given, _) = match string("experiment")? {
         Some(e) => e,

@@ -158,11 +158,13 @@ fn unit(number: usize, row: &Row, columns: &Columns, defaults: &RowDefaults) -> 
     let (line, table) = (row.line, row.table);
     let record_given = cell(columns.file).to_string();
     let record = defaults.dir.join(&record_given);
-    if record_given.is_empty() || !record.is_file() {
-        return Err(at(
-            columns.file,
-            format!("no such record: {}", record.display()),
-        ));
+    let problem = if record_given.is_empty() {
+        Some(format!("no such record: {}", record.display()))
+    } else {
+        stf_core::data::bounded::record_path_problem(&record)
+    };
+    if let Some(problem) = problem {
+        return Err(at(columns.file, problem));
     }
     let given = |c: Option<usize>| c.map(cell).filter(|s| !s.is_empty());
     let experiment_given = match given(columns.experiment).or(defaults.experiment) {

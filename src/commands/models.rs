@@ -63,6 +63,17 @@ pub fn check(path: &Path) -> Result<()> {
         limits.call_operations,
         limits.run_operations
     );
+    let seconds = model.call_seconds();
+    let calls = 10.0 * (params.len() as f64 + 1.0) * 100_000.0;
+    println!(
+        "  one force evaluation takes ~{} here (measured at load): a force-level fit of 10^5 \
+         samples needs ~{} calls, ~{}, six times that at trajectory level (budget {} of \
+         script calls a run, `[scripts] run_seconds`)",
+        stf_plugins::limits::duration_text(seconds),
+        stf_plugins::limits::count_text(calls),
+        stf_plugins::limits::duration_text(seconds * calls),
+        stf_plugins::limits::duration_text(limits.run_seconds)
+    );
     print_params(params);
     Ok(())
 }

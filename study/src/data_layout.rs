@@ -27,8 +27,9 @@ use crate::experiment::raw_drive::RawDrive;
 pub struct RawData {
     /// The record; absent, `[data]` gives only the layout (of the `[[identify]]` records).
     file: Option<String>,
-    /// Time window to use, s.
-    window: Option<[f64; 2]>,
+    /// Time window to use, s: `[start, end]` (read as a list, so that a third value is an
+    /// error rather than dropped).
+    window: Option<Spanned<Vec<f64>>>,
     /// Where each signal is: a column (variable) name or a CSV column number from 1.
     #[serde(default)]
     columns: BTreeMap<String, Spanned<Value>>,
@@ -79,12 +80,20 @@ pub fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Result<Da
         });
     };
     let (span, raw) = (d.span(), d.get_ref());
-    let window = raw.window.map(|[a, b]| (a, b));
-    if let Some((a, b)) = window {
-        if !(b > a) {
-            return Err(cx.at(span, "data.window", format!("[{a}, {b}] is empty")));
-        }
-    }
+    let window = match &raw.window {
+        None => None,
+        Some(w) => match w.get_ref()[..] {
+            [a, b] if b > a => Some((a, b)),
+            [a, b] => return Err(cx.at(w.span(), "data.window", format!("[{a}, {b}] is empty"))),
+            ref other => {
+                let msg = format!(
+                    "give two times, [start, end] in s, not {} value(s)",
+                    other.len()
+                );
+                return Err(cx.at(w.span(), "data.window", msg));
+            }
+        },
+    };
     let layout = layout(cx, &span, raw)?;
     Ok(DataSection {
         file: raw.file.as_ref().map(|f| dir.join(f)),
@@ -334,6 +343,23 @@ mod tests {
             "{msg}"
         );
         assert!(msg.contains(words), "{msg}");
+    }
+
+    #[test]
+    fn a_window_is_two_increasing_times_and_a_third_value_is_refused() {
+        assert_eq!(
+            parse("window = [1.0, 2.5]\n").unwrap().data_window,
+            Some((1.0, 2.5))
+        );
+        // It was read as its first two values, the third dropped without a word.
+        expect(
+            "\nwindow = [0.0, 1.0, 2.0]\n",
+            5,
+            "data.window",
+            "give two times, [start, end] in s, not 3 value(s)",
+        );
+        expect("window = [3.0]\n", 4, "data.window", "not 1 value(s)");
+        expect("window = [2.0, 1.0]\n", 4, "data.window", "[2, 1] is empty");
     }
 
     #[test]

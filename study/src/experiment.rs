@@ -22,6 +22,7 @@ use toml::Spanned;
 use crate::data_layout::{self, RawData};
 
 pub mod context;
+mod counts;
 mod discover;
 mod drive;
 mod filter;
@@ -125,7 +126,7 @@ pub const MAX_EXPERIMENT_BYTES: u64 = 16 << 20;
 /// The text of the experiment file at `path`, at most `limit` bytes.
 pub fn read_text(path: &Path, limit: u64) -> Result<String> {
     read_file_to_string(path, limit).map_err(|e| match e {
-        BoundedError::TooLarge { .. } => {
+        BoundedError::TooLarge { .. } | BoundedError::NoMemory { .. } => {
             anyhow::anyhow!("{}: the experiment file {e}", path.display())
         }
         BoundedError::Io(e) => {

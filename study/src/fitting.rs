@@ -105,12 +105,11 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let Some(file) = &exp.data_file else {
         bail!("{}: has no [data] file to fit", exp.path.display());
     };
-    if !file.is_file() {
+    if let Some(problem) = stf_core::data::bounded::record_path_problem(file) {
         bail!(
-            "{}:{}: `data.file`: no such record: {}",
+            "{}:{}: `data.file`: {problem}",
             exp.path.display(),
-            exp.data_line,
-            file.display()
+            exp.data_line
         );
     }
     let mut record = read_record(exp, file)?;
@@ -522,6 +521,8 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Res
             })
             .collect::<Result<_>>()?
     };
+    let calls = crate::script_plan::fit_calls(&configured, data.record.len(), data.level);
+    crate::script_plan::check(exp, calls, "this fit", progress)?;
     let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
     overall.message(&jobs_message(0, configured.len(), 0.0));
     let (started, done) = (

@@ -35,6 +35,7 @@ pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
 pub mod prelude;
+pub mod script_plan;
 pub mod simulate;
 pub mod validation;
 pub mod verdict;

@@ -52,9 +52,8 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         return Ok(None);
     };
     let key = "validate.file";
-    if !spec.file.is_file() {
-        let msg = format!("no such record: {}", spec.file.display());
-        return Err(spec.error(key, msg));
+    if let Some(problem) = stf_core::data::bounded::record_path_problem(&spec.file) {
+        return Err(spec.error(key, problem));
     }
     let mut record = read_record(exp, &spec.file).map_err(|e| spec.error(key, format!("{e:#}")))?;
     let record_warnings = crate::plausibility::check(exp, &spec.file, &record)

@@ -7,6 +7,8 @@
 //! record, ends in a clear error instead of exhausting the machine's memory. The cap is
 //! checked twice: against the file's length before reading (a regular file is refused at
 //! once) and while reading (a device or pipe that does not end is stopped one byte past it).
+//! A cap raised past the memory this machine has available ([`crate::data::memory`]) is
+//! lowered to it, so a raised `max_bytes` cannot make a read abort the process.
 
 use std::io::Read;
 use std::path::Path;
@@ -23,6 +25,20 @@ pub enum BoundedError {
         /// ran past the cap.
         size: Option<u64>,
         /// The cap, bytes.
+        limit: u64,
+    },
+    /// The input is larger than the memory available to read it into, under a cap raised
+    /// past that memory.
+    #[error(
+        "holds more than the {} of memory this machine has available (the cap, {}, is more \
+         than the machine can hold)",
+        super::memory::gigabytes(*available as f64),
+        byte_size(*limit)
+    )]
+    NoMemory {
+        /// Memory available, bytes.
+        available: u64,
+        /// The cap asked for, bytes.
         limit: u64,
     },
     /// The input could not be read.
@@ -54,12 +70,25 @@ pub fn byte_size(bytes: u64) -> String {
 /// Read all of `reader`, refusing it once it holds more than `limit` bytes (at most
 /// `limit + 1` bytes are read).
 pub fn read_to_end<R: Read>(reader: R, limit: u64) -> Result<Vec<u8>, BoundedError> {
+    read_within(reader, limit, super::memory::available())
+}
+
+/// [`read_to_end`] on a machine with `available` bytes of memory (if known): a cap above half
+/// of it (what a growing buffer may need twice over) is lowered to that half.
+fn read_within<R: Read>(
+    reader: R,
+    limit: u64,
+    available: Option<u64>,
+) -> Result<Vec<u8>, BoundedError> {
+    let room = available.map_or(u64::MAX, |a| a / 2);
+    let cap = limit.min(room);
     let mut data = Vec::new();
-    reader
-        .take(limit.saturating_add(1))
-        .read_to_end(&mut data)?;
-    if data.len() as u64 > limit {
-        return Err(BoundedError::TooLarge { size: None, limit });
+    reader.take(cap.saturating_add(1)).read_to_end(&mut data)?;
+    if data.len() as u64 > cap {
+        return Err(match available {
+            Some(available) if cap < limit => BoundedError::NoMemory { available, limit },
+            _ => BoundedError::TooLarge { size: None, limit },
+        });
     }
     Ok(data)
 }
@@ -76,8 +105,49 @@ pub fn check_len(path: &Path, limit: u64) -> Result<(), BoundedError> {
     }
 }
 
-/// Read the file at `path`, refusing it when it holds more than `limit` bytes.
+/// What is at `path` (following links) when it is neither a regular file nor a device: a
+/// folder, a FIFO or a socket. A FIFO is named before it is opened, since opening one waits
+/// for a writer that may never come.
+pub fn not_readable_kind(path: &Path) -> Option<&'static str> {
+    let kind = std::fs::metadata(path).ok()?.file_type();
+    if kind.is_dir() {
+        return Some("a folder");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("a FIFO (named pipe)");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
+        }
+    }
+    None
+}
+
+/// Why the path a record is read from is not one: `None` for a regular file; else "no such
+/// record: PATH" or "PATH is a folder, not a record file" (a FIFO, socket or device likewise,
+/// `/dev/zero` included).
+pub fn record_path_problem(path: &Path) -> Option<String> {
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Some(format!("no such record: {}", path.display()));
+    };
+    if meta.is_file() {
+        return None;
+    }
+    let what = not_readable_kind(path).unwrap_or("a device");
+    Some(format!("{} is {what}, not a record file", path.display()))
+}
+
+/// Read the file at `path`, refusing it when it holds more than `limit` bytes, and a folder,
+/// FIFO or socket at once ([`not_readable_kind`]: reading a FIFO could wait forever).
 pub fn read_file(path: &Path, limit: u64) -> Result<Vec<u8>, BoundedError> {
+    if let Some(what) = not_readable_kind(path) {
+        return Err(BoundedError::Io(std::io::Error::other(format!(
+            "it is {what}, not a file"
+        ))));
+    }
     check_len(path, limit)?;
     read_to_end(std::fs::File::open(path)?, limit)
 }
@@ -134,6 +204,68 @@ mod tests {
             read_file_to_string(&path, 2_000_001).unwrap().len(),
             2_000_001
         );
+    }
+
+    #[test]
+    fn a_cap_raised_past_the_machine_s_memory_stops_at_half_of_it() {
+        // As if the machine had 10 kB free: /dev/zero under a cap of 10¹⁵ bytes stops at 5 kB.
+        let endless = std::io::repeat(0u8);
+        let e = read_within(endless, 1_000_000_000_000_000, Some(10_000)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                BoundedError::NoMemory {
+                    available: 10_000,
+                    limit: 1_000_000_000_000_000
+                }
+            ),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .starts_with("holds more than the 0 MB of memory"),
+            "{e}"
+        );
+        assert_eq!(
+            read_within(&[1u8; 5000][..], u64::MAX, Some(10_000))
+                .unwrap()
+                .len(),
+            5000
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn folders_fifos_and_devices_are_named_and_a_fifo_is_never_opened() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        // No writer: opening it would block this test forever.
+        let e = read_file(&fifo, 1000).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "cannot read: it is a FIFO (named pipe), not a file"
+        );
+        let e = read_file(dir.path(), 1000).unwrap_err();
+        assert_eq!(e.to_string(), "cannot read: it is a folder, not a file");
+        let shown = |p: &Path| record_path_problem(p).unwrap();
+        assert!(shown(&fifo).ends_with("pipe is a FIFO (named pipe), not a record file"));
+        assert!(shown(dir.path()).ends_with(" is a folder, not a record file"));
+        assert_eq!(
+            shown(Path::new("/dev/zero")),
+            "/dev/zero is a device, not a record file"
+        );
+        assert_eq!(
+            shown(Path::new("/no/such.csv")),
+            "no such record: /no/such.csv"
+        );
+        let file = dir.path().join("r.csv");
+        std::fs::write(&file, "t,x\n").unwrap();
+        assert_eq!(record_path_problem(&file), None);
     }
 
     #[cfg(unix)]

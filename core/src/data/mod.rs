@@ -6,6 +6,7 @@ pub mod bounded;
 pub mod estimate;
 pub mod force_data;
 pub mod kinematics;
+pub mod memory;
 pub mod record;
 pub mod record_bounds;
 pub mod recover;

@@ -92,19 +92,23 @@ fn between(cuts: &[usize], t: &[f64], omega: impl Fn(usize, usize) -> f64) -> Ve
 
 /// `count` equal stretches of a record that has too few cycles of its own to hold some out
 /// (a positioning stroke, a single transient): each stretch is scored as a cycle would be,
-/// with `omega` 2π over its duration.
+/// with `omega` 2π over its duration. Like a cycle, each ends at the first sample of the next
+/// (the last at the record's last sample), so integrals over a stretch have the sample they
+/// close on: every `end` is below `t.len()`.
 pub fn segments(t: &[f64], count: usize) -> Vec<Cycle> {
-    let n = t.len();
-    let count = count.clamp(1, n.max(1));
+    let Some(last) = t.len().checked_sub(1) else {
+        return Vec::new();
+    };
+    let count = count.clamp(1, last.max(1));
     (0..count)
-        .map(|i| (i * n / count, (i + 1) * n / count))
+        .map(|i| (i * last / count, (i + 1) * last / count))
         .filter(|(a, b)| b > a)
         .map(|(start, end)| {
-            let span = (t[end - 1] - t[start]).max(f64::MIN_POSITIVE);
+            let span = (t[end] - t[start]).max(f64::MIN_POSITIVE);
             Cycle {
                 start,
                 end,
-                t_mid: 0.5 * (t[start] + t[end - 1]),
+                t_mid: 0.5 * (t[start] + t[end]),
                 omega: std::f64::consts::TAU / span,
             }
         })
@@ -160,6 +164,39 @@ mod tests {
 
     fn grid(n: usize, rate: f64) -> Vec<f64> {
         (0..n).map(|i| i as f64 / rate).collect()
+    }
+
+    #[test]
+    fn segments_end_inside_the_record_so_their_features_can_be_read() {
+        // The bundled chirp record's shape: 4 001 samples at 200 Hz, cut into 10 stretches.
+        // The last stretch once ended at 4 001, past the last sample an integral over it
+        // closes on ("cycle 3875..4001 does not fit 4001 samples").
+        for n in [4001, 6001, 2, 3, 10] {
+            let t = grid(n, 200.0);
+            let segs = segments(&t, 10);
+            assert!(!segs.is_empty(), "{n}");
+            assert_eq!(segs[0].start, 0);
+            assert_eq!(segs.last().unwrap().end, n - 1, "{n}");
+            assert!(segs.windows(2).all(|w| w[0].end == w[1].start));
+            let x: Vec<f64> = t.iter().map(|t| (6.0 * t).sin()).collect();
+            let f: Vec<f64> = x.iter().map(|x| 0.5 * x).collect();
+            let sig = crate::data::force_data::ForceData {
+                t: &t,
+                x: &x,
+                v: &x,
+                a: &x,
+                f: &f,
+            };
+            for c in &segs {
+                assert!(
+                    c.end < n && c.omega.is_finite() && c.omega > 0.0,
+                    "{n}: {c:?}"
+                );
+                crate::regimes::features::cycle_features(&sig, c, 0.1, 0.5).unwrap();
+            }
+        }
+        assert!(segments(&[], 10).is_empty());
+        assert!(segments(&[0.0], 10).is_empty());
     }
 
     #[test]

@@ -30,6 +30,13 @@ use columns::{Columns, DriveColumns, Rows, PARALLEL_SAMPLES};
 /// 1.4 GB and a 0.6 GB CSV file; 5·10⁷ would already ask 7 GB of a lab laptop.
 pub const DEFAULT_MAX_SAMPLES: u64 = 10_000_000;
 
+/// Bytes a run holds a sample, about (measured: see [`DEFAULT_MAX_SAMPLES`]), plus 16 for each
+/// internal state of the model: what a run's count is checked against the machine's memory
+/// with ([`crate::data::memory`]) before anything is allocated.
+pub fn bytes_per_sample(internal_states: usize) -> f64 {
+    140.0 + 16.0 * internal_states as f64
+}
+
 /// Samples of a simulated run.
 #[derive(Clone, Debug, Default)]
 pub struct Trajectory {
@@ -115,8 +122,27 @@ impl<'a> Simulation<'a> {
                 self.max_samples
             )));
         }
+        let internal = self
+            .osc
+            .initial_state(self.x0, self.v0)
+            .len()
+            .saturating_sub(2);
+        let bytes = count * bytes_per_sample(internal);
+        crate::data::memory::check(bytes, crate::data::memory::available()).map_err(|why| {
+            SimError::BadSettings(format!(
+                "{t0} to {t1} s at {} samples/s is {} samples, which {why} (`max_samples` \
+                 allows {})",
+                self.rate,
+                count_text(count),
+                self.max_samples
+            ))
+        })?;
         let n = count as usize;
-        let times: Vec<f64> = (0..n).map(|i| t0 + i as f64 / self.rate).collect();
+        let mut times: Vec<f64> = Vec::new();
+        times.try_reserve_exact(n).map_err(|e| {
+            SimError::BadSettings(format!("cannot hold {} samples: {e}", count_text(count)))
+        })?;
+        times.extend((0..n).map(|i| t0 + i as f64 / self.rate));
         self.sample(times)
     }
 

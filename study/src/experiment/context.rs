@@ -13,7 +13,55 @@ pub fn line_of(text: &str, offset: usize) -> usize {
 
 /// `FILE:LINE: `KEY`: MSG`, the form of every error about a value in an experiment file.
 pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
+    let (key, msg) = (shorten(key), shorten(&msg.to_string()));
     anyhow::anyhow!("{}:{}: `{}`: {}", file.display(), line, key, msg)
+}
+
+/// Longest run of text from a file shown whole in a message (a key, a value, a name).
+const SHOWN_WHOLE: usize = 200;
+
+/// `text` with every word longer than [`SHOWN_WHOLE`] bytes cut to its start and end and its
+/// size, so that a 5 MB key is not echoed whole.
+pub fn shorten(text: &str) -> String {
+    if text.len() <= SHOWN_WHOLE {
+        return text.to_string();
+    }
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(start) = rest.find(|c: char| !c.is_whitespace()) {
+        out.push_str(&rest[..start]);
+        rest = &rest[start..];
+        let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+        let word = &rest[..end];
+        if word.len() > SHOWN_WHOLE {
+            let head = floor_char(word, 40);
+            let tail = &word[ceil_char(word, word.len() - 20)..];
+            out.push_str(&format!("{head}…({} bytes)…{tail}", word.len()));
+        } else {
+            out.push_str(word);
+        }
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The largest char boundary of `s` at or below `i`.
+fn floor_char(s: &str, i: usize) -> &str {
+    let mut i = i.min(s.len());
+    while !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    &s[..i]
+}
+
+/// The smallest char boundary of `s` at or above `i`.
+fn ceil_char(s: &str, i: usize) -> usize {
+    let mut i = i.min(s.len());
+    while !s.is_char_boundary(i) {
+        i += 1;
+    }
+    i
 }
 
 /// Where errors point: the experiment file and its text.
@@ -77,11 +125,20 @@ impl<'a> Ctx<'a> {
     /// A deserialisation error of the file's text: its line, the key path of the value it is
     /// about (none for a key unknown at the top level) and serde's message.
     pub fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {
-        let line = e.span().map_or(0, |s| line_of(self.text, s.start));
         let msg = e.message().trim_end();
+        // toml gives no place for some errors (nesting too deep): then no line is named.
+        let Some(span) = e.span() else {
+            let hint = if msg.contains("recursion") {
+                " (keys or tables nested too deeply)"
+            } else {
+                ""
+            };
+            return anyhow::anyhow!("{}: {}{hint}", self.file.display(), shorten(msg));
+        };
+        let line = line_of(self.text, span.start);
         match key_path(e) {
             Some(key) => error_at(self.file, line, &key, msg),
-            None => anyhow::anyhow!("{}:{}: {}", self.file.display(), line, msg),
+            None => anyhow::anyhow!("{}:{}: {}", self.file.display(), line, shorten(msg)),
         }
     }
 }
@@ -103,6 +160,39 @@ mod tests {
 
     fn message(text: &str) -> String {
         format!("{:#}", crate::experiment::parse_exp(text).unwrap_err())
+    }
+
+    #[test]
+    fn a_huge_key_or_value_is_shown_cut_with_its_size() {
+        let key = "k".repeat(5_000_000);
+        let msg = message(&format!("[system]\n{key} = 1.0\n"));
+        assert!(msg.len() < 2_000, "{} bytes", msg.len());
+        assert!(msg.starts_with("exp.toml:2: `system`: "), "{}", &msg[..200]);
+        // The word shown cut is the key with its quotes and comma.
+        assert!(
+            msg.contains("unknown field `kkkk") && msg.contains("…(5000003 bytes)…"),
+            "{msg}"
+        );
+        // Short text is shown whole; multibyte text is cut on a character boundary.
+        assert_eq!(super::shorten("a `b` c"), "a `b` c");
+        let wide = "é".repeat(300);
+        assert!(super::shorten(&wide).contains("…(600 bytes)…"));
+    }
+
+    #[test]
+    fn an_error_without_a_place_names_no_line() {
+        // A table header or a dotted key nested too deeply: toml says "recursion limit" with
+        // no place, once shown as line 0.
+        for deep in [
+            format!("[{}a]\n", "a.".repeat(3000)),
+            format!("{}a = 1\n", "a.".repeat(3000)),
+        ] {
+            let msg = message(&deep);
+            assert_eq!(
+                msg, "exp.toml: recursion limit (keys or tables nested too deeply)",
+                "{msg}"
+            );
+        }
     }
 
     #[test]

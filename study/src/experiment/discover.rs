@@ -20,7 +20,8 @@ pub struct DiscoverSpec {
     pub candidates: Option<Vec<String>>,
     /// At most this many effects are added.
     pub max_effects: Option<usize>,
-    /// Every k-th cycle is held out for scoring.
+    /// Every k-th cycle is held out for scoring (k ≥ 2).
+    #[serde(default, deserialize_with = "super::counts::holdout")]
     pub holdout_every: Option<usize>,
     /// `force` or `trajectory`; `None`: as `[fit] level`, else force when the record has
     /// `f_stf`.
@@ -62,6 +63,31 @@ mod tests {
 
     fn parse(text: &str) -> anyhow::Result<Experiment> {
         Experiment::parse(Path::new("exp.toml"), text)
+    }
+
+    #[test]
+    fn zero_iterations_or_a_holdout_of_every_cycle_name_the_key() {
+        // Both printed a settings struct with no key when the run started.
+        let msg = format!("{:#}", parse("[fit]\nmax_iters = 0\n").unwrap_err());
+        assert_eq!(
+            msg,
+            "exp.toml:2: `fit.max_iters`: 0 is not a count of iterations (a whole number, at \
+             least 1)"
+        );
+        let msg = format!(
+            "{:#}",
+            parse("[discover]\nbase = \"viscous\"\nholdout_every = 0\n").unwrap_err()
+        );
+        assert_eq!(
+            msg,
+            "exp.toml:3: `discover.holdout_every`: 0 is not a count of cycles (a whole number, \
+             at least 2)"
+        );
+        let e =
+            parse("[fit]\nmax_iters = 1e3\n[discover]\nbase = \"viscous\"\nholdout_every = 4\n")
+                .unwrap();
+        assert_eq!(e.fit.settings.max_iters, 1000);
+        assert_eq!(e.discover.unwrap().holdout_every, Some(4));
     }
 
     #[test]

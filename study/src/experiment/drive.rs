@@ -149,11 +149,7 @@ impl RawProfile {
             "simulate.profile.t",
             "times must increase",
         )?;
-        let angle = RotorAngle::Profile {
-            t: t.clone(),
-            omega: omega.clone(),
-            phi0: self.phi0,
-        };
+        let angle = RotorAngle::profile(t.clone(), omega.clone(), self.phi0);
         Ok(Checked {
             drive: Drive::Rotor(angle),
             t0: t[0],

@@ -87,6 +87,7 @@ enum Initial {
 pub(super) struct RawFit {
     level: Option<FitLevel>,
     solver: Option<Solver>,
+    #[serde(default, deserialize_with = "super::counts::iterations")]
     max_iters: Option<u64>,
     seed: Option<u64>,
     #[serde(default)]

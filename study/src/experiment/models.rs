@@ -114,11 +114,24 @@ impl ModelEntry {
 
 /// Check a list of entries whose key is `prefix` (`models`, `simulate.truth`).
 pub(super) fn check(list: &[Spanned<RawModel>], prefix: &str, cx: &Ctx) -> Result<Vec<ModelEntry>> {
+    if let Some(past) = list.get(MAX_MODELS) {
+        let msg = format!(
+            "{} entries; a run takes at most {MAX_MODELS} (each is fitted, kept in memory with \
+             its curves and written with its report: 2 000 took 1.6 GB and 1.8 GB of output): \
+             split them across experiments, or run them as a campaign",
+            list.len()
+        );
+        return Err(cx.at(past.span(), prefix, msg));
+    }
     list.iter()
         .enumerate()
         .map(|(i, m)| entry(m, format!("{prefix}[{i}]"), cx))
         .collect()
 }
+
+/// The most entries of one list of models (`[[models]]`, `[[simulate.truth]]`): far more than
+/// a comparison reads, few enough that a run's memory and output stay small.
+pub const MAX_MODELS: usize = 100;
 
 /// One entry: exactly one of `name` and `script`.
 fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
@@ -168,6 +181,23 @@ fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
 mod tests {
     use super::*;
     use crate::experiment::parse_exp as parse;
+
+    #[test]
+    fn more_models_than_a_run_takes_are_refused_at_the_first_past_the_limit() {
+        let entries = |n: usize| "[[models]]\nname = \"viscous\"\n".repeat(n);
+        assert_eq!(
+            parse(&entries(MAX_MODELS)).unwrap().models.len(),
+            MAX_MODELS
+        );
+        let msg = parse(&entries(2000)).unwrap_err().to_string();
+        assert!(
+            msg.starts_with(&format!(
+                "exp.toml:{}: `models`: 2000 entries; a run takes at most 100",
+                2 * MAX_MODELS + 1
+            )),
+            "{msg}"
+        );
+    }
 
     #[test]
     fn an_entry_is_checked_into_its_source_sum_and_parameters_with_their_lines() {

@@ -144,6 +144,26 @@ fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64
         count_text(count)
     );
     cx.ensure(count <= limit as f64, span.clone(), "simulate.rate", asked)?;
+    // The limit is a setting: raised past what this machine can hold, the run is refused
+    // here, naming the key, instead of aborting when it allocates.
+    // (The truth's internal states, not known here, add a little; the run checks them too.)
+    let bytes = count * stf_core::simulate::bytes_per_sample(0);
+    if let Err(why) = stf_core::data::memory::check(bytes, stf_core::data::memory::available()) {
+        let key = if s.max_samples.is_some() {
+            "simulate.max_samples"
+        } else {
+            "simulate.rate"
+        };
+        let span = s.max_samples.as_ref().map_or(span.clone(), |m| m.span());
+        let msg = format!(
+            "{} samples/s from t0 = {t0} to t1 = {t1} s is {} samples, which {why}; the limit \
+             of {limit} samples (`simulate.max_samples`) does not make room for them: lower \
+             `rate` or the drive's end time",
+            s.rate,
+            count_text(count)
+        );
+        return Err(cx.at(span, key, msg));
+    }
     Ok(limit)
 }
 
@@ -168,12 +188,13 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(msg.contains("asks for 1.00e300 samples"), "{msg}");
-        // The limit is a setting: raised, the same run parses; lowered, a short one is refused.
+        // The limit is a setting: raised, a run past the default parses (1.5·10⁷ samples,
+        // 2.1 GB, within this machine's memory); lowered, a short one is refused.
         let e = parse(
-            "[simulate]\nconstant = { omega = 6.0, t1 = 1e9 }\nrate = 1e6\nmax_samples = 2e15\n",
+            "[simulate]\nconstant = { omega = 6.0, t1 = 15.0 }\nrate = 1e6\nmax_samples = 2e7\n",
         )
         .unwrap();
-        assert_eq!(e.simulate.unwrap().max_samples, 2_000_000_000_000_000);
+        assert_eq!(e.simulate.unwrap().max_samples, 20_000_000);
         let msg = parse("[simulate]\nfree = { t1 = 1.0 }\nrate = 100.0\nmax_samples = 100\n")
             .unwrap_err()
             .to_string();
@@ -183,6 +204,24 @@ mod tests {
             .to_string();
         assert!(
             msg.starts_with("exp.toml:3: `simulate.max_samples`: -3 is not"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn a_raised_limit_past_the_machine_s_memory_is_refused_at_the_key() {
+        // The issue's case aborted with "memory allocation of 80000000000008 bytes failed".
+        let msg = parse(
+            "[simulate]\nconstant = { omega = 8.2, t1 = 1e4 }\nrate = 1e9\nmax_samples = 1e18\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            msg.starts_with(
+                "exp.toml:4: `simulate.max_samples`: 1000000000 samples/s from t0 = 0 \
+                             to t1 = 10000 s is 1.00e13 samples, which needs about"
+            ) && msg.contains("of memory this machine has available")
+                && msg.contains("lower `rate`"),
             "{msg}"
         );
     }

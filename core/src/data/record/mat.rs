@@ -168,7 +168,7 @@ fn vector(
 
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // tests may unwrap
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// MATLAB array classes used by the generator.
@@ -257,7 +257,7 @@ mod tests {
         p
     }
 
-    fn col<'a>(name: &'a str, values: &'a [f64], column: bool) -> Var<'a> {
+    pub fn col<'a>(name: &'a str, values: &'a [f64], column: bool) -> Var<'a> {
         let n = values.len() as i32;
         Var {
             name,
@@ -341,7 +341,7 @@ mod tests {
     }
 
     /// `bytes` (a file from [`mat_v5`]) with every variable zlib-compressed, as `-v7` saves.
-    fn compressed(bytes: &[u8]) -> Vec<u8> {
+    pub fn compressed(bytes: &[u8]) -> Vec<u8> {
         use std::io::Write;
         let mut out = bytes[..128].to_vec();
         let mut at = 128;
