@@ -5,13 +5,13 @@
 //! by less than 1e-15 of itself and never cuts a measured digit (records carry far fewer).
 //!
 //! ```
-//! use stf_lab::digits::carried;
+//! use stf_study::digits::carried;
 //! assert_eq!(carried(2.35 + 0.047 * 82.0).to_string(), "6.204");
 //! assert_eq!(carried(0.1 + 0.2).to_string(), "0.3");
-//! assert_eq!(stf_lab::digits::fixed(-0.04, 1), "0.0");
-//! assert_eq!(stf_lab::digits::fixed(-0.06, 1), "-0.1");
-//! assert_eq!(stf_lab::digits::with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
-//! assert_eq!(stf_lab::digits::with_error(3.02331, 0.313), "3.02 ± 0.31");
+//! assert_eq!(stf_study::digits::fixed(-0.04, 1), "0.0");
+//! assert_eq!(stf_study::digits::fixed(-0.06, 1), "-0.1");
+//! assert_eq!(stf_study::digits::with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
+//! assert_eq!(stf_study::digits::with_error(3.02331, 0.313), "3.02 ± 0.31");
 //! ```
 
 use serde_json::Value;
