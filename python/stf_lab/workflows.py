@@ -1,0 +1,61 @@
+"""The lab's workflows from Python: simulate, fit, compare (discover and identify follow the
+study layer). Each takes an :class:`stf_lab.Experiment` (or an experiment file's path), runs
+in process what the command line runs — the same calls, the same numbers — and writes
+nothing. Long runs release the GIL; Ctrl-C or the notebook's stop button raises
+:class:`stf_lab.Interrupted`. ``progress`` is a callable taking ``(status, elapsed_s)``,
+called at the start and about ten times a second; ``progress=True`` prints a status line.
+"""
+
+import sys
+
+from . import _stf_lab
+from .experiment import as_experiment
+from .record import Record
+from .results import CompareResult, FitResult
+
+__all__ = ["simulate", "fit", "compare"]
+
+
+class _StatusLine:
+    """``progress=True``: the status and the time on one line of stderr, rewritten in place."""
+
+    def __init__(self):
+        self.last = None
+
+    def __call__(self, status, elapsed):
+        text = f"{status}  [{elapsed:.0f} s]"
+        if text != self.last:
+            sys.stderr.write("\r" + text.ljust(60))
+            sys.stderr.flush()
+            self.last = text
+
+
+def _progress(progress):
+    if progress is True:
+        return _StatusLine()
+    return progress or None
+
+
+def _args(experiment):
+    exp = as_experiment(experiment)
+    return exp, exp.path, exp.text if exp.built else None
+
+
+def simulate(experiment, progress=None):
+    """The synthetic record of the experiment's ``[simulate]`` section (``stf-lab simulate``
+    without its files): the oscillator with the hidden ``truth`` models, the rig's sensors."""
+    exp, path, text = _args(experiment)
+    return Record(_stf_lab.simulate(path, text, _progress(progress)))
+
+
+def fit(experiment, progress=None):
+    """Fit every model of the experiment to its record (``stf-lab fit``): a :class:`FitResult`."""
+    exp, path, text = _args(experiment)
+    return FitResult(_stf_lab.fit(path, text, _progress(progress)), exp)
+
+
+def compare(experiment, progress=None):
+    """Fit, then compare the models regime by regime (``stf-lab compare``): a
+    :class:`CompareResult`."""
+    exp, path, text = _args(experiment)
+    return CompareResult(_stf_lab.compare(path, text, _progress(progress)), exp)
