@@ -109,12 +109,12 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, String)> {
     let exp = dir.join(format!("{stem}.toml"));
     std::fs::write(&exp, experiment(case, &record))?;
     if !dir.join(&record).exists() {
-        stf_lab::cmd_simulate::run(&exp, &dir.join(&record), true)?;
+        stf_lab::commands::simulate::run(&exp, &dir.join(&record), true)?;
     }
     let out = dir.join(&stem);
     let clock = Instant::now();
     let loaded = stf_lab::experiment::Experiment::load(&exp)?;
-    stf_lab::cmd_discover::run_experiment(loaded, &out, true, true)?;
+    stf_lab::commands::discover::run_experiment(loaded, &out, true, true)?;
     let wall = clock.elapsed().as_secs_f64();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;

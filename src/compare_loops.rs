@@ -13,9 +13,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use stf_core::regimes::{
-    Boundary, Classification, Comparison, CycleFeatures, MetricRanking, Regime,
-};
+use stf_core::regimes::{Classification, Comparison, CycleFeatures, MetricRanking, Regime};
 
 use crate::digits::fixed;
 use crate::output::write_atomic;
@@ -24,41 +22,7 @@ use crate::report::Table;
 /// The on-fraction in words, for reports.
 pub const DUTY_EXPLAINED: &str = "On-fraction (duty): the share of each cycle in which the force is on, |F| above the on-threshold (3 σ of the force noise, at least 0.05 N), lone noise samples ignored and gaps under 5 % of the cycle bridged; 1 for a damper, small for spikes with zero force between them.";
 
-/// A boundary as reports show it.
-#[derive(Clone, Debug, Serialize)]
-pub struct BoundaryNote {
-    /// `pre_resonance` (pre → resonance) or `resonance_post`.
-    pub boundary: &'static str,
-    /// ω, rad/s.
-    pub omega: f64,
-    /// Half-width of its uncertainty, rad/s.
-    pub uncertainty: f64,
-    /// The rule that placed it (`force_onset`, `on_off`, `force_gone`, `on_off_from_onset`,
-    /// `amplitude`).
-    pub rule: stf_core::regimes::BoundaryRule,
-    /// The rule in words.
-    pub explanation: &'static str,
-}
-
-/// The measured boundaries, with the rule that placed each.
-pub fn boundary_notes(c: &Classification) -> Vec<BoundaryNote> {
-    let note = |name, b: Option<Boundary>| {
-        b.map(|b| BoundaryNote {
-            boundary: name,
-            omega: b.omega,
-            uncertainty: b.uncertainty,
-            rule: b.rule,
-            explanation: b.rule.describe(),
-        })
-    };
-    [
-        note("pre_resonance", c.boundaries.pre_resonance),
-        note("resonance_post", c.boundaries.resonance_post),
-    ]
-    .into_iter()
-    .flatten()
-    .collect()
-}
+pub use stf_study::compare::{boundary_notes, BoundaryNote};
 
 /// One line per boundary for compare.md and the report (and one saying a boundary is absent).
 pub fn boundary_lines(c: &Classification) -> Vec<String> {

@@ -8,9 +8,9 @@ use std::fmt::Write as _;
 
 use stf_core::regimes::Regime;
 
-use crate::cmd_compare::Compared;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
+use stf_study::compare::Compared;
 
 /// What the duty and its error are, with the record's on-threshold.
 pub fn duty_meaning(on_threshold: f64) -> String {

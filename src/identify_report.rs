@@ -6,29 +6,12 @@
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::fit::{FitResult, FitWarning, NoiseFloor};
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use crate::report::{measured_vs_model, milli, FigureRef, Section, Table, DISPLACEMENT_MM};
 use crate::standard_report::write_report;
 
-/// One identification stage as fitted.
-pub struct StageOutcome {
-    /// The stage's record, as given.
-    pub record: String,
-    /// Its times, s.
-    pub t: Vec<f64>,
-    /// Its measured displacement, m.
-    pub x: Vec<f64>,
-    /// The displacement simulated with the stage's fitted values, m (empty if it failed).
-    pub simulated: Vec<f64>,
-    /// The fit.
-    pub result: FitResult,
-    /// Its noise floor (the position noise).
-    pub floor: NoiseFloor,
-    /// Its warnings.
-    pub warnings: Vec<FitWarning>,
-}
+pub use stf_study::identify::StageOutcome;
 
 /// `x` with `digits` significant digits, trailing zeros dropped (`269.935`, `0.0461989`).
 fn significant(x: f64, digits: i32) -> String {

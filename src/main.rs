@@ -20,8 +20,13 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use stf_lab::campaign::slurm_script::SlurmOptions;
 use stf_lab::{
-    cmd_campaign, cmd_compare, cmd_discover, cmd_fit, cmd_models, cmd_simulate,
-    experiment::Experiment, interrupt, tell,
+    campaign::command as cmd_campaign,
+    commands::{
+        compare as cmd_compare, discover as cmd_discover, fit as cmd_fit, models as cmd_models,
+        simulate as cmd_simulate,
+    },
+    experiment::Experiment,
+    interrupt, tell,
 };
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.

@@ -20,9 +20,9 @@ use std::path::Path;
 
 use common::{csv_column, simulate_ok};
 use stf_core::regimes::{cycles_from_phase, duty, Boundary, BoundaryRule, RegimeThresholds};
-use stf_lab::cmd_compare::measured_regimes;
 use stf_lab::experiment::Experiment;
 use stf_lab::fitting::load_data;
+use stf_study::compare::measured_regimes;
 
 /// The force sensor's σ of the rig (`SensorNoise::RIG`), N.
 const SENSOR_SIGMA: f64 = 0.02;

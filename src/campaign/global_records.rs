@@ -63,7 +63,7 @@ pub fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Res
     fexp.system = exp.system;
     fexp.system_given = exp.system_given;
     let configured = configure(spec, gexp, &data.scales(&fexp.system))?;
-    let hidden = indicatif::ProgressBar::hidden();
+    let hidden = stf_study::observer::Silent;
     let own = fitting::fit_model(&fexp, &data, Some(&configured), &hidden)?;
     let k = &data.kinematics;
     let (f, fit, params) = match (&own.predictor, spec.level) {

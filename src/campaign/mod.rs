@@ -5,11 +5,12 @@
 //! [`slurm_script`]) — and recognised as finished by the hash of its inputs ([`hash`]). After the units, the
 //! [`table`] (`campaign.csv`, `campaign.json`: a row per record × model) and the
 //! [`report`] are built from the units' JSON ([`unit_results`]). The output folder's rules
-//! are in [`out_dir`]; `crate::cmd_campaign` runs it all. A `[global]` section
+//! are in [`out_dir`]; [`command`] runs it all. A `[global]` section
 //! ([`global_file`]) adds a joint fit of all records with shared and law parameters
 //! ([`global_records`], [`global_fit`], [`prediction_cache`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
 //! shown first in the report ([`global_report`]).
 
+pub mod command;
 pub mod file;
 pub mod global;
 pub mod global_file;

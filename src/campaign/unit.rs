@@ -114,9 +114,9 @@ pub fn run_one(
     let started = Instant::now();
     let exp = exp.with_data_file(unit.record.clone());
     let result = match unit.command {
-        CommandName::Fit => crate::cmd_fit::run_experiment(exp, &dir, true, quiet),
-        CommandName::Compare => crate::cmd_compare::run_experiment(exp, &dir, true, quiet),
-        CommandName::Discover => crate::cmd_discover::run_experiment(exp, &dir, true, quiet),
+        CommandName::Fit => crate::commands::fit::run_experiment(exp, &dir, true, quiet),
+        CommandName::Compare => crate::commands::compare::run_experiment(exp, &dir, true, quiet),
+        CommandName::Discover => crate::commands::discover::run_experiment(exp, &dir, true, quiet),
     };
     let mut json = UnitJson {
         unit: number,

@@ -17,7 +17,6 @@ use stf_core::physics::force_model::ForceModel;
 
 use crate::digits::carried;
 use crate::fitting::ModelFit;
-use crate::output::write_atomic;
 
 /// One row of the table.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -97,7 +96,7 @@ pub fn rows_of_fits(fits: &[ModelFit]) -> Vec<ParamRow> {
         .collect()
 }
 
-/// Write `rows` as CSV to `path`, atomically.
-pub fn write_params_csv(path: &Path, rows: &[ParamRow]) -> Result<()> {
-    write_atomic(path, &crate::outputs::csv_rows(path, rows)?)
+/// The text of `params.csv` (`path`, for messages): `rows` under their header.
+pub fn params_csv(path: &Path, rows: &[ParamRow]) -> Result<Vec<u8>> {
+    crate::outputs::csv_rows(path, rows)
 }

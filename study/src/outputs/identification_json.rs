@@ -8,7 +8,7 @@ use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
 use super::fit_json::ResultJson;
 use crate::experiment::StageSpec;
-use crate::identify_report::StageOutcome;
+use crate::identify::StageOutcome;
 
 /// The whole of the identification's `fit.json`.
 #[derive(Serialize)]

@@ -10,27 +10,21 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use stf_core::data::kinematics::Kinematics;
-use stf_core::fit::{
-    fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
-};
+use anyhow::Result;
+use stf_core::fit::{FitResult, FitWarning};
+use stf_study::fit::Fitted;
+use stf_study::identify::Identification;
 
 use crate::experiment::{Experiment, FitLevel, StageSpec};
-use crate::fitting::{
-    estimate_line, fit_all, load_data, oscillator_fit, system_param, FitData, ModelFit,
-};
-use crate::identify_report::{system_line, write_identification_report, StageOutcome};
-use crate::output::write_json;
-use crate::outputs::columns_csv::Columns;
-use crate::outputs::fit_json::FitJson;
+use crate::fitting::{estimate_line, FitData, ModelFit};
+use crate::identify_report::{system_line, write_identification_report};
+use crate::output::{write_atomic, write_json};
 use crate::outputs::identification_json::IdentificationJson;
-use crate::param_table::{rows_of, rows_of_fits, write_params_csv, ParamRow};
-use crate::progress::{fit_message, Progress};
+use crate::param_table::{params_csv, rows_of, ParamRow};
+use crate::progress::Progress;
 use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
-use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::Regime;
 
 /// Run `stf-lab fit` on an experiment loaded (from its file, or a campaign's unit: its
@@ -40,18 +34,18 @@ pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool)
     let progress = Progress::new(quiet);
     let mut files = vec!["fit.json", "params.csv"];
     let results = if !exp.identify.is_empty() {
-        if let Some(spec) = &exp.validate {
-            let msg = "scores the fits of `[[models]]`; `[[identify]]` stages are not scored";
-            return Err(spec.error("validate", msg));
-        }
         let results = ResultsDir::begin(out, force)?;
-        identify(&exp, results.path(), &progress)?;
+        let found = stf_study::identify::identify(&exp, &progress)?;
+        write_identification(&exp, results.path(), &found)?;
         results
     } else {
-        let data = load_data(&mut exp)?;
-        let validation = crate::validation::load(&exp, &data)?;
+        let inputs = stf_study::fit::load(&mut exp, &progress)?;
         let results = ResultsDir::begin(out, force)?;
-        write_fits(&exp, &data, validation.as_ref(), results.path(), &progress)?;
+        if let Some(line) = estimate_line(&inputs.data) {
+            say!("{line}");
+        }
+        let fitted = inputs.fit(&exp, &progress)?;
+        write_fits(&exp, &fitted, results.path())?;
         files.push("fitted.csv");
         results
     };
@@ -60,56 +54,29 @@ pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool)
     Ok(())
 }
 
-/// Fit every model of `exp` to `data`, print the summary and write the results into `out`.
-fn write_fits(
-    exp: &Experiment,
-    data: &FitData,
-    validation: Option<&ValidationRecord>,
-    out: &Path,
-    progress: &Progress,
-) -> Result<()> {
-    if let Some(line) = estimate_line(data) {
-        say!("{line}");
-    }
-    let mut fits = fit_all(exp, data, progress)?;
-    if let Some(rec) = validation {
-        crate::validation::score_fits(&mut fits, rec);
-    }
+/// Write the fit's results into `out` and print its summary.
+fn write_fits(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()> {
+    let (data, fits) = (&fitted.data, &fitted.fits);
+    write_json(&out.join("fit.json"), &fitted.json(exp))?;
+    let params = out.join("params.csv");
+    write_atomic(&params, &params_csv(&params, &fitted.param_rows())?)?;
+    let csv = fitted.fitted_columns().to_csv()?;
+    write_atomic(&out.join("fitted.csv"), &csv)?;
 
-    write_json(&out.join("fit.json"), &FitJson::new(&exp.path, data, &fits))?;
-    write_params_csv(&out.join("params.csv"), &rows_of_fits(&fits))?;
-    fitted_columns(data, &fits).write(&out.join("fitted.csv"))?;
-
-    print_summary(data, &fits);
-    if let Some(rec) = validation {
-        print_validation(rec, &fits);
+    print_summary(data, fits);
+    if let Some(rec) = &fitted.validation {
+        print_validation(rec, fits);
     }
     if exp.output.report {
-        write_fit_report(exp, data, validation, &fits, out)?;
+        write_fit_report(exp, fitted, out)?;
     }
     Ok(())
 }
 
-/// `fitted.csv`: t, the measured signal (`f_stf` or `x`) and each model's fit of it
-/// (`f_stf_<label>` or `x_<label>`).
-fn fitted_columns<'a>(data: &'a FitData, fits: &'a [ModelFit]) -> Columns<'a> {
-    let measured = data.level.signal().column;
-    let columns = Columns::new()
-        .with("t", &data.record.t)
-        .with(measured, data.target());
-    fits.iter().fold(columns, |c, f| {
-        c.with(format!("{measured}_{}", f.label), &f.fitted)
-    })
-}
-
 /// The fit's report (report.html, report.md, figures/) in `out`.
-fn write_fit_report(
-    exp: &Experiment,
-    data: &FitData,
-    validation: Option<&ValidationRecord>,
-    fits: &[ModelFit],
-    out: &Path,
-) -> Result<()> {
+fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()> {
+    let (data, fits) = (&fitted.data, fitted.fits.as_slice());
+    let validation = fitted.validation.as_ref();
     let level = data.level;
     let mut sections = Vec::new();
     if let Some(rec) = validation {
@@ -127,7 +94,7 @@ fn write_fit_report(
         exp, data, &forces, out,
     )?);
     let mut intro = vec![
-        crate::verdict::fit_verdict(fits, level),
+        fitted.verdict(),
         format!(
             "stf-lab fitted {} model(s) of {} to {}.",
             fits.len(),
@@ -265,92 +232,13 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
     print_warnings(warnings);
 }
 
-/// The oscillator stage `i` of `exp` starts from: `system` as the earlier stages left it,
-/// its preset's values for the parameters no earlier stage found, then its `set` values.
-fn stage_start(exp: &Experiment, i: usize, system: &mut OscillatorParams) {
-    let stage = &exp.identify[i];
-    if let Some(preset) = stage.preset {
-        let found: Vec<OscParam> = exp.identify[..i]
-            .iter()
-            .flat_map(|s| &s.free)
-            .copied()
-            .collect();
-        for param in OscParam::ALL {
-            if !found.contains(&param) {
-                system[param] = preset[param];
-            }
-        }
+/// Write the identification's fit.json, params.csv and report into `out`, and print each
+/// stage and the oscillator found.
+fn write_identification(exp: &Experiment, out: &Path, found: &Identification) -> Result<()> {
+    let (system, outcomes) = (&found.system, &found.stages);
+    for (i, (stage, o)) in exp.identify.iter().zip(outcomes).enumerate() {
+        print_stage(i, stage, &o.result, &o.warnings);
     }
-    for &(param, value) in &stage.set {
-        system[param] = value;
-    }
-}
-
-/// The source study's identification: each stage fits the oscillator's parameters against a
-/// record's displacement, starting from the previous stage's values.
-fn identify(exp: &Experiment, out: &Path, progress: &Progress) -> Result<()> {
-    let mut system = exp.system;
-    let mut outcomes = Vec::new();
-    for (i, stage) in exp.identify.iter().enumerate() {
-        stage_start(exp, i, &mut system);
-        let record = crate::fitting::read_record(exp, &stage.data)?;
-        let k = Kinematics::from_record(&record, &exp.kinematics)
-            .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
-        let mut fit = oscillator_fit(exp, system, &k).settings(exp.fit.settings.clone());
-        let mut free: Vec<_> = stage
-            .free
-            .iter()
-            .map(|&param| system_param(param, &system, &k))
-            .collect();
-        if exp.fit.fit_initial {
-            free.extend(k.initial_state_params());
-        }
-        fit = free.iter().cloned().fold(fit, TrajectoryFit::free);
-        let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
-        let observer = |p: stf_core::fit::FitProgress| bar.set_message(fit_message(&p, "mm", 1e3));
-        let data = TrajectoryData {
-            t: &record.t,
-            x: &record.x,
-        };
-        let result = fit.fit(&data, Some(&observer)).with_context(|| {
-            format!(
-                "{}:{}: identification stage {} failed",
-                exp.path.display(),
-                stage.line,
-                i + 1
-            )
-        })?;
-        bar.finish_and_clear();
-        crate::interrupt::finished_step(format!("identification stage {}", i + 1));
-        for &param in &stage.free {
-            if let Some(v) = result.value(param.name()) {
-                system[param] = v;
-            }
-        }
-        let floor = NoiseFloor::displacement(k.sigma_x);
-        let warnings = fit_warnings(&result, &free, Some(&floor));
-        print_stage(i, stage, &result, &warnings);
-        let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
-        outcomes.push(StageOutcome {
-            record: stage.data.display().to_string(),
-            simulated: fit.predict(&data, &values).unwrap_or_default(),
-            t: record.t.clone(),
-            x: record.x.clone(),
-            result,
-            floor,
-            warnings,
-        });
-    }
-    finish_identification(exp, out, &system, &outcomes)
-}
-
-/// Write the identification's fit.json, params.csv and report into `out`.
-fn finish_identification(
-    exp: &Experiment,
-    out: &Path,
-    system: &OscillatorParams,
-    outcomes: &[StageOutcome],
-) -> Result<()> {
     let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system);
     write_json(&out.join("fit.json"), &doc)?;
     let rows: Vec<ParamRow> = outcomes
@@ -358,7 +246,8 @@ fn finish_identification(
         .enumerate()
         .flat_map(|(i, o)| rows_of(&format!("stage {}", i + 1), &o.result, None, &o.warnings))
         .collect();
-    write_params_csv(&out.join("params.csv"), &rows)?;
+    let params = out.join("params.csv");
+    write_atomic(&params, &params_csv(&params, &rows)?)?;
     say!("identified system: {}", system_line(system));
     if exp.output.report {
         write_identification_report(&exp.path, outcomes, system, out)?;

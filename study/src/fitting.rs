@@ -13,19 +13,22 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use rayon::prelude::*;
+use serde::Serialize;
 use stf_core::data::estimate::{linear_oscillator, LinearEstimate};
 use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
+use stf_core::fit::Validation;
 use stf_core::fit::{
     fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor, TrajectoryData,
     TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
+use stf_core::regimes::{PerRegime, RegimeRms};
 
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
-use crate::progress::{fit_message, Progress};
+use crate::observer::{fit_message, jobs_message, Job, Observer};
 use stf_core::data::record_bounds::DataScales;
 
 /// A record with its kinematics, ready to fit.
@@ -113,9 +116,6 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let mut record = read_record(exp, file)?;
     let record_warnings = crate::plausibility::check(exp, file, &record)
         .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
-    for w in &record_warnings {
-        eprintln!("warning: {w}");
-    }
     if let Some((t0, t1)) = exp.data_window {
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
@@ -270,7 +270,7 @@ pub struct ModelFit {
     /// (force level), or the free parameters as listed (trajectory level).
     pub values: Vec<f64>,
     /// The model's error on the `[validate]` record, once scored.
-    pub validation: Option<crate::validation::ModelValidation>,
+    pub validation: Option<ModelValidation>,
 }
 
 impl ModelFit {
@@ -289,6 +289,30 @@ impl ModelFit {
                 .map(|p| self.result.value(&p.name).unwrap_or(p.value))
                 .collect()
         })
+    }
+}
+
+/// A fitted model's error on the validation record (fit.json's `validation`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelValidation {
+    /// The record, as the experiment names it.
+    pub file: String,
+    /// Unit of the errors: N (force level) or m (trajectory level).
+    pub unit: &'static str,
+    /// `rms`, `measured_rms`, `normalised`, `samples`, `initial`, `initial_fitted`.
+    #[serde(flatten)]
+    pub score: Option<Validation>,
+    /// The same per regime of the record's rotor cycles (none without a rotor).
+    pub per_regime: Option<PerRegime<RegimeRms>>,
+    /// Why the model could not be scored, if it could not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+impl ModelValidation {
+    /// The RMS error, if scored.
+    pub fn rms(&self) -> Option<f64> {
+        self.score.as_ref().map(|s| s.rms)
     }
 }
 
@@ -324,11 +348,10 @@ pub fn fit_model(
     exp: &Experiment,
     data: &FitData,
     configured: Option<&ConfiguredModel>,
-    progress: &indicatif::ProgressBar,
+    progress: &dyn Job,
 ) -> Result<ModelFit> {
     let (unit, scale) = data.level.shown();
-    let observer =
-        |p: stf_core::fit::FitProgress| progress.set_message(fit_message(&p, unit, scale));
+    let observer = |p: stf_core::fit::FitProgress| progress.message(&fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     let predictor = Predictor::build(exp, data, configured)?;
     let result = predictor
@@ -368,7 +391,7 @@ pub fn fit_model(
 }
 
 /// A progress observer.
-type Observer<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
+type FitObserver<'a> = dyn Fn(stf_core::fit::FitProgress) + Sync + 'a;
 
 impl Predictor {
     /// The fit of `configured` (or the bare oscillator) at `data`'s level: the model's
@@ -419,7 +442,7 @@ impl Predictor {
     }
 
     /// Run the fit on `data`'s target signal.
-    fn fit(&self, data: &FitData, observer: &Observer) -> Result<FitResult, FitError> {
+    fn fit(&self, data: &FitData, observer: &FitObserver) -> Result<FitResult, FitError> {
         match self {
             Predictor::Force(f) => f.fit(&data.force_data(), Some(observer)),
             Predictor::Trajectory(f) => f.fit(&data.trajectory_data(), Some(observer)),
@@ -471,7 +494,7 @@ pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics
 
 /// Configure and fit every model of the experiment, in parallel (bounds widened where the
 /// record needs it: [`FitData::scales`]).
-pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<Vec<ModelFit>> {
+pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Result<Vec<ModelFit>> {
     let scales = data.scales(&exp.system);
     let configured: Vec<Option<ConfiguredModel>> = if exp.models.is_empty() {
         if data.level == FitLevel::Force {
@@ -500,7 +523,7 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
             .collect::<Result<_>>()?
     };
     let overall = progress.job(&format!("fitting {} model(s)", configured.len()));
-    overall.set_message(crate::progress::jobs_message(0, configured.len(), 0.0));
+    overall.message(&jobs_message(0, configured.len(), 0.0));
     let (started, done) = (
         std::time::Instant::now(),
         std::sync::atomic::AtomicUsize::new(0),
@@ -513,19 +536,22 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &Progress) -> Result<
         .par_iter()
         .zip(bars.par_iter())
         .map(|(c, bar)| {
-            let r = fit_model(exp, data, c.as_ref(), bar);
-            bar.finish_and_clear();
+            if progress.cancelled() {
+                return Err(crate::error::Interrupted.into());
+            }
+            let r = fit_model(exp, data, c.as_ref(), bar.as_ref());
+            bar.finish();
             let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             let elapsed = started.elapsed().as_secs_f64();
-            overall.set_message(crate::progress::jobs_message(n, configured.len(), elapsed));
+            overall.message(&jobs_message(n, configured.len(), elapsed));
             if r.is_ok() {
                 let name = c.as_ref().map_or("the oscillator", |c| c.model.name());
-                crate::interrupt::finished_step(format!("the fit of `{name}`"));
+                progress.finished(&format!("the fit of `{name}`"));
             }
             r
         })
         .collect::<Result<_>>()?;
-    overall.finish_and_clear();
+    overall.finish();
     let names: Vec<String> = fits.iter().map(|f| f.label.replace(' ', "")).collect();
     for (i, f) in fits.iter_mut().enumerate() {
         let same = names[..i].iter().filter(|n| **n == names[i]).count();

@@ -8,8 +8,7 @@ use stf_core::regimes::{
 };
 
 use super::fit_json::ModelFitJson;
-use crate::cmd_compare::Compared;
-use crate::compare_loops::BoundaryNote;
+use crate::compare::{BoundaryNote, CompareResult, Compared};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 
@@ -133,7 +132,7 @@ impl<'a> CompareJson<'a> {
                 cycles: measured.labels.len(),
                 cycles_per_regime,
                 boundaries: &measured.boundaries,
-                boundary_notes: crate::compare_loops::boundary_notes(measured),
+                boundary_notes: crate::compare::boundary_notes(measured),
                 resonance: PeakJson {
                     peak_x_m: peak.amplitude,
                     peak_omega_rad_s: peak.omega,
@@ -180,4 +179,11 @@ fn models<'a>(data: &'a FitData, c: &'a Compared) -> Vec<ModelComparisonJson<'a>
             }),
         })
         .collect()
+}
+
+impl CompareResult {
+    /// `compare.json` of the experiment `exp`.
+    pub fn json<'a>(&'a self, exp: &'a Experiment) -> CompareJson<'a> {
+        CompareJson::new(exp, &self.data, &self.compared)
+    }
 }

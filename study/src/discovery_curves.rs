@@ -10,7 +10,6 @@
 //! `tests/discover_command.rs` redraws them.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use anyhow::Result;
@@ -134,19 +133,18 @@ pub fn trajectory_curves(d: &Discovery, tf: &TrajectoryPart) -> FittedCurves {
     }
 }
 
-/// Write `discovered.csv` into `out`: t, the measured `signal` (`f_stf` or `x`) and the
-/// base's and the final model's curves (`signal_base`, `signal_final`), at full precision.
-pub fn write_curves(
-    out: &Path,
+/// The text of `discovered.csv`: t, the measured `signal` (`f_stf` or `x`) and the base's
+/// and the final model's curves (`signal_base`, `signal_final`), at full precision.
+pub fn discovered_csv(
     signal: &str,
     t: &[f64],
     measured: &[f64],
     (base, final_curve): (&[f64], &[f64]),
-) -> Result<()> {
+) -> Result<Vec<u8>> {
     Columns::new()
         .with("t", t)
         .with(signal, measured)
         .with(format!("{signal}_base"), base)
         .with(format!("{signal}_final"), final_curve)
-        .write(&out.join("discovered.csv"))
+        .to_csv()
 }

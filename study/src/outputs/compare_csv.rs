@@ -10,7 +10,6 @@ use serde::{Serialize, Serializer};
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 
 use super::csv_rows;
-use crate::output::write_atomic;
 
 /// One row: a model's errors in one regime.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -100,11 +99,11 @@ pub fn rows<'a>(labels: &[&'a str], comparisons: &[Comparison]) -> Vec<CompareRo
         .collect()
 }
 
-/// Write `rows` under their header to `path`, atomically (the header alone when no model
-/// was scored in any regime).
-pub fn write(path: &Path, rows: &[CompareRow]) -> Result<()> {
+/// The text of `compare.csv` (`path`, for messages): `rows` under their header (the header
+/// alone when no model was scored in any regime).
+pub fn csv_text(path: &Path, rows: &[CompareRow]) -> Result<Vec<u8>> {
     if !rows.is_empty() {
-        return write_atomic(path, &csv_rows(path, rows)?);
+        return csv_rows(path, rows);
     }
     // The header line alone, as the csv crate derives it from the fields of [`CompareRow`]
     // (it writes a header with the first row only).
@@ -113,7 +112,7 @@ pub fn write(path: &Path, rows: &[CompareRow]) -> Result<()> {
         .iter()
         .position(|b| *b == b'\n')
         .map_or(text.len(), |i| i + 1);
-    write_atomic(path, &text[..end])
+    Ok(text[..end].to_vec())
 }
 
 #[cfg(test)]
@@ -122,8 +121,7 @@ mod tests {
 
     #[test]
     fn numbers_keep_their_shortest_form_and_no_rows_still_give_the_header() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("compare.csv");
+        let path = std::path::Path::new("compare.csv");
         let row = CompareRow {
             model: "power_law",
             regime: "resonance",
@@ -132,8 +130,7 @@ mod tests {
             energy_error: 0.000025,
             ..CompareRow::default()
         };
-        write(&path, &[row]).unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
+        let text = String::from_utf8(csv_text(path, &[row]).unwrap()).unwrap();
         let mut lines = text.lines();
         let header = lines.next().unwrap();
         assert!(
@@ -144,9 +141,8 @@ mod tests {
             lines.next().unwrap(),
             "power_law,resonance,3,0,0,0.000025,0,0,1,0,0,0,0,0,0"
         );
-        write(&path, &[]).unwrap();
         assert_eq!(
-            std::fs::read_to_string(&path).unwrap(),
+            String::from_utf8(csv_text(path, &[]).unwrap()).unwrap(),
             format!("{header}\n")
         );
     }

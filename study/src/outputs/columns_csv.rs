@@ -4,12 +4,9 @@
 //! the table is written record by record with the csv crate (which quotes a name that needs
 //! it); numbers carry their own digits ([`crate::digits`]), in Rust's shortest form.
 
-use std::path::Path;
-
 use anyhow::{Context, Result};
 
 use crate::digits::carried;
-use crate::output::write_atomic;
 
 /// Columns of one table, left to right; rows as long as the shortest column.
 #[derive(Clone, Debug, Default)]
@@ -40,14 +37,6 @@ impl<'a> Columns<'a> {
             w.write_record(self.values.iter().map(|c| carried(c[i]).to_string()))?;
         }
         w.into_inner().context("cannot build a CSV table")
-    }
-
-    /// Write the table to `path`, atomically.
-    pub fn write(&self, path: &Path) -> Result<()> {
-        let bytes = self
-            .to_csv()
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        write_atomic(path, &bytes)
     }
 }
 

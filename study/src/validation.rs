@@ -19,9 +19,9 @@ use serde::Serialize;
 use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::Kinematics;
 use stf_core::discovery::{Discovery, DiscoveryValidation};
-use stf_core::fit::{TrajectoryFit, Validation};
+use stf_core::fit::TrajectoryFit;
 use stf_core::physics::excitation::Excitation;
-use stf_core::regimes::{classify, rms_by_regime, Cycle, PerRegime, Regime, RegimeRms};
+use stf_core::regimes::{classify, rms_by_regime, Cycle, Regime};
 
 use crate::experiment::{Experiment, FitLevel, ValidateSpec};
 use crate::fitting::{cycles_of, read_record, FitData, ModelFit, Predictor};
@@ -59,9 +59,6 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
     let mut record = read_record(exp, &spec.file).map_err(|e| spec.error(key, format!("{e:#}")))?;
     let record_warnings = crate::plausibility::check(exp, &spec.file, &record)
         .map_err(|e| spec.error(key, format!("{e:#}")))?;
-    for w in &record_warnings {
-        eprintln!("warning: {w}");
-    }
     check_columns(exp, spec, &record, estimation)?;
     if let Some((t0, t1)) = spec.window {
         record = record.slice_time(t0, t1);
@@ -163,29 +160,7 @@ fn regimes_of(exp: &Experiment, data: &FitData) -> Option<(Vec<Cycle>, Vec<Regim
     Some((c.cycles, c.labels))
 }
 
-/// A fitted model's error on the validation record (fit.json's `validation`).
-#[derive(Clone, Debug, Serialize)]
-pub struct ModelValidation {
-    /// The record, as the experiment names it.
-    pub file: String,
-    /// Unit of the errors: N (force level) or m (trajectory level).
-    pub unit: &'static str,
-    /// `rms`, `measured_rms`, `normalised`, `samples`, `initial`, `initial_fitted`.
-    #[serde(flatten)]
-    pub score: Option<Validation>,
-    /// The same per regime of the record's rotor cycles (none without a rotor).
-    pub per_regime: Option<PerRegime<RegimeRms>>,
-    /// Why the model could not be scored, if it could not.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
-}
-
-impl ModelValidation {
-    /// The RMS error, if scored.
-    pub fn rms(&self) -> Option<f64> {
-        self.score.as_ref().map(|s| s.rms)
-    }
-}
+pub use crate::fitting::ModelValidation;
 
 /// Score one fitted model on the validation record with its fitted values.
 fn score_fit(fit: &ModelFit, rec: &ValidationRecord) -> ModelValidation {

@@ -17,7 +17,7 @@ pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display
 }
 
 /// Where errors point: the experiment file and its text.
-pub(crate) struct Ctx<'a> {
+pub struct Ctx<'a> {
     pub(super) file: &'a Path,
     pub(super) text: &'a str,
 }
@@ -25,27 +25,22 @@ pub(crate) struct Ctx<'a> {
 impl<'a> Ctx<'a> {
     /// Errors about `text`, the contents of `file` (another TOML file read the same way, such
     /// as a campaign file).
-    pub(crate) fn new(file: &'a Path, text: &'a str) -> Self {
+    pub fn new(file: &'a Path, text: &'a str) -> Self {
         Ctx { file, text }
     }
 
     /// The 1-based line of a byte offset.
-    pub(crate) fn line(&self, offset: usize) -> usize {
+    pub fn line(&self, offset: usize) -> usize {
         line_of(self.text, offset)
     }
 
     /// An error at `span`'s line, about `key`.
-    pub(crate) fn at(
-        &self,
-        span: Range<usize>,
-        key: &str,
-        msg: impl std::fmt::Display,
-    ) -> anyhow::Error {
+    pub fn at(&self, span: Range<usize>, key: &str, msg: impl std::fmt::Display) -> anyhow::Error {
         error_at(self.file, line_of(self.text, span.start), key, msg)
     }
 
     /// Nothing when `holds`, else the error [`Ctx::at`] gives: the shape of every range check.
-    pub(crate) fn ensure(
+    pub fn ensure(
         &self,
         holds: bool,
         span: Range<usize>,
@@ -61,7 +56,7 @@ impl<'a> Ctx<'a> {
 
     /// A whole count read from a number: at least `least` and within `u64`, else the error
     /// [`Ctx::at`] gives, "V is not a WHAT (at least LEAST)".
-    pub(crate) fn count(
+    pub fn count(
         &self,
         value: &toml::Spanned<f64>,
         key: &str,
@@ -81,7 +76,7 @@ impl<'a> Ctx<'a> {
 
     /// A deserialisation error of the file's text: its line, the key path of the value it is
     /// about (none for a key unknown at the top level) and serde's message.
-    pub(crate) fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {
+    pub fn deserialize_error(&self, e: &toml::de::Error) -> anyhow::Error {
         let line = e.span().map_or(0, |s| line_of(self.text, s.start));
         let msg = e.message().trim_end();
         match key_path(e) {

@@ -21,7 +21,7 @@ use toml::Spanned;
 
 use crate::data_layout::{self, RawData};
 
-mod context;
+pub mod context;
 mod discover;
 mod drive;
 mod filter;
@@ -31,21 +31,22 @@ mod identify;
 mod integrator;
 mod models;
 mod output;
+pub mod raw_drive;
 mod regimes;
 mod scripts;
 mod simulate;
 mod system;
 mod validate;
 
-pub(crate) use context::Ctx;
+pub use context::Ctx;
 pub use context::{error_at, line_of};
 pub use discover::DiscoverSpec;
 pub use drive::{Chirp, Drive};
-pub(crate) use filter::RawDrive;
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
 pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
 pub use output::OutputSpec;
+pub use raw_drive::RawDrive;
 pub use simulate::SimulateSpec;
 pub use validate::ValidateSpec;
 
@@ -218,7 +219,7 @@ impl Experiment {
 
 /// `text` parsed as the experiment file `exp.toml`: what the tests of every section check.
 #[cfg(test)]
-pub(crate) fn parse_exp(text: &str) -> Result<Experiment> {
+pub fn parse_exp(text: &str) -> Result<Experiment> {
     Experiment::parse(Path::new("exp.toml"), text)
 }
 

@@ -14,16 +14,9 @@ use stf_core::numerics::derivative::{Boundary, PolyFilter};
 use stf_core::numerics::reconstruct::DriveSmoothing;
 use toml::Spanned;
 
+use super::raw_drive::{RawDrive, RawFilterSpec};
 use super::Ctx;
 use crate::data_layout::RawData;
-
-/// A filter as written: polynomial order and window (samples).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct RawFilterSpec {
-    order: usize,
-    window: usize,
-}
 
 /// `boundary` as written: core's [`Boundary`] by name.
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -51,14 +44,6 @@ pub(super) struct RawFilter {
     boundary: Option<BoundaryName>,
     #[serde(default)]
     paper: bool,
-}
-
-/// A `[data] drive` value as written.
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-pub(crate) enum RawDrive {
-    Named(String),
-    Filter(RawFilterSpec),
 }
 
 /// `kinematics` with the drive reconstruction `[data] drive` asks for, if it does; `[filter]

@@ -18,12 +18,13 @@ use stf_core::data::record::{
 };
 use toml::{Spanned, Value};
 
-use crate::experiment::{Ctx, RawDrive};
+use crate::experiment::context::Ctx;
+use crate::experiment::raw_drive::RawDrive;
 
 /// `[data]` as written.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(crate) struct RawData {
+pub struct RawData {
     /// The record; absent, `[data]` gives only the layout (of the `[[identify]]` records).
     file: Option<String>,
     /// Time window to use, s.
@@ -70,7 +71,7 @@ pub struct DataSection {
 }
 
 /// Validate `[data]` (absent: no record, the default layout).
-pub(crate) fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Result<DataSection> {
+pub fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Result<DataSection> {
     let Some(d) = data else {
         return Ok(DataSection {
             plausibility: true,
