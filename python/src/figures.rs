@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use stf_lab::report::{measured_vs_model, DISPLACEMENT_MM, STF_FORCE};
 
-use crate::errors::{py_error, Kind};
+use crate::errors::other;
 
 /// `measured_vs_fitted(level, t, measured, fitted)`: the report's "measured against each
 /// fitted model" figure — the STF force (`level = "force"`, N) or the displacement
@@ -23,10 +23,10 @@ pub fn measured_vs_fitted<'py>(
     let (quantity, scale) = match level {
         "force" => (STF_FORCE, 1.0),
         "trajectory" => (DISPLACEMENT_MM, 1e3),
-        other => {
+        unknown => {
             let msg =
-                format!("level `{other}`: a figure is drawn at `force` or `trajectory` level");
-            return Err(py_error(py, Kind::Other, msg));
+                format!("level `{unknown}`: a figure is drawn at `force` or `trajectory` level");
+            return Err(other(py, msg));
         }
     };
     let scaled = |a: &PyReadonlyArray1<'py, f64>| -> Vec<f64> {
@@ -55,8 +55,7 @@ pub fn measured_vs_fitted<'py>(
             std::fs::read(&files.png)?,
         ))
     });
-    let (svg, png) =
-        drawn.map_err(|e| py_error(py, Kind::Other, format!("cannot draw the figure: {e:#}")))?;
+    let (svg, png) = drawn.map_err(|e| other(py, format!("cannot draw the figure: {e:#}")))?;
     let d = PyDict::new(py);
     d.set_item("svg", svg)?;
     d.set_item("png", PyBytes::new(py, &png))?;

@@ -17,13 +17,15 @@ pub mod models;
 pub mod record;
 pub mod run;
 pub mod study_calls;
+pub mod watch;
 
 use run::run_interruptible;
-use study_calls::FitOutcome;
+use study_calls::Outcome;
 
-/// A fit or comparison outcome as a dict: `json` (text), `verdict`, `level`, and the arrays
-/// `t`, `measured` and `fitted` (a list of `(label, array)`), moved into numpy.
-fn outcome_dict(py: Python<'_>, o: FitOutcome) -> PyResult<Bound<'_, PyDict>> {
+/// A workflow's outcome as a dict: `json` (text), `verdict`, `params_table` and
+/// `regimes_table` (JSON text), `best`, `level`, `warnings`, `entries`, and the arrays `t`,
+/// `measured` and `curves` (a list of `(label, array)`), moved into numpy.
+fn outcome_dict(py: Python<'_>, o: Outcome) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("json", o.json)?;
     d.set_item("verdict", o.verdict)?;
@@ -31,14 +33,32 @@ fn outcome_dict(py: Python<'_>, o: FitOutcome) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("regimes_table", o.regimes_table)?;
     d.set_item("best", o.best)?;
     d.set_item("level", o.level)?;
+    d.set_item("warnings", o.warnings)?;
+    d.set_item("entries", o.entries)?;
     d.set_item("t", PyArray1::from_vec(py, o.t))?;
     d.set_item("measured", PyArray1::from_vec(py, o.measured))?;
-    let fitted = PyList::empty(py);
-    for (label, values) in o.fitted {
-        fitted.append((label, PyArray1::from_vec(py, values)))?;
+    let curves = PyList::empty(py);
+    for (label, values) in o.curves {
+        curves.append((label, PyArray1::from_vec(py, values)))?;
     }
-    d.set_item("fitted", fitted)?;
+    d.set_item("curves", curves)?;
     Ok(d)
+}
+
+/// Run `workflow` on the experiment `path` (or `text`) off the GIL, Ctrl-C honoured.
+fn workflow<'py>(
+    py: Python<'py>,
+    (path, text): (PathBuf, Option<String>),
+    progress: Option<Bound<'py, PyAny>>,
+    workflow: fn(
+        stf_study::experiment::Experiment,
+        &run::Run,
+    ) -> Result<Outcome, stf_study::error::StudyError>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let o = run_interruptible(py, progress.as_ref(), move |run| {
+        workflow(study_calls::experiment(&path, text.as_deref())?, run)
+    })?;
+    outcome_dict(py, o)
 }
 
 /// `check_experiment(path, text=None)`: read and validate the experiment (from its file, or
@@ -47,7 +67,7 @@ fn outcome_dict(py: Python<'_>, o: FitOutcome) -> PyResult<Bound<'_, PyDict>> {
 #[pyo3(signature = (path, text=None))]
 fn check_experiment(py: Python<'_>, path: PathBuf, text: Option<String>) -> PyResult<()> {
     py.detach(|| study_calls::experiment(&path, text.as_deref()).map(|_| ()))
-        .map_err(|e| e.into_py(py))
+        .map_err(|e| errors::to_py(py, &e))
 }
 
 /// `fit(path, text=None, progress=None)`: `stf-lab fit` in process, nothing written.
@@ -59,10 +79,7 @@ fn fit<'py>(
     text: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let o = run_interruptible(py, progress.as_ref(), move |job| {
-        study_calls::fit(study_calls::experiment(&path, text.as_deref())?, job)
-    })?;
-    outcome_dict(py, o)
+    workflow(py, (path, text), progress, study_calls::fit)
 }
 
 /// `compare(path, text=None, progress=None)`: `stf-lab compare` in process, nothing written.
@@ -74,10 +91,32 @@ fn compare<'py>(
     text: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let o = run_interruptible(py, progress.as_ref(), move |job| {
-        study_calls::compare(study_calls::experiment(&path, text.as_deref())?, job)
-    })?;
-    outcome_dict(py, o)
+    workflow(py, (path, text), progress, study_calls::compare)
+}
+
+/// `identify(path, text=None, progress=None)`: the `[[identify]]` stages of `stf-lab fit`.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, progress=None))]
+fn identify<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    text: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    workflow(py, (path, text), progress, study_calls::identify)
+}
+
+/// `discover(path, text=None, progress=None)`: `stf-lab discover` in process, nothing
+/// written.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, progress=None))]
+fn discover<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    text: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    workflow(py, (path, text), progress, study_calls::discover)
 }
 
 /// `simulate(path, text=None, progress=None)`: the record of the experiment's `[simulate]`
@@ -90,10 +129,10 @@ fn simulate<'py>(
     text: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let s = run_interruptible(py, progress.as_ref(), move |job| {
-        study_calls::simulate(study_calls::experiment(&path, text.as_deref())?, job)
+    let record = run_interruptible(py, progress.as_ref(), move |run| {
+        study_calls::simulate(study_calls::experiment(&path, text.as_deref())?, run)
     })?;
-    record::record_dict(py, s.record)
+    record::record_dict(py, record)
 }
 
 /// The module.
@@ -104,6 +143,8 @@ fn _stf_lab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(discover, m)?)?;
     m.add_function(wrap_pyfunction!(record::read_record, m)?)?;
     m.add_function(wrap_pyfunction!(record::record_from_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(models::list_models, m)?)?;

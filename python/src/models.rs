@@ -11,7 +11,7 @@ use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::param_spec::ParamSpec;
 use stf_plugins::registry::Registry;
 
-use crate::errors::{py_error, Kind};
+use crate::errors::py_error;
 
 /// A parameter as a dict.
 fn param_dict<'py>(py: Python<'py>, p: &ParamSpec) -> PyResult<Bound<'py, PyDict>> {
@@ -81,7 +81,7 @@ pub fn describe_model<'py>(
             .collect::<Result<Vec<_>, _>>()?;
         Ok(ModelSum::new(parts)?)
     });
-    let model = model.map_err(|e| py_error(py, Kind::Model, format!("{e:#}")))?;
+    let model = model.map_err(|e| py_error(py, "ModelError", format!("{e:#}")))?;
     let is_script = terms.iter().any(|t| t.ends_with(".rhai"));
     let summary = match model.terms().len() {
         1 => stf_models::BUILTINS

@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use stf_core::data::record::{Record, RecordError, Signal, Unit};
-use stf_lab::experiment::Experiment;
+use stf_core::data::record::{Record, RecordError, Signal, Unit, MEMORY_SOURCE};
+use stf_study::error::{ErrorKind, StudyError};
 
-use crate::errors::{CallError, Kind, OrKind};
+use crate::errors::{of_kind, to_py};
 
 /// The record as a dict: `source`, and each signal of the data contract as a float64 array
 /// (`None` where the record lacks it). The vectors move into the arrays.
@@ -36,14 +36,14 @@ pub fn record_dict(py: Python<'_>, r: Record) -> PyResult<Bound<'_, PyDict>> {
 
 /// Read the record `file` with the layout of the experiment `layout` (an experiment file's
 /// text holding a `[data]` section, paths relative to `dir`), or the data contract's.
-pub fn read(file: &Path, layout: Option<(&Path, &str)>) -> Result<Record, CallError> {
+pub fn read(file: &Path, layout: Option<(&Path, &str)>) -> Result<Record, StudyError> {
     let Some((exp_path, text)) = layout else {
         return stf_core::data::record::ReadOptions::default()
             .read(file)
-            .map_err(|e| CallError::new(e.into(), Kind::Record));
+            .map_err(|e| of_kind(ErrorKind::Record, e.to_string()));
     };
-    let exp = Experiment::parse(exp_path, text).or_kind(Kind::Experiment)?;
-    stf_lab::fitting::read_record(&exp, file).or_kind(Kind::Record)
+    let exp = crate::study_calls::experiment(exp_path, Some(text))?;
+    stf_study::fitting::read_record(&exp, file).map_err(StudyError::from)
 }
 
 /// `read_record(path, layout_path=None, layout_text=None)`: the record at `path` (its type
@@ -60,7 +60,7 @@ pub fn read_record<'py>(
     let layout = layout_path.as_deref().zip(layout_text.as_deref());
     let record = py
         .detach(|| read(&path, layout))
-        .map_err(|e| e.into_py(py))?;
+        .map_err(|e| to_py(py, &e))?;
     record_dict(py, record)
 }
 
@@ -72,15 +72,15 @@ fn in_si(
     unit: Option<&str>,
     gain: Option<f64>,
     per_rev: Option<f64>,
-) -> Result<Vec<f64>, CallError> {
+) -> Result<Vec<f64>, StudyError> {
     let scale = match unit {
         None => 1.0,
         Some(u) => Unit::parse(signal, u, gain, per_rev)
             .map_err(|e| {
                 let msg = format!("units.{}: {e}", signal.name());
-                CallError::new(
-                    RecordError::new(stf_core::data::record::MEMORY_SOURCE, msg).into(),
-                    Kind::Record,
+                of_kind(
+                    ErrorKind::Record,
+                    RecordError::new(MEMORY_SOURCE, msg).to_string(),
                 )
             })?
             .scale(),
@@ -122,18 +122,22 @@ pub fn record_from_arrays<'py>(
         let gain: Option<f64> = lookup(gains, name)?.map(|g| g.extract()).transpose()?;
         let per_rev = (signal == Signal::Phi).then_some(per_rev).flatten();
         let si =
-            in_si(signal, values, unit.as_deref(), gain, per_rev).map_err(|e| e.into_py(py))?;
+            in_si(signal, values, unit.as_deref(), gain, per_rev).map_err(|e| to_py(py, &e))?;
         signals.push(Some(si));
     }
-    let record = build(signals, rate, t0).map_err(|e| e.into_py(py))?;
+    let record = build(signals, rate, t0).map_err(|e| to_py(py, &e))?;
     record_dict(py, record)
 }
 
 /// The record of the contract's `signals` (in [`Signal::ALL`]'s order), its time from `t` or
 /// from `rate` and `t0`, validated.
-fn build(mut s: Vec<Option<Vec<f64>>>, rate: Option<f64>, t0: f64) -> Result<Record, CallError> {
-    let memory = stf_core::data::record::MEMORY_SOURCE;
-    let fail = |msg: &str| CallError::new(RecordError::new(memory, msg).into(), Kind::Record);
+fn build(mut s: Vec<Option<Vec<f64>>>, rate: Option<f64>, t0: f64) -> Result<Record, StudyError> {
+    let fail = |msg: &str| {
+        of_kind(
+            ErrorKind::Record,
+            RecordError::new(MEMORY_SOURCE, msg).to_string(),
+        )
+    };
     let mut take = |i: usize| s.get_mut(i).and_then(Option::take);
     let (t, x, phi, f_stf, omega, u) = (take(0), take(1), take(2), take(3), take(4), take(5));
     let x = x.ok_or_else(|| fail("no `x` column: a record needs the displacement"))?;
@@ -151,7 +155,7 @@ fn build(mut s: Vec<Option<Vec<f64>>>, rate: Option<f64>, t0: f64) -> Result<Rec
         (None, None) => return Err(fail("no `t` column and no sample `rate`")),
     };
     let record = Record {
-        source: memory.to_string(),
+        source: MEMORY_SOURCE.to_string(),
         t,
         x,
         phi,
@@ -161,6 +165,6 @@ fn build(mut s: Vec<Option<Vec<f64>>>, rate: Option<f64>, t0: f64) -> Result<Rec
     };
     record
         .validate()
-        .map_err(|e| CallError::new(e.into(), Kind::Record))?;
+        .map_err(|e| of_kind(ErrorKind::Record, e.to_string()))?;
     Ok(record)
 }

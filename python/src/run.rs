@@ -4,9 +4,10 @@
 //! status to an optional Python progress callback.
 //!
 //! An interrupt raises `stf_lab.Interrupted` at once and asks the run to stop ([`Cancel`]):
-//! work that looks at it (an observer called during fits) unwinds with [`Cancelled`], which
-//! is caught here and never printed; work that does not finishes in the background and its
-//! result is dropped. The bindings write nothing, so nothing is ever half-written. A panic on
+//! the study's observer ([`crate::watch`]) answers that it is cancelled, so the study stops
+//! between jobs, and unwinds a job at its next progress message with [`Cancelled`], which is
+//! caught here and never printed; a step that sends no message (a simulation of the
+//! `[simulate]` section) finishes in the background and its result is dropped. The bindings write nothing, so nothing is ever half-written. A panic on
 //! the worker thread is caught too and becomes `StfLabError` naming it a bug: no panic
 //! reaches Python.
 
@@ -20,7 +21,9 @@ use std::time::{Duration, Instant};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
-use crate::errors::{py_error, CallError, Kind};
+use stf_study::error::StudyError;
+
+use crate::errors::{other, py_error, to_py};
 
 /// How often the waiting thread looks for Ctrl-C and reports progress.
 pub const POLL: Duration = Duration::from_millis(100);
@@ -53,13 +56,13 @@ impl Cancel {
 
 /// What a running job shares with the waiting thread: its status line and the stop request.
 #[derive(Clone, Debug, Default)]
-pub struct Job {
+pub struct Run {
     /// Set by an interrupt.
     pub cancel: Cancel,
     status: Arc<Mutex<String>>,
 }
 
-impl Job {
+impl Run {
     /// Say what the run is doing now (shown by the progress callback).
     pub fn say(&self, status: impl Into<String>) {
         if let Ok(mut s) = self.status.lock() {
@@ -72,10 +75,10 @@ impl Job {
     }
 }
 
-/// The message of an interrupted run.
-pub const INTERRUPTED: &str =
-    "interrupted: the run was stopped before it finished; no result was returned and nothing \
-     was written";
+/// The message of an interrupted run: the study's own.
+pub fn interrupted_message() -> String {
+    stf_study::error::Interrupted.to_string()
+}
 
 /// What a panic's payload says.
 fn panic_text(payload: &(dyn Any + Send)) -> String {
@@ -89,16 +92,15 @@ fn panic_text(payload: &(dyn Any + Send)) -> String {
 }
 
 /// The outcome of the worker thread as a Python result.
-fn outcome<T>(py: Python<'_>, r: std::thread::Result<Result<T, CallError>>) -> PyResult<T> {
+fn outcome<T>(py: Python<'_>, r: std::thread::Result<Result<T, StudyError>>) -> PyResult<T> {
     match r {
         Ok(Ok(v)) => Ok(v),
-        Ok(Err(e)) => Err(e.into_py(py)),
+        Ok(Err(e)) => Err(to_py(py, &e)),
         Err(payload) if payload.is::<Cancelled>() => {
-            Err(py_error(py, Kind::Interrupted, INTERRUPTED.into()))
+            Err(py_error(py, "Interrupted", interrupted_message()))
         }
-        Err(payload) => Err(py_error(
+        Err(payload) => Err(other(
             py,
-            Kind::Other,
             format!(
                 "internal error (a bug of stf-lab; please report it): {}",
                 panic_text(payload.as_ref())
@@ -108,7 +110,7 @@ fn outcome<T>(py: Python<'_>, r: std::thread::Result<Result<T, CallError>>) -> P
 }
 
 /// Call `progress(status, elapsed_s)`; an exception it raises stops the run.
-fn report(progress: Option<&Bound<'_, PyAny>>, job: &Job, t0: Instant) -> PyResult<()> {
+fn report(progress: Option<&Bound<'_, PyAny>>, job: &Run, t0: Instant) -> PyResult<()> {
     match progress {
         Some(cb) => cb
             .call1((job.status(), t0.elapsed().as_secs_f64()))
@@ -120,7 +122,7 @@ fn report(progress: Option<&Bound<'_, PyAny>>, job: &Job, t0: Instant) -> PyResu
 /// A `KeyboardInterrupt` becomes `stf_lab.Interrupted` (itself a `KeyboardInterrupt`).
 fn interrupted(py: Python<'_>, e: PyErr) -> PyErr {
     if e.is_instance_of::<PyKeyboardInterrupt>(py) {
-        py_error(py, Kind::Interrupted, INTERRUPTED.into())
+        py_error(py, "Interrupted", interrupted_message())
     } else {
         e
     }
@@ -136,9 +138,10 @@ pub fn run_interruptible<T, F>(
 ) -> PyResult<T>
 where
     T: Send + 'static,
-    F: FnOnce(&Job) -> Result<T, CallError> + Send + 'static,
+    F: FnOnce(&Run) -> Result<T, StudyError> + Send + 'static,
 {
-    let job = Job::default();
+    let job = Run::default();
+    job.say("starting");
     let (tx, mut rx) = channel();
     let worker = job.clone();
     let t0 = Instant::now();
@@ -148,13 +151,7 @@ where
             let r = catch_unwind(AssertUnwindSafe(|| work(&worker)));
             let _ = tx.send(r);
         })
-        .map_err(|e| {
-            py_error(
-                py,
-                Kind::Other,
-                format!("cannot start the run's thread: {e}"),
-            )
-        })?;
+        .map_err(|e| other(py, format!("cannot start the run's thread: {e}")))?;
     let stop = |e: PyErr| {
         job.cancel.set();
         interrupted(py, e)
@@ -169,7 +166,7 @@ where
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => {
                 let msg = "internal error: the run's thread ended without a result";
-                return Err(py_error(py, Kind::Other, msg.into()));
+                return Err(other(py, msg.into()));
             }
         }
         py.check_signals().map_err(stop)?;

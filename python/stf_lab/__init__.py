@@ -10,11 +10,12 @@ The same lab as the ``stf-lab`` command line, in process::
 
 Records (:func:`read_record`, :meth:`Record.from_arrays`), models (:func:`models`,
 :func:`model`), experiments (:class:`Experiment`: a file, or built in code), workflows
-(:func:`simulate`, :func:`fit`, :func:`compare`) and the exceptions (:class:`StfLabError` and
+(:func:`simulate`, :func:`fit`, :func:`identify`, :func:`compare`, :func:`discover`) and the exceptions (:class:`StfLabError` and
 its kinds).
 """
 
 from ._errors import (
+    DiscoveryError,
     ExperimentError,
     FitError,
     Interrupted,
@@ -27,8 +28,8 @@ from ._display import Figure
 from .experiment import Experiment
 from .models import Model, ParamSpec, model, models
 from .record import Record, read_record
-from .results import CompareResult, FitResult, ModelFit, Param
-from .workflows import compare, fit, simulate
+from .results import CompareResult, DiscoveryResult, FitResult, IdentifyResult, ModelFit, Param
+from .workflows import compare, discover, fit, identify, simulate
 
 __all__ = [
     "__version__",
@@ -37,6 +38,7 @@ __all__ = [
     "ExperimentError",
     "ModelError",
     "FitError",
+    "DiscoveryError",
     "Interrupted",
     "Figure",
     "Experiment",
@@ -48,9 +50,13 @@ __all__ = [
     "read_record",
     "FitResult",
     "CompareResult",
+    "DiscoveryResult",
+    "IdentifyResult",
     "ModelFit",
     "Param",
     "simulate",
     "fit",
+    "identify",
     "compare",
+    "discover",
 ]

@@ -7,7 +7,8 @@ message ``stf-lab`` prints after ``error:`` (the file, line and key where it has
     ├── RecordError             a record cannot be read or is not usable (file, row, column)
     ├── ExperimentError         an experiment (file or built in Python) is not valid (file, line, key)
     ├── ModelError              a model name, sum or script cannot be resolved or evaluated
-    ├── FitError                a fit, comparison or discovery cannot run
+    ├── FitError                a fit, comparison or simulation cannot go on
+    │   └── DiscoveryError      a discovery cannot go on
     └── Interrupted             Ctrl-C / the notebook's stop button; also a KeyboardInterrupt
 """
 
@@ -17,6 +18,7 @@ __all__ = [
     "ExperimentError",
     "ModelError",
     "FitError",
+    "DiscoveryError",
     "Interrupted",
 ]
 
@@ -38,11 +40,16 @@ class ModelError(StfLabError):
 
 
 class FitError(StfLabError):
-    """A fit, comparison or discovery cannot run."""
+    """A fit, comparison or simulation cannot go on."""
+
+
+class DiscoveryError(FitError):
+    """A discovery cannot go on (too few cycles, bad settings, …)."""
 
 
 class Interrupted(StfLabError, KeyboardInterrupt):
     """The run was stopped (Ctrl-C, the notebook's stop button): no result, nothing written.
 
-    It is a ``KeyboardInterrupt`` too, so code that stops on one stops on this.
+    It is a ``KeyboardInterrupt`` too, so code that stops on one stops on this (and, being
+    a ``StfLabError``, ``except Exception`` catches it as well).
     """

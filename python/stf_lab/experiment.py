@@ -110,6 +110,11 @@ class Experiment:
                 self.text = f.read()
         _stf_lab.check_experiment(self.path, text)
 
+    @property
+    def has_stages(self):
+        """Whether the experiment holds ``[[identify]]`` stages."""
+        return any(line.strip().startswith("[[identify]]") for line in self.text.splitlines())
+
     @classmethod
     def load(cls, path):
         """The experiment file at ``path``, checked (:class:`stf_lab.ExperimentError` if not valid)."""

@@ -15,7 +15,7 @@ import numpy as np
 from ._display import Figure, fmt, html_table
 from . import _stf_lab
 
-__all__ = ["Param", "ModelFit", "FitResult", "CompareResult"]
+__all__ = ["Param", "ModelFit", "FitResult", "CompareResult", "DiscoveryResult", "IdentifyResult"]
 
 
 class Param:
@@ -103,7 +103,8 @@ class FitResult:
         self.level = outcome["level"]
         self.t = outcome["t"]
         self.measured = outcome["measured"]
-        fitted = dict(outcome["fitted"])
+        fitted = dict(outcome["curves"])
+        self.warnings_of_inputs = list(outcome.get("warnings", []))
         entries = self._entries()
         self.models = [
             ModelFit(e, [r for r in self._rows if r["model"] == e["label"]], fitted.get(e["label"]))
@@ -147,8 +148,7 @@ class FitResult:
         """The report's figure of the measured signal against every fitted model."""
         if self._figure is None:
             curves = [(m.label, m.fitted) for m in self.models if m.fitted is not None]
-            d = _stf_lab.measured_vs_fitted(self.level, self.t, self.measured, curves)
-            self._figure = Figure("measured_vs_fitted", d["svg"], d["png"])
+            self._figure = _figure("measured_vs_fitted", self.level, self.t, self.measured, curves)
         return self._figure
 
     def __repr__(self):
@@ -188,10 +188,7 @@ class FitResult:
         return ""
 
     def _repr_html_(self):
-        try:
-            fig = self.figure().html()
-        except Exception as e:  # a figure that cannot be drawn must not hide the result
-            fig = f"<p>(figure not drawn: {escape(str(e))})</p>"
+        fig = _figure_html(self)
         title = "Fit" if self.kind == "fit" else "Comparison"
         return (f"<div class='stf-lab-result'><h4>{title}: {escape(str(self.record))}</h4>"
                 f"<p>{escape(self.verdict)}</p>{self._warnings_html()}{self._extra_html()}"
@@ -235,3 +232,152 @@ class CompareResult(FitResult):
         rows = [[r, fmt(self.best_by_regime.get(r))] for r in
                 ("pre_resonance", "resonance", "post_resonance", "overall")]
         return html_table(["regime", "best model"], rows, "Best model by relative force RMS error")
+
+
+def _figure(name, level, t, measured, curves):
+    d = _stf_lab.measured_vs_fitted(level, t, measured, curves)
+    return Figure(name, d["svg"], d["png"])
+
+
+def _figure_html(result):
+    try:
+        return result.figure().html()
+    except Exception as e:  # a figure that cannot be drawn must not hide the result
+        return f"<p>(figure not drawn: {escape(str(e))})</p>"
+
+
+class DiscoveryResult:
+    """``stf-lab discover`` in Python: the effects named and added to the base model.
+
+    Attributes of ``discovery.json``: ``effects`` (names, in order), ``gap_before`` and
+    ``gap_after`` (RMS of measured − modelled signal, in ``gap_unit``: N, or m at trajectory
+    level), ``noise_floor``, ``steps``, ``final_model`` (its ``params``, ``std_errors`` and
+    ``experiment_entry``: a ``[[models]]`` entry ``fit`` and ``compare`` accept), ``validation``;
+    ``verdict`` (the report's first paragraph); the arrays ``t``, ``measured``, ``base`` and
+    ``final`` (the measured signal and both models' curves of it). ``to_pandas()`` gives every
+    candidate's scores at every step.
+    """
+
+    def __init__(self, outcome, experiment):
+        self.experiment = experiment
+        self._doc = json.loads(outcome["json"])
+        self.verdict = outcome["verdict"]
+        self.level = outcome["level"]
+        self.t = outcome["t"]
+        self.measured = outcome["measured"]
+        curves = dict(outcome["curves"])
+        self.base, self.final = curves["base"], curves["final"]
+        self.models_entry, self.system_entry = outcome["entries"]
+        self.warnings_of_inputs = list(outcome.get("warnings", []))
+        d = self._doc
+        self.record = d["record"]
+        self.base_model = d["base"]
+        self.effects = d["effects"]
+        self.gap_before, self.gap_after = d["gap_before"], d["gap_after"]
+        self.gap_unit = d["gap_unit"]
+        self.noise_floor = d["noise_floor"]
+        self.steps = d["steps"]
+        self.final_model = d["final_model"]
+        self.validation = d.get("validation")
+        self.notes = d.get("notes", [])
+        self._figure = None
+
+    def to_dict(self):
+        """The command line's JSON (``discovery.json``)."""
+        return self._doc
+
+    def to_pandas(self):
+        """Every candidate at every step: step, candidate, held-out RMS, gain z, effective n,
+        explained share, ΔBIC, significant, accepted."""
+        import pandas as pd
+
+        rows = []
+        for i, step in enumerate(self.steps, 1):
+            for c in step["candidates"]:
+                rows.append({"step": i, "current": step["current"], "candidate": c["name"],
+                             "holdout_rms": c["holdout_rms"], "gain_z": c["gain_z"],
+                             "effective_n": c["effective_n"],
+                             "explained_share": c["explained_share"],
+                             "delta_bic": c["delta_bic"], "significant": c["significant"],
+                             "accepted": step["accepted"] == c["name"]})
+        return pd.DataFrame(rows)
+
+    def figure(self):
+        """The measured signal against the base's and the final model's curves."""
+        if self._figure is None:
+            curves = [(f"base ({self.base_model})", self.base), ("final", self.final)]
+            self._figure = _figure("discovered", self.level, self.t, self.measured, curves)
+        return self._figure
+
+    def __repr__(self):
+        named = ", ".join(self.effects) or "nothing"
+        return (f"DiscoveryResult({self.record}: from {self.base_model!r} named {named}; gap "
+                f"{fmt(self.gap_before, 4)} → {fmt(self.gap_after, 4)} {self.gap_unit} against a "
+                f"floor of {fmt(self.noise_floor, 4)})\n  {self.verdict}")
+
+    def _repr_html_(self):
+        rows = [[i, s["current"], s["accepted"] or "—", ", ".join(s.get("tie_with", [])) or "",
+                 s["verdict"]] for i, s in enumerate(self.steps, 1)]
+        steps = html_table(["step", "model", "accepted", "tied with", "verdict"], rows,
+                           "Steps of the discovery")
+        params = [[k, fmt(v, 8), fmt(self.final_model.get("std_errors", {}).get(k), 3)]
+                  for k, v in self.final_model.get("params", {}).items()]
+        final = html_table(["parameter", "value", "std. error"], params,
+                           f"Final model: {self.final_model.get('name', '')} (SI units)")
+        return (f"<div class='stf-lab-result'><h4>Discovery: {escape(str(self.record))}</h4>"
+                f"<p>{escape(self.verdict)}</p>{steps}{final}"
+                f"<pre>{escape(self.models_entry)}</pre>{_figure_html(self)}</div>")
+
+
+class IdentifyResult:
+    """The staged identification of ``[[identify]]`` (``stf-lab fit`` on such an experiment):
+    each stage's oscillator fit against its record's displacement.
+
+    ``stages`` (``fit.json``'s: record, free parameters, values, errors, S(μ) in mm², warnings),
+    ``system`` (the oscillator after the last stage), ``to_pandas()`` (``params.csv``: one
+    row per stage and parameter), ``t``/``measured`` and the last stage's simulated x.
+    """
+
+    def __init__(self, outcome, experiment):
+        self.experiment = experiment
+        self._doc = json.loads(outcome["json"])
+        self._rows = json.loads(outcome["params_table"])
+        self.level = "trajectory"
+        self.t = outcome["t"]
+        self.measured = outcome["measured"]
+        self.simulated = dict(outcome["curves"])
+        self.stages = self._doc["stages"]
+        self.system = self._doc["system"]
+        self.warnings = self._doc["models"][0]["warnings"]
+        self._figure = None
+
+    def to_dict(self):
+        """The command line's JSON (the identification's ``fit.json``)."""
+        return self._doc
+
+    def to_pandas(self):
+        """The parameters table (``params.csv``): one row per stage and parameter."""
+        return _params_frame(self._rows)
+
+    def figure(self):
+        """The last stage's measured displacement against the identified oscillator's."""
+        if self._figure is None:
+            label = list(self.simulated)[-1]
+            curves = [(label, self.simulated[label])]
+            self._figure = _figure("identified", "trajectory", self.t, self.measured, curves)
+        return self._figure
+
+    def __repr__(self):
+        parts = [f"stage {i}: S(μ) = {fmt(s.get('s_mm2'), 4)} mm²" for i, s in
+                 enumerate(self.stages, 1)]
+        return f"IdentifyResult({'; '.join(parts)}; system {self.system})"
+
+    def _repr_html_(self):
+        rows = [[r["model"], r["parameter"], fmt(r["value"], 8), fmt(r["std_error"], 3),
+                 r["unit"]] for r in self._rows]
+        table = html_table(["stage", "parameter", "value", "std. error", "unit"], rows,
+                           "Identified parameters (SI units)")
+        stages = "".join(f"<li>stage {i} ({escape(s['record'])}): S(μ) = "
+                         f"{fmt(s.get('s_mm2'), 4)} mm²</li>" for i, s in enumerate(self.stages, 1))
+        return (f"<div class='stf-lab-result'><h4>Identification</h4><ul>{stages}</ul>{table}"
+                f"{_figure_html(self)}</div>")

@@ -1,5 +1,5 @@
-"""The lab's workflows from Python: simulate, fit, compare (discover and identify follow the
-study layer). Each takes an :class:`stf_lab.Experiment` (or an experiment file's path), runs
+"""The lab's workflows from Python: simulate, fit (the oscillator's staged identification
+too), compare, discover — the study layer's calls, as the command line makes them. Each takes an :class:`stf_lab.Experiment` (or an experiment file's path), runs
 in process what the command line runs — the same calls, the same numbers — and writes
 nothing. Long runs release the GIL; Ctrl-C or the notebook's stop button raises
 :class:`stf_lab.Interrupted`. ``progress`` is a callable taking ``(status, elapsed_s)``,
@@ -11,9 +11,9 @@ import sys
 from . import _stf_lab
 from .experiment import as_experiment
 from .record import Record
-from .results import CompareResult, FitResult
+from .results import CompareResult, DiscoveryResult, FitResult, IdentifyResult
 
-__all__ = ["simulate", "fit", "compare"]
+__all__ = ["simulate", "fit", "identify", "compare", "discover"]
 
 
 class _StatusLine:
@@ -49,9 +49,28 @@ def simulate(experiment, progress=None):
 
 
 def fit(experiment, progress=None):
-    """Fit every model of the experiment to its record (``stf-lab fit``): a :class:`FitResult`."""
+    """Fit every model of the experiment to its record (``stf-lab fit``): a :class:`FitResult`
+    (force or trajectory level, as the record and ``[fit] level`` say; each model scored on
+    ``[validate]``'s second record when there is one). An experiment of ``[[identify]]``
+    stages is identified instead (:func:`identify`)."""
     exp, path, text = _args(experiment)
+    if exp.has_stages:
+        return IdentifyResult(_stf_lab.identify(path, text, _progress(progress)), exp)
     return FitResult(_stf_lab.fit(path, text, _progress(progress)), exp)
+
+
+def identify(experiment, progress=None):
+    """The oscillator's staged identification of ``[[identify]]`` (``stf-lab fit`` on such an
+    experiment): an :class:`IdentifyResult`."""
+    exp, path, text = _args(experiment)
+    return IdentifyResult(_stf_lab.identify(path, text, _progress(progress)), exp)
+
+
+def discover(experiment, progress=None):
+    """Find, name and add the effect the ``[discover] base`` misses (``stf-lab discover``): a
+    :class:`DiscoveryResult`."""
+    exp, path, text = _args(experiment)
+    return DiscoveryResult(_stf_lab.discover(path, text, _progress(progress)), exp)
 
 
 def compare(experiment, progress=None):

@@ -52,3 +52,28 @@ def test_compare_json_is_the_command_lines(repo, stf_lab_bin, tmp_path):
     _run(stf_lab_bin, "compare", exp, tmp_path / "out")
     cli = json.loads((tmp_path / "out" / "compare.json").read_text())
     _same(stf_lab.compare(exp).to_dict(), cli)
+
+
+def _without(doc, key):
+    """`doc` without `key` anywhere (a run's wall time, which no two runs share)."""
+    if isinstance(doc, dict):
+        return {k: _without(v, key) for k, v in doc.items() if k != key}
+    if isinstance(doc, list):
+        return [_without(v, key) for v in doc]
+    return doc
+
+
+@pytest.mark.parametrize("experiment", ["experiments/discovery.toml",
+                                        "experiments/trajectory_discovery.toml"])
+def test_discovery_json_is_the_command_lines(repo, stf_lab_bin, tmp_path, experiment):
+    _run(stf_lab_bin, "discover", experiment, tmp_path / "out")
+    cli = json.loads((tmp_path / "out" / "discovery.json").read_text())
+    res = stf_lab.discover(experiment)
+    _same(_without(res.to_dict(), "wall_seconds"), _without(cli, "wall_seconds"))
+
+
+def test_the_identifications_fit_json_is_the_command_lines(repo, stf_lab_bin, tmp_path):
+    exp = "experiments/paper_identification.toml"
+    _run(stf_lab_bin, "fit", exp, tmp_path / "out")
+    cli = json.loads((tmp_path / "out" / "fit.json").read_text())
+    _same(stf_lab.fit(exp).to_dict(), cli)

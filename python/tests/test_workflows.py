@@ -85,3 +85,28 @@ def test_compare_ranks_the_models_by_regime(repo):
     assert {"model", "regime"} <= set(df.columns)
     assert set(df.model) == {m.label for m in res.models}
     assert res.params_frame().shape[0] > 0
+
+
+def test_discover_names_the_hidden_cubic_spring(repo):
+    res = stf_lab.discover("experiments/discovery.toml")
+    assert res.effects == ["cubic_stiffness"]
+    assert res.gap_after < 0.5 * res.gap_before and res.gap_unit == "N"
+    assert res.gap_after < 1.2 * res.noise_floor
+    assert "cubic_stiffness" in res.models_entry and "[[models]]" in res.models_entry
+    df = res.to_pandas()
+    assert df[df.accepted].candidate.tolist() == ["cubic_stiffness"]
+    assert res.base.shape == res.final.shape == res.t.shape
+    assert "cubic_stiffness" in res._repr_html_()
+
+
+def test_discover_at_trajectory_level_refits_the_oscillator(repo):
+    res = stf_lab.discover("experiments/trajectory_discovery.toml")
+    assert res.level == "trajectory" and res.effects == ["cubic_stiffness"]
+    assert res.to_dict()["s_after_mm2"] < res.to_dict()["s_before_mm2"]
+
+
+def test_the_paper_identification_runs_in_stages(repo):
+    res = stf_lab.fit("experiments/paper_identification.toml")
+    assert isinstance(res, stf_lab.IdentifyResult) and len(res.stages) == 2
+    assert res.system["k"] == pytest.approx(269.93, rel=0.05)
+    assert set(res.to_pandas().model) == {"stage 1", "stage 2"}
