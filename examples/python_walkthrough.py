@@ -1,6 +1,6 @@
 """The README's walk-through in Python: simulate the paper's sweep, fit models to a record,
-compare them regime by regime — the same numbers as the command line, nothing written
-unless asked.
+compare them regime by regime, discover a missing effect — the same numbers as the command
+line, nothing written unless asked.
 
     pip install ./python
     python examples/python_walkthrough.py          # from the repository's root
@@ -45,7 +45,14 @@ cmp = stf_lab.compare("experiments/jamming_compare.toml")
 print(cmp.verdict)
 print("best by regime:", cmp.best_by_regime)
 
-# 5. A fit built in code: the same record, the power law and a sum, at force level.
+# 5. Discovery: the effect a power law misses, named and added.
+found = stf_lab.discover("experiments/discovery.toml")
+print(found.verdict)
+print(f"effects {found.effects}: gap {found.gap_before:.4f} → {found.gap_after:.4f} "
+      f"{found.gap_unit} (noise floor {found.noise_floor:.4f})")
+print(found.models_entry)
+
+# 6. A fit built in code: the same record, the power law and a sum, at force level.
 exp = stf_lab.Experiment.build("experiments", data="records/power_law_sweep.csv",
                                models=["power_law", "power_law + added_mass"])
 print(stf_lab.fit(exp).verdict)
