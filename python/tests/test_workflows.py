@@ -110,3 +110,23 @@ def test_the_paper_identification_runs_in_stages(repo):
     assert isinstance(res, stf_lab.IdentifyResult) and len(res.stages) == 2
     assert res.system["k"] == pytest.approx(269.93, rel=0.05)
     assert set(res.to_pandas().model) == {"stage 1", "stage 2"}
+
+
+def test_validation_on_a_second_record_scores_every_fit(repo, tmp_path):
+    # A second record of the same truth with another noise seed, written as a CSV.
+    second = stf_lab.simulate(stf_lab.Experiment.build(
+        "experiments",
+        simulate={"sweep": {"w0": 3.0, "alpha": 0.1, "t0": 0.0, "t1": 60.0}, "rate": 200.0,
+                  "seed": 8, "truth": [("power_law", {"K": 4.0, "n": 1.5})]},
+    ))
+    columns = np.column_stack([second.t, second.phi, second.x, second.f_stf])
+    np.savetxt(tmp_path / "second.csv", columns, delimiter=",", fmt="%.17g",
+               header="t,phi,x,f_stf", comments="")
+    exp = stf_lab.Experiment.build("experiments", data="records/power_law_sweep.csv",
+                                   models=["viscous", "power_law"],
+                                   validate=tmp_path / "second.csv")
+    res = stf_lab.fit(exp)
+    pl, visc = res["power_law"], res["viscous"]
+    assert pl.validation["samples"] == len(second)
+    assert pl.validation_rms == pytest.approx(pl.rms, rel=0.1)
+    assert visc.validation_rms > 1.2 * pl.validation_rms
