@@ -86,6 +86,16 @@ class Record:
         d["source"] = self.source
         return d
 
+    def save_csv(self, path):
+        """Write the record as a CSV of the data contract (a header row, the present signals
+        in SI units, every number in a form that reads back to the same double), so that an
+        experiment's ``[data] file`` can name it. Returns the path."""
+        path = os.fspath(path)
+        columns = np.column_stack([getattr(self, name) for name in self.signals])
+        np.savetxt(path, columns, delimiter=",", fmt="%.17g", header=",".join(self.signals),
+                   comments="")
+        return path
+
     def to_pandas(self):
         """The record as a pandas DataFrame, one column per present signal (SI units)."""
         import pandas as pd

@@ -22,10 +22,15 @@ class _StatusLine:
     def __init__(self):
         self.last = None
 
+    def done(self):
+        if self.last is not None:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
     def __call__(self, status, elapsed):
         text = f"{status}  [{elapsed:.0f} s]"
         if text != self.last:
-            sys.stderr.write("\r" + text.ljust(60))
+            sys.stderr.write("\r" + text.ljust(len(self.last or "")))
             sys.stderr.flush()
             self.last = text
 
@@ -34,6 +39,16 @@ def _progress(progress):
     if progress is True:
         return _StatusLine()
     return progress or None
+
+
+def _call(function, path, text, progress):
+    """``function(path, text, progress)`` with a status line ended when it returns or fails."""
+    progress = _progress(progress)
+    try:
+        return function(path, text, progress)
+    finally:
+        if isinstance(progress, _StatusLine):
+            progress.done()
 
 
 def _args(experiment):
@@ -45,7 +60,7 @@ def simulate(experiment, progress=None):
     """The synthetic record of the experiment's ``[simulate]`` section (``stf-lab simulate``
     without its files): the oscillator with the hidden ``truth`` models, the rig's sensors."""
     exp, path, text = _args(experiment)
-    return Record(_stf_lab.simulate(path, text, _progress(progress)))
+    return Record(_call(_stf_lab.simulate, path, text, progress))
 
 
 def fit(experiment, progress=None):
@@ -55,26 +70,26 @@ def fit(experiment, progress=None):
     stages is identified instead (:func:`identify`)."""
     exp, path, text = _args(experiment)
     if exp.has_stages:
-        return IdentifyResult(_stf_lab.identify(path, text, _progress(progress)), exp)
-    return FitResult(_stf_lab.fit(path, text, _progress(progress)), exp)
+        return IdentifyResult(_call(_stf_lab.identify, path, text, progress), exp)
+    return FitResult(_call(_stf_lab.fit, path, text, progress), exp)
 
 
 def identify(experiment, progress=None):
     """The oscillator's staged identification of ``[[identify]]`` (``stf-lab fit`` on such an
     experiment): an :class:`IdentifyResult`."""
     exp, path, text = _args(experiment)
-    return IdentifyResult(_stf_lab.identify(path, text, _progress(progress)), exp)
+    return IdentifyResult(_call(_stf_lab.identify, path, text, progress), exp)
 
 
 def discover(experiment, progress=None):
     """Find, name and add the effect the ``[discover] base`` misses (``stf-lab discover``): a
     :class:`DiscoveryResult`."""
     exp, path, text = _args(experiment)
-    return DiscoveryResult(_stf_lab.discover(path, text, _progress(progress)), exp)
+    return DiscoveryResult(_call(_stf_lab.discover, path, text, progress), exp)
 
 
 def compare(experiment, progress=None):
     """Fit, then compare the models regime by regime (``stf-lab compare``): a
     :class:`CompareResult`."""
     exp, path, text = _args(experiment)
-    return CompareResult(_stf_lab.compare(path, text, _progress(progress)), exp)
+    return CompareResult(_call(_stf_lab.compare, path, text, progress), exp)

@@ -67,3 +67,11 @@ def test_a_lab_layout_is_read_with_an_experiments_data_keys(tmp_path):
     rec = stf_lab.read_record(tmp_path / "rig.csv", exp)
     np.testing.assert_allclose(rec.t, [0.0, 0.01])
     np.testing.assert_allclose(rec.x, [1.5e-3, 2.5e-3])
+
+
+def test_a_saved_record_reads_back_to_the_same_doubles(repo, tmp_path):
+    rec = stf_lab.read_record("experiments/records/power_law_sweep.csv")
+    back = stf_lab.read_record(rec.save_csv(tmp_path / "copy.csv"))
+    assert back.signals == rec.signals
+    for name in rec.signals:
+        np.testing.assert_array_equal(getattr(back, name), getattr(rec, name))

@@ -119,9 +119,7 @@ def test_validation_on_a_second_record_scores_every_fit(repo, tmp_path):
         simulate={"sweep": {"w0": 3.0, "alpha": 0.1, "t0": 0.0, "t1": 60.0}, "rate": 200.0,
                   "seed": 8, "truth": [("power_law", {"K": 4.0, "n": 1.5})]},
     ))
-    columns = np.column_stack([second.t, second.phi, second.x, second.f_stf])
-    np.savetxt(tmp_path / "second.csv", columns, delimiter=",", fmt="%.17g",
-               header="t,phi,x,f_stf", comments="")
+    second.save_csv(tmp_path / "second.csv")
     exp = stf_lab.Experiment.build("experiments", data="records/power_law_sweep.csv",
                                    models=["viscous", "power_law"],
                                    validate=tmp_path / "second.csv")
