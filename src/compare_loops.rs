@@ -89,7 +89,7 @@ pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
         .iter()
         .map(|m| {
             let mut line = format!(
-                "by {} ({}): best overall {}",
+                "by {} ({}): best over the regimes {}",
                 m.metric.name(),
                 m.criterion,
                 m.overall.first().map_or("—", |s| s.model.as_str())
@@ -98,10 +98,17 @@ pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
                 if let Some(rank) = m.per_regime.get(r) {
                     let best = rank.scores.first().map_or("—", |s| s.model.as_str());
                     let test = rank.test.as_ref().map_or(String::new(), |t| {
-                        format!(
-                            ", paired z {:.1} against {} over {} cycles",
-                            t.z, t.runner_up, t.cycles
-                        )
+                        if t.cycles < 3 || !t.z.is_finite() {
+                            format!(
+                                ", too few cycles ({}) for a paired test against {}",
+                                t.cycles, t.runner_up
+                            )
+                        } else {
+                            format!(
+                                ", paired z {:.1} against {} over {} cycles",
+                                t.z, t.runner_up, t.cycles
+                            )
+                        }
                     });
                     line.push_str(&format!("; {} {best}{test}", r.name().replace('_', "-")));
                 }

@@ -49,7 +49,10 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
         }
     }
     if let Some(b) = c.ranking.best_overall() {
-        let _ = writeln!(md, "- best overall: **{b}**");
+        let _ = writeln!(
+            md,
+            "- best over the regimes (mean of the per-regime errors): **{b}**"
+        );
     }
     let energy = crate::compare_loops::energy_table(&c.labels(), &c.comparisons);
     crate::compare_loops::write_markdown(&mut md, &c.loop_rankings, &energy);
@@ -66,7 +69,7 @@ fn errors_table(md: &mut String, c: &Compared) {
     );
     let _ = writeln!(
         md,
-        "| model | pre-resonance | resonance | post-resonance | overall | peak x (mm) at ω |"
+        "| model | pre-resonance | resonance | post-resonance | all cycles | peak x (mm) at ω |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     for ((f, cmp), p) in c.fits.iter().zip(&c.comparisons).zip(c.peaks()) {

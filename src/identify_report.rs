@@ -6,69 +6,14 @@
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
+use stf_core::physics::oscillator_params::OscillatorParams;
 
 use crate::report::{measured_vs_model, milli, FigureRef, Section, Table, DISPLACEMENT_MM};
 use crate::standard_report::write_report;
 
 pub use stf_study::identify::StageOutcome;
-
-/// `x` with `digits` significant digits, trailing zeros dropped (`269.935`, `0.0461989`).
-fn significant(x: f64, digits: i32) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return x.to_string();
-    }
-    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
-/// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`.
-pub fn system_line(system: &OscillatorParams) -> String {
-    OscParam::ALL
-        .into_iter()
-        .filter(|p| !p.is_offset() || system[*p] != 0.0)
-        .map(|p| format!("{p} {} {}", significant(system[p], 6), p.unit()))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// The verdict: what was identified, how close each stage came to its noise floor, and
-/// whether any warning stands.
-fn verdict(stages: &[StageOutcome], system: &OscillatorParams) -> String {
-    let fits: Vec<String> = stages
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let floor_mm2 = (s.floor.sigma * 1e3).powi(2);
-            format!(
-                "stage {} ({}) S(μ) = {:.4} mm² against the position noise's {:.4} mm² ({:.1}×)",
-                i + 1,
-                s.record,
-                s.result.s_mm2.unwrap_or(f64::NAN),
-                floor_mm2,
-                s.result.s_mm2.unwrap_or(f64::NAN) / floor_mm2
-            )
-        })
-        .collect();
-    let warned: usize = stages.iter().map(|s| s.warnings.len()).sum();
-    format!(
-        "Identified oscillator: {}. {}. {}",
-        system_line(system),
-        fits.join("; "),
-        if warned == 0 {
-            "No stage carries a warning: every stage converged, its free parameters determined, \
-             none on a bound and none indistinguishable from another."
-                .to_string()
-        } else {
-            format!("⚠ {warned} warning(s): see each stage's box below before using these values.")
-        }
-    )
-}
+use stf_study::verdict::identify_verdict as verdict;
+pub use stf_study::verdict::system_line;
 
 fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
     let mut section = Section::new(format!("Stage {}: {}", i + 1, s.record));

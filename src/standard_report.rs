@@ -80,7 +80,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
     let mut s = Section::new("Fits");
     s.paragraphs.push(format!(
         "Each model fitted to the measured {what} ({} level).",
-        crate::outputs::level_name(data.level)
+        data.level.name()
     ));
     if let Some(drive) = &data.kinematics.drive {
         s.paragraphs.push(format!("Drive: {drive}."));

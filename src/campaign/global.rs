@@ -360,7 +360,7 @@ fn assemble(
     let caveats = all_caveats(spec, training, &global, &per_record, holdout.as_ref());
     GlobalJson {
         model: spec.model.clone(),
-        level: level_name(spec.level).into(),
+        level: spec.level.name().into(),
         condition_units: units.conditions.clone(),
         rms_unit: shown.0.into(),
         shared: spec.shared.clone(),
@@ -405,14 +405,6 @@ impl Units {
             .iter()
             .find(|s| s.name == name)
             .map_or_else(String::new, |s| s.unit.clone())
-    }
-}
-
-/// `force` or `trajectory`, as `[fit] level` is written.
-fn level_name(level: FitLevel) -> &'static str {
-    match level {
-        FitLevel::Force => "force",
-        FitLevel::Trajectory => "trajectory",
     }
 }
 

@@ -108,13 +108,7 @@ fn write_compare_report(
     sections.extend(crate::regime_figures::regime_section(
         exp, data, &forces, out,
     )?);
-    let verdict = crate::verdict::compare_verdict(
-        &c.ranking,
-        &c.measured.cycles,
-        &c.measured.labels,
-        data.record.f_stf.as_deref().unwrap_or(&[]),
-        &forces,
-    );
+    let verdict = crate::verdict::compare_verdict(c);
     let record = format!(
         "{} cycles of {}; noise floor σ = {:.4} N.",
         c.measured.labels.len(),
@@ -153,7 +147,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
     let fig = regime_errors(
         &out.join("figures"),
         "regime_errors",
-        &["pre-resonance", "resonance", "post-resonance", "overall"],
+        &["pre-resonance", "resonance", "post-resonance", "all cycles"],
         &bars,
         "relative force RMS error",
     )?;
@@ -167,14 +161,14 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
 /// The relative force RMS error (duty error) of each model per regime and overall.
 fn errors_table(c: &Compared) -> Table {
     let cell = |m: &RegimeMetrics| format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error);
-    let caption =
-        "Relative force RMS error per regime (on–off duty error in brackets); lower is better.";
+    let caption = "Relative force RMS error per regime and over all cycles together (on–off \
+                   duty error in brackets); lower is better.";
     let columns = [
         "model",
         "pre-resonance",
         "resonance",
         "post-resonance",
-        "overall",
+        "all cycles",
     ];
     let rows = per_regime(c, |m| m.map_or("—".to_string(), cell));
     let rows = rows

@@ -200,14 +200,12 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         "{}.",
         held_out_and_validation(found.holdout_cycles, score, unit, scale)
     ));
-    if data.level == FitLevel::Force {
-        let tables = found
-            .steps
-            .iter()
-            .enumerate()
-            .map(|(i, step)| step_table(i, step));
-        s.tables.extend(tables);
-    }
+    let tables = found
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, step)| step_table(i, step, (unit, scale)));
+    s.tables.extend(tables);
     let (b, a, r_after) = (shown(&before), shown(&after), shown(&found.residual_after));
     let figures = [
         (
@@ -233,20 +231,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         )?);
     }
     sections.extend(record_sections(data, &[], out)?);
-    let verdict = crate::verdict::discover_verdict(
-        &found.effects,
-        found.gap_before * scale,
-        found.gap_after * scale,
-        found.noise_floor * scale,
-        unit,
-    );
-    let mut intro = vec![match &found.trajectory {
-        None => verdict,
-        Some(tf) => format!(
-            "{verdict} S(μ) {:.4} → {:.4} mm².",
-            tf.s_before_mm2, tf.s_after_mm2
-        ),
-    }];
+    let mut intro = vec![discovered.verdict().text];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));
     write_report(
         &format!("Discovery: {}", exp.path.display()),
@@ -256,12 +241,13 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     )
 }
 
-/// The table of step `i`'s candidates (force level).
-fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
+/// The table of step `i`'s candidates, RMS in `unit` (`scale` from SI).
+fn step_table(i: usize, step: &stf_core::discovery::Step, (unit, scale): (&str, f64)) -> Table {
     let caption = format!("Step {}: candidates added to `{}`", i + 1, step.current);
+    let rms = format!("held-out RMS, {unit}");
     let columns = [
         "candidate",
-        "held-out RMS, N",
+        rms.as_str(),
         "ΔBIC",
         "paired z (units)",
         "explains of the excess",
@@ -270,7 +256,7 @@ fn step_table(i: usize, step: &stf_core::discovery::Step) -> Table {
     let rows = step.candidates.iter().map(|c| {
         vec![
             c.name.clone(),
-            format!("{:.5}", c.holdout_rms),
+            format!("{:.5}", c.holdout_rms * scale),
             format!("{:.1}", c.delta_bic),
             format!("{:.1} ({})", c.gain_z, c.effective_n),
             format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),

@@ -94,7 +94,7 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
         exp, data, &forces, out,
     )?);
     let mut intro = vec![
-        fitted.verdict(),
+        fitted.verdict().text,
         format!(
             "stf-lab fitted {} model(s) of {} to {}.",
             fits.len(),
@@ -127,7 +127,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
     say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
-        crate::outputs::level_name(data.level),
+        data.level.name(),
         data.record.len(),
         data.record.source
     );

@@ -34,6 +34,7 @@ use crate::observer::{discovery_observer, Observer};
 use crate::outputs::discovery_json::{DiscoveryJson, FinalSystemJson};
 use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
 use crate::validation::{DiscoveryScore, ValidationRecord};
+use crate::verdict::{discover_verdict, DiscoverVerdict};
 
 /// The inputs of a discovery: its settings, the record at its level and the `[validate]`
 /// record, read and checked.
@@ -155,6 +156,28 @@ impl Discovered {
             self.score.as_ref(),
             self.wall_s,
         )
+    }
+
+    /// The verdict: what was named, the gap before and after against the noise floor (in the
+    /// level's unit), the share of the excess explained; at trajectory level S(μ) before and
+    /// after.
+    pub fn verdict(&self) -> DiscoverVerdict {
+        let (unit, scale) = self.data.level.shown();
+        let f = &self.found;
+        let mut verdict = discover_verdict(
+            &f.effects,
+            f.gap_before * scale,
+            f.gap_after * scale,
+            f.noise_floor * scale,
+            unit,
+        );
+        if let Some(tf) = &f.trajectory {
+            verdict.text = format!(
+                "{} S(μ) {:.4} → {:.4} mm².",
+                verdict.text, tf.s_before_mm2, tf.s_after_mm2
+            );
+        }
+        verdict
     }
 
     /// The base's and the final model's curves of the measured signal.

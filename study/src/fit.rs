@@ -94,8 +94,9 @@ impl Fitted {
         })
     }
 
-    /// The verdict: the best model, how far it is to be trusted, and why.
-    pub fn verdict(&self) -> String {
-        crate::verdict::fit_verdict(&self.fits, self.data.level)
+    /// The verdict: the best model, how far it is to be trusted, and why (fit.json's
+    /// `verdict`; its `text` opens the report).
+    pub fn verdict(&self) -> crate::verdict::FitVerdict {
+        crate::verdict::FitVerdict::new(&self.fits, self.data.level)
     }
 }

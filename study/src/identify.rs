@@ -14,6 +14,18 @@ use crate::experiment::Experiment;
 use crate::fitting::{oscillator_fit, system_param};
 use crate::observer::{fit_message, Observer};
 
+impl StageOutcome {
+    /// The position noise floor as a mean square, mm² (S(μ)'s floor).
+    pub fn floor_mm2(&self) -> f64 {
+        (self.floor.sigma * 1e3).powi(2)
+    }
+
+    /// S(μ) over its floor: 1 is a fit at the noise.
+    pub fn s_over_floor(&self) -> f64 {
+        self.result.s_mm2.unwrap_or(f64::NAN) / self.floor_mm2()
+    }
+}
+
 /// The identification's result: each stage as fitted, and the oscillator they found.
 pub struct Identification {
     /// The stages, in order.

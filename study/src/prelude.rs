@@ -13,7 +13,7 @@
 //! for f in &fitted.fits {
 //!     println!("{}: RMS {:.4} N, AIC {:.1}", f.label, f.result.rms, f.result.aic);
 //! }
-//! println!("{}", fitted.verdict());
+//! println!("{}", fitted.verdict().text);
 //!
 //! // Four models compared regime by regime on an on–off jamming record.
 //! let mut exp = read_experiment("experiments/jamming_compare.toml")?;

@@ -3,8 +3,14 @@
 //! the ranking in each regime, the measure behind it and a paired test of the first two over
 //! the regime's cycles; for `discover`, what was named and its share of the excess.
 
+use serde::Serialize;
 use stf_core::fit::FitWarning;
-use stf_core::regimes::{Cycle, Ranking, Regime};
+use stf_core::regimes::{LoopMetric, PairedTest, Regime};
+
+use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
+
+use crate::compare::Compared;
+use crate::identify::StageOutcome;
 
 use crate::experiment::FitLevel;
 use crate::fitting::ModelFit;
@@ -30,41 +36,109 @@ pub fn best_by_aic(fits: &[(f64, usize)]) -> Option<usize> {
     near.into_iter().min_by_key(|&i| fits[i].1)
 }
 
-/// The verdict of a set of fits: the best by AIC, how far the others are behind (ΔAIC and
-/// RMS), and the warnings that stand against the best and the others.
-pub fn fit_verdict(fits: &[ModelFit], level: FitLevel) -> String {
+/// How one of the other fits stands against the best (fit.json's `verdict.others`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Behind {
+    /// The fit's label.
+    pub label: String,
+    /// Its AIC minus the best's.
+    pub delta_aic: f64,
+    /// Its RMS residual over the best's, minus 1, in %.
+    pub rms_change_percent: f64,
+    /// Whether the data do not prefer either (|ΔAIC| below `aic_tie`).
+    pub as_good: bool,
+}
+
+/// The verdict of a set of fits (fit.json's `verdict`): the best by AIC, how far the others
+/// are behind (ΔAIC and RMS), and the warnings that stand against the best and the others;
+/// `text` is the paragraph the report opens with, written from these fields.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitVerdict {
+    /// The best fit's label (none when no model could be fitted).
+    pub best: Option<String>,
+    /// Whether the best has the lowest AIC (else it is the simplest within `aic_tie` of it).
+    pub lowest_aic: bool,
+    /// ΔAIC below which the data do not prefer one fit over another.
+    pub aic_tie: f64,
+    /// The other fits with a finite AIC, lowest AIC first.
+    pub others: Vec<Behind>,
+    /// The paragraph.
+    pub text: String,
+}
+
+impl FitVerdict {
+    /// The verdict of `fits` at `level`.
+    pub fn new(fits: &[ModelFit], level: FitLevel) -> Self {
+        let mut ranked: Vec<&ModelFit> = fits.iter().filter(|f| f.result.aic.is_finite()).collect();
+        ranked.sort_by(|a, b| a.result.aic.total_cmp(&b.result.aic));
+        let free = |f: &ModelFit| f.result.params.iter().filter(|p| !p.fixed).count();
+        let scored: Vec<(f64, usize)> = fits.iter().map(|f| (f.result.aic, free(f))).collect();
+        let Some(best) = best_by_aic(&scored).map(|i| &fits[i]) else {
+            return FitVerdict {
+                best: None,
+                lowest_aic: false,
+                aic_tie: AIC_TIE,
+                others: Vec::new(),
+                text: "No model could be fitted: see the warnings below.".into(),
+            };
+        };
+        let others: Vec<Behind> = ranked
+            .iter()
+            .filter(|f| f.label != best.label)
+            .map(|f| {
+                let delta_aic = f.result.aic - best.result.aic;
+                Behind {
+                    label: f.label.clone(),
+                    delta_aic,
+                    rms_change_percent: 100.0 * (f.result.rms / best.result.rms - 1.0),
+                    as_good: delta_aic.abs() < AIC_TIE,
+                }
+            })
+            .collect();
+        let lowest_aic = best.result.aic <= ranked[0].result.aic;
+        let text = fit_text(best, lowest_aic, &others, fits, level);
+        FitVerdict {
+            best: Some(best.label.clone()),
+            lowest_aic,
+            aic_tie: AIC_TIE,
+            others,
+            text,
+        }
+    }
+}
+
+/// The paragraph of a fit's verdict.
+fn fit_text(
+    best: &ModelFit,
+    lowest_aic: bool,
+    others: &[Behind],
+    fits: &[ModelFit],
+    level: FitLevel,
+) -> String {
     let (unit, scale) = level.shown();
-    let mut ranked: Vec<&ModelFit> = fits.iter().filter(|f| f.result.aic.is_finite()).collect();
-    ranked.sort_by(|a, b| a.result.aic.total_cmp(&b.result.aic));
-    let free = |f: &ModelFit| f.result.params.iter().filter(|p| !p.fixed).count();
-    let scored: Vec<(f64, usize)> = fits.iter().map(|f| (f.result.aic, free(f))).collect();
-    let Some(best) = best_by_aic(&scored).map(|i| &fits[i]) else {
-        return "No model could be fitted: see the warnings below.".into();
-    };
-    let lowest = ranked[0].result.aic;
     let mut text = format!(
         "Best fit: `{}`, RMS residual {:.4} {unit}, AIC {:.1}{}.",
         best.label,
         best.result.rms * scale,
         best.result.aic,
-        if best.result.aic > lowest {
-            " (the simplest of the fits within ΔAIC 2 of the lowest)"
-        } else {
+        if lowest_aic {
             " (the lowest)"
+        } else {
+            " (the simplest of the fits within ΔAIC 2 of the lowest)"
         }
     );
-    let others: Vec<String> = ranked
+    let others: Vec<String> = others
         .iter()
-        .filter(|f| f.label != best.label)
-        .map(|f| {
-            let d = f.result.aic - best.result.aic;
-            let rms = f.result.rms / best.result.rms - 1.0;
-            let tie = if d.abs() < AIC_TIE {
+        .map(|o| {
+            let tie = if o.as_good {
                 ", as good: the data do not prefer either"
             } else {
                 ""
             };
-            format!("`{}` ΔAIC {d:+.1}, RMS {:+.1} %{tie}", f.label, 100.0 * rms)
+            format!(
+                "`{}` ΔAIC {:+.1}, RMS {:+.1} %{tie}",
+                o.label, o.delta_aic, o.rms_change_percent
+            )
         })
         .collect();
     if !others.is_empty() {
@@ -106,46 +180,29 @@ fn trust(best: &ModelFit, fits: &[ModelFit]) -> String {
     }
 }
 
-/// The verdict of a comparison: the models in order in each regime the record has, by the
-/// relative force RMS error over the regime's cycles, and whether the first is ahead of the
-/// second cycle by cycle: a paired z of their per-cycle mean squared errors (`models`' fitted
-/// forces against `measured` over each `cycles[i]` labelled `labels[i]`), cycles being the
-/// independent units.
-pub fn compare_verdict(
-    ranking: &Ranking,
-    cycles: &[Cycle],
-    labels: &[Regime],
-    measured: &[f64],
-    models: &[(&str, &[f64])],
-) -> String {
+/// The verdict of a comparison (compare.json's `verdict`): the models in order in each
+/// regime the record has, by their relative force RMS error over the regime's cycles
+/// (compare.json's `ranking`), and whether the best by per-cycle force error is ahead of the
+/// runner-up cycle by cycle (the paired test of `loop_rankings`' `force` metric, cycles
+/// being the independent units).
+pub fn compare_verdict(c: &Compared) -> String {
+    let force = c
+        .loop_rankings
+        .iter()
+        .find(|m| m.metric == LoopMetric::Force);
     let mut parts = Vec::new();
     for r in Regime::ALL {
-        let Some(scores) = ranking.per_regime.get(r) else {
+        let Some(scores) = c.ranking.per_regime.get(r) else {
             continue;
         };
         let order: Vec<String> = scores
             .iter()
             .map(|s| format!("`{}` {:.3}", s.model, s.score))
             .collect();
-        let test = match scores.as_slice() {
-            [first, second, ..] => {
-                let in_regime: Vec<&Cycle> = cycles
-                    .iter()
-                    .zip(labels)
-                    .filter(|(_, l)| **l == r)
-                    .map(|(c, _)| c)
-                    .collect();
-                let errors = |name: &str| {
-                    let f = models.iter().find(|(l, _)| *l == name)?.1;
-                    Some(cycle_errors(&in_regime, measured, f))
-                };
-                match (errors(&first.model), errors(&second.model)) {
-                    (Some(a), Some(b)) => paired_test(&a, &b, &first.model, &second.model),
-                    _ => String::new(),
-                }
-            }
-            _ => String::new(),
-        };
+        let test = force
+            .and_then(|m| m.per_regime.get(r))
+            .and_then(|rank| rank.test.as_ref())
+            .map_or(String::new(), paired_text);
         parts.push(format!(
             "{}: {}{test}",
             r.name().replace('_', "-"),
@@ -155,12 +212,14 @@ pub fn compare_verdict(
     if parts.is_empty() {
         return "The record has no regime with cycles to rank the models on.".into();
     }
-    let overall = ranking
+    let overall = c
+        .ranking
         .overall
         .first()
         .map(|s| {
             format!(
-                " Best overall (the mean over regimes, each weighing the same): `{}` ({:.3}).",
+                " Best over the regimes (the mean of the per-regime errors, each regime weighing \
+                 the same): `{}` ({:.3}).",
                 s.model, s.score
             )
         })
@@ -168,48 +227,40 @@ pub fn compare_verdict(
     format!(
         "Models ranked in each regime by their relative force RMS error over the regime's cycles \
          (the RMS of model − measured force over the measured force's RMS; 0 is perfect, 1 is \
-         no better than no force), the first two compared cycle by cycle: {}.{overall}",
+         no better than no force), with the best and the runner-up by per-cycle force error \
+         compared cycle by cycle: {}.{overall}",
         parts.join("; ")
     )
 }
 
-/// The mean squared error of `fitted` against `measured` over each cycle.
-fn cycle_errors(cycles: &[&Cycle], measured: &[f64], fitted: &[f64]) -> Vec<f64> {
-    cycles
-        .iter()
-        .filter(|c| c.end <= measured.len() && c.end <= fitted.len() && c.start < c.end)
-        .map(|c| {
-            let n = (c.end - c.start) as f64;
-            (c.start..c.end)
-                .map(|i| (fitted[i] - measured[i]).powi(2))
-                .sum::<f64>()
-                / n
-        })
-        .collect()
+/// ` (`best` ahead of `runner-up`: paired z Z over N cycles)`, or why it was not tested.
+fn paired_text(t: &PairedTest) -> String {
+    if t.cycles < 3 || !t.z.is_finite() {
+        return format!(
+            " (too few cycles, {}, to tell `{}` from `{}` cycle by cycle)",
+            t.cycles, t.best, t.runner_up
+        );
+    }
+    let call = if t.z > 3.0 { "ahead" } else { "not told apart" };
+    format!(
+        " (`{}` {call} of `{}`: paired z {:.1} over {} cycles)",
+        t.best, t.runner_up, t.z, t.cycles
+    )
 }
 
-/// ` (paired over N cycles: z Z, ahead in K)` for the per-cycle errors `a` (the first) and `b`.
-fn paired_test(a: &[f64], b: &[f64], first: &str, second: &str) -> String {
-    let d: Vec<f64> = b
-        .iter()
-        .zip(a)
-        .map(|(b, a)| b - a)
-        .filter(|d| d.is_finite())
-        .collect();
-    let n = d.len();
-    if n < 3 {
-        return format!(" (too few cycles, {n}, to tell `{first}` from `{second}`)");
-    }
-    let mean = d.iter().sum::<f64>() / n as f64;
-    let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
-    let ahead = d.iter().filter(|x| **x > 0.0).count();
-    let z = if sd > 0.0 {
-        mean / (sd / (n as f64).sqrt())
-    } else {
-        f64::INFINITY
-    };
-    let call = if z > 3.0 { "ahead" } else { "not told apart" };
-    format!(" (`{first}` {call} of `{second}`: paired z {z:.1} over {n} cycles, smaller error in {ahead})")
+/// The verdict of a discovery (discovery.json's `verdict`): the effects named, the gap
+/// before and after against the noise floor (discovery.json's `gap_before`, `gap_after`,
+/// `noise_floor`, shown in the level's unit), and the share of the base's excess over the
+/// floor the effects explain; `text` is the report's opening paragraph, from these fields.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiscoverVerdict {
+    /// The share (0–1) of the base's excess over the noise floor, in mean square, that the
+    /// effects explain (none when the base had no excess).
+    pub excess_explained: Option<f64>,
+    /// Whether what is left is noise (the final gap within 1.2 × the floor).
+    pub left_is_noise: bool,
+    /// The paragraph.
+    pub text: String,
 }
 
 /// The verdict of a discovery: the effects named and how much of the base's excess over the
@@ -220,16 +271,15 @@ pub fn discover_verdict(
     after: f64,
     floor: f64,
     unit: &str,
-) -> String {
+) -> DiscoverVerdict {
     let excess = |g: f64| (g * g - floor * floor).max(0.0);
-    let share = if excess(before) > 0.0 {
+    let excess_explained = (excess(before) > 0.0).then(|| 1.0 - excess(after) / excess(before));
+    let share = excess_explained.map_or(String::new(), |share| {
         format!(
             ", which explains {:.0} % of the base's excess over the noise floor (in mean square)",
-            100.0 * (1.0 - excess(after) / excess(before))
+            100.0 * share
         )
-    } else {
-        String::new()
-    };
+    });
     let named = if effects.is_empty() {
         "Nothing named: no effect of the vocabulary improved the held-out fit by the evidence \
          rule"
@@ -244,14 +294,77 @@ pub fn discover_verdict(
                 .join(", then ")
         )
     };
-    format!(
+    let left_is_noise = after <= 1.2 * floor;
+    let text = format!(
         "{named}. The gap (RMS of measured − modelled) went from {before:.4} to {after:.4} {unit} \
          against a noise floor of {floor:.4} {unit}{share}; {}",
-        if after <= 1.2 * floor {
+        if left_is_noise {
             "what is left is noise."
         } else {
             "what is left is above the noise: something is still missing, or the floor is \
              underestimated."
+        }
+    );
+    DiscoverVerdict {
+        excess_explained,
+        left_is_noise,
+        text,
+    }
+}
+
+/// `x` with `digits` significant digits, trailing zeros dropped (`269.935`, `0.0461989`).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return x.to_string();
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`.
+pub fn system_line(system: &OscillatorParams) -> String {
+    OscParam::ALL
+        .into_iter()
+        .filter(|p| !p.is_offset() || system[*p] != 0.0)
+        .map(|p| format!("{p} {} {}", significant(system[p], 6), p.unit()))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The verdict of an identification (its fit.json's `verdict`): what was identified, how
+/// close each stage came to its noise floor (each stage's `floor_mm2` and `s_over_floor`),
+/// and whether any warning stands.
+pub fn identify_verdict(stages: &[StageOutcome], system: &OscillatorParams) -> String {
+    let fits: Vec<String> = stages
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            format!(
+                "stage {} ({}) S(μ) = {:.4} mm² against the position noise's {:.4} mm² ({:.1}×)",
+                i + 1,
+                s.record,
+                s.result.s_mm2.unwrap_or(f64::NAN),
+                s.floor_mm2(),
+                s.s_over_floor()
+            )
+        })
+        .collect();
+    let warned: usize = stages.iter().map(|s| s.warnings.len()).sum();
+    format!(
+        "Identified oscillator: {}. {}. {}",
+        system_line(system),
+        fits.join("; "),
+        if warned == 0 {
+            "No stage carries a warning: every stage converged, its free parameters determined, \
+             none on a bound and none indistinguishable from another."
+                .to_string()
+        } else {
+            format!("⚠ {warned} warning(s): see each stage's box below before using these values.")
         }
     )
 }
@@ -261,27 +374,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_paired_test_tells_a_consistent_lead_from_a_coin_toss() {
-        let a = [1.0, 1.1, 0.9, 1.0, 1.05, 0.95];
-        let better: Vec<f64> = a.iter().map(|x| x + 0.5).collect();
-        let said = paired_test(&a, &better, "p", "q");
+    fn the_paired_test_tells_a_lead_from_a_coin_toss_and_says_when_it_cannot_tell() {
+        let test = |cycles, z| PairedTest {
+            best: "p".into(),
+            runner_up: "q".into(),
+            cycles,
+            mean_difference: 0.1,
+            z,
+        };
+        let said = paired_text(&test(475, 111.36));
+        assert_eq!(said, " (`p` ahead of `q`: paired z 111.4 over 475 cycles)");
+        assert!(paired_text(&test(39, 0.08)).contains("not told apart"));
+        let one = paired_text(&test(1, f64::NAN));
         assert!(
-            said.contains("`p` ahead of `q`") && said.contains("smaller error in 6"),
-            "{said}"
+            one.contains("too few cycles, 1,") && !one.contains("NaN"),
+            "{one}"
         );
-        let mixed = [1.2, 0.8, 1.1, 0.9, 1.0, 1.0];
-        let said = paired_test(&a, &mixed, "p", "q");
-        assert!(said.contains("not told apart"), "{said}");
-        assert!(paired_test(&a[..2], &mixed[..2], "p", "q").contains("too few cycles"));
     }
 
     #[test]
     fn a_discovery_verdict_says_what_was_named_and_its_share() {
-        let v = discover_verdict(&["cubic_stiffness".into()], 0.1189, 0.0200, 0.0201, "N");
+        let v = discover_verdict(&["cubic_stiffness".into()], 0.1189, 0.0200, 0.0201, "N").text;
         assert!(v.starts_with("Named: `cubic_stiffness`."), "{v}");
         assert!(v.contains("100 % of the base's excess"), "{v}");
         assert!(v.ends_with("what is left is noise."), "{v}");
-        let none = discover_verdict(&[], 0.05, 0.05, 0.02, "N");
+        let none = discover_verdict(&[], 0.05, 0.05, 0.02, "N").text;
         assert!(
             none.starts_with("Nothing named") && none.contains(" 0 % "),
             "{none}"

@@ -22,6 +22,14 @@ pub enum FitLevel {
 }
 
 impl FitLevel {
+    /// The level's one name, in outputs and messages: `force` or `trajectory`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FitLevel::Force => "force",
+            FitLevel::Trajectory => "trajectory",
+        }
+    }
+
     /// The unit errors and gaps are shown in at this level, and the factor from SI: N at
     /// force level, mm at trajectory level.
     pub fn shown(self) -> (&'static str, f64) {

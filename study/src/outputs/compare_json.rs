@@ -33,6 +33,8 @@ pub struct CompareJson<'a> {
     pub best: Best<'a>,
     /// The per-cycle table beside this file.
     pub cycles_csv: &'static str,
+    /// The report's opening paragraph, written from `ranking` and `loop_rankings`.
+    pub verdict: String,
 }
 
 /// The measured record's regimes and resonance.
@@ -149,6 +151,7 @@ impl<'a> CompareJson<'a> {
                 overall: c.ranking.best_overall(),
             },
             cycles_csv: "cycles.csv",
+            verdict: crate::verdict::compare_verdict(c),
         }
     }
 }

@@ -18,6 +18,7 @@ use crate::discovery_curves::FittedCurves;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::validation::DiscoveryScore;
+use crate::verdict::DiscoverVerdict;
 
 /// The whole of `discovery.json`.
 #[derive(Serialize)]
@@ -64,6 +65,8 @@ pub struct DiscoveryJson<'a> {
     /// The base and final model on the `[validate]` record (absent without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub validation: Option<&'a DiscoveryScore>,
+    /// What was named and the share of the excess it explains; the report's opening paragraph.
+    pub verdict: Option<DiscoverVerdict>,
 }
 
 /// The keys only a trajectory-level discovery has.
@@ -154,6 +157,7 @@ impl<'a> DiscoveryJson<'a> {
             notes: data.record_warnings.iter().chain(&found.notes).collect(),
             trajectory: None,
             validation: score,
+            verdict: None,
         }
     }
 

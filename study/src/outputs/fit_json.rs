@@ -10,10 +10,11 @@ use stf_core::numerics::derivative::{noise_estimate, NoiseEstimate};
 use stf_core::numerics::reconstruct::DriveReport;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
-use super::{errors_by_name, level_name, values_by_name};
+use super::{errors_by_name, values_by_name};
 use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::validation::ModelValidation;
+use crate::verdict::FitVerdict;
 
 /// The whole of `fit.json`.
 #[derive(Serialize)]
@@ -36,6 +37,8 @@ pub struct FitJson<'a> {
     pub system_estimate: Option<LinearEstimate>,
     /// One entry per model, in the experiment's order.
     pub models: Vec<ModelFitJson<'a>>,
+    /// The best model, how far the others are behind, and the report's opening paragraph.
+    pub verdict: FitVerdict,
 }
 
 impl<'a> FitJson<'a> {
@@ -45,7 +48,7 @@ impl<'a> FitJson<'a> {
         FitJson {
             experiment: experiment.display().to_string(),
             record: &data.record.source,
-            level: level_name(data.level),
+            level: data.level.name(),
             samples: data.record.len(),
             motion_filter: MotionFilter {
                 order: filter.order(),
@@ -58,6 +61,7 @@ impl<'a> FitJson<'a> {
                 .iter()
                 .map(|f| ModelFitJson::new(f, data.level))
                 .collect(),
+            verdict: FitVerdict::new(fits, data.level),
         }
     }
 }
@@ -122,7 +126,7 @@ impl<'a> ModelFitJson<'a> {
         ModelFitJson {
             name: fit.name(),
             label: &fit.label,
-            level: level_name(level),
+            level: level.name(),
             result: ResultJson::new(r, fit.floor, &fit.warnings),
             naive_std_errors: errors_by_name(&r.params, |p| p.naive_std_error),
             error_blocks: r.error_blocks,

@@ -23,6 +23,8 @@ pub struct IdentificationJson<'a> {
     pub system: OscillatorParams,
     /// One entry, `none`: the identified oscillator.
     pub models: [IdentifiedJson<'a>; 1],
+    /// The report's opening paragraph, from `system` and each stage's S(μ) and floor.
+    pub verdict: String,
 }
 
 impl<'a> IdentificationJson<'a> {
@@ -48,6 +50,8 @@ impl<'a> IdentificationJson<'a> {
             record: &o.record,
             free: spec.free.iter().map(OscParam::to_string).collect(),
             result: ResultJson::new(&o.result, Some(o.floor), &o.warnings),
+            floor_mm2: o.floor_mm2(),
+            s_over_floor: o.s_over_floor(),
         });
         IdentificationJson {
             experiment: experiment.display().to_string(),
@@ -60,6 +64,7 @@ impl<'a> IdentificationJson<'a> {
                 rms: outcomes.last().map(|s| s.result.rms),
                 warnings,
             }],
+            verdict: crate::verdict::identify_verdict(outcomes, &system),
         }
     }
 }
@@ -75,6 +80,10 @@ pub struct StageJson<'a> {
     /// warnings, as every fit states them.
     #[serde(flatten)]
     pub result: ResultJson<'a>,
+    /// The position noise floor as a mean square, mm² (S(μ)'s floor).
+    pub floor_mm2: f64,
+    /// S(μ) over that floor.
+    pub s_over_floor: f64,
 }
 
 /// A warning of one stage, in the identified model's `warnings`.

@@ -64,14 +64,6 @@ pub fn errors_by_name(
     params.iter().map(|p| (p.name.clone(), error(p))).collect()
 }
 
-/// The name of a fit level in JSON: `force` or `trajectory`.
-pub fn level_name(level: crate::experiment::FitLevel) -> &'static str {
-    match level {
-        crate::experiment::FitLevel::Force => "force",
-        crate::experiment::FitLevel::Trajectory => "trajectory",
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
