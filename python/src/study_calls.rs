@@ -100,14 +100,15 @@ pub fn fit(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
     let fitted = prelude::fit(&mut exp, &watch)?;
     let json = json_text(&fitted.json(&exp))?;
     let params_table = json_text(&fitted.param_rows())?;
+    let verdict = fitted.verdict().text;
     let data = fitted.data;
     Ok(Outcome {
         json,
-        verdict: stf_study::verdict::fit_verdict(&fitted.fits, data.level),
+        verdict,
         params_table,
         regimes_table: "[]".into(),
         best: best_of(&fitted.fits),
-        level: stf_study::outputs::level_name(data.level),
+        level: data.level.name(),
         measured: data.target().to_vec(),
         t: data.record.t,
         curves: curves_of(fitted.fits),
@@ -167,19 +168,7 @@ pub fn compare(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
         &c.comparisons,
     ))?;
     let params_table = json_text(&stf_study::param_table::rows_of_fits(&c.fits))?;
-    let forces: Vec<(&str, &[f64])> = c
-        .fits
-        .iter()
-        .map(|f| (f.label.as_str(), f.fitted.as_slice()))
-        .collect();
-    let f_stf = result.data.record.f_stf.as_deref().unwrap_or(&[]);
-    let verdict = stf_study::verdict::compare_verdict(
-        &c.ranking,
-        &c.measured.cycles,
-        &c.measured.labels,
-        f_stf,
-        &forces,
-    );
+    let verdict = stf_study::verdict::compare_verdict(c);
     let best = best_of(&c.fits);
     let data = result.data;
     Ok(Outcome {
@@ -204,17 +193,9 @@ pub fn discover(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
     let found = prelude::discover(&mut exp, &watch)?;
     let (doc, entries) = found.json(&exp).map_err(study)?;
     let json = json_text(&doc)?;
-    let (unit, scale) = found.data.level.shown();
-    let d = &found.found;
-    let verdict = stf_study::verdict::discover_verdict(
-        &d.effects,
-        d.gap_before * scale,
-        d.gap_after * scale,
-        d.noise_floor * scale,
-        unit,
-    );
+    let verdict = found.verdict().text;
     let (before, after) = found.modelled();
-    let level = stf_study::outputs::level_name(found.data.level);
+    let level = found.data.level.name();
     let measured = found.data.target().to_vec();
     Ok(Outcome {
         json,

@@ -110,8 +110,14 @@ class FitResult:
             ModelFit(e, [r for r in self._rows if r["model"] == e["label"]], fitted.get(e["label"]))
             for e in entries
         ]
+        # The verdict's choice, as fit.json states it (else by the same rule, computed).
+        verdict = self._doc.get("verdict")
+        label = verdict.get("best") if isinstance(verdict, dict) else None
         best = outcome["best"]
-        self.best = self.models[best] if best is not None else None
+        if label is not None:
+            self.best = self[label]
+        else:
+            self.best = self.models[best] if best is not None else None
         self.record = self._doc.get("record")
         self.samples = self._doc.get("samples", len(self.t))
         self._figure = None
