@@ -2,8 +2,9 @@
 //! in `python/stf_lab/` wraps it in result classes). It converts at the boundary only —
 //! numpy arrays in and out ([`record`]), the command line's JSON as text, errors as the
 //! exceptions of `stf_lab._errors` ([`errors`]) — and runs long work off the GIL with Ctrl-C
-//! honoured ([`run`]). The workflows themselves are called from one file,
-//! [`study_calls`].
+//! honoured ([`run`]; the study's observer is [`watch`]). The workflows themselves — the study
+//! layer's `stf_study::prelude` — are called from one file, [`study_calls`]; the report's
+//! figures come from the program crate ([`figures`]).
 
 use std::path::PathBuf;
 
