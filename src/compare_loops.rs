@@ -16,8 +16,8 @@ use serde::Serialize;
 use stf_core::regimes::{Classification, Comparison, CycleFeatures, MetricRanking, Regime};
 
 use crate::digits::fixed;
-use crate::output::write_atomic;
 use crate::report::Table;
+use crate::writing::write_atomic;
 
 /// The on-fraction in words, for reports.
 pub const DUTY_EXPLAINED: &str = "On-fraction (duty): the share of each cycle in which the force is on, |F| above the on-threshold (3 σ of the force noise, at least 0.05 N), lone noise samples ignored and gaps under 5 % of the cycle bridged; 1 for a damper, small for spikes with zero force between them.";

@@ -70,7 +70,7 @@ pub fn write_identification_report(
     out: &Path,
 ) -> Result<()> {
     let dir = out.join("figures");
-    std::fs::create_dir_all(&dir)?;
+    crate::writing::atomic::ensure_dir(&dir)?;
     let sections = stages
         .iter()
         .enumerate()

@@ -2,7 +2,7 @@
 //! science is the study crate's (`stf_study`: experiment settings, fits, comparisons,
 //! discovery, their typed results, re-exported here under their old paths); this crate runs
 //! the [`commands`] (simulate, fit, compare, discover, models: each reads the experiment, runs
-//! the study, writes its results through [`output`] and renders its documents through
+//! the study, writes its results through [`writing`] and renders its documents through
 //! [`report`], [`standard_report`] and the figures), [`campaign`]s of them over many records,
 //! and the terminal ([`terminal`], [`progress`], [`interrupt`]). The binary (`src/main.rs`)
 //! only parses the command line and calls one command; integration tests and fuzz targets use
@@ -23,12 +23,9 @@ pub mod compare_loops;
 pub mod compare_markdown;
 pub mod identify_report;
 pub mod interrupt;
-pub mod output;
-pub mod output_lock;
 pub mod progress;
 pub mod regime_figures;
 pub mod report;
-pub mod results_dir;
-pub mod staged_files;
 pub mod standard_report;
 pub mod terminal;
+pub mod writing;

@@ -176,6 +176,14 @@ fn main() -> ExitCode {
             },
         ),
     };
+    let result = result.and_then(|()| {
+        // What was printed must have reached its stream (`> /dev/full` is a failure).
+        let _ = std::io::Write::flush(&mut std::io::stdout());
+        match stf_lab::terminal::output_failure() {
+            Some(failure) => Err(anyhow::anyhow!("{failure}: what was printed is incomplete")),
+            None => Ok(()),
+        }
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

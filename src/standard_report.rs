@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use stf_core::fit::{CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR};
 
@@ -24,7 +24,7 @@ use stf_core::regimes::Regime;
 /// A section of the figures of a record and its fits.
 pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<Vec<Section>> {
     let dir = out.join("figures");
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::writing::atomic::ensure_dir(&dir)?;
     let mut sections = Vec::new();
     if let Some(f) = data.record.f_stf.as_deref() {
         sections.push(record_section(data, f, &dir)?);
@@ -193,7 +193,7 @@ pub fn validation_section(
     out: &Path,
 ) -> Result<Section> {
     let dir = out.join("figures");
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::writing::atomic::ensure_dir(&dir)?;
     let (unit, scale) = rec.data.level.shown();
     let mut s = Section::new("Validation on a second record");
     s.paragraphs.push(format!(
@@ -316,7 +316,7 @@ pub fn frequency_section(
     out: &Path,
 ) -> Result<Section> {
     let dir = out.join("figures");
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::writing::atomic::ensure_dir(&dir)?;
     let mut s = Section::new("Frequency response");
     s.paragraphs.push(
         "Local maxima of the displacement against the rotor speed, with the smoothed trend \

@@ -6,8 +6,10 @@
 //! overrides that reorder a line as displayed, are shown as escapes (`\u{1b}`, `\r`).
 //!
 //! `println!` panics when standard output is a closed pipe (`stf-lab models | head -1`), so the
-//! program prints through [`say!`](crate::say) and [`tell!`](crate::tell): a closed or failed
-//! stream ends printing to it quietly while the run goes on (its results are still written).
+//! program prints through [`say!`](crate::say) and [`tell!`](crate::tell): a closed pipe ends
+//! printing to it quietly while the run goes on (its results are still written). Any other
+//! failure to write (a full disk: `> /dev/full`) ends printing too, and is kept
+//! ([`output_failure`]) so that the program does not exit 0 with its output lost.
 
 use std::borrow::Cow;
 use std::fmt;
@@ -16,6 +18,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
 static STDERR_CLOSED: AtomicBool = AtomicBool::new(false);
+static FAILURE: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
 
 /// Whether `c` must not reach a terminal raw: a control character other than `\n` and `\t`
 /// (C0, DEL, C1), or a bidirectional embedding, override or isolate.
@@ -41,26 +44,48 @@ pub fn escape_controls(text: &str) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
-/// Write one line to `stream`, escaped, unless it is known closed; a failed write marks it
-/// closed.
-fn line(mut stream: impl Write, closed: &AtomicBool, args: fmt::Arguments) {
+/// Write one line to `stream` (`name`: what it is, for a failure), escaped, unless it is
+/// known closed; a failed write marks it closed, and one that is not a closed pipe is kept.
+fn line(mut stream: impl Write, name: &str, closed: &AtomicBool, args: fmt::Arguments) {
     if closed.load(Ordering::Relaxed) {
         return;
     }
     let text = args.to_string();
-    if writeln!(stream, "{}", escape_controls(&text)).is_err() {
+    let written = writeln!(stream, "{}", escape_controls(&text)).and_then(|()| stream.flush());
+    if let Err(e) = written {
         closed.store(true, Ordering::Relaxed);
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            if let Ok(mut failure) = FAILURE.lock() {
+                failure.get_or_insert_with(|| format!("cannot write to {name}: {e}"));
+            }
+        }
     }
 }
 
 /// One line on standard output (use [`say!`](crate::say)).
 pub fn say_line(args: fmt::Arguments) {
-    line(std::io::stdout().lock(), &STDOUT_CLOSED, args);
+    line(
+        std::io::stdout().lock(),
+        "standard output",
+        &STDOUT_CLOSED,
+        args,
+    );
 }
 
 /// One line on standard error (use [`tell!`](crate::tell)).
 pub fn tell_line(args: fmt::Arguments) {
-    line(std::io::stderr().lock(), &STDERR_CLOSED, args);
+    line(
+        std::io::stderr().lock(),
+        "standard error",
+        &STDERR_CLOSED,
+        args,
+    );
+}
+
+/// The first failure to print that was not a closed pipe (a full disk, an I/O error): what
+/// was printed is incomplete, and the program must not exit 0.
+pub fn output_failure() -> Option<String> {
+    FAILURE.lock().ok().and_then(|f| f.clone())
 }
 
 /// `println!` for the program: escaped, and quiet on a closed pipe.
@@ -101,10 +126,12 @@ mod tests {
             }
         }
         let closed = AtomicBool::new(false);
-        line(Broken, &closed, format_args!("one"));
+        line(Broken, "a pipe", &closed, format_args!("one"));
         assert!(closed.load(Ordering::Relaxed));
         let mut sink = Vec::new();
-        line(&mut sink, &closed, format_args!("two"));
+        line(&mut sink, "a pipe", &closed, format_args!("two"));
         assert!(sink.is_empty());
+        // A closed pipe is no failure of the run.
+        assert!(output_failure().is_none_or(|f| !f.contains("a pipe")));
     }
 }

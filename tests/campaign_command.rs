@@ -594,3 +594,258 @@ fn assert_refused_before_any_unit(file: &Path, dir: &Path, t: &str, what: &str, 
     );
     assert!(!out.exists(), "{what}: a unit started");
 }
+
+/// The bundled campaign cut to its first `n` records (the `[global]` section dropped).
+fn first_records(dir: &Path, n: usize) -> PathBuf {
+    let file = bundled_copy(dir);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let cut: String = text
+        .split("\n[[records]]")
+        .take(n + 1)
+        .collect::<Vec<_>>()
+        .join("\n[[records]]");
+    let cut = match cut.find("\n[global]") {
+        Some(at) => cut[..at].to_string(),
+        None => cut,
+    };
+    std::fs::write(&file, cut).unwrap();
+    file
+}
+
+/// Processes still running whose command line names `out` (the units of a campaign into it).
+fn live_units(out: &Path) -> Vec<String> {
+    let needle = out.as_os_str().as_encoded_bytes().to_vec();
+    let Ok(procs) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    procs
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let cmdline = std::fs::read(e.path().join("cmdline")).ok()?;
+            let named = cmdline
+                .windows(needle.len())
+                .any(|w| w == needle.as_slice());
+            named.then(|| String::from_utf8_lossy(&cmdline).replace('\0', " "))
+        })
+        .collect()
+}
+
+/// Hidden names (this program's temporaries) directly in `dir`.
+fn hidden(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with('.'))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Start `stf-lab campaign FILE --out OUT ARGS…`, wait for its first finished unit, then send
+/// `signal`: its exit status, stdout and stderr.
+fn signalled_after_first_unit(
+    file: &Path,
+    out: &Path,
+    args: &[&str],
+    signal: &str,
+) -> (std::process::ExitStatus, String, String) {
+    use std::io::{BufRead, Read};
+    let mut child = stf_lab()
+        .arg("campaign")
+        .arg(file)
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut said = String::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        said.push_str(&line);
+        said.push('\n');
+        if line.contains(": ok, ") {
+            break;
+        }
+    }
+    let sent = std::process::Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    for line in lines {
+        said.push_str(&line.unwrap());
+        said.push('\n');
+    }
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (child.wait().unwrap(), said, err)
+}
+
+/// The units whose unit.json says ok.
+fn ok_units(out: &Path) -> usize {
+    std::fs::read_dir(out.join("units"))
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .filter(|e| {
+                    std::fs::read(e.path().join("unit.json"))
+                        .ok()
+                        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+                        .is_some_and(|u| u["status"] == "ok")
+                })
+                .count()
+        })
+        .unwrap_or(0)
+}
+
+#[test]
+fn sigterm_stops_the_units_and_counts_what_finished() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 6);
+    let out = tmp.path().join("out");
+    let (status, said, err) = signalled_after_first_unit(&file, &out, &["--jobs", "1"], "-TERM");
+    assert_eq!(status.code(), Some(130), "{said}\n{err}");
+    // When the campaign has exited its units have too: none goes on writing.
+    assert_eq!(live_units(&out), Vec::<String>::new());
+    let finished = ok_units(&out);
+    assert!(finished >= 1, "{said}");
+    assert!(
+        err.contains(&format!(
+            "interrupted: {finished} of 6 unit(s) to run had finished"
+        )),
+        "{finished} finished: {err}"
+    );
+    assert!(
+        err.contains("the campaign's table and report were not written"),
+        "{err}"
+    );
+    assert!(!out.join("campaign.json").exists());
+    // Every log is in place, none left staged.
+    assert_eq!(hidden(&out.join("logs")), Vec::<String>::new());
+    assert_eq!(hidden(&out.join("units")), Vec::<String>::new());
+    assert_eq!(hidden(&out), Vec::<String>::new());
+}
+
+#[test]
+fn a_killed_campaign_leaves_no_unit_running_and_a_rerun_finishes_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 6);
+    let out = tmp.path().join("out");
+    let (status, said, _) = signalled_after_first_unit(&file, &out, &["--jobs", "2"], "-KILL");
+    assert_eq!(
+        std::os::unix::process::ExitStatusExt::signal(&status),
+        Some(9),
+        "{said}"
+    );
+    // A rerun at once: units of the killed run still ending are waited for, not failed.
+    let rerun = campaign(&file, &out, &["--jobs", "2"]);
+    assert!(
+        rerun.status.success(),
+        "{}\n{}",
+        stdout(&rerun),
+        stderr(&rerun)
+    );
+    assert_eq!(ok_units(&out), 6);
+    assert_eq!(rows(&out).len(), 12);
+    assert!(rows(&out).iter().all(|r| r["status"] == "ok"));
+    assert_eq!(live_units(&out), Vec::<String>::new());
+    assert_eq!(hidden(&out.join("logs")), Vec::<String>::new());
+    assert_eq!(hidden(&out.join("units")), Vec::<String>::new());
+    assert_eq!(hidden(&out), Vec::<String>::new());
+}
+
+#[test]
+fn a_forced_unit_that_refuses_is_failed_not_reported_with_stale_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 2);
+    let out = tmp.path().join("out");
+    let first = campaign(&file, &out, &["--quiet"]);
+    assert!(first.status.success(), "{}", stderr(&first));
+    let unit2 = out.join("units/002-a1_c2");
+    let before = std::fs::read(unit2.join("unit.json")).unwrap();
+    std::fs::write(unit2.join("notes.txt"), "mine").unwrap();
+    let forced = campaign(&file, &out, &["--force"]);
+    assert!(!forced.status.success(), "{}", stdout(&forced));
+    let said = stdout(&forced);
+    assert!(said.contains("unit 2 records/a1_c2.csv: failed"), "{said}");
+    assert!(said.contains("unit 1 records/a1_c1.csv: ok"), "{said}");
+    let row = rows(&out).into_iter().find(|r| r["unit"] == 2).unwrap();
+    assert_eq!(row["status"], "failed");
+    assert!(
+        row["error"].as_str().unwrap().contains("holds notes.txt"),
+        "{row}"
+    );
+    assert!(
+        stderr(&forced).contains("1 of 2 unit(s) failed"),
+        "{}",
+        stderr(&forced)
+    );
+    // The user's file is kept; the unit's folder as it was.
+    assert_eq!(std::fs::read(unit2.join("notes.txt")).unwrap(), b"mine");
+    assert_eq!(std::fs::read(unit2.join("unit.json")).unwrap(), before);
+}
+
+#[test]
+fn the_tables_go_in_as_one_unit_and_a_cut_commit_is_finished() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 2);
+    let out = tmp.path().join("out");
+    assert!(campaign(&file, &out, &["--quiet"]).status.success());
+    // Killed between the renames of the tables: campaign.json in place, the rest staged.
+    let killed = stf_lab()
+        .arg("campaign")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .args(["--quiet", "--force"])
+        .env("STF_LAB_FAILPOINT", "commit:campaign.json=kill")
+        .output()
+        .unwrap();
+    assert_eq!(
+        std::os::unix::process::ExitStatusExt::signal(&killed.status),
+        Some(9),
+        "{}",
+        stderr(&killed)
+    );
+    let rerun = campaign(&file, &out, &[]);
+    assert!(rerun.status.success(), "{}", stderr(&rerun));
+    let msg = stderr(&rerun);
+    for name in ["campaign.csv", "report.md", "report.html"] {
+        assert!(
+            msg.contains("was stopped while putting its files in place") && msg.contains(name),
+            "{name}: {msg}"
+        );
+    }
+    assert_eq!(hidden(&out), Vec::<String>::new());
+    let csv = std::fs::read_to_string(out.join("campaign.csv")).unwrap();
+    assert_eq!(csv.lines().count() - 1, rows(&out).len());
+}
+
+#[test]
+fn user_files_among_the_campaign_figures_are_named_and_kept() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 2);
+    let out = tmp.path().join("out");
+    assert!(campaign(&file, &out, &["--quiet"]).status.success());
+    std::fs::create_dir_all(out.join("figures")).unwrap();
+    std::fs::write(out.join("figures/mynotes.txt"), "mine").unwrap();
+    let run = campaign(&file, &out, &["--force"]);
+    assert!(!run.status.success());
+    assert!(
+        stderr(&run).contains("holds figures/mynotes.txt"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(
+        std::fs::read(out.join("figures/mynotes.txt")).unwrap(),
+        b"mine"
+    );
+}

@@ -134,11 +134,8 @@ fn a_forced_rerun_replaces_the_whole_folder_and_says_only_what_it_wrote() {
     );
     let doc = common::read_json(&out.join("fit.json"));
     assert!(doc["experiment"].as_str().unwrap().ends_with("b.toml"));
-    // Nothing is left beside the folder but its lock file.
-    assert_eq!(
-        entries(tmp.path()),
-        [".fit.lock", "a.toml", "b.toml", "fit"]
-    );
+    // Nothing is left beside the folder, not even its lock file.
+    assert_eq!(entries(tmp.path()), ["a.toml", "b.toml", "fit"]);
 }
 
 #[test]
@@ -148,7 +145,7 @@ fn a_folder_being_written_by_another_run_is_refused() {
     let exp = fit_experiment(tmp.path(), "exp.toml", false);
     assert!(fit(&exp, &out, false).status.success());
     let before = std::fs::read(out.join("fit.json")).unwrap();
-    let held = stf_lab::output_lock::OutputLock::acquire(&out).unwrap();
+    let held = stf_lab::writing::lock::OutputLock::acquire(&out).unwrap();
     let second = fit(&exp, &out, true);
     assert!(!second.status.success());
     let msg = stderr(&second);
@@ -190,7 +187,7 @@ fn what_a_killed_run_left_is_repaired_and_strangers_are_kept() {
         std::fs::read_to_string(out.join("fit.json")).unwrap(),
         "{\"old\": true}"
     );
-    assert_eq!(entries(tmp.path()), [".fit.lock", "exp.toml", "fit"]);
+    assert_eq!(entries(tmp.path()), ["exp.toml", "fit"]);
 
     // A stray temporary of an older version's killed write does not count as results.
     std::fs::remove_file(out.join("fit.json")).unwrap();
@@ -314,4 +311,197 @@ fn script_text_in_the_model_list_reaches_the_terminal_escaped() {
         "{text}"
     );
     assert!(text.contains("doc \\u{1b}]0;title\\u{7} here"), "{text}");
+}
+
+/// `stf-lab fit -q -f -o OUT EXP` with `STF_LAB_FAILPOINT` set to `failpoint`.
+fn fit_with_failpoint(exp: &Path, out: &Path, failpoint: &str) -> Output {
+    stf_lab()
+        .args(["fit", "-q", "-f", "-o"])
+        .arg(out)
+        .arg(exp)
+        .env("STF_LAB_FAILPOINT", failpoint)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn force_keeps_and_names_user_files_one_level_down() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = fit_experiment(tmp.path(), "exp.toml", true);
+    // Results with figures, and a user's files among the figures.
+    let s2 = tmp.path().join("S2");
+    assert!(fit(&exp, &s2, false).status.success());
+    let before = std::fs::read(s2.join("fit.json")).unwrap();
+    std::fs::write(s2.join("figures/mynotes.txt"), "notes").unwrap();
+    std::fs::create_dir(s2.join("figures/sub")).unwrap();
+    std::fs::write(s2.join("figures/sub/data.bin"), "x").unwrap();
+    // A folder holding only a draft among figures, and one whose folder is named like a result.
+    let draft = tmp.path().join("draft");
+    std::fs::create_dir_all(draft.join("figures")).unwrap();
+    std::fs::write(draft.join("figures/paper_draft.docx"), "draft").unwrap();
+    let thesis = tmp.path().join("thesis");
+    std::fs::create_dir_all(thesis.join("fit.json")).unwrap();
+    std::fs::write(thesis.join("fit.json/thesis.tex"), "tex").unwrap();
+    for (out, kept) in [
+        (&s2, vec!["figures/mynotes.txt", "figures/sub/data.bin"]),
+        (&draft, vec!["figures/paper_draft.docx"]),
+        (&thesis, vec!["fit.json/thesis.tex"]),
+    ] {
+        let run = fit(&exp, out, true);
+        assert!(!run.status.success(), "{}", out.display());
+        let msg = stderr(&run);
+        for file in kept {
+            assert!(msg.contains(file), "{file} not named: {msg}");
+            assert!(out.join(file).is_file(), "{file} was lost");
+        }
+        assert!(msg.contains("which stf-lab does not write"), "{msg}");
+    }
+    assert_eq!(std::fs::read(s2.join("fit.json")).unwrap(), before);
+    // Nothing is left beside the folders: no staging, no lock file.
+    assert_eq!(entries(tmp.path()), ["S2", "draft", "exp.toml", "thesis"]);
+}
+
+#[test]
+fn lock_files_never_stay_beside_or_above_the_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = fit_experiment(tmp.path(), "exp.toml", true);
+    let pl = tmp.path().join("pl");
+    assert!(fit(&exp, &pl, false).status.success());
+    // A refused run into a folder inside the results leaves no lock file in them …
+    let refused = fit(&exp, &pl.join("figures"), false);
+    assert!(!refused.status.success());
+    assert!(!pl.join(".figures.lock").exists(), "{:?}", entries(&pl));
+    // … so a forced rerun into the results is not refused for holding one.
+    let again = fit(&exp, &pl, true);
+    assert!(again.status.success(), "{}", stderr(&again));
+    // A refused `--out DIR --force` (DIR holds a stranger, as /tmp does) leaves nothing
+    // beside DIR, in the folder above it.
+    let busy = tmp.path().join("busy");
+    std::fs::create_dir(&busy).unwrap();
+    std::fs::write(busy.join("other.txt"), "x").unwrap();
+    let refused = fit(&exp, &busy, true);
+    assert!(
+        stderr(&refused).contains("holds other.txt"),
+        "{}",
+        stderr(&refused)
+    );
+    assert_eq!(entries(tmp.path()), ["busy", "exp.toml", "pl"]);
+}
+
+/// A short simulation experiment of `seconds` seconds at 100 samples a second.
+fn short_simulation(dir: &Path, name: &str, seconds: f64) -> PathBuf {
+    let exp = dir.join(name);
+    std::fs::write(
+        &exp,
+        format!(
+            "[system]\npreset = \"forced\"\n\n[simulate]\nconstant = {{ omega = 6.0, t1 = {seconds} }}\n\
+             rate = 100.0\nnoise = false\n"
+        ),
+    )
+    .unwrap();
+    exp
+}
+
+/// The record's data rows and the sample count its sidecar states.
+fn rows_and_sidecar_samples(record: &Path) -> (usize, u64) {
+    let rows = std::fs::read_to_string(record).unwrap().lines().count() - 1;
+    let sidecar = common::read_json(&record.with_extension("json"));
+    (rows, sidecar["summary"]["samples"].as_u64().unwrap())
+}
+
+#[test]
+fn a_record_and_its_sidecar_from_a_killed_commit_are_put_right_by_the_next_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let short = short_simulation(tmp.path(), "short.toml", 1.0);
+    let long = short_simulation(tmp.path(), "long.toml", 2.0);
+    let rec = tmp.path().join("sw.csv");
+    common::simulate_ok(&short, &rec);
+    // Killed between the two renames of the commit: the new record is in place, the
+    // sidecar not yet.
+    let killed = stf_lab()
+        .args(["simulate", "--force", "--out"])
+        .arg(&rec)
+        .arg(&long)
+        .env("STF_LAB_FAILPOINT", "commit:sw.csv=kill")
+        .output()
+        .unwrap();
+    assert_eq!(
+        std::os::unix::process::ExitStatusExt::signal(&killed.status),
+        Some(9),
+        "{}",
+        stderr(&killed)
+    );
+    // The next run into the same record notices and finishes the commit before anything else
+    // (here it then refuses to replace the record without --force).
+    let next = common::simulate(&long, &rec, &[]);
+    let msg = stderr(&next);
+    assert!(
+        msg.contains("was stopped while putting its files in place") && msg.contains("sw.json"),
+        "{msg}"
+    );
+    assert!(msg.contains("pass --force"), "{msg}");
+    let (rows, samples) = rows_and_sidecar_samples(&rec);
+    assert_eq!(rows as u64, samples, "record and sidecar are from one run");
+    assert_eq!(rows, 201);
+    assert_eq!(
+        entries(tmp.path()),
+        ["long.toml", "short.toml", "sw.csv", "sw.json"]
+    );
+}
+
+#[test]
+fn records_that_share_a_sidecar_are_not_written_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = short_simulation(tmp.path(), "exp.toml", 1.0);
+    // Another run writing `q.csv` holds its sidecar `q.json`: `--out q.CSV` (a different record
+    // on a case-sensitive disk, the same sidecar) must wait its turn.
+    let held = stf_lab::writing::lock::OutputLock::acquire(&tmp.path().join("q.json")).unwrap();
+    let run = common::simulate(&exp, &tmp.path().join("q.CSV"), &[]);
+    assert!(!run.status.success());
+    let msg = stderr(&run);
+    assert!(
+        msg.contains("q.json is being written by another stf-lab run"),
+        "{msg}"
+    );
+    assert!(!tmp.path().join("q.CSV").exists() && !tmp.path().join("q.json").exists());
+    drop(held);
+    common::simulate_ok(&exp, &tmp.path().join("q.CSV"));
+    assert_eq!(entries(tmp.path()), ["exp.toml", "q.CSV", "q.json"]);
+}
+
+#[test]
+fn output_lost_to_a_full_disk_is_a_failure() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full here
+    };
+    let run = stf_lab()
+        .arg("models")
+        .stdout(Stdio::from(full))
+        .output()
+        .unwrap();
+    assert!(!run.status.success(), "exit 0 with the listing lost");
+    assert!(
+        stderr(&run).contains("cannot write to standard output"),
+        "{}",
+        stderr(&run)
+    );
+}
+
+#[test]
+fn ctrl_c_while_report_md_is_written_leaves_no_staging_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = fit_experiment(tmp.path(), "exp.toml", true);
+    let out = tmp.path().join("fit");
+    assert!(fit(&exp, &out, false).status.success());
+    let before = std::fs::read(out.join("fit.json")).unwrap();
+    // Ctrl-C arrives as report.md starts being written; the write goes on meanwhile.
+    let run = fit_with_failpoint(&exp, &out, "write:report.md=int");
+    assert_eq!(run.status.code(), Some(130), "{}", stderr(&run));
+    assert!(
+        stderr(&run).contains("no results were written"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(std::fs::read(out.join("fit.json")).unwrap(), before);
+    assert_eq!(entries(tmp.path()), ["exp.toml", "fit"]);
 }

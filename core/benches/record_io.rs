@@ -49,7 +49,9 @@ fn main() {
     let path = dir.path().join("bench.csv");
 
     let start = Instant::now();
-    rec.write_csv(&path).expect("the record is written");
+    let file = std::fs::File::create(&path).expect("the file is created");
+    rec.write_csv(std::io::BufWriter::new(file))
+        .expect("the record is written");
     let write_s = start.elapsed().as_secs_f64();
     let bytes = std::fs::metadata(&path).expect("the file exists").len() as f64;
 

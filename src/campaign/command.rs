@@ -4,7 +4,9 @@
 //! With `--unit N` it runs unit N alone, in this process: what each child, and later each
 //! Slurm array task, runs. With a `[global]` section, the joint fit of all records
 //! (`crate::campaign::global`) follows the units, into `DIR/global.json` and the report's
-//! first section.
+//! first section. `campaign.json`, `campaign.csv`, `report.md` and `report.html` are put in
+//! place as one unit (`crate::writing::staged_files`). Interrupted, the run stops its units
+//! and says how many finished (`crate::campaign::runner`); it writes no table then.
 //!
 //! With `--slurm` the units not finished are submitted instead as a Slurm job array, and a
 //! job after it runs `--collect`: the table, report and `[global]` fit from the units' folders
@@ -21,8 +23,9 @@ use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::campaign::{slurm, slurm_script};
-use crate::output::{resolve, write_json};
 use crate::say;
+use crate::writing::staged_files::StagedFiles;
+use crate::writing::{resolve, write_json};
 
 /// The command line's settings.
 pub struct Settings {
@@ -52,6 +55,7 @@ pub struct SlurmSettings {
 pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
     let campaign = Campaign::load(path)?;
     if let Some(n) = settings.unit {
+        crate::campaign::runner::die_with_parent();
         out_dir::check(out)?;
         run_one(&campaign, n, out, settings.force, settings.quiet)?;
         say!("wrote {}", unit_dir(out, campaign.unit(n)?).display());
@@ -88,6 +92,7 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         .into_iter()
         .filter_map(|f| f.error.map(|e| (f.number, e)))
         .collect();
+    crate::interrupt::park_if_interrupted();
     finish(&campaign, out, &errors)
 }
 
@@ -186,11 +191,23 @@ fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings
 /// The table, report and `[global]` fit of the units in `out`; `errors` holds, by unit, why
 /// a unit has no results. An error naming the failed units after everything is written.
 fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> Result<()> {
+    crate::interrupt::set_outcome(format!(
+        "every unit had ended (their results are in {}); the campaign's table and report were \
+         not written for this run (earlier ones are intact)",
+        out.join(crate::campaign::unit::UNITS).display()
+    ));
     let table = table::collect(campaign, out, errors);
-    write_json(&out.join("campaign.json"), &table)?;
-    table::write_csv(&out.join("campaign.csv"), &table)?;
     let (global, global_error) = global_fit(campaign, out);
-    report::write(&table, global.as_ref(), out)?;
+    let mut staged = StagedFiles::new();
+    write_json(&staged.stage(&out.join("campaign.json"))?, &table)?;
+    table::write_csv(&staged.stage(&out.join("campaign.csv"))?, &table)?;
+    let drawn = report::write(&table, global.as_ref(), out, &mut staged)?;
+    staged.commit()?;
+    crate::interrupt::set_outcome(format!(
+        "the units, the campaign's table and its report were already written to {}",
+        out.display()
+    ));
+    report::remove_stale_figures(&drawn, &out.join("figures"))?;
     if let Some(g) = &global {
         say!("global fit: {}", g.verdict);
         say!("wrote {}", out.join(global::GLOBAL_JSON).display());

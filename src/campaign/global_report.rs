@@ -159,7 +159,7 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
                 .conditions
                 .iter()
                 .filter(|(c, _)| **c != law.condition)
-                .map(|(c, v)| super::report::value_label(c, *v, g.condition_units.get(c)))
+                .map(|(c, v)| super::labels::value_label(c, *v, g.condition_units.get(c)))
                 .collect();
             if others.is_empty() {
                 "records".into()
@@ -206,8 +206,8 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
         &name,
         &title,
         (
-            &super::report::axis_label(&law.condition, law.condition_unit.as_deref()),
-            &super::report::axis_label(&law.param, Some(&law.unit)),
+            &super::labels::axis_label(&law.condition, law.condition_unit.as_deref()),
+            &super::labels::axis_label(&law.param, Some(&law.unit)),
         ),
         &series,
         Some(&curve),

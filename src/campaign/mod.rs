@@ -7,19 +7,17 @@
 //! [`report`] are built from the units' JSON ([`unit_results`]). The output folder's rules
 //! are in [`out_dir`]; [`command`] runs it all. A `[global]` section
 //! ([`global_file`]) adds a joint fit of all records with shared and law parameters
-//! ([`global_records`], [`global_fit`], [`prediction_cache`]), compared with per-record fits ([`global`]: `DIR/global.json`) and
+//! (the study's `stf_study::joint`), compared with per-record fits ([`global`] writes `DIR/global.json`) and
 //! shown first in the report ([`global_report`]).
 
 pub mod command;
 pub mod file;
 pub mod global;
 pub mod global_file;
-pub mod global_fit;
-pub mod global_records;
 pub mod global_report;
 pub mod hash;
+pub mod labels;
 pub mod out_dir;
-pub mod prediction_cache;
 pub mod records_table;
 pub mod report;
 pub mod runner;
@@ -28,5 +26,6 @@ pub mod slurm_script;
 pub mod table;
 pub mod unit;
 pub mod unit_results;
+pub mod units;
 
 pub use file::{Campaign, CommandName, Unit};

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use serde::Deserialize;
 
-use super::file::{CommandName, Unit, MAX_CAMPAIGN_BYTES, RECORD_KEYS};
+use super::units::{CommandName, Unit, MAX_CAMPAIGN_BYTES, RECORD_KEYS};
 use crate::experiment::error_at;
 
 /// What `[campaign]` gives every row, and where paths resolve.

@@ -2,9 +2,10 @@
 //! `crate::report`) with, for each model's fitted parameter, a figure of its value against
 //! each condition with ±1 standard error bars — one series per combination of the other
 //! conditions — and the campaign table. Figures go to `figures/` as SVG, PNG and CSV; an
-//! earlier run's figures that this one does not draw are removed from there, and unit folders
-//! of records no longer in the campaign are named in a note (never deleted: they are the
-//! user's results).
+//! earlier run's figures that this one does not draw are removed from there (figures only:
+//! an SVG, PNG and CSV of one name), and unit folders of records no longer in the campaign
+//! are named in a note (never deleted: they are the user's results). `report.md` and
+//! `report.html` are staged with the tables and put in place with them.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,13 +13,21 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::global::GlobalJson;
+use super::labels::{axis_label, value_label};
 use super::table::{param_names, CampaignJson, CampaignRow};
 use crate::digits::{carried, with_error};
 use crate::report::{self, ErrorPoint, ErrorSeries, FigureRef, Report, Section, Table};
+use crate::writing::results_dir::is_figure;
+use crate::writing::staged_files::StagedFiles;
 
-/// Write `report.md`, `report.html` and `figures/` of `table` into `out`, the global fit's
-/// section first when there is one.
-pub fn write(table: &CampaignJson, global: Option<&GlobalJson>, out: &Path) -> Result<()> {
+/// Draw `figures/` of `table` into `out` and stage `report.md` and `report.html` in
+/// `staged`, the global fit's section first when there is one. The figure files drawn.
+pub fn write(
+    table: &CampaignJson,
+    global: Option<&GlobalJson>,
+    out: &Path,
+    staged: &mut StagedFiles,
+) -> Result<Vec<std::ffi::OsString>> {
     let mut doc = Report::new(format!("Campaign {}", table.campaign));
     let ok_units = table.units - table.failed;
     doc.intro.push(format!(
@@ -53,30 +62,37 @@ pub fn write(table: &CampaignJson, global: Option<&GlobalJson>, out: &Path) -> R
     let mut section = Section::new("Table");
     section.tables.push(table_of(table));
     doc.sections.push(section);
-    report::write_markdown(&doc, &out.join("report.md"))?;
-    report::write_html(&doc, &out.join("report.html"))?;
-    remove_stale_figures(&doc, &out.join("figures"))
-}
-
-/// Remove the files of `dir` (the campaign's own `figures/`) that this report does not draw:
-/// an earlier run's figures of a parameter, condition or law the campaign no longer has.
-/// The program's temporaries and anything not a regular file are left alone.
-fn remove_stale_figures(doc: &Report, dir: &Path) -> Result<()> {
-    let drawn: Vec<&std::ffi::OsStr> = doc
+    report::write_markdown(&doc, &staged.stage(&out.join("report.md"))?)?;
+    report::write_html(&doc, &staged.stage(&out.join("report.html"))?)?;
+    Ok(doc
         .sections
         .iter()
         .flat_map(|s| &s.figures)
         .flat_map(|f| [&f.files.svg, &f.files.png, &f.files.csv])
-        .filter_map(|p| p.file_name())
-        .collect();
+        .filter_map(|p| p.file_name().map(|n| n.to_os_string()))
+        .collect())
+}
+
+/// Remove the figures of `dir` (the campaign's own `figures/`) that this report does not draw
+/// (`drawn`): an earlier run's figures of a parameter, condition or law the campaign no
+/// longer has. Only figures (an SVG, PNG and CSV of one name) are removed; the program's
+/// temporaries and anything else are left alone.
+pub fn remove_stale_figures(drawn: &[std::ffi::OsString], dir: &Path) -> Result<()> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
-    for entry in entries.filter_map(|e| e.ok()) {
+    let entries: Vec<_> = entries.filter_map(|e| e.ok()).collect();
+    let files: Vec<String> = entries
+        .iter()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+    for entry in &entries {
         let name = entry.file_name();
-        let regular = entry.file_type().is_ok_and(|t| t.is_file());
-        if regular && !drawn.contains(&name.as_os_str()) && !name.to_string_lossy().starts_with('.')
-        {
+        let figure = files.contains(&name.to_string_lossy().as_ref())
+            && is_figure(&name.to_string_lossy(), &files);
+        if figure && !drawn.contains(&name) {
             std::fs::remove_file(entry.path()).with_context(|| {
                 format!("cannot remove the stale figure {}", entry.path().display())
             })?;
@@ -144,24 +160,6 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
         }
     }
     Ok(figures)
-}
-
-/// An axis's label: the name and its unit in brackets (`K [N·(s/m)ⁿ]`, `n [–]` for a
-/// dimensionless one), the name alone when the unit is not known.
-pub(super) fn axis_label(name: &str, unit: Option<&str>) -> String {
-    match unit.map(str::trim) {
-        None => name.to_string(),
-        Some("") => format!("{name} [–]"),
-        Some(u) => format!("{name} [{u}]"),
-    }
-}
-
-/// `name = value unit` (the unit where the campaign gives one) for a legend.
-pub(super) fn value_label(name: &str, value: f64, unit: Option<&String>) -> String {
-    match unit {
-        Some(u) => format!("{name} = {} {u}", carried(value)),
-        None => format!("{name} = {}", carried(value)),
-    }
 }
 
 /// How many different values `condition` takes over `rows`.

@@ -16,7 +16,7 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, Context, Result};
 
 use super::slurm_script::{Job, Scripts, COLLECT_SCRIPT, UNITS_SCRIPT};
-use crate::output::write_atomic;
+use crate::writing::write_atomic;
 
 /// The job ids Slurm gave.
 pub struct Submitted {
@@ -61,8 +61,7 @@ fn commands_shown(folder: &Path) -> [String; 2] {
 /// Write both scripts into the job's folder, each atomically.
 pub fn write_scripts(job: &Job, scripts: &Scripts) -> Result<()> {
     let folder = job.folder();
-    std::fs::create_dir_all(&folder)
-        .with_context(|| format!("cannot create folder {}", folder.display()))?;
+    crate::writing::atomic::ensure_dir(&folder)?;
     write_atomic(&folder.join(UNITS_SCRIPT), scripts.units.as_bytes())?;
     write_atomic(&folder.join(COLLECT_SCRIPT), scripts.collect.as_bytes())
 }

@@ -181,7 +181,8 @@ pub fn write_csv(path: &Path, table: &CampaignJson) -> Result<()> {
         w.write_record(csv_row(r, &table.conditions, &names))?;
     }
     let bytes = w.into_inner().context("cannot build campaign.csv")?;
-    crate::output::write_atomic(path, &bytes)
+    crate::writing::write_atomic(path, &bytes)?;
+    Ok(())
 }
 
 /// One row's fields in the order of the header.

@@ -3,12 +3,15 @@
 //! runner starts it as a child process; a Slurm array task will run the same line, so a
 //! cluster run and a local run give identical unit outputs.
 //!
-//! The command's usual outputs are written by the command itself (its folder swapped in whole
-//! and locked, `crate::results_dir`), then `unit.json` ([`UnitJson`]) beside them, atomically:
-//! a unit killed midway leaves no `unit.json` that matches its inputs, so it is rerun. A unit
-//! whose command fails gets a folder holding only its `unit.json` (status `failed`, the
-//! error). Without `--force` a unit whose `unit.json` says `ok` with the same inputs' hash
-//! ([`super::hash`]) is skipped.
+//! The unit's folder is locked from the start of its run to the end (`crate::writing::lock`),
+//! so no other run writes it meanwhile. The command's usual outputs are written by the
+//! command itself (its folder swapped in whole, `crate::writing::results_dir`), then
+//! `unit.json` ([`UnitJson`]) beside them, atomically: a unit killed midway leaves no
+//! `unit.json` that matches its inputs, so it is rerun. A unit whose command fails gets a
+//! folder holding only its `unit.json` (status `failed`, the error); if even that cannot be
+//! written (the folder holds a file stf-lab did not write) the unit's error says so, and its
+//! earlier `unit.json` stays as it was. Without `--force` a unit whose `unit.json` says `ok`
+//! with the same inputs' hash ([`super::hash`]) is skipped.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -20,8 +23,9 @@ use serde::{Deserialize, Serialize};
 use super::file::{Campaign, CommandName, Unit};
 use super::hash::unit_hash;
 use crate::experiment::Experiment;
-use crate::output::write_json;
-use crate::results_dir::ResultsDir;
+use crate::writing::lock::OutputLock;
+use crate::writing::results_dir::ResultsDir;
+use crate::writing::write_json;
 
 /// The folder of unit folders under the campaign's output.
 pub const UNITS: &str = "units";
@@ -109,8 +113,9 @@ pub fn run_one(
             return Ok(done);
         }
     }
-    std::fs::create_dir_all(out.join(UNITS))
+    crate::writing::atomic::ensure_dir(&out.join(UNITS))
         .with_context(|| format!("cannot create folder {}", out.join(UNITS).display()))?;
+    let _lock = OutputLock::acquire(&dir)?;
     let started = Instant::now();
     let exp = exp.with_data_file(unit.record.clone());
     let result = match unit.command {
@@ -136,13 +141,22 @@ pub fn run_one(
             Ok(json)
         }
         Err(e) => {
-            let message = format!("{e:#}");
             json.status = UnitStatus::Failed;
-            json.error = Some(message.clone());
-            let results = ResultsDir::begin(&dir, true)?;
-            write_json(&results.path().join(UNIT_JSON), &json)?;
-            results.commit()?;
-            Err(e.context(format!("unit {number} ({}) failed", unit.record_given)))
+            json.error = Some(format!("{e:#}"));
+            let failed = format!("unit {number} ({}) failed", unit.record_given);
+            match write_failed(&dir, &json) {
+                Ok(()) => Err(e.context(failed)),
+                Err(w) => Err(e.context(format!(
+                    "{failed}, and its unit.json could not be written either ({w:#})"
+                ))),
+            }
         }
     }
+}
+
+/// A folder holding only the failed unit's `unit.json`, swapped in whole.
+fn write_failed(dir: &Path, json: &UnitJson) -> Result<()> {
+    let results = ResultsDir::begin(dir, true)?;
+    write_json(&results.path().join(UNIT_JSON), json)?;
+    results.commit()
 }

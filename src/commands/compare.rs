@@ -18,13 +18,13 @@ use stf_study::compare::{response, simulated_response, Compared};
 use crate::compare_markdown::{compare_markdown, duty_meaning};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
-use crate::output::{write_atomic, write_json};
 use crate::outputs::compare_csv;
 use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::standard_report::{frequency_section, record_sections, write_report};
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::{write_atomic, write_json};
 
 /// Run `stf-lab compare` on an experiment loaded (from its file, or a campaign's unit: its
 /// record set with [`Experiment::with_data_file`]): the results are built in a staging

@@ -19,16 +19,16 @@ use stf_study::discover::Discovered;
 
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, FitData};
-use crate::output::{write_atomic, write_json};
 use crate::progress::Progress;
 use crate::report::{
     measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
 };
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::standard_report::{record_sections, write_report};
 use crate::validation::DiscoveryScore;
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::{write_atomic, write_json};
 
 /// Run `stf-lab discover` on an experiment loaded (from its file, or a campaign's unit: its
 /// record set with [`Experiment::with_data_file`]): the results are built in a staging
@@ -184,7 +184,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     let (data, found) = (&discovered.data, &discovered.found);
     let score = discovered.score.as_ref();
     let dir = out.join("figures");
-    std::fs::create_dir_all(&dir)?;
+    crate::writing::atomic::ensure_dir(&dir)?;
     let (unit, scale) = data.level.shown();
     let drawn = match data.level {
         FitLevel::Force => &FORCE_DRAWN,

@@ -18,13 +18,13 @@ use stf_study::identify::Identification;
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{estimate_line, FitData, ModelFit};
 use crate::identify_report::{system_line, write_identification_report};
-use crate::output::{write_atomic, write_json};
 use crate::outputs::identification_json::IdentificationJson;
 use crate::param_table::{params_csv, rows_of, ParamRow};
 use crate::progress::Progress;
-use crate::results_dir::{wrote_line, ResultsDir};
 use crate::say;
 use crate::validation::ValidationRecord;
+use crate::writing::results_dir::{wrote_line, ResultsDir};
+use crate::writing::{write_atomic, write_json};
 use stf_core::regimes::Regime;
 
 /// Run `stf-lab fit` on an experiment loaded (from its file, or a campaign's unit: its

@@ -1,5 +1,5 @@
 //! `stf-lab models`: list the models (built-ins and the scripts of `models/scripts`) with
-//! their parameters; `--check SCRIPT` validates one script.
+//! their parameters; `--check SCRIPT` checks one script.
 
 use std::path::{Path, PathBuf};
 

@@ -8,26 +8,23 @@
 //!
 //! The record and its sidecar are refused if they would be one file (`--out rec.json`) or
 //! replace something that is not a regular file; they are staged beside their targets and
-//! renamed into place together, the record locked for the run ([`crate::staged_files`]).
+//! renamed into place as one unit ([`crate::writing::staged_files`]: a commit cut short by a kill
+//! is finished by the next run). The record and the sidecar are both locked for the run, so
+//! two runs whose records differ but share a sidecar (`--out q.csv`, `--out q.CSV`) cannot
+//! write it at once.
 
 use std::path::Path;
-use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use stf_core::data::response::{breakaway, peak, stop, BREAKAWAY_DISPLACEMENT, MOVING_SPEED};
-use stf_core::numerics::interpolate::Linear;
-use stf_core::physics::excitation::Excitation;
-use stf_core::physics::oscillator::Oscillator;
-use stf_core::simulate::synthetic::{sample_record, SensorNoise};
-use stf_core::simulate::{Simulation, Trajectory as SimRun};
 
-use crate::experiment::{Drive, Experiment};
-use crate::model_config::configure_for;
-use crate::output::{check_distinct, check_overwrite, ensure_parent, write_json};
-use crate::output_lock::OutputLock;
-use crate::outputs::simulate_json::{SimulateJson, Summary, Truth};
+use crate::experiment::Experiment;
+use crate::outputs::simulate_json::{SimulateJson, Summary};
 use crate::say;
-use crate::staged_files::{clean_stale, StagedFiles};
+use crate::writing::lock::OutputLock;
+use crate::writing::staged_files::{finish_commits, StagedFiles};
+use crate::writing::{check_distinct, check_overwrite, check_regular_or_new};
+use crate::writing::{clean_stale, ensure_parent};
+use crate::writing::{write_json, write_with};
 
 /// Run the `[simulate]` section of `exp_path` and write the record to `out`.
 pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
@@ -39,51 +36,16 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         );
     };
     let sidecar = out.with_extension("json");
-    let _lock = claim_outputs(out, &sidecar, force)?;
-
-    // The sample times, as `Simulation::run` makes them.
-    let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
-    let times: Vec<f64> = (0..n).map(|i| spec.t0 + i as f64 / spec.rate).collect();
-    let (excitation, rotor) = excitation_of(&spec.drive, &times);
-    let free = matches!(spec.drive, Drive::Free);
-    let mut osc = Oscillator::new(exp.system, excitation);
-    let mut truth_json = Vec::new();
-    if !spec.truth.is_empty() {
-        let truth = configure_for(&spec.truth, &exp.path, &exp.dir, &exp.scripts, None)?;
-        truth_json.push(Truth {
-            model: truth.model.name().to_string(),
-            params: truth
-                .params
-                .iter()
-                .map(|p| (p.name.clone(), p.value))
-                .collect(),
-        });
-        let values = truth.values();
-        osc = osc
-            .with_model(truth.model, values)
-            .context("cannot plug the truth model into the oscillator")?;
-    }
-
-    let started = Instant::now();
-    let run = Simulation::new(&osc)
-        .settings(exp.integrator.clone())
-        .initial(spec.x0, spec.v0)
-        .run_at(&times)
-        .with_context(|| format!("simulation of {} failed", exp_path.display()))?;
-    let wall = started.elapsed();
-
-    let noise = if spec.noise {
-        SensorNoise::RIG
-    } else {
-        SensorNoise::NONE
-    };
-    let mut record = sample_record(&run, &noise, spec.seed, rotor);
+    let _locks = claim_outputs(out, &sidecar, force)?;
+    let simulated = stf_study::simulate::simulate(&exp)?;
+    let (run, mut record) = (&simulated.run, simulated.record.clone());
     record.source = out.display().to_string();
 
     let mut staged = StagedFiles::new();
-    record
-        .write_csv(&staged.stage(out))
-        .with_context(|| format!("cannot write {}", out.display()))?;
+    write_with(&staged.stage(out)?, |w| {
+        record.write_csv(w).map_err(std::io::Error::other)
+    })
+    .with_context(|| format!("cannot write {}", out.display()))?;
     let meta = SimulateJson {
         generator: "stf-lab simulate",
         version: env!("CARGO_PKG_VERSION"),
@@ -93,13 +55,13 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         simulate: &spec.as_json,
         system: exp.system,
         integrator: (&exp.integrator).into(),
-        truth: truth_json,
-        noise,
+        truth: simulated.truth.clone(),
+        noise: simulated.noise,
         seed: spec.seed,
         record: out.display().to_string(),
-        summary: summary(&run, free),
+        summary: simulated.summary.clone(),
     };
-    write_json(&staged.stage(&sidecar), &meta)
+    write_json(&staged.stage(&sidecar)?, &meta)
         .with_context(|| format!("cannot write {}", sidecar.display()))?;
     staged.commit()?;
 
@@ -107,17 +69,19 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
         "simulated {:.1} s ({} samples) in {:.0} ms, {} right-hand-side calls",
         spec.t1 - spec.t0,
         run.t.len(),
-        wall.as_secs_f64() * 1e3,
+        simulated.wall_s * 1e3,
         run.stats.rhs_calls
     );
-    print_outcome(&run, free);
+    print_outcome(&simulated.summary, simulated.free);
     say!("wrote {} and {}", out.display(), sidecar.display());
     Ok(())
 }
 
 /// Check that the record `out` and its `sidecar` may be written (distinct, regular or new,
-/// replaced only with `force`), lock the record and clear what an interrupted run left.
-fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> {
+/// replaced only with `force`), lock both, finish a commit a killed run left and clear its
+/// temporaries — before a refusal to replace them, so that a rerun without `--force` puts
+/// right what a killed run left too.
+fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<[OutputLock; 2]> {
     if check_distinct(&[("the record", out), ("its JSON sidecar", sidecar)]).is_err() {
         bail!(
             "{}: the JSON sidecar is written to the record's path with the extension .json, \
@@ -125,10 +89,13 @@ fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> 
             out.display()
         );
     }
-    check_overwrite(out, force)?;
-    check_overwrite(sidecar, force)?;
+    check_regular_or_new(out)?;
+    check_regular_or_new(sidecar)?;
     ensure_parent(out)?;
-    let lock = OutputLock::acquire(out)?;
+    let locks = [OutputLock::acquire(out)?, OutputLock::acquire(sidecar)?];
+    for note in finish_commits(out)? {
+        crate::tell!("note: {note}");
+    }
     for target in [out, sidecar] {
         for name in clean_stale(target)? {
             crate::tell!(
@@ -137,80 +104,36 @@ fn claim_outputs(out: &Path, sidecar: &Path, force: bool) -> Result<OutputLock> 
             );
         }
     }
-    Ok(lock)
+    check_overwrite(out, force)?;
+    check_overwrite(sidecar, force)?;
+    Ok(locks)
 }
 
-/// The excitation of `drive` at the sample `times`, and whether it is a rotor. A force is
-/// tabulated at the sample times (held, or interpolated linearly).
-fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
-    match drive {
-        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
-        Drive::Free => (Excitation::None, false),
-        Drive::Force(chirp) => {
-            let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held() {
-                Linear::held(times.to_vec(), u)
-            } else {
-                Linear::new(times.to_vec(), u)
-            };
-            (Excitation::Force(held), false)
+/// The terminal lines of the run: its peak, the breakaway and where free motion stops
+/// (from the sidecar's summary).
+fn print_outcome(s: &Summary, free: bool) {
+    if let (Some(x), Some(t)) = (s.peak_x_m, s.peak_t_s) {
+        match s.peak_omega_rad_s.filter(|w| w.is_finite()) {
+            Some(w) => say!(
+                "peak |x| = {:.2} mm at ω = {w:.2} rad/s (t = {t:.1} s)",
+                x * 1e3
+            ),
+            None => say!("peak |x| = {:.2} mm at t = {t:.2} s", x * 1e3),
         }
     }
-}
-
-/// What the run shows, for the sidecar (`free`: free vibration, where motion stops).
-fn summary(run: &SimRun, free: bool) -> Summary {
-    let omega = run.omega.as_deref();
-    let pk = peak(&run.t, &run.x, omega);
-    let brk = breakaway(&run.x, BREAKAWAY_DISPLACEMENT);
-    Summary {
-        peak_x_m: pk.map(|p| p.amplitude),
-        peak_t_s: pk.map(|p| p.t),
-        peak_omega_rad_s: pk.map(|p| p.omega),
-        breakaway_omega_rad_s: brk.and_then(|i| omega.map(|w| w[i])),
-        motion_stops_t_s: if free {
-            stop(&run.v, MOVING_SPEED).map(|i| run.t[i])
-        } else {
-            None
-        },
-        samples: run.t.len(),
-        rhs_calls: run.stats.rhs_calls,
-        steps: run.stats.accepted,
-    }
-}
-
-/// The terminal lines of the run: its peak, the breakaway and where free motion stops.
-fn print_outcome(run: &SimRun, free: bool) {
-    let omega = run.omega.as_deref();
-    if let Some(p) = peak(&run.t, &run.x, omega) {
-        if p.omega.is_finite() {
-            say!(
-                "peak |x| = {:.2} mm at ω = {:.2} rad/s (t = {:.1} s)",
-                p.amplitude * 1e3,
-                p.omega,
-                p.t
-            );
-        } else {
-            say!("peak |x| = {:.2} mm at t = {:.2} s", p.amplitude * 1e3, p.t);
-        }
-    }
-    match (breakaway(&run.x, BREAKAWAY_DISPLACEMENT), omega) {
-        (Some(i), Some(w)) => say!(
-            "breakaway (|x| first above {:.1} mm) at ω = {:.2} rad/s (t = {:.1} s)",
-            BREAKAWAY_DISPLACEMENT * 1e3,
-            w[i],
-            run.t[i]
+    let threshold_mm = s.breakaway_displacement_m * 1e3;
+    match (s.breakaway_omega_rad_s, s.breakaway_t_s) {
+        (Some(w), Some(t)) => say!(
+            "breakaway (|x| first above {threshold_mm:.1} mm) at ω = {w:.2} rad/s (t = {t:.1} s)"
         ),
-        (None, Some(_)) => say!("the trolley never broke away from sticking"),
+        _ if s.peak_omega_rad_s.is_some_and(f64::is_finite) => {
+            say!("the trolley never broke away from sticking")
+        }
         _ => {}
     }
     if free {
-        if let Some(i) = stop(&run.v, MOVING_SPEED) {
-            say!(
-                "motion stops at t = {:.2} s, {:.2} mm from zero",
-                run.t[i],
-                run.x[i].abs() * 1e3
-            );
+        if let (Some(t), Some(x)) = (s.motion_stops_t_s, s.motion_stops_x_m) {
+            say!("motion stops at t = {t:.2} s, {:.2} mm from zero", x * 1e3);
         }
     }
 }

@@ -58,6 +58,15 @@ pub enum ReportError {
     Font,
 }
 
+impl From<crate::writing::WriteError> for ReportError {
+    fn from(e: crate::writing::WriteError) -> Self {
+        match e {
+            crate::writing::WriteError::NotRegularFile { path } => Self::NotRegularFile { path },
+            crate::writing::WriteError::Io { path, source } => Self::Io { path, source },
+        }
+    }
+}
+
 impl ReportError {
     /// [`ReportError::NoData`] about `what`.
     pub fn no_data(what: impl Into<String>) -> Self {

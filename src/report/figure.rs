@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::atomic::{ensure_dir, write_atomic};
 use super::colour::series_colour;
 use super::font::{ensure_registered, FAMILY};
 use super::raster::svg_to_png;
 use super::series_csv::{write_csv, Column};
 use super::ReportError;
+use crate::writing::atomic::{ensure_dir, write_atomic};
 
 /// The files of one figure.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -6,9 +6,9 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::atomic::write_atomic;
 use super::document::{FigureRef, Report, Table};
 use super::ReportError;
+use crate::writing::atomic::write_atomic;
 use base64::Engine;
 
 const STYLE: &str = r#"
@@ -219,9 +219,9 @@ pub fn to_html(report: &Report) -> Result<String, ReportError> {
 pub fn write_html(report: &Report, path: &Path) -> Result<(), ReportError> {
     let html = to_html(report)?;
     if let Some(dir) = path.parent() {
-        super::atomic::ensure_dir(dir)?;
+        crate::writing::atomic::ensure_dir(dir)?;
     }
-    write_atomic(path, html.as_bytes())
+    Ok(write_atomic(path, html.as_bytes())?)
 }
 
 #[cfg(test)]

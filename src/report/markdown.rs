@@ -6,9 +6,9 @@
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
-use super::atomic::{ensure_dir, write_atomic};
 use super::document::{Report, Table};
 use super::ReportError;
+use crate::writing::atomic::{ensure_dir, write_atomic};
 
 /// Text for the Markdown report: HTML's `&`, `<`, `>` as entities, except inside backtick
 /// code spans (shown literally there); an unpaired backtick leaves the whole text escaped.
@@ -111,7 +111,7 @@ pub fn to_markdown(report: &Report, base: &Path) -> String {
 pub fn write_markdown(report: &Report, path: &Path) -> Result<(), ReportError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     ensure_dir(dir)?;
-    write_atomic(path, to_markdown(report, dir).as_bytes())
+    Ok(write_atomic(path, to_markdown(report, dir).as_bytes())?)
 }
 
 #[cfg(test)]

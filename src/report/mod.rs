@@ -5,7 +5,8 @@
 //!
 //! The API takes plain data (slices of `f64`, labels), so it knows nothing of fitting.
 //! Fonts are embedded in the binary ([`font`]), so rendering needs no system library. Every
-//! file is written atomically (a temporary file beside the target, then a rename).
+//! file is written atomically (a temporary file beside the target, then a rename:
+//! [`crate::writing::atomic`]).
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -24,7 +25,6 @@
 //! # Ok(()) }
 //! ```
 
-mod atomic;
 mod colour;
 mod decimate;
 mod document;
@@ -49,7 +49,6 @@ mod smoothing;
 pub mod test_signals;
 mod time_history;
 
-pub use atomic::write_atomic as write_file_atomic;
 pub use decimate::{decimate_indices, decimate_union, MAX_POINTS_PER_LINE};
 pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use super::atomic::write_atomic;
 use super::ReportError;
+use crate::writing::atomic::write_atomic;
 
 /// A named column of numbers.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,7 +57,7 @@ pub fn to_csv(columns: &[Column]) -> String {
 
 /// Write `columns` to `path` atomically.
 pub fn write_csv(path: &Path, columns: &[Column]) -> Result<(), ReportError> {
-    write_atomic(path, to_csv(columns).as_bytes())
+    Ok(write_atomic(path, to_csv(columns).as_bytes())?)
 }
 
 /// Read a figure CSV back into columns (empty cells end a column). For tests and for users

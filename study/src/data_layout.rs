@@ -55,7 +55,7 @@ pub struct RawData {
     plausibility: Option<bool>,
 }
 
-/// A validated `[data]` section.
+/// A checked `[data]` section.
 #[derive(Clone, Debug, Default)]
 pub struct DataSection {
     /// The record, resolved against the experiment's folder.

@@ -72,7 +72,7 @@ struct RawExperiment {
     scripts: Option<Spanned<scripts::RawScripts>>,
 }
 
-/// A validated experiment.
+/// A checked experiment.
 #[derive(Clone, Debug)]
 pub struct Experiment {
     /// The file it came from.
@@ -150,7 +150,7 @@ impl Experiment {
         self
     }
 
-    /// Read and validate an experiment file.
+    /// Read and check an experiment file.
     pub fn load(path: &Path) -> Result<Experiment> {
         Self::load_capped(path, MAX_EXPERIMENT_BYTES)
     }

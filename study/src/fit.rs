@@ -9,7 +9,6 @@ use crate::experiment::Experiment;
 use crate::fitting::{fit_all, load_data, FitData, ModelFit};
 use crate::observer::Observer;
 use crate::outputs::columns_csv::Columns;
-use crate::outputs::fit_json::FitJson;
 use crate::param_table::{rows_of_fits, ParamRow};
 use crate::validation::ValidationRecord;
 
@@ -72,11 +71,6 @@ pub fn warn_about(data: &FitData, observer: &dyn Observer) {
 }
 
 impl Fitted {
-    /// `fit.json` of the experiment `exp`.
-    pub fn json<'a>(&'a self, exp: &'a Experiment) -> FitJson<'a> {
-        FitJson::new(&exp.path, &self.data, &self.fits)
-    }
-
     /// The rows of `params.csv`.
     pub fn param_rows(&self) -> Vec<ParamRow> {
         rows_of_fits(&self.fits)
@@ -92,11 +86,5 @@ impl Fitted {
         self.fits.iter().fold(columns, |c, f| {
             c.with(format!("{measured}_{}", f.label), &f.fitted)
         })
-    }
-
-    /// The verdict: the best model, how far it is to be trusted, and why (fit.json's
-    /// `verdict`; its `text` opens the report).
-    pub fn verdict(&self) -> crate::verdict::FitVerdict {
-        crate::verdict::FitVerdict::new(&self.fits, self.data.level)
     }
 }

@@ -107,6 +107,14 @@ impl FitVerdict {
     }
 }
 
+impl crate::fit::Fitted {
+    /// The verdict: the best model, how far it is to be trusted, and why (fit.json's
+    /// `verdict`; its `text` opens the report).
+    pub fn verdict(&self) -> FitVerdict {
+        FitVerdict::new(&self.fits, self.data.level)
+    }
+}
+
 /// The paragraph of a fit's verdict.
 fn fit_text(
     best: &ModelFit,

@@ -265,7 +265,7 @@ pub fn discover_force(
     cycles: &[Cycle],
     settings: &DiscoverySettings,
 ) -> Result<Discovery, DiscoveryError> {
-    settings.validate()?;
+    settings.check()?;
     let level = ForceLevel::new(data, cycles, settings)?;
     search::discover(&level, base, candidates, settings)
 }

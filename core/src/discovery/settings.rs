@@ -14,8 +14,8 @@ use crate::fit::{FitSettings, Solver};
 /// ```
 /// use stf_core::discovery::DiscoverySettings;
 /// let s = DiscoverySettings::default().max_effects(2).holdout_every(5);
-/// assert!(s.validate().is_ok());
-/// assert!(DiscoverySettings::default().holdout_every(1).validate().is_err());
+/// assert!(s.check().is_ok());
+/// assert!(DiscoverySettings::default().holdout_every(1).check().is_err());
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Setters)]
 #[serde(default)]
@@ -151,9 +151,9 @@ impl DiscoverySettings {
     }
 
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), DiscoveryError> {
+    pub fn check(&self) -> Result<(), DiscoveryError> {
         self.fit
-            .validate()
+            .check()
             .map_err(|e| DiscoveryError::BadSettings(e.to_string()))?;
         let sigma_ok = self.noise_sigma.is_none_or(|s| s > 0.0 && s.is_finite());
         let ok = self.holdout_every >= 2

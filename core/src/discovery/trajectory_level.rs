@@ -75,7 +75,7 @@ pub fn discover_trajectory(
     setup: &TrajectorySetup,
     settings: &DiscoverySettings,
 ) -> Result<Discovery, DiscoveryError> {
-    settings.validate()?;
+    settings.check()?;
     let level = TrajectoryLevel::new(data, cycles, setup, settings)?;
     let base_params: Vec<(&ParamSpec, bool)> = base.params().iter().map(|s| (s, true)).collect();
     check_same_terms(&base_params, &level.rig.oscillator, &setup.fit.excitation)

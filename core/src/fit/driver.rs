@@ -1,32 +1,34 @@
-//! The driver shared by every kind of fit: validated parameters in, [`FitResult`] out.
+//! The driver shared by every kind of fit: checked parameters in, [`FitResult`] out.
 //!
-//! It runs the stages of the chosen [`Solver`] on an [`Objective`], then computes the residuals
+//! It runs the stages of the chosen [`Solver`] on an [`Objective`] — each stage one run of
+//! argmin's `Executor` ([`super::stages`]), watched by the fit's observer
+//! ([`super::observer`]); the chain between them (which stage follows which, the start kept
+//! if nothing beats it, a pinned parameter released) is ours — then computes the residuals
 //! and a forward-difference Jacobian at the best point in the user's parameter space (so the
 //! standard errors are those of the values reported, whatever the transforms; robust to
 //! residuals correlated over blocks of samples, which are chosen from the residuals), and the
 //! statistics of the result.
 
+use std::sync::mpsc::Sender;
 use std::time::Instant;
 
-use argmin::core::{Executor, State, TerminationReason};
-use argmin::solver::neldermead::NelderMead;
-use argmin::solver::particleswarm::ParticleSwarm;
 use nalgebra::DMatrix;
-use rand::rngs::StdRng;
-use rand::SeedableRng;
 
 use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::fit_param::FitParam;
-use super::levenberg_marquardt::{self, BoundStop, Refined, MAX_FD_STEP, NOISE_PROBE};
-use super::objective::{LnCost, Objective, Residuals};
+use super::levenberg_marquardt::{BoundStop, MAX_FD_STEP, NOISE_PROBE};
+use super::objective::{Objective, Residuals};
+use super::observer::Watch;
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
 use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
 use super::solver::{FitSettings, Solver};
+use super::stages::{self, StageEnd};
 
 /// Fit the free members of `params` (all of them, in order) of `problem`, whose
 /// [`Residuals::residuals`] receives the user values of the free parameters only.
-/// `trajectory`: report S(μ) in mm² (the residuals are displacements in m).
+/// `trajectory`: report S(μ) in mm² (the residuals are displacements in m). `observer` sees
+/// the fit's progress after every iteration of every stage (see [`super::observer`]).
 pub fn run(
     problem: &dyn Residuals,
     params: &[FitParam],
@@ -34,12 +36,29 @@ pub fn run(
     observer: Option<&(dyn Fn(FitProgress) + Sync)>,
     trajectory: bool,
 ) -> Result<FitResult, FitError> {
+    Watch::forwarding(observer, |display| {
+        run_watched(problem, params, settings, display, trajectory)
+    })
+}
+
+/// [`run`], its progress sent to `display`.
+fn run_watched(
+    problem: &dyn Residuals,
+    params: &[FitParam],
+    settings: &FitSettings,
+    display: Option<Sender<FitProgress>>,
+    trajectory: bool,
+) -> Result<FitResult, FitError> {
     let clock = Instant::now();
     let free = checked(problem, params, settings)?;
-    let obj = Objective::new(
-        problem,
-        free.iter().map(|p| p.transform()).collect(),
-        observer,
+    let transforms: Vec<_> = free.iter().map(|p| p.transform()).collect();
+    let obj = Objective::new(problem, transforms.clone());
+    let names: Vec<&str> = free.iter().map(|p| p.name.as_str()).collect();
+    let watch = Watch::new(
+        obj.tally(),
+        display,
+        settings.trace.as_deref(),
+        (&names, transforms),
     );
     let u0 = vec![0.0; obj.dim()];
     if obj.cost(&u0).is_none() {
@@ -52,12 +71,18 @@ pub fn run(
         free: &free,
         settings,
         trajectory,
+        watch: &watch,
         iterations: 0,
         log: Vec::new(),
     };
-    let (u, convergence) = chain.solve(&u0)?;
-    let (u, convergence) = chain.no_worse_than(u0, u, convergence);
-    chain.finish(params, &u, convergence, clock)
+    let fitted = chain.solve(&u0).and_then(|(u, convergence)| {
+        let (u, convergence) = chain.no_worse_than(u0, u, convergence);
+        chain.finish(params, &u, convergence, clock)
+    });
+    // The trace is written whatever the end; the fit's own error comes first.
+    let written = watch.write_trace();
+    let fitted = fitted?;
+    written.map(|()| fitted)
 }
 
 /// The free members of `params` after checking the settings, each parameter, that no name
@@ -67,9 +92,9 @@ fn checked<'p>(
     params: &'p [FitParam],
     settings: &FitSettings,
 ) -> Result<Vec<&'p FitParam>, FitError> {
-    settings.validate()?;
+    settings.check()?;
     for (i, p) in params.iter().enumerate() {
-        p.validate()?;
+        p.check()?;
         if params[..i].iter().any(|q| q.name == p.name) {
             return Err(FitError::DuplicateParam(p.name.clone()));
         }
@@ -92,6 +117,8 @@ struct Chain<'a> {
     free: &'a [&'a FitParam],
     settings: &'a FitSettings,
     trajectory: bool,
+    /// The fit's observer of every stage.
+    watch: &'a Watch,
     iterations: u64,
     log: Vec<String>,
 }
@@ -109,7 +136,7 @@ impl Chain<'_> {
         let (u, convergence) = match settings.solver {
             Solver::NelderMead => self.nelder_mead(u0, settings.simplex_tol)?,
             Solver::Auto => {
-                let (u, conv) = self.lm(u0);
+                let (u, conv) = self.lm(u0)?;
                 if conv.converged() {
                     (u, conv)
                 } else {
@@ -123,51 +150,44 @@ impl Chain<'_> {
                     );
                     let tol = settings.simplex_tol.max(settings.presearch_tol);
                     let (u, _) = self.nelder_mead(&u, tol)?;
-                    self.lm(&u)
+                    self.lm(&u)?
                 }
             }
-            Solver::LevenbergMarquardt => self.lm(u0),
+            Solver::LevenbergMarquardt => self.lm(u0)?,
             Solver::ParticleSwarm => {
                 let u = self.particle_swarm(u0)?;
-                self.lm(&u)
+                self.lm(&u)?
             }
         };
-        Ok(if self.trajectory {
+        if self.trajectory {
             release_pinned(self, u, convergence)
         } else {
-            (u, convergence)
-        })
+            Ok((u, convergence))
+        }
     }
 
     /// Levenberg–Marquardt from `start`, logged. In a trajectory fit a refinement that pins a
     /// parameter on a bound stops there; the parameter is then released (see
     /// [`release_pinned`]).
-    fn lm(&mut self, start: &[f64]) -> (Vec<f64>, Convergence) {
-        let out = self.refine(start);
+    fn lm(&mut self, start: &[f64]) -> Result<(Vec<f64>, Convergence), FitError> {
+        let out = self.refine(start)?;
         self.log.push(format!(
             "levenberg_marquardt: {} iterations, {:?}",
             out.iterations, out.convergence
         ));
-        (out.u, out.convergence)
+        Ok((out.u, out.convergence))
     }
 
     /// Levenberg–Marquardt from `start`, its iterations counted; in a trajectory fit it stops
     /// where a parameter is pinned on a bound.
-    fn refine(&mut self, start: &[f64]) -> Refined {
-        let (obj, free, settings) = (self.obj, self.free, self.settings);
+    fn refine(&mut self, start: &[f64]) -> Result<StageEnd, FitError> {
+        let (obj, free) = (self.obj, self.free);
         let at_bound = |u: &[f64]| !pinned(obj, free, u).is_empty();
         let stop_at_bound: BoundStop = self.trajectory.then_some(&at_bound);
-        obj.set_stage(SolverStage::LevenbergMarquardt);
-        let out = levenberg_marquardt::refine(
-            obj,
-            start,
-            settings.max_iters,
-            settings.tol,
-            settings.fd_step,
-            stop_at_bound,
-        );
+        let out =
+            stages::levenberg_marquardt(obj, start, self.settings, stop_at_bound, self.watch)?;
         self.iterations += out.iterations;
-        out
+        Ok(out)
     }
 
     /// Nelder–Mead from `start` to the simplex tolerance `tol`, logged.
@@ -176,41 +196,12 @@ impl Chain<'_> {
         start: &[f64],
         tol: f64,
     ) -> Result<(Vec<f64>, Convergence), FitError> {
-        self.obj.set_stage(SolverStage::NelderMead);
-        let p = start.len();
-        let mut simplex = vec![start.to_vec()];
-        for j in 0..p {
-            let mut v = start.to_vec();
-            v[j] += self.settings.simplex_step;
-            simplex.push(v);
-        }
-        let solver = NelderMead::new(simplex)
-            .with_sd_tolerance(tol)
-            .map_err(|e| FitError::Solver(e.to_string()))?;
-        let res = Executor::new(LnCost(self.obj), solver)
-            .configure(|s| s.max_iters(self.settings.max_iters))
-            .timer(false)
-            .run()
-            .map_err(|e| FitError::Solver(e.to_string()))?;
-        let state = res.state();
-        let u = state
-            .get_best_param()
-            .cloned()
-            .unwrap_or_else(|| start.to_vec());
-        let conv = match state.get_termination_reason() {
-            Some(TerminationReason::SolverConverged) => Convergence::Converged {
-                reason: format!("spread of ln(cost) over the simplex < {tol:.1e}"),
-            },
-            Some(TerminationReason::MaxItersReached) => Convergence::MaxIterations,
-            other => Convergence::Failed {
-                reason: format!("Nelder–Mead stopped: {other:?}"),
-            },
-        };
-        let it = state.get_iter();
+        let out = stages::nelder_mead(self.obj, start, tol, self.settings, self.watch)?;
+        let (it, conv) = (out.iterations, out.convergence);
         self.iterations += it;
         self.log
             .push(format!("nelder_mead: {it} iterations, {conv:?}"));
-        Ok((u, conv))
+        Ok((out.u, conv))
     }
 
     /// A fit never ends worse than its start: whatever the chain did, the start `u0` is kept
@@ -271,22 +262,22 @@ fn release_pinned(
     chain: &mut Chain,
     u: Vec<f64>,
     convergence: Convergence,
-) -> (Vec<f64>, Convergence) {
+) -> Result<(Vec<f64>, Convergence), FitError> {
     let (obj, free) = (chain.obj, chain.free);
     let stuck = pinned(obj, free, &u);
     if stuck.is_empty() {
-        return (u, convergence);
+        return Ok((u, convergence));
     }
     let Some(cost) = obj.cost(&u) else {
-        return (u, convergence);
+        return Ok((u, convergence));
     };
     let mut restart = u.clone();
     for &j in &stuck {
         restart[j] = 0.0;
     }
-    let out = chain.refine(&restart);
+    let out = chain.refine(&restart)?;
     let names: Vec<&str> = stuck.iter().map(|&j| free[j].name.as_str()).collect();
-    match obj.cost(&out.u) {
+    Ok(match obj.cost(&out.u) {
         Some(c) if c < cost => {
             chain.log.push(format!(
                 "{} ended on a bound: released to the start, levenberg_marquardt again: {} \
@@ -306,32 +297,22 @@ fn release_pinned(
             ));
             (u, convergence)
         }
-    }
+    })
 }
 
 impl Chain<'_> {
     /// The particle swarm over the whole box, logged: its best point, or `u0` if it found
     /// nothing better.
     fn particle_swarm(&mut self, u0: &[f64]) -> Result<Vec<f64>, FitError> {
-        let (obj, settings) = (self.obj, self.settings);
-        obj.set_stage(SolverStage::ParticleSwarm);
-        let (lo, hi): (Vec<f64>, Vec<f64>) =
-            obj.transforms().iter().map(|t| t.search_box()).unzip();
-        let solver = ParticleSwarm::new((lo, hi), settings.particles)
-            .with_rng_generator(StdRng::seed_from_u64(settings.seed));
-        let res = Executor::new(LnCost(obj), solver)
-            .configure(|s| s.max_iters(settings.max_iters))
-            .timer(false)
-            .run()
-            .map_err(|e| FitError::Solver(e.to_string()))?;
-        let state = res.state();
-        let it = state.get_iter();
+        let obj = self.obj;
+        let swarm = stages::particle_swarm(obj, self.settings, self.watch)?;
+        let it = swarm.iterations;
         self.iterations += it;
         self.log.push(format!("particle_swarm: {it} iterations"));
         // Keep the start if the swarm found nothing better.
         let start_cost = obj.cost(u0).unwrap_or(f64::INFINITY).max(1e-300).ln();
-        Ok(match state.get_best_param() {
-            Some(b) if state.get_best_cost() < start_cost => b.position.clone(),
+        Ok(match swarm.best {
+            Some((b, cost)) if cost < start_cost => b,
             _ => u0.to_vec(),
         })
     }
@@ -346,7 +327,7 @@ impl Chain<'_> {
         clock: Instant,
     ) -> Result<FitResult, FitError> {
         let (obj, mut log) = (self.obj, self.log);
-        obj.set_stage(SolverStage::Errors);
+        self.watch.announce(SolverStage::Errors);
         let n = obj.len();
         let x = obj.to_user(u);
         let mut r0 = vec![0.0; n];

@@ -62,6 +62,15 @@ pub enum FitError {
     /// The optimiser itself reported an error.
     #[error("optimiser error: {0}")]
     Solver(String),
+    /// The trace of the fit's iterations ([`FitSettings::trace`](super::FitSettings::trace))
+    /// cannot be written.
+    #[error("cannot write the fit's trace to {path}: {reason}")]
+    Trace {
+        /// The trace file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
 }
 
 impl From<ForceDataError> for FitError {

@@ -107,7 +107,7 @@ impl FitParam {
     }
 
     /// Check bounds and start value.
-    pub fn validate(&self) -> Result<(), FitError> {
+    pub fn check(&self) -> Result<(), FitError> {
         if self.min.partial_cmp(&self.max) != Some(std::cmp::Ordering::Less) {
             return Err(FitError::BadBounds {
                 name: self.name.clone(),
@@ -160,21 +160,21 @@ mod tests {
 
     #[test]
     fn validation_names_the_fault() {
-        assert!(FitParam::new("a", 1.0).validate().is_ok());
+        assert!(FitParam::new("a", 1.0).check().is_ok());
         assert!(matches!(
-            FitParam::new("a", 1.0).bounds(2.0, 1.0).validate(),
+            FitParam::new("a", 1.0).bounds(2.0, 1.0).check(),
             Err(FitError::BadBounds { .. })
         ));
         assert!(matches!(
-            FitParam::new("a", 5.0).bounds(0.0, 1.0).validate(),
+            FitParam::new("a", 5.0).bounds(0.0, 1.0).check(),
             Err(FitError::OutOfBounds { .. })
         ));
         assert!(matches!(
-            FitParam::new("a", f64::NAN).validate(),
+            FitParam::new("a", f64::NAN).check(),
             Err(FitError::OutOfBounds { .. })
         ));
-        assert!(FitParam::new("a", 1.0).scale(0.0).validate().is_err());
-        assert!(FitParam::new("a", 1.0).bounds(1.0, 2.0).validate().is_ok());
+        assert!(FitParam::new("a", 1.0).scale(0.0).check().is_err());
+        assert!(FitParam::new("a", 1.0).bounds(1.0, 2.0).check().is_ok());
     }
 
     #[test]

@@ -102,7 +102,7 @@ impl ForceFit {
         all
     }
 
-    /// Run the fit; `observer` is called after every evaluation.
+    /// Run the fit; `observer` is called after every iteration of every solver stage.
     pub fn fit(
         &self,
         data: &ForceData,

@@ -1,37 +1,47 @@
-//! A damped Gauss–Newton (Levenberg–Marquardt) refinement, written with nalgebra.
+//! A damped Gauss–Newton (Levenberg–Marquardt) refinement as an argmin [`Solver`].
 //!
-//! Why not argmin's `GaussNewton`: it takes undamped steps, which diverge from a start that is
-//! not already close (and our bound transforms flatten the residuals near a bound), it has no
-//! way to treat a failed evaluation as "step rejected", and its finite-difference Jacobian
-//! would be ours anyway. This is Nielsen's update of the damping λ with Marquardt's diagonal
-//! scaling, in the transforms' internal coordinates:
+//! What is argmin's: the iteration itself — argmin's `Executor` starts the solver
+//! ([`Solver::init`]), calls one [`Solver::next_iter`] per Jacobian, counts the iterations,
+//! stops at `max_iters` (`TerminationReason::MaxItersReached`), shows every iteration to the
+//! fit's observer ([`super::observer::FitObserver`]: the progress display, the trace) and
+//! says how the run ended (`TerminationReason`, from which the fit's
+//! [`Convergence`](super::result::Convergence) is read in [`super::stages`]).
 //!
-//! ```text
-//! (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
-//! ```
+//! What is ours, and why:
+//! - the update. argmin's `GaussNewton` takes undamped steps, which diverge from a start that
+//!   is not already close (and our bound transforms flatten the residuals near a bound). This
+//!   is Nielsen's update of the damping λ with Marquardt's diagonal scaling, in the
+//!   transforms' internal coordinates:
 //!
-//! Steps are shortened to at most two scales of any parameter. The Jacobian is exact where the
-//! problem gives one ([`super::objective::Residuals::jacobian`]: force fits of built-ins
-//! without state); else its difference steps start at `fd_step` and grow above the residuals'
-//! noise, measured once (see [`super::residual_jacobian`]): a column that is mostly integrator noise
-//! gives a step that raises the cost at every damping, and the refinement stopped far from
-//! the optimum.
+//!   ```text
+//!   (JᵀJ + λ·diag(JᵀJ))·δ = −Jᵀr,   accept if the cost drops, ρ = actual / predicted drop
+//!   ```
+//!
+//!   Steps are shortened to at most two scales of any parameter.
+//! - failed evaluations. argmin's `Operator` and `Jacobian` return a `Result` whose error ends
+//!   the run; here a trial point whose simulation fails is a rejected step (λ grows), so the
+//!   solver evaluates through the fit's [`Objective`] ([`LeastSquares`]), which counts a failure
+//!   and answers `None`.
+//! - the Jacobian. It is exact where the problem gives one
+//!   ([`super::objective::Residuals::jacobian`]: force fits of built-ins without state); else
+//!   its difference steps start at `fd_step` and grow above the residuals' noise, measured once
+//!   (see [`super::residual_jacobian`]): a column that is mostly integrator noise gives a step
+//!   that raises the cost at every damping, and the refinement stopped far from the optimum.
+//!   The steps and the noise are the solver's memory between iterations.
+//! - the stopping rules and the state. A small relative change of the cost, residuals
+//!   orthogonal to the Jacobian, no step at any damping, a parameter pinned on its bound, and
+//!   the stall rule ([`small_change`]) end a run with argmin's `SolverConverged` or, for a
+//!   stall, its `SolverExit` with [`STALLED`], their numbers in words in the state
+//!   ([`LmState`]: argmin's `IterState` has no room for the residuals, the damping or the
+//!   words).
 
+use argmin::core::{Error as ArgminError, Problem, Solver, TerminationReason, KV};
 use nalgebra::{DMatrix, DVector};
 
+use super::lm_state::LmState;
 use super::objective::Objective;
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
-use super::result::Convergence;
-
-/// What the refinement did.
-pub struct Refined {
-    /// Best internal coordinates.
-    pub u: Vec<f64>,
-    /// Iterations (Jacobians computed).
-    pub iterations: u64,
-    /// How it ended.
-    pub convergence: Convergence,
-}
+use super::transform::BoundTransform;
 
 /// Longest step in internal coordinates (units of the parameters' scales).
 const MAX_STEP: f64 = 2.0;
@@ -54,129 +64,186 @@ const LAMBDA_MAX: f64 = 1e16;
 /// that changed a discovery verdict, at 35 % more work.
 const STALL_COSINE: f64 = 0.1;
 
+/// argmin's `SolverExit` reason of a refinement that stalled ([`small_change`]).
+pub const STALLED: &str = "stalled";
+
+/// argmin's `SolverExit` reason of a refinement whose start cannot be evaluated.
+pub const START_FAILS: &str = "the start of the refinement cannot be evaluated";
+
+/// How a refinement ends by one of its own rules: argmin's reason, and the rule in words.
+type End = (TerminationReason, String);
+
 /// How a refinement whose last step lowered the cost by the fraction `drop` (< `tol`) ends.
 /// With an exact Jacobian, whose largest cosine with the residuals was `cosine` before the
 /// step (over the parameters away from their bounds), a cosine above [`STALL_COSINE`] means
 /// the linearisation promised a drop of at least cosine² (1 %) and the step got less than
 /// `tol`: a crawl along a curved valley, not an optimum (the fit of `power_law +
 /// jamming_on_off` from its defaults crawled to n_j = 1 at cosine 0.17 and an RMS 12 % above
-/// the optimum this way), reported as [`Convergence::Stalled`] so that the chain goes on.
+/// the optimum this way), reported as a stall ([`STALLED`]) so that the chain goes on.
 /// With differences the cosine carries their noise and is not judged.
-fn small_change(drop: f64, tol: f64, cosine: Option<f64>) -> Convergence {
+fn small_change(drop: f64, tol: f64, cosine: Option<f64>) -> End {
     match cosine {
-        Some(c) if c > STALL_COSINE => Convergence::Stalled {
-            reason: format!(
+        Some(c) if c > STALL_COSINE => (
+            TerminationReason::SolverExit(STALLED.into()),
+            format!(
                 "relative cost change {drop:.1e} < {tol:.1e} with the residuals at cosine \
                  {c:.1e} to the Jacobian"
             ),
-        },
-        _ => Convergence::Converged {
-            reason: format!("relative cost change {drop:.1e} < {tol:.1e}"),
-        },
+        ),
+        _ => (
+            TerminationReason::SolverConverged,
+            format!("relative cost change {drop:.1e} < {tol:.1e}"),
+        ),
     }
 }
 
-/// A test of internal coordinates that stops a refinement (see [`refine`]).
+/// A test of internal coordinates that stops a refinement (see [`LeastSquares`]).
 pub type BoundStop<'a> = Option<&'a dyn Fn(&[f64]) -> bool>;
 
-/// Refine `u0` by Levenberg–Marquardt; stops after `max_iters` Jacobians, or as soon as an
-/// accepted point satisfies `stop_at_bound` (a parameter on a bound, where its map is flat and
-/// further iterations only creep: the caller decides what to do from there).
-pub fn refine(
-    obj: &Objective,
-    u0: &[f64],
-    max_iters: u64,
-    tol: f64,
-    fd_step: f64,
-    stop_at_bound: BoundStop,
-) -> Refined {
-    let (n, p) = (obj.len(), obj.dim());
-    let mut r = vec![0.0; n];
-    let Some(rss) = obj.residuals_user(&obj.to_user(u0), &mut r) else {
-        let reason = "the start of the refinement cannot be evaluated".into();
-        return Refined {
-            u: u0.to_vec(),
-            iterations: 0,
-            convergence: Convergence::Failed { reason },
-        };
-    };
-    let mut lm = Lm {
-        obj,
-        u: u0.to_vec(),
-        r,
-        trial: vec![0.0; n],
-        rss,
-        lambda: 1e-3,
-        nu: 2.0,
-        jac: DMatrix::<f64>::zeros(n, p),
-        steps: vec![fd_step; p],
-        floor: None,
-        fd_step,
-    };
-    for iter in 1..=max_iters {
-        let all_exact = lm.jacobian();
-        let jt = lm.jac.transpose();
-        let a = &jt * &lm.jac;
-        let g = &jt * DVector::from_column_slice(&lm.r);
-        let (cosine, inner_cosine) = lm.cosines(&a, &g);
-        let end = if lm.rss.sqrt() == 0.0 || cosine < tol.sqrt() * 1e-2 {
-            Some(Convergence::Converged {
-                reason: format!("residuals orthogonal to the Jacobian (cosine {cosine:.1e})"),
-            })
-        } else {
-            lm.step(
-                &a,
-                &g,
-                (tol, all_exact.then_some(inner_cosine)),
-                stop_at_bound,
-            )
-        };
-        if let Some(convergence) = end {
-            return lm.refined(iter, convergence);
-        }
-    }
-    lm.refined(max_iters, Convergence::MaxIterations)
+/// The problem a refinement solves, as argmin's `Executor` holds it: the fit's objective, and
+/// a test that stops the refinement as soon as an accepted point satisfies it (a parameter on
+/// a bound, where its map is flat and further iterations only creep: the caller decides what
+/// to do from there).
+pub struct LeastSquares<'o, 'a> {
+    /// The residuals, evaluated in internal coordinates.
+    pub obj: &'o Objective<'a>,
+    /// Stop on a bound (trajectory fits), or not.
+    pub stop_at_bound: BoundStop<'o>,
 }
 
-/// A refinement under way: the point, its residuals and cost, the damping, the Jacobian and
-/// its difference steps.
-struct Lm<'a> {
-    obj: &'a Objective<'a>,
-    u: Vec<f64>,
-    r: Vec<f64>,
+/// The problem inside argmin's `Problem`.
+fn least_squares<'p, 'o, 'a>(
+    problem: &'p Problem<LeastSquares<'o, 'a>>,
+) -> Result<&'p LeastSquares<'o, 'a>, ArgminError> {
+    problem
+        .problem
+        .as_ref()
+        .ok_or_else(|| ArgminError::msg("the refinement was given no problem"))
+}
+
+/// The Levenberg–Marquardt solver: its settings and its memory between iterations (the
+/// Jacobian, its difference steps and their floor above the residuals' noise).
+pub struct LevenbergMarquardt {
+    /// A step that lowers the cost by less than this fraction ends the refinement.
+    tol: f64,
+    /// First finite-difference step, in scales.
+    fd_step: f64,
     /// The residuals of the last trial point.
     trial: Vec<f64>,
-    rss: f64,
-    lambda: f64,
-    nu: f64,
     jac: DMatrix<f64>,
     steps: Vec<f64>,
     /// The difference steps' floor above the residuals' noise, measured once (lazily: an
     /// exact Jacobian needs no noise).
     floor: Option<StepFloor>,
-    fd_step: f64,
 }
 
-impl Lm<'_> {
-    /// Where the refinement ended after `iterations`, and how.
-    fn refined(self, iterations: u64, convergence: Convergence) -> Refined {
-        Refined {
-            u: self.u,
-            iterations,
-            convergence,
+impl LevenbergMarquardt {
+    /// A refinement that stops when an accepted step lowers the cost by less than the
+    /// fraction `tol` (or the residuals are orthogonal to the Jacobian to `√tol·1e-2`), its
+    /// difference steps starting at `fd_step` scales.
+    pub fn new(tol: f64, fd_step: f64) -> Self {
+        LevenbergMarquardt {
+            tol,
+            fd_step,
+            trial: Vec::new(),
+            jac: DMatrix::zeros(0, 0),
+            steps: Vec::new(),
+            floor: None,
         }
     }
+}
 
-    /// The Jacobian at `u`: exact where the problem gives one, else differences whose steps
-    /// grow above the residuals' noise; non-finite entries zeroed. Whether it is all exact.
-    fn jacobian(&mut self) -> bool {
-        let (obj, p) = (self.obj, self.u.len());
+impl Solver<LeastSquares<'_, '_>, LmState> for LevenbergMarquardt {
+    fn name(&self) -> &str {
+        "Levenberg–Marquardt"
+    }
+
+    /// Evaluate the start; a start that fails ends the run ([`START_FAILS`]).
+    fn init(
+        &mut self,
+        problem: &mut Problem<LeastSquares<'_, '_>>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), ArgminError> {
+        let obj = least_squares(problem)?.obj;
+        let (n, p) = (obj.len(), obj.dim());
+        state.residuals = vec![0.0; n];
+        self.trial = vec![0.0; n];
+        self.jac = DMatrix::zeros(n, p);
+        self.steps = vec![self.fd_step; p];
+        self.floor = None;
+        let start = obj.residuals_user(&obj.to_user(&state.u), &mut state.residuals);
+        Ok(match start {
+            Some(rss) => {
+                state.rss = rss;
+                (state, None)
+            }
+            None => {
+                let reason = TerminationReason::SolverExit(START_FAILS.into());
+                (state.ended(reason, START_FAILS.into()), None)
+            }
+        })
+    }
+
+    /// One Jacobian, then one accepted step (the damping raised until a step lowers the
+    /// cost), or the end.
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<LeastSquares<'_, '_>>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), ArgminError> {
+        let ls = least_squares(problem)?;
+        let all_exact = self.jacobian(ls.obj, &state.u, &state.residuals);
+        let jt = self.jac.transpose();
+        let a = &jt * &self.jac;
+        let g = &jt * DVector::from_column_slice(&state.residuals);
+        let (cosine, inner_cosine) = cosines(ls.obj.transforms(), &state, &a, &g);
+        let end = if state.rss.sqrt() == 0.0 || cosine < self.tol.sqrt() * 1e-2 {
+            Some((
+                TerminationReason::SolverConverged,
+                format!("residuals orthogonal to the Jacobian (cosine {cosine:.1e})"),
+            ))
+        } else {
+            self.step(ls, &mut state, (&a, &g), all_exact.then_some(inner_cosine))
+        };
+        Ok(match end {
+            Some((reason, words)) => (state.ended(reason, words), None),
+            None => (state, None),
+        })
+    }
+}
+
+/// The largest cosine between the residuals and a column of the Jacobian (`a` = JᵀJ,
+/// `g` = Jᵀr), over all parameters and over those away from their bounds (where the map is
+/// not flat: a parameter pressing on its bound has a large cosine that no step can use).
+fn cosines(
+    transforms: &[BoundTransform],
+    state: &LmState,
+    a: &DMatrix<f64>,
+    g: &DVector<f64>,
+) -> (f64, f64) {
+    let rnorm = state.rss.sqrt();
+    let u = &state.u;
+    let cosine = |inner: bool| {
+        (0..u.len())
+            .filter(|&j| a[(j, j)] > 0.0 && !(inner && transforms[j].saturated(u[j])))
+            .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
+            .fold(0.0_f64, f64::max)
+    };
+    (cosine(false), cosine(true))
+}
+
+impl LevenbergMarquardt {
+    /// The Jacobian at `u` (residuals `r`): exact where the problem gives one, else
+    /// differences whose steps grow above the residuals' noise; non-finite entries zeroed.
+    /// Whether it is all exact.
+    fn jacobian(&mut self, obj: &Objective, u: &[f64], r: &[f64]) -> bool {
+        let p = u.len();
         let exact = obj
-            .jacobian_internal(&self.u, &mut self.jac)
+            .jacobian_internal(u, &mut self.jac)
             .unwrap_or_else(|| vec![false; p]);
         let all_exact = exact.iter().all(|&e| e);
         if !all_exact {
-            let (u, r, fd_step) = (&self.u, &self.r, self.fd_step);
+            let fd_step = self.fd_step;
             let floor = self.floor.get_or_insert_with(|| StepFloor {
                 noise: residual_noise(u, r, &vec![NOISE_PROBE; p], &|point, out| {
                     obj.residuals_user(&obj.to_user(point), out).is_some()
@@ -202,73 +269,57 @@ impl Lm<'_> {
         all_exact
     }
 
-    /// The largest cosine between the residuals and a column of the Jacobian (`a` = JᵀJ,
-    /// `g` = Jᵀr), over all parameters and over those away from their bounds (where the map
-    /// is not flat: a parameter pressing on its bound has a large cosine that no step can
-    /// use).
-    fn cosines(&self, a: &DMatrix<f64>, g: &DVector<f64>) -> (f64, f64) {
-        let rnorm = self.rss.sqrt();
-        let transforms = self.obj.transforms();
-        let cosine = |inner: bool| {
-            (0..self.u.len())
-                .filter(|&j| a[(j, j)] > 0.0 && !(inner && transforms[j].saturated(self.u[j])))
-                .map(|j| g[j].abs() / (a[(j, j)].sqrt() * rnorm))
-                .fold(0.0_f64, f64::max)
-        };
-        (cosine(false), cosine(true))
-    }
-
     /// One iteration's step: the damping raised until a step lowers the cost, then lowered
     /// (Nielsen). How the refinement ends, if it does here: stopped on a bound, a small
     /// change (below `tol`; `inner_cosine` as [`small_change`] reads it), or no step lowering
     /// the cost at any damping.
     fn step(
         &mut self,
-        a: &DMatrix<f64>,
-        g: &DVector<f64>,
-        (tol, inner_cosine): (f64, Option<f64>),
-        stop_at_bound: BoundStop,
-    ) -> Option<Convergence> {
-        let dmax = (0..self.u.len()).map(|j| a[(j, j)]).fold(0.0_f64, f64::max);
+        ls: &LeastSquares,
+        state: &mut LmState,
+        (a, g): (&DMatrix<f64>, &DVector<f64>),
+        inner_cosine: Option<f64>,
+    ) -> Option<End> {
+        let dmax = (0..state.u.len())
+            .map(|j| a[(j, j)])
+            .fold(0.0_f64, f64::max);
         let floor = (1e-12 * dmax).max(f64::MIN_POSITIVE);
-        loop {
-            let Some((cand, new_rss, rho, step_size)) = self.tried(a, g, floor) else {
-                self.lambda *= self.nu;
-                self.nu *= 2.0;
-                if self.lambda > LAMBDA_MAX {
-                    let reason = "no step lowers the cost any further".into();
-                    return Some(Convergence::Converged { reason });
-                }
-                continue;
-            };
-            let drop = (self.rss - new_rss) / self.rss;
-            self.u = cand;
-            self.rss = new_rss;
-            std::mem::swap(&mut self.r, &mut self.trial);
-            self.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
-            self.nu = 2.0;
-            if stop_at_bound.is_some_and(|pinned| pinned(&self.u)) {
-                let reason = "stopped on a parameter's bound".into();
-                return Some(Convergence::Converged { reason });
+        let (cand, new_rss, rho, step_size) = loop {
+            if let Some(accepted) = self.tried(ls.obj, state, (a, g), floor) {
+                break accepted;
             }
-            if drop < tol || step_size < 1e-12 {
-                return Some(small_change(drop, tol, inner_cosine));
+            state.lambda *= state.nu;
+            state.nu *= 2.0;
+            if state.lambda > LAMBDA_MAX {
+                let words = "no step lowers the cost any further".into();
+                return Some((TerminationReason::SolverConverged, words));
             }
-            return None;
+        };
+        let drop = (state.rss - new_rss) / state.rss;
+        state.u = cand;
+        state.rss = new_rss;
+        std::mem::swap(&mut state.residuals, &mut self.trial);
+        state.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+        state.nu = 2.0;
+        if ls.stop_at_bound.is_some_and(|pinned| pinned(&state.u)) {
+            let words = "stopped on a parameter's bound".into();
+            return Some((TerminationReason::SolverConverged, words));
         }
+        (drop < self.tol || step_size < 1e-12).then(|| small_change(drop, self.tol, inner_cosine))
     }
 
     /// The step at the current damping (diagonal at least `floor`), if it lowers the cost
     /// with a positive gain ratio: the point, its cost, the ratio and the step's length.
     fn tried(
         &mut self,
-        a: &DMatrix<f64>,
-        g: &DVector<f64>,
+        obj: &Objective,
+        state: &LmState,
+        (a, g): (&DMatrix<f64>, &DVector<f64>),
         floor: f64,
     ) -> Option<(Vec<f64>, f64, f64, f64)> {
         let mut m = a.clone();
-        for j in 0..self.u.len() {
-            m[(j, j)] += self.lambda * a[(j, j)].max(floor);
+        for j in 0..state.u.len() {
+            m[(j, j)] += state.lambda * a[(j, j)].max(floor);
         }
         let delta = m.cholesky()?.solve(&(-g));
         // A step of at most MAX_STEP scales: a long one would run into the flat, saturated
@@ -279,16 +330,15 @@ impl Lm<'_> {
         } else {
             delta
         };
-        let cand: Vec<f64> = self
+        let cand: Vec<f64> = state
             .u
             .iter()
             .zip(delta.iter())
             .map(|(a, b)| a + b)
             .collect();
-        let obj = self.obj;
         let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut self.trial)?;
         let predicted = -2.0 * g.dot(&delta) - delta.dot(&(a * &delta));
-        let rho = (self.rss - new_rss) / predicted;
-        (new_rss < self.rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
+        let rho = (state.rss - new_rss) / predicted;
+        (new_rss < state.rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
     }
 }

@@ -10,8 +10,12 @@
 //! Parameters ([`FitParam`]) have start values, bounds (honoured by a change of variables,
 //! [`BoundTransform`], never by clipping) and a fixed/free switch. The default solver
 //! ([`Solver::Auto`]) runs a Levenberg–Marquardt refinement and falls back on Nelder–Mead
-//! (argmin) followed by another refinement if it does not converge; [`Solver::NelderMead`] is
-//! the source study's method; [`Solver::ParticleSwarm`] (argmin) searches the whole box first. Every fit ends
+//! followed by another refinement if it does not converge; [`Solver::NelderMead`] is
+//! the source study's method; [`Solver::ParticleSwarm`] searches the whole box first. Every
+//! stage is one run of argmin's `Executor`: Nelder–Mead and the swarm are argmin's solvers,
+//! Levenberg–Marquardt is ours written as an argmin `Solver` (its own state, `LmState`; why,
+//! in `levenberg_marquardt.rs`), and how a stage ended is argmin's termination reason, read
+//! into [`Convergence`]. Every fit ends
 //! with standard errors from a finite-difference Jacobian in the user's parameter space —
 //! cluster-robust over blocks of consecutive samples as long as the residuals' correlation
 //! ([`ErrorBlocks`]; the classical `s²·(JᵀJ)⁻¹`, too small for correlated residuals, is kept
@@ -22,7 +26,9 @@
 //! determined, or cannot be told apart from another. A failure inside the fit (a simulation
 //! that diverges, a model
 //! that errs) scores a penalty and is counted, never a crash. Fits are deterministic (the
-//! swarm is seeded). An observer closure receives [`FitProgress`] after every evaluation.
+//! swarm is seeded). An observer closure receives [`FitProgress`] after every iteration of
+//! every stage, from the fit's argmin observer, which also writes a trace of the iterations
+//! when [`FitSettings::trace`] names a file.
 //! A fitted model is scored on another record ([`Validation`]) by [`ForceFit::validate`] and
 //! [`TrajectoryFit::validate`].
 
@@ -32,12 +38,15 @@ mod error;
 mod fit_param;
 mod force_fit;
 mod levenberg_marquardt;
+mod lm_state;
 mod noise_floor;
 mod objective;
+mod observer;
 mod residual_jacobian;
 mod result;
 mod same_term;
 mod solver;
+mod stages;
 mod trajectory_fit;
 mod transform;
 mod validation;

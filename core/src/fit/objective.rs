@@ -4,15 +4,15 @@
 //! A fit problem implements [`Residuals`]: given the user values of the free parameters it
 //! streams its residuals to a sink (no residual vector is allocated for a plain cost). The
 //! [`Objective`] maps internal coordinates through the bound transforms, scores the mean
-//! squared residual, and counts every evaluation and every failure.
+//! squared residual, and counts every evaluation and every failure in its [`Tally`], which
+//! the fit's observer ([`super::observer::FitObserver`]) reads for the progress display.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use argmin::core::{CostFunction, Error as ArgminError};
 use nalgebra::DMatrix;
 
-use super::result::{FitProgress, SolverStage};
 use super::transform::BoundTransform;
 
 /// A least-squares problem: residuals as a function of the free parameters' user values.
@@ -40,39 +40,57 @@ pub trait Residuals: Sync {
 /// ln of the cost that stands for a failed evaluation in the optimisers (cost 1e300).
 pub const PENALTY_LN_COST: f64 = 690.775_527_898_213_7;
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// The counts of a fit's evaluations, shared (behind an `Arc`) by its [`Objective`] and the
+/// observer that shows them.
+#[derive(Debug)]
+pub struct Tally {
+    evaluations: AtomicU64,
+    failures: AtomicU64,
+    last_failure: Mutex<Option<String>>,
+    best: Mutex<f64>,
+}
+
+impl Tally {
+    /// Evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.load(Ordering::Relaxed)
+    }
+
+    /// Lowest mean squared residual of any evaluation so far (infinite before the first).
+    pub fn best(&self) -> f64 {
+        *lock(&self.best)
+    }
 }
 
 /// The objective of a fit in internal coordinates.
 pub struct Objective<'a> {
     problem: &'a dyn Residuals,
     transforms: Vec<BoundTransform>,
-    observer: Option<&'a (dyn Fn(FitProgress) + Sync)>,
-    evaluations: AtomicU64,
-    failures: AtomicU64,
-    last_failure: Mutex<Option<String>>,
-    best: Mutex<f64>,
-    stage: Mutex<SolverStage>,
+    tally: Arc<Tally>,
 }
 
 impl<'a> Objective<'a> {
     /// The objective of `problem` with one transform per free parameter.
-    pub fn new(
-        problem: &'a dyn Residuals,
-        transforms: Vec<BoundTransform>,
-        observer: Option<&'a (dyn Fn(FitProgress) + Sync)>,
-    ) -> Self {
+    pub fn new(problem: &'a dyn Residuals, transforms: Vec<BoundTransform>) -> Self {
         Objective {
             problem,
             transforms,
-            observer,
-            evaluations: AtomicU64::new(0),
-            failures: AtomicU64::new(0),
-            last_failure: Mutex::new(None),
-            best: Mutex::new(f64::INFINITY),
-            stage: Mutex::new(SolverStage::NelderMead),
+            tally: Arc::new(Tally {
+                evaluations: AtomicU64::new(0),
+                failures: AtomicU64::new(0),
+                last_failure: Mutex::new(None),
+                best: Mutex::new(f64::INFINITY),
+            }),
         }
+    }
+
+    /// The counts of evaluations, to share with an observer.
+    pub fn tally(&self) -> Arc<Tally> {
+        Arc::clone(&self.tally)
     }
 
     /// Number of free parameters.
@@ -90,24 +108,19 @@ impl<'a> Objective<'a> {
         &self.transforms
     }
 
-    /// Report progress as this stage from now on.
-    pub fn set_stage(&self, stage: SolverStage) {
-        *lock(&self.stage) = stage;
-    }
-
     /// Evaluations so far.
     pub fn evaluations(&self) -> u64 {
-        self.evaluations.load(Ordering::Relaxed)
+        self.tally.evaluations()
     }
 
     /// Failed evaluations so far.
     pub fn failures(&self) -> u64 {
-        self.failures.load(Ordering::Relaxed)
+        self.tally.failures.load(Ordering::Relaxed)
     }
 
     /// The last failure's message.
     pub fn last_failure(&self) -> Option<String> {
-        lock(&self.last_failure).clone()
+        lock(&self.tally.last_failure).clone()
     }
 
     /// User values of the free parameters at internal coordinates `u`.
@@ -122,7 +135,8 @@ impl<'a> Objective<'a> {
     /// Evaluate at user values `x`, streaming residuals to `sink`; `None` on failure (counted
     /// and remembered). Returns the residual sum of squares.
     pub fn eval_user(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Option<f64> {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let tally = &*self.tally;
+        tally.evaluations.fetch_add(1, Ordering::Relaxed);
         let mut rss = 0.0;
         let outcome = self.problem.residuals(x, &mut |i, r| {
             rss += r * r;
@@ -134,24 +148,14 @@ impl<'a> Objective<'a> {
             Ok(()) => None,
         };
         if let Some(reason) = failure {
-            self.failures.fetch_add(1, Ordering::Relaxed);
-            *lock(&self.last_failure) = Some(reason);
+            tally.failures.fetch_add(1, Ordering::Relaxed);
+            *lock(&tally.last_failure) = Some(reason);
             return None;
         }
         let mean = rss / self.len().max(1) as f64;
-        let best = {
-            let mut b = lock(&self.best);
-            if mean < *b {
-                *b = mean;
-            }
-            *b
-        };
-        if let Some(observer) = self.observer {
-            observer(FitProgress {
-                stage: *lock(&self.stage),
-                evaluations: self.evaluations(),
-                best_cost: best,
-            });
+        let mut best = lock(&tally.best);
+        if mean < *best {
+            *best = mean;
         }
         Some(rss)
     }
@@ -170,9 +174,9 @@ impl<'a> Objective<'a> {
     /// when the problem gives none or it failed. Counted as an evaluation.
     pub fn jacobian_user(&self, x: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
         let outcome = self.problem.jacobian(x, jac)?;
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        self.tally.evaluations.fetch_add(1, Ordering::Relaxed);
         if let Err(e) = outcome {
-            *lock(&self.last_failure) = Some(e);
+            *lock(&self.tally.last_failure) = Some(e);
             return None;
         }
         let exact: Vec<bool> = jac

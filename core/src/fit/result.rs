@@ -49,7 +49,8 @@ pub enum SolverStage {
     Errors,
 }
 
-/// Progress of a running fit, passed to the observer after every evaluation.
+/// Progress of a running fit, passed to the observer at the start and after every iteration
+/// of each solver stage, and when the standard errors' stage begins.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitProgress {
     /// The stage running.

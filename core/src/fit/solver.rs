@@ -1,4 +1,6 @@
-//! Which optimiser a fit uses and when it stops.
+//! Which optimiser a fit uses, when it stops, and whether it keeps a trace of its iterations.
+
+use std::path::PathBuf;
 
 use derive_setters::Setters;
 use serde::{Deserialize, Serialize};
@@ -65,6 +67,11 @@ pub struct FitSettings {
     pub particles: usize,
     /// Seed of every random choice (the swarm).
     pub seed: u64,
+    /// A file to which each fit appends every iteration's cost and parameters, stage by
+    /// stage (see the fit's observer); none by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[setters(strip_option)]
+    pub trace: Option<PathBuf>,
 }
 
 impl Default for FitSettings {
@@ -79,6 +86,7 @@ impl Default for FitSettings {
             fd_step: 1e-5,
             particles: 40,
             seed: 1,
+            trace: None,
         }
     }
 }
@@ -113,7 +121,7 @@ impl FitSettings {
     }
 
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), FitError> {
+    pub fn check(&self) -> Result<(), FitError> {
         let pos = |v: f64| v > 0.0 && v.is_finite();
         let ok = self.max_iters > 0
             && pos(self.tol)

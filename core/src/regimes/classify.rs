@@ -118,7 +118,7 @@ pub fn classify(
     cycles: Vec<Cycle>,
     th: &RegimeThresholds,
 ) -> Result<Classification, RegimeError> {
-    th.validate()?;
+    th.check()?;
     sig.check()?;
     let noise_sigma = match th.noise_sigma {
         Some(s) => s,

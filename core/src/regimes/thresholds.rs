@@ -89,7 +89,7 @@ impl Default for RegimeThresholds {
 
 impl RegimeThresholds {
     /// Check every threshold lies in its range.
-    pub fn validate(&self) -> Result<(), RegimeError> {
+    pub fn check(&self) -> Result<(), RegimeError> {
         let bad = |name, value, why| Err(RegimeError::BadThreshold { name, value, why });
         let nonneg = |x: f64| x >= 0.0 && x.is_finite();
         let frac = |x: f64| (0.0..=1.0).contains(&x);
@@ -140,7 +140,7 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_a_file_overrides_some_keys() {
-        RegimeThresholds::default().validate().unwrap();
+        RegimeThresholds::default().check().unwrap();
         let t: RegimeThresholds =
             serde_json::from_str(r#"{"resonance_duty": 0.6, "noise_sigma": 0.03}"#).unwrap();
         assert_eq!(t.resonance_duty, 0.6);
@@ -162,12 +162,12 @@ mod tests {
             resonance_duty: 1.5,
             ..Default::default()
         };
-        assert!(t.validate().is_err());
+        assert!(t.check().is_err());
         t.resonance_duty = 0.7;
         t.smoothing_cycles = 4;
-        assert!(t.validate().is_err());
+        assert!(t.check().is_err());
         t.smoothing_cycles = 3;
         t.noise_sigma = Some(f64::NAN);
-        assert!(t.validate().is_err());
+        assert!(t.check().is_err());
     }
 }

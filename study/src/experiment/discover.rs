@@ -8,7 +8,7 @@ use serde::{Deserialize, Deserializer};
 
 use super::FitLevel;
 
-/// A validated `[discover]` section: every key's shape is its serde type.
+/// A checked `[discover]` section: every key's shape is its serde type.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiscoverSpec {

@@ -1,7 +1,11 @@
 //! The `[fit]` section of an experiment file: the fit `level` (`force`, `trajectory`), the
 //! `solver` (a serde enum of core's, [`Solver`]), `max_iters` and `seed`, oscillator
-//! parameters fitted along (`system`), a constant `offset`, and whether a trajectory fit
-//! fits its `initial` state or takes the record's.
+//! parameters fitted along (`system`), a constant `offset`, whether a trajectory fit
+//! fits its `initial` state or takes the record's, and a `trace` file to which every fit
+//! appends each iteration's cost and parameters (core's `FitSettings::trace`; relative to the
+//! experiment file).
+
+use std::path::PathBuf;
 
 use anyhow::Result;
 use serde::Deserialize;
@@ -90,9 +94,10 @@ pub(super) struct RawFit {
     #[serde(default)]
     offset: bool,
     initial: Option<Initial>,
+    trace: Option<PathBuf>,
 }
 
-/// A validated `[fit]` section.
+/// A checked `[fit]` section.
 #[derive(Clone, Debug)]
 pub struct FitSpec {
     /// Force or trajectory level; `None`: force when the record has `f_stf`.
@@ -143,6 +148,7 @@ pub(super) fn check(raw: Option<&Spanned<RawFit>>, cx: &Ctx) -> Result<FitSpec> 
     if let Some(seed) = f.seed {
         fit.settings.seed = seed;
     }
+    fit.settings.trace = f.trace.as_ref().map(|t| super::folder_of(cx.file).join(t));
     fit.offset = f.offset;
     fit.fit_initial = f.initial != Some(Initial::Record);
     Ok(fit)
@@ -166,6 +172,10 @@ mod tests {
         assert_eq!((f.settings.max_iters, f.settings.seed), (50, 9));
         assert_eq!(f.system_free, [OscParam::K, OscParam::C]);
         assert!(f.offset && !f.fit_initial);
+        assert_eq!(f.settings.trace, None);
+        let e = parse("[fit]\ntrace = \"fit-trace.txt\"\n").unwrap();
+        let trace = e.fit.settings.trace.unwrap();
+        assert_eq!(trace.file_name().unwrap(), "fit-trace.txt");
         let e = parse("[fit]\nlevel = \"force\"\ninitial = \"fit\"\n").unwrap();
         assert_eq!(e.fit.level, Some(FitLevel::Force));
         assert!(e.fit.fit_initial);

@@ -18,7 +18,7 @@ pub(super) fn check(raw: Option<&Spanned<toml::Value>>, cx: &Ctx) -> Result<Regi
         .clone()
         .try_into()
         .map_err(|e: toml::de::Error| cx.at(v.span(), "regimes", e.message()))?;
-    th.validate().map_err(|e| cx.at(v.span(), "regimes", e))?;
+    th.check().map_err(|e| cx.at(v.span(), "regimes", e))?;
     Ok(th)
 }
 

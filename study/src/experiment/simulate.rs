@@ -49,7 +49,7 @@ fn one() -> u64 {
     1
 }
 
-/// A validated `[simulate]` section.
+/// A checked `[simulate]` section.
 #[derive(Clone, Debug)]
 pub struct SimulateSpec {
     /// The drive.

@@ -196,3 +196,9 @@ impl<'a> ResultJson<'a> {
         }
     }
 }
+impl crate::fit::Fitted {
+    /// `fit.json` of the experiment `exp`.
+    pub fn json<'a>(&'a self, exp: &'a crate::experiment::Experiment) -> FitJson<'a> {
+        FitJson::new(&exp.path, &self.data, &self.fits)
+    }
+}

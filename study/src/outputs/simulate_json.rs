@@ -63,7 +63,7 @@ impl From<&IntegratorSettings> for Integrator {
 }
 
 /// The true STF model.
-#[derive(Serialize)]
+#[derive(Clone, Debug, Serialize)]
 pub struct Truth {
     /// Its name (`power_law + cubic_stiffness`).
     pub model: String,
@@ -72,7 +72,7 @@ pub struct Truth {
 }
 
 /// What the simulated run shows.
-#[derive(Serialize)]
+#[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     /// Largest |x|, m.
     pub peak_x_m: Option<f64>,
@@ -82,8 +82,14 @@ pub struct Summary {
     pub peak_omega_rad_s: Option<f64>,
     /// ω where |x| first exceeds the breakaway displacement, rad/s.
     pub breakaway_omega_rad_s: Option<f64>,
+    /// When that is, s (null without a rotor).
+    pub breakaway_t_s: Option<f64>,
+    /// The breakaway displacement, m.
+    pub breakaway_displacement_m: f64,
     /// When free vibration stops, s (free vibration only).
     pub motion_stops_t_s: Option<f64>,
+    /// |x| where it stops, m.
+    pub motion_stops_x_m: Option<f64>,
     /// Samples written.
     pub samples: usize,
     /// Right-hand-side evaluations of the integrator.

@@ -781,7 +781,8 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("out.csv");
-        rec.write_csv(&path).unwrap();
+        rec.write_csv(std::fs::File::create(&path).unwrap())
+            .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.starts_with("t,phi,x,f_stf,u\n"), "{}", &text[..40]);
         let back = Record::read_csv(&path).unwrap();
@@ -825,7 +826,8 @@ mod tests {
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("awkward.csv");
-        rec.write_csv(&path).unwrap();
+        rec.write_csv(std::fs::File::create(&path).unwrap())
+            .unwrap();
         let back = Record::read_csv(&path).unwrap();
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&back.x), bits(&rec.x));
@@ -840,7 +842,7 @@ mod tests {
     }
 
     #[test]
-    fn write_refuses_an_invalid_record_and_leaves_no_file() {
+    fn write_refuses_an_invalid_record_and_names_a_failed_write() {
         let rec = Record {
             source: MEMORY_SOURCE.into(),
             t: vec![0.0, 1.0],
@@ -850,19 +852,29 @@ mod tests {
             omega: None,
             u: None,
         };
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("bad.csv");
-        let e = rec.write_csv(&path).unwrap_err();
+        let mut written = Vec::new();
+        let e = rec.write_csv(&mut written).unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(2), Some("x")));
-        assert!(!path.exists());
+        assert!(written.is_empty());
         let good = Record {
             x: vec![0.0, 1.0],
             ..rec
         };
-        let missing_dir = dir.path().join("no_dir/x.csv");
-        let e = good.write_csv(&missing_dir).unwrap_err();
-        assert!(e.message.contains("cannot write"), "{e}");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        // A writer that fails (a full disk) is an error naming the record.
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::other("no space left"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let e = good.write_csv(Full).unwrap_err();
+        assert!(
+            e.message.contains("cannot write") && e.message.contains("no space left"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -962,7 +974,8 @@ mod tests {
                 );
             }
             let copy = dir.path().join("copy.csv");
-            rec.write_csv(&copy).unwrap();
+            rec.write_csv(std::fs::File::create(&copy).unwrap())
+                .unwrap();
             assert!(
                 std::fs::read(&copy).unwrap() == text.as_bytes(),
                 "{}",

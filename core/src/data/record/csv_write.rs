@@ -1,5 +1,7 @@
-//! Writing a record as CSV: every number in the shortest text that reads back to the same
-//! `f64`, the file synced and then renamed into place.
+//! Writing a record as CSV to any `impl Write`: every number in the shortest text that reads
+//! back to the same `f64`. Where the bytes go — and writing a file atomically (a temporary
+//! file beside it, synced, then renamed into place) — is the caller's: the program does it
+//! in `stf_lab::writing`.
 //!
 //! Numbers come from `ryu` (shortest round-trip digits, without `fmt`'s machinery or an
 //! allocation per number) and keep the layout the writer has always had — plain notation for
@@ -9,7 +11,6 @@
 
 use super::{Record, RecordError};
 use std::io::Write;
-use std::path::Path;
 
 /// Rows are gathered into a buffer this big before each write.
 const CHUNK: usize = 1 << 20;
@@ -66,40 +67,18 @@ fn columns(record: &Record) -> Vec<(&'static str, &[f64])> {
     columns
 }
 
-/// Write a (validated) record atomically: temporary file in the same directory, synced, then
-/// renamed into place.
-pub(super) fn write(record: &Record, path: &Path) -> Result<(), RecordError> {
-    let target = path.display().to_string();
-    let fail = |what: &str, e: std::io::Error| RecordError::new(&target, format!("{what}: {e}"));
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| RecordError::new(&target, "not a file path"))?;
-    let temp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let written = (|| -> std::io::Result<()> {
-        let mut file = std::fs::File::create(&temp)?;
-        write_rows(&mut file, &columns(record))?;
-        file.sync_all()
-    })();
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&temp);
-        return Err(fail(&format!("cannot write {}", temp.display()), e));
-    }
-    std::fs::rename(&temp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&temp);
-        fail("cannot move the written file into place", e)
+/// Write a (validated) record to `out`, a chunk at a time.
+pub(super) fn write(record: &Record, out: &mut impl Write) -> Result<(), RecordError> {
+    write_rows(out, &columns(record)).map_err(|e| {
+        RecordError::new(
+            &record.source,
+            format!("cannot write the record as CSV: {e}"),
+        )
     })
 }
 
 /// The header and the rows, gathered a chunk at a time.
-fn write_rows(file: &mut std::fs::File, columns: &[(&str, &[f64])]) -> std::io::Result<()> {
+fn write_rows(file: &mut impl Write, columns: &[(&str, &[f64])]) -> std::io::Result<()> {
     let mut chunk = Vec::with_capacity(CHUNK + 4096);
     let header: Vec<&str> = columns.iter().map(|(label, _)| *label).collect();
     chunk.extend_from_slice(header.join(",").as_bytes());
@@ -123,7 +102,8 @@ fn write_rows(file: &mut std::fs::File, columns: &[(&str, &[f64])]) -> std::io::
             chunk.clear();
         }
     }
-    file.write_all(&chunk)
+    file.write_all(&chunk)?;
+    file.flush()
 }
 
 #[cfg(test)]

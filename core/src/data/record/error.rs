@@ -4,7 +4,7 @@
 use derive_setters::Setters;
 use thiserror::Error;
 
-/// A record could not be read, validated or written.
+/// A record could not be read, checked or written.
 ///
 /// Displays as `file:row N, column `x`: message`, leaving out the parts that do not apply.
 /// For CSV files, `row` is the line number a user sees in an editor (the header is line 1,

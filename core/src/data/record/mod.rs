@@ -260,7 +260,7 @@ impl Record {
     /// Check a record (e.g. one built in memory) against the data contract: equal lengths,
     /// at least one sample, finite values, strictly increasing `t`, `phi` or `u` present.
     /// Rows in errors are 1-based sample numbers.
-    pub fn validate(&self) -> Result<(), RecordError> {
+    pub fn check(&self) -> Result<(), RecordError> {
         let raw = [
             Some(self.t.clone()),
             Some(self.x.clone()),
@@ -272,13 +272,22 @@ impl Record {
         into_record(raw, &self.source, &contract_labels(), &|i| i + 1).map(|_| ())
     }
 
-    /// Write the record as CSV with columns `t, phi, x, f_stf, omega, u` (those present), each
-    /// number in the shortest form that reads back to the same `f64`. The file is written to
-    /// a temporary file in the same directory and renamed into place, so a reader never sees
-    /// half a file. The record is validated first.
-    pub fn write_csv(&self, path: &Path) -> Result<(), RecordError> {
-        self.validate()?;
-        csv_write::write(self, path)
+    /// Write the record as CSV to `out` with columns `t, phi, x, f_stf, omega, u` (those
+    /// present), each number in the shortest form that reads back to the same `f64`. The
+    /// record is checked first, so nothing is written for an invalid one. Writing a file
+    /// safely (a temporary beside it, then a rename) is the caller's part.
+    ///
+    /// ```
+    /// # use stf_core::data::record::Record;
+    /// let rec = Record { source: "memory".into(), t: vec![0.0, 0.5], phi: Some(vec![0.0, 0.1]),
+    ///     x: vec![0.0, 1e-3], f_stf: None, omega: None, u: None };
+    /// let mut text = Vec::new();
+    /// rec.write_csv(&mut text).unwrap();
+    /// assert_eq!(String::from_utf8(text).unwrap(), "t,phi,x\n0,0,0\n0.5,0.1,0.001\n");
+    /// ```
+    pub fn write_csv(&self, mut out: impl std::io::Write) -> Result<(), RecordError> {
+        self.check()?;
+        csv_write::write(self, &mut out)
     }
 
     /// Number of samples.
@@ -356,20 +365,20 @@ mod tests {
     }
 
     #[test]
-    fn validate_catches_length_mismatch_and_missing_drive() {
+    fn check_catches_length_mismatch_and_missing_drive() {
         let mut r = memory(5);
         r.x.pop();
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert_eq!(e.column.as_deref(), Some("x"));
         assert_eq!(e.file, MEMORY_SOURCE);
         let mut r = memory(5);
         r.phi = None;
         r.u = None;
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert!(e.message.contains("missing column `phi` (or `u`"), "{e}");
         let mut r = memory(5);
         r.t[3] = r.t[2];
-        let e = r.validate().unwrap_err();
+        let e = r.check().unwrap_err();
         assert_eq!((e.row, e.column.as_deref()), (Some(4), Some("t")));
     }
 

@@ -124,7 +124,7 @@ impl Default for Settings {
 }
 
 impl Settings {
-    fn validate(&self) -> Result<(), SimError> {
+    fn check(&self) -> Result<(), SimError> {
         let ok = self.rtol > 0.0 && self.atol > 0.0 && self.h_max >= 0.0 && self.max_steps > 0;
         if ok && self.rtol.is_finite() && self.atol.is_finite() && self.h_max.is_finite() {
             Ok(())
@@ -194,7 +194,7 @@ pub(crate) fn integrate_states(
     t_out: &[f64],
     settings: &Settings,
 ) -> Result<(Vec<f64>, Stats), SimError> {
-    settings.validate()?;
+    settings.check()?;
     if y0.len() != sys.dim() {
         return Err(SimError::BadSettings(format!(
             "initial state has {} values, the system {}",

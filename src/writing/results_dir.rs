@@ -1,15 +1,18 @@
 //! The output folder of `fit`, `compare` and `discover` is written as one unit. A run builds
-//! its results in a staging folder beside the output, `.<name>.new-<pid>`, and swaps it in
-//! at the end: the old folder is renamed to `.<name>.old-<pid>`, the new one to `<name>`, and
-//! the old one removed. A reader, or a run killed at any moment, sees the old results or the
-//! new ones, never a mix; a folder whose run writes no report keeps no old report.
+//! its results in a staging folder beside the output, `.<name>.new-<pid>-<n>`, and swaps it
+//! in at the end: the old folder is renamed to `.<name>.old-<pid>-<n>`, the new one to
+//! `<name>`, and the old one removed ([`super::names`]' pattern). A reader, or a run killed
+//! at any moment, sees the old results or the new ones, never a mix; a folder whose run
+//! writes no report keeps no old report.
 //!
-//! The output is locked for the run ([`crate::output_lock`]), so a second run into it is
-//! refused. Under that lock, what a killed run left is ours to clean: [`repair`] puts the old
-//! folder back if the run died between the two renames (the output missing, its `.old-`
-//! beside it) and removes stale staging and old folders. `--force` replaces only a folder
-//! that holds nothing but this program's results ([`RESULT_NAMES`]) and temporaries: a
-//! stranger in it (notes, the experiment's record) would be lost, so it is refused instead.
+//! The output is locked for the run ([`super::lock`]), so a second run into it is refused.
+//! Under that lock, what a killed run left is ours to clean: [`repair`] puts the old folder
+//! back if the run died between the two renames (the output missing, its `.old-` beside it)
+//! and removes stale staging and old folders. `--force` replaces only a folder that holds
+//! nothing but this program's results and temporaries, one level down included: the result
+//! files ([`RESULT_FILES`]) as regular files, and `figures/` holding only figures (each an
+//! SVG, a PNG and a CSV of one name: [`is_figure`]). Anything else (notes, the experiment's
+//! record, a folder named like a result) would be lost, so it is named in an error and kept.
 //!
 //! The swap is split into plain steps ([`step_aside`], [`step_in`], [`clear_old`]) so tests
 //! can stop between them as a crash would.
@@ -18,11 +21,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use crate::output::{is_temporary_name, parent_of, sibling};
-use crate::output_lock::OutputLock;
+use super::lock::OutputLock;
+use super::names::{self, Role};
+use super::{is_temporary_name, parent_of};
 
-/// Every name this program writes in an output folder (all commands).
-pub const RESULT_NAMES: &[&str] = &[
+/// Every file this program writes in an output folder (all commands).
+pub const RESULT_FILES: &[&str] = &[
     "fit.json",
     "params.csv",
     "fitted.csv",
@@ -35,8 +39,13 @@ pub const RESULT_NAMES: &[&str] = &[
     "unit.json",
     "report.html",
     "report.md",
-    "figures",
 ];
+
+/// The folder of figures in an output folder.
+pub const FIGURES: &str = "figures";
+
+/// At most this many strangers are named in an error (then how many more).
+const NAMED: usize = 8;
 
 /// The closing line of a command: `wrote out/fit.json, out/params.csv and out/report.html …`,
 /// the report's files (`report.html`, `report.md`, `figures/`) only when `report` was written.
@@ -70,20 +79,24 @@ impl ResultsDir {
     /// Lock `target`, repair what a killed run left, check that it may be replaced (new,
     /// empty, or with `force` holding only results), and create the staging folder.
     pub fn begin(target: &Path, force: bool) -> Result<Self> {
-        let name = folder_name(target)?;
+        folder_name(target)?;
         check_folder_or_new(target)?;
+        // Checked before the lock too, so that a refused run leaves no lock file behind.
+        check_replaceable(target, force)?;
         let parent = parent_of(target);
-        std::fs::create_dir_all(&parent)
-            .with_context(|| format!("cannot create folder {}", parent.display()))?;
+        super::atomic::ensure_dir(&parent)?;
         let lock = OutputLock::acquire(target)?;
         for note in repair(target)? {
             crate::tell!("note: {note}");
         }
         check_replaceable(target, force)?;
-        let staging = parent.join(format!(".{name}.new-{}", std::process::id()));
-        std::fs::create_dir(&staging)
-            .with_context(|| format!("cannot create folder {}", staging.display()))?;
-        crate::interrupt::staged(&staging);
+        let staging = names::temporary(target, Role::New);
+        {
+            let _w = crate::interrupt::writing();
+            std::fs::create_dir(&staging)
+                .with_context(|| format!("cannot create folder {}", staging.display()))?;
+            crate::interrupt::staged(&staging);
+        }
         Ok(ResultsDir {
             target: target.to_path_buf(),
             staging,
@@ -103,7 +116,7 @@ impl ResultsDir {
         let _hold = crate::interrupt::hold_off();
         check_folder_or_new(&self.target)?;
         check_replaceable(&self.target, true)?;
-        let old = sibling(&self.target, &format!("old-{}", std::process::id()));
+        let old = names::temporary(&self.target, Role::Old);
         let moved = step_aside(&self.target, &old)?;
         if let Err(e) = step_in(&self.staging, &self.target) {
             if moved {
@@ -162,22 +175,29 @@ pub fn check_folder_or_new(target: &Path) -> Result<()> {
 }
 
 /// Refuse to replace `target` if it holds results and `force` is not set, or if it holds
-/// anything this program does not write (that would be lost).
+/// anything this program does not write, one level down included (that would be lost).
 pub fn check_replaceable(target: &Path, force: bool) -> Result<()> {
-    let Ok(entries) = std::fs::read_dir(target) else {
+    let Ok(held) = entries(target) else {
         return Ok(());
     };
-    let mut held = entries
-        .map(|e| Ok(e?.file_name().to_string_lossy().into_owned()))
-        .collect::<std::io::Result<Vec<String>>>()
-        .with_context(|| format!("cannot read folder {}", target.display()))?;
-    held.retain(|n| !is_temporary_name(n));
-    held.sort();
-    if let Some(stranger) = held.iter().find(|n| !RESULT_NAMES.contains(&n.as_str())) {
+    let mut strangers = Vec::new();
+    for (name, kind) in &held {
+        match (name.as_str(), kind) {
+            (FIGURES, Kind::Folder) => strangers.extend(
+                figure_strangers(&target.join(FIGURES))?
+                    .into_iter()
+                    .map(|s| format!("{FIGURES}/{s}")),
+            ),
+            (n, Kind::File) if RESULT_FILES.contains(&n) => {}
+            _ => strangers.push(describe(target, name, *kind)),
+        }
+    }
+    if !strangers.is_empty() {
         bail!(
-            "{} holds {stranger}, which stf-lab does not write; replacing the folder would lose \
-             it: move it, or choose another output folder",
-            target.display()
+            "{} holds {}, which stf-lab does not write; replacing the folder would lose it: \
+             move it, or choose another output folder",
+            target.display(),
+            name_list(&strangers)
         );
     }
     if !held.is_empty() && !force {
@@ -187,6 +207,95 @@ pub fn check_replaceable(target: &Path, force: bool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// What an entry is: a regular file, a folder, or anything else (a link, a FIFO …).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Kind {
+    /// A regular file (not a link).
+    File,
+    /// A folder (not a link).
+    Folder,
+    /// A symbolic link, device, FIFO or socket.
+    Other,
+}
+
+/// The entries of `folder` with their kinds, sorted, this program's temporaries left out.
+pub fn entries(folder: &Path) -> Result<Vec<(String, Kind)>> {
+    let read = std::fs::read_dir(folder)?;
+    let mut held = Vec::new();
+    for entry in read {
+        let entry = entry.with_context(|| format!("cannot read folder {}", folder.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if is_temporary_name(&name) {
+            continue;
+        }
+        let kind = match entry.file_type() {
+            Ok(t) if t.is_file() => Kind::File,
+            Ok(t) if t.is_dir() => Kind::Folder,
+            _ => Kind::Other,
+        };
+        held.push((name, kind));
+    }
+    held.sort();
+    Ok(held)
+}
+
+/// `name`, a folder named with its first file (`fit.json/thesis.tex`) or a `/`.
+pub fn describe(parent: &Path, name: &str, kind: Kind) -> String {
+    if kind != Kind::Folder {
+        return name.to_string();
+    }
+    match entries(&parent.join(name))
+        .ok()
+        .and_then(|e| e.into_iter().next())
+    {
+        Some((inner, inner_kind)) => format!(
+            "{name}/{}",
+            describe(&parent.join(name), &inner, inner_kind)
+        ),
+        None => format!("{name}/"),
+    }
+}
+
+/// `a, b and c` (at most [`NAMED`], then how many more).
+pub fn name_list(names: &[String]) -> String {
+    let shown: Vec<&str> = names.iter().take(NAMED).map(String::as_str).collect();
+    let more = names.len().saturating_sub(NAMED);
+    match shown.split_last() {
+        _ if more > 0 => format!("{} and {more} more", shown.join(", ")),
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+/// Whether `name` in a figures folder holding `names` is part of a figure: an SVG, a PNG and
+/// a CSV of one stem, all three regular files.
+pub fn is_figure(name: &str, files: &[&str]) -> bool {
+    let Some((stem, ext)) = name.rsplit_once('.') else {
+        return false;
+    };
+    ["svg", "png", "csv"].contains(&ext)
+        && ["svg", "png", "csv"]
+            .iter()
+            .all(|e| files.contains(&format!("{stem}.{e}").as_str()))
+}
+
+/// What a figures folder holds besides figures and temporaries (sub-folders named with
+/// their first file).
+pub fn figure_strangers(dir: &Path) -> Result<Vec<String>> {
+    let held = entries(dir)?;
+    let files: Vec<&str> = held
+        .iter()
+        .filter(|(_, k)| *k == Kind::File)
+        .map(|(n, _)| n.as_str())
+        .collect();
+    Ok(held
+        .iter()
+        .filter(|(n, k)| !(*k == Kind::File && is_figure(n, &files)))
+        .map(|(n, k)| describe(dir, n, *k))
+        .collect())
 }
 
 /// Step 1 of the swap: rename `target` (if it exists) to `old`. Whether it was moved.
@@ -225,13 +334,11 @@ pub fn clear_old(old: &Path) -> Result<()> {
     })
 }
 
-/// The tag of `name` if it is a swap folder of `target_name`: `.<name>.new-<pid>` or
-/// `.<name>.old-<pid>` ("new" or "old").
-fn swap_kind<'a>(name: &'a str, target_name: &str) -> Option<&'a str> {
-    let rest = name.strip_prefix('.')?.strip_prefix(target_name)?;
-    let (kind, pid) = rest.strip_prefix('.')?.split_once('-')?;
-    let digits = !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit());
-    (digits && (kind == "new" || kind == "old")).then_some(kind)
+/// The role of `name` if it is a swap folder of `target_name` (staging or old results).
+fn swap_kind(name: &str, target_name: &str) -> Option<Role> {
+    names::parse(name)
+        .filter(|t| t.of == target_name && t.role != Role::Commit)
+        .map(|t| t.role)
 }
 
 /// Under the output's lock: put the old results back if a run died between the swap's two
@@ -242,17 +349,17 @@ pub fn repair(target: &Path) -> Result<Vec<String>> {
     let Ok(entries) = std::fs::read_dir(&parent) else {
         return Ok(Vec::new());
     };
-    let mut stale: Vec<(String, PathBuf)> = entries
+    let mut stale: Vec<(bool, PathBuf)> = entries
         .filter_map(|e| e.ok())
         .filter_map(|e| {
             let file = e.file_name().to_string_lossy().into_owned();
-            swap_kind(&file, &name).map(|k| (k.to_string(), e.path()))
+            swap_kind(&file, &name).map(|k| (k == Role::Old, e.path()))
         })
         .collect();
     stale.sort();
     let mut notes = Vec::new();
     if std::fs::symlink_metadata(target).is_err() {
-        if let Some(i) = stale.iter().position(|(k, _)| k == "old") {
+        if let Some(i) = stale.iter().position(|(old, _)| *old) {
             let (_, old) = stale.remove(i);
             std::fs::rename(&old, target).with_context(|| {
                 format!(
@@ -271,7 +378,11 @@ pub fn repair(target: &Path) -> Result<Vec<String>> {
         }
     }
     for (_, path) in stale {
-        std::fs::remove_dir_all(&path).with_context(|| {
+        let removed = match path.is_dir() {
+            true => std::fs::remove_dir_all(&path),
+            false => std::fs::remove_file(&path),
+        };
+        removed.with_context(|| {
             format!(
                 "cannot remove {}, left by an interrupted run",
                 path.display()
@@ -345,7 +456,7 @@ mod tests {
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
-        assert_eq!(left.len(), 2, "{left:?}"); // the folder and its lock file
+        assert_eq!(left, ["fit"], "the folder alone: no staging, no lock file");
     }
 
     #[test]
@@ -420,6 +531,48 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("give the output folder by name"), "{e}");
+    }
+
+    #[test]
+    fn strangers_one_level_down_are_named_and_kept() {
+        let (_tmp, out) = old_results();
+        for stem in ["loop_x", "parity"] {
+            for ext in ["svg", "png", "csv"] {
+                write(&out.join("figures"), &format!("{stem}.{ext}"), "f");
+            }
+        }
+        assert!(check_replaceable(&out, true).is_ok(), "figures are results");
+        write(&out.join("figures"), "mynotes.txt", "mine");
+        write(&out.join("figures/sub"), "data.bin", "x");
+        write(&out.join("figures"), "lone.csv", "a,b");
+        std::fs::remove_file(out.join("fit.json")).unwrap();
+        write(&out.join("fit.json"), "thesis.tex", "mine");
+        let e = ResultsDir::begin(&out, true).unwrap_err().to_string();
+        for named in [
+            "figures/lone.csv",
+            "figures/mynotes.txt",
+            "figures/sub/data.bin",
+            "fit.json/thesis.tex",
+        ] {
+            assert!(e.contains(named), "{named}: {e}");
+        }
+        assert!(!e.contains("loop_x"), "{e}");
+        assert_eq!(read(&out, "figures/sub/data.bin"), "x");
+        assert_eq!(read(&out, "fit.json/thesis.tex"), "mine");
+    }
+
+    #[test]
+    fn a_refused_run_leaves_no_lock_file() {
+        let (tmp, out) = old_results();
+        write(&out, "notes.txt", "mine");
+        assert!(ResultsDir::begin(&out, true).is_err());
+        assert!(ResultsDir::begin(&out, false).is_err());
+        let mut left: Vec<_> = std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["fit"]);
     }
 
     #[test]

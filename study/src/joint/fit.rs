@@ -26,8 +26,8 @@ use stf_core::fit::{
 };
 use stf_core::physics::force_model::ForceModel;
 
-use super::global_file::Law;
 use super::prediction_cache::PredictionCache;
+use super::spec::Law;
 
 /// Where one value of a record's parameter vector comes from.
 #[derive(Clone, Debug)]

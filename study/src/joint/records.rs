@@ -15,10 +15,10 @@ use anyhow::{bail, Result};
 use stf_core::data::record_bounds::DataScales;
 use stf_core::fit::{FitParam, FORCE_OFFSET};
 
-use super::file::Unit;
-use super::global_file::GlobalSpec;
-use super::global_fit::{self, JointRecord, RecordFit};
+use super::fit::{self as global_fit, JointRecord, RecordFit};
 use super::prediction_cache::PredictionCache;
+use super::spec::GlobalSpec;
+use super::Unit;
 use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{self, ModelFit, Predictor};
 use crate::model_config::{configure_for, ConfiguredModel};
@@ -63,7 +63,7 @@ pub fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Res
     fexp.system = exp.system;
     fexp.system_given = exp.system_given;
     let configured = configure(spec, gexp, &data.scales(&fexp.system))?;
-    let hidden = stf_study::observer::Silent;
+    let hidden = crate::observer::Silent;
     let own = fitting::fit_model(&fexp, &data, Some(&configured), &hidden)?;
     let k = &data.kinematics;
     let (f, fit, params) = match (&own.predictor, spec.level) {
