@@ -12,18 +12,16 @@ figure.
 import os
 import sys
 
-import numpy as np
-
 import stf_lab
 
 os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 # 1. The source study's 0.047 rad/s² sweep without STF: where is the resonance?
 sweep = stf_lab.simulate("experiments/paper_sweep.toml")
-i = int(np.argmax(np.abs(sweep.x)))
-omega = 2.35 + 0.047 * (sweep.t[i] - 50.0)
-print(f"simulated {sweep.duration:.0f} s ({len(sweep)} samples); "
-      f"peak |x| = {abs(sweep.x[i]) * 1e3:.2f} mm at ω ≈ {omega:.2f} rad/s")
+run = sweep.summary  # the simulated run, before the sensors' noise
+print(f"simulated {sweep.duration:.0f} s ({len(sweep)} samples); peak |x| = "
+      f"{run['peak_x_m'] * 1e3:.2f} mm at ω = {run['peak_omega_rad_s']:.2f} rad/s; breakaway at "
+      f"ω = {run['breakaway_omega_rad_s']:.2f} rad/s")
 
 # 2. The models available, with their parameters and units.
 for m in stf_lab.models():

@@ -121,7 +121,8 @@ fn discover<'py>(
 }
 
 /// `simulate(path, text=None, progress=None)`: the record of the experiment's `[simulate]`
-/// section, as a dict of numpy arrays (`stf-lab simulate` without its files).
+/// section, as a dict of numpy arrays with the run's `summary` (JSON text), as `stf-lab
+/// simulate` makes them, without its files.
 #[pyfunction]
 #[pyo3(signature = (path, text=None, progress=None))]
 fn simulate<'py>(
@@ -130,10 +131,12 @@ fn simulate<'py>(
     text: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let record = run_interruptible(py, progress.as_ref(), move |run| {
+    let (record, summary) = run_interruptible(py, progress.as_ref(), move |run| {
         study_calls::simulate(study_calls::experiment(&path, text.as_deref())?, run)
     })?;
-    record::record_dict(py, record)
+    let d = record::record_dict(py, record)?;
+    d.set_item("summary", summary)?;
+    Ok(d)
 }
 
 /// The module.

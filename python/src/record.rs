@@ -164,7 +164,7 @@ fn build(mut s: Vec<Option<Vec<f64>>>, rate: Option<f64>, t0: f64) -> Result<Rec
         u,
     };
     record
-        .validate()
+        .check()
         .map_err(|e| of_kind(ErrorKind::Record, e.to_string()))?;
     Ok(record)
 }

@@ -1,21 +1,15 @@
 //! Every call into the lab's workflows, in one file: the study API (`stf_study::prelude`:
-//! read an experiment, fit, identify, compare, discover) and the simulation of a `[simulate]`
-//! section. Each returns an owned [`Outcome`] — the JSON the command line writes (the same
+//! read an experiment, fit, identify, compare, discover; `stf_study::simulate` for a
+//! `[simulate]` section). Each returns an owned [`Outcome`] — the JSON the command line writes (the same
 //! `Serialize` type, its numbers tidied to the digits they carry as `stf-lab` writes them),
 //! the report's verdict, the tables behind its CSV files and the arrays behind its figures —
 //! and writes nothing.
 
 use std::path::Path;
 
-use anyhow::{bail, Context};
 use serde::Serialize;
-use stf_core::numerics::interpolate::Linear;
-use stf_core::physics::excitation::Excitation;
-use stf_core::physics::oscillator::Oscillator;
-use stf_core::simulate::synthetic::{sample_record, SensorNoise};
-use stf_core::simulate::Simulation;
 use stf_study::error::{ErrorKind, StudyError};
-use stf_study::experiment::{Drive, Experiment};
+use stf_study::experiment::Experiment;
 use stf_study::fitting::ModelFit;
 use stf_study::outputs::identification_json::IdentificationJson;
 use stf_study::prelude;
@@ -212,70 +206,15 @@ pub fn discover(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
     })
 }
 
-/// The excitation of `drive` at the sample `times`, and whether it is a rotor. Restates the
-/// program's private `excitation_of` (`src/commands/simulate.rs`) until the study exposes
-/// the simulation of a `[simulate]` section.
-fn excitation_of(drive: &Drive, times: &[f64]) -> (Excitation, bool) {
-    match drive {
-        Drive::Rotor(angle) => (Excitation::Rotor(angle.clone()), true),
-        Drive::Free => (Excitation::None, false),
-        Drive::Force(chirp) => {
-            let u = times.iter().map(|&t| chirp.at(t)).collect();
-            let held = if chirp.held() {
-                Linear::held(times.to_vec(), u)
-            } else {
-                Linear::new(times.to_vec(), u)
-            };
-            (Excitation::Force(held), false)
-        }
-    }
-}
-
-/// `stf-lab simulate` without its files: the record of the experiment's `[simulate]`
-/// (restating `src/commands/simulate.rs`'s run, as above).
-pub fn simulate(exp: Experiment, run: &Run) -> Result<stf_core::data::record::Record, StudyError> {
-    let Some(spec) = &exp.simulate else {
-        let msg = format!(
-            "{}: has no [simulate] section to make a record from",
-            exp.path.display()
-        );
-        return Err(of_kind(ErrorKind::Experiment, msg));
-    };
-    let n = ((spec.t1 - spec.t0) * spec.rate).round() as usize + 1;
-    let times: Vec<f64> = (0..n).map(|i| spec.t0 + i as f64 / spec.rate).collect();
-    let (excitation, rotor) = excitation_of(&spec.drive, &times);
-    let made = || -> anyhow::Result<stf_core::data::record::Record> {
-        let mut osc = Oscillator::new(exp.system, excitation);
-        if !spec.truth.is_empty() {
-            let truth = stf_study::model_config::configure_for(
-                &spec.truth,
-                &exp.path,
-                &exp.dir,
-                &exp.scripts,
-                None,
-            )?;
-            let values = truth.values();
-            osc = osc
-                .with_model(truth.model, values)
-                .context("cannot plug the truth model into the oscillator")?;
-        }
-        run.say(format!("simulating {:.1} s", spec.t1 - spec.t0));
-        let sim = Simulation::new(&osc)
-            .settings(exp.integrator.clone())
-            .initial(spec.x0, spec.v0)
-            .run_at(&times)
-            .with_context(|| format!("simulation of {} failed", exp.path.display()))?;
-        if sim.t.is_empty() {
-            bail!("simulation of {} made no samples", exp.path.display());
-        }
-        let noise = if spec.noise {
-            SensorNoise::RIG
-        } else {
-            SensorNoise::NONE
-        };
-        let mut record = sample_record(&sim, &noise, spec.seed, rotor);
-        record.source = format!("simulated from {}", exp.path.display());
-        Ok(record)
-    };
-    made().map_err(study)
+/// `stf-lab simulate` without its files: the record of the experiment's `[simulate]` and its
+/// run's summary (the sidecar's `summary`: peak, breakaway, …) as JSON text.
+pub fn simulate(
+    exp: Experiment,
+    run: &Run,
+) -> Result<(stf_core::data::record::Record, String), StudyError> {
+    run.say("simulating");
+    let mut made = stf_study::simulate::simulate(&exp).map_err(study)?;
+    made.record.source = format!("simulated from {}", exp.path.display());
+    let summary = json_text(&made.summary)?;
+    Ok((made.record, summary))
 }

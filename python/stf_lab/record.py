@@ -6,6 +6,7 @@ sample rate. The columns are read-only float64 numpy arrays that own the buffers
 reader filled (no copy on the way). ``Record.to_pandas()`` gives a DataFrame.
 """
 
+import json
 import os
 
 import numpy as np
@@ -43,6 +44,10 @@ class Record:
 
     def __init__(self, columns):
         self.source = columns.get("source", "(memory)")
+        summary = columns.get("summary")
+        #: For a simulated record: the run's summary as ``stf-lab simulate``'s sidecar states
+        #: it (``peak_x_m``, ``peak_omega_rad_s``, ``breakaway_omega_rad_s``, …); else None.
+        self.summary = json.loads(summary) if summary else None
         for name, _ in SIGNALS:
             setattr(self, name, _frozen(columns.get(name)))
 

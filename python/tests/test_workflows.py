@@ -13,6 +13,11 @@ def test_simulate_remakes_the_bundled_record(repo):
     assert rec.signals == bundled.signals
     for name in bundled.signals:
         np.testing.assert_array_equal(getattr(rec, name), getattr(bundled, name), err_msg=name)
+    # The run's summary, as the sidecar beside the bundled record states it.
+    import json
+
+    sidecar = json.loads(open("experiments/records/power_law_sweep.json").read())
+    assert {k: rec.summary[k] for k in sidecar["summary"]} == sidecar["summary"]
 
 
 def test_a_built_experiment_simulates_like_its_file(repo):
