@@ -1,0 +1,46 @@
+"""Ctrl-C during a run (the notebook's stop button): `Interrupted`, itself a KeyboardInterrupt,
+with nothing returned or written; the package works on afterwards."""
+
+import os
+import signal
+import threading
+
+import pytest
+
+import stf_lab
+
+EXP = "experiments/power_law_fit.toml"
+
+
+def test_a_sigint_during_a_run_raises_interrupted(repo):
+    sent = []
+
+    def progress(status, elapsed):
+        if not sent:  # the first call, as the run starts: interrupt from another thread
+            sent.append(status)
+            threading.Thread(target=os.kill, args=(os.getpid(), signal.SIGINT)).start()
+
+    # A discovery (seconds long), so the signal surely arrives while it runs.
+    with pytest.raises(stf_lab.Interrupted) as e:
+        stf_lab.discover("experiments/discovery.toml", progress=progress)
+    assert isinstance(e.value, KeyboardInterrupt)
+    assert "nothing was written" in str(e.value)
+    assert sent
+
+
+def test_a_keyboard_interrupt_in_the_progress_callback_stops_the_run(repo):
+    def progress(status, elapsed):
+        raise KeyboardInterrupt
+
+    with pytest.raises(stf_lab.Interrupted):
+        stf_lab.fit(EXP, progress=progress)
+    # The lab is usable after an interrupt.
+    assert len(stf_lab.simulate(EXP)) == 12001
+
+
+def test_progress_reports_what_the_run_does(repo):
+    seen = []
+    stf_lab.fit(EXP, progress=lambda status, elapsed: seen.append((status, elapsed)))
+    assert seen and all(e >= 0 for _, e in seen)
+    assert seen[0][0] == "starting"
+    assert any(s.startswith("power_law  ") and "evaluations" in s for s, _ in seen), seen
