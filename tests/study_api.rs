@@ -161,3 +161,30 @@ fn a_bad_experiment_is_an_error_of_its_kind_naming_the_key() {
     let err = read_experiment(&path).expect_err("a number is no file name");
     assert!(err.message.contains("exp.toml:2"), "{}", err.message);
 }
+
+#[test]
+fn settings_built_in_code_fit_as_the_same_experiment_file_does() {
+    let record = common::root().join("experiments/records/power_law_sweep.csv");
+    let mut built = Experiment::for_record(&record)
+        .unwrap()
+        .with_model("power_law")
+        .with_model("viscous");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("exp.toml");
+    let text = format!(
+        "[data]\nfile = {:?}\n[[models]]\nname = \"power_law\"\n[[models]]\nname = \"viscous\"\n",
+        record.display().to_string()
+    );
+    std::fs::write(&path, text).unwrap();
+    let mut read = read_experiment(&path).unwrap();
+    let (a, b) = (
+        fit(&mut built, &Silent).unwrap(),
+        fit(&mut read, &Silent).unwrap(),
+    );
+    assert_eq!(a.fits.len(), 2);
+    for (x, y) in a.fits.iter().zip(&b.fits) {
+        assert_eq!(x.label, y.label);
+        assert_eq!(x.result.rms, y.result.rms, "{}", x.label);
+        assert_eq!(x.model_values(), y.model_values(), "{}", x.label);
+    }
+}

@@ -52,7 +52,7 @@ pub use simulate::SimulateSpec;
 pub use validate::ValidateSpec;
 
 /// The whole file as written: one raw type per section.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawExperiment {
     data: Option<Spanned<RawData>>,
@@ -177,6 +177,50 @@ impl Experiment {
         let cx = Ctx { file: path, text };
         let raw: RawExperiment = toml::from_str(text).map_err(|e| cx.deserialize_error(&e))?;
         Self::check(raw, &cx)
+    }
+
+    /// Settings for `record` built in code, no experiment file: every section at its default
+    /// (the source study's oscillator, its filters and thresholds, the default solver), no
+    /// model yet ([`Experiment::with_model`]). Script paths are relative to the record's
+    /// folder; messages name the record.
+    ///
+    /// ```no_run
+    /// use stf_study::prelude::*;
+    /// let mut exp = Experiment::for_record("experiments/records/power_law_sweep.csv")?
+    ///     .with_model("power_law")
+    ///     .with_model("viscous");
+    /// let fitted = fit(&mut exp, &Silent)?;
+    /// # Ok::<(), StudyError>(())
+    /// ```
+    pub fn for_record(record: impl Into<PathBuf>) -> Result<Experiment> {
+        let record = record.into();
+        let text = String::new();
+        let cx = Ctx {
+            file: &record,
+            text: &text,
+        };
+        let mut exp = Self::check(RawExperiment::default(), &cx)?;
+        exp.data_file = Some(record);
+        Ok(exp)
+    }
+
+    /// These settings with one more model to fit: a built-in's name, a sum (`"power_law +
+    /// added_mass"`) or a rhai script's path (ending in `.rhai`), its parameters at their
+    /// defaults.
+    pub fn with_model(mut self, model: &str) -> Experiment {
+        let source = if model.ends_with(".rhai") {
+            ModelSource::Script(model.to_string())
+        } else {
+            ModelSource::Name(model.to_string())
+        };
+        self.models.push(ModelEntry {
+            source,
+            plus: Vec::new(),
+            params: Vec::new(),
+            line: 0,
+            key: format!("models[{}]", self.models.len()),
+        });
+        self
     }
 
     /// The sections of `raw`, checked in turn; `cx` is the file they come from.

@@ -40,7 +40,8 @@ pub use crate::fitting::{FitData, ModelFit};
 pub use crate::identify::Identification;
 pub use crate::observer::{Job, Observer, Silent};
 
-/// Read and check an experiment file (TOML): the typed settings of every workflow.
+/// Read and check an experiment file (TOML): the typed settings of every workflow. Settings
+/// can also be built in code: [`Experiment::for_record`] and [`Experiment::with_model`].
 pub fn read_experiment(path: impl AsRef<Path>) -> Result<Experiment, StudyError> {
     Ok(Experiment::load(path.as_ref())?)
 }
