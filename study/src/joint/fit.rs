@@ -28,6 +28,7 @@ use stf_core::physics::force_model::ForceModel;
 
 use super::prediction_cache::PredictionCache;
 use super::spec::Law;
+use crate::experiment::FitLevel;
 
 /// Where one value of a record's parameter vector comes from.
 #[derive(Clone, Debug)]
@@ -347,13 +348,14 @@ impl Residuals for Joint<'_> {
     }
 }
 
-/// Fit θ of `layout` to `records` (in the layout's order) with `settings`; `trajectory`:
-/// by the rules of a trajectory fit (the records' residuals are displacements).
+/// Fit θ of `layout` to `records` (in the layout's order) with `settings`, at `level`: at
+/// trajectory level by the rules of a trajectory fit (the records' residuals are
+/// displacements).
 pub fn fit(
     layout: &Layout,
     records: &[&JointRecord],
     settings: &stf_core::fit::FitSettings,
-    trajectory: bool,
+    level: FitLevel,
 ) -> Result<FitResult> {
     let mut starts = Vec::with_capacity(records.len());
     let mut len = 0;
@@ -368,7 +370,7 @@ pub fn fit(
         starts,
         len,
     };
-    let result = if trajectory {
+    let result = if level == FitLevel::Trajectory {
         fit_trajectory_residuals(&problem, &layout.params, settings, None)
     } else {
         fit_residuals(&problem, &layout.params, settings, None)
@@ -470,7 +472,7 @@ mod tests {
         assert_eq!(names, ["a0", "a_p", "b"]);
         assert_eq!(layout.roles, ["law coefficient", "law exponent", "shared"]);
         let refs: Vec<&JointRecord> = records.iter().collect();
-        let result = fit(&layout, &refs, &Default::default(), false).unwrap();
+        let result = fit(&layout, &refs, &Default::default(), FitLevel::Force).unwrap();
         for (name, truth) in [("a0", 3.0), ("a_p", 1.5), ("b", 0.7)] {
             let v = result.value(name).unwrap();
             assert!((v - truth).abs() < 1e-6, "{name} = {v}");
@@ -494,7 +496,7 @@ mod tests {
         let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, ["a", "b@4", "b@5"]);
         let refs: Vec<&JointRecord> = records.iter().collect();
-        let result = fit(&layout, &refs, &Default::default(), false).unwrap();
+        let result = fit(&layout, &refs, &Default::default(), FitLevel::Force).unwrap();
         assert!((result.value("b@4").unwrap() - 2.0).abs() < 1e-6);
         assert!((result.value("b@5").unwrap() + 1.0).abs() < 1e-6);
         assert!((result.value("a").unwrap() - 1.5).abs() < 1e-6);

@@ -261,16 +261,15 @@ fn joint_fit(campaign: &JointInputs) -> Result<GlobalJson> {
     let starts: Vec<Vec<f64>> = training.iter().map(|l| l.own.values.clone()).collect();
     let layout = global_fit::layout(&spec.shared, &spec.laws, &records, &starts);
     let joint: Vec<&JointRecord> = training.iter().map(|l| &l.joint).collect();
-    let trajectory = spec.level == FitLevel::Trajectory;
-    let settings = if trajectory {
-        gexp.fit
+    let settings = match spec.level {
+        FitLevel::Trajectory => gexp
+            .fit
             .settings
             .clone()
-            .for_simulation(gexp.integrator.rtol)
-    } else {
-        gexp.fit.settings.clone()
+            .for_simulation(gexp.integrator.rtol),
+        FitLevel::Force => gexp.fit.settings.clone(),
     };
-    let result = global_fit::fit(&layout, &joint, &settings, trajectory)?;
+    let result = global_fit::fit(&layout, &joint, &settings, spec.level)?;
     let holdout = spec
         .holdout
         .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result))
