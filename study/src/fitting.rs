@@ -341,7 +341,7 @@ pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) 
 }
 
 /// Fit one configured model (or, with `None`, the bare oscillator) to `data`, at its level:
-/// the fit ([`Predictor::build`]), the prediction with the fitted values, the noise floor and
+/// the fit (`Predictor::build`), the prediction with the fitted values, the noise floor and
 /// the warnings.
 pub fn fit_model(
     exp: &Experiment,

@@ -5,7 +5,7 @@
 //! best RMS ([`fit_message`]), several jobs' count and time left ([`jobs_message`]), and a
 //! discovery's step, candidate and best held-out score ([`discovery_observer`]). An observer
 //! also says whether the run is to stop ([`Observer::cancelled`]): a study checks it between
-//! jobs and returns [`crate::StudyError::Interrupted`].
+//! jobs and returns an interrupted [`crate::error::StudyError`] ([`crate::error::ErrorKind::Interrupted`]).
 
 use std::sync::{Arc, Mutex};
 use std::time::Instant;

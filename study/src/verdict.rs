@@ -21,7 +21,7 @@ const AIC_TIE: f64 = 2.0;
 
 /// The best of fits given as `(AIC, free parameters)`: among those the data do not tell apart
 /// from the lowest finite AIC (within ΔAIC 2), the simplest; its index, `None` if no AIC is
-/// finite. The rule of [`fit_verdict`], shared with the campaign table.
+/// finite. The rule of [`FitVerdict`], shared with the campaign table.
 pub fn best_by_aic(fits: &[(f64, usize)]) -> Option<usize> {
     let lowest = fits
         .iter()

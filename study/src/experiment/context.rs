@@ -1,7 +1,7 @@
 //! Where an experiment file's errors point: [`Ctx`] holds the file and its text, and every
 //! error about a value reads `FILE:LINE: `KEY`: MSG` ([`error_at`]). Errors from serde (an
 //! unknown key, a wrong type, an unknown variant of a serde enum, which lists the accepted
-//! ones) take the same form through [`deserialize_error`], with the key path `toml` records.
+//! ones) take the same form through [`Ctx::deserialize_error`], with the key path `toml` records.
 
 use std::ops::Range;
 use std::path::Path;
@@ -20,7 +20,7 @@ pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display
 /// Longest run of text from a file shown whole in a message (a key, a value, a name).
 const SHOWN_WHOLE: usize = 200;
 
-/// `text` with every word longer than [`SHOWN_WHOLE`] bytes cut to its start and end and its
+/// `text` with every word longer than `SHOWN_WHOLE` bytes cut to its start and end and its
 /// size, so that a 5 MB key is not echoed whole.
 pub fn shorten(text: &str) -> String {
     if text.len() <= SHOWN_WHOLE {

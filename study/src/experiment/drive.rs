@@ -26,7 +26,7 @@ pub enum Drive {
 
 /// A linear chirp force `u = A·sin(2π·(f0·s + (f1 − f0)·s²/(2·(t1 − t0))))`, `s = t − t0`:
 /// the frequency sweeps linearly from `f0` at `t0` to `f1` at `t1`. Read as written (`chirp =
-/// { f0, f1, amplitude, t0, t1, hold }`), then checked ([`Chirp::check`]).
+/// { f0, f1, amplitude, t0, t1, hold }`), then checked (`Chirp::check`).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Chirp {

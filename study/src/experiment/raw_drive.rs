@@ -1,6 +1,6 @@
 //! How a filter of a measured drive is written, in `[data] drive` and `[filter] motion` /
 //! `omega`: a name (`"auto"`, `"none"`, …) or a table of polynomial order and window. Both
-//! sections read it; [`super::filter`] checks it.
+//! sections read it; `filter.rs` checks it.
 
 use serde::Deserialize;
 

@@ -1,7 +1,7 @@
 //! The results files, one type each: what a command writes is a value of one of these
-//! `Serialize` types, built from the command's results and then written — JSON through
-//! [`crate::output::write_json`] (numbers tidied by [`crate::digits`]), CSV through the `csv`
-//! crate, the experiment entry through `toml_edit`. A type's fields *are* the file's
+//! `Serialize` types, built from the study's results; the program writes them — JSON through
+//! its `writing::write_json` (numbers tidied by [`crate::digits`]), CSV through the `csv`
+//! crate (this module gives the bytes), the experiment entry through `toml_edit`. A type's fields *are* the file's
 //! contract (docs/ARCHITECTURE.md §6): each carries its unit in its doc comment.
 //!
 //! | file | type |
@@ -16,7 +16,7 @@
 //! | `fitted.csv`, `discovered.csv` | [`columns_csv::Columns`] |
 //!
 //! `params.csv` and `cycles.csv` are [`crate::param_table::ParamRow`] and
-//! [`crate::compare_loops`]'s `CycleRow`.
+//! the program's `compare_loops` `CycleRow`.
 
 pub mod columns_csv;
 pub mod compare_csv;
