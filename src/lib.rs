@@ -2,9 +2,9 @@
 //! science is the study crate's (`stf_study`: experiment settings, fits, comparisons,
 //! discovery, their typed results, re-exported here under their old paths); this crate runs
 //! the [`commands`] (simulate, fit, compare, discover, models: each reads the experiment, runs
-//! the study, writes its results through [`writing`] and renders its documents through
-//! [`report`], [`standard_report`] and the figures), [`campaign`]s of them over many records,
-//! and the terminal ([`terminal`], [`progress`], [`interrupt`]). The binary (`src/main.rs`)
+//! the study, writes its results through [`writing`] and renders its [`documents`], whose
+//! figures [`report`] draws), [`campaign`]s of them over many records, and the [`terminal`]
+//! (what is printed, the progress display, Ctrl-C). The binary (`src/main.rs`)
 //! only parses the command line and calls one command; integration tests and fuzz targets use
 //! the same functions.
 
@@ -19,13 +19,7 @@ pub use stf_study::{
 
 pub mod campaign;
 pub mod commands;
-pub mod compare_loops;
-pub mod compare_markdown;
-pub mod identify_report;
-pub mod interrupt;
-pub mod progress;
-pub mod regime_figures;
+pub mod documents;
 pub mod report;
-pub mod standard_report;
 pub mod terminal;
 pub mod writing;

@@ -26,7 +26,8 @@ use stf_lab::{
         simulate as cmd_simulate,
     },
     experiment::Experiment,
-    interrupt, tell,
+    tell,
+    terminal::interrupt,
 };
 
 /// A lab for shear-thickening fluid force models: simulate, fit, compare, discover.

@@ -92,7 +92,7 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         .into_iter()
         .filter_map(|f| f.error.map(|e| (f.number, e)))
         .collect();
-    crate::interrupt::park_if_interrupted();
+    crate::terminal::interrupt::park_if_interrupted();
     finish(&campaign, out, &errors)
 }
 
@@ -191,7 +191,7 @@ fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings
 /// The table, report and `[global]` fit of the units in `out`; `errors` holds, by unit, why
 /// a unit has no results. An error naming the failed units after everything is written.
 fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> Result<()> {
-    crate::interrupt::set_outcome(format!(
+    crate::terminal::interrupt::set_outcome(format!(
         "every unit had ended (their results are in {}); the campaign's table and report were \
          not written for this run (earlier ones are intact)",
         out.join(crate::campaign::unit::UNITS).display()
@@ -203,7 +203,7 @@ fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> 
     table::write_csv(&staged.stage(&out.join("campaign.csv"))?, &table)?;
     let drawn = report::write(&table, global.as_ref(), out, &mut staged)?;
     staged.commit()?;
-    crate::interrupt::set_outcome(format!(
+    crate::terminal::interrupt::set_outcome(format!(
         "the units, the campaign's table and its report were already written to {}",
         out.display()
     ));

@@ -16,7 +16,7 @@
 //! Children die with the campaign: each asks the kernel for SIGTERM when its parent ends
 //! (`PR_SET_PDEATHSIG`, [`die_with_parent`]), so even a SIGKILLed campaign leaves no unit
 //! running; on Ctrl-C or SIGTERM the campaign stops them and waits for them
-//! (`crate::interrupt`), then says how many units finished. A unit still locked by a child
+//! (`crate::terminal::interrupt`), then says how many units finished. A unit still locked by a child
 //! of an earlier run (one that had not yet ended) is waited for before it is started again.
 //!
 //! Threads from the standard library: each only waits on its child, so a pool crate would
@@ -85,22 +85,24 @@ impl Runner<'_> {
         let next = AtomicUsize::new(0);
         let done = Mutex::new(Vec::new());
         let total = pending.len();
-        crate::interrupt::set_outcome(interrupted_text(self.out, pending, &[]));
+        crate::terminal::interrupt::set_outcome(interrupted_text(self.out, pending, &[]));
         std::thread::scope(|s| {
             for _ in 0..self.jobs.clamp(1, total.max(1)) {
                 s.spawn(|| loop {
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(p) = pending.get(i) else { break };
-                    if crate::interrupt::is_interrupted() {
+                    if crate::terminal::interrupt::is_interrupted() {
                         break;
                     }
                     let (finished, pid) = self.run_child(&exe, &logs, p);
                     let mut done = done.lock().unwrap_or_else(|e| e.into_inner());
                     done.push((i, finished.clone()));
-                    crate::interrupt::set_outcome(interrupted_text(self.out, pending, &done));
+                    crate::terminal::interrupt::set_outcome(interrupted_text(
+                        self.out, pending, &done,
+                    ));
                     crate::say!("{}", progress_line(done.len(), total, p.unit, &finished));
                     if let Some(pid) = pid {
-                        crate::interrupt::child_ended(pid);
+                        crate::terminal::interrupt::child_ended(pid);
                     }
                 });
             }
@@ -111,7 +113,7 @@ impl Runner<'_> {
     }
 
     /// One child: `stf-lab campaign C --out DIR --unit N --force --quiet`. How it ended, and
-    /// its process id if it was started (to be told to [`crate::interrupt::child_ended`]
+    /// its process id if it was started (to be told to [`crate::terminal::interrupt::child_ended`]
     /// once its outcome is recorded).
     fn run_child(&self, exe: &Path, logs: &Path, p: &Pending) -> (Finished, Option<u32>) {
         let started = Instant::now();
@@ -169,7 +171,7 @@ impl Runner<'_> {
             .stdin(Stdio::null())
             .stdout(out)
             .stderr(err);
-        let started = crate::interrupt::child_started(|| {
+        let started = crate::terminal::interrupt::child_started(|| {
             let child = command.spawn()?;
             let id = child.id();
             Ok((child, id))
@@ -183,7 +185,7 @@ impl Runner<'_> {
                 match status {
                     Ok(status) => Ok((status, id)),
                     Err(e) => {
-                        crate::interrupt::child_ended(id);
+                        crate::terminal::interrupt::child_ended(id);
                         Err(format!("cannot wait for unit {}: {e}", p.unit.number))
                     }
                 }
@@ -206,7 +208,7 @@ fn wait_for_live_unit(p: &Pending) -> Result<(), String> {
     );
     let until = Instant::now() + LIVE_UNIT_PATIENCE;
     while is_held_elsewhere(&p.dir) {
-        if Instant::now() > until || crate::interrupt::is_interrupted() {
+        if Instant::now() > until || crate::terminal::interrupt::is_interrupted() {
             return Err(format!(
                 "{} is still being written by an earlier run{who}; rerun when it has ended",
                 p.dir.display()

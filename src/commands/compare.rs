@@ -6,7 +6,7 @@
 //! force, label agreement, boundary error), and the oscillator with the model plugged in is
 //! simulated against the record for the resonance peak. Writes `compare.json`, `compare.md`
 //! and `compare.csv` (models × regimes; [`crate::outputs::compare_json`],
-//! [`crate::outputs::compare_csv`], [`crate::compare_markdown`]). With `[validate]`, each
+//! [`crate::outputs::compare_csv`], [`crate::documents::compare_markdown`]). With `[validate]`, each
 //! model's `fit` in compare.json carries its error on the second record, as in fit.json.
 
 use std::path::Path;
@@ -15,14 +15,14 @@ use anyhow::Result;
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 use stf_study::compare::{response, simulated_response, Compared};
 
-use crate::compare_markdown::{compare_markdown, duty_meaning};
+use crate::documents::compare_markdown::{compare_markdown, duty_meaning};
+use crate::documents::standard_report::{frequency_section, record_sections, write_report};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::outputs::compare_csv;
-use crate::progress::Progress;
 use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
 use crate::say;
-use crate::standard_report::{frequency_section, record_sections, write_report};
+use crate::terminal::progress::Progress;
 use crate::writing::results_dir::{wrote_line, ResultsDir};
 use crate::writing::{write_atomic, write_json};
 
@@ -41,7 +41,7 @@ pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: b
     let rows = compare_csv::rows(&labels, &c.comparisons);
     let csv = out.join("compare.csv");
     write_atomic(&csv, &compare_csv::csv_text(&csv, &rows)?)?;
-    crate::compare_loops::write_cycles_csv(
+    crate::documents::compare_loops::write_cycles_csv(
         &out.join("cycles.csv"),
         &c.measured,
         &labels,
@@ -105,7 +105,7 @@ fn write_compare_report(
         .iter()
         .map(|f| (f.label.as_str(), f.fitted.as_slice()))
         .collect();
-    sections.extend(crate::regime_figures::regime_section(
+    sections.extend(crate::documents::regime_figures::regime_section(
         exp, data, &forces, out,
     )?);
     let verdict = crate::verdict::compare_verdict(c);
@@ -138,11 +138,13 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
     regimes.tables.push(errors_table(c));
     regimes
         .paragraphs
-        .push(crate::compare_loops::DUTY_EXPLAINED.into());
-    regimes.tables.push(crate::compare_loops::energy_table(
-        &c.labels(),
-        &c.comparisons,
-    ));
+        .push(crate::documents::compare_loops::DUTY_EXPLAINED.into());
+    regimes
+        .tables
+        .push(crate::documents::compare_loops::energy_table(
+            &c.labels(),
+            &c.comparisons,
+        ));
     let bars = per_regime(c, |m| m.map_or(f64::NAN, |m| m.relative_rms_error));
     let fig = regime_errors(
         &out.join("figures"),

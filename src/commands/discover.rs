@@ -17,15 +17,15 @@ use anyhow::Result;
 use stf_core::discovery::Discovery;
 use stf_study::discover::Discovered;
 
+use crate::documents::standard_report::{record_sections, write_report};
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::{estimate_line, FitData};
-use crate::progress::Progress;
 use crate::report::{
     measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
 };
 use crate::say;
-use crate::standard_report::{record_sections, write_report};
+use crate::terminal::progress::Progress;
 use crate::validation::DiscoveryScore;
 use crate::writing::results_dir::{wrote_line, ResultsDir};
 use crate::writing::{write_atomic, write_json};
@@ -226,7 +226,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     let mut sections = vec![s];
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];
-        sections.extend(crate::regime_figures::regime_section(
+        sections.extend(crate::documents::regime_figures::regime_section(
             exp, data, &curves, out,
         )?);
     }
@@ -260,7 +260,7 @@ fn step_table(i: usize, step: &stf_core::discovery::Step, (unit, scale): (&str, 
             format!("{:.1}", c.delta_bic),
             format!("{:.1} ({})", c.gain_z, c.effective_n),
             format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),
-            crate::standard_report::yes_no(c.significant),
+            crate::documents::standard_report::yes_no(c.significant),
         ]
     });
     Table::new(caption, &columns).with_rows(rows.collect())

@@ -15,13 +15,13 @@ use stf_core::fit::{FitResult, FitWarning};
 use stf_study::fit::Fitted;
 use stf_study::identify::Identification;
 
+use crate::documents::identify_report::{system_line, write_identification_report};
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{estimate_line, FitData, ModelFit};
-use crate::identify_report::{system_line, write_identification_report};
 use crate::outputs::identification_json::IdentificationJson;
 use crate::param_table::{params_csv, rows_of, ParamRow};
-use crate::progress::Progress;
 use crate::say;
+use crate::terminal::progress::Progress;
 use crate::validation::ValidationRecord;
 use crate::writing::results_dir::{wrote_line, ResultsDir};
 use crate::writing::{write_atomic, write_json};
@@ -80,9 +80,13 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
     let level = data.level;
     let mut sections = Vec::new();
     if let Some(rec) = validation {
-        sections.push(crate::standard_report::validation_section(rec, fits, out)?);
+        sections.push(crate::documents::standard_report::validation_section(
+            rec, fits, out,
+        )?);
     }
-    sections.extend(crate::standard_report::record_sections(data, fits, out)?);
+    sections.extend(crate::documents::standard_report::record_sections(
+        data, fits, out,
+    )?);
     let forces: Vec<(&str, &[f64])> = match level {
         FitLevel::Force => fits
             .iter()
@@ -90,7 +94,7 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
             .collect(),
         FitLevel::Trajectory => Vec::new(),
     };
-    sections.extend(crate::regime_figures::regime_section(
+    sections.extend(crate::documents::regime_figures::regime_section(
         exp, data, &forces, out,
     )?);
     let mut intro = vec![
@@ -103,7 +107,9 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
         ),
     ];
     if let Some(rec) = validation {
-        intro.push(crate::standard_report::validation_intro(rec, fits));
+        intro.push(crate::documents::standard_report::validation_intro(
+            rec, fits,
+        ));
     }
     let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
     if warned > 0 {
@@ -112,7 +118,7 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
             fits.len()
         ));
     }
-    crate::standard_report::write_report(
+    crate::documents::standard_report::write_report(
         &format!("Fit: {}", exp.path.display()),
         intro,
         sections,

@@ -4,7 +4,7 @@
 //! fails. A crash never leaves a half-written file under the final name, and what it leaves
 //! is recognised and removed by the next run. A target that exists and is not a regular file
 //! (a device, FIFO, socket or folder, or a link to one) is refused: the rename would put a
-//! file in its place. Each write holds [`crate::interrupt::writing`], so an interrupt waits
+//! file in its place. Each write holds [`crate::terminal::interrupt::writing`], so an interrupt waits
 //! for it and none starts once an interrupt is handled.
 //!
 //! Records, results, figures, reports, campaign tables, scripts and logs are all written
@@ -66,7 +66,7 @@ impl AtomicFile {
     /// Create the temporary file of `target` (refused if `target` is not a regular file or
     /// new).
     pub fn create(target: &Path) -> Result<Self, WriteError> {
-        let _w = crate::interrupt::writing();
+        let _w = crate::terminal::interrupt::writing();
         Self::create_unguarded(target)
     }
 
@@ -118,7 +118,7 @@ impl AtomicFile {
 
     /// Sync the file and rename it over its target.
     pub fn commit(self) -> Result<(), WriteError> {
-        let _w = crate::interrupt::writing();
+        let _w = crate::terminal::interrupt::writing();
         self.commit_unguarded()
     }
 
@@ -143,7 +143,7 @@ pub fn write_with(
     fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
     super::failpoint(&format!("write:{}", super::names::file_name(path)));
-    let _w = crate::interrupt::writing();
+    let _w = crate::terminal::interrupt::writing();
     write_unguarded(path, fill)
 }
 
@@ -172,7 +172,7 @@ pub fn ensure_dir(dir: &Path) -> Result<(), WriteError> {
     if dir.as_os_str().is_empty() {
         return Ok(());
     }
-    let _w = crate::interrupt::writing();
+    let _w = crate::terminal::interrupt::writing();
     std::fs::create_dir_all(dir).map_err(WriteError::io(dir))
 }
 

@@ -37,7 +37,7 @@ impl Drop for Held {
     fn drop(&mut self) {
         // Still locked here: the file closes (and unlocks) after this.
         let _ = std::fs::remove_file(&self.path);
-        crate::interrupt::unstaged(&self.path);
+        crate::terminal::interrupt::unstaged(&self.path);
     }
 }
 
@@ -69,7 +69,7 @@ impl OutputLock {
         }
         let file = lock_file(target, &path)?;
         // An interrupt removes the lock file as it removes staged results (still holding it).
-        crate::interrupt::staged(&path);
+        crate::terminal::interrupt::staged(&path);
         let lock = Arc::new(Held { path, _file: file });
         held.push((key, Arc::downgrade(&lock)));
         Ok(OutputLock { _held: lock })

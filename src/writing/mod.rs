@@ -209,7 +209,7 @@ pub fn failpoint(step: &str) {
             "int" => {
                 let _ = raise(Signal::SIGINT);
                 for _ in 0..5000 {
-                    if crate::interrupt::is_interrupted() {
+                    if crate::terminal::interrupt::is_interrupted() {
                         break;
                     }
                     std::thread::sleep(std::time::Duration::from_millis(1));

@@ -92,10 +92,10 @@ impl ResultsDir {
         check_replaceable(target, force)?;
         let staging = names::temporary(target, Role::New);
         {
-            let _w = crate::interrupt::writing();
+            let _w = crate::terminal::interrupt::writing();
             std::fs::create_dir(&staging)
                 .with_context(|| format!("cannot create folder {}", staging.display()))?;
-            crate::interrupt::staged(&staging);
+            crate::terminal::interrupt::staged(&staging);
         }
         Ok(ResultsDir {
             target: target.to_path_buf(),
@@ -113,7 +113,7 @@ impl ResultsDir {
     /// Swap the new results in: rename the old folder aside, the new one into place, then
     /// remove the old one. Interrupts wait until the results are in place.
     pub fn commit(mut self) -> Result<()> {
-        let _hold = crate::interrupt::hold_off();
+        let _hold = crate::terminal::interrupt::hold_off();
         check_folder_or_new(&self.target)?;
         check_replaceable(&self.target, true)?;
         let old = names::temporary(&self.target, Role::Old);
@@ -125,8 +125,8 @@ impl ResultsDir {
             return Err(e);
         }
         self.committed = true;
-        crate::interrupt::unstaged(&self.staging);
-        crate::interrupt::written(self.target.display().to_string());
+        crate::terminal::interrupt::unstaged(&self.staging);
+        crate::terminal::interrupt::written(self.target.display().to_string());
         sync_folder(&parent_of(&self.target));
         if moved {
             if let Err(e) = clear_old(&old) {
@@ -141,7 +141,7 @@ impl Drop for ResultsDir {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
-            crate::interrupt::unstaged(&self.staging);
+            crate::terminal::interrupt::unstaged(&self.staging);
         }
     }
 }

@@ -3,7 +3,7 @@
 //! written in full beside its target under a temporary name ([`super::names`]); then
 //! [`StagedFiles::commit`] writes the list of renames to a commit file beside the first
 //! target (`.<name>.commit-<pid>-<n>`, synced), makes the renames, and removes the list —
-//! interrupts held off meanwhile ([`crate::interrupt::hold_off`]). Dropped without a commit,
+//! interrupts held off meanwhile ([`crate::terminal::interrupt::hold_off`]). Dropped without a commit,
 //! the staged files are removed and the old files stay as they were.
 //!
 //! A run killed between two renames leaves its commit file; the next run into the same
@@ -52,7 +52,7 @@ impl StagedFiles {
             }
         }
         let staged = names::temporary(target, Role::New);
-        crate::interrupt::staged(&staged);
+        crate::terminal::interrupt::staged(&staged);
         self.pairs.push((staged.clone(), target.to_path_buf()));
         Ok(staged)
     }
@@ -63,7 +63,7 @@ impl StagedFiles {
         let Some((_, first)) = self.pairs.first().cloned() else {
             return Ok(());
         };
-        let _hold = crate::interrupt::hold_off();
+        let _hold = crate::terminal::interrupt::hold_off();
         for (_, target) in &self.pairs {
             check_regular_or_new(target)?;
         }
@@ -88,8 +88,8 @@ impl StagedFiles {
                     target.display()
                 )
             })?;
-            crate::interrupt::unstaged(&staged);
-            crate::interrupt::written(target.display().to_string());
+            crate::terminal::interrupt::unstaged(&staged);
+            crate::terminal::interrupt::written(target.display().to_string());
         }
         sync_folder(&parent_of(&first));
         std::fs::remove_file(&journal)
@@ -101,7 +101,7 @@ impl Drop for StagedFiles {
     fn drop(&mut self) {
         for (staged, _) in &self.pairs {
             let _ = std::fs::remove_file(staged);
-            crate::interrupt::unstaged(staged);
+            crate::terminal::interrupt::unstaged(staged);
         }
     }
 }

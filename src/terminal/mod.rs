@@ -11,6 +11,9 @@
 //! failure to write (a full disk: `> /dev/full`) ends printing too, and is kept
 //! ([`output_failure`]) so that the program does not exit 0 with its output lost.
 
+pub mod interrupt;
+pub mod progress;
+
 use std::borrow::Cow;
 use std::fmt;
 use std::io::Write;

@@ -8,8 +8,8 @@ use std::path::Path;
 use anyhow::Result;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
+use crate::documents::standard_report::write_report;
 use crate::report::{measured_vs_model, milli, FigureRef, Section, Table, DISPLACEMENT_MM};
-use crate::standard_report::write_report;
 
 pub use stf_study::identify::StageOutcome;
 use stf_study::verdict::identify_verdict as verdict;

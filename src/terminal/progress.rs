@@ -2,7 +2,7 @@
 //! standard error is not a terminal: the command line's [`stf_study::observer::Observer`].
 //! Job names and messages quote model names, which may come from script files: their control
 //! characters are escaped ([`crate::terminal`]). A finished step is recorded for the interrupt
-//! message ([`crate::interrupt`]).
+//! message ([`crate::terminal::interrupt`]).
 
 use std::io::IsTerminal;
 use std::sync::Arc;
@@ -73,6 +73,6 @@ impl Observer for Progress {
         eprintln!("warning: {text}");
     }
     fn finished(&self, what: &str) {
-        crate::interrupt::finished_step(what);
+        crate::terminal::interrupt::finished_step(what);
     }
 }

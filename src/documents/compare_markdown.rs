@@ -39,7 +39,7 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
             ""
         }
     );
-    for line in crate::compare_loops::boundary_lines(measured) {
+    for line in crate::documents::compare_loops::boundary_lines(measured) {
         let _ = writeln!(md, "- {line}");
     }
     errors_table(&mut md, c);
@@ -54,8 +54,8 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
             "- best over the regimes (mean of the per-regime errors): **{b}**"
         );
     }
-    let energy = crate::compare_loops::energy_table(&c.labels(), &c.comparisons);
-    crate::compare_loops::write_markdown(&mut md, &c.loop_rankings, &energy);
+    let energy = crate::documents::compare_loops::energy_table(&c.labels(), &c.comparisons);
+    crate::documents::compare_loops::write_markdown(&mut md, &c.loop_rankings, &energy);
     misses_and_warnings(&mut md, c);
     md
 }
