@@ -397,8 +397,8 @@ pub fn repair(target: &Path) -> Result<Vec<String>> {
 }
 
 /// Make the renames in `folder` durable (best effort; a no-op where folders cannot be
-/// opened as files).
-fn sync_folder(folder: &Path) {
+/// opened as files). Shared with [`super::staged_files`].
+pub(super) fn sync_folder(folder: &Path) {
     if let Ok(f) = std::fs::File::open(folder) {
         let _ = f.sync_all();
     }

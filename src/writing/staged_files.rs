@@ -91,7 +91,7 @@ impl StagedFiles {
             crate::terminal::interrupt::unstaged(&staged);
             crate::terminal::interrupt::written(target.display().to_string());
         }
-        sync_folder(&parent_of(&first));
+        super::results_dir::sync_folder(&parent_of(&first));
         std::fs::remove_file(&journal)
             .with_context(|| format!("cannot remove {}", journal.display()))
     }
@@ -157,13 +157,6 @@ pub fn finish_commits(first: &Path) -> Result<Vec<String>> {
         }
     }
     Ok(notes)
-}
-
-/// Make the renames in `folder` durable (best effort).
-fn sync_folder(folder: &Path) {
-    if let Ok(f) = std::fs::File::open(folder) {
-        let _ = f.sync_all();
-    }
 }
 
 #[cfg(test)]
