@@ -21,5 +21,6 @@ pub mod campaign;
 pub mod commands;
 pub mod documents;
 pub mod report;
+pub mod results;
 pub mod terminal;
 pub mod writing;

@@ -4,8 +4,9 @@
 //! cluster run and a local run give identical unit outputs.
 //!
 //! The unit's folder is locked from the start of its run to the end (`crate::writing::lock`),
-//! so no other run writes it meanwhile. The command's usual outputs are written by the
-//! command itself (its folder swapped in whole, `crate::writing::results_dir`), then
+//! so no other run writes it meanwhile. The unit runs the command's study call
+//! (`stf_study::fit`, `compare`, `discover`) and writes its results folder as the command does
+//! ([`crate::results`], swapped in whole, `crate::writing::results_dir`), then
 //! `unit.json` ([`UnitJson`]) beside them, atomically: a unit killed midway leaves no
 //! `unit.json` that matches its inputs, so it is rerun. A unit whose command fails gets a
 //! folder holding only its `unit.json` (status `failed`, the error); if even that cannot be
@@ -23,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use super::file::{Campaign, CommandName, Unit};
 use super::hash::unit_hash;
 use crate::experiment::Experiment;
+use crate::terminal::progress::Progress;
 use crate::writing::lock::OutputLock;
 use crate::writing::results_dir::ResultsDir;
 use crate::writing::write_json;
@@ -118,11 +120,7 @@ pub fn run_one(
     let _lock = OutputLock::acquire(&dir)?;
     let started = Instant::now();
     let exp = exp.with_data_file(unit.record.clone());
-    let result = match unit.command {
-        CommandName::Fit => crate::commands::fit::run_experiment(exp, &dir, true, quiet),
-        CommandName::Compare => crate::commands::compare::run_experiment(exp, &dir, true, quiet),
-        CommandName::Discover => crate::commands::discover::run_experiment(exp, &dir, true, quiet),
-    };
+    let result = run_study(unit.command, exp, &dir, quiet);
     let mut json = UnitJson {
         unit: number,
         record: unit.record_given.clone(),
@@ -152,6 +150,33 @@ pub fn run_one(
             }
         }
     }
+}
+
+/// Run the unit's study (`command` on `exp`) and write its results folder in `dir`, swapped
+/// in whole: the same study calls and writers as the command's.
+fn run_study(command: CommandName, mut exp: Experiment, dir: &Path, quiet: bool) -> Result<()> {
+    let progress = Progress::new(quiet);
+    let results = ResultsDir::begin(dir, true)?;
+    let out = results.path();
+    match command {
+        CommandName::Fit if !exp.identify.is_empty() => {
+            let found = stf_study::identify::identify(&exp, &progress)?;
+            crate::results::fit::write_identification(&exp, out, &found)?;
+        }
+        CommandName::Fit => {
+            let fitted = stf_study::fit::fit(&mut exp, &progress)?;
+            crate::results::fit::write(&exp, &fitted, out)?;
+        }
+        CommandName::Compare => {
+            let compared = stf_study::compare::compare(&mut exp, &progress)?;
+            crate::results::compare::write(&exp, &compared, out)?;
+        }
+        CommandName::Discover => {
+            let found = stf_study::discover::discover(&mut exp, &progress)?;
+            crate::results::discover::write(&exp, &found, out)?;
+        }
+    }
+    results.commit()
 }
 
 /// A folder holding only the failed unit's `unit.json`, swapped in whole.

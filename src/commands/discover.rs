@@ -1,267 +1,32 @@
 //! `stf-lab discover EXP.toml --out DIR`: find where the base model and the measurement
-//! disagree, name the missing effect, add it, repeat, and show the gap shrink.
-//!
-//! Candidates are the effects of docs/ARCHITECTURE.md §5 (the built-ins `viscous`, `power_law`,
-//! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`) not
-//! already in the base, plus any scripts `[discover] candidates` lists. Writes
-//! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
-//! scores, and the final model as an experiment entry), a report and figures. A record
-//! without `f_stf` (or `[discover] level = "trajectory"`) is discovered at trajectory level,
-//! along the same path: what differs is the core level ([`discover_force`] or
-//! [`discover_trajectory`] with the refitted oscillator), the signal and unit
-//! ([`FitLevel::shown`]), the oscillator's entry and the figures ([`Drawn`]).
+//! disagree, name the missing effect, add it, repeat, and show the gap shrink: the study's
+//! discovery ([`stf_study::discover`]), its results folder written by
+//! [`crate::results::discover`].
 
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::discovery::Discovery;
-use stf_study::discover::Discovered;
 
-use crate::documents::standard_report::{record_sections, write_report};
-use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
-use crate::fitting::{estimate_line, FitData};
-use crate::report::{
-    measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
-    DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
-};
+use crate::experiment::Experiment;
+use crate::fitting::estimate_line;
+use crate::results;
 use crate::say;
 use crate::terminal::progress::Progress;
-use crate::validation::DiscoveryScore;
 use crate::writing::results_dir::{wrote_line, ResultsDir};
-use crate::writing::{write_atomic, write_json};
 
-/// Run `stf-lab discover` on an experiment loaded (from its file, or a campaign's unit: its
-/// record set with [`Experiment::with_data_file`]): the results are built in a staging
-/// folder and swapped in as a whole ([`ResultsDir`]).
-pub fn run_experiment(mut exp: Experiment, out_arg: &Path, force: bool, quiet: bool) -> Result<()> {
+/// Run `stf-lab discover` on an experiment loaded from its file: the results are built in a
+/// staging folder and swapped in as a whole ([`ResultsDir`]).
+pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let progress = Progress::new(quiet);
     let inputs = stf_study::discover::load(&mut exp, &progress)?;
     if let Some(line) = estimate_line(&inputs.data) {
         say!("{line}");
     }
-    let results = ResultsDir::begin(out_arg, force)?;
+    let results = ResultsDir::begin(out, force)?;
     let found = inputs.discover(&exp, &progress)?;
-    let out = results.path();
-    let (doc, entries) = found.json(&exp)?;
-    write_json(&out.join("discovery.json"), &doc)?;
-    write_atomic(&out.join("discovered.csv"), &found.discovered_csv()?)?;
-    let (data, score) = (&found.data, found.score.as_ref());
-    if exp.output.report {
-        report(&exp, &found, out)?;
-    }
+    results::discover::write(&exp, &found, results.path())?;
     results.commit()?;
-    print_summary(
-        &found.spec,
-        data,
-        &found.found,
-        score,
-        (&entries, found.wall_s),
-    );
-    say!(
-        "{}",
-        wrote_line(
-            out_arg,
-            &["discovery.json", "discovered.csv"],
-            exp.output.report
-        )
-    );
+    let files = ["discovery.json", "discovered.csv"];
+    say!("{}", wrote_line(out, &files, exp.output.report));
     Ok(())
-}
-
-/// The terminal summary of a discovery; `entries` are the final model's `[[models]]` and
-/// (trajectory level) `[system]` entries.
-fn print_summary(
-    spec: &DiscoverSpec,
-    data: &FitData,
-    found: &Discovery,
-    score: Option<&DiscoveryScore>,
-    (entries, wall): (&(String, String), f64),
-) {
-    let (unit, scale) = data.level.shown();
-    let effects = if found.effects.is_empty() {
-        "none".to_string()
-    } else {
-        found.effects.join(", ")
-    };
-    let summary = match &found.trajectory {
-        None => {
-            say!(
-                "base `{}`: gap {:.4} N; {}",
-                spec.base_text(),
-                found.gap_before,
-                found.where_before.summary
-            );
-            format!(
-                "effects: {effects}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {wall:.1} s",
-                found.gap_before, found.gap_after, found.noise_floor,
-            )
-        }
-        Some(tf) => format!(
-            "effects: {effects}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {wall:.1} s",
-            tf.s_before_mm2,
-            tf.s_after_mm2,
-            found.noise_floor * 1e3,
-        ),
-    };
-    let held_out = held_out_and_validation(found.holdout_cycles, score, unit, scale);
-    for step in &found.steps {
-        say!("  {}", step.verdict);
-    }
-    say!("{summary}");
-    say!("  {held_out}");
-    if found.trajectory.is_none() {
-        for note in &found.notes {
-            say!("  note: {note}");
-        }
-    }
-    say!(
-        "final model, as an experiment entry:\n{}{}",
-        entries.0,
-        entries.1
-    );
-}
-
-/// The held-out cycles every step was scored on and, with `[validate]`, the base's and the
-/// final model's errors on the validation record, in one sentence (errors shown in `unit`,
-/// `scale` from SI).
-fn held_out_and_validation(
-    holdout_cycles: usize,
-    score: Option<&DiscoveryScore>,
-    unit: &str,
-    scale: f64,
-) -> String {
-    let held_out = format!("held out: {holdout_cycles} cycles of the record");
-    match score {
-        Some(score) => format!("{held_out}; {}", score.summary(unit, scale)),
-        None => held_out,
-    }
-}
-
-/// What a discovery's report draws at one level: the section's title, the measured signal
-/// against the base and the final model, and their residuals (figure names, quantities,
-/// captions).
-struct Drawn {
-    title: &'static str,
-    signal: (&'static str, Quantity, &'static str),
-    residual: (&'static str, Quantity, &'static str),
-}
-
-/// [`Drawn`] at force level.
-const FORCE_DRAWN: Drawn = Drawn {
-    title: "Discovery",
-    signal: (
-        "discovery_force",
-        STF_FORCE,
-        "Measured STF force against the base and the final model.",
-    ),
-    residual: (
-        "discovery_residual",
-        STF_FORCE_RESIDUAL,
-        "Residual (measured − model) of the base (grey band) and of the final model.",
-    ),
-};
-
-/// [`Drawn`] at trajectory level.
-const TRAJECTORY_DRAWN: Drawn = Drawn {
-    title: "Discovery (trajectory level)",
-    signal: (
-        "discovery_x",
-        DISPLACEMENT_MM,
-        "Measured displacement against the simulated base and final model.",
-    ),
-    residual: (
-        "discovery_x_residual",
-        DISPLACEMENT_RESIDUAL_MM,
-        "Displacement residual (measured − simulated) of the base (grey band) and of the \
-         final model.",
-    ),
-};
-
-/// The report of a discovery: its notes, the steps' tables (force level), the measured
-/// signal against the base and the final model and their residuals (in the level's unit),
-/// the regime windows (force level) and the record's sections.
-fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
-    let (data, found) = (&discovered.data, &discovered.found);
-    let score = discovered.score.as_ref();
-    let dir = out.join("figures");
-    crate::writing::atomic::ensure_dir(&dir)?;
-    let (unit, scale) = data.level.shown();
-    let drawn = match data.level {
-        FitLevel::Force => &FORCE_DRAWN,
-        FitLevel::Trajectory => &TRAJECTORY_DRAWN,
-    };
-    let shown = |v: &[f64]| v.iter().map(|v| v * scale).collect::<Vec<f64>>();
-    let target = data.target();
-    let (before, after) = discovered.modelled();
-    let mut s = Section::new(drawn.title);
-    // The notes are the base's gap, each step's verdict and the final gap, in order.
-    s.paragraphs.extend(found.notes.iter().cloned());
-    s.paragraphs.push(format!(
-        "{}.",
-        held_out_and_validation(found.holdout_cycles, score, unit, scale)
-    ));
-    let tables = found
-        .steps
-        .iter()
-        .enumerate()
-        .map(|(i, step)| step_table(i, step, (unit, scale)));
-    s.tables.extend(tables);
-    let (b, a, r_after) = (shown(&before), shown(&after), shown(&found.residual_after));
-    let figures = [
-        (
-            drawn.signal,
-            shown(target),
-            vec![("base", &b[..]), ("final", &a[..])],
-        ),
-        (
-            drawn.residual,
-            shown(&found.residual_before),
-            vec![("final", &r_after[..])],
-        ),
-    ];
-    for ((name, quantity, caption), measured, curves) in figures {
-        let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
-        s.figures.push(FigureRef::new(fig, caption));
-    }
-    let mut sections = vec![s];
-    if data.level == FitLevel::Force {
-        let curves = [("base", before.as_slice()), ("final", after.as_slice())];
-        sections.extend(crate::documents::regime_figures::regime_section(
-            exp, data, &curves, out,
-        )?);
-    }
-    sections.extend(record_sections(data, &[], out)?);
-    let mut intro = vec![discovered.verdict().text];
-    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));
-    write_report(
-        &format!("Discovery: {}", exp.path.display()),
-        intro,
-        sections,
-        out,
-    )
-}
-
-/// The table of step `i`'s candidates, RMS in `unit` (`scale` from SI).
-fn step_table(i: usize, step: &stf_core::discovery::Step, (unit, scale): (&str, f64)) -> Table {
-    let caption = format!("Step {}: candidates added to `{}`", i + 1, step.current);
-    let rms = format!("held-out RMS, {unit}");
-    let columns = [
-        "candidate",
-        rms.as_str(),
-        "ΔBIC",
-        "paired z (units)",
-        "explains of the excess",
-        "significant",
-    ];
-    let rows = step.candidates.iter().map(|c| {
-        vec![
-            c.name.clone(),
-            format!("{:.5}", c.holdout_rms * scale),
-            format!("{:.1}", c.delta_bic),
-            format!("{:.1} ({})", c.gain_z, c.effective_n),
-            format!("{} %", crate::digits::fixed(100.0 * c.explained_share, 0)),
-            crate::documents::standard_report::yes_no(c.significant),
-        ]
-    });
-    Table::new(caption, &columns).with_rows(rows.collect())
 }

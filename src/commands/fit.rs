@@ -1,42 +1,28 @@
 //! `stf-lab fit EXP.toml --out DIR`: calibrate every model of the experiment, or run the
-//! oscillator identification stages of `[[identify]]`.
-//!
-//! Writes `DIR/fit.json` (for each model: `name`, `params`, `rms`, standard errors, AIC/BIC,
-//! convergence, the noise floor, `warnings` …; with `[validate]`, `validation_rms` and
-//! `validation`, its error on the second record, [`crate::validation`]) and `DIR/fitted.csv` (the measured signal and
-//! each model's fit). The summary on the terminal prints each model's warnings under its line
-//! ([`stf_core::fit::fit_warnings`]: not converged, residual above the noise floor, a
-//! parameter on a bound or not determined, two parameters not told apart).
+//! oscillator identification stages of `[[identify]]`: the study's fit
+//! ([`stf_study::fit`], [`stf_study::identify`]), its results folder written by
+//! [`crate::results::fit`].
 
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::fit::{FitResult, FitWarning};
-use stf_study::fit::Fitted;
-use stf_study::identify::Identification;
 
-use crate::documents::identify_report::{system_line, write_identification_report};
-use crate::experiment::{Experiment, FitLevel, StageSpec};
-use crate::fitting::{estimate_line, FitData, ModelFit};
-use crate::outputs::identification_json::IdentificationJson;
-use crate::param_table::{params_csv, rows_of, ParamRow};
+use crate::experiment::Experiment;
+use crate::fitting::estimate_line;
+use crate::results;
 use crate::say;
 use crate::terminal::progress::Progress;
-use crate::validation::ValidationRecord;
 use crate::writing::results_dir::{wrote_line, ResultsDir};
-use crate::writing::{write_atomic, write_json};
-use stf_core::regimes::Regime;
 
-/// Run `stf-lab fit` on an experiment loaded (from its file, or a campaign's unit: its
-/// record set with [`Experiment::with_data_file`]): the results are built in a staging
-/// folder and swapped in as a whole ([`ResultsDir`]).
+/// Run `stf-lab fit` on an experiment loaded from its file: the results are built in a
+/// staging folder and swapped in as a whole ([`ResultsDir`]).
 pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool) -> Result<()> {
     let progress = Progress::new(quiet);
     let mut files = vec!["fit.json", "params.csv"];
     let results = if !exp.identify.is_empty() {
         let results = ResultsDir::begin(out, force)?;
         let found = stf_study::identify::identify(&exp, &progress)?;
-        write_identification(&exp, results.path(), &found)?;
+        results::fit::write_identification(&exp, results.path(), &found)?;
         results
     } else {
         let inputs = stf_study::fit::load(&mut exp, &progress)?;
@@ -45,218 +31,11 @@ pub fn run_experiment(mut exp: Experiment, out: &Path, force: bool, quiet: bool)
             say!("{line}");
         }
         let fitted = inputs.fit(&exp, &progress)?;
-        write_fits(&exp, &fitted, results.path())?;
+        results::fit::write(&exp, &fitted, results.path())?;
         files.push("fitted.csv");
         results
     };
     results.commit()?;
     say!("{}", wrote_line(out, &files, exp.output.report));
-    Ok(())
-}
-
-/// Write the fit's results into `out` and print its summary.
-fn write_fits(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()> {
-    let (data, fits) = (&fitted.data, &fitted.fits);
-    write_json(&out.join("fit.json"), &fitted.json(exp))?;
-    let params = out.join("params.csv");
-    write_atomic(&params, &params_csv(&params, &fitted.param_rows())?)?;
-    let csv = fitted.fitted_columns().to_csv()?;
-    write_atomic(&out.join("fitted.csv"), &csv)?;
-
-    print_summary(data, fits);
-    if let Some(rec) = &fitted.validation {
-        print_validation(rec, fits);
-    }
-    if exp.output.report {
-        write_fit_report(exp, fitted, out)?;
-    }
-    Ok(())
-}
-
-/// The fit's report (report.html, report.md, figures/) in `out`.
-fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()> {
-    let (data, fits) = (&fitted.data, fitted.fits.as_slice());
-    let validation = fitted.validation.as_ref();
-    let level = data.level;
-    let mut sections = Vec::new();
-    if let Some(rec) = validation {
-        sections.push(crate::documents::standard_report::validation_section(
-            rec, fits, out,
-        )?);
-    }
-    sections.extend(crate::documents::standard_report::record_sections(
-        data, fits, out,
-    )?);
-    let forces: Vec<(&str, &[f64])> = match level {
-        FitLevel::Force => fits
-            .iter()
-            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
-            .collect(),
-        FitLevel::Trajectory => Vec::new(),
-    };
-    sections.extend(crate::documents::regime_figures::regime_section(
-        exp, data, &forces, out,
-    )?);
-    let mut intro = vec![
-        fitted.verdict().text,
-        format!(
-            "stf-lab fitted {} model(s) of {} to {}.",
-            fits.len(),
-            exp.path.display(),
-            data.record.source
-        ),
-    ];
-    if let Some(rec) = validation {
-        intro.push(crate::documents::standard_report::validation_intro(
-            rec, fits,
-        ));
-    }
-    let warned = fits.iter().filter(|f| !f.warnings.is_empty()).count();
-    if warned > 0 {
-        intro.push(format!(
-            "⚠ {warned} of the {} fits carry warnings: see the box under Fits.",
-            fits.len()
-        ));
-    }
-    crate::documents::standard_report::write_report(
-        &format!("Fit: {}", exp.path.display()),
-        intro,
-        sections,
-        out,
-    )?;
-    Ok(())
-}
-
-/// The terminal summary: one line per model, its warnings under it.
-fn print_summary(data: &FitData, fits: &[ModelFit]) {
-    let (unit, scale) = data.level.shown();
-    say!(
-        "fitted {} model(s) at {} level on {} samples of {}",
-        fits.len(),
-        data.level.name(),
-        data.record.len(),
-        data.record.source
-    );
-    if let Some(drive) = &data.kinematics.drive {
-        say!("  {drive}");
-    }
-    for f in fits {
-        let params: Vec<String> = f
-            .result
-            .params
-            .iter()
-            .filter(|p| !p.fixed)
-            .map(crate::digits::param_with_error)
-            .collect();
-        say!(
-            "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
-            f.label,
-            f.result.rms * scale,
-            f.result.aic,
-            params.join(", "),
-            if f.result.convergence.converged() {
-                ""
-            } else {
-                "  (did not converge)"
-            }
-        );
-        print_warnings(&f.warnings);
-    }
-}
-
-/// The validation block: each model's error on the `[validate]` record, per regime where
-/// the record has them.
-fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
-    let (unit, scale) = rec.data.level.shown();
-    say!(
-        "validation on {} ({} samples), fitted parameters held{}:",
-        rec.spec.given,
-        rec.data.record.len(),
-        if rec.data.level == FitLevel::Trajectory {
-            ", initial state as in the fit"
-        } else {
-            ""
-        }
-    );
-    for f in fits {
-        let Some(v) = &f.validation else { continue };
-        let Some(score) = &v.score else {
-            say!(
-                "  {:<24} not scored: {}",
-                f.label,
-                v.error.as_deref().unwrap_or("?")
-            );
-            continue;
-        };
-        let regimes: Vec<String> = v
-            .per_regime
-            .iter()
-            .flat_map(|p| Regime::ALL.map(|r| p.get(r).map(|e| (r, e.rms))))
-            .flatten()
-            .map(|(r, rms)| format!("{} {:.4}", r.name(), rms * scale))
-            .collect();
-        say!(
-            "  {:<24} rms {:.4} {unit} ({:.3} of the measured RMS){}",
-            f.label,
-            score.rms * scale,
-            score.normalised,
-            if regimes.is_empty() {
-                String::new()
-            } else {
-                format!("; {}", regimes.join(", "))
-            }
-        );
-    }
-}
-
-/// Each warning on its own line, indented under the model's line.
-fn print_warnings(warnings: &[FitWarning]) {
-    for w in warnings {
-        say!("      warning: {w}");
-    }
-}
-
-/// The terminal line of identification stage `i`, its warnings under it.
-fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitWarning]) {
-    say!(
-        "stage {} ({}): S(μ) = {:.4} mm², {}{}",
-        i + 1,
-        stage.data.display(),
-        result.s_mm2.unwrap_or(f64::NAN),
-        result
-            .params
-            .iter()
-            .map(crate::digits::param_with_error)
-            .collect::<Vec<_>>()
-            .join(", "),
-        if result.convergence.converged() {
-            ""
-        } else {
-            " (did not converge)"
-        }
-    );
-    print_warnings(warnings);
-}
-
-/// Write the identification's fit.json, params.csv and report into `out`, and print each
-/// stage and the oscillator found.
-fn write_identification(exp: &Experiment, out: &Path, found: &Identification) -> Result<()> {
-    let (system, outcomes) = (&found.system, &found.stages);
-    for (i, (stage, o)) in exp.identify.iter().zip(outcomes).enumerate() {
-        print_stage(i, stage, &o.result, &o.warnings);
-    }
-    let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system);
-    write_json(&out.join("fit.json"), &doc)?;
-    let rows: Vec<ParamRow> = outcomes
-        .iter()
-        .enumerate()
-        .flat_map(|(i, o)| rows_of(&format!("stage {}", i + 1), &o.result, None, &o.warnings))
-        .collect();
-    let params = out.join("params.csv");
-    write_atomic(&params, &params_csv(&params, &rows)?)?;
-    say!("identified system: {}", system_line(system));
-    if exp.output.report {
-        write_identification_report(&exp.path, outcomes, system, out)?;
-    }
     Ok(())
 }
