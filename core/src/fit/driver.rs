@@ -18,6 +18,7 @@ use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::fit_param::FitParam;
 use super::levenberg_marquardt::{BoundStop, MAX_FD_STEP, NOISE_PROBE};
+use super::noise_floor::Quantity;
 use super::objective::{Objective, Residuals};
 use super::observer::Watch;
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
@@ -27,17 +28,18 @@ use super::stages::{self, StageEnd};
 
 /// Fit the free members of `params` (all of them, in order) of `problem`, whose
 /// [`Residuals::residuals`] receives the user values of the free parameters only.
-/// `trajectory`: report S(μ) in mm² (the residuals are displacements in m). `observer` sees
+/// `quantity`: what the residuals measure (displacements: a trajectory fit, S(μ) reported in
+/// mm²). `observer` sees
 /// the fit's progress after every iteration of every stage (see [`super::observer`]).
 pub fn run(
     problem: &dyn Residuals,
     params: &[FitParam],
     settings: &FitSettings,
     observer: Option<&(dyn Fn(FitProgress) + Sync)>,
-    trajectory: bool,
+    quantity: Quantity,
 ) -> Result<FitResult, FitError> {
     Watch::forwarding(observer, |display| {
-        run_watched(problem, params, settings, display, trajectory)
+        run_watched(problem, params, settings, display, quantity)
     })
 }
 
@@ -47,7 +49,7 @@ fn run_watched(
     params: &[FitParam],
     settings: &FitSettings,
     display: Option<Sender<FitProgress>>,
-    trajectory: bool,
+    quantity: Quantity,
 ) -> Result<FitResult, FitError> {
     let clock = Instant::now();
     let free = checked(problem, params, settings)?;
@@ -70,7 +72,7 @@ fn run_watched(
         obj: &obj,
         free: &free,
         settings,
-        trajectory,
+        quantity,
         watch: &watch,
         iterations: 0,
         log: Vec::new(),
@@ -116,7 +118,7 @@ struct Chain<'a> {
     obj: &'a Objective<'a>,
     free: &'a [&'a FitParam],
     settings: &'a FitSettings,
-    trajectory: bool,
+    quantity: Quantity,
     /// The fit's observer of every stage.
     watch: &'a Watch,
     iterations: u64,
@@ -124,6 +126,11 @@ struct Chain<'a> {
 }
 
 impl Chain<'_> {
+    /// Whether the residuals are displacements of a simulated trajectory.
+    fn is_trajectory(&self) -> bool {
+        self.quantity == Quantity::Displacement
+    }
+
     /// The stages of the chosen solver from `u0` (then, in a trajectory fit, the release of
     /// pinned parameters): where they end and how.
     fn solve(&mut self, u0: &[f64]) -> Result<(Vec<f64>, Convergence), FitError> {
@@ -159,7 +166,7 @@ impl Chain<'_> {
                 self.lm(&u)?
             }
         };
-        if self.trajectory {
+        if self.is_trajectory() {
             release_pinned(self, u, convergence)
         } else {
             Ok((u, convergence))
@@ -183,7 +190,7 @@ impl Chain<'_> {
     fn refine(&mut self, start: &[f64]) -> Result<StageEnd, FitError> {
         let (obj, free) = (self.obj, self.free);
         let at_bound = |u: &[f64]| !pinned(obj, free, u).is_empty();
-        let stop_at_bound: BoundStop = self.trajectory.then_some(&at_bound);
+        let stop_at_bound: BoundStop = self.is_trajectory().then_some(&at_bound);
         let out =
             stages::levenberg_marquardt(obj, start, self.settings, stop_at_bound, self.watch)?;
         self.iterations += out.iterations;
@@ -372,7 +379,7 @@ impl Chain<'_> {
             n_free: p,
             rss,
             rms: mean.sqrt(),
-            s_mm2: self.trajectory.then_some(mean * 1e6),
+            s_mm2: (self.quantity == Quantity::Displacement).then_some(mean * 1e6),
             aic: ln_term + 2.0 * p as f64,
             bic: ln_term + p as f64 * nf.ln(),
             evaluations: obj.evaluations(),
@@ -561,7 +568,7 @@ mod tests {
             for iters in [1, 2, 200] {
                 let params = [FitParam::new("k", best).bounds(0.0, 1e9)];
                 let settings = FitSettings::default().solver(solver).max_iters(iters);
-                let fit = run(&line, &params, &settings, None, false).unwrap();
+                let fit = run(&line, &params, &settings, None, Quantity::Force).unwrap();
                 assert!(
                     fit.rss <= start_rss * (1.0 + 1e-12),
                     "{solver:?}, {iters} iterations: rss {} > start {start_rss}, k = {}",

@@ -40,6 +40,7 @@ use nalgebra::DMatrix;
 use super::driver;
 use super::error::FitError;
 use super::fit_param::{full_values, held, FitParam};
+use super::noise_floor::Quantity;
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::solver::FitSettings;
@@ -150,7 +151,7 @@ impl ForceFit {
             all: &all,
             rows,
         };
-        driver::run(&problem, &all, settings, observer, false)
+        driver::run(&problem, &all, settings, observer, Quantity::Force)
     }
 
     /// The modelled force (with the offset, if any) at every sample for the full parameter

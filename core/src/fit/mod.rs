@@ -79,7 +79,7 @@ pub fn fit_residuals(
     settings: &FitSettings,
     observer: Option<&(dyn Fn(FitProgress) + Sync)>,
 ) -> Result<FitResult, FitError> {
-    driver::run(problem, params, settings, observer, false)
+    driver::run(problem, params, settings, observer, Quantity::Force)
 }
 
 /// Fit `problem`, whose residuals are displacements in m, as a trajectory fit is fitted:
@@ -102,7 +102,7 @@ pub fn fit_trajectory_residuals(
     settings: &FitSettings,
     observer: Option<&(dyn Fn(FitProgress) + Sync)>,
 ) -> Result<FitResult, FitError> {
-    driver::run(problem, params, settings, observer, true)
+    driver::run(problem, params, settings, observer, Quantity::Displacement)
 }
 
 #[cfg(test)]

@@ -29,6 +29,7 @@ use derive_setters::Setters;
 use super::driver;
 use super::error::FitError;
 use super::fit_param::{full_values, held, FitParam};
+use super::noise_floor::Quantity;
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::same_term::check_same_terms;
@@ -286,7 +287,13 @@ impl TrajectoryFit {
         self.check(data)?;
         let problem = self.problem(data)?;
         let settings = self.settings.clone().for_simulation(self.sim.rtol);
-        driver::run(&problem, &self.free, &settings, observer, true)
+        driver::run(
+            &problem,
+            &self.free,
+            &settings,
+            observer,
+            Quantity::Displacement,
+        )
     }
 
     /// [`check_same_terms`] on the parameters this fit frees.
