@@ -3,10 +3,11 @@
 //! failed; the results are the types the command line renders and writes, so a number read
 //! here is the number `fit.json`, `compare.json` or `discovery.json` holds.
 //!
-//! ```no_run
+//! ```
 //! use stf_study::prelude::*;
 //!
 //! # fn main() -> Result<(), StudyError> {
+//! # std::env::set_current_dir("..").expect("the workspace root, where experiments/ is");
 //! // A power law fitted to the bundled record (force level: it has `f_stf`).
 //! let mut exp = read_experiment("experiments/power_law_fit.toml")?;
 //! let fitted = fit(&mut exp, &Silent)?;
