@@ -4,7 +4,8 @@
 //! exceptions of `stf_lab._errors` ([`errors`]) — and runs long work off the GIL with Ctrl-C
 //! honoured ([`run`]; the study's observer is [`watch`]). The workflows themselves — the study
 //! layer's `stf_study::prelude` — are called from one file, [`study_calls`]; the report's
-//! figures come from the program crate ([`figures`]).
+//! figures come from the program crate ([`figures`]), and so does a campaign, run in process
+//! into its folder ([`campaign`]).
 
 use std::path::PathBuf;
 
@@ -12,6 +13,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+pub mod campaign;
 pub mod errors;
 pub mod figures;
 pub mod models;
@@ -154,5 +156,7 @@ fn _stf_lab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models::list_models, m)?)?;
     m.add_function(wrap_pyfunction!(models::describe_model, m)?)?;
     m.add_function(wrap_pyfunction!(figures::measured_vs_fitted, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign::read_campaign, m)?)?;
     Ok(())
 }

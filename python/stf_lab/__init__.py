@@ -10,7 +10,8 @@ The same lab as the ``stf-lab`` command line, in process::
 
 Records (:func:`read_record`, :meth:`Record.from_arrays`), models (:func:`models`,
 :func:`model`), experiments (:class:`Experiment`: a file, or built in code), workflows
-(:func:`simulate`, :func:`fit`, :func:`identify`, :func:`compare`, :func:`discover`) and the exceptions (:class:`StfLabError` and
+(:func:`simulate`, :func:`fit`, :func:`identify`, :func:`compare`, :func:`discover`), campaigns
+(:func:`campaign`, :func:`read_campaign`) and the exceptions (:class:`StfLabError` and
 its kinds).
 """
 
@@ -25,6 +26,7 @@ from ._errors import (
 )
 from ._stf_lab import __version__
 from ._display import Figure
+from .campaign import CampaignResult, campaign, read_campaign
 from .experiment import Experiment
 from .models import Model, ParamSpec, model, models
 from .record import Record, read_record
@@ -59,4 +61,7 @@ __all__ = [
     "identify",
     "compare",
     "discover",
+    "campaign",
+    "read_campaign",
+    "CampaignResult",
 ]

@@ -64,3 +64,14 @@ def test_a_progress_callback_that_fails_stops_the_run_with_its_error(repo):
 
     with pytest.raises(ValueError, match="callback bug"):
         stf_lab.fit("experiments/power_law_fit.toml", progress=broken)
+
+
+def test_a_script_that_fails_in_an_experiment_is_a_model_error(tmp_path):
+    (tmp_path / "broken.rhai").write_text("fn params() { [\n")
+    rec = tmp_path / "r.csv"
+    rec.write_text("t,phi,x,f_stf\n" + "".join(f"{i / 100},{i / 10},{i / 1000},0.0\n" for i in range(50)))
+    exp = stf_lab.Experiment.build(tmp_path, data="r.csv", models=["broken.rhai"])
+    with pytest.raises(stf_lab.ModelError) as e:
+        stf_lab.fit(exp)
+    msg = str(e.value)
+    assert "`models[0]`" in msg and "broken.rhai" in msg and "syntax error" in msg, msg

@@ -20,12 +20,14 @@ use anyhow::{bail, Context, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
 use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
-use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, unit_dir, UnitStatus};
+use crate::campaign::unit::UnitStatus;
+use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, run_one_observed, unit_dir};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::campaign::{slurm, slurm_script};
 use crate::say;
 use crate::writing::staged_files::StagedFiles;
 use crate::writing::{resolve, write_json};
+use stf_study::observer::Observer;
 
 /// The command line's settings.
 pub struct Settings {
@@ -93,6 +95,35 @@ pub fn run(path: &Path, out: &Path, settings: &Settings) -> Result<()> {
         .filter_map(|f| f.error.map(|e| (f.number, e)))
         .collect();
     crate::terminal::interrupt::park_if_interrupted();
+    finish(&campaign, out, &errors)
+}
+
+/// Run the campaign at `path` into `out` in this process, as `stf-lab campaign` does but one
+/// unit after another with no child processes: for a front end that is not this program
+/// (Python has no `stf-lab` to start). The units not finished (all with `force`) run the
+/// study watched by `observer`; then the table, report and `[global]` fit are written. Asked
+/// to stop (`observer.cancelled()`), it stops between units and writes no table; the units
+/// that finished keep their folders.
+pub fn run_in_process(path: &Path, out: &Path, force: bool, observer: &dyn Observer) -> Result<()> {
+    let campaign = Campaign::load(path)?;
+    let _lock = out_dir::begin(out)?;
+    let pending = plan(&campaign, out, force)?;
+    let mut errors = BTreeMap::new();
+    for (i, p) in pending.iter().enumerate() {
+        if observer.cancelled() {
+            return Err(stf_study::error::Interrupted.into());
+        }
+        let unit = p.unit;
+        observer.note(&format!(
+            "unit {} of {} to run: {}",
+            i + 1,
+            pending.len(),
+            unit.record_given
+        ));
+        if let Err(e) = run_one_observed(&campaign, unit.number, out, true, observer) {
+            errors.insert(unit.number, format!("{e:#}"));
+        }
+    }
     finish(&campaign, out, &errors)
 }
 

@@ -28,6 +28,7 @@ use crate::terminal::progress::Progress;
 use crate::writing::lock::OutputLock;
 use crate::writing::results_dir::ResultsDir;
 use crate::writing::write_json;
+use stf_study::observer::Observer;
 
 /// The folder of unit folders under the campaign's output.
 pub const UNITS: &str = "units";
@@ -102,6 +103,17 @@ pub fn run_one(
     force: bool,
     quiet: bool,
 ) -> Result<UnitJson> {
+    run_one_observed(campaign, number, out, force, &Progress::new(quiet))
+}
+
+/// [`run_one`], the unit's study watched by `observer` (a front end's own: Python's).
+pub fn run_one_observed(
+    campaign: &Campaign,
+    number: usize,
+    out: &Path,
+    force: bool,
+    observer: &dyn Observer,
+) -> Result<UnitJson> {
     let unit = campaign.unit(number)?;
     let dir = unit_dir(out, unit);
     let exp = Experiment::load(&unit.experiment)?;
@@ -120,7 +132,7 @@ pub fn run_one(
     let _lock = OutputLock::acquire(&dir)?;
     let started = Instant::now();
     let exp = exp.with_data_file(unit.record.clone());
-    let result = run_study(unit.command, exp, &dir, quiet);
+    let result = run_study(unit.command, exp, &dir, observer);
     let mut json = UnitJson {
         unit: number,
         record: unit.record_given.clone(),
@@ -154,25 +166,29 @@ pub fn run_one(
 
 /// Run the unit's study (`command` on `exp`) and write its results folder in `dir`, swapped
 /// in whole: the same study calls and writers as the command's.
-fn run_study(command: CommandName, mut exp: Experiment, dir: &Path, quiet: bool) -> Result<()> {
-    let progress = Progress::new(quiet);
+fn run_study(
+    command: CommandName,
+    mut exp: Experiment,
+    dir: &Path,
+    progress: &dyn Observer,
+) -> Result<()> {
     let results = ResultsDir::begin(dir, true)?;
     let out = results.path();
     match command {
         CommandName::Fit if !exp.identify.is_empty() => {
-            let found = stf_study::identify::identify(&exp, &progress)?;
+            let found = stf_study::identify::identify(&exp, progress)?;
             crate::results::fit::write_identification(&exp, out, &found)?;
         }
         CommandName::Fit => {
-            let fitted = stf_study::fit::fit(&mut exp, &progress)?;
+            let fitted = stf_study::fit::fit(&mut exp, progress)?;
             crate::results::fit::write(&exp, &fitted, out)?;
         }
         CommandName::Compare => {
-            let compared = stf_study::compare::compare(&mut exp, &progress)?;
+            let compared = stf_study::compare::compare(&mut exp, progress)?;
             crate::results::compare::write(&exp, &compared, out)?;
         }
         CommandName::Discover => {
-            let found = stf_study::discover::discover(&mut exp, &progress)?;
+            let found = stf_study::discover::discover(&mut exp, progress)?;
             crate::results::discover::write(&exp, &found, out)?;
         }
     }

@@ -22,6 +22,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
 static STDERR_CLOSED: AtomicBool = AtomicBool::new(false);
 static FAILURE: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+static SILENT: AtomicBool = AtomicBool::new(false);
+
+/// Print nothing from now on: for a front end that shows results its own way (the Python
+/// package, which calls the campaign in process and reads its table), not on the terminal.
+pub fn silence() {
+    SILENT.store(true, Ordering::Relaxed);
+}
 
 /// Whether `c` must not reach a terminal raw: a control character other than `\n` and `\t`
 /// (C0, DEL, C1), or a bidirectional embedding, override or isolate.
@@ -50,7 +57,7 @@ pub fn escape_controls(text: &str) -> Cow<'_, str> {
 /// Write one line to `stream` (`name`: what it is, for a failure), escaped, unless it is
 /// known closed; a failed write marks it closed, and one that is not a closed pipe is kept.
 fn line(mut stream: impl Write, name: &str, closed: &AtomicBool, args: fmt::Arguments) {
-    if closed.load(Ordering::Relaxed) {
+    if closed.load(Ordering::Relaxed) || SILENT.load(Ordering::Relaxed) {
         return;
     }
     let text = args.to_string();

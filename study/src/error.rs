@@ -68,7 +68,13 @@ fn kind_of(e: &(dyn std::error::Error + 'static)) -> Option<ErrorKind> {
         Some(ErrorKind::Interrupted)
     } else if e.is::<RecordError>() || e.is::<BoundedError>() {
         Some(ErrorKind::Record)
-    } else if e.is::<ModelError>() || e.is::<ScriptError>() {
+    } else if let Some(script) = e.downcast_ref::<ScriptError>() {
+        // A name no model has is a mistake of the settings; a script that fails is the model's.
+        Some(match script {
+            ScriptError::UnknownModel { .. } => ErrorKind::Experiment,
+            _ => ErrorKind::Model,
+        })
+    } else if e.is::<ModelError>() {
         Some(ErrorKind::Model)
     } else if e.is::<DiscoveryError>() {
         Some(ErrorKind::Discovery)

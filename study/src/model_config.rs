@@ -16,6 +16,7 @@ use stf_core::physics::model_sum::ModelSum;
 
 use stf_plugins::ScriptRun;
 
+use crate::experiment::context::place;
 use crate::experiment::{error_at, ModelEntry, ParamGiven};
 
 /// A model ready to plug into the oscillator.
@@ -54,9 +55,10 @@ pub fn configure_for(
 ) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
-        let at = |msg: String| error_at(file, entry.line, &entry.key, msg);
         for spec in entry.specs() {
-            let model = resolve(spec, dir, run).map_err(|e| at(format!("{e:#}")))?;
+            // The cause stays typed (a script's error is a model error to a front end).
+            let model = resolve(spec, dir, run)
+                .map_err(|e| e.context(place(file, entry.line, &entry.key)))?;
             parts.push(match scales {
                 Some(s) => widened(model, s),
                 None => model,

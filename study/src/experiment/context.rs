@@ -17,6 +17,12 @@ pub fn error_at(file: &Path, line: usize, key: &str, msg: impl std::fmt::Display
     anyhow::anyhow!("{}:{}: `{}`: {}", file.display(), line, key, msg)
 }
 
+/// Where [`error_at`] says an error is (`file:line: \`key\``), for a cause kept as it is under
+/// it (`anyhow`'s context: the message reads the same, the cause's type is kept).
+pub fn place(file: &Path, line: usize, key: &str) -> String {
+    format!("{}:{}: `{}`", file.display(), line, shorten(key))
+}
+
 /// Longest run of text from a file shown whole in a message (a key, a value, a name).
 const SHOWN_WHOLE: usize = 200;
 
