@@ -241,6 +241,15 @@ fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> 
     report::remove_stale_figures(&drawn, &out.join("figures"))?;
     if let Some(g) = &global {
         say!("global fit: {}", g.verdict);
+        let values: Vec<String> = g
+            .params
+            .iter()
+            .map(|p| {
+                let value = stf_study::digits::with_error(p.value, p.std_error);
+                format!("{} = {value} ({})", p.name, p.role)
+            })
+            .collect();
+        say!("  {} over the records: {}", g.model, values.join(", "));
         say!("wrote {}", out.join(global::GLOBAL_JSON).display());
     }
     say!(

@@ -48,8 +48,56 @@ pub fn write(exp: &Experiment, result: &CompareResult, out: &Path) -> Result<()>
     if exp.output.report {
         write_compare_report(exp, data, c, &md, out)?;
     }
-    say!("{}", md.strip_suffix('\n').unwrap_or(&md));
+    print_summary(result);
     Ok(())
+}
+
+/// The terminal summary: the verdict, then each model's relative force RMS error per regime
+/// and its fitted values, its warnings under it (compare.md holds the whole comparison).
+fn print_summary(result: &CompareResult) {
+    let (data, c) = (&result.data, &result.compared);
+    say!("{}", crate::verdict::compare_verdict(c));
+    say!(
+        "compared {} model(s) on {} cycles of {} (noise floor σ = {:.4} N); relative force RMS \
+         error per regime, lower is better:",
+        c.fits.len(),
+        c.measured.labels.len(),
+        data.record.source,
+        c.measured.noise_sigma
+    );
+    let name_width = c
+        .fits
+        .iter()
+        .map(|f| f.label.chars().count())
+        .max()
+        .unwrap_or(5);
+    say!(
+        "  {:<name_width$}  {:>9} {:>9} {:>9} {:>9}  fitted values",
+        "model",
+        "pre-res.",
+        "resonance",
+        "post-res.",
+        "all"
+    );
+    let cell = |m: Option<&RegimeMetrics>| {
+        m.map_or("—".to_string(), |m| {
+            format!("{:.3}", m.relative_rms_error)
+        })
+    };
+    for ((label, cells), f) in per_regime(c, cell).into_iter().zip(&c.fits) {
+        let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f));
+        say!(
+            "  {label:<name_width$}  {:>9} {:>9} {:>9} {:>9}  {}",
+            cells[0],
+            cells[1],
+            cells[2],
+            cells[3],
+            crate::results::shown::values_line(&rows)
+        );
+        for w in &f.warnings {
+            say!("      warning: {w}");
+        }
+    }
 }
 
 /// The report: regimes table, frequency response, the record and the fits.

@@ -21,6 +21,7 @@ use stf_study::discover::Discovered;
 use crate::documents::standard_report::{record_sections, write_report};
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::FitData;
+use crate::param_table::rows_of;
 use crate::report::{
     measured_vs_model, FigureRef, Quantity, Section, Table, DISPLACEMENT_MM,
     DISPLACEMENT_RESIDUAL_MM, STF_FORCE, STF_FORCE_RESIDUAL,
@@ -38,6 +39,7 @@ pub fn write(exp: &Experiment, found: &Discovered, out: &Path) -> Result<()> {
     if exp.output.report {
         report(exp, found, out)?;
     }
+    say!("{}", found.verdict().text);
     print_summary(
         &found.spec,
         &found.data,
@@ -89,11 +91,17 @@ fn print_summary(
     }
     say!("{summary}");
     say!("  {held_out}");
-    if found.trajectory.is_none() {
-        for note in &found.notes {
-            say!("  note: {note}");
-        }
-    }
+    let rows = rows_of(
+        "final",
+        &found.final_fit,
+        Some(found.final_model.as_ref()),
+        &[],
+    );
+    say!(
+        "final model `{}`: {}",
+        found.final_model_name,
+        crate::results::shown::values_line(&rows)
+    );
     say!(
         "final model, as an experiment entry:\n{}{}",
         entries.0,

@@ -17,7 +17,8 @@ use crate::documents::identify_report::{system_line, write_identification_report
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{FitData, ModelFit};
 use crate::outputs::identification_json::IdentificationJson;
-use crate::param_table::{params_csv, rows_of, ParamRow};
+use crate::param_table::{params_csv, rows_of, rows_of_fits, ParamRow};
+use crate::results::shown::values_line;
 use crate::say;
 use crate::validation::ValidationRecord;
 use crate::writing::{write_atomic, write_json};
@@ -33,6 +34,7 @@ pub fn write(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()> {
     let csv = fitted.fitted_columns().to_csv()?;
     write_atomic(&out.join("fitted.csv"), &csv)?;
 
+    say!("{}", fitted.verdict().text);
     print_summary(data, fits);
     if let Some(rec) = &fitted.validation {
         print_validation(rec, fits);
@@ -111,19 +113,13 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
         say!("  {drive}");
     }
     for f in fits {
-        let params: Vec<String> = f
-            .result
-            .params
-            .iter()
-            .filter(|p| !p.fixed)
-            .map(crate::digits::param_with_error)
-            .collect();
+        let rows = rows_of_fits(std::slice::from_ref(f));
         say!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
             f.label,
             f.result.rms * scale,
             f.result.aic,
-            params.join(", "),
+            values_line(&rows),
             if f.result.convergence.converged() {
                 ""
             } else {

@@ -7,3 +7,4 @@
 pub mod compare;
 pub mod discover;
 pub mod fit;
+pub mod shown;
