@@ -253,7 +253,9 @@ fn the_true_model_on_its_own_record_draws_no_warning_and_a_cut_fit_says_so() {
     );
     // No warning line under the model (the verdict above says it "carries no warning").
     assert!(
-        !stdout.lines().any(|l| l.trim_start().starts_with("warning:")),
+        !stdout
+            .lines()
+            .any(|l| l.trim_start().starts_with("warning:")),
         "{stdout}"
     );
 

@@ -3,7 +3,8 @@
 //! table (the summary: the fits, a stage's values, the per-regime errors, a discovery step's
 //! candidates) are parsed, and each number in them is found among the numbers of the JSON the
 //! same run wrote (`fit.json`, `compare.json`, `discovery.json`), as shown: SI or in mm (×1e3)
-//! or in % (×100), rounded to the digits printed. Names in backticks and ordinals that name a
+//! or in % (×100), rounded to the digits printed; a relative standard error is traced to
+//! `100·se/|value|` of a parameter both are in the JSON for. Names in backticks and ordinals that name a
 //! stage or step are labels, not numbers, and are left out.
 
 mod common;
@@ -17,6 +18,33 @@ fn numbers(v: &Value, out: &mut Vec<f64>) {
         Value::Number(n) => out.extend(n.as_f64()),
         Value::Array(a) => a.iter().for_each(|x| numbers(x, out)),
         Value::Object(o) => o.values().for_each(|x| numbers(x, out)),
+        _ => {}
+    }
+}
+
+/// Each relative standard error the reports' results tables show, in %: `100·se/|value|` of
+/// every parameter with both a value and a standard error in `v` (a fit's `params` beside its
+/// `std_errors`; a discovery's final `values` beside them).
+fn relative_errors(v: &Value, out: &mut Vec<f64>) {
+    match v {
+        Value::Array(a) => a.iter().for_each(|x| relative_errors(x, out)),
+        Value::Object(o) => {
+            if let Some(Value::Object(se)) = o.get("std_errors") {
+                for key in ["params", "values"] {
+                    if let Some(Value::Object(values)) = o.get(key) {
+                        for (name, value) in values {
+                            let (Some(x), Some(e)) =
+                                (value.as_f64(), se.get(name).and_then(Value::as_f64))
+                            else {
+                                continue;
+                            };
+                            out.push(100.0 * e / x.abs());
+                        }
+                    }
+                }
+            }
+            o.values().for_each(|x| relative_errors(x, out));
+        }
         _ => {}
     }
 }
@@ -122,6 +150,7 @@ fn check(command: &str, experiment: &str, json_name: &str) {
     let json = common::read_json(&out.join(json_name));
     let mut all = Vec::new();
     numbers(&json, &mut all);
+    relative_errors(&json, &mut all);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     let (verdict, table) = verdict_and_summary(&report);
     assert!(!verdict.is_empty(), "{experiment}: no verdict");

@@ -9,4 +9,5 @@ pub mod compare_loops;
 pub mod compare_markdown;
 pub mod identify_report;
 pub mod regime_figures;
+pub mod results_table;
 pub mod standard_report;

@@ -130,7 +130,14 @@ fn write_compare_report(
         change(c.measured.boundaries.resonance_post),
     ];
     let frequency = frequency_section(&curves, changes, out)?;
-    let mut sections = vec![regimes_section(c, md, out)?, frequency];
+    let fits: Vec<(&str, &stf_core::fit::FitResult)> = c
+        .fits
+        .iter()
+        .map(|f| (f.label.as_str(), &f.result))
+        .collect();
+    let rows = crate::param_table::rows_of_fits(&c.fits);
+    let results = crate::documents::results_table::results_section("Results", &rows, &fits);
+    let mut sections = vec![results, regimes_section(c, md, out)?, frequency];
     sections.extend(record_sections(data, &c.fits, out)?);
     let forces: Vec<(&str, &[f64])> = c
         .fits

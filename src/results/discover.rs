@@ -211,7 +211,16 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
         s.figures.push(FigureRef::new(fig, caption));
     }
-    let mut sections = vec![s];
+    let rows = rows_of(
+        "final",
+        &found.final_fit,
+        Some(found.final_model.as_ref()),
+        &[],
+    );
+    let title = format!("Final model: {}", found.final_model_name);
+    let fits = [("final", &found.final_fit)];
+    let results = crate::documents::results_table::results_section(&title, &rows, &fits);
+    let mut sections = vec![results, s];
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];
         sections.extend(crate::documents::regime_figures::regime_section(

@@ -14,6 +14,7 @@ use stf_study::fit::Fitted;
 use stf_study::identify::Identification;
 
 use crate::documents::identify_report::{system_line, write_identification_report};
+use crate::documents::results_table::results_section;
 use crate::experiment::{Experiment, FitLevel, StageSpec};
 use crate::fitting::{FitData, ModelFit};
 use crate::outputs::identification_json::IdentificationJson;
@@ -50,7 +51,9 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
     let (data, fits) = (&fitted.data, fitted.fits.as_slice());
     let validation = fitted.validation.as_ref();
     let level = data.level;
-    let mut sections = Vec::new();
+    let results: Vec<(&str, &FitResult)> =
+        fits.iter().map(|f| (f.label.as_str(), &f.result)).collect();
+    let mut sections = vec![results_section("Results", &fitted.param_rows(), &results)];
     if let Some(rec) = validation {
         sections.push(crate::documents::standard_report::validation_section(
             rec, fits, out,

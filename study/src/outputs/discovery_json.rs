@@ -99,6 +99,10 @@ pub struct FinalModelJson<'a> {
     pub params: BTreeMap<String, f64>,
     /// Standard errors of every fitted value by name; null where not determined.
     pub std_errors: BTreeMap<String, f64>,
+    /// Every value of the final fit by name, SI units: the model's, an offset, and at
+    /// trajectory level the refitted oscillator and initial state (`x0`, `v0`) — the values
+    /// `std_errors` belong to.
+    pub values: BTreeMap<String, f64>,
     /// The model as a `[[models]]` entry (TOML).
     pub experiment_entry: String,
     /// The refitted oscillator (trajectory level; absent at force level).
@@ -150,6 +154,7 @@ impl<'a> DiscoveryJson<'a> {
                 name: &found.final_model_name,
                 params: values_by_name(model_params.iter().copied()),
                 std_errors: errors_by_name(&found.final_params, |p| p.std_error),
+                values: errors_by_name(&found.final_params, |p| p.value),
                 experiment_entry,
                 system: None,
             },
