@@ -12,7 +12,7 @@ use std::sync::Arc;
 use stf_core::data::force_data::ForceData;
 use stf_core::data::kinematics::{Kinematics, KinematicsSettings};
 use stf_core::fit::{FitParam, ForceFit, TrajectoryData, TrajectoryFit};
-use stf_core::physics::channel_law::{Channel, ChannelLaw, Law};
+use stf_core::physics::channel_law::{ChannelLaw, Law, MeasuredChannel};
 use stf_core::physics::excitation::{Excitation, RotorAngle};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
@@ -52,7 +52,7 @@ fn control(seed: u64, levels: &[f64]) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// `viscous + bouc_wen` with the hysteretic force following `channel` by `law`.
-fn damper(channel: &Arc<Channel>, law: Law) -> Arc<dyn ForceModel> {
+fn damper(channel: &Arc<MeasuredChannel>, law: Law) -> Arc<dyn ForceModel> {
     Arc::new(ChannelLaw::new(Arc::new(constant()), "F_bw", law, channel.clone()).unwrap())
 }
 
@@ -96,7 +96,7 @@ fn record(truth: Arc<dyn ForceModel>, p: Vec<f64>, seed: u64) -> Case {
 /// and check every value within 5 %.
 fn check(law: Law, levels: &[f64], truth: &[f64], seed: u64) {
     let (t, u) = control(seed, levels);
-    let channel = Arc::new(Channel::new("u_ctrl", t, u).unwrap());
+    let channel = Arc::new(MeasuredChannel::new("u_ctrl", t, u).unwrap());
     let model = damper(&channel, law);
     let c = record(model.clone(), truth.to_vec(), seed);
     let data = ForceData::new(&c.t, &c.x, &c.v, &c.a, &c.f);
@@ -152,7 +152,7 @@ fn a_linear_and_a_power_law_with_an_offset_are_recovered() {
 fn the_law_is_recovered_at_trajectory_level() {
     let truth = [2.0, 0.3, 0.6, 3e-3, 0.7];
     let (t, u) = control(1, &[0.0, 1.0]);
-    let channel = Arc::new(Channel::new("u_ctrl", t, u).unwrap());
+    let channel = Arc::new(MeasuredChannel::new("u_ctrl", t, u).unwrap());
     let model = damper(&channel, Law::Affine);
     let c = record(model.clone(), truth.to_vec(), 1);
     let starts: Vec<f64> = model.params().iter().map(|s| s.default).collect();

@@ -8,7 +8,7 @@
 //! | [`Law::Power`] | P_base + P_gain·\|c\|^P_exp | `P_base`, `P_gain`, `P_exp` |
 //!
 //! [`ChannelLaw`] wraps a model: it replaces P among the parameters by the law's coefficients
-//! (in P's place), reads the channel at the state's time ([`Channel::at`], linear
+//! (in P's place), reads the channel at the state's time ([`MeasuredChannel::at`], linear
 //! interpolation, so a trajectory integrator's intermediate stages see it too) and hands the
 //! wrapped model P's value, clamped into P's bounds. Being a model, it goes wherever a model
 //! goes: force and trajectory fits, sums, discovery's base. Starts and bounds (the design
@@ -97,13 +97,13 @@ impl Law {
 /// A measured column of the record on its time grid, read at any time by linear
 /// interpolation (held at its end values outside the grid).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Channel {
+pub struct MeasuredChannel {
     name: String,
     t: Vec<f64>,
     values: Vec<f64>,
 }
 
-impl Channel {
+impl MeasuredChannel {
     /// The channel `name` sampled at the strictly increasing times `t`; an error when the
     /// lengths differ, it is empty, or a value is not finite.
     pub fn new(name: &str, t: Vec<f64>, values: Vec<f64>) -> Result<Self, ModelError> {
@@ -121,7 +121,7 @@ impl Channel {
         if t.windows(2).any(|w| w[1] <= w[0]) {
             return bad("its times must increase strictly".into());
         }
-        Ok(Channel {
+        Ok(MeasuredChannel {
             name: name.to_string(),
             t,
             values,
@@ -164,7 +164,7 @@ pub struct ChannelLaw {
     /// Where the parameter sits among the inner model's parameters.
     index: usize,
     law: Law,
-    channel: Arc<Channel>,
+    channel: Arc<MeasuredChannel>,
     /// The inner parameter's bounds: the law's value is clamped into them.
     bounds: (f64, f64),
     specs: Vec<ParamSpec>,
@@ -177,7 +177,7 @@ impl ChannelLaw {
         inner: Arc<dyn ForceModel>,
         param: &str,
         law: Law,
-        channel: Arc<Channel>,
+        channel: Arc<MeasuredChannel>,
     ) -> Result<Self, ModelError> {
         let specs = inner.params();
         let Some(index) = specs.iter().position(|s| s.name == param) else {
@@ -245,7 +245,7 @@ impl ChannelLaw {
 }
 
 /// The specs of `law`'s coefficients for the parameter `p` following `channel`.
-fn coefficient_specs(p: &ParamSpec, law: Law, channel: &Channel) -> Vec<ParamSpec> {
+fn coefficient_specs(p: &ParamSpec, law: Law, channel: &MeasuredChannel) -> Vec<ParamSpec> {
     let reach = channel.max_abs();
     let range = p.max - p.min;
     let gain_bound = if reach > 0.0 && range.is_finite() {
@@ -420,8 +420,8 @@ mod tests {
         ]))
     }
 
-    fn step_channel() -> Arc<Channel> {
-        Arc::new(Channel::new("u", vec![0.0, 1.0, 2.0], vec![0.0, 0.0, 2.0]).unwrap())
+    fn step_channel() -> Arc<MeasuredChannel> {
+        Arc::new(MeasuredChannel::new("u", vec![0.0, 1.0, 2.0], vec![0.0, 0.0, 2.0]).unwrap())
     }
 
     #[test]
@@ -431,9 +431,9 @@ mod tests {
         assert_eq!(ch.at(1.5), 1.0);
         assert_eq!(ch.at(5.0), 2.0);
         assert_eq!(ch.max_abs(), 2.0);
-        assert!(Channel::new("u", vec![0.0, 0.0], vec![1.0, 2.0]).is_err());
-        assert!(Channel::new("u", vec![0.0], vec![f64::NAN]).is_err());
-        assert!(Channel::new("u", vec![0.0, 1.0], vec![1.0]).is_err());
+        assert!(MeasuredChannel::new("u", vec![0.0, 0.0], vec![1.0, 2.0]).is_err());
+        assert!(MeasuredChannel::new("u", vec![0.0], vec![f64::NAN]).is_err());
+        assert!(MeasuredChannel::new("u", vec![0.0, 1.0], vec![1.0]).is_err());
     }
 
     #[test]
