@@ -14,6 +14,8 @@
 //! | `cubic_stiffness` | k3·x³ | `k3` |
 //! | `maxwell` | dF/dt = (c_m·v − F)/τ | `c_m`, `tau` |
 //! | `jamming_on_off` | K_j·\|v\|^n_j·sign v, gated on above v_c | `K_j`, `n_j`, `v_c`, `w` |
+//! | `bouc_wen` | F_bw·w, ẇ = (ẋ − beta·\|ẋ\|·w − (1 − beta)·ẋ·\|w\|)/x_bw | `F_bw`, `x_bw`, `beta` |
+//! | `linear_spring` | k_s·x | `k_s` |
 //!
 //! ```
 //! use stf_models::find;
@@ -29,9 +31,11 @@ use std::sync::Arc;
 use stf_core::physics::force_model::ForceModel;
 
 pub mod added_mass;
+pub mod bouc_wen;
 mod builtin;
 pub mod cubic_stiffness;
 pub mod jamming_on_off;
+pub mod linear_spring;
 pub mod maxwell;
 pub mod power_law;
 mod values;
@@ -60,6 +64,8 @@ pub const BUILTINS: &[BuiltinEntry] = &[
     cubic_stiffness::CubicStiffness::ENTRY,
     maxwell::Maxwell::ENTRY,
     jamming_on_off::JammingOnOff::ENTRY,
+    bouc_wen::BoucWen::ENTRY,
+    linear_spring::LinearSpring::ENTRY,
 ];
 
 /// The built-in model called `name`, if there is one.
@@ -90,6 +96,8 @@ mod tests {
             "cubic_stiffness",
             "maxwell",
             "jamming_on_off",
+            "bouc_wen",
+            "linear_spring",
         ];
         assert_eq!(names(), expected);
         for e in BUILTINS {

@@ -108,3 +108,21 @@ fn names_jamming_on_off() {
         "power_law",
     );
 }
+
+#[test]
+fn names_bouc_wen() {
+    check(
+        "bouc_wen",
+        &[("power_law", &[5.0, 1.6]), ("bouc_wen", &[0.3, 3e-3, 0.7])],
+        "power_law",
+    );
+}
+
+#[test]
+fn names_linear_spring() {
+    check(
+        "linear_spring",
+        &[("power_law", &[5.0, 1.6]), ("linear_spring", &[20.0])],
+        "power_law",
+    );
+}

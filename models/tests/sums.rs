@@ -101,7 +101,8 @@ fn a_sum_with_all_builtins_is_a_model() {
             .collect(),
     );
     let m = all.unwrap();
-    assert_eq!(m.n_internal(), 1);
+    // `maxwell` and `bouc_wen` carry one state each.
+    assert_eq!(m.n_internal(), 2);
     let values = defaults(m.params());
     let osc = Oscillator::new(
         OscillatorParams::FORCED,

@@ -5,7 +5,7 @@ import pytest
 import stf_lab
 
 BUILTINS = ["viscous", "power_law", "added_mass", "jamming_on_off", "yield", "wall_impact",
-            "cubic_stiffness", "maxwell"]
+            "cubic_stiffness", "maxwell", "bouc_wen", "linear_spring"]
 
 
 def test_every_builtin_is_listed_with_its_parameters():

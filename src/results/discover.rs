@@ -3,8 +3,9 @@
 //! measurement disagree, the effects named and added, and the gap shrinking.
 //!
 //! Candidates are the effects of docs/ARCHITECTURE.md §5 (the built-ins `viscous`, `power_law`,
-//! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`) not
-//! already in the base, plus any scripts `[discover] candidates` lists. Writes
+//! `added_mass`, `yield`, `wall_impact`, `cubic_stiffness`, `maxwell`, `jamming_on_off`,
+//! `bouc_wen`, `linear_spring`) not already in the base, plus any scripts `[discover]
+//! candidates` lists. Writes
 //! `DIR/discovery.json` (`effects`, `gap_before`, `gap_after`, the steps with every candidate's
 //! scores, and the final model as an experiment entry), a report and figures. A record
 //! without `f_stf` (or `[discover] level = "trajectory"`) is discovered at trajectory level,

@@ -2,6 +2,7 @@
 //! it, the bearing resistance, and the seam through which any STF force model (alone, or as a
 //! sum of models) plugs in, with its named parameters.
 
+pub mod channel_law;
 pub mod excitation;
 pub mod force_model;
 pub mod model_sum;
