@@ -407,7 +407,8 @@ impl Predictor {
             let fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
             let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
-                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
+                let b = offset_reach(data.target());
+                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-b, b).scale(1e-3 * b));
             }
             return Ok(Predictor::Force(fit));
         }
@@ -422,7 +423,12 @@ impl Predictor {
             free.push(system_param(param, &exp.system, k));
         }
         if exp.fit.offset {
-            free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+            let b = offset_reach(&data.record.x);
+            free.push(
+                FitParam::new("x_off", 0.0)
+                    .bounds(-b, b)
+                    .scale(1e-3_f64.min(0.1 * b)),
+            );
         }
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
@@ -478,6 +484,22 @@ impl Predictor {
         sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
             .transpose()
+    }
+}
+
+/// The bounds ± this of an offset of the measured `signal`: twice its largest |value|. A
+/// record is its signal plus the offset, and the signal swings about zero, so the offset is
+/// never larger than the record's largest |value| (a damper's −124 N offset on a force of
+/// hundreds of N lies well inside; a fixed ±100 N stopped it at −99.93).
+fn offset_reach(signal: &[f64]) -> f64 {
+    let largest = signal
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    if largest > 0.0 {
+        2.0 * largest
+    } else {
+        1.0
     }
 }
 

@@ -283,6 +283,7 @@ mod tests {
             std_error: 0.1,
             naive_std_error: 0.1,
             fixed: false,
+            held_by: None,
         };
         // Same held-out residuals: a tie. The four-parameter one has the lower BIC.
         let mut four = score("four", 1.0, 20.0, -540.0, -340.0);
