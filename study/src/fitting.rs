@@ -343,7 +343,39 @@ pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) 
 /// Fit one configured model (or, with `None`, the bare oscillator) to `data`, at its level:
 /// the fit (`Predictor::build`), the prediction with the fitted values, the noise floor and
 /// the warnings.
+///
+/// A sum that contains a smaller one (all its parts but the last) never ends worse than the
+/// smaller one's optimum: the smaller one is fitted first (so, in turn, its own), and the sum
+/// is fitted again from that optimum with the last part's amplitude neutral
+/// ([`ConfiguredModel::started_from`]: the smaller model's residual, to within a millionth
+/// of the term's default contribution); of the fit from the entry's starts and this one, the lower RMS is
+/// kept. (From its defaults alone `viscous + yield + maxwell` was seen to end at 32.4 N on a
+/// damper record where `viscous + yield` reached 26.5 N.)
 pub fn fit_model(
+    exp: &Experiment,
+    data: &FitData,
+    configured: Option<&ConfiguredModel>,
+    progress: &dyn Job,
+) -> Result<ModelFit> {
+    let fit = fit_from_starts(exp, data, configured, progress)?;
+    let Some((c, (base, amp))) = configured.and_then(|c| Some((c, c.base()?))) else {
+        return Ok(fit);
+    };
+    let base_fit = fit_model(exp, data, Some(&base), progress)?;
+    let nested = c.started_from(&base_fit.model_values(), amp);
+    let from_base = fit_from_starts(exp, data, Some(&nested), progress)?;
+    Ok(if from_base.result.rms < fit.result.rms {
+        ModelFit {
+            configured: Some(c.clone()),
+            ..from_base
+        }
+    } else {
+        fit
+    })
+}
+
+/// [`fit_model`] from the starts `configured` gives, once.
+fn fit_from_starts(
     exp: &Experiment,
     data: &FitData,
     configured: Option<&ConfiguredModel>,
