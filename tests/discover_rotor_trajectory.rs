@@ -215,8 +215,11 @@ fn a_small_hidden_maxwell_element_is_named_and_no_candidate_ends_worse_than_its_
                 };
                 let name = c["name"].as_str().unwrap();
                 let rss_term = delta_aic - 2.0 * own_params(name);
+                // Within the neutral term's own contribution and the fit's tolerance: a
+                // relative RSS excess of 5e-6 over 10 000 training samples; the failure seen
+                // was 8.5 % (N·ln 1.085 ≈ 800).
                 assert!(
-                    rss_term <= 1e-6,
+                    rss_term <= 0.05,
                     "seed {seed}: `{name}` ends above the model it extends: N·ln(RSS ratio) \
                      {rss_term}\n{c}"
                 );
