@@ -138,3 +138,59 @@ fn discovery_is_validated_on_a_second_record_and_its_json_redraws_its_curves() {
     assert_eq!(entry["name"], "power_law + cubic_stiffness");
     assert_eq!(entry["params"]["k3"], doc["final_model"]["params"]["k3"]);
 }
+
+/// Script effects are printed by their paths: a discovery from the bundled power-law script
+/// with a cubic spring written as a script among the candidates names the spring, and the
+/// entry it prints (on the terminal and in `discovery.json`) names both scripts by the paths
+/// the experiment gave; pasted as it is into an experiment beside it, that entry fits. (It
+/// printed the spring by its name, `plus = ["stiff"]`: "unknown model `stiff`".)
+#[test]
+fn a_script_effect_is_printed_by_its_path_and_the_entry_pasted_back_fits() {
+    let out = tempfile::tempdir().unwrap();
+    let scripts = out.path().join("scripts");
+    std::fs::create_dir(&scripts).unwrap();
+    std::fs::copy(
+        root().join("models/scripts/power_law.rhai"),
+        scripts.join("power_law.rhai"),
+    )
+    .unwrap();
+    std::fs::write(
+        scripts.join("stiff.rhai"),
+        "fn params() {\n    #{ k3: [1e4, 0.0, 1e7, \"N/m^3\"] }\n}\n\n\
+         fn force(p, t, x, v, z) {\n    p.k3 * x * x * x\n}\n",
+    )
+    .unwrap();
+    let record = root().join("experiments/records/discovery_sweep.csv");
+    let data = format!("[data]\nfile = {:?}\n\n", record.display().to_string());
+    let exp = out.path().join("discover.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "{data}[discover]\nbase = \"scripts/power_law.rhai\"\n\
+             candidates = [\"viscous\", \"scripts/stiff.rhai\"]\n"
+        ),
+    )
+    .unwrap();
+    let dir = out.path().join("disc");
+    let printed = run_ok("discover", &exp, &dir);
+    let doc = read_json(&dir.join("discovery.json"));
+    assert_eq!(doc["effects"], serde_json::json!(["stiff"]), "{doc}");
+    let entry = doc["final_model"]["experiment_entry"].as_str().unwrap();
+    assert!(
+        entry.contains("name = \"scripts/power_law.rhai\"")
+            && entry.contains("plus = [\"scripts/stiff.rhai\"]"),
+        "{entry}"
+    );
+    let stdout = String::from_utf8_lossy(&printed.stdout);
+    let shown = stdout
+        .split("final model, as an experiment entry:\n")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no entry printed: {stdout}"));
+    assert!(shown.starts_with(entry), "{shown}");
+    let refit = out.path().join("refit.toml");
+    std::fs::write(&refit, format!("{data}{}", &shown[..entry.len()])).unwrap();
+    let _ = run_ok("fit", &refit, &out.path().join("refit"));
+    let fitted = read_json(&out.path().join("refit/fit.json"));
+    let k3 = fitted["models"][0]["params"]["k3"].as_f64().unwrap();
+    assert!((k3 / 2e4 - 1.0).abs() < 0.05, "k3 = {k3}");
+}

@@ -186,3 +186,46 @@ fn on_the_papers_sweep_exactly_the_hidden_effect_is_named() {
         assert_at_the_noise(&d);
     }
 }
+
+/// The parameters of each built-in candidate, to read a candidate's training RSS against the
+/// current model's from its ΔAIC (N·ln(RSS/N) + 2p).
+fn own_params(name: &str) -> f64 {
+    match name {
+        "viscous" | "added_mass" | "cubic_stiffness" => 1.0,
+        "power_law" | "yield" | "maxwell" => 2.0,
+        "wall_impact" | "jamming_on_off" => 4.0,
+        other => panic!("unknown candidate {other}"),
+    }
+}
+
+/// A small Maxwell element hidden beside the power law (c_m 1 N·s/m, τ 0.05 s; t, φ, x
+/// only, the scouted CI record at two seeds): no candidate that was fitted ends with a
+/// training RSS above the model it extends (each starts, among its starts, from that
+/// model's optimum with its own term neutral), and `maxwell` is named. (On a record of an
+/// independent implementation of the rig, every candidate's scout fit ended above the
+/// base's training RMS and nothing was named.)
+#[test]
+fn a_small_hidden_maxwell_element_is_named_and_no_candidate_ends_worse_than_its_base() {
+    for seed in [1, 2] {
+        let d = discover(Some(("maxwell", ", c_m = 1.0, tau = 0.05")), seed, None);
+        for step in d["steps"].as_array().unwrap() {
+            for c in step["candidates"].as_array().unwrap() {
+                let Some(delta_aic) = c["delta_aic"].as_f64() else {
+                    continue;
+                };
+                let name = c["name"].as_str().unwrap();
+                let rss_term = delta_aic - 2.0 * own_params(name);
+                // Within the neutral term's own contribution and the fit's tolerance: a
+                // relative RSS excess of 5e-6 over 10 000 training samples; the failure seen
+                // was 8.5 % (N·ln 1.085 ≈ 800).
+                assert!(
+                    rss_term <= 0.05,
+                    "seed {seed}: `{name}` ends above the model it extends: N·ln(RSS ratio) \
+                     {rss_term}\n{c}"
+                );
+            }
+        }
+        assert_eq!(effects(&d), ["maxwell"], "seed {seed}: {}", d["verdict"]);
+        assert_at_the_noise(&d);
+    }
+}

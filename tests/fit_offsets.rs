@@ -133,3 +133,115 @@ fn a_linear_base_finds_the_spring_and_leaves_out_the_duplicate_of_c() {
     let notes = found["notes"].to_string();
     assert!(notes.contains("`viscous` not tried"), "{notes}");
 }
+
+/// A damper-like shaker record (viscous + yield, a force of hundreds of N, the rig's sensors)
+/// with a force sensor's offset of −124 N added to F_STF, and the experiment that fits it at
+/// force level with `offset = true`; `extra` goes into the model's entry.
+fn damper(dir: &std::path::Path, seed: u64, f1: f64, extra: &str) -> std::path::PathBuf {
+    let make = format!(
+        "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
+         [simulate]\nchirp = {{ f0 = 0.5, f1 = {f1}, amplitude = 600.0, t1 = 10.0 }}\n\
+         rate = 1000.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"viscous\"\n\
+         params = {{ c_s = 800.0 }}\n\n[[simulate.truth]]\nname = \"yield\"\n\
+         params = {{ F_y = {{ value = 150.0, max = 1000.0 }} }}\n"
+    );
+    let make_path = dir.join("make.toml");
+    std::fs::write(&make_path, make).unwrap();
+    simulate_ok(&make_path, &dir.join("r.csv"));
+    let text = std::fs::read_to_string(dir.join("r.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let col = header.split(',').position(|c| c == "f_stf").unwrap();
+    let mut shifted = format!("{header}\n");
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(str::to_string).collect();
+        cells[col] = (cells[col].parse::<f64>().unwrap() - 124.0).to_string();
+        shifted += &(cells.join(",") + "\n");
+    }
+    std::fs::write(dir.join("r.csv"), shifted).unwrap();
+    let fit = format!(
+        "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
+         [fit]\nlevel = \"force\"\noffset = true\n\n[[models]]\nname = \"viscous\"\n\
+         plus = [\"yield\"]\n{extra}"
+    );
+    let fit_path = dir.join("fit.toml");
+    std::fs::write(&fit_path, fit).unwrap();
+    fit_path
+}
+
+/// The rows of `params.csv` as (parameter, at_bound).
+fn at_bound_column(params_csv: &std::path::Path) -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(params_csv).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            (cells[1].to_string(), cells[6].to_string())
+        })
+        .collect()
+}
+
+/// The force offset's bounds follow the measured force (± twice its largest |value|): a
+/// −124 N offset on a damper's force of hundreds of N is recovered within its standard
+/// errors, converged and on no bound (a fixed ±100 N box stopped it at −99.93 with
+/// `at_bound = false`, "did not converge").
+#[test]
+fn a_large_force_offset_is_recovered_inside_bounds_that_follow_the_force() {
+    for (seed, f1) in [(1, 3.0), (2, 2.0)] {
+        let dir = tempfile::tempdir().unwrap();
+        let fit_path = damper(dir.path(), seed, f1, "");
+        let out = dir.path().join("fit");
+        run_ok("fit", &fit_path, &out);
+        let model = &read_json(&out.join("fit.json"))["models"][0];
+        let (got, se) = (
+            model["params"]["f_off"].as_f64().unwrap(),
+            model["std_errors"]["f_off"].as_f64().unwrap(),
+        );
+        assert!(
+            (got + 124.0).abs() < 2.0 && (got + 124.0).abs() < 4.0 * se,
+            "seed {seed}: f_off {got} ± {se}, truth −124\n{model}"
+        );
+        let warnings = model["warnings"].to_string();
+        assert!(
+            !warnings.contains("on_bound") && !warnings.contains("not_converged"),
+            "seed {seed}: {warnings}"
+        );
+        assert!(
+            at_bound_column(&out.join("params.csv"))
+                .iter()
+                .all(|(_, b)| b == "false"),
+            "seed {seed}"
+        );
+    }
+}
+
+/// A parameter the data push past a bound the experiment gives (a yield force of 150 N held
+/// under 100 N) is flagged wherever the solver stopped short of the bound: an `on_bound`
+/// warning in `fit.json` naming it, and `at_bound = true` in `params.csv`.
+#[test]
+fn a_parameter_held_by_a_bound_is_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit_path = damper(
+        dir.path(),
+        1,
+        3.0,
+        "params = { F_y = { value = 20.0, max = 100.0 } }\n",
+    );
+    let out = dir.path().join("fit");
+    run_ok("fit", &fit_path, &out);
+    let model = &read_json(&out.join("fit.json"))["models"][0];
+    let held: Vec<&serde_json::Value> = model["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["kind"] == "on_bound" && w["param"] == "F_y")
+        .collect();
+    assert_eq!(held.len(), 1, "{model}");
+    assert_eq!(held[0]["side"], "upper");
+    assert_eq!(held[0]["bound"].as_f64(), Some(100.0));
+    let rows = at_bound_column(&out.join("params.csv"));
+    assert!(
+        rows.iter().any(|(p, b)| p == "F_y" && b == "true"),
+        "{rows:?}"
+    );
+}

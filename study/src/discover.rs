@@ -63,6 +63,9 @@ pub struct Discovered {
     pub cycles: usize,
     /// How long the search took, s.
     pub wall_s: f64,
+    /// Each script model's name with its path as `[discover]` gives it: what the printed
+    /// entry names it by, so that it loads as it is.
+    pub script_paths: Vec<(String, String)>,
 }
 
 /// Discover what the base of `exp`'s `[discover]` misses on its record.
@@ -99,6 +102,7 @@ impl DiscoverInputs {
     pub fn discover(self, exp: &Experiment, observer: &dyn Observer) -> Result<Discovered> {
         let (spec, data) = (&self.spec, &self.data);
         let (base, candidates) = models_of(exp, spec, data)?;
+        let script_paths = script_paths(exp, spec)?;
         let cycles = crate::fitting::cycles_of(data)?;
         let mut settings = settings_of(exp, spec, data.level);
         let job = observer.job("discover");
@@ -138,6 +142,7 @@ impl DiscoverInputs {
             score,
             cycles: cycles.len(),
             wall_s,
+            script_paths,
         })
     }
 }
@@ -153,6 +158,7 @@ impl Discovered {
             exp,
             &self.data,
             (&self.found, &self.refitted),
+            &self.script_paths,
             self.score.as_ref(),
             self.wall_s,
         )
@@ -274,6 +280,20 @@ fn models_of(
     Ok((base, candidates))
 }
 
+/// The name of every script of `[discover]`'s base and candidates, with its path as given
+/// there (relative to the experiment, as an entry pasted into it reads it).
+fn script_paths(exp: &Experiment, spec: &DiscoverSpec) -> Result<Vec<(String, String)>> {
+    let given = spec.base.iter().chain(spec.candidates.iter().flatten());
+    given
+        .filter(|s| s.trim().ends_with(".rhai"))
+        .map(|s| {
+            let model = resolve(s, &exp.dir, &exp.scripts)
+                .with_context(|| format!("{}: `discover`: {s}", exp.path.display()))?;
+            Ok((model.name().to_string(), s.clone()))
+        })
+        .collect()
+}
+
 /// Discovery's settings from `[fit]` and `[discover]` at `level`.
 fn settings_of(exp: &Experiment, spec: &DiscoverSpec, level: FitLevel) -> DiscoverySettings {
     let fit = match level {
@@ -300,6 +320,7 @@ fn results<'a>(
     exp: &'a Experiment,
     data: &'a FitData,
     (found, names): (&'a Discovery, &'a [String]),
+    script_paths: &[(String, String)],
     score: Option<&'a DiscoveryScore>,
     wall: f64,
 ) -> Result<(DiscoveryJson<'a>, (String, String))> {
@@ -311,7 +332,19 @@ fn results<'a>(
     let model_params: Vec<&FittedParam> = found.final_params.iter().filter(|p| !own(p)).collect();
     // The final model as an experiment's `[[models]]` entry that `fit` and `compare` accept
     // as it is (TOML).
-    let toml_entry = ModelsEntry::new(&found.final_model.terms(), model_params.iter().copied())
+    // A script's term is named by its path, which an experiment loads it by.
+    let terms: Vec<&str> = found
+        .final_model
+        .terms()
+        .into_iter()
+        .map(|t| {
+            script_paths
+                .iter()
+                .find(|(name, _)| name == t)
+                .map_or(t, |(_, path)| path.as_str())
+        })
+        .collect();
+    let toml_entry = ModelsEntry::new(&terms, model_params.iter().copied())
         .to_toml()
         .context("cannot write the final model as an experiment entry")?;
     let (doc, system_entry) = match &found.trajectory {

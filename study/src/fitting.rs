@@ -343,7 +343,39 @@ pub fn system_param(param: OscParam, system: &OscillatorParams, k: &Kinematics) 
 /// Fit one configured model (or, with `None`, the bare oscillator) to `data`, at its level:
 /// the fit (`Predictor::build`), the prediction with the fitted values, the noise floor and
 /// the warnings.
+///
+/// A sum that contains a smaller one (all its parts but the last) never ends worse than the
+/// smaller one's optimum: the smaller one is fitted first (so, in turn, its own), and the sum
+/// is fitted again from that optimum with the last part's amplitude neutral
+/// ([`ConfiguredModel::started_from`]: the smaller model's residual, to within a millionth
+/// of the term's default contribution); of the fit from the entry's starts and this one, the lower RMS is
+/// kept. (From its defaults alone `viscous + yield + maxwell` was seen to end at 32.4 N on a
+/// damper record where `viscous + yield` reached 26.5 N.)
 pub fn fit_model(
+    exp: &Experiment,
+    data: &FitData,
+    configured: Option<&ConfiguredModel>,
+    progress: &dyn Job,
+) -> Result<ModelFit> {
+    let fit = fit_from_starts(exp, data, configured, progress)?;
+    let Some((c, (base, amp))) = configured.and_then(|c| Some((c, c.base()?))) else {
+        return Ok(fit);
+    };
+    let base_fit = fit_model(exp, data, Some(&base), progress)?;
+    let nested = c.started_from(&base_fit.model_values(), amp);
+    let from_base = fit_from_starts(exp, data, Some(&nested), progress)?;
+    Ok(if from_base.result.rms < fit.result.rms {
+        ModelFit {
+            configured: Some(c.clone()),
+            ..from_base
+        }
+    } else {
+        fit
+    })
+}
+
+/// [`fit_model`] from the starts `configured` gives, once.
+fn fit_from_starts(
     exp: &Experiment,
     data: &FitData,
     configured: Option<&ConfiguredModel>,
@@ -407,7 +439,8 @@ impl Predictor {
             let fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
             let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
-                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-100.0, 100.0));
+                let b = offset_reach(data.target());
+                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-b, b).scale(1e-3 * b));
             }
             return Ok(Predictor::Force(fit));
         }
@@ -422,7 +455,12 @@ impl Predictor {
             free.push(system_param(param, &exp.system, k));
         }
         if exp.fit.offset {
-            free.push(FitParam::new("x_off", 0.0).bounds(-0.05, 0.05).scale(1e-3));
+            let b = offset_reach(&data.record.x);
+            free.push(
+                FitParam::new("x_off", 0.0)
+                    .bounds(-b, b)
+                    .scale(1e-3_f64.min(0.1 * b)),
+            );
         }
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
@@ -478,6 +516,22 @@ impl Predictor {
         sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
             .transpose()
+    }
+}
+
+/// The bounds ± this of an offset of the measured `signal`: twice its largest |value|. A
+/// record is its signal plus the offset, and the signal swings about zero, so the offset is
+/// never larger than the record's largest |value| (a damper's −124 N offset on a force of
+/// hundreds of N lies well inside; a fixed ±100 N stopped it at −99.93).
+fn offset_reach(signal: &[f64]) -> f64 {
+    let largest = signal
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    if largest > 0.0 {
+        2.0 * largest
+    } else {
+        1.0
     }
 }
 

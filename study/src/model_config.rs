@@ -12,7 +12,7 @@ use anyhow::{anyhow, Result};
 use stf_core::data::record_bounds::{widened, DataScales};
 use stf_core::fit::FitParam;
 use stf_core::physics::force_model::ForceModel;
-use stf_core::physics::model_sum::ModelSum;
+use stf_core::physics::model_sum::{neutral_amplitude, ModelSum};
 
 use stf_plugins::ScriptRun;
 
@@ -26,9 +26,59 @@ pub struct ConfiguredModel {
     pub model: Arc<dyn ForceModel>,
     /// Parameter settings (name in the sum, value, bounds, fixed), in the model's order.
     pub params: Vec<FitParam>,
+    /// The parts summed, in order.
+    pub parts: Vec<Arc<dyn ForceModel>>,
 }
 
 impl ConfiguredModel {
+    /// The sum of all parts but the last, with the settings of their parameters, and the
+    /// index in `params` of the last part's amplitude (its first parameter, by the models'
+    /// convention) with its neutral start ([`neutral_amplitude`]): `None` for a single
+    /// model, or when the last part's amplitude cannot start neutral (fixed, no positive
+    /// default, or bounds that exclude the neutral value).
+    pub fn base(&self) -> Option<(ConfiguredModel, (usize, f64))> {
+        let (last, rest) = self.parts.split_last()?;
+        if rest.is_empty() {
+            return None;
+        }
+        let n_base = self.params.len() - last.params().len();
+        let amp = self.params.get(n_base)?;
+        let neutral = neutral_amplitude(last.as_ref())?;
+        if amp.fixed || !(amp.min..=amp.max).contains(&neutral) {
+            return None;
+        }
+        let sum = ModelSum::new(rest.to_vec()).ok()?;
+        let params = sum
+            .params()
+            .iter()
+            .zip(&self.params)
+            .map(|(spec, p)| FitParam {
+                name: spec.name.clone(),
+                ..p.clone()
+            })
+            .collect();
+        let base = ConfiguredModel {
+            model: Arc::new(sum),
+            params,
+            parts: rest.to_vec(),
+        };
+        Some((base, (n_base, neutral)))
+    }
+
+    /// This model started from `base_values` (the fitted values of [`Self::base`]'s
+    /// parameters, in order) with the last part's amplitude (index and neutral value `amp`)
+    /// neutral; its other parameters as they are. Fixed parameters keep their values.
+    pub fn started_from(&self, base_values: &[f64], amp: (usize, f64)) -> ConfiguredModel {
+        let mut out = self.clone();
+        for (p, &v) in out.params.iter_mut().zip(base_values) {
+            if !p.fixed && v.is_finite() {
+                p.value = v.clamp(p.min, p.max);
+            }
+        }
+        out.params[amp.0].value = amp.1;
+        out
+    }
+
     /// The parameter values, in order.
     pub fn values(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.value).collect()
@@ -76,6 +126,7 @@ pub fn configure_for(
         }
     }
     Ok(ConfiguredModel {
+        parts: sum.parts().to_vec(),
         model: Arc::new(sum),
         params,
     })

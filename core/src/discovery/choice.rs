@@ -223,12 +223,7 @@ pub(super) fn decide(
         .iter()
         .map(|s| s.1.as_ref().map_or(&[][..], |t| t.holdout.as_slice()))
         .collect();
-    let choice = acceptance::choose(
-        &scores,
-        &holdout,
-        &|a, b| (yardstick.gain_z)(a, b).0,
-        settings,
-    );
+    let choice = acceptance::choose(&scores, &holdout, &|a, b| (yardstick.gain_z)(a, b).0);
     let mut step = step_on(current, scores, yardstick);
     let Some((winner, ties)) = choice else {
         step.verdict = rejected(&step, said, settings);
@@ -241,8 +236,9 @@ pub(super) fn decide(
     step.verdict = accepted(&step, winner, said);
     if !tie_names.is_empty() {
         step.verdict.push_str(&format!(
-            "; `{}` explain the data equally well (the best is not better by the held-out \
-             test), `{}` is chosen as the simplest (fewest parameters, then lowest BIC)",
+            "; `{}` explain the data equally well (the best's held-out gain over them is \
+             within one standard error of the paired test), `{}` is chosen as the simplest \
+             (fewest parameters, then lowest BIC)",
             tie_names.join("`, `"),
             step.candidates[winner].name
         ));

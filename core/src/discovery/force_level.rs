@@ -30,6 +30,7 @@ use super::settings::DiscoverySettings;
 use crate::data::force_data::ForceData;
 use crate::fit::{Convergence, FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
 use crate::physics::force_model::{ForceModel, Reach};
+use crate::physics::model_sum::neutral_amplitude;
 use crate::regimes::Cycle;
 
 impl SearchModel {
@@ -312,10 +313,19 @@ impl<'a> ForceLevel<'a> {
         stage: impl Fn(&[f64]) -> SearchModel,
     ) -> Result<Trial, DiscoveryError> {
         let train = &self.split.train;
-        let starts = candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
+        let mut starts =
+            candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
         let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
         if let Some(released) = stages.first().and_then(SearchModel::released) {
             stages.push(released);
+        }
+        // The neutral start: the current model's optimum with the candidate's amplitude at
+        // next to nothing, so that no candidate ends worse than the model it extends.
+        if let Some(amp) = neutral_amplitude(c.model.as_ref()) {
+            let mut neutral: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+            neutral[0] = amp;
+            starts.push(neutral);
+            stages.push(stage(&starts[starts.len() - 1]));
         }
         let trials: Vec<Result<Trial, DiscoveryError>> = stages
             .iter()

@@ -12,6 +12,7 @@
 
 use rayon::prelude::*;
 
+use super::acceptance;
 use super::candidate::Candidate;
 use super::choice::{self, Trial, Yardstick};
 use super::error::DiscoveryError;
@@ -147,7 +148,7 @@ impl<L: Level> Recheck<'_, L> {
         let wins = score.significant;
         let tie = !wins
             && score.failure.is_none()
-            && score.gain_z >= -settings.min_gain_sigma
+            && score.gain_z >= -acceptance::TIE_SIGMA
             && n_own < old_len
             && score.delta_bic < 0.0;
         score.significant = wins || tie;

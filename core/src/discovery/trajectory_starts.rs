@@ -7,6 +7,7 @@ use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use super::trajectory_setup::TrajectorySetup;
 use super::trajectory_subset_fit::Track;
+use crate::physics::model_sum::neutral_amplitude;
 use crate::physics::param_spec::ParamSpec;
 
 /// Factors of the new effect's first parameter tried before its fit (see
@@ -76,7 +77,24 @@ impl SearchModel {
                 values: best.1,
             });
         }
+        out.extend(self.neutral(osc_start.len()));
         out
+    }
+
+    /// This stage with its new effect neutral: its amplitude at
+    /// [`crate::physics::model_sum::NEUTRAL_AMPLITUDE`] × its default, every other value as
+    /// it is (the current model's optimum), so that it starts at the current model's residual;
+    /// `None` when the effect's amplitude cannot start neutral.
+    pub(super) fn neutral(&self, n_osc: usize) -> Option<SearchModel> {
+        let extra = self.parts.last()?;
+        let amp = neutral_amplitude(extra.as_ref())?;
+        let i = self.start_of(self.parts.len() - 1, n_osc);
+        let mut values = self.values.clone();
+        *values.get_mut(i)? = amp;
+        Some(SearchModel {
+            parts: self.parts.clone(),
+            values,
+        })
     }
 
     /// The current values; the current model on the oscillator `osc_start`; every parameter

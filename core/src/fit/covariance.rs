@@ -132,6 +132,31 @@ pub fn from_jacobian(jac: &DMatrix<f64>, rss: f64) -> Covariance {
     assemble(&nm, &cov)
 }
 
+/// The Gauss–Newton step `δ = −(JᵀJ)⁻¹·Jᵀr` from Jacobian `jac` (N × p) and residuals `r`
+/// (residual = data − model, `J = ∂r/∂x`): where the linearised fit would move each parameter
+/// if nothing bounded it. Zero for a parameter in a direction the data do not determine (or
+/// with a bad column), so that an undetermined parameter never seems pushed anywhere.
+pub fn gauss_newton_step(jac: &DMatrix<f64>, r: &[f64]) -> Vec<f64> {
+    let (n, p) = jac.shape();
+    if r.len() != n {
+        return vec![0.0; p];
+    }
+    let nm = normal_matrix(jac);
+    let mut g = DVector::<f64>::zeros(p);
+    for j in 0..p {
+        if nm.status[j] == Column::Determined {
+            g[j] = nm.d[j] * jac.column(j).iter().zip(r).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+    let step = &nm.pinv * g;
+    (0..p)
+        .map(|j| match nm.status[j] {
+            Column::Determined if step[j].is_finite() => -nm.d[j] * step[j],
+            _ => 0.0,
+        })
+        .collect()
+}
+
 /// The cluster-robust covariance from Jacobian `jac` (N × p) and residuals `r` (in sample
 /// order), over blocks of `block` consecutive samples (the N samples are split into
 /// `G = N / block` blocks of as equal lengths as can be). NaN standard errors if `G < 2`.

@@ -16,7 +16,7 @@ use nalgebra::DMatrix;
 
 use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
-use super::fit_param::FitParam;
+use super::fit_param::{BoundSide, FitParam};
 use super::levenberg_marquardt::{BoundStop, MAX_FD_STEP, NOISE_PROBE};
 use super::noise_floor::Quantity;
 use super::objective::{Objective, Residuals};
@@ -393,8 +393,35 @@ impl Chain<'_> {
     }
 }
 
+/// How near a bound (as a fraction of the box's width, or of the typical size for a bound on
+/// one side only) a parameter the data push past it counts as held by it. A bounded map
+/// flattens towards its bounds, so a solver stops short of one it is pushed against (an offset
+/// of −124 N stopped at −99.93 in a box of ±100 N, 0.07 % of the width inside).
+pub const HELD_REACH: f64 = 0.05;
+
+/// The bound that holds `q` at `value`: within [`HELD_REACH`] of it, and the Gauss–Newton
+/// `step` from there crosses it.
+fn held_by(q: &FitParam, value: f64, step: f64) -> Option<BoundSide> {
+    let width = q.max - q.min;
+    let reach = HELD_REACH
+        * if width.is_finite() {
+            width
+        } else {
+            q.effective_scale()
+        };
+    let to = value + step;
+    if q.min.is_finite() && to < q.min && value - q.min <= reach {
+        Some(BoundSide::Lower)
+    } else if q.max.is_finite() && to > q.max && q.max - value <= reach {
+        Some(BoundSide::Upper)
+    } else {
+        None
+    }
+}
+
 /// Every parameter as fitted: a fixed one at its value with no error, a free one at its entry
-/// of the free values `x` with its standard errors (none when nothing was free to fit).
+/// of the free values `x` with its standard errors (none when nothing was free to fit) and the
+/// bound that holds it, if one does.
 fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec<FittedParam> {
     let mut free = x.iter().enumerate();
     params
@@ -407,6 +434,7 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
                     std_error: 0.0,
                     naive_std_error: 0.0,
                     fixed: true,
+                    held_by: None,
                 });
             }
             let e = errors?;
@@ -417,6 +445,7 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
                 std_error: e.robust.std_errors[k],
                 naive_std_error: e.naive[k],
                 fixed: false,
+                held_by: held_by(q, value, e.step[k]),
             })
         })
         .collect()
@@ -491,6 +520,8 @@ struct Errors {
     robust: covariance::Covariance,
     naive: Vec<f64>,
     blocks: ErrorBlocks,
+    /// The Gauss–Newton step from the end, per free parameter.
+    step: Vec<f64>,
 }
 
 /// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`);
@@ -514,6 +545,7 @@ fn standard_errors(jac: &DMatrix<f64>, r: &[f64], rss: f64, log: &mut Vec<String
         robust: covariance::sandwich(jac, r, blocks.length),
         naive: covariance::from_jacobian(jac, rss).std_errors,
         blocks,
+        step: covariance::gauss_newton_step(jac, r),
     }
 }
 
@@ -576,6 +608,37 @@ mod tests {
                     fit.params[0].value
                 );
                 assert!((fit.params[0].value / best - 1.0).abs() < 1e-6);
+            }
+        }
+    }
+
+    /// A slope the data put at −124 in a box of ±100: wherever the solvers stop short of the
+    /// lower bound, the slope is held by it (and a fit's warnings say so); a slope of −95
+    /// inside the same box, as near the bound, is held by nothing.
+    #[test]
+    fn a_parameter_the_data_push_past_a_bound_is_held_by_it() {
+        let x: Vec<f64> = (0..400).map(|i| (i as f64 * 0.05).sin()).collect();
+        for (truth, held) in [(-124.0, Some(BoundSide::Lower)), (-95.0, None)] {
+            let y: Vec<f64> = x
+                .iter()
+                .enumerate()
+                .map(|(i, x)| truth * x + 0.1 * ((i * 7919 % 13) as f64 - 6.0))
+                .collect();
+            let line = Line { x: x.clone(), y };
+            let params = [FitParam::new("k", 0.0).bounds(-100.0, 100.0).scale(0.1)];
+            for solver in Solver::ALL {
+                let settings = FitSettings::default().solver(solver);
+                let fit = run(&line, &params, &settings, None, false).unwrap();
+                let p = &fit.params[0];
+                assert_eq!(
+                    p.held_by, held,
+                    "{solver:?}, truth {truth}: k = {}",
+                    p.value
+                );
+                let flagged = super::super::fit_warnings(&fit, &params, None)
+                    .iter()
+                    .any(|w| w.kind() == "on_bound");
+                assert_eq!(flagged, held.is_some(), "{solver:?}, truth {truth}");
             }
         }
     }

@@ -7,6 +7,26 @@ use super::error::FitError;
 use super::transform::BoundTransform;
 use crate::physics::param_spec::ParamSpec;
 
+/// Which bound of a parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BoundSide {
+    /// The lower bound.
+    Lower,
+    /// The upper bound.
+    Upper,
+}
+
+impl BoundSide {
+    /// `lower` or `upper`.
+    pub fn name(self) -> &'static str {
+        match self {
+            BoundSide::Lower => "lower",
+            BoundSide::Upper => "upper",
+        }
+    }
+}
+
 /// One parameter of a fit, as the user gives it.
 ///
 /// ```

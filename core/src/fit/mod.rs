@@ -52,8 +52,9 @@ mod transform;
 mod validation;
 mod warning;
 
+pub use driver::HELD_REACH;
 pub use error::FitError;
-pub use fit_param::{full_values, FitParam};
+pub use fit_param::{full_values, BoundSide, FitParam};
 pub use force_fit::{ForceFit, FORCE_OFFSET};
 pub use noise_floor::{NoiseFloor, Quantity};
 pub use objective::Residuals;
@@ -66,8 +67,7 @@ pub use trajectory_fit::{
 pub use transform::BoundTransform;
 pub use validation::Validation;
 pub use warning::{
-    fit_warnings, BoundSide, FitWarning, StatedWarning, CORRELATION_LIMIT, NEAR_BOUND,
-    RESIDUAL_OVER_FLOOR,
+    fit_warnings, FitWarning, StatedWarning, CORRELATION_LIMIT, NEAR_BOUND, RESIDUAL_OVER_FLOOR,
 };
 
 /// Fit any least-squares problem: `params` lists every parameter (free and fixed, in order);

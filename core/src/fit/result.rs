@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use super::fit_param::BoundSide;
+
 /// How a fit ended.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
@@ -76,6 +78,11 @@ pub struct FittedParam {
     pub naive_std_error: f64,
     /// Held fixed.
     pub fixed: bool,
+    /// The bound that holds this free parameter: it lies near the bound (within
+    /// [`HELD_REACH`](super::HELD_REACH) of its box) and the data push it past: the
+    /// Gauss–Newton step from the end would cross the bound. `None`: free to move either way.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub held_by: Option<BoundSide>,
 }
 
 /// The blocks of consecutive samples over which the standard errors' residuals were taken as

@@ -17,7 +17,7 @@
 use serde::Serialize;
 use thiserror::Error;
 
-use super::fit_param::FitParam;
+use super::fit_param::{BoundSide, FitParam};
 use super::noise_floor::{NoiseFloor, Quantity};
 use super::result::{Convergence, FitResult};
 
@@ -37,16 +37,6 @@ pub const RESIDUAL_OVER_FLOOR: f64 = 1.5;
 pub const NEAR_BOUND: f64 = 1e-3;
 /// Two free parameters whose correlation exceeds this in magnitude are not told apart.
 pub const CORRELATION_LIMIT: f64 = 0.99;
-
-/// Which bound of a parameter.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BoundSide {
-    /// The lower bound.
-    Lower,
-    /// The upper bound.
-    Upper,
-}
 
 /// A reason not to trust a fit's result as it stands.
 #[derive(Clone, Debug, PartialEq, Serialize, Error)]
@@ -147,16 +137,6 @@ impl FitWarning {
     }
 }
 
-impl BoundSide {
-    /// `lower` or `upper`.
-    fn name(self) -> &'static str {
-        match self {
-            BoundSide::Lower => "lower",
-            BoundSide::Upper => "upper",
-        }
-    }
-}
-
 /// The sentence of [`FitWarning::NotConverged`]: what the end of the fit says, and what to try.
 fn not_converged(convergence: &Convergence) -> String {
     match convergence {
@@ -218,7 +198,7 @@ pub fn fit_warnings(
     let free: Vec<_> = result.params.iter().filter(|p| !p.fixed).collect();
     for p in &free {
         if let Some(q) = params.iter().find(|q| q.name == p.name) {
-            out.extend(on_bound(q, p.value));
+            out.extend(on_bound(q, p.value, p.held_by));
         }
     }
     for p in &free {
@@ -258,8 +238,9 @@ pub fn fit_warnings(
     out
 }
 
-/// Whether `value` of parameter `q` lies on one of its bounds (see [`NEAR_BOUND`]).
-fn on_bound(q: &FitParam, value: f64) -> Option<FitWarning> {
+/// Whether `value` of parameter `q` lies on one of its bounds (see [`NEAR_BOUND`]) or is
+/// `held` by one (the data push it past a bound it stopped short of: [`crate::fit::HELD_REACH`]).
+fn on_bound(q: &FitParam, value: f64, held: Option<BoundSide>) -> Option<FitWarning> {
     let width = q.max - q.min;
     let size = q.effective_scale();
     let reach = NEAR_BOUND * if width < size { width } else { size };
@@ -267,6 +248,15 @@ fn on_bound(q: &FitParam, value: f64) -> Option<FitWarning> {
         (BoundSide::Lower, q.min)
     } else if q.max.is_finite() && q.max - value <= reach {
         (BoundSide::Upper, q.max)
+    } else if let Some(side) = held {
+        (
+            side,
+            if side == BoundSide::Lower {
+                q.min
+            } else {
+                q.max
+            },
+        )
     } else {
         return None;
     };
@@ -290,6 +280,7 @@ mod tests {
             std_error,
             naive_std_error: std_error,
             fixed: false,
+            held_by: None,
         }
     }
 

@@ -11,6 +11,23 @@ use std::sync::Arc;
 use crate::physics::force_model::{ForceModel, ModelError, ModelState};
 use crate::physics::param_spec::ParamSpec;
 
+/// The factor of its default that an added term's amplitude (its first parameter, by the
+/// models' convention) starts at when the term starts neutral: a millionth of its default's
+/// contribution, nothing against the rest of the sum, yet inside its bounds, where a fit's
+/// bound map is not flat. A sum started so, from the optimum of the sum without that term,
+/// starts at that optimum's residual and, since a fit never ends worse than its start, ends
+/// no worse.
+pub const NEUTRAL_AMPLITUDE: f64 = 1e-6;
+
+/// The neutral start of `model`'s amplitude ([`NEUTRAL_AMPLITUDE`] × its first parameter's
+/// default), if it has one: a positive default and a lower bound at or below the neutral
+/// value.
+pub fn neutral_amplitude(model: &dyn ForceModel) -> Option<f64> {
+    let spec = model.params().first()?;
+    let v = NEUTRAL_AMPLITUDE * spec.default;
+    (spec.default > 0.0 && spec.min <= v && v <= spec.max).then_some(v)
+}
+
 /// A sum of force models, itself a [`ForceModel`].
 pub struct ModelSum {
     name: String,

@@ -84,6 +84,7 @@ mod tests {
             std_error,
             naive_std_error: f64::NAN,
             fixed: false,
+            held_by: None,
         };
         let doc = Doc {
             aic: f64::NEG_INFINITY,

@@ -85,6 +85,7 @@ mod tests {
             std_error: f64::NAN,
             naive_std_error: f64::NAN,
             fixed: false,
+            held_by: None,
         }
     }
 

@@ -127,7 +127,7 @@ impl TrajectoryLevel<'_> {
                     .observer
                     .candidate(step, i, tried.len(), &tried[i].name);
                 let h = hinted[i].as_ref().map(|(s, _)| s);
-                Some(self.searched(withs[i].clone(), h))
+                Some(self.searched(withs[i].clone(), h, current.train.rms))
             })
             .collect();
         let scout_rank = self.scout_ranks(&searched, current);
@@ -169,25 +169,42 @@ impl TrajectoryLevel<'_> {
     /// defaults; `hinted`: its force-level start): the best of its starts, fitted on the
     /// scout when there is one; its mean square on the scout's training samples (m²;
     /// infinite without a scout) and its RMS on the whole record's training samples (m; NaN
-    /// without a scout).
+    /// without a scout). Among the starts is the neutral one (the current model's optimum,
+    /// the effect at next to nothing: [`SearchModel::neutral`]); where the search on the
+    /// scout still ends above the current model's training RMS `current_rms` on the whole
+    /// record, the neutral start is scouted in its place, and the better of the two kept: a
+    /// candidate never ends worse than the model it extends.
     pub(in crate::discovery) fn searched(
         &self,
         with: SearchModel,
         hinted: Option<&SearchModel>,
+        current_rms: f64,
     ) -> (SearchModel, f64, f64) {
         let (track, train): (&dyn Track, &[usize]) = match self.scout.as_ref() {
             Some(scout) => (scout, &scout.train),
             None => (&self.rig, &self.split.train),
         };
         let starts = with.starts(track, train, &self.osc_start, hinted);
-        let stage =
-            SearchModel::started(starts, track, self.setup, train, self.settings).unwrap_or(with);
-        match self.scout.as_ref() {
-            Some(scout) => {
-                let on = (&self.rig, self.setup, self.split.train.as_slice());
-                scouted(stage, scout, on, &trial_settings(self.settings))
+        let stage = SearchModel::started(starts, track, self.setup, train, self.settings)
+            .unwrap_or_else(|| with.clone());
+        let Some(scout) = self.scout.as_ref() else {
+            return (stage, f64::INFINITY, f64::NAN);
+        };
+        let on = (&self.rig, self.setup, self.split.train.as_slice());
+        let found = scouted(stage, scout, on, &trial_settings(self.settings));
+        if found.2 < current_rms {
+            return found;
+        }
+        match with.neutral(self.osc_start.len()) {
+            Some(neutral) => {
+                let alt = scouted(neutral, scout, on, &trial_settings(self.settings));
+                if alt.2 < found.2 {
+                    alt
+                } else {
+                    found
+                }
             }
-            None => (stage, f64::INFINITY, f64::NAN),
+            None => found,
         }
     }
 
