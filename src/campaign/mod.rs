@@ -22,6 +22,8 @@ pub mod records_table;
 pub mod report;
 pub mod runner;
 pub mod slurm;
+pub mod slurm_file;
+pub mod slurm_plan;
 pub mod slurm_script;
 pub mod table;
 pub mod unit;
