@@ -25,7 +25,7 @@ use common::{read_json, root, stf_lab};
 const SLURM_DIR: &str = "/tmp/stf-lab-slurm";
 
 /// The longest wait for a submitted campaign's collect job to end.
-const JOB_TIMEOUT: Duration = Duration::from_secs(300);
+const JOB_TIMEOUT: Duration = Duration::from_secs(600);
 
 /// Three records of the bundled campaign (three concentrations, three amplitudes) copied into
 /// `dir`, with its experiment, a `[global]` fit (n shared, K a law of the concentration) and,
@@ -137,14 +137,20 @@ fn slurm() -> Option<PathBuf> {
     }
 }
 
-/// The job ids `--slurm` printed: (units job, collect job).
-fn job_ids(stdout: &str) -> (String, String) {
-    let id = |key: &str| {
-        let line = stdout.lines().find_map(|l| l.strip_prefix(key));
-        let line = line.unwrap_or_else(|| panic!("no {key:?} line in:\n{stdout}"));
-        line.split_whitespace().next().unwrap().to_string()
-    };
-    (id("units job: "), id("collect job: "))
+/// The job ids `--slurm` printed: (units jobs, one per array; collect job).
+fn job_ids(stdout: &str) -> (Vec<String>, String) {
+    let first_word = |l: &str| l.split_whitespace().next().unwrap().to_string();
+    let units: Vec<String> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("units job: "))
+        .map(first_word)
+        .collect();
+    assert!(!units.is_empty(), "no \"units job: \" line in:\n{stdout}");
+    let collect = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("collect job: "))
+        .unwrap_or_else(|| panic!("no \"collect job: \" line in:\n{stdout}"));
+    (units, first_word(collect))
 }
 
 /// What a campaign's Slurm jobs and the test cluster logged, for a failure's message.
@@ -299,9 +305,10 @@ fn a_campaign_through_single_node_slurm_gives_the_local_run_s_outputs() {
         text(&run.stderr)
     );
     let (units, collect) = job_ids(&text(&run.stdout));
+    assert_eq!(units.len(), 1, "three units fit one array");
     let state = wait_for(&collect, &cluster, &conf);
     assert_eq!(state, "COMPLETED", "{}", logs(&cluster, &conf));
-    assert_eq!(wait_for(&units, &cluster, &conf), "COMPLETED");
+    assert_eq!(wait_for(&units[0], &cluster, &conf), "COMPLETED");
 
     let names = results(&local);
     assert_eq!(names, results(&cluster));
@@ -364,7 +371,7 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
         logs(&out, &conf)
     );
     // Three tasks ran their unit, the fourth failed; the collect job ran all the same.
-    assert_eq!(wait_for(&units, &out, &conf), "COMPLETED,FAILED");
+    assert_eq!(wait_for(&units[0], &out, &conf), "COMPLETED,FAILED");
     let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
     assert!(
         log.contains("1 of 4 unit(s) failed") && log.contains("unit 4 (records/broken.csv): "),
@@ -386,17 +393,23 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
 }
 
 /// A stand-in `sbatch` in `dir` that appends its arguments to `dir/calls` and prints the
-/// job ids 41, then 42.
+/// job ids 41, 42, …; and a stand-in `scontrol` whose configuration says `MaxArraySize = 2`.
 fn fake_sbatch(dir: &Path) {
-    let script = "#!/bin/sh\n\
+    let sbatch = "#!/bin/sh\n\
         echo \"$@\" >> \"$(dirname \"$0\")/calls\"\n\
         n=$(wc -l < \"$(dirname \"$0\")/calls\")\n\
         echo $((40 + n))\n";
-    let path = dir.join("sbatch");
-    std::fs::write(&path, script).unwrap();
-    let mut mode = std::fs::metadata(&path).unwrap().permissions();
-    std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
-    std::fs::set_permissions(&path, mode).unwrap();
+    let scontrol = "#!/bin/sh\n\
+        echo \"Configuration data as of 2026-11-27T22:00:00\"\n\
+        echo \"MaxArraySize            = 2\"\n\
+        echo \"MaxJobCount             = 10000\"\n";
+    for (name, script) in [("sbatch", sbatch), ("scontrol", scontrol)] {
+        let path = dir.join(name);
+        std::fs::write(&path, script).unwrap();
+        let mut mode = std::fs::metadata(&path).unwrap().permissions();
+        std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
+        std::fs::set_permissions(&path, mode).unwrap();
+    }
 }
 
 /// PATH with `dir` first.
@@ -439,17 +452,22 @@ fn a_dry_run_prints_the_scripts_of_the_unfinished_units_and_submits_nothing() {
     let out = out.canonicalize().unwrap();
     let slurm = out.join("slurm");
     for line in [
-        "#SBATCH --array=1,3".to_string(),
-        format!("#SBATCH --output={}/unit-%a.log", slurm.display()),
+        "2 unit(s) in 2 task(s) of at most 1 unit(s) (the default for these commands), 1 \
+         array(s) of at most 2 task(s) (the cluster's MaxArraySize (scontrol show config))"
+            .to_string(),
+        "#SBATCH --array=0-1\n".into(),
+        "  0) units=\"1\" ;;\n  1) units=\"3\" ;;\n".into(),
+        format!("#SBATCH --output={}/array-1-task-%a.log", slurm.display()),
         "#SBATCH --partition=short".into(),
         "#SBATCH --time=00:20:00".into(),
         "#SBATCH --mem=2G".into(),
         "#SBATCH --account=lab".into(),
-        "--unit \"$SLURM_ARRAY_TASK_ID\"".into(),
+        "--unit \"$n\" --quiet".into(),
+        "} > \"unit-$n.log\" 2>&1".into(),
         format!("--out {} --collect --quiet", out.display()),
-        format!("sbatch --parsable {}/units.sbatch", slurm.display()),
+        format!("sbatch --parsable {}/units-1.sbatch", slurm.display()),
         format!(
-            "sbatch --parsable --dependency=afterany:<units job id> {}/collect.sbatch",
+            "sbatch --parsable --dependency=afterany:<units job 1 id> {}/collect.sbatch",
             slurm.display()
         ),
     ] {
@@ -462,10 +480,21 @@ fn a_dry_run_prints_the_scripts_of_the_unfinished_units_and_submits_nothing() {
     );
 }
 
+/// `file`'s text with `[slurm]` settings added.
+fn with_slurm_settings(file: &Path, settings: &str) {
+    let body = std::fs::read_to_string(file).unwrap();
+    std::fs::write(file, format!("{body}\n[slurm]\n{settings}")).unwrap();
+}
+
 #[test]
-fn the_collect_job_is_submitted_after_the_array_whatever_its_tasks_end_with() {
+fn the_collect_job_is_submitted_after_every_array_whatever_their_tasks_end_with() {
     let tmp = tempfile::tempdir().unwrap();
     let file = small_campaign(&tmp.path().join("campaign"), false);
+    // Three units, at most 2 tasks per array: two arrays.
+    with_slurm_settings(
+        &file,
+        "units_per_task = 1\nthrottle = 5\ncpus_per_task = 2\n",
+    );
     let out = tmp.path().join("out");
     let bin = tmp.path().join("bin");
     std::fs::create_dir_all(&bin).unwrap();
@@ -474,19 +503,44 @@ fn the_collect_job_is_submitted_after_the_array_whatever_its_tasks_end_with() {
     let run = campaign(&file, &out, &["--slurm"], &[("PATH", path.as_os_str())]);
     let said = text(&run.stdout);
     assert!(run.status.success(), "{said}{}", text(&run.stderr));
-    assert_eq!(job_ids(&said), ("41".to_string(), "42".to_string()));
+    assert_eq!(
+        job_ids(&said),
+        (vec!["41".to_string(), "42".to_string()], "43".to_string())
+    );
     let slurm = out.canonicalize().unwrap().join("slurm");
     let calls = std::fs::read_to_string(bin.join("calls")).unwrap();
     assert_eq!(
         calls,
         format!(
-            "--parsable {0}/units.sbatch\n--parsable --dependency=afterany:41 {0}/collect.sbatch\n",
+            "--parsable {0}/units-1.sbatch\n--parsable {0}/units-2.sbatch\n\
+             --parsable --dependency=afterany:41:42 {0}/collect.sbatch\n",
             slurm.display()
         )
     );
-    let units = std::fs::read_to_string(slurm.join("units.sbatch")).unwrap();
-    assert!(units.contains("#SBATCH --array=1-3\n"), "{units}");
+    let first = std::fs::read_to_string(slurm.join("units-1.sbatch")).unwrap();
+    assert!(first.contains("#SBATCH --array=0-1%5\n"), "{first}");
+    assert!(first.contains("#SBATCH --cpus-per-task=2\n"), "{first}");
+    assert!(first.contains("  0) units=\"1\" ;;\n  1) units=\"2\" ;;\n"));
+    let second = std::fs::read_to_string(slurm.join("units-2.sbatch")).unwrap();
+    assert!(second.contains("#SBATCH --array=0-0%5\n"), "{second}");
+    assert!(second.contains("  0) units=\"3\" ;;\n"), "{second}");
     assert!(slurm.join("collect.sbatch").is_file());
+
+    // Three units per task: one array, one task; the second array's script of the last
+    // submission is removed, so DIR/slurm/ holds only what this one submitted.
+    let body = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        body.replace("units_per_task = 1", "units_per_task = 3"),
+    )
+    .unwrap();
+    let run = campaign(&file, &out, &["--slurm"], &[("PATH", path.as_os_str())]);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    assert_eq!(job_ids(&said).0, ["44"]);
+    let first = std::fs::read_to_string(slurm.join("units-1.sbatch")).unwrap();
+    assert!(first.contains("  0) units=\"1 2 3\" ;;\n"), "{first}");
+    assert!(!slurm.join("units-2.sbatch").exists());
 }
 
 #[test]
@@ -529,4 +583,116 @@ fn collect_names_the_units_that_did_not_finish() {
         .filter(|r| r["status"] == "ok")
         .count();
     assert_eq!(ok, 2, "unit 1's two models");
+}
+
+/// The identity of each unit's `unit.json` under `out` (inode and modification time), by
+/// unit folder: a rewritten file gets a new one.
+fn unit_stamps(out: &Path) -> Vec<(String, u64, std::time::SystemTime)> {
+    let mut stamps = Vec::new();
+    for e in std::fs::read_dir(out.join("units")).unwrap() {
+        let dir = e.unwrap().path();
+        if let Ok(meta) = std::fs::metadata(dir.join("unit.json")) {
+            let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+            let ino = std::os::unix::fs::MetadataExt::ino(&meta);
+            stamps.push((name, ino, meta.modified().unwrap()));
+        }
+    }
+    stamps.sort();
+    stamps
+}
+
+#[test]
+fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("campaign");
+    let file = small_campaign(&dir, false);
+    // A fourth record (a copy of the first, repeated): four units. At most 3 tasks per array
+    // and one unit per task: two arrays of 3 and 1 tasks. One task of an array at a time,
+    // so the third task of the first array is still waiting when it is cancelled.
+    std::fs::copy(
+        dir.join("records/a1_c1.csv"),
+        dir.join("records/a1_c1_again.csv"),
+    )
+    .unwrap();
+    let body = std::fs::read_to_string(&file).unwrap();
+    let (records, global) = body.split_once("\n[global]").unwrap();
+    std::fs::write(
+        &file,
+        format!(
+            "{records}\n[[records]]\nfile = \"records/a1_c1_again.csv\"\nF0 = 0.035\n\
+             concentration = 0.36\n\n[global]{global}\n[slurm]\nmax_array_size = 3\n\
+             units_per_task = 1\nthrottle = 1\n"
+        ),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
+    let run = campaign(&file, &out, &flags, &env);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    let (units, collect) = job_ids(&said);
+    assert_eq!(units.len(), 2, "{said}");
+    assert!(
+        said.contains("4 unit(s) in 4 task(s) of at most 1 unit(s) ([slurm] units_per_task), 2 array(s) of at most 3 task(s) ([slurm] max_array_size)"),
+        "{said}"
+    );
+    // The scheduler kills task 2 of the first array (unit 3) before it runs.
+    let cancel = Command::new("scancel")
+        .arg(format!("{}_2", units[0]))
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "FAILED",
+        "{}",
+        logs(&out, &conf)
+    );
+    // (squeue may no longer list a task cancelled while it waited.)
+    let states = wait_for(&units[0], &out, &conf);
+    assert!(
+        ["CANCELLED,COMPLETED", "COMPLETED"].contains(&states.as_str()),
+        "{states}"
+    );
+    assert_eq!(wait_for(&units[1], &out, &conf), "COMPLETED");
+    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    assert!(
+        log.contains("1 of 4 unit(s) failed")
+            && log.contains("unit 3 (records/a3_c3.csv): it did not finish: no unit.json in"),
+        "{log}"
+    );
+    for n in [1, 2, 4] {
+        let unit_log = std::fs::read_to_string(out.join(format!("slurm/unit-{n}.log"))).unwrap();
+        assert!(
+            unit_log.starts_with("[stf-lab campaign] run by Slurm task "),
+            "{unit_log}"
+        );
+    }
+    let finished = unit_stamps(&out);
+    assert_eq!(finished.len(), 3, "{finished:?}");
+
+    // Submitted again: only unit 3 goes to Slurm; the finished units are not touched.
+    let again = campaign(&file, &out, &flags, &env);
+    let said = text(&again.stdout);
+    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    assert!(said.contains("1 unit(s) in 1 task(s)"), "{said}");
+    let (units, collect) = job_ids(&said);
+    assert_eq!(units.len(), 1, "{said}");
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "COMPLETED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let now = unit_stamps(&out);
+    assert_eq!(now.len(), 4, "{now:?}");
+    for stamp in &finished {
+        assert!(now.contains(stamp), "{stamp:?} was rewritten: {now:?}");
+    }
+    let rows = read_json(&out.join("campaign.json"));
+    assert_eq!(rows["failed"], 0);
+    assert_eq!(rows["units"], 4);
 }
