@@ -2,13 +2,16 @@
 //! `[global]` fit) run through a real single-node Slurm, brought up on this machine by
 //! `tests/slurm/start.sh`, gives the units, `campaign.json`, `campaign.csv` and
 //! `global.json` of a local run, timing fields apart; a unit that fails on the cluster is
-//! named by the collect job. Without Slurm (no `sbatch`, `slurmctld`, `slurmd` or `munged`
-//! on PATH, or not root) these two tests say why they are skipped and pass, unless
-//! `STF_LAB_REQUIRE_SLURM=1` (CI), where they fail.
+//! named by the collect job; four units with `[slurm] max_array_size = 3` go to two arrays,
+//! and an array task cancelled by the scheduler (`scancel`) is named by the collect job and
+//! rerun alone by the next submission, the finished units untouched. Without Slurm (no
+//! `sbatch`, `slurmctld`, `slurmd` or `munged` on PATH, or not root) these tests say why they
+//! are skipped and pass, unless `STF_LAB_REQUIRE_SLURM=1` (CI), where they fail.
 //!
 //! The other tests need no Slurm: `--dry-run` prints the scripts and calls no `sbatch`, a
-//! stand-in `sbatch` shows what is submitted and in which order, a missing `sbatch` is a
-//! clear error, and `--collect` names the units that did not finish.
+//! stand-in `sbatch` and `scontrol` show what is submitted and in which order (arrays cut at
+//! the `MaxArraySize` scontrol says), a missing `sbatch` is a clear error, and `--collect`
+//! names the units that did not finish.
 //!
 //! Every wait has a time limit and ends with the jobs' and daemons' logs.
 
@@ -245,17 +248,27 @@ fn fake_sbatch(dir: &Path) {
         echo \"$@\" >> \"$(dirname \"$0\")/calls\"\n\
         n=$(wc -l < \"$(dirname \"$0\")/calls\")\n\
         echo $((40 + n))\n";
-    let scontrol = "#!/bin/sh\n\
-        echo \"Configuration data as of 2026-11-27T22:00:00\"\n\
-        echo \"MaxArraySize            = 2\"\n\
-        echo \"MaxJobCount             = 10000\"\n";
-    for (name, script) in [("sbatch", sbatch), ("scontrol", scontrol)] {
-        let path = dir.join(name);
-        std::fs::write(&path, script).unwrap();
-        let mut mode = std::fs::metadata(&path).unwrap().permissions();
-        std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
-        std::fs::set_permissions(&path, mode).unwrap();
-    }
+    write_script(&dir.join("sbatch"), sbatch);
+    fake_scontrol(dir, 2);
+}
+
+/// A stand-in `scontrol` in `dir` whose configuration says `MaxArraySize = max`.
+fn fake_scontrol(dir: &Path, max: usize) {
+    let scontrol = format!(
+        "#!/bin/sh\n\
+         echo \"Configuration data as of 2026-11-27T22:00:00\"\n\
+         echo \"MaxArraySize            = {max}\"\n\
+         echo \"MaxJobCount             = 10000\"\n"
+    );
+    write_script(&dir.join("scontrol"), &scontrol);
+}
+
+/// An executable file at `path`.
+fn write_script(path: &Path, body: &str) {
+    std::fs::write(path, body).unwrap();
+    let mut mode = std::fs::metadata(path).unwrap().permissions();
+    std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
+    std::fs::set_permissions(path, mode).unwrap();
 }
 
 /// PATH with `dir` first.
@@ -541,4 +554,60 @@ fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
     let rows = read_json(&out.join("campaign.json"));
     assert_eq!(rows["failed"], 0);
     assert_eq!(rows["units"], 4);
+}
+
+#[test]
+fn three_thousand_units_one_per_task_go_to_three_arrays_below_slurm_s_default_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("campaign");
+    small_campaign(&dir, false);
+    let mut table = String::from("file,F0,concentration\n");
+    for i in 0..3000 {
+        table.push_str(&format!(
+            "records/a1_c1.csv,0.035,{}\n",
+            0.30 + 0.001 * (i % 100) as f64
+        ));
+    }
+    std::fs::write(dir.join("records.csv"), table).unwrap();
+    let file = dir.join("big.toml");
+    std::fs::write(
+        &file,
+        "[campaign]\nexperiment = \"power_law.toml\"\ncommand = \"fit\"\n\
+         conditions = [\"F0\", \"concentration\"]\nrecords = \"records.csv\"\n\n\
+         [slurm]\nunits_per_task = 1\nthrottle = 100\n",
+    )
+    .unwrap();
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    fake_scontrol(&bin, 1001);
+    let path = path_with(&bin);
+    let out = tmp.path().join("out");
+    let run = campaign(
+        &file,
+        &out,
+        &["--slurm", "--dry-run"],
+        &[("PATH", path.as_os_str())],
+    );
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(
+        said.contains("3000 unit(s) in 3000 task(s) of at most 1 unit(s) ([slurm] units_per_task), 3 array(s) of at most 1001 task(s) (the cluster's MaxArraySize (scontrol show config))"),
+        "{}",
+        &said[..said.len().min(2000)]
+    );
+    // Indices 0 to 1000 (below 1001), twice, then the 998 left; each unit once, in order.
+    let arrays: Vec<&str> = said
+        .lines()
+        .filter_map(|l| l.strip_prefix("#SBATCH --array="))
+        .collect();
+    assert_eq!(arrays, ["0-1000%100", "0-1000%100", "0-997%100"]);
+    let units: Vec<usize> = said
+        .lines()
+        .filter_map(|l| l.trim().split_once(") units=\""))
+        .map(|(_, u)| u.trim_end_matches("\" ;;").parse().unwrap())
+        .collect();
+    assert_eq!(units, (1..=3000).collect::<Vec<_>>());
+    assert!(
+        said.contains("--dependency=afterany:<units job 1 id>:<units job 2 id>:<units job 3 id> ")
+    );
 }

@@ -8,8 +8,9 @@
 //! place as one unit (`crate::writing::staged_files`). Interrupted, the run stops its units
 //! and says how many finished (`crate::campaign::runner`); it writes no table then.
 //!
-//! With `--slurm` the units not finished are submitted instead as a Slurm job array, and a
-//! job after it runs `--collect`: the table, report and `[global]` fit from the units' folders
+//! With `--slurm` the units not finished are submitted instead as Slurm job arrays (cut by
+//! `crate::campaign::slurm_plan` within the cluster's `MaxArraySize`), and a job after all of
+//! them runs `--collect`: the table, report and `[global]` fit from the units' folders
 //! — the same step a local run ends with — naming every unit that is missing or failed
 //! (`crate::campaign::slurm`). `--dry-run` shows what `--slurm` would submit.
 

@@ -1,7 +1,9 @@
-//! The two Slurm batch scripts of a campaign (`--slurm`): a job array whose task N runs unit
-//! N with the line the local runner runs (`stf-lab campaign C.toml --out DIR --unit N`), and
-//! a collect job (`--collect`: the table, the report and `[global]` from the finished units).
-//! Only text is built here; [`super::slurm`] writes and submits it.
+//! The Slurm batch scripts of a campaign (`--slurm`): one per job array
+//! ([`super::slurm_plan`]), whose task I runs its units one after another, each with the line
+//! the local runner runs (`stf-lab campaign C.toml --out DIR --unit N`) and its output in
+//! `unit-N.log`, with the throttle (`%N`), CPUs per task and a time limit of `--time` per
+//! unit; and a collect job (`--collect`: the table, the report and `[global]` from the
+//! finished units). Only text is built here; [`super::slurm`] writes and submits it.
 //!
 //! Paths are absolute, so the scripts run from any folder and can be resubmitted by hand.
 //! The command lines are quoted by the `shlex` crate; the values that go into `#SBATCH`
