@@ -19,6 +19,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::time::{Duration, Instant};
 
 use common::slurm::{job_ids, logs, slurm, text, wait_for};
 use common::{read_json, root, stf_lab};
@@ -610,4 +611,73 @@ fn three_thousand_units_one_per_task_go_to_three_arrays_below_slurm_s_default_li
     assert!(
         said.contains("--dependency=afterany:<units job 1 id>:<units job 2 id>:<units job 3 id> ")
     );
+}
+
+#[test]
+fn a_running_task_killed_by_the_scheduler_is_named_with_slurm_s_reason() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    // The three units in one task, one after another: a few seconds at least.
+    with_slurm_settings(&file, "units_per_task = 3\n");
+    let out = tmp.path().join("out");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
+    let run = campaign(&file, &out, &flags, &env);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    let (units, collect) = job_ids(&said);
+    // The task writes unit 1's log as it starts the unit: then it is running, with three
+    // units (each a process of its own) ahead of it.
+    let started = Instant::now();
+    while !out.join("slurm/unit-1.log").exists() {
+        assert!(
+            started.elapsed() < common::slurm::JOB_TIMEOUT,
+            "the task never started:\n{}",
+            logs(&out, &conf)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let cancel = Command::new("scancel")
+        .arg(format!("{}_0", units[0]))
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "FAILED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    assert!(
+        log.contains("it did not finish: no unit.json in")
+            && log.contains("Slurm stopped its task: \"JOB ")
+            && log.contains(" CANCELLED AT "),
+        "{log}"
+    );
+    let finished = unit_stamps(&out);
+    assert!(finished.len() < 3, "{finished:?}");
+
+    // Submitted again: the units the kill stopped run; a unit that had finished stays as it was.
+    let again = campaign(&file, &out, &flags, &env);
+    let said = text(&again.stdout);
+    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    assert!(
+        said.contains(&format!("{} unit(s) in 1 task(s)", 3 - finished.len())),
+        "{said}"
+    );
+    let (_, collect) = job_ids(&said);
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "COMPLETED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let now = unit_stamps(&out);
+    assert_eq!(now.len(), 3, "{now:?}");
+    for stamp in &finished {
+        assert!(now.contains(stamp), "{stamp:?} was rewritten: {now:?}");
+    }
 }
