@@ -17,6 +17,8 @@
 //! …`), and everything is checked before any unit starts: each record exists, each condition
 //! is a finite number on every record, each unit's experiment parses (its own errors name it)
 //! and has what its command needs.
+//! Two optional sections have files of their own: `[global]` (`super::global_file`) and
+//! `[slurm]` (`super::slurm_file`: how `--slurm` cuts the units into jobs).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
