@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::slurm::{job_ids, logs, slurm, text, wait_for};
+use common::slurm::{job_ids, logs, slurm, text, wait_up_to};
 use common::{read_json, root};
 
 /// The bundled records and their conditions (as in `experiments/campaign/campaign.toml`).
@@ -48,6 +48,10 @@ const RECORDS: [(&str, f64, f64); 10] = [
 
 /// Samples kept of each record (4 s at 100 Hz): a small unit.
 const SAMPLES: usize = 400;
+
+/// The longest wait for the campaign's jobs on the test cluster (3 000 units take about half
+/// an hour on 2 busy cores).
+const SLURM_PATIENCE: Duration = Duration::from_secs(4 * 3600);
 
 /// Records of the plain loop.
 const LOOP_RECORDS: usize = 100;
@@ -368,11 +372,11 @@ fn thousands_of_units_locally_and_on_single_node_slurm() {
             .find(|l| l.contains(" task(s) of at most "))
             .unwrap_or("");
         let (units, collect_job) = job_ids(&said);
-        let state = wait_for(&collect_job, &cluster, &conf);
+        let state = wait_up_to(&collect_job, &cluster, &conf, SLURM_PATIENCE);
         let wall = started.elapsed();
         assert_eq!(state, "COMPLETED", "{}", logs(&cluster, &conf));
         for id in &units {
-            assert_eq!(wait_for(id, &cluster, &conf), "COMPLETED");
+            assert_eq!(wait_up_to(id, &cluster, &conf, SLURM_PATIENCE), "COMPLETED");
         }
         assert_eq!(finished_units(&cluster), n);
         assert_eq!(read_json(&cluster.join("campaign.json"))["failed"], 0);

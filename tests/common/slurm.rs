@@ -124,6 +124,11 @@ pub fn logs(out: &Path, conf: &Path) -> String {
 /// sorted (`COMPLETED`, `FAILED`, …, joined by `,`). Panics with the logs after
 /// [`JOB_TIMEOUT`].
 pub fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
+    wait_up_to(id, out, conf, JOB_TIMEOUT)
+}
+
+/// [`wait_for`] with a time limit of `limit`.
+pub fn wait_up_to(id: &str, out: &Path, conf: &Path, limit: Duration) -> String {
     let started = Instant::now();
     let ended = [
         "COMPLETED",
@@ -154,8 +159,8 @@ pub fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
             return states.join(",");
         }
         assert!(
-            started.elapsed() < JOB_TIMEOUT,
-            "job {id} has not ended after {JOB_TIMEOUT:?} (states {states:?}):\n{}",
+            started.elapsed() < limit,
+            "job {id} has not ended after {limit:?} (states {states:?}):\n{}",
             logs(out, conf)
         );
         std::thread::sleep(Duration::from_millis(500));
