@@ -2,13 +2,16 @@
 //! `[global]` fit) run through a real single-node Slurm, brought up on this machine by
 //! `tests/slurm/start.sh`, gives the units, `campaign.json`, `campaign.csv` and
 //! `global.json` of a local run, timing fields apart; a unit that fails on the cluster is
-//! named by the collect job. Without Slurm (no `sbatch`, `slurmctld`, `slurmd` or `munged`
-//! on PATH, or not root) these two tests say why they are skipped and pass, unless
-//! `STF_LAB_REQUIRE_SLURM=1` (CI), where they fail.
+//! named by the collect job; four units with `[slurm] max_array_size = 3` go to two arrays,
+//! and an array task cancelled by the scheduler (`scancel`) is named by the collect job and
+//! rerun alone by the next submission, the finished units untouched. Without Slurm (no
+//! `sbatch`, `slurmctld`, `slurmd` or `munged` on PATH, or not root) these tests say why they
+//! are skipped and pass, unless `STF_LAB_REQUIRE_SLURM=1` (CI), where they fail.
 //!
 //! The other tests need no Slurm: `--dry-run` prints the scripts and calls no `sbatch`, a
-//! stand-in `sbatch` shows what is submitted and in which order, a missing `sbatch` is a
-//! clear error, and `--collect` names the units that did not finish.
+//! stand-in `sbatch` and `scontrol` show what is submitted and in which order (arrays cut at
+//! the `MaxArraySize` scontrol says), a missing `sbatch` is a clear error, and `--collect`
+//! names the units that did not finish.
 //!
 //! Every wait has a time limit and ends with the jobs' and daemons' logs.
 
@@ -16,16 +19,10 @@ mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+use common::slurm::{job_ids, logs, slurm, text, wait_for};
 use common::{read_json, root, stf_lab};
-
-/// The folder of the test cluster's files (`tests/slurm/start.sh`'s default).
-const SLURM_DIR: &str = "/tmp/stf-lab-slurm";
-
-/// The longest wait for a submitted campaign's collect job to end.
-const JOB_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// Three records of the bundled campaign (three concentrations, three amplitudes) copied into
 /// `dir`, with its experiment, a `[global]` fit (n shared, K a law of the concentration) and,
@@ -78,147 +75,6 @@ fn campaign(file: &Path, out: &Path, args: &[&str], env: &[(&str, &std::ffi::OsS
         cmd.env(k, v);
     }
     cmd.output().unwrap()
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// Whether `name` is an executable file in a folder of PATH.
-fn on_path(name: &str) -> bool {
-    std::env::var_os("PATH")
-        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(name).is_file()))
-}
-
-/// The test cluster's `SLURM_CONF`, Slurm brought up once for this test binary; `None` (the
-/// test is skipped) when this machine cannot run it, unless `STF_LAB_REQUIRE_SLURM=1`.
-fn slurm() -> Option<PathBuf> {
-    static STARTED: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    let started = STARTED.get_or_init(|| {
-        let missing: Vec<&str> = ["sbatch", "squeue", "slurmctld", "slurmd", "munged"]
-            .into_iter()
-            .filter(|n| !on_path(n))
-            .collect();
-        if !missing.is_empty() {
-            return Err(format!(
-                "not on PATH: {} (apt-get install -y slurm-wlm munge)",
-                missing.join(", ")
-            ));
-        }
-        let uid = Command::new("id")
-            .arg("-u")
-            .output()
-            .map(|o| text(&o.stdout));
-        if uid.ok().as_deref().map(str::trim) != Some("0") {
-            return Err("tests/slurm/start.sh runs slurmd, which needs root".into());
-        }
-        let start = Command::new(root().join("tests/slurm/start.sh"))
-            .env("STF_LAB_SLURM_DIR", SLURM_DIR)
-            .output()
-            .unwrap();
-        assert!(
-            start.status.success(),
-            "tests/slurm/start.sh failed:\n{}{}",
-            text(&start.stdout),
-            text(&start.stderr)
-        );
-        println!("{}", text(&start.stdout).trim());
-        Ok(Path::new(SLURM_DIR).join("slurm.conf"))
-    });
-    match started {
-        Ok(conf) => Some(conf.clone()),
-        Err(why) if std::env::var("STF_LAB_REQUIRE_SLURM").as_deref() == Ok("1") => {
-            panic!("STF_LAB_REQUIRE_SLURM=1 but Slurm cannot run here: {why}")
-        }
-        Err(why) => {
-            println!("skipped: no single-node Slurm on this machine: {why}");
-            None
-        }
-    }
-}
-
-/// The job ids `--slurm` printed: (units job, collect job).
-fn job_ids(stdout: &str) -> (String, String) {
-    let id = |key: &str| {
-        let line = stdout.lines().find_map(|l| l.strip_prefix(key));
-        let line = line.unwrap_or_else(|| panic!("no {key:?} line in:\n{stdout}"));
-        line.split_whitespace().next().unwrap().to_string()
-    };
-    (id("units job: "), id("collect job: "))
-}
-
-/// What a campaign's Slurm jobs and the test cluster logged, for a failure's message.
-fn logs(out: &Path, conf: &Path) -> String {
-    let mut said = String::new();
-    let squeue = Command::new("squeue")
-        .args(["--states=all", "-o", "%i %j %T %r"])
-        .env("SLURM_CONF", conf)
-        .output();
-    if let Ok(o) = squeue {
-        said.push_str(&format!(
-            "---- squeue\n{}{}",
-            text(&o.stdout),
-            text(&o.stderr)
-        ));
-    }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(out.join("slurm"))
-        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
-        .unwrap_or_default();
-    files.sort();
-    files.push(Path::new(SLURM_DIR).join("slurmctld.log"));
-    files.push(Path::new(SLURM_DIR).join("slurmd.log"));
-    for f in files
-        .iter()
-        .filter(|f| f.extension().is_some_and(|e| e == "log"))
-    {
-        let body = std::fs::read_to_string(f).unwrap_or_default();
-        let tail: Vec<&str> = body.lines().rev().take(30).collect();
-        let tail: Vec<&str> = tail.into_iter().rev().collect();
-        said.push_str(&format!("---- {}\n{}\n", f.display(), tail.join("\n")));
-    }
-    said
-}
-
-/// Wait until job `id` (each task of an array) has ended; its final states, distinct and
-/// sorted (`COMPLETED`, `FAILED`, …, joined by `,`). Panics with the logs after
-/// [`JOB_TIMEOUT`].
-fn wait_for(id: &str, out: &Path, conf: &Path) -> String {
-    let started = Instant::now();
-    let ended = [
-        "COMPLETED",
-        "FAILED",
-        "CANCELLED",
-        "TIMEOUT",
-        "NODE_FAIL",
-        "OUT_OF_MEMORY",
-        "BOOT_FAIL",
-        "DEADLINE",
-        "PREEMPTED",
-    ];
-    loop {
-        let o = Command::new("squeue")
-            .args(["-h", "--states=all", "-j", id, "-o", "%T"])
-            .env("SLURM_CONF", conf)
-            .output()
-            .unwrap();
-        let said = text(&o.stdout);
-        let mut states: Vec<&str> = said.split_whitespace().collect();
-        states.sort();
-        states.dedup();
-        if !states.is_empty()
-            && states
-                .iter()
-                .all(|s| ended.iter().any(|e| s.starts_with(e)))
-        {
-            return states.join(",");
-        }
-        assert!(
-            started.elapsed() < JOB_TIMEOUT,
-            "job {id} has not ended after {JOB_TIMEOUT:?} (states {states:?}):\n{}",
-            logs(out, conf)
-        );
-        std::thread::sleep(Duration::from_millis(500));
-    }
 }
 
 /// The timing fields of the results: measured, so never the same twice.
@@ -299,9 +155,10 @@ fn a_campaign_through_single_node_slurm_gives_the_local_run_s_outputs() {
         text(&run.stderr)
     );
     let (units, collect) = job_ids(&text(&run.stdout));
+    assert_eq!(units.len(), 1, "three units fit one array");
     let state = wait_for(&collect, &cluster, &conf);
     assert_eq!(state, "COMPLETED", "{}", logs(&cluster, &conf));
-    assert_eq!(wait_for(&units, &cluster, &conf), "COMPLETED");
+    assert_eq!(wait_for(&units[0], &cluster, &conf), "COMPLETED");
 
     let names = results(&local);
     assert_eq!(names, results(&cluster));
@@ -364,7 +221,7 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
         logs(&out, &conf)
     );
     // Three tasks ran their unit, the fourth failed; the collect job ran all the same.
-    assert_eq!(wait_for(&units, &out, &conf), "COMPLETED,FAILED");
+    assert_eq!(wait_for(&units[0], &out, &conf), "COMPLETED,FAILED");
     let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
     assert!(
         log.contains("1 of 4 unit(s) failed") && log.contains("unit 4 (records/broken.csv): "),
@@ -386,17 +243,33 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
 }
 
 /// A stand-in `sbatch` in `dir` that appends its arguments to `dir/calls` and prints the
-/// job ids 41, then 42.
+/// job ids 41, 42, …; and a stand-in `scontrol` whose configuration says `MaxArraySize = 2`.
 fn fake_sbatch(dir: &Path) {
-    let script = "#!/bin/sh\n\
+    let sbatch = "#!/bin/sh\n\
         echo \"$@\" >> \"$(dirname \"$0\")/calls\"\n\
         n=$(wc -l < \"$(dirname \"$0\")/calls\")\n\
         echo $((40 + n))\n";
-    let path = dir.join("sbatch");
-    std::fs::write(&path, script).unwrap();
-    let mut mode = std::fs::metadata(&path).unwrap().permissions();
+    write_script(&dir.join("sbatch"), sbatch);
+    fake_scontrol(dir, 2);
+}
+
+/// A stand-in `scontrol` in `dir` whose configuration says `MaxArraySize = max`.
+fn fake_scontrol(dir: &Path, max: usize) {
+    let scontrol = format!(
+        "#!/bin/sh\n\
+         echo \"Configuration data as of 2026-11-27T22:00:00\"\n\
+         echo \"MaxArraySize            = {max}\"\n\
+         echo \"MaxJobCount             = 10000\"\n"
+    );
+    write_script(&dir.join("scontrol"), &scontrol);
+}
+
+/// An executable file at `path`.
+fn write_script(path: &Path, body: &str) {
+    std::fs::write(path, body).unwrap();
+    let mut mode = std::fs::metadata(path).unwrap().permissions();
     std::os::unix::fs::PermissionsExt::set_mode(&mut mode, 0o755);
-    std::fs::set_permissions(&path, mode).unwrap();
+    std::fs::set_permissions(path, mode).unwrap();
 }
 
 /// PATH with `dir` first.
@@ -439,17 +312,22 @@ fn a_dry_run_prints_the_scripts_of_the_unfinished_units_and_submits_nothing() {
     let out = out.canonicalize().unwrap();
     let slurm = out.join("slurm");
     for line in [
-        "#SBATCH --array=1,3".to_string(),
-        format!("#SBATCH --output={}/unit-%a.log", slurm.display()),
+        "2 unit(s) in 2 task(s) of at most 1 unit(s) (the default for these commands), 1 \
+         array(s) of at most 2 task(s) (the cluster's MaxArraySize (scontrol show config))"
+            .to_string(),
+        "#SBATCH --array=0-1\n".into(),
+        "  0) units=\"1\" ;;\n  1) units=\"3\" ;;\n".into(),
+        format!("#SBATCH --output={}/array-1-task-%a.log", slurm.display()),
         "#SBATCH --partition=short".into(),
         "#SBATCH --time=00:20:00".into(),
         "#SBATCH --mem=2G".into(),
         "#SBATCH --account=lab".into(),
-        "--unit \"$SLURM_ARRAY_TASK_ID\"".into(),
+        "--unit \"$n\" --quiet".into(),
+        "} > \"unit-$n.log\" 2>&1".into(),
         format!("--out {} --collect --quiet", out.display()),
-        format!("sbatch --parsable {}/units.sbatch", slurm.display()),
+        format!("sbatch --parsable {}/units-1.sbatch", slurm.display()),
         format!(
-            "sbatch --parsable --dependency=afterany:<units job id> {}/collect.sbatch",
+            "sbatch --parsable --dependency=afterany:<units job 1 id> {}/collect.sbatch",
             slurm.display()
         ),
     ] {
@@ -462,10 +340,21 @@ fn a_dry_run_prints_the_scripts_of_the_unfinished_units_and_submits_nothing() {
     );
 }
 
+/// `file`'s text with `[slurm]` settings added.
+fn with_slurm_settings(file: &Path, settings: &str) {
+    let body = std::fs::read_to_string(file).unwrap();
+    std::fs::write(file, format!("{body}\n[slurm]\n{settings}")).unwrap();
+}
+
 #[test]
-fn the_collect_job_is_submitted_after_the_array_whatever_its_tasks_end_with() {
+fn the_collect_job_is_submitted_after_every_array_whatever_their_tasks_end_with() {
     let tmp = tempfile::tempdir().unwrap();
     let file = small_campaign(&tmp.path().join("campaign"), false);
+    // Three units, at most 2 tasks per array: two arrays.
+    with_slurm_settings(
+        &file,
+        "units_per_task = 1\nthrottle = 5\ncpus_per_task = 2\n",
+    );
     let out = tmp.path().join("out");
     let bin = tmp.path().join("bin");
     std::fs::create_dir_all(&bin).unwrap();
@@ -474,19 +363,44 @@ fn the_collect_job_is_submitted_after_the_array_whatever_its_tasks_end_with() {
     let run = campaign(&file, &out, &["--slurm"], &[("PATH", path.as_os_str())]);
     let said = text(&run.stdout);
     assert!(run.status.success(), "{said}{}", text(&run.stderr));
-    assert_eq!(job_ids(&said), ("41".to_string(), "42".to_string()));
+    assert_eq!(
+        job_ids(&said),
+        (vec!["41".to_string(), "42".to_string()], "43".to_string())
+    );
     let slurm = out.canonicalize().unwrap().join("slurm");
     let calls = std::fs::read_to_string(bin.join("calls")).unwrap();
     assert_eq!(
         calls,
         format!(
-            "--parsable {0}/units.sbatch\n--parsable --dependency=afterany:41 {0}/collect.sbatch\n",
+            "--parsable {0}/units-1.sbatch\n--parsable {0}/units-2.sbatch\n\
+             --parsable --dependency=afterany:41:42 {0}/collect.sbatch\n",
             slurm.display()
         )
     );
-    let units = std::fs::read_to_string(slurm.join("units.sbatch")).unwrap();
-    assert!(units.contains("#SBATCH --array=1-3\n"), "{units}");
+    let first = std::fs::read_to_string(slurm.join("units-1.sbatch")).unwrap();
+    assert!(first.contains("#SBATCH --array=0-1%5\n"), "{first}");
+    assert!(first.contains("#SBATCH --cpus-per-task=2\n"), "{first}");
+    assert!(first.contains("  0) units=\"1\" ;;\n  1) units=\"2\" ;;\n"));
+    let second = std::fs::read_to_string(slurm.join("units-2.sbatch")).unwrap();
+    assert!(second.contains("#SBATCH --array=0-0%5\n"), "{second}");
+    assert!(second.contains("  0) units=\"3\" ;;\n"), "{second}");
     assert!(slurm.join("collect.sbatch").is_file());
+
+    // Three units per task: one array, one task; the second array's script of the last
+    // submission is removed, so DIR/slurm/ holds only what this one submitted.
+    let body = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        body.replace("units_per_task = 1", "units_per_task = 3"),
+    )
+    .unwrap();
+    let run = campaign(&file, &out, &["--slurm"], &[("PATH", path.as_os_str())]);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    assert_eq!(job_ids(&said).0, ["44"]);
+    let first = std::fs::read_to_string(slurm.join("units-1.sbatch")).unwrap();
+    assert!(first.contains("  0) units=\"1 2 3\" ;;\n"), "{first}");
+    assert!(!slurm.join("units-2.sbatch").exists());
 }
 
 #[test]
@@ -529,4 +443,241 @@ fn collect_names_the_units_that_did_not_finish() {
         .filter(|r| r["status"] == "ok")
         .count();
     assert_eq!(ok, 2, "unit 1's two models");
+}
+
+/// The identity of each unit's `unit.json` under `out` (inode and modification time), by
+/// unit folder: a rewritten file gets a new one.
+fn unit_stamps(out: &Path) -> Vec<(String, u64, std::time::SystemTime)> {
+    let mut stamps = Vec::new();
+    for e in std::fs::read_dir(out.join("units")).unwrap() {
+        let dir = e.unwrap().path();
+        if let Ok(meta) = std::fs::metadata(dir.join("unit.json")) {
+            let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+            let ino = std::os::unix::fs::MetadataExt::ino(&meta);
+            stamps.push((name, ino, meta.modified().unwrap()));
+        }
+    }
+    stamps.sort();
+    stamps
+}
+
+#[test]
+fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("campaign");
+    let file = small_campaign(&dir, false);
+    // A fourth record (a copy of the first, repeated): four units. At most 3 tasks per array
+    // and one unit per task: two arrays of 3 and 1 tasks. One task of an array at a time,
+    // so the third task of the first array is still waiting when it is cancelled.
+    std::fs::copy(
+        dir.join("records/a1_c1.csv"),
+        dir.join("records/a1_c1_again.csv"),
+    )
+    .unwrap();
+    let body = std::fs::read_to_string(&file).unwrap();
+    let (records, global) = body.split_once("\n[global]").unwrap();
+    std::fs::write(
+        &file,
+        format!(
+            "{records}\n[[records]]\nfile = \"records/a1_c1_again.csv\"\nF0 = 0.035\n\
+             concentration = 0.36\n\n[global]{global}\n[slurm]\nmax_array_size = 3\n\
+             units_per_task = 1\nthrottle = 1\n"
+        ),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
+    let run = campaign(&file, &out, &flags, &env);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    let (units, collect) = job_ids(&said);
+    assert_eq!(units.len(), 2, "{said}");
+    assert!(
+        said.contains("4 unit(s) in 4 task(s) of at most 1 unit(s) ([slurm] units_per_task), 2 array(s) of at most 3 task(s) ([slurm] max_array_size)"),
+        "{said}"
+    );
+    // The scheduler kills task 2 of the first array (unit 3) before it runs.
+    let cancel = Command::new("scancel")
+        .arg(format!("{}_2", units[0]))
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "FAILED",
+        "{}",
+        logs(&out, &conf)
+    );
+    // (squeue may no longer list a task cancelled while it waited.)
+    let states = wait_for(&units[0], &out, &conf);
+    assert!(
+        ["CANCELLED,COMPLETED", "COMPLETED"].contains(&states.as_str()),
+        "{states}"
+    );
+    assert_eq!(wait_for(&units[1], &out, &conf), "COMPLETED");
+    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    assert!(
+        log.contains("1 of 4 unit(s) failed")
+            && log.contains("unit 3 (records/a3_c3.csv): it did not finish: no unit.json in"),
+        "{log}"
+    );
+    for n in [1, 2, 4] {
+        let unit_log = std::fs::read_to_string(out.join(format!("slurm/unit-{n}.log"))).unwrap();
+        assert!(
+            unit_log.starts_with("[stf-lab campaign] run by Slurm task "),
+            "{unit_log}"
+        );
+    }
+    let finished = unit_stamps(&out);
+    assert_eq!(finished.len(), 3, "{finished:?}");
+
+    // Submitted again: only unit 3 goes to Slurm; the finished units are not touched.
+    let again = campaign(&file, &out, &flags, &env);
+    let said = text(&again.stdout);
+    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    assert!(said.contains("1 unit(s) in 1 task(s)"), "{said}");
+    let (units, collect) = job_ids(&said);
+    assert_eq!(units.len(), 1, "{said}");
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "COMPLETED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let now = unit_stamps(&out);
+    assert_eq!(now.len(), 4, "{now:?}");
+    for stamp in &finished {
+        assert!(now.contains(stamp), "{stamp:?} was rewritten: {now:?}");
+    }
+    let rows = read_json(&out.join("campaign.json"));
+    assert_eq!(rows["failed"], 0);
+    assert_eq!(rows["units"], 4);
+}
+
+#[test]
+fn three_thousand_units_one_per_task_go_to_three_arrays_below_slurm_s_default_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("campaign");
+    small_campaign(&dir, false);
+    let mut table = String::from("file,F0,concentration\n");
+    for i in 0..3000 {
+        table.push_str(&format!(
+            "records/a1_c1.csv,0.035,{}\n",
+            0.30 + 0.001 * (i % 100) as f64
+        ));
+    }
+    std::fs::write(dir.join("records.csv"), table).unwrap();
+    let file = dir.join("big.toml");
+    std::fs::write(
+        &file,
+        "[campaign]\nexperiment = \"power_law.toml\"\ncommand = \"fit\"\n\
+         conditions = [\"F0\", \"concentration\"]\nrecords = \"records.csv\"\n\n\
+         [slurm]\nunits_per_task = 1\nthrottle = 100\n",
+    )
+    .unwrap();
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    fake_scontrol(&bin, 1001);
+    let path = path_with(&bin);
+    let out = tmp.path().join("out");
+    let run = campaign(
+        &file,
+        &out,
+        &["--slurm", "--dry-run"],
+        &[("PATH", path.as_os_str())],
+    );
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(
+        said.contains("3000 unit(s) in 3000 task(s) of at most 1 unit(s) ([slurm] units_per_task), 3 array(s) of at most 1001 task(s) (the cluster's MaxArraySize (scontrol show config))"),
+        "{}",
+        &said[..said.len().min(2000)]
+    );
+    // Indices 0 to 1000 (below 1001), twice, then the 998 left; each unit once, in order.
+    let arrays: Vec<&str> = said
+        .lines()
+        .filter_map(|l| l.strip_prefix("#SBATCH --array="))
+        .collect();
+    assert_eq!(arrays, ["0-1000%100", "0-1000%100", "0-997%100"]);
+    let units: Vec<usize> = said
+        .lines()
+        .filter_map(|l| l.trim().split_once(") units=\""))
+        .map(|(_, u)| u.trim_end_matches("\" ;;").parse().unwrap())
+        .collect();
+    assert_eq!(units, (1..=3000).collect::<Vec<_>>());
+    assert!(
+        said.contains("--dependency=afterany:<units job 1 id>:<units job 2 id>:<units job 3 id> ")
+    );
+}
+
+#[test]
+fn a_running_task_killed_by_the_scheduler_is_named_with_slurm_s_reason() {
+    let Some(conf) = slurm() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let file = small_campaign(&tmp.path().join("campaign"), false);
+    // The three units in one task, one after another: a few seconds at least.
+    with_slurm_settings(&file, "units_per_task = 3\n");
+    let out = tmp.path().join("out");
+    let env = [("SLURM_CONF", conf.as_os_str())];
+    let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
+    let run = campaign(&file, &out, &flags, &env);
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    let (units, collect) = job_ids(&said);
+    // The task writes unit 1's log as it starts the unit: then it is running, with three
+    // units (each a process of its own) ahead of it.
+    let started = Instant::now();
+    while !out.join("slurm/unit-1.log").exists() {
+        assert!(
+            started.elapsed() < common::slurm::JOB_TIMEOUT,
+            "the task never started:\n{}",
+            logs(&out, &conf)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let cancel = Command::new("scancel")
+        .arg(format!("{}_0", units[0]))
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "FAILED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    assert!(
+        log.contains("it did not finish: no unit.json in")
+            && log.contains("Slurm stopped its task: \"JOB ")
+            && log.contains(" CANCELLED AT "),
+        "{log}"
+    );
+    let finished = unit_stamps(&out);
+    assert!(finished.len() < 3, "{finished:?}");
+
+    // Submitted again: the units the kill stopped run; a unit that had finished stays as it was.
+    let again = campaign(&file, &out, &flags, &env);
+    let said = text(&again.stdout);
+    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    assert!(
+        said.contains(&format!("{} unit(s) in 1 task(s)", 3 - finished.len())),
+        "{said}"
+    );
+    let (_, collect) = job_ids(&said);
+    assert_eq!(
+        wait_for(&collect, &out, &conf),
+        "COMPLETED",
+        "{}",
+        logs(&out, &conf)
+    );
+    let now = unit_stamps(&out);
+    assert_eq!(now.len(), 3, "{now:?}");
+    for stamp in &finished {
+        assert!(now.contains(stamp), "{stamp:?} was rewritten: {now:?}");
+    }
 }

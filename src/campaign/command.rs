@@ -8,8 +8,9 @@
 //! place as one unit (`crate::writing::staged_files`). Interrupted, the run stops its units
 //! and says how many finished (`crate::campaign::runner`); it writes no table then.
 //!
-//! With `--slurm` the units not finished are submitted instead as a Slurm job array, and a
-//! job after it runs `--collect`: the table, report and `[global]` fit from the units' folders
+//! With `--slurm` the units not finished are submitted instead as Slurm job arrays (cut by
+//! `crate::campaign::slurm_plan` within the cluster's `MaxArraySize`), and a job after all of
+//! them runs `--collect`: the table, report and `[global]` fit from the units' folders
 //! — the same step a local run ends with — naming every unit that is missing or failed
 //! (`crate::campaign::slurm`). `--dry-run` shows what `--slurm` would submit.
 
@@ -23,7 +24,7 @@ use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
 use crate::campaign::unit::UnitStatus;
 use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, run_one_observed, unit_dir};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
-use crate::campaign::{slurm, slurm_script};
+use crate::campaign::{slurm, slurm_plan, slurm_script};
 use crate::say;
 use crate::writing::staged_files::StagedFiles;
 use crate::writing::{resolve, write_json};
@@ -142,11 +143,7 @@ fn collect(campaign: &Campaign, out: &Path) -> Result<()> {
             ),
             Some(_) => continue,
         };
-        let log = out.join(SLURM).join(format!("unit-{}.log", unit.number));
-        let log = match log.is_file() {
-            true => format!(" (its log: {})", log.display()),
-            false => String::new(),
-        };
+        let log = slurm::unit_log_note(&out.join(SLURM), unit.number);
         errors.insert(unit.number, format!("{why}{log}"));
     }
     finish(campaign, out, &errors)
@@ -179,14 +176,7 @@ fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings
         say!("nothing to submit: the table is collected here");
         return collect(campaign, out);
     }
-    let job = Job {
-        exe: std::env::current_exe().context("cannot find this program for the batch scripts")?,
-        campaign: resolve(&campaign.path),
-        out: resolve(out),
-        units: pending.iter().map(|p| p.unit.number).collect(),
-        force,
-        options: &settings.options,
-    };
+    let job = slurm_job(campaign, out, force, &pending, &settings.options)?;
     let scripts = job.scripts()?;
     if settings.dry_run {
         say!("dry run: nothing is submitted or written\n");
@@ -197,26 +187,71 @@ fn submit(campaign: &Campaign, out: &Path, force: bool, settings: &SlurmSettings
     let ids = slurm::submit(&job)?;
     drop(lock);
     let folder = job.folder();
+    for (k, (id, array)) in ids.units_jobs.iter().zip(&job.arrays).enumerate() {
+        say!(
+            "units job: {id} (array {} of {}: {} task(s), units {}; logs {}/unit-N.log)",
+            k + 1,
+            job.arrays.len(),
+            array.tasks.len(),
+            slurm_script::array_spec(&array.units().collect::<Vec<_>>()),
+            folder.display()
+        );
+    }
     say!(
-        "units job: {} (array {}, logs {}/unit-N.log)",
-        ids.units_job,
-        slurm_script::array_spec(&job.units),
-        folder.display()
-    );
-    say!(
-        "collect job: {} (after job {} ends, log {}/collect.log)",
+        "collect job: {} (after job(s) {} end, log {}/collect.log)",
         ids.collect_job,
-        ids.units_job,
+        ids.units_jobs.join(", "),
         folder.display()
     );
     say!(
         "follow with: squeue -j {},{}; the table and report are written into {} by the collect \
          job",
-        ids.units_job,
+        ids.units_jobs.join(","),
         ids.collect_job,
         out.display()
     );
     Ok(())
+}
+
+/// The Slurm jobs of `pending`: units per task and arrays within the cluster's
+/// `MaxArraySize`, from the campaign's `[slurm]` settings or their defaults (said).
+fn slurm_job<'a>(
+    campaign: &Campaign,
+    out: &Path,
+    force: bool,
+    pending: &[Pending],
+    options: &'a SlurmOptions,
+) -> Result<Job<'a>> {
+    let spec = &campaign.slurm;
+    let (max_array_size, source) = slurm::max_array_size(spec.max_array_size);
+    let commands: Vec<_> = pending.iter().map(|p| p.unit.command).collect();
+    let per_task = spec
+        .units_per_task
+        .unwrap_or_else(|| slurm_plan::default_units_per_task(&commands));
+    let units: Vec<usize> = pending.iter().map(|p| p.unit.number).collect();
+    let arrays = slurm_plan::arrays(&units, per_task, max_array_size);
+    say!(
+        "{} unit(s) in {} task(s) of at most {per_task} unit(s) ({}), {} array(s) of at most \
+         {max_array_size} task(s) ({source})",
+        units.len(),
+        arrays.iter().map(|a| a.tasks.len()).sum::<usize>(),
+        match spec.units_per_task {
+            Some(_) => "[slurm] units_per_task",
+            None => "the default for these commands",
+        },
+        arrays.len(),
+    );
+    Ok(Job {
+        exe: std::env::current_exe().context("cannot find this program for the batch scripts")?,
+        campaign: resolve(&campaign.path),
+        out: resolve(out),
+        arrays,
+        units_per_task: per_task,
+        throttle: spec.throttle,
+        cpus_per_task: spec.cpus_per_task.unwrap_or(1),
+        force,
+        options,
+    })
 }
 
 /// The table, report and `[global]` fit of the units in `out`; `errors` holds, by unit, why

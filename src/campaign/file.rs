@@ -17,6 +17,8 @@
 //! …`), and everything is checked before any unit starts: each record exists, each condition
 //! is a finite number on every record, each unit's experiment parses (its own errors name it)
 //! and has what its command needs.
+//! Two optional sections have files of their own: `[global]` (`super::global_file`) and
+//! `[slurm]` (`super::slurm_file`: how `--slurm` cuts the units into jobs).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -52,6 +54,7 @@ struct RawCampaign {
     #[serde(default)]
     records: Vec<RawRecord>,
     global: Option<Spanned<super::global_file::RawGlobal>>,
+    slurm: Option<Spanned<super::slurm_file::RawSlurm>>,
 }
 
 /// A `[[records]]` table as written.
@@ -70,6 +73,8 @@ pub struct Campaign {
     pub units: Vec<Unit>,
     /// The joint fit of `[global]`, if any.
     pub global: Option<super::global_file::GlobalSpec>,
+    /// How `--slurm` cuts the units into jobs (`[slurm]`; empty when absent).
+    pub slurm: super::slurm_file::SlurmSpec,
 }
 
 /// The folder of the file at `path`, `.` for a bare name.
@@ -123,12 +128,17 @@ impl Campaign {
                 )
             })
             .transpose()?;
+        let slurm = match &raw.slurm {
+            Some(s) => super::slurm_file::check(s, path, text)?,
+            None => Default::default(),
+        };
         Ok(Campaign {
             path: path.to_path_buf(),
             conditions,
             condition_units,
             units,
             global,
+            slurm,
         })
     }
 

@@ -11,6 +11,7 @@
 //! shown first in the report ([`global_report`]).
 
 pub mod command;
+pub mod figure_series;
 pub mod file;
 pub mod global;
 pub mod global_file;
@@ -22,6 +23,8 @@ pub mod records_table;
 pub mod report;
 pub mod runner;
 pub mod slurm;
+pub mod slurm_file;
+pub mod slurm_plan;
 pub mod slurm_script;
 pub mod table;
 pub mod unit;

@@ -1,22 +1,23 @@
 //! The campaign's report: `report.md` and `report.html` (the house's report module,
 //! `crate::report`) with, for each model's fitted parameter, a figure of its value against
 //! each condition with ±1 standard error bars — one series per combination of the other
-//! conditions — and the campaign table. Figures go to `figures/` as SVG, PNG and CSV; an
+//! conditions, aggregated for large campaigns ([`super::figure_series`]) — and the campaign
+//! table (its first [`TABLE_ROWS`] rows and the failed ones). Figures go to `figures/` as SVG, PNG and CSV; an
 //! earlier run's figures that this one does not draw are removed from there (figures only:
 //! an SVG, PNG and CSV of one name), and unit folders of records no longer in the campaign
 //! are named in a note (never deleted: they are the user's results). `report.md` and
 //! `report.html` are staged with the tables and put in place with them.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
 
+use super::figure_series::series_of;
 use super::global::GlobalJson;
-use super::labels::{axis_label, value_label};
+use super::labels::axis_label;
 use super::table::{param_names, CampaignJson, CampaignRow};
 use crate::digits::{carried, with_error};
-use crate::report::{self, ErrorPoint, ErrorSeries, FigureRef, Report, Section, Table};
+use crate::report::{self, FigureRef, Report, Section, Table};
 use crate::writing::results_dir::is_figure;
 use crate::writing::staged_files::StagedFiles;
 
@@ -136,7 +137,7 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
                 if distinct < 2 {
                     continue;
                 }
-                let series = series_of(&rows, &param, condition, table);
+                let drawn = series_of(&rows, &param, condition, table);
                 let name = file_name(&format!("{model}_{param}_vs_{condition}"));
                 let title = format!("{model}: {param} against {condition}");
                 let unit = rows
@@ -147,15 +148,21 @@ fn parameter_figures(table: &CampaignJson, dir: &Path) -> Result<Vec<FigureRef>>
                     table.condition_units.get(condition).map(String::as_str),
                 );
                 let y = axis_label(&param, unit);
-                let files = report::error_bars(dir, &name, &title, (&x, &y), &series)?;
-                figures.push(FigureRef::new(
-                    files,
-                    format!(
+                let files = report::error_bars(dir, &name, &title, (&x, &y), &drawn.series)?;
+                let caption = match drawn.aggregated {
+                    false => format!(
                         "`{model}`'s fitted {param} (± one standard error) against {condition}, \
                          over {} record(s).",
                         rows.len()
                     ),
-                ));
+                    true => format!(
+                        "`{model}`'s fitted {param} against {condition}, over {} records: each \
+                         marker is the mean of the records at that {condition}, its bar ± their \
+                         standard deviation (the spread between records, not an error).",
+                        rows.len()
+                    ),
+                };
+                figures.push(FigureRef::new(files, caption));
             }
         }
     }
@@ -173,50 +180,6 @@ fn distinct_values(rows: &[&CampaignRow], condition: &str) -> usize {
     values.len()
 }
 
-/// `param` against `condition`, one series per combination of the other conditions.
-fn series_of(
-    rows: &[&CampaignRow],
-    param: &str,
-    condition: &str,
-    table: &CampaignJson,
-) -> Vec<ErrorSeries> {
-    let mut groups: BTreeMap<String, Vec<ErrorPoint>> = BTreeMap::new();
-    let mut order: Vec<String> = Vec::new();
-    for r in rows {
-        let (Some(x), Some(p)) = (r.conditions.get(condition), r.result.params.get(param)) else {
-            continue;
-        };
-        let label: Vec<String> = table
-            .conditions
-            .iter()
-            .filter(|c| *c != condition)
-            .filter_map(|c| {
-                let v = r.conditions.get(c)?;
-                Some(value_label(c, *v, table.condition_units.get(c)))
-            })
-            .collect();
-        let label = if label.is_empty() {
-            "records".to_string()
-        } else {
-            label.join(", ")
-        };
-        if !order.contains(&label) {
-            order.push(label.clone());
-        }
-        groups
-            .entry(label)
-            .or_default()
-            .push((*x, p.value, p.std_error.unwrap_or(f64::NAN)));
-    }
-    order
-        .into_iter()
-        .map(|label| ErrorSeries {
-            points: groups.remove(&label).unwrap_or_default(),
-            label,
-        })
-        .collect()
-}
-
 /// A figure's file name: letters, digits, `-` and `_`.
 fn file_name(text: &str) -> String {
     text.chars()
@@ -230,7 +193,12 @@ fn file_name(text: &str) -> String {
         .collect()
 }
 
-/// The table for a person: conditions, model, parameters ± errors, RMS, verdicts.
+/// Rows of the report's table, at most (failed units' rows are shown all the same).
+pub const TABLE_ROWS: usize = 200;
+
+/// The table for a person: conditions, model, parameters ± errors, RMS, verdicts; the first
+/// [`TABLE_ROWS`] rows and every failed one (a campaign of thousands of records would make a
+/// page no one reads; `campaign.csv` has them all).
 fn table_of(table: &CampaignJson) -> Table {
     let mut columns: Vec<String> = vec!["unit".into(), "record".into()];
     columns.extend(table.conditions.iter().cloned());
@@ -245,9 +213,23 @@ fn table_of(table: &CampaignJson) -> Table {
         ]
         .map(String::from),
     );
-    let rows = table
+    let shown: Vec<&CampaignRow> = table
         .rows
         .iter()
+        .enumerate()
+        .filter(|(i, r)| *i < TABLE_ROWS || r.status != "ok")
+        .map(|(_, r)| r)
+        .collect();
+    let caption = match shown.len() < table.rows.len() {
+        true => format!(
+            "The first {TABLE_ROWS} of {} rows, and every failed unit's; campaign.csv and \
+             campaign.json hold them all.",
+            table.rows.len()
+        ),
+        false => String::new(),
+    };
+    let rows = shown
+        .into_iter()
         .map(|r| {
             let mut cells = vec![r.unit.to_string(), r.record.clone()];
             cells.extend(table.conditions.iter().map(|c| {
@@ -286,7 +268,7 @@ fn table_of(table: &CampaignJson) -> Table {
         })
         .collect();
     Table {
-        caption: String::new(),
+        caption,
         columns,
         rows,
     }

@@ -2,6 +2,8 @@
 //! results. (Each test binary uses a part of them.)
 #![allow(dead_code)]
 
+pub mod slurm;
+
 use std::path::Path;
 use std::process::{Command, Output};
 

@@ -10,6 +10,7 @@
 #   tests/slurm/stop.sh
 #
 # Ports: $STF_LAB_SLURM_PORT (slurmctld, default 6817) and the next one (slurmd).
+# MaxArraySize is written as Slurm's default, 1001 (array task indices below it).
 # Waits at most $STF_LAB_SLURM_WAIT seconds (default 60) for the node to be idle; on failure
 # it prints why and the daemons' logs, and exits 1.
 set -euo pipefail
@@ -105,6 +106,7 @@ SelectTypeParameters=CR_Core_Memory
 DefMemPerCPU=1024
 ReturnToService=2
 MinJobAge=600
+MaxArraySize=1001
 SlurmdTimeout=60
 ${node[*]} NodeAddr=127.0.0.1 State=UNKNOWN
 PartitionName=debug Nodes=${node[0]#NodeName=} Default=YES MaxTime=INFINITE State=UP
