@@ -255,6 +255,33 @@ pub fn draw_line<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The runs of consecutive samples whose x and y are both finite: a line is drawn through
+/// each run apart, so it never bridges a gap (a non-finite sample) with a chord.
+pub fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+    let mut runs = vec![Vec::new()];
+    for (a, b) in x.iter().zip(y) {
+        if a.is_finite() && b.is_finite() {
+            runs.last_mut().expect("one run at least").push((*a, *b));
+        } else if runs.last().is_some_and(|r| !r.is_empty()) {
+            runs.push(Vec::new());
+        }
+    }
+    runs.retain(|r| !r.is_empty());
+    runs
+}
+
+/// Draw `y` against `x` on `chart` in `style`, broken where either is not finite.
+pub fn draw_runs<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    (x, y): (&[f64], &[f64]),
+    style: ShapeStyle,
+) -> Result<(), String> {
+    for run in finite_runs(x, y) {
+        draw_line(chart, run, style)?;
+    }
+    Ok(())
+}
+
 /// The legend entries of model lines: each label, with `suffix`, in its series colour.
 pub fn model_entries<'a>(
     labels: impl IntoIterator<Item = &'a str>,
@@ -370,7 +397,18 @@ pub fn tick_label(v: f64, span: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::tick_label;
+    use super::{finite_runs, tick_label};
+
+    #[test]
+    fn runs_break_at_gaps_and_drop_empty_ones() {
+        let nan = f64::NAN;
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let y = [1.0, nan, nan, 2.0, 3.0, 4.0, nan];
+        assert_eq!(
+            finite_runs(&x, &y),
+            vec![vec![(0.0, 1.0)], vec![(3.0, 2.0), (4.0, 3.0), (5.0, 4.0)]]
+        );
+    }
 
     #[test]
     fn tick_labels_have_the_digits_the_axis_needs_and_no_negative_zero() {
