@@ -29,8 +29,13 @@ pub struct FigureFiles {
 pub const F_LABEL: &str = "F_STF, N";
 /// The time axis, as every figure labels it.
 pub const T_LABEL: &str = "time t, s";
-/// A measured signal is a wide light-grey line under the models' lines, so both stay visible.
+/// The band of a measured signal's envelope: light grey under the models' lines.
 pub const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
+/// A measured signal drawn as a line: thin and mid-grey, under the models' lines, so a fit
+/// is never hidden behind the data and the data's noise stays readable.
+pub const MEASURED_LINE: RGBColor = RGBColor(110, 110, 110);
+/// Width of a measured signal's line, pixels (the models' lines are 2).
+pub const MEASURED_WIDTH: u32 = 1;
 
 /// Width × height of a one-panel figure, pixels.
 pub const SIZE: (u32, u32) = (1000, 600);
@@ -296,6 +301,44 @@ pub fn model_entries<'a>(
     labels.into_iter().enumerate().map(entry).collect()
 }
 
+/// For each of `series`, the first earlier one it draws over (every value within a thousandth
+/// of their common range of the other's): a curve drawn exactly over another hides it, and the
+/// legend must say so.
+pub fn same_as_earlier(series: &[&[f64]]) -> Vec<Option<usize>> {
+    let range = super::plot_range::finite_bounds(
+        &series
+            .iter()
+            .flat_map(|s| s.iter().copied())
+            .collect::<Vec<f64>>(),
+    )
+    .map_or(0.0, |(lo, hi)| hi - lo);
+    let close = |a: &[f64], b: &[f64]| {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| (x.is_nan() && y.is_nan()) || (x - y).abs() <= 1e-3 * range)
+    };
+    (0..series.len())
+        .map(|i| (0..i).find(|&j| close(series[i], series[j])))
+        .collect()
+}
+
+/// [`model_entries`] with each label whose curve lies on an earlier one's (`same`, from
+/// [`same_as_earlier`]) flagged `(= earlier, drawn over it)`: the later curve is drawn on top.
+pub fn model_entries_flagged(
+    labels: &[&str],
+    same: &[Option<usize>],
+    suffix: &str,
+) -> Vec<(String, Swatch)> {
+    let mut entries = model_entries(labels.iter().copied(), suffix);
+    for (entry, same) in entries.iter_mut().zip(same) {
+        if let Some(j) = same {
+            entry.0 = format!("{} (= {}, drawn over it)", entry.0, labels[*j]);
+        }
+    }
+    entries
+}
+
 /// A figure that can draw itself on any plotters backend.
 pub trait Draw {
     /// Draw on `root` (already filled white).
@@ -398,6 +441,20 @@ pub fn tick_label(v: f64, span: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::{finite_runs, tick_label};
+
+    #[test]
+    fn curves_on_earlier_ones_are_found() {
+        let a = [0.0, 1.0, 2.0];
+        let b = [0.0, 1.0005, 2.0];
+        let c = [0.0, 1.5, 2.0];
+        assert_eq!(
+            super::same_as_earlier(&[&a, &c, &b]),
+            vec![None, None, Some(0)]
+        );
+        let labels = ["power_law", "viscous", "power_law#2"];
+        let entries = super::model_entries_flagged(&labels, &[None, None, Some(0)], "");
+        assert_eq!(entries[2].0, "power_law#2 (= power_law, drawn over it)");
+    }
 
     #[test]
     fn runs_break_at_gaps_and_drop_empty_ones() {

@@ -13,8 +13,9 @@ use plotters::prelude::*;
 use super::colour::series_colour;
 use super::decimate::{decimate_union, pick};
 use super::figure::{
-    draw_line, draw_mesh, finite_points, legend_strip, model_entries, msg, render, same_length,
-    small_panel, tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
+    draw_line, draw_mesh, finite_points, legend_strip, model_entries_flagged, msg, render,
+    same_as_earlier, same_length, small_panel, tick_label, tick_style, titled, Draw, FigureFiles,
+    Swatch,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -201,7 +202,17 @@ impl ParityPlot<'_> {
     /// The legend the panels share, above them: each model's colour (its scatter and its
     /// histogram) and the noise floor's curve.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let mut entries = model_entries(self.models.iter().map(|(l, _)| *l), "");
+        let labels: Vec<&str> = self.models.iter().map(|(l, _)| *l).collect();
+        let drawn: Vec<Vec<f64>> = (0..labels.len())
+            .map(|i| {
+                self.groups
+                    .iter()
+                    .flat_map(|g| g.fitted[i].clone())
+                    .collect()
+            })
+            .collect();
+        let curves: Vec<&[f64]> = drawn.iter().map(Vec::as_slice).collect();
+        let mut entries = model_entries_flagged(&labels, &same_as_earlier(&curves), "");
         if self.quantity.noise_sigma.is_some_and(|s| s > 0.0) {
             entries.push(("noise floor".into(), Swatch::Line(GREY, 3)));
         }

@@ -1,7 +1,7 @@
 //! A few cycles of each regime side by side, as the source study shows them: one column per
 //! window (pre-resonance, resonance, post-resonance), the STF force over time on top and the
 //! hysteresis loops F–x, F–v, F–a under it, each fitted model's force drawn over the measured
-//! one (a wide grey line). A long record squeezed into one plot is a solid band; a window of
+//! one (a thin grey line under them). A long record squeezed into one plot is a solid band; a window of
 //! a few cycles shows the loops' shapes.
 
 use std::path::Path;
@@ -12,8 +12,9 @@ use plotters::prelude::*;
 use super::colour::series_colour;
 use super::decimate::{decimate_ranges, pick};
 use super::figure::{
-    draw_mesh, draw_runs, legend_strip, model_entries, msg, render, same_length, small_panel,
-    tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, MEASURED_GREY,
+    draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg, render, same_as_earlier,
+    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL,
+    MEASURED_LINE, MEASURED_WIDTH,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -84,7 +85,11 @@ impl WindowsPlot<'_> {
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
         draw_mesh(&mut chart, (x_label, F_LABEL), Some((5, 6)), tick_style())?;
-        draw_runs(&mut chart, (&x, &f), MEASURED_GREY.stroke_width(5))?;
+        draw_runs(
+            &mut chart,
+            (&x, &f),
+            MEASURED_LINE.stroke_width(MEASURED_WIDTH),
+        )?;
         for (i, m) in models.iter().enumerate() {
             draw_runs(&mut chart, (&x, m), series_colour(i).stroke_width(2))?;
         }
@@ -93,8 +98,17 @@ impl WindowsPlot<'_> {
 
     /// The legend the panels share, above them: the measured force and each model's.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let measured = ("measured".to_string(), Swatch::Line(MEASURED_GREY, 5));
-        let models = model_entries(self.series.models.iter().map(|(l, _)| *l), "");
+        let measured = ("measured".to_string(), Swatch::Line(MEASURED_LINE, 2));
+        let labels: Vec<&str> = self.series.models.iter().map(|(l, _)| *l).collect();
+        let rows: Vec<usize> = self.windows.iter().flat_map(|(_, r)| r.clone()).collect();
+        let drawn: Vec<Vec<f64>> = self
+            .series
+            .models
+            .iter()
+            .map(|(_, m)| pick(m, &rows))
+            .collect();
+        let curves: Vec<&[f64]> = drawn.iter().map(Vec::as_slice).collect();
+        let models = model_entries_flagged(&labels, &same_as_earlier(&curves), "");
         std::iter::once(measured).chain(models).collect()
     }
 }
