@@ -6,48 +6,60 @@
 pub const MAX_POINTS_PER_LINE: usize = 20_000;
 
 /// Indices (increasing) of at most `max_points` samples of `y` that keep, in each of
-/// `max_points / 2 - 1` equal buckets, the smallest and the largest finite value, plus the first
-/// and the last sample. A series no longer than `max_points` is kept whole.
+/// `(max_points - 2) / 3` equal buckets, the smallest and the largest finite value, plus the
+/// first and the last sample. A bucket holding a non-finite sample (a gap) also keeps the
+/// first of them, so a line drawn through the kept samples breaks there instead of bridging
+/// the gap with a chord. A series no longer than `max_points` is kept whole.
 pub fn decimate_indices(y: &[f64], max_points: usize) -> Vec<usize> {
     let n = y.len();
-    if n <= max_points.max(4) {
+    if n <= max_points.max(5) {
         return (0..n).collect();
     }
-    let buckets = (max_points.max(4) / 2 - 1).max(1);
+    let buckets = ((max_points.max(5) - 2) / 3).max(1);
     let size = n.div_ceil(buckets);
-    let mut keep = Vec::with_capacity(2 * buckets + 2);
+    let mut keep = Vec::with_capacity(3 * buckets + 2);
     keep.push(0);
     for start in (0..n).step_by(size) {
         let end = (start + size).min(n);
-        let mut lo: Option<usize> = None;
-        let mut hi: Option<usize> = None;
-        for i in start..end {
-            if !y[i].is_finite() {
-                continue;
-            }
-            if lo.is_none_or(|j| y[i] < y[j]) {
-                lo = Some(i);
-            }
-            if hi.is_none_or(|j| y[i] > y[j]) {
-                hi = Some(i);
-            }
-        }
-        match (lo, hi) {
-            (Some(a), Some(b)) => {
-                keep.push(a.min(b));
-                keep.push(a.max(b));
-            }
-            _ => keep.push(start),
-        }
+        keep.extend(bucket_keeps(y, start..end));
     }
     keep.push(n - 1);
     keep.dedup();
     keep
 }
 
+/// What one bucket `range` of `y` keeps, increasing: its smallest and largest finite sample
+/// and its first non-finite one (or its first sample, if none is finite).
+fn bucket_keeps(y: &[f64], range: std::ops::Range<usize>) -> Vec<usize> {
+    let start = range.start;
+    let mut lo: Option<usize> = None;
+    let mut hi: Option<usize> = None;
+    let mut gap: Option<usize> = None;
+    for i in range {
+        if !y[i].is_finite() {
+            gap = gap.or(Some(i));
+            continue;
+        }
+        if lo.is_none_or(|j| y[i] < y[j]) {
+            lo = Some(i);
+        }
+        if hi.is_none_or(|j| y[i] > y[j]) {
+            hi = Some(i);
+        }
+    }
+    let mut kept: Vec<usize> = [lo, hi, gap].into_iter().flatten().collect();
+    if kept.is_empty() {
+        kept.push(start);
+    }
+    kept.sort_unstable();
+    kept.dedup();
+    kept
+}
+
 /// Indices that decimate several series of equal length together: each gets an equal share of
-/// `max_points`, and the union of their kept samples is returned (increasing, at most
-/// `max_points` long), so one set of rows serves every series of a figure.
+/// `max_points` (five at least), and the union of their kept samples is returned (increasing,
+/// at most `max_points` long, or five per series when there are more series than
+/// `max_points / 5`), so one set of rows serves every series of a figure.
 pub fn decimate_union(series: &[&[f64]], max_points: usize) -> Vec<usize> {
     let Some(n) = series.iter().map(|s| s.len()).min() else {
         return Vec::new();
@@ -55,7 +67,7 @@ pub fn decimate_union(series: &[&[f64]], max_points: usize) -> Vec<usize> {
     if n <= max_points {
         return (0..n).collect();
     }
-    let share = (max_points / series.len().max(1)).max(4);
+    let share = (max_points / series.len().max(1)).max(5);
     let mut keep: Vec<usize> = series
         .iter()
         .flat_map(|s| decimate_indices(&s[..n], share))
@@ -63,6 +75,25 @@ pub fn decimate_union(series: &[&[f64]], max_points: usize) -> Vec<usize> {
     keep.sort_unstable();
     keep.dedup();
     keep
+}
+
+/// [`decimate_union`] within each of several stretches `ranges` of the series (windows of a
+/// record, regimes), each stretch with an equal share of `max_points`: the kept indices of
+/// every stretch in turn (each stretch's increasing), into the whole series.
+pub fn decimate_ranges(
+    series: &[&[f64]],
+    ranges: &[std::ops::Range<usize>],
+    max_points: usize,
+) -> Vec<Vec<usize>> {
+    let share = max_points / ranges.len().max(1);
+    ranges
+        .iter()
+        .map(|r| {
+            let parts: Vec<&[f64]> = series.iter().map(|s| &s[r.clone()]).collect();
+            let kept = decimate_union(&parts, share);
+            kept.into_iter().map(|i| i + r.start).collect()
+        })
+        .collect()
 }
 
 /// The samples of `y` at `indices`.
@@ -124,6 +155,36 @@ mod tests {
         assert!(keep.contains(&4242));
         let argmax_a = (0..a.len()).max_by(|&i, &j| a[i].total_cmp(&a[j])).unwrap();
         assert!(keep.contains(&argmax_a));
+    }
+
+    #[test]
+    fn a_gap_is_kept_so_lines_break_there() {
+        let mut y = noisy_sine(100_000);
+        for v in &mut y[40_000..40_010] {
+            *v = f64::NAN;
+        }
+        let keep = decimate_indices(&y, 1_000);
+        assert!(keep.len() <= 1_000, "{} points", keep.len());
+        let gaps: Vec<usize> = keep.iter().copied().filter(|&i| y[i].is_nan()).collect();
+        assert_eq!(gaps, [40_000]);
+    }
+
+    #[test]
+    fn ranges_are_decimated_apart_within_their_share() {
+        let y = noisy_sine(300_000);
+        let ranges = [1_000..101_000, 200_000..200_500];
+        let kept = decimate_ranges(&[&y], &ranges, 2_000);
+        assert!(
+            kept[0].len() <= 1_000 && kept[0].len() > 600,
+            "{}",
+            kept[0].len()
+        );
+        assert!(kept[0].iter().all(|i| ranges[0].contains(i)));
+        assert_eq!(kept[1], (200_000..200_500).collect::<Vec<_>>());
+        let max = (1_000..101_000)
+            .max_by(|&i, &j| y[i].total_cmp(&y[j]))
+            .unwrap();
+        assert!(kept[0].contains(&max));
     }
 
     #[test]

@@ -29,8 +29,13 @@ pub struct FigureFiles {
 pub const F_LABEL: &str = "F_STF, N";
 /// The time axis, as every figure labels it.
 pub const T_LABEL: &str = "time t, s";
-/// A measured signal is a wide light-grey line under the models' lines, so both stay visible.
+/// The band of a measured signal's envelope: light grey under the models' lines.
 pub const MEASURED_GREY: RGBColor = RGBColor(170, 170, 170);
+/// A measured signal drawn as a line: thin and mid-grey, under the models' lines, so a fit
+/// is never hidden behind the data and the data's noise stays readable.
+pub const MEASURED_LINE: RGBColor = RGBColor(110, 110, 110);
+/// Width of a measured signal's line, pixels (the models' lines are 2).
+pub const MEASURED_WIDTH: u32 = 1;
 
 /// Width × height of a one-panel figure, pixels.
 pub const SIZE: (u32, u32) = (1000, 600);
@@ -255,6 +260,33 @@ pub fn draw_line<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The runs of consecutive samples whose x and y are both finite: a line is drawn through
+/// each run apart, so it never bridges a gap (a non-finite sample) with a chord.
+pub fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+    let mut runs = vec![Vec::new()];
+    for (a, b) in x.iter().zip(y) {
+        if a.is_finite() && b.is_finite() {
+            runs.last_mut().expect("one run at least").push((*a, *b));
+        } else if runs.last().is_some_and(|r| !r.is_empty()) {
+            runs.push(Vec::new());
+        }
+    }
+    runs.retain(|r| !r.is_empty());
+    runs
+}
+
+/// Draw `y` against `x` on `chart` in `style`, broken where either is not finite.
+pub fn draw_runs<DB: DrawingBackend>(
+    chart: &mut Chart2d<'_, DB>,
+    (x, y): (&[f64], &[f64]),
+    style: ShapeStyle,
+) -> Result<(), String> {
+    for run in finite_runs(x, y) {
+        draw_line(chart, run, style)?;
+    }
+    Ok(())
+}
+
 /// The legend entries of model lines: each label, with `suffix`, in its series colour.
 pub fn model_entries<'a>(
     labels: impl IntoIterator<Item = &'a str>,
@@ -267,6 +299,44 @@ pub fn model_entries<'a>(
         )
     };
     labels.into_iter().enumerate().map(entry).collect()
+}
+
+/// For each of `series`, the first earlier one it draws over (every value within a thousandth
+/// of their common range of the other's): a curve drawn exactly over another hides it, and the
+/// legend must say so.
+pub fn same_as_earlier(series: &[&[f64]]) -> Vec<Option<usize>> {
+    let range = super::plot_range::finite_bounds(
+        &series
+            .iter()
+            .flat_map(|s| s.iter().copied())
+            .collect::<Vec<f64>>(),
+    )
+    .map_or(0.0, |(lo, hi)| hi - lo);
+    let close = |a: &[f64], b: &[f64]| {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .all(|(x, y)| (x.is_nan() && y.is_nan()) || (x - y).abs() <= 1e-3 * range)
+    };
+    (0..series.len())
+        .map(|i| (0..i).find(|&j| close(series[i], series[j])))
+        .collect()
+}
+
+/// [`model_entries`] with each label whose curve lies on an earlier one's (`same`, from
+/// [`same_as_earlier`]) flagged `(= earlier, drawn over it)`: the later curve is drawn on top.
+pub fn model_entries_flagged(
+    labels: &[&str],
+    same: &[Option<usize>],
+    suffix: &str,
+) -> Vec<(String, Swatch)> {
+    let mut entries = model_entries(labels.iter().copied(), suffix);
+    for (entry, same) in entries.iter_mut().zip(same) {
+        if let Some(j) = same {
+            entry.0 = format!("{} (= {}, drawn over it)", entry.0, labels[*j]);
+        }
+    }
+    entries
 }
 
 /// A figure that can draw itself on any plotters backend.
@@ -370,7 +440,32 @@ pub fn tick_label(v: f64, span: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::tick_label;
+    use super::{finite_runs, tick_label};
+
+    #[test]
+    fn curves_on_earlier_ones_are_found() {
+        let a = [0.0, 1.0, 2.0];
+        let b = [0.0, 1.0005, 2.0];
+        let c = [0.0, 1.5, 2.0];
+        assert_eq!(
+            super::same_as_earlier(&[&a, &c, &b]),
+            vec![None, None, Some(0)]
+        );
+        let labels = ["power_law", "viscous", "power_law#2"];
+        let entries = super::model_entries_flagged(&labels, &[None, None, Some(0)], "");
+        assert_eq!(entries[2].0, "power_law#2 (= power_law, drawn over it)");
+    }
+
+    #[test]
+    fn runs_break_at_gaps_and_drop_empty_ones() {
+        let nan = f64::NAN;
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let y = [1.0, nan, nan, 2.0, 3.0, 4.0, nan];
+        assert_eq!(
+            finite_runs(&x, &y),
+            vec![vec![(0.0, 1.0)], vec![(3.0, 2.0), (4.0, 3.0), (5.0, 4.0)]]
+        );
+    }
 
     #[test]
     fn tick_labels_have_the_digits_the_axis_needs_and_no_negative_zero() {

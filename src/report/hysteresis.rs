@@ -9,8 +9,8 @@ use plotters::prelude::*;
 use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
-    axis_desc_style, draw_mesh, msg, render, require_finite, same_length, tick_label, tick_style,
-    titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL,
+    axis_desc_style, draw_mesh, finite_runs, msg, render, require_finite, same_length, tick_label,
+    tick_style, titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -29,21 +29,21 @@ struct HysteresisPlot {
 }
 
 impl HysteresisPlot {
-    /// The loop cut into runs of consecutive samples, each with the colour of its mid time.
+    /// The loop cut into runs of consecutive samples, each with the colour of its mid time,
+    /// and broken where a sample is not finite (a gap is never bridged by a chord).
     fn coloured_runs(&self, t0: f64, t1: f64) -> Vec<(Vec<(f64, f64)>, RGBColor)> {
         let n = self.t.len();
         let run = n.div_ceil(COLOUR_STEPS).max(1);
         let span = if t1 > t0 { t1 - t0 } else { 1.0 };
         (0..n)
             .step_by(run)
-            .map(|start| {
+            .flat_map(|start| {
                 let end = (start + run + 1).min(n); // overlap one sample: no gaps
-                let points = (start..end)
-                    .filter(|&i| self.x[i].is_finite() && self.f[i].is_finite())
-                    .map(|i| (self.x[i], self.f[i]))
-                    .collect();
                 let mid = self.t[(start + end - 1) / 2];
-                (points, viridis((mid - t0) / span))
+                let colour = viridis((mid - t0) / span);
+                finite_runs(&self.x[start..end], &self.f[start..end])
+                    .into_iter()
+                    .map(move |points| (points, colour))
             })
             .collect()
     }
@@ -170,6 +170,41 @@ mod tests {
             let svg = std::fs::read_to_string(&files.svg).unwrap();
             assert!(svg.contains(T_LABEL));
             assert!(svg.matches("<rect").count() >= COLOUR_STEPS);
+        }
+    }
+
+    #[test]
+    fn a_gap_breaks_the_loop_instead_of_a_chord() {
+        let s = damped_sine(100_000, 20.0);
+        let mut a = s.a.clone();
+        for v in &mut a[30_000..30_400] {
+            *v = f64::NAN;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let label = "acceleration a, m/s²";
+        let files = hysteresis(dir.path(), "loop_a", (label, &a), &s.f, &s.t).unwrap();
+        let cols = assert_rendered(&files, SIZE);
+        let t = column(&cols, "t, s");
+        assert!(t.len() <= MAX_POINTS_PER_LINE, "{} rows", t.len());
+        let x = column(&cols, label);
+        // The gap survives decimation (its first sample, NaN), and no drawn segment joins the
+        // samples either side of it.
+        let gap = t.iter().position(|&v| v >= s.t[30_000]).unwrap();
+        assert!(t[gap] == s.t[30_000] && x[gap].is_nan());
+        let plot = HysteresisPlot {
+            label: label.into(),
+            t: s.t.clone(),
+            x: a.clone(),
+            f: s.f.clone(),
+        };
+        let (before, after) = ((a[29_999], s.f[29_999]), (a[30_400], s.f[30_400]));
+        for (points, _) in plot.coloured_runs(0.0, 20.0) {
+            for pair in points.windows(2) {
+                assert!(
+                    !(pair[0] == before && pair[1] == after),
+                    "a chord across the gap"
+                );
+            }
         }
     }
 

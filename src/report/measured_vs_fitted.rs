@@ -11,9 +11,9 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
-    axis_desc_style, draw_line, draw_mesh, finite_points, legend_strip, model_entries, msg,
-    one_panel, render, require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch,
-    MEASURED_GREY, SIZE, T_LABEL,
+    axis_desc_style, draw_line, draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg,
+    one_panel, render, require_finite, same_as_earlier, same_length, titled, Chart2d, Draw,
+    FigureFiles, Swatch, MEASURED_GREY, MEASURED_LINE, MEASURED_WIDTH, SIZE, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -124,8 +124,10 @@ impl MeasuredVsFittedPlot {
             ""
         };
         let band = format!("{}{suffix}", self.quantity.band);
-        let models = model_entries(self.fitted.iter().map(|(l, _)| l.as_str()), suffix);
-        std::iter::once((band, Swatch::Line(MEASURED_GREY, 6)))
+        let labels: Vec<&str> = self.fitted.iter().map(|(l, _)| l.as_str()).collect();
+        let curves: Vec<&[f64]> = self.fitted.iter().map(|(_, f)| f.as_slice()).collect();
+        let models = model_entries_flagged(&labels, &same_as_earlier(&curves), suffix);
+        std::iter::once((band, Swatch::Line(MEASURED_LINE, 2)))
             .chain(models)
             .collect()
     }
@@ -150,11 +152,15 @@ impl Draw for MeasuredVsFittedPlot {
         if dense(&self.measured) {
             return self.draw_envelopes(&mut chart);
         }
-        let measured = finite_points(&self.t, &self.measured);
-        draw_line(&mut chart, measured, MEASURED_GREY.stroke_width(6))?;
+        let measured = (self.t.as_slice(), self.measured.as_slice());
+        draw_runs(
+            &mut chart,
+            measured,
+            MEASURED_LINE.stroke_width(MEASURED_WIDTH),
+        )?;
         for (i, (_, f)) in self.fitted.iter().enumerate() {
             let style = series_colour(i).stroke_width(2);
-            draw_line(&mut chart, finite_points(&self.t, f), style)?;
+            draw_runs(&mut chart, (&self.t, f), style)?;
         }
         Ok(())
     }

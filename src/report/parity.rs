@@ -11,10 +11,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
-use super::decimate::pick;
+use super::decimate::{decimate_union, pick};
 use super::figure::{
-    draw_line, draw_mesh, legend_strip, model_entries, msg, render, same_length, small_panel,
-    tick_label, tick_style, titled, Draw, FigureFiles, Swatch,
+    draw_line, draw_mesh, finite_points, legend_strip, model_entries_flagged, msg, render,
+    same_as_earlier, same_length, small_panel, tick_label, tick_style, titled, Draw, FigureFiles,
+    Swatch,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -41,11 +42,27 @@ pub struct ParityQuantity {
 
 const BINS: usize = 40;
 const GREY: RGBColor = RGBColor(120, 120, 120);
+/// The most points a group's scatter draws over all models: its samples are decimated
+/// together, keeping each one's extremes of the measured value and of every residual.
+pub const MAX_SCATTER_POINTS: usize = 6_000;
+
+/// One group as drawn: the scatter's samples (decimated) and the residuals' histograms (of
+/// every sample).
+struct PlottedGroup {
+    name: String,
+    /// The measured values of the samples drawn.
+    measured: Vec<f64>,
+    /// Per model, its values at the samples drawn.
+    fitted: Vec<Vec<f64>>,
+    /// The histograms' range, if any residual is finite.
+    range: Option<Range<f64>>,
+    /// Per model, the density of its residual in each of [`BINS`] bins over `range`.
+    histograms: Vec<Vec<f64>>,
+}
 
 struct ParityPlot<'a> {
     quantity: &'a ParityQuantity,
-    /// Per group: name, measured, and per model the fitted values.
-    groups: Vec<(String, Vec<f64>, Vec<Vec<f64>>)>,
+    groups: Vec<PlottedGroup>,
     models: &'a [(&'a str, &'a [f64])],
 }
 
@@ -106,17 +123,13 @@ fn bell(x: f64, s: f64) -> f64 {
     (-0.5 * (x / s).powi(2)).exp() / (s * (2.0 * std::f64::consts::PI).sqrt())
 }
 
-/// Every `step`-th index, so a scatter has at most `max` points.
-fn thin(n: usize, max: usize) -> impl Iterator<Item = usize> {
-    (0..n).step_by(n.div_ceil(max.max(1)).max(1))
-}
-
 impl ParityPlot<'_> {
     fn parity<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
-        (name, measured, fitted): &(String, Vec<f64>, Vec<Vec<f64>>),
+        g: &PlottedGroup,
     ) -> Result<(), String> {
+        let (name, measured, fitted) = (&g.name, &g.measured, &g.fitted);
         let range = padded_range(measured.iter().chain(fitted.iter().flatten()))
             .ok_or_else(|| format!("{name}: no finite value"))?;
         let mut chart = small_panel(area, Some(name))
@@ -125,14 +138,13 @@ impl ParityPlot<'_> {
         let label = &self.quantity.label;
         let desc = (format!("measured {label}"), format!("fitted {label}"));
         draw_mesh(&mut chart, desc, Some((5, 5)), tick_style())?;
-        let per_model = 3_000 / fitted.len().max(1);
         for (i, f) in fitted.iter().enumerate() {
             let colour = series_colour(i).mix(0.35).filled();
             chart
                 .draw_series(
-                    thin(measured.len(), per_model)
-                        .filter(|&k| measured[k].is_finite() && f[k].is_finite())
-                        .map(|k| Circle::new((measured[k], f[k]), 2, colour)),
+                    finite_points(measured, f)
+                        .into_iter()
+                        .map(|p| Circle::new(p, 2, colour)),
                 )
                 .map_err(msg)?;
         }
@@ -143,13 +155,14 @@ impl ParityPlot<'_> {
     fn residuals<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
-        (name, measured, fitted): &(String, Vec<f64>, Vec<Vec<f64>>),
+        g: &PlottedGroup,
     ) -> Result<(), String> {
-        let residuals = residuals_of(measured, fitted);
-        let range = histogram_range(&residuals, self.quantity.noise_sigma)
+        let (name, histograms) = (&g.name, &g.histograms);
+        let range = g
+            .range
+            .clone()
             .ok_or_else(|| format!("{name}: no finite residual"))?;
         let width = (range.end - range.start) / BINS as f64;
-        let histograms: Vec<Vec<f64>> = residuals.iter().map(|r| density(r, &range)).collect();
         let sigma = self.quantity.noise_sigma.filter(|s| *s > 0.0);
         let top = histograms
             .iter()
@@ -189,7 +202,17 @@ impl ParityPlot<'_> {
     /// The legend the panels share, above them: each model's colour (its scatter and its
     /// histogram) and the noise floor's curve.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let mut entries = model_entries(self.models.iter().map(|(l, _)| *l), "");
+        let labels: Vec<&str> = self.models.iter().map(|(l, _)| *l).collect();
+        let drawn: Vec<Vec<f64>> = (0..labels.len())
+            .map(|i| {
+                self.groups
+                    .iter()
+                    .flat_map(|g| g.fitted[i].clone())
+                    .collect()
+            })
+            .collect();
+        let curves: Vec<&[f64]> = drawn.iter().map(Vec::as_slice).collect();
+        let mut entries = model_entries_flagged(&labels, &same_as_earlier(&curves), "");
         if self.quantity.noise_sigma.is_some_and(|s| s > 0.0) {
             entries.push(("noise floor".into(), Swatch::Line(GREY, 3)));
         }
@@ -211,10 +234,103 @@ impl Draw for ParityPlot<'_> {
     }
 }
 
+/// A group as drawn: its samples decimated for the scatter (each model's share of
+/// [`MAX_SCATTER_POINTS`], keeping the extremes of the measured value and of every residual;
+/// the indices returned) and the histograms of every sample's residual.
+fn plotted_group(
+    g: &SampleGroup,
+    measured: &[f64],
+    models: &[(&str, &[f64])],
+    sigma: Option<f64>,
+) -> (PlottedGroup, Vec<usize>) {
+    let m = pick(measured, &g.samples);
+    let fitted: Vec<Vec<f64>> = models.iter().map(|(_, f)| pick(f, &g.samples)).collect();
+    let residuals = residuals_of(&m, &fitted);
+    let range = histogram_range(&residuals, sigma);
+    let histograms = match &range {
+        Some(r) => residuals.iter().map(|res| density(res, r)).collect(),
+        None => Vec::new(),
+    };
+    // Residuals with NaN where a value is missing, aligned with the samples.
+    let aligned: Vec<Vec<f64>> = fitted
+        .iter()
+        .map(|f| m.iter().zip(f).map(|(a, b)| a - b).collect())
+        .collect();
+    let mut series: Vec<&[f64]> = vec![&m];
+    series.extend(aligned.iter().map(Vec::as_slice));
+    let keep = decimate_union(&series, MAX_SCATTER_POINTS / models.len().max(1));
+    let rows = pick_indices(&g.samples, &keep);
+    let group = PlottedGroup {
+        name: g.name.clone(),
+        measured: pick(&m, &keep),
+        fitted: fitted.iter().map(|f| pick(f, &keep)).collect(),
+        range,
+        histograms,
+    };
+    (group, rows)
+}
+
+/// `indices[keep[k]]` for each k.
+fn pick_indices(indices: &[usize], keep: &[usize]) -> Vec<usize> {
+    keep.iter()
+        .filter_map(|&k| indices.get(k).copied())
+        .collect()
+}
+
+/// The CSV of the figure: the scatter's rows (group number, measured, each model) and each
+/// group's histograms (group number, bin centre, each model's density).
+fn parity_columns(
+    quantity: &ParityQuantity,
+    measured: &[f64],
+    models: &[(&str, &[f64])],
+    plotted: &[(PlottedGroup, Vec<usize>)],
+) -> Vec<Column> {
+    let label = &quantity.label;
+    let rows: Vec<usize> = plotted
+        .iter()
+        .flat_map(|(_, r)| r.iter().copied())
+        .collect();
+    let mut columns = vec![
+        Column::numbered("group", plotted.iter().map(|(_, r)| r.len())),
+        Column::new(format!("measured {label}"), pick(measured, &rows)),
+    ];
+    columns.extend(
+        models
+            .iter()
+            .map(|(name, f)| Column::new(format!("{name} {label}"), pick(f, &rows))),
+    );
+    let binned: Vec<&PlottedGroup> = plotted
+        .iter()
+        .map(|(g, _)| g)
+        .filter(|g| g.range.is_some())
+        .collect();
+    let centres = binned.iter().flat_map(|g| {
+        let r = g.range.clone().unwrap_or(0.0..0.0);
+        let width = (r.end - r.start) / BINS as f64;
+        (0..BINS).map(move |b| r.start + width * (b as f64 + 0.5))
+    });
+    columns.push(Column::numbered(
+        "histogram group",
+        binned.iter().map(|_| BINS),
+    ));
+    columns.push(Column::new(
+        format!("residual bin centre, {label}"),
+        centres.collect(),
+    ));
+    columns.extend(models.iter().enumerate().map(|(i, (name, _))| {
+        let density = binned.iter().flat_map(|g| g.histograms[i].iter().copied());
+        Column::new(format!("{name} residual density"), density.collect())
+    }));
+    columns
+}
+
 /// Draw, for each group of samples, the parity plot of every model (`(label, fitted)`)
 /// against `measured` and the histogram of its residual with the noise floor's normal
-/// curve, to `out_dir/name.{svg,png,csv}`. The CSV holds the group's number, the measured
-/// value and each model's, for every sample of every group.
+/// curve, to `out_dir/name.{svg,png,csv}`. A group's scatter is decimated (at most
+/// [`MAX_SCATTER_POINTS`] over its models, every extreme of the measured value and of each
+/// residual kept); its histograms count every sample. The CSV holds the scatter as drawn (the
+/// group's number, the measured value and each model's) and the histograms (the group's
+/// number, each bin's centre and each model's density).
 pub fn parity(
     out_dir: &Path,
     name: &str,
@@ -235,34 +351,15 @@ pub fn parity(
             "parity: no group of samples, or no model",
         ));
     }
-    let plotted: Vec<(String, Vec<f64>, Vec<Vec<f64>>)> = groups
+    let plotted: Vec<(PlottedGroup, Vec<usize>)> = groups
         .iter()
-        .map(|g| {
-            let of = |v: &[f64]| pick(v, &g.samples);
-            (
-                g.name.clone(),
-                of(measured),
-                models.iter().map(|(_, f)| of(f)).collect(),
-            )
-        })
+        .map(|g| plotted_group(g, measured, models, quantity.noise_sigma))
         .collect();
-    let rows: Vec<usize> = groups.iter().flat_map(|g| g.samples.clone()).collect();
-    let mut columns = vec![
-        Column::numbered("group", groups.iter().map(|g| g.samples.len())),
-        Column::new(
-            format!("measured {}", quantity.label),
-            pick(measured, &rows),
-        ),
-    ];
-    columns.extend(
-        models
-            .iter()
-            .map(|(label, f)| Column::new(format!("{label} {}", quantity.label), pick(f, &rows))),
-    );
+    let columns = parity_columns(quantity, measured, models, &plotted);
     let size = (480 * plotted.len() as u32 + 40, 900);
     let plot = ParityPlot {
         quantity,
-        groups: plotted,
+        groups: plotted.into_iter().map(|(g, _)| g).collect(),
         models,
     };
     render(out_dir, name, size, &plot, &columns)
@@ -304,5 +401,53 @@ mod tests {
         assert_eq!(column(&cols, "group")[1_500], 2.0);
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         assert!(svg.contains("\nsecond half\n") && svg.contains("\nnoise floor\n"));
+    }
+
+    #[test]
+    fn a_million_samples_are_drawn_and_written_decimated_with_their_extremes() {
+        let s = damped_sine(1_000_000, 100.0);
+        let mut model: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
+        let mut f = s.f.clone();
+        // A spike in the measured force and one in the model's, where nothing else is extreme.
+        f[123_457] = 3.0;
+        model[654_321] = -2.5;
+        let groups = [
+            SampleGroup {
+                name: "early".into(),
+                samples: (0..500_000).collect(),
+            },
+            SampleGroup {
+                name: "late".into(),
+                samples: (500_000..1_000_000).collect(),
+            },
+        ];
+        let quantity = ParityQuantity {
+            label: "F_STF, N".into(),
+            noise_sigma: Some(0.0015),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let models = [("power law", model.as_slice())];
+        let files = parity(dir.path(), "parity", &quantity, &f, &models, &groups).unwrap();
+        let cols = assert_rendered(&files, (1000, 900));
+        let measured = column(&cols, "measured F_STF, N");
+        assert!(
+            measured.len() <= 2 * MAX_SCATTER_POINTS,
+            "{} rows",
+            measured.len()
+        );
+        let fitted = column(&cols, "power law F_STF, N");
+        assert!(measured.contains(&3.0) && fitted.contains(&-2.5));
+        let extreme = |v: &[f64], pick: fn(f64, f64) -> f64| v.iter().copied().reduce(pick);
+        assert_eq!(extreme(measured, f64::min), extreme(&f, f64::min));
+        // Every sample counts in the histograms: each density integrates to at most 1 and
+        // the best model's to nearly 1.
+        let density = column(&cols, "power law residual density");
+        let centres = column(&cols, "residual bin centre, F_STF, N");
+        assert_eq!((density.len(), centres.len()), (2 * BINS, 2 * BINS));
+        let width = centres[1] - centres[0];
+        let mass: f64 = density[..BINS].iter().sum::<f64>() * width;
+        assert!(mass > 0.9 && mass <= 1.0 + 1e-9, "{mass}");
+        let bytes = std::fs::metadata(&files.csv).unwrap().len();
+        assert!(bytes < 2_000_000, "parity.csv is {bytes} bytes");
     }
 }

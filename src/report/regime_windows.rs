@@ -1,7 +1,7 @@
 //! A few cycles of each regime side by side, as the source study shows them: one column per
 //! window (pre-resonance, resonance, post-resonance), the STF force over time on top and the
 //! hysteresis loops F–x, F–v, F–a under it, each fitted model's force drawn over the measured
-//! one (a wide grey line). A long record squeezed into one plot is a solid band; a window of
+//! one (a thin grey line under them). A long record squeezed into one plot is a solid band; a window of
 //! a few cycles shows the loops' shapes.
 
 use std::path::Path;
@@ -10,9 +10,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
+use super::decimate::{decimate_ranges, pick};
 use super::figure::{
-    draw_line, draw_mesh, finite_points, legend_strip, model_entries, msg, render, same_length,
-    small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL, MEASURED_GREY,
+    draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg, render, same_as_earlier,
+    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL,
+    MEASURED_LINE, MEASURED_WIDTH,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -47,51 +49,66 @@ pub struct WindowSeries<'a> {
     pub models: &'a [(&'a str, &'a [f64])],
 }
 
+/// The most samples a window keeps (its series decimated together, every extreme kept).
+pub const MAX_POINTS_PER_WINDOW: usize = 4_000;
+
 struct WindowsPlot<'a> {
     series: WindowSeries<'a>,
-    windows: Vec<RegimeWindow>,
+    /// Each window with the samples it draws (increasing indices into the series).
+    windows: Vec<(RegimeWindow, Vec<usize>)>,
 }
 
 impl WindowsPlot<'_> {
-    /// One panel: the measured force and each model's against `x` over `w`'s samples.
+    /// One panel: the measured force and each model's against `x` over the window's kept
+    /// samples `rows`.
     fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
-        w: &RegimeWindow,
+        (w, rows): &(RegimeWindow, Vec<usize>),
         (x_label, x): (&str, &[f64]),
         caption: Option<&str>,
     ) -> Result<(), String> {
-        let r = w.start..w.end;
         let s = &self.series;
-        let all_f = s.f[r.clone()]
-            .iter()
-            .chain(s.models.iter().flat_map(|(_, m)| &m[r.clone()]));
+        let x = pick(x, rows);
+        let f = pick(s.f, rows);
+        let models: Vec<Vec<f64>> = s.models.iter().map(|(_, m)| pick(m, rows)).collect();
+        let all_f = f.iter().chain(models.iter().flatten());
         let no_data = || format!("{}: no finite value", w.name);
         let f_range = padded_range(all_f).ok_or_else(no_data)?;
         let x_range = if x_label.starts_with("time") {
-            exact_range(&x[r.clone()])
+            exact_range(&x)
         } else {
-            padded_range(&x[r.clone()])
+            padded_range(&x)
         }
         .ok_or_else(no_data)?;
         let mut chart = small_panel(area, caption)
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
         draw_mesh(&mut chart, (x_label, F_LABEL), Some((5, 6)), tick_style())?;
-        let x = &x[r.clone()];
-        let measured = finite_points(x, &s.f[r.clone()]);
-        draw_line(&mut chart, measured, MEASURED_GREY.stroke_width(5))?;
-        for (i, (_, m)) in s.models.iter().enumerate() {
-            let style = series_colour(i).stroke_width(2);
-            draw_line(&mut chart, finite_points(x, &m[r.clone()]), style)?;
+        draw_runs(
+            &mut chart,
+            (&x, &f),
+            MEASURED_LINE.stroke_width(MEASURED_WIDTH),
+        )?;
+        for (i, m) in models.iter().enumerate() {
+            draw_runs(&mut chart, (&x, m), series_colour(i).stroke_width(2))?;
         }
         Ok(())
     }
 
     /// The legend the panels share, above them: the measured force and each model's.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let measured = ("measured".to_string(), Swatch::Line(MEASURED_GREY, 5));
-        let models = model_entries(self.series.models.iter().map(|(l, _)| *l), "");
+        let measured = ("measured".to_string(), Swatch::Line(MEASURED_LINE, 2));
+        let labels: Vec<&str> = self.series.models.iter().map(|(l, _)| *l).collect();
+        let rows: Vec<usize> = self.windows.iter().flat_map(|(_, r)| r.clone()).collect();
+        let drawn: Vec<Vec<f64>> = self
+            .series
+            .models
+            .iter()
+            .map(|(_, m)| pick(m, &rows))
+            .collect();
+        let curves: Vec<&[f64]> = drawn.iter().map(Vec::as_slice).collect();
+        let models = model_entries_flagged(&labels, &same_as_earlier(&curves), "");
         std::iter::once(measured).chain(models).collect()
     }
 }
@@ -111,7 +128,7 @@ impl Draw for WindowsPlot<'_> {
         for (k, cell) in cells.iter().enumerate() {
             let (row, col) = (k / self.windows.len(), k % self.windows.len());
             let w = &self.windows[col];
-            let caption = (row == 0).then_some(w.name.as_str());
+            let caption = (row == 0).then_some(w.0.name.as_str());
             self.panel(cell, w, rows[row], caption)?;
         }
         Ok(())
@@ -144,25 +161,28 @@ pub fn regime_windows(
             "regime windows: no window of at least two samples",
         ));
     }
-    let rows: Vec<usize> = windows.iter().flat_map(|w| w.start..w.end).collect();
-    let pick = |v: &[f64]| rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+    let mut all: Vec<&[f64]> = vec![s.x_mm, s.v_mm, s.a, s.f];
+    all.extend(s.models.iter().map(|(_, m)| *m));
+    let ranges: Vec<_> = windows.iter().map(|w| w.start..w.end).collect();
+    let kept = decimate_ranges(&all, &ranges, MAX_POINTS_PER_WINDOW * windows.len());
+    let rows: Vec<usize> = kept.iter().flatten().copied().collect();
     let mut columns = vec![
-        Column::numbered("window", windows.iter().map(|w| w.end - w.start)),
-        Column::new("t, s", pick(s.t)),
-        Column::new("x, mm", pick(s.x_mm)),
-        Column::new("v, mm/s", pick(s.v_mm)),
-        Column::new("a, m/s²", pick(s.a)),
-        Column::new("F_STF measured, N", pick(s.f)),
+        Column::numbered("window", kept.iter().map(Vec::len)),
+        Column::new("t, s", pick(s.t, &rows)),
+        Column::new("x, mm", pick(s.x_mm, &rows)),
+        Column::new("v, mm/s", pick(s.v_mm, &rows)),
+        Column::new("a, m/s²", pick(s.a, &rows)),
+        Column::new("F_STF measured, N", pick(s.f, &rows)),
     ];
     columns.extend(
         s.models
             .iter()
-            .map(|(label, m)| Column::new(format!("F_STF {label}, N"), pick(m))),
+            .map(|(label, m)| Column::new(format!("F_STF {label}, N"), pick(m, &rows))),
     );
     let size = (500 * windows.len() as u32 + 20, 1500);
     let plot = WindowsPlot {
         series: *s,
-        windows,
+        windows: windows.into_iter().zip(kept).collect(),
     };
     render(out_dir, name, size, &plot, &columns)
 }
@@ -215,5 +235,37 @@ mod tests {
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         assert!(svg.contains("\nearly\n") && svg.contains("\nlate\n"));
         assert!(!svg.contains("\nempty\n"));
+    }
+
+    #[test]
+    fn a_window_of_a_million_samples_is_drawn_decimated_with_its_peaks() {
+        let s = damped_sine(1_000_000, 20.0);
+        let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
+        let (x, v) = (mm(&s.x), mm(&s.v));
+        let mut f = s.f.clone();
+        f[400_001] = 5.0;
+        let models = [("linear", s.v.as_slice())];
+        let series = WindowSeries {
+            t: &s.t,
+            x_mm: &x,
+            v_mm: &v,
+            a: &s.a,
+            f: &f,
+            models: &models,
+        };
+        let windows = [RegimeWindow {
+            name: "all".into(),
+            start: 0,
+            end: 1_000_000,
+        }];
+        let dir = tempfile::tempdir().unwrap();
+        let files = regime_windows(dir.path(), "windows", &series, &windows).unwrap();
+        let cols = assert_rendered(&files, (520, 1500));
+        let t = column(&cols, "t, s");
+        assert!(t.len() <= MAX_POINTS_PER_WINDOW, "{} rows", t.len());
+        let measured = column(&cols, "F_STF measured, N");
+        assert!(measured.contains(&5.0));
+        let x_max = x.iter().copied().fold(f64::MIN, f64::max);
+        assert!(column(&cols, "x, mm").contains(&x_max));
     }
 }

@@ -14,7 +14,7 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_line, draw_mesh_with, finite_points, legend_strip, milli, model_entries,
+    axis_desc_style, draw_line, draw_mesh_with, finite_runs, legend_strip, milli, model_entries,
     msg, render, require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles,
     Swatch, F_LABEL, SIZE_TALL, T_LABEL,
 };
@@ -132,13 +132,14 @@ impl TimeHistoryPlot {
                 .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
                 .map_err(msg)?;
         } else {
-            draw_line(chart, finite_points(&self.t, y), c_motion.stroke_width(2))?;
-            chart
-                .draw_secondary_series(LineSeries::new(
-                    finite_points(&self.t, &self.f),
-                    c_force.stroke_width(1),
-                ))
-                .map_err(msg)?;
+            for run in finite_runs(&self.t, y) {
+                draw_line(chart, run, c_motion.stroke_width(2))?;
+            }
+            for run in finite_runs(&self.t, &self.f) {
+                chart
+                    .draw_secondary_series(LineSeries::new(run, c_force.stroke_width(1)))
+                    .map_err(msg)?;
+            }
         }
         Ok(())
     }
@@ -174,7 +175,11 @@ pub fn time_history(
     same_length("time history: t and F_STF", t, f_stf)?;
     require_finite("time history", &[("t", t), ("x", x), ("F_STF", f_stf)])?;
 
-    let marks_full = extrema(f_stf, noise_delta(f_stf));
+    // More extrema than a plot can mark are neither drawn nor written.
+    let mut marks_full = extrema(f_stf, noise_delta(f_stf));
+    if marks_full.len() > MAX_MARKS {
+        marks_full.clear();
+    }
     let mut keep = decimate_union(&[x, v, a, f_stf], MAX_POINTS_PER_LINE);
     keep.extend(marks_full.iter().map(|e| e.index));
     keep.sort_unstable();

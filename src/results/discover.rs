@@ -146,7 +146,7 @@ const FORCE_DRAWN: Drawn = Drawn {
     residual: (
         "discovery_residual",
         STF_FORCE_RESIDUAL,
-        "Residual (measured − model) of the base (grey band) and of the final model.",
+        "Residual (measured − model) of the base (grey) and of the final model.",
     ),
 };
 
@@ -161,7 +161,7 @@ const TRAJECTORY_DRAWN: Drawn = Drawn {
     residual: (
         "discovery_x_residual",
         DISPLACEMENT_RESIDUAL_MM,
-        "Displacement residual (measured − simulated) of the base (grey band) and of the \
+        "Displacement residual (measured − simulated) of the base (grey) and of the \
          final model.",
     ),
 };

@@ -149,6 +149,18 @@ pub fn cycle_features(
     min_off_fraction: f64,
 ) -> Result<CycleFeatures, RegimeError> {
     let n = sig.check()?;
+    features_of_checked(sig, n, cycle, on_threshold, min_off_fraction)
+}
+
+/// [`cycle_features`] of signals already checked to be `n` samples long and finite (the
+/// check reads every sample: once a record, not once a cycle).
+fn features_of_checked(
+    sig: &ForceData,
+    n: usize,
+    cycle: &Cycle,
+    on_threshold: f64,
+    min_off_fraction: f64,
+) -> Result<CycleFeatures, RegimeError> {
     let (s, e) = (cycle.start, cycle.end);
     if !(s < e && e < n) {
         return Err(RegimeError::BadCycle {
@@ -208,9 +220,10 @@ pub fn features(
     sigma: f64,
 ) -> Result<Vec<CycleFeatures>, RegimeError> {
     let on = th.on_threshold(sigma);
+    let n = sig.check()?;
     cycles
         .iter()
-        .map(|c| cycle_features(sig, c, on, th.min_off_fraction))
+        .map(|c| features_of_checked(sig, n, c, on, th.min_off_fraction))
         .collect()
 }
 

@@ -116,9 +116,9 @@ impl ModelEntry {
 pub(super) fn check(list: &[Spanned<RawModel>], prefix: &str, cx: &Ctx) -> Result<Vec<ModelEntry>> {
     if let Some(past) = list.get(MAX_MODELS) {
         let msg = format!(
-            "{} entries; a run takes at most {MAX_MODELS} (each is fitted, kept in memory with \
-             its curves and written with its report: 2 000 took 1.6 GB and 1.8 GB of output): \
-             split them across experiments, or run them as a campaign",
+            "{} `[[{prefix}]]` entries; a run takes at most {MAX_MODELS} (each is fitted, kept in \
+             memory with its curves and written with its report: 2 000 took 1.6 GB and 1.8 GB \
+             of output): split them across experiments, or run them as a campaign",
             list.len()
         );
         return Err(cx.at(past.span(), prefix, msg));
@@ -192,7 +192,7 @@ mod tests {
         let msg = parse(&entries(2000)).unwrap_err().to_string();
         assert!(
             msg.starts_with(&format!(
-                "exp.toml:{}: `models`: 2000 entries; a run takes at most 100",
+                "exp.toml:{}: `models`: 2000 `[[models]]` entries; a run takes at most 100",
                 2 * MAX_MODELS + 1
             )),
             "{msg}"
