@@ -142,6 +142,15 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
             file.display()
         );
     }
+    let mut record_warnings = record_warnings;
+    let driven = record.phi.is_some() || record.omega.is_some() || record.u.is_some();
+    if level == FitLevel::Trajectory && !driven {
+        record_warnings.push(format!(
+            "{}: no drive column (`phi`, `omega` or `u`): the trajectory-level fit simulates \
+             it as a free vibration",
+            file.display()
+        ));
+    }
     let system_estimate = match (&record.u, level, exp.system_given) {
         (Some(u), FitLevel::Trajectory, false) => {
             let dt = record.sample_step().unwrap_or(f64::NAN);

@@ -1,0 +1,129 @@
+//! End to end: records as other rigs write them are read without friction. Each record is
+//! made by `simulate` (the rig's sensors on) and then rewritten as a lab would have it:
+//! columns dropped (a damper rig records t, x and the force only), other units, time stamps
+//! rounded, a measured velocity beside x, a unit declared wrongly.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{read_json, run, run_ok, simulate_ok};
+
+/// A force-level record through resonance: 2 s at rest, a spin-up, then a sweep to `w1`
+/// rad/s; the STF force is a power law, K = 4, n = 1.5.
+fn simulate_record(dir: &Path, w1: f64, seed: u64) -> String {
+    let sim = dir.join(format!("sim_{seed}.toml"));
+    let text = format!(
+        "[simulate]\nprofile = {{ t = [0.0, 2.0, 2.5, 22.5], omega = [0.0, 0.0, 4.0, {w1}] }}\n\
+         rate = 200.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
+         params = {{ K = 4.0, n = 1.5 }}\n"
+    );
+    std::fs::write(&sim, text).unwrap();
+    let csv = dir.join(format!("sim_{seed}.csv"));
+    simulate_ok(&sim, &csv);
+    std::fs::read_to_string(&csv).unwrap()
+}
+
+/// The simulator's columns (t, phi, x, f_stf) as numbers, one row a sample.
+fn rows(si_csv: &str) -> Vec<[f64; 4]> {
+    let mut lines = si_csv.lines();
+    assert_eq!(lines.next(), Some("t,phi,x,f_stf"));
+    lines
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect()
+}
+
+/// Write `header` and one line per row made by `line`.
+fn write_csv(
+    dir: &Path,
+    name: &str,
+    header: &str,
+    rows: &[[f64; 4]],
+    line: impl Fn(&[f64; 4]) -> String,
+) -> PathBuf {
+    let mut text = format!("{header}\n");
+    for r in rows {
+        text += &line(r);
+        text.push('\n');
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A force-level experiment on `file` with `[data]` keys `data`, fitting a power law.
+fn experiment(dir: &Path, file: &str, data: &str) -> PathBuf {
+    let text = format!(
+        "[data]\nfile = \"{file}\"\nwindow = [2.0, 22.5]\n{data}\n\n[output]\nreport = false\n\n\
+         [[models]]\nname = \"power_law\"\n"
+    );
+    let path = dir.join(format!("{file}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The fitted power law's (K, n) and their standard errors.
+fn power_law(out: &Path) -> ([f64; 2], [f64; 2]) {
+    let fit = read_json(&out.join("fit.json"));
+    let m = &fit["models"][0];
+    let value = |p: &str| m["params"][p].as_f64().unwrap();
+    let se = |p: &str| m["std_errors"][p].as_f64().unwrap();
+    ([value("K"), value("n")], [se("K"), se("n")])
+}
+
+#[test]
+fn a_force_record_of_t_x_and_the_force_alone_fits_to_the_truth() {
+    // A damper rig records no rotor angle or drive: t, x and the force are enough at force
+    // level. Two sweep rates, two seeds.
+    for (w1, seed) in [(8.0, 5), (10.0, 6)] {
+        let dir = tempfile::tempdir().unwrap();
+        let rows = rows(&simulate_record(dir.path(), w1, seed));
+        write_csv(dir.path(), "damper.csv", "t,x,f_stf", &rows, |r| {
+            format!("{},{},{}", r[0], r[2], r[3])
+        });
+        let exp = experiment(dir.path(), "damper.csv", "");
+        let out = dir.path().join("fit");
+        run_ok("fit", &exp, &out);
+        let ([k, n], [se_k, se_n]) = power_law(&out);
+        eprintln!("w1 {w1}, seed {seed}: K = {k} ± {se_k}, n = {n} ± {se_n}");
+        assert!((k - 4.0).abs() < 3.0 * se_k && (k / 4.0 - 1.0).abs() < 0.05, "K = {k}");
+        assert!((n - 1.5).abs() < 3.0 * se_n && (n / 1.5 - 1.0).abs() < 0.05, "n = {n}");
+        // compare and discover read it too.
+        for command in ["compare", "discover"] {
+            let text = std::fs::read_to_string(&exp).unwrap()
+                + "\n[[models]]\nname = \"viscous\"\n\n[discover]\nbase = \"viscous\"\n\
+                   candidates = [\"power_law\"]\n";
+            let both = dir.path().join("both.toml");
+            std::fs::write(&both, text).unwrap();
+            run_ok(command, &both, &dir.path().join(command));
+        }
+    }
+}
+
+#[test]
+fn a_record_without_drive_at_trajectory_level_is_a_free_vibration_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = rows(&simulate_record(dir.path(), 8.0, 5));
+    write_csv(dir.path(), "damper.csv", "t,x,f_stf", &rows, |r| {
+        format!("{},{},{}", r[0], r[2], r[3])
+    });
+    let exp = experiment(dir.path(), "damper.csv", "");
+    let text = std::fs::read_to_string(&exp).unwrap() + "\n[fit]\nlevel = \"trajectory\"\n";
+    std::fs::write(&exp, text).unwrap();
+    let out = common::stf_lab()
+        .args(["fit", "--out"])
+        .arg(dir.path().join("traj"))
+        .arg(&exp)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        format!("{stdout}{stderr}").contains("no drive column"),
+        "{stdout}\n{stderr}"
+    );
+    let _ = run;
+}
