@@ -12,10 +12,15 @@ use common::{read_json, run, run_ok, simulate_ok};
 /// A force-level record through resonance: 2 s at rest, a spin-up, then a sweep to `w1`
 /// rad/s; the STF force is a power law, K = 4, n = 1.5.
 fn simulate_record(dir: &Path, w1: f64, seed: u64) -> String {
+    simulate_at(dir, w1, seed, 200.0)
+}
+
+/// [`simulate_record`] at `rate` samples per second.
+fn simulate_at(dir: &Path, w1: f64, seed: u64, rate: f64) -> String {
     let sim = dir.join(format!("sim_{seed}.toml"));
     let text = format!(
         "[simulate]\nprofile = {{ t = [0.0, 2.0, 2.5, 22.5], omega = [0.0, 0.0, 4.0, {w1}] }}\n\
-         rate = 200.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
+         rate = {rate}\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
          params = {{ K = 4.0, n = 1.5 }}\n"
     );
     std::fs::write(&sim, text).unwrap();
@@ -89,8 +94,14 @@ fn a_force_record_of_t_x_and_the_force_alone_fits_to_the_truth() {
         run_ok("fit", &exp, &out);
         let ([k, n], [se_k, se_n]) = power_law(&out);
         eprintln!("w1 {w1}, seed {seed}: K = {k} ± {se_k}, n = {n} ± {se_n}");
-        assert!((k - 4.0).abs() < 3.0 * se_k && (k / 4.0 - 1.0).abs() < 0.05, "K = {k}");
-        assert!((n - 1.5).abs() < 3.0 * se_n && (n / 1.5 - 1.0).abs() < 0.05, "n = {n}");
+        assert!(
+            (k - 4.0).abs() < 3.0 * se_k && (k / 4.0 - 1.0).abs() < 0.05,
+            "K = {k}"
+        );
+        assert!(
+            (n - 1.5).abs() < 3.0 * se_n && (n / 1.5 - 1.0).abs() < 0.05,
+            "n = {n}"
+        );
         // compare and discover read it too.
         for command in ["compare", "discover"] {
             let text = std::fs::read_to_string(&exp).unwrap()
@@ -100,6 +111,101 @@ fn a_force_record_of_t_x_and_the_force_alone_fits_to_the_truth() {
             std::fs::write(&both, text).unwrap();
             run_ok(command, &both, &dir.path().join(command));
         }
+    }
+}
+
+#[test]
+fn the_common_lab_units_are_known() {
+    // The same record in SI, then in two labs' units (the rotor angle in turns, time in
+    // minutes or ms, x in cm or inches, the force in kN or pounds-force): the same fit.
+    let dir = tempfile::tempdir().unwrap();
+    let rows = rows(&simulate_record(dir.path(), 8.0, 5));
+    let si = dir.path().join("si");
+    write_csv(dir.path(), "si.csv", "t,phi,x,f_stf", &rows, |r| {
+        format!("{},{},{},{}", r[0], r[1], r[2], r[3])
+    });
+    run_ok("fit", &experiment(dir.path(), "si.csv", ""), &si);
+    let (truth, _) = power_law(&si);
+    let tau = std::f64::consts::TAU;
+    let labs: [(&str, &str, [f64; 4]); 2] = [
+        (
+            "metric.csv",
+            "units = { t = \"min\", phi = \"rev\", x = \"cm\", f_stf = \"kN\" }",
+            [1.0 / 60.0, 1.0 / tau, 100.0, 1e-3],
+        ),
+        (
+            "imperial.csv",
+            "units = { t = \"ms\", phi = \"deg\", x = \"in\", f_stf = \"lbf\" }",
+            [1e3, 360.0 / tau, 1.0 / 0.0254, 1.0 / 4.448_221_615_260_5],
+        ),
+    ];
+    for (name, units, k) in labs {
+        write_csv(dir.path(), name, "t,phi,x,f_stf", &rows, |r| {
+            format!(
+                "{},{},{},{}",
+                r[0] * k[0],
+                r[1] * k[1],
+                r[2] * k[2],
+                r[3] * k[3]
+            )
+        });
+        let out = dir.path().join(name.replace(".csv", ""));
+        // The window is in s whatever the file's time unit: only the units differ.
+        run_ok("fit", &experiment(dir.path(), name, units), &out);
+        let (fitted, _) = power_law(&out);
+        eprintln!("{name}: K, n = {fitted:?} (SI: {truth:?})");
+        for (a, b) in fitted.iter().zip(truth) {
+            assert!(
+                (a / b - 1.0).abs() < 1e-6,
+                "{name}: {fitted:?} against {truth:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn time_stamps_rounded_to_a_tenth_of_a_ms_are_read_as_uniform() {
+    // 610.35 Hz (a step of 1.6384 ms) written to 0.1 ms: steps of 1.6 and 1.7 ms. Force
+    // only (t, x, f_stf), two seeds.
+    for seed in [5, 6] {
+        let dir = tempfile::tempdir().unwrap();
+        let rows = rows(&simulate_at(dir.path(), 8.0, seed, 610.35));
+        write_csv(dir.path(), "exact.csv", "t,x,f_stf", &rows, |r| {
+            format!("{},{},{}", r[0], r[2], r[3])
+        });
+        write_csv(dir.path(), "rounded.csv", "t,x,f_stf", &rows, |r| {
+            format!("{:.4},{},{}", r[0], r[2], r[3])
+        });
+        let exact = dir.path().join("exact");
+        run_ok("fit", &experiment(dir.path(), "exact.csv", ""), &exact);
+        let rounded = dir.path().join("rounded");
+        run_ok("fit", &experiment(dir.path(), "rounded.csv", ""), &rounded);
+        let ((a, se), (b, _)) = (power_law(&exact), power_law(&rounded));
+        eprintln!("seed {seed}: exact time {a:?} ± {se:?}, rounded {b:?}");
+        for i in 0..2 {
+            assert!((a[i] - b[i]).abs() < 0.05 * se[i], "{a:?} against {b:?}");
+        }
+        assert!((a[0] / 4.0 - 1.0).abs() < 0.05 && (a[1] / 1.5 - 1.0).abs() < 0.05);
+
+        // Stamps that are not uniform, rounded or not (a clock with 3 % of jitter), are
+        // refused, and the message names the fix: the sample rate.
+        write_csv(dir.path(), "jitter.csv", "t,x,f_stf", &rows, |r| {
+            let i = (r[0] * 610.35).round() as u64;
+            let hash = i.wrapping_mul(2_654_435_761) >> 7;
+            let jitter = 0.03 / 610.35 * ((hash % 1000) as f64 / 1000.0 - 0.5);
+            format!("{},{},{}", r[0] + jitter, r[2], r[3])
+        });
+        let failed = run(
+            "fit",
+            &experiment(dir.path(), "jitter.csv", ""),
+            &dir.path().join("j"),
+        );
+        assert!(!failed.status.success());
+        let msg = String::from_utf8_lossy(&failed.stderr);
+        assert!(
+            msg.contains("not uniform") && msg.contains("`rate = 610."),
+            "{msg}"
+        );
     }
 }
 
@@ -125,5 +231,4 @@ fn a_record_without_drive_at_trajectory_level_is_a_free_vibration_and_says_so() 
         format!("{stdout}{stderr}").contains("no drive column"),
         "{stdout}\n{stderr}"
     );
-    let _ = run;
 }

@@ -670,7 +670,9 @@ mod tests {
             .header(false)
             .column(Signal::T, Column::Number(1))
             .column(Signal::X, Column::Number(2));
-        let r = no_drive.read_csv_from("0,5\n".as_bytes(), "lab.csv").unwrap();
+        let r = no_drive
+            .read_csv_from("0,5\n".as_bytes(), "lab.csv")
+            .unwrap();
         assert_eq!((r.t, r.x), (vec![0.0], vec![5.0]));
         // A named signal (by default, by name) cannot be found without a header.
         expect_with(

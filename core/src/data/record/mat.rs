@@ -433,7 +433,10 @@ pub(super) mod tests {
             &mat_v5(&[col("t", &T, true), col("x", &X, true)]),
         );
         let r = Record::read_mat(&p).unwrap();
-        assert!(r.phi.is_none() && r.u.is_none(), "t and x alone are a record");
+        assert!(
+            r.phi.is_none() && r.u.is_none(),
+            "t and x alone are a record"
+        );
     }
 
     #[test]

@@ -36,6 +36,7 @@ mod error;
 mod layout;
 mod mat;
 mod mat_inflate;
+mod time_grid;
 
 pub use error::RecordError;
 pub use layout::{
@@ -164,7 +165,8 @@ impl ReadOptions {
 
 /// Check the signals of a record being assembled (by [`Signal`] index; `t` and `x` present)
 /// and make a record: equal lengths, at least one sample, finite values, strictly increasing
-/// time. The drive (φ, ω or u) is optional: a force-level fit needs only t, x and the force,
+/// time, read as the uniform grid it rounds where its stamps are rounded (module
+/// `time_grid`). The drive (φ, ω or u) is optional: a force-level fit needs only t, x and the force,
 /// and a record without any drive is a free vibration at trajectory level. `labels` name the columns (by [`Signal`] index) and `row_of` turns a
 /// 0-based sample index into the row a user sees.
 pub(crate) fn into_record(
@@ -214,6 +216,7 @@ pub(crate) fn into_record(
         .at_row(row_of(i + 1))
         .in_column(label(Signal::T)));
     }
+    let t = time_grid::regular_within_rounding(&t).unwrap_or(t);
     Ok(Record {
         source: source.to_string(),
         t,
