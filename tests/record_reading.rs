@@ -59,10 +59,16 @@ fn write_csv(
     path
 }
 
-/// A force-level experiment on `file` with `[data]` keys `data`, fitting a power law.
+/// A force-level experiment on `file` with `[data]` keys `data` (and the window of the
+/// sweep, 2 – 22.5 s, unless they give one), fitting a power law.
 fn experiment(dir: &Path, file: &str, data: &str) -> PathBuf {
+    let window = if data.contains("window") {
+        ""
+    } else {
+        "window = [2.0, 22.5]\n"
+    };
     let text = format!(
-        "[data]\nfile = \"{file}\"\nwindow = [2.0, 22.5]\n{data}\n\n[output]\nreport = false\n\n\
+        "[data]\nfile = \"{file}\"\n{window}{data}\n\n[output]\nreport = false\n\n\
          [[models]]\nname = \"power_law\"\n"
     );
     let path = dir.join(format!("{file}.toml"));
@@ -231,4 +237,56 @@ fn a_record_without_drive_at_trajectory_level_is_a_free_vibration_and_says_so() 
         format!("{stdout}{stderr}").contains("no drive column"),
         "{stdout}\n{stderr}"
     );
+}
+
+/// The warnings of reading `file` with `[data]` keys `data` (the library's `load_data`).
+fn warnings(dir: &Path, file: &str, data: &str) -> Vec<String> {
+    let exp = experiment(dir, file, data);
+    let mut exp = stf_lab::experiment::Experiment::load(&exp).unwrap();
+    stf_lab::fitting::load_data(&mut exp)
+        .map(|d| d.record_warnings)
+        .unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+#[test]
+fn implausible_scales_warn_and_name_the_likely_unit_mistake() {
+    for (w1, seed) in [(8.0, 5), (10.0, 6)] {
+        let dir = tempfile::tempdir().unwrap();
+        let rows = rows(&simulate_record(dir.path(), w1, seed));
+        let si = |r: &[f64; 4]| format!("{},{},{},{}", r[0], r[1], r[2], r[3]);
+        write_csv(dir.path(), "rotor.csv", "t,phi,x,f_stf", &rows, si);
+        write_csv(dir.path(), "damper.csv", "t,x,f_stf", &rows, |r| {
+            format!("{},{},{}", r[0], r[2], r[3])
+        });
+        // Read as recorded: not a word (the window is in s, so none when t is read as ms).
+        assert_eq!(warnings(dir.path(), "rotor.csv", ""), Vec::<String>::new());
+        assert_eq!(warnings(dir.path(), "damper.csv", ""), Vec::<String>::new());
+        // A record in s read as ms: a rotor at thousands of rad/s, cycles of x at ~1 kHz.
+        let ms = "units = { t = \"ms\" }\nwindow = [0.002, 0.0225]";
+        for file in ["rotor.csv", "damper.csv"] {
+            let w = warnings(dir.path(), file, ms);
+            eprintln!("{file}, t read as ms: {w:?}");
+            assert!(
+                w.iter().any(|w| w.contains("is `t` in s read as ms?")),
+                "{file}: {w:?}"
+            );
+        }
+        // A record in m read as mm: a stroke of hundredths of a mm.
+        for file in ["rotor.csv", "damper.csv"] {
+            let w = warnings(dir.path(), file, "units = { x = \"mm\" }");
+            eprintln!("{file}, x read as mm: {w:?}");
+            assert!(
+                w.iter().any(|w| w.contains("in m (or cm) read as mm?")),
+                "{file}: {w:?}"
+            );
+        }
+        // The same record written in mm and read as mm: not a word.
+        write_csv(dir.path(), "mm.csv", "t,x,f_stf", &rows, |r| {
+            format!("{},{},{}", r[0], r[2] * 1e3, r[3])
+        });
+        assert_eq!(
+            warnings(dir.path(), "mm.csv", "units = { x = \"mm\" }"),
+            Vec::<String>::new()
+        );
+    }
 }

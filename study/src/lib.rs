@@ -34,6 +34,7 @@ pub mod observer;
 pub mod outputs;
 pub mod param_table;
 pub mod plausibility;
+pub mod plausible_scale;
 pub mod prelude;
 pub mod script_plan;
 pub mod simulate;
