@@ -290,3 +290,44 @@ fn implausible_scales_warn_and_name_the_likely_unit_mistake() {
         );
     }
 }
+
+#[test]
+fn a_force_record_without_rotor_is_reported_without_regimes() {
+    // A damper's record (t, x, f_stf): its report speaks of thirds of the record and periods
+    // of the motion, not of a rotor's regimes, in fit's and discover's reports alike.
+    let dir = tempfile::tempdir().unwrap();
+    let rows = rows(&simulate_record(dir.path(), 8.0, 5));
+    write_csv(dir.path(), "damper.csv", "t,x,f_stf", &rows, |r| {
+        format!("{},{},{}", r[0], r[2], r[3])
+    });
+    let exp = experiment(dir.path(), "damper.csv", "");
+    let text = std::fs::read_to_string(&exp)
+        .unwrap()
+        .replace("report = false", "report = true")
+        + "\n[[models]]\nname = \"viscous\"\n\n[discover]\nbase = \"viscous\"\n\
+           candidates = [\"power_law\", \"yield\"]\n";
+    std::fs::write(&exp, text).unwrap();
+    for command in ["fit", "discover"] {
+        let out = dir.path().join(command);
+        run_ok(command, &exp, &out);
+        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(report.contains("Start, middle and end"), "{command}");
+        for word in ["regime", "resonance"] {
+            let hit = report.lines().find(|l| l.to_lowercase().contains(word));
+            assert!(hit.is_none(), "{command}: `{word}` in {hit:?}");
+        }
+    }
+    // The rotor's record, the same otherwise, keeps its regimes.
+    write_csv(dir.path(), "rotor.csv", "t,phi,x,f_stf", &rows, |r| {
+        format!("{},{},{},{}", r[0], r[1], r[2], r[3])
+    });
+    let rotor = dir.path().join("rotor.toml");
+    let text = std::fs::read_to_string(&exp)
+        .unwrap()
+        .replace("damper.csv", "rotor.csv");
+    std::fs::write(&rotor, text).unwrap();
+    let out = dir.path().join("rotor");
+    run_ok("fit", &rotor, &out);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Regime by regime"), "{report}");
+}
