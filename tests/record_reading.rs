@@ -17,22 +17,28 @@ fn simulate_record(dir: &Path, w1: f64, seed: u64) -> String {
 
 /// [`simulate_record`] at `rate` samples per second.
 fn simulate_at(dir: &Path, w1: f64, seed: u64, rate: f64) -> String {
-    let sim = dir.join(format!("sim_{seed}.toml"));
+    simulate_with(dir, w1, seed, rate, true)
+}
+
+/// [`simulate_at`] with the sensors on or off (`noise`): the same run either way.
+fn simulate_with(dir: &Path, w1: f64, seed: u64, rate: f64, noise: bool) -> String {
+    let sim = dir.join(format!("sim_{seed}_{noise}.toml"));
     let text = format!(
         "[simulate]\nprofile = {{ t = [0.0, 2.0, 2.5, 22.5], omega = [0.0, 0.0, 4.0, {w1}] }}\n\
-         rate = {rate}\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
+         rate = {rate}\nnoise = {noise}\nseed = {seed}\n\n[[simulate.truth]]\nname = \"power_law\"\n\
          params = {{ K = 4.0, n = 1.5 }}\n"
     );
     std::fs::write(&sim, text).unwrap();
-    let csv = dir.join(format!("sim_{seed}.csv"));
+    let csv = dir.join(format!("sim_{seed}_{noise}.csv"));
     simulate_ok(&sim, &csv);
     std::fs::read_to_string(&csv).unwrap()
 }
 
-/// The simulator's columns (t, phi, x, f_stf) as numbers, one row a sample.
+/// The simulator's first columns (t, phi, x, f_stf) as numbers, one row a sample.
 fn rows(si_csv: &str) -> Vec<[f64; 4]> {
     let mut lines = si_csv.lines();
-    assert_eq!(lines.next(), Some("t,phi,x,f_stf"));
+    // (An exact run adds the rotor's ω.)
+    assert!(lines.next().unwrap().starts_with("t,phi,x,f_stf"));
     lines
         .map(|l| {
             let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
@@ -330,4 +336,47 @@ fn a_force_record_without_rotor_is_reported_without_regimes() {
     run_ok("fit", &rotor, &out);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("Regime by regime"), "{report}");
+}
+
+#[test]
+fn a_measured_velocity_is_used_when_it_agrees_with_x_and_flagged_when_not() {
+    // The rig's sensors on x and the force; a velocity sensor beside them: the exact run's
+    // velocity (central differences of its x) with 1 mm/s of noise. Two seeds, two sweeps.
+    for (w1, seed) in [(8.0, 5), (10.0, 6)] {
+        let dir = tempfile::tempdir().unwrap();
+        let noisy = rows(&simulate_with(dir.path(), w1, seed, 200.0, true));
+        let exact = rows(&simulate_with(dir.path(), w1, seed, 200.0, false));
+        let n = exact.len();
+        let v: Vec<f64> = (0..n)
+            .map(|i| {
+                let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+                let hash = (i as u64 + 7 * seed).wrapping_mul(2_654_435_761) >> 7;
+                let noise = 1e-3 * 1.7 * ((hash % 1000) as f64 / 1000.0 - 0.5);
+                (exact[b][2] - exact[a][2]) / (exact[b][0] - exact[a][0]) + noise
+            })
+            .collect();
+        for (name, k) in [("v.csv", 1.0), ("v_mm.csv", 1e3), ("v_sign.csv", -1.0)] {
+            let mut text = String::from("t,x,v,f_stf\n");
+            for (r, v) in noisy.iter().zip(&v) {
+                text += &format!("{},{},{},{}\n", r[0], r[2], v * k, r[3]);
+            }
+            std::fs::write(dir.path().join(name), text).unwrap();
+        }
+        // Agreeing: used, not a word, and the fit finds the truth.
+        assert_eq!(warnings(dir.path(), "v.csv", ""), Vec::<String>::new());
+        let out = dir.path().join("v");
+        run_ok("fit", &experiment(dir.path(), "v.csv", ""), &out);
+        let ([k, n_exp], [se_k, se_n]) = power_law(&out);
+        eprintln!("w1 {w1}, seed {seed}, measured v: K = {k} ± {se_k}, n = {n_exp} ± {se_n}");
+        assert!((k / 4.0 - 1.0).abs() < 0.05 && (n_exp / 1.5 - 1.0).abs() < 0.05);
+        // In mm/s, or of the other sign: flagged with the likely mistake, and not used.
+        let w = warnings(dir.path(), "v_mm.csv", "");
+        assert!(w.iter().any(|w| w.contains("in mm/s")), "{w:?}");
+        let w = warnings(dir.path(), "v_sign.csv", "");
+        assert!(w.iter().any(|w| w.contains("sign")), "{w:?}");
+        let out = dir.path().join("v_mm");
+        run_ok("fit", &experiment(dir.path(), "v_mm.csv", ""), &out);
+        let ([k_mm, _], _) = power_law(&out);
+        assert!((k_mm / 4.0 - 1.0).abs() < 0.05, "K = {k_mm} with v flagged");
+    }
 }

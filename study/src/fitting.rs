@@ -126,7 +126,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
             );
         }
     }
-    let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
+    let mut kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
         anyhow!(
             "cannot derive the kinematics of {}: {e}{}",
             file.display(),
@@ -148,6 +148,14 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         );
     }
     let mut record_warnings = record_warnings;
+    if let Some(v) = crate::measured_velocity::read(&exp.data_layout, file, exp.data_window) {
+        let name = file.display().to_string();
+        record_warnings.extend(crate::measured_velocity::use_or_warn(
+            &mut kinematics,
+            v,
+            &name,
+        ));
+    }
     let driven = record.phi.is_some() || record.omega.is_some() || record.u.is_some();
     if level == FitLevel::Trajectory && !driven {
         record_warnings.push(format!(

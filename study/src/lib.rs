@@ -29,6 +29,7 @@ pub mod fit;
 pub mod fitting;
 pub mod identify;
 pub mod joint;
+pub mod measured_velocity;
 pub mod model_config;
 pub mod observer;
 pub mod outputs;
