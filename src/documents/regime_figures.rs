@@ -3,7 +3,8 @@
 //! the measured ones ([`crate::report::regime_windows`]), and measured against fitted with the
 //! residual's distribution per regime ([`crate::report::parity`]). The regimes are the
 //! record's own (classified on its STF force, as `compare` does); a record without them (no
-//! rotor, no STF force to speak of) gets windows at its start, middle and end instead.
+//! rotor, no STF force to speak of) gets windows at its start, middle and end instead, said in
+//! words that fit it (periods of the motion, thirds of the record: a damper has no regimes).
 
 use std::path::Path;
 
@@ -80,6 +81,44 @@ fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Opti
     Ok((cycles, labels))
 }
 
+/// The words of the section: a rotor's regimes and cycles, a rotor's record too quiet to
+/// classify, or — without a rotor — thirds of the record and periods of its motion.
+struct Words {
+    title: &'static str,
+    figure: &'static str,
+    cycles: &'static str,
+    stretch: &'static str,
+    group: &'static str,
+}
+
+impl Words {
+    fn of(regimes: bool, rotor: bool) -> Words {
+        match (regimes, rotor) {
+            (true, _) => Words {
+                title: "Regime by regime",
+                figure: "regime_windows",
+                cycles: "cycles",
+                stretch: "regime of the record (classified on its STF force, as `compare` does)",
+                group: "regime",
+            },
+            (false, true) => Words {
+                title: "Start, middle and end",
+                figure: "regime_windows",
+                cycles: "cycles",
+                stretch: "third of the record (its STF force is too small to tell regimes apart)",
+                group: "third of the record",
+            },
+            (false, false) => Words {
+                title: "Start, middle and end",
+                figure: "windows",
+                cycles: "periods of the motion",
+                stretch: "third of the record",
+                group: "third of the record",
+            },
+        }
+    }
+}
+
 /// [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch, named with their ω.
 fn windows_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<RegimeWindow> {
     found
@@ -140,26 +179,22 @@ pub fn regime_section(
         f,
         models,
     };
-    let mut s = Section::new(if labels.is_some() {
-        "Regime by regime"
-    } else {
-        "Start, middle and end"
-    });
+    let rotor = k.phi.is_some() || k.omega.is_some();
+    let words = Words::of(labels.is_some(), rotor);
+    let mut s = Section::new(words.title);
     s.paragraphs.push(format!(
-        "{} whole cycles from the middle of the longest stretch of each {}, and every sample of \
-         it for measured against fitted.",
-        CYCLES_PER_WINDOW,
-        if labels.is_some() {
-            "regime of the record (classified on its STF force, as `compare` does)"
-        } else {
-            "third of the record (it has no regimes to classify: no rotor, or no STF force)"
-        }
+        "{} whole {} from the middle of the longest stretch of each {}, and every sample of it \
+         for measured against fitted.",
+        CYCLES_PER_WINDOW, words.cycles, words.stretch
     ));
-    let fig = regime_windows(&dir, "regime_windows", &series, &windows)?;
+    let fig = regime_windows(&dir, words.figure, &series, &windows)?;
     s.figures.push(FigureRef::new(
         fig,
-        "A few cycles of each regime: the STF force over time, and its loops against x, v and a; \
-         each model's force over the measured one (grey).",
+        format!(
+            "A few {} of each {}: the STF force over time, and its loops against x, v and a; \
+             each model's force over the measured one (grey).",
+            words.cycles, words.group
+        ),
     ));
     if !models.is_empty() {
         let groups = groups_of(&found, &cycles);
@@ -170,8 +205,11 @@ pub fn regime_section(
         let fig = parity(&dir, "parity", &quantity, f, models, &groups)?;
         s.figures.push(FigureRef::new(
             fig,
-            "Measured against fitted STF force in each regime (on y = x where they agree), and \
-             the residual's distribution against the normal curve of the force noise.",
+            format!(
+                "Measured against fitted STF force in each {} (on y = x where they agree), and \
+                 the residual's distribution against the normal curve of the force noise.",
+                words.group
+            ),
         ));
     }
     Ok(Some(s))

@@ -464,7 +464,7 @@ offsets = { x = 12.5 }
             "units = { x = \"furlong\" }\n",
             4,
             "data.units.x",
-            "known: m, mm, um (or µm)",
+            "known: m, cm, mm, um (or µm)",
         );
         expect(
             "\nunits = { t = \"s\",\n  omega = \"rps\" }\n",
@@ -489,7 +489,7 @@ offsets = { x = 12.5 }
             "units = { f_stf = \"kg\" }\n",
             4,
             "data.units.f_stf",
-            "known: N, mN, V (with `gain`",
+            "known: N, kN, mN, lbf, V (with `gain`",
         );
         expect(
             "units = { y = \"m\" }\n",

@@ -242,7 +242,9 @@ fn discover_at(
 ) -> Result<Discovery, DiscoveryError> {
     match setup {
         None => {
-            let settings = settings.kinematics(&data.kinematics);
+            let mut settings = settings.kinematics(&data.kinematics);
+            let k = &data.kinematics;
+            settings.regimes = k.phi.is_some() || k.omega.is_some();
             discover_force(base, candidates, &data.force_data(), cycles, &settings)
         }
         Some(setup) => {

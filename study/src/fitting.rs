@@ -126,8 +126,13 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
             );
         }
     }
-    let kinematics = Kinematics::from_record(&record, &exp.kinematics)
-        .with_context(|| format!("cannot derive the kinematics of {}", file.display()))?;
+    let mut kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
+        anyhow!(
+            "cannot derive the kinematics of {}: {e}{}",
+            file.display(),
+            rate_hint(&e)
+        )
+    })?;
     let level = match asked.or(exp.fit.level) {
         Some(l) => l,
         None if record.f_stf.is_some() && (!exp.models.is_empty() || exp.discover.is_some()) => {
@@ -141,6 +146,23 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
             exp.path.display(),
             file.display()
         );
+    }
+    let mut record_warnings = record_warnings;
+    if let Some(v) = crate::measured_velocity::read(&exp.data_layout, file, exp.data_window) {
+        let name = file.display().to_string();
+        record_warnings.extend(crate::measured_velocity::use_or_warn(
+            &mut kinematics,
+            v,
+            &name,
+        ));
+    }
+    let driven = record.phi.is_some() || record.omega.is_some() || record.u.is_some();
+    if level == FitLevel::Trajectory && !driven {
+        record_warnings.push(format!(
+            "{}: no drive column (`phi`, `omega` or `u`): the trajectory-level fit simulates \
+             it as a free vibration",
+            file.display()
+        ));
     }
     let system_estimate = match (&record.u, level, exp.system_given) {
         (Some(u), FitLevel::Trajectory, false) => {
@@ -167,6 +189,20 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         system_estimate,
         record_warnings,
     })
+}
+
+/// The fix for a time column that is not uniform (nor uniform within its rounding): a
+/// constant sample rate in `[data]`, at the column's mean step and from its first stamp.
+pub fn rate_hint(e: &stf_core::numerics::derivative::FilterError) -> String {
+    match e {
+        stf_core::numerics::derivative::FilterError::NonUniform { mean, .. } => format!(
+            "; if the rig sampled at a constant rate, give it in `[data]`: `rate = {:.6}` (Hz, \
+             the column's mean step; with `t0` = the first time stamp, s), and the time column \
+             is not read",
+            1.0 / mean
+        ),
+        _ => String::new(),
+    }
 }
 
 /// The terminal line saying where the oscillator came from, if the record gave it.
@@ -664,6 +700,6 @@ calibration = { a = 0.2942906, b = 0.0044168 }
             msg.contains("exp.toml:3") && msg.contains("data.units.x"),
             "{msg}"
         );
-        assert!(msg.contains("known: m, mm, um"), "{msg}");
+        assert!(msg.contains("known: m, cm, mm, um"), "{msg}");
     }
 }

@@ -4,7 +4,9 @@
 //! record are checked alike.
 //!
 //! Clearly impossible records are refused with what looks wrong and the `[data] units` key
-//! that likely fixes it; merely suspicious ones give warnings (printed, and in
+//! that likely fixes it; merely suspicious ones — among them the scales of
+//! [`crate::plausible_scale`]: a motion too fast or too small for the units declared — give
+//! warnings (printed, and in
 //! `discovery.json`'s notes). The sample-rate check needs the frequency the record must
 //! resolve: the rotor's (its ω), else the natural frequency of a configured `[system]`, which
 //! is unit-consistent in any unit system. The displacement checks use the trolley's sizes, so
@@ -79,6 +81,16 @@ pub fn check(exp: &Experiment, file: &std::path::Path, record: &Record) -> Resul
         }
     }
     check_x(record, &name.to_string(), off, &mut warnings)?;
+    warnings.extend(crate::plausible_scale::too_fast(
+        exp,
+        record,
+        &name.to_string(),
+    ));
+    warnings.extend(crate::plausible_scale::too_small(
+        exp,
+        record,
+        &name.to_string(),
+    ));
     if let Some(w) = rate_against_column(exp, file, record) {
         warnings.push(w);
     }

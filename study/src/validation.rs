@@ -73,7 +73,11 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
     let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
         spec.error(
             key,
-            format!("cannot derive the kinematics of {}: {e}", spec.given),
+            format!(
+                "cannot derive the kinematics of {}: {e}{}",
+                spec.given,
+                crate::fitting::rate_hint(&e)
+            ),
         )
     })?;
     let data = FitData {

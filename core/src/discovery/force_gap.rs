@@ -149,6 +149,22 @@ pub fn locate_gap(r: &[f64], data: &ForceData, cycles: &[Cycle], floor: f64) -> 
     }
 }
 
+/// `g` without its breakdown by regime, said again: for a record without a rotor, which has
+/// no regimes.
+pub(super) fn without_regimes(mut g: GapLocation) -> GapLocation {
+    g.breakdowns.retain(|b| b.by != "regime");
+    let head = head_of(g.rms, g.noise_floor);
+    g.summary = summary(
+        head,
+        g.rms,
+        g.noise_floor,
+        &g.breakdowns,
+        "ω and states",
+        |v| format!("{v:.3} N"),
+    );
+    g
+}
+
 fn finish(by: &str, groups: Vec<GapGroup>) -> GapBreakdown {
     let groups: Vec<GapGroup> = groups.into_iter().filter(|g| g.n > 0).collect();
     let max = groups.iter().map(|g| g.rms).fold(0.0, f64::max);
@@ -165,12 +181,17 @@ fn finish(by: &str, groups: Vec<GapGroup>) -> GapBreakdown {
     }
 }
 
-/// The one-line description of where the gap lives.
-fn summarise(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
-    let head = format!(
+/// The residual `total` against the noise floor `floor`, in words.
+fn head_of(total: f64, floor: f64) -> String {
+    format!(
         "residual {total:.3} N RMS against a noise floor of {floor:.3} N ({:.1}×)",
         total / floor
-    );
+    )
+}
+
+/// The one-line description of where the gap lives.
+fn summarise(total: f64, floor: f64, breakdowns: &[GapBreakdown]) -> String {
+    let head = head_of(total, floor);
     summary(
         head,
         total,

@@ -420,6 +420,11 @@ impl Level for ForceLevel<'_> {
     ) -> Result<(Vec<f64>, GapLocation), DiscoveryError> {
         let r = self.residual(stage)?;
         let location = locate_gap(&r, self.data, self.cycles, floor.sigma);
+        let location = if self.settings.regimes {
+            location
+        } else {
+            super::force_gap::without_regimes(location)
+        };
         Ok((r, location))
     }
 

@@ -90,6 +90,13 @@ pub struct DiscoverySettings {
     /// ([`super::search`]). `None`: the level's default (off at force level, on at trajectory
     /// level).
     pub polish: Option<bool>,
+    /// Whether the record's cycles are a rotor's, whose regimes (pre-resonance, resonance,
+    /// post-resonance) the gap is broken down by (default true); a record without a rotor
+    /// (a damper, a shaker) has no regimes, and its gap is said by ω and states alone. Set
+    /// from the record; not read from a file.
+    #[serde(skip)]
+    #[setters(skip)]
+    pub regimes: bool,
     /// Called as the run goes (step, candidate, score): for a live display.
     #[serde(skip)]
     #[setters(skip)]
@@ -114,6 +121,7 @@ impl Default for DiscoverySettings {
             scout_from: super::scout::SCOUT_FROM,
             recheck: None,
             polish: None,
+            regimes: true,
             observer: Observer::default(),
         }
     }

@@ -204,19 +204,9 @@ fn resolve(
                 index,
                 label,
             }),
-            None if must => return Err(missing(source, opts, signal, header, line, "")),
+            None if must => return Err(missing(source, opts, signal, header, line)),
             None => {}
         }
-    }
-    if !places
-        .iter()
-        .any(|p| matches!(p.signal, Signal::Phi | Signal::U))
-    {
-        let extra = format!(
-            " (or `{}` for a force-driven rig)",
-            column_name(opts, Signal::U)
-        );
-        return Err(missing(source, opts, Signal::Phi, header, line, &extra));
     }
     Ok(Found {
         places,
@@ -241,7 +231,6 @@ fn missing(
     signal: Signal,
     header: Option<&[String]>,
     line: usize,
-    extra: &str,
 ) -> RecordError {
     let name = column_name(opts, signal);
     let err = |message: String| {
@@ -251,7 +240,7 @@ fn missing(
     };
     let Some(header) = header else {
         return err(format!(
-            "no column for `{signal}`{extra}: a file without a header row takes columns by \
+            "no column for `{signal}`: a file without a header row takes columns by \
              number, e.g. columns = {{ {signal} = 2 }}"
         ));
     };
@@ -261,7 +250,7 @@ fn missing(
         .map(|h| format!(" (`{h}` differs only in case; names are case-sensitive)"))
         .unwrap_or_default();
     err(format!(
-        "missing column `{name}`{extra}{similar}; the header has: {}",
+        "missing column `{name}`{similar}; the header has: {}",
         header.join(", ")
     ))
 }
@@ -404,7 +393,7 @@ mod tests {
     }
 
     #[test]
-    fn force_driven_rig_needs_u_instead_of_phi() {
+    fn force_driven_rig_reads_u_instead_of_phi() {
         let r = read_str("t,x,u\n0,0,1.5\n1,0,1.6\n").unwrap();
         assert_eq!(r.u, Some(vec![1.5, 1.6]));
         assert!(r.phi.is_none());
@@ -451,13 +440,11 @@ mod tests {
     }
 
     #[test]
-    fn error_missing_phi_and_u() {
-        expect(
-            "t,x\n0,0\n",
-            Some(1),
-            Some("phi"),
-            "missing column `phi` (or `u` for a force-driven rig)",
-        );
+    fn a_record_without_drive_is_read() {
+        // A damper rig records t, x and the force only.
+        let r = read_str("t,x,f_stf\n0,0,1.5\n1,0.1,1.6\n").unwrap();
+        assert_eq!(r.f_stf, Some(vec![1.5, 1.6]));
+        assert!(r.phi.is_none() && r.u.is_none() && r.omega.is_none());
     }
 
     #[test]
@@ -615,10 +602,10 @@ mod tests {
         expect_with(&opts, text, Some(5), Some("t"), "not strictly increasing");
         expect_with(
             &opts,
-            "a\nb\nt;x\n0;0\n",
+            "a\nb\nt;phi\n0;0\n",
             Some(3),
-            Some("phi"),
-            "missing column `phi`",
+            Some("x"),
+            "missing column `x`",
         );
         expect_with(&opts, "a\nb\nt;x;phi\n", Some(4), None, "no data rows");
         expect_with(
@@ -683,11 +670,16 @@ mod tests {
             .header(false)
             .column(Signal::T, Column::Number(1))
             .column(Signal::X, Column::Number(2));
+        let r = no_drive
+            .read_csv_from("0,5\n".as_bytes(), "lab.csv")
+            .unwrap();
+        assert_eq!((r.t, r.x), (vec![0.0], vec![5.0]));
+        // A named signal (by default, by name) cannot be found without a header.
         expect_with(
-            &no_drive,
+            &no_drive.column(Signal::Phi, Column::Name("angle".into())),
             "0,5\n",
-            Some(1),
-            Some("phi"),
+            None,
+            None,
             "takes columns by number",
         );
     }

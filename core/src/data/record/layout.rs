@@ -70,11 +70,11 @@ impl Signal {
     /// The units this signal may be recorded in, as a user writes them (for messages).
     pub fn unit_list(self) -> &'static str {
         match self {
-            Signal::T => "s, ms, us (or µs)",
-            Signal::X => "m, mm, um (or µm), V (with `gain`, metres per volt)",
-            Signal::Phi => "rad, deg, counts (with `per_rev`, encoder counts per revolution)",
+            Signal::T => "s, ms, us (or µs), min",
+            Signal::X => "m, cm, mm, um (or µm), in, V (with `gain`, metres per volt)",
+            Signal::Phi => "rad, deg, rev, counts (with `per_rev`, encoder counts per revolution)",
             Signal::Omega => "rad/s, rpm, Hz",
-            Signal::FStf | Signal::U => "N, mN, V (with `gain`, newtons per volt)",
+            Signal::FStf | Signal::U => "N, kN, mN, lbf, V (with `gain`, newtons per volt)",
         }
     }
 
@@ -98,16 +98,24 @@ pub enum Unit {
     Millisecond,
     /// µs.
     Microsecond,
+    /// Minutes.
+    Minute,
     /// m.
     Metre,
+    /// cm.
+    Centimetre,
     /// mm.
     Millimetre,
     /// µm.
     Micrometre,
+    /// Inches (25.4 mm).
+    Inch,
     /// rad.
     Radian,
     /// Degrees.
     Degree,
+    /// Revolutions (turns).
+    Revolution,
     /// Encoder counts, `per_rev` counts a revolution.
     Counts {
         /// Counts per revolution.
@@ -121,8 +129,12 @@ pub enum Unit {
     Hertz,
     /// N.
     Newton,
+    /// kN.
+    Kilonewton,
     /// mN.
     Millinewton,
+    /// Pounds-force (4.448 221 615 260 5 N).
+    PoundForce,
     /// Volts of a sensor with `gain` SI units per volt: newtons for a force, metres for a
     /// displacement.
     Volt {
@@ -156,11 +168,15 @@ impl Unit {
             (S::T, "s") => Unit::Second,
             (S::T, "ms") => Unit::Millisecond,
             (S::T, "us" | "µs" | "μs") => Unit::Microsecond,
+            (S::T, "min") => Unit::Minute,
             (S::X, "m") => Unit::Metre,
+            (S::X, "cm") => Unit::Centimetre,
             (S::X, "mm") => Unit::Millimetre,
             (S::X, "um" | "µm" | "μm") => Unit::Micrometre,
+            (S::X, "in") => Unit::Inch,
             (S::Phi, "rad") => Unit::Radian,
             (S::Phi, "deg") => Unit::Degree,
+            (S::Phi, "rev") => Unit::Revolution,
             (S::Phi, "counts") => Unit::Counts {
                 per_rev: parameter(name, "per_rev", per_rev)?,
             },
@@ -168,7 +184,9 @@ impl Unit {
             (S::Omega, "rpm") => Unit::Rpm,
             (S::Omega, "Hz") => Unit::Hertz,
             (S::FStf | S::U, "N") => Unit::Newton,
+            (S::FStf | S::U, "kN") => Unit::Kilonewton,
             (S::FStf | S::U, "mN") => Unit::Millinewton,
+            (S::FStf | S::U, "lbf") => Unit::PoundForce,
             (S::X | S::FStf | S::U, "V") => Unit::Volt {
                 gain: parameter(name, "gain", gain)?,
             },
@@ -195,12 +213,16 @@ impl Unit {
     pub fn fits(self, signal: Signal) -> bool {
         use Signal as S;
         match self {
-            Unit::Second | Unit::Millisecond | Unit::Microsecond => signal == S::T,
-            Unit::Metre | Unit::Millimetre | Unit::Micrometre => signal == S::X,
-            Unit::Radian | Unit::Degree => signal == S::Phi,
+            Unit::Second | Unit::Millisecond | Unit::Microsecond | Unit::Minute => signal == S::T,
+            Unit::Metre | Unit::Centimetre | Unit::Millimetre | Unit::Micrometre | Unit::Inch => {
+                signal == S::X
+            }
+            Unit::Radian | Unit::Degree | Unit::Revolution => signal == S::Phi,
             Unit::Counts { per_rev } => signal == S::Phi && per_rev.is_finite() && per_rev > 0.0,
             Unit::RadianPerSecond | Unit::Rpm | Unit::Hertz => signal == S::Omega,
-            Unit::Newton | Unit::Millinewton => matches!(signal, S::FStf | S::U),
+            Unit::Newton | Unit::Kilonewton | Unit::Millinewton | Unit::PoundForce => {
+                matches!(signal, S::FStf | S::U)
+            }
             Unit::Volt { gain } => {
                 matches!(signal, S::X | S::FStf | S::U) && gain.is_finite() && gain != 0.0
             }
@@ -213,7 +235,13 @@ impl Unit {
             Unit::Second | Unit::Metre | Unit::Radian | Unit::RadianPerSecond | Unit::Newton => 1.0,
             Unit::Millisecond | Unit::Millimetre | Unit::Millinewton => 1e-3,
             Unit::Microsecond | Unit::Micrometre => 1e-6,
+            Unit::Minute => 60.0,
+            Unit::Centimetre => 1e-2,
+            Unit::Inch => 0.0254,
+            Unit::Kilonewton => 1e3,
+            Unit::PoundForce => 4.448_221_615_260_5,
             Unit::Degree => PI / 180.0,
+            Unit::Revolution => TAU,
             Unit::Counts { per_rev } => TAU / per_rev,
             Unit::Rpm => TAU / 60.0,
             Unit::Hertz => TAU,
@@ -754,6 +782,12 @@ mod tests {
             (Signal::Omega, "Hz", TAU),
             (Signal::FStf, "mN", 1e-3),
             (Signal::U, "N", 1.0),
+            (Signal::T, "min", 60.0),
+            (Signal::X, "cm", 1e-2),
+            (Signal::X, "in", 0.0254),
+            (Signal::Phi, "rev", TAU),
+            (Signal::FStf, "kN", 1e3),
+            (Signal::U, "lbf", 4.448_221_615_260_5),
         ];
         for (signal, name, k) in cases {
             let unit = Unit::parse(signal, name, None, None).unwrap();
@@ -775,8 +809,8 @@ mod tests {
         let e = Unit::parse(Signal::X, "furlong", None, None).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown unit `furlong` for `x`; known: m, mm, um (or µm), V (with `gain`, metres \
-             per volt)"
+            "unknown unit `furlong` for `x`; known: m, cm, mm, um (or µm), in, V (with `gain`, \
+             metres per volt)"
         );
         let e = Unit::parse(Signal::T, "mm", None, None).unwrap_err();
         assert!(e.to_string().contains("known: s, ms, us"), "{e}");

@@ -65,27 +65,20 @@ pub(super) fn read_bytes(
         labels[signal.index()].clone_from(name);
         raw[signal.index()] = vector(source, &file, name)?;
         if opts.needs(signal) && raw[signal.index()].is_none() {
-            return Err(missing(source, &file, name, ""));
+            return Err(missing(source, &file, name));
         }
-    }
-    if raw[Signal::Phi.index()].is_none() && raw[Signal::U.index()].is_none() {
-        let extra = format!(
-            " (or `{}` for a force-driven rig)",
-            labels[Signal::U.index()]
-        );
-        return Err(missing(source, &file, &labels[Signal::Phi.index()], &extra));
     }
     let raw = layout::apply(opts, raw, source, &labels, &|i| i + 1)?;
     super::into_record(raw, source, &labels, &|i| i + 1)
 }
 
 /// The variable `name` is not in the file (or not readable).
-fn missing(source: &str, file: &matfile::MatFile, name: &str, extra: &str) -> RecordError {
+fn missing(source: &str, file: &matfile::MatFile, name: &str) -> RecordError {
     let known: Vec<&str> = file.arrays().iter().map(|a| a.name()).collect();
     RecordError::new(
         source,
         format!(
-            "missing variable `{name}`{extra}; numeric variables in the file: {} \
+            "missing variable `{name}`; numeric variables in the file: {} \
              (char, struct and cell variables are not read: {SAVE_HINT})",
             if known.is_empty() {
                 "none".to_string()
@@ -439,8 +432,11 @@ pub(super) mod tests {
             "n.mat",
             &mat_v5(&[col("t", &T, true), col("x", &X, true)]),
         );
-        let e = Record::read_mat(&p).unwrap_err();
-        assert!(e.message.contains("(or `u` for a force-driven rig)"), "{e}");
+        let r = Record::read_mat(&p).unwrap();
+        assert!(
+            r.phi.is_none() && r.u.is_none(),
+            "t and x alone are a record"
+        );
     }
 
     #[test]

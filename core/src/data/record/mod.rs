@@ -1,9 +1,11 @@
 //! Records: measured (or synthetic) time series of the rig, and reading and writing them.
 //!
-//! A record holds, in SI units, the time `t` (s, strictly increasing), the displacement `x`
-//! (m), and the rotor angle `phi` (rad, wrapped or unwrapped) or — for a rig driven by a
-//! shaker — the measured drive force `u` (N); optionally the STF force `f_stf` (N) and the
-//! rotor speed `omega` (rad/s).
+//! A record holds, in SI units, the time `t` (s, strictly increasing) and the displacement
+//! `x` (m); optionally its drive — the rotor angle `phi` (rad, wrapped or unwrapped) and
+//! speed `omega` (rad/s), or for a rig driven by a shaker or an actuator the measured drive
+//! force `u` (N) — and the STF force `f_stf` (N). A force-level fit needs t, x and `f_stf`
+//! only (a damper rig records no drive); a trajectory-level fit simulates the rig driven by
+//! its drive, and one without any is a free vibration.
 //!
 //! Records are read from CSV files with a header row ([`Record::read_csv`]) and from MATLAB
 //! `.mat` v5/v7 files with variables of the same names ([`Record::read_mat`]). Extra columns
@@ -34,6 +36,7 @@ mod error;
 mod layout;
 mod mat;
 mod mat_inflate;
+mod time_grid;
 
 pub use error::RecordError;
 pub use layout::{
@@ -162,7 +165,9 @@ impl ReadOptions {
 
 /// Check the signals of a record being assembled (by [`Signal`] index; `t` and `x` present)
 /// and make a record: equal lengths, at least one sample, finite values, strictly increasing
-/// time, φ or u present. `labels` name the columns (by [`Signal`] index) and `row_of` turns a
+/// time, read as the uniform grid it rounds where its stamps are rounded (module
+/// `time_grid`). The drive (φ, ω or u) is optional: a force-level fit needs only t, x and the force,
+/// and a record without any drive is a free vibration at trajectory level. `labels` name the columns (by [`Signal`] index) and `row_of` turns a
 /// 0-based sample index into the row a user sees.
 pub(crate) fn into_record(
     raw: layout::Raw,
@@ -211,14 +216,7 @@ pub(crate) fn into_record(
         .at_row(row_of(i + 1))
         .in_column(label(Signal::T)));
     }
-    if phi.is_none() && u.is_none() {
-        return Err(err(format!(
-            "missing column `{}` (or `{}` for a force-driven rig)",
-            label(Signal::Phi),
-            label(Signal::U)
-        ))
-        .in_column(label(Signal::Phi)));
-    }
+    let t = time_grid::regular_within_rounding(&t).unwrap_or(t);
     Ok(Record {
         source: source.to_string(),
         t,
@@ -258,7 +256,7 @@ impl Record {
     }
 
     /// Check a record (e.g. one built in memory) against the data contract: equal lengths,
-    /// at least one sample, finite values, strictly increasing `t`, `phi` or `u` present.
+    /// at least one sample, finite values, strictly increasing `t`.
     /// Rows in errors are 1-based sample numbers.
     pub fn check(&self) -> Result<(), RecordError> {
         let raw = [
@@ -365,7 +363,7 @@ mod tests {
     }
 
     #[test]
-    fn check_catches_length_mismatch_and_missing_drive() {
+    fn check_catches_length_mismatch_and_accepts_a_record_without_drive() {
         let mut r = memory(5);
         r.x.pop();
         let e = r.check().unwrap_err();
@@ -374,8 +372,7 @@ mod tests {
         let mut r = memory(5);
         r.phi = None;
         r.u = None;
-        let e = r.check().unwrap_err();
-        assert!(e.message.contains("missing column `phi` (or `u`"), "{e}");
+        assert!(r.check().is_ok(), "t and x alone are a record");
         let mut r = memory(5);
         r.t[3] = r.t[2];
         let e = r.check().unwrap_err();
