@@ -92,6 +92,15 @@ pub enum ScriptError {
         /// The cost of a call, the calls the run needs and the limit.
         message: String,
     },
+    /// A file given as a script (`script = "…"`) that is not one: a folder, or a file whose
+    /// name does not end in `.rhai`.
+    #[error("{path}: {why}")]
+    NotAScript {
+        /// The path as given, resolved.
+        path: String,
+        /// What it is instead, and what to give.
+        why: String,
+    },
     /// A name is neither a built-in model nor a script path.
     #[error(
         "unknown model `{name}`; built-in models: {known}; or give a script path ending in .rhai"

@@ -24,6 +24,27 @@ pub fn carried(x: f64) -> f64 {
     format!("{x:.14e}").parse().unwrap_or(x)
 }
 
+/// `x` in a message: at most 15 significant digits ([`carried`]), plain between 10⁻³ and
+/// 10⁶ and in exponent form outside (`1e300`, not a number of 301 digits; `2.5e-7`).
+pub fn shown(x: f64) -> String {
+    let x = carried(x);
+    if x == 0.0 {
+        "0".into()
+    } else if !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// The times `t` run over, for a message: `from 0 to 70 s` (`none`, for no samples).
+pub fn time_span(t: &[f64]) -> String {
+    match (t.first(), t.last()) {
+        (Some(&a), Some(&b)) => format!("from {} to {} s", shown(a), shown(b)),
+        _ => "none".into(),
+    }
+}
+
 /// `x` with `decimals` decimals for a person to read, never as a negative zero ("-0.0" for
 /// -0.04 at one decimal reads as a sign the value does not have).
 pub fn fixed(x: f64, decimals: usize) -> String {
@@ -106,6 +127,17 @@ mod tests {
         assert_eq!(with_error(1234.5678, 0.0), "1234.57 ± 0");
         assert_eq!(with_error(1234.5678, f64::NAN), "1234.57 ± NaN");
         assert_eq!(with_error(-0.0001, 1e-9), "-1.000000e-4 ± 1.0e-9");
+    }
+
+    #[test]
+    fn a_number_in_a_message_is_short() {
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(1e301), "1e301");
+        assert_eq!(shown(2.5e-7), "2.5e-7");
+        assert_eq!(shown(70.0), "70");
+        assert_eq!(shown(0.1 + 0.2), "0.3");
+        assert_eq!(shown(-0.0), "0");
+        assert_eq!(shown(-1234567.0), "-1.234567e6");
     }
 
     #[test]

@@ -61,7 +61,7 @@ struct RawExperiment {
     #[serde(default)]
     models: Vec<Spanned<models::RawModel>>,
     simulate: Option<Spanned<simulate::RawSimulate>>,
-    discover: Option<DiscoverSpec>,
+    discover: Option<Spanned<DiscoverSpec>>,
     fit: Option<Spanned<fit::RawFit>>,
     filter: Option<Spanned<filter::RawFilter>>,
     #[serde(default)]
@@ -257,7 +257,13 @@ impl Experiment {
             integrator,
             models,
             simulate,
-            discover: raw.discover,
+            discover: raw.discover.map(|d| {
+                let line = cx.line(d.span().start);
+                DiscoverSpec {
+                    line,
+                    ..d.into_inner()
+                }
+            }),
         })
     }
 }

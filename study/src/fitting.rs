@@ -26,6 +26,7 @@ use stf_core::fit::{
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
 
+use crate::digits::shown;
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
 use crate::observer::{fit_message, jobs_message, Job, Observer};
@@ -116,11 +117,16 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let record_warnings = crate::plausibility::check(exp, file, &record)
         .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
     if let Some((t0, t1)) = exp.data_window {
+        let span = crate::digits::time_span(&record.t);
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
             bail!(
-                "{}: `data.window` [{t0}, {t1}] keeps {} samples of {}",
+                "{}:{}: `data.window` [{}, {}] keeps {} samples of {}, whose times run {span}: \
+                 give a window of at least 10 samples within them",
                 exp.path.display(),
+                exp.data_line,
+                shown(t0),
+                shown(t1),
                 record.len(),
                 file.display()
             );

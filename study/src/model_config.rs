@@ -16,7 +16,7 @@ use stf_core::physics::model_sum::ModelSum;
 
 use stf_plugins::ScriptRun;
 
-use crate::experiment::{error_at, ModelEntry, ParamGiven};
+use crate::experiment::{error_at, ModelEntry, ModelSource, ParamGiven};
 
 /// A model ready to plug into the oscillator.
 #[derive(Clone)]
@@ -40,6 +40,12 @@ pub fn resolve(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceM
     Ok(stf_plugins::registry::Registry::in_run(run.clone()).resolve(spec, dir)?)
 }
 
+/// [`resolve`] for a path given as a script (`script = "…"`): a folder or a file that is not
+/// a `.rhai` script is named as such.
+pub fn resolve_script(path: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
+    Ok(stf_plugins::registry::Registry::in_run(run.clone()).resolve_script(path, dir)?)
+}
+
 /// Build one model from experiment entries: the parts of every entry are summed (one entry
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
 /// are applied. `file` is the experiment file, `dir` its folder, `run` where scripts load.
@@ -55,8 +61,12 @@ pub fn configure_for(
     let mut parts = Vec::new();
     for entry in entries {
         let at = |msg: String| error_at(file, entry.line, &entry.key, msg);
-        for spec in entry.specs() {
-            let model = resolve(spec, dir, run).map_err(|e| at(format!("{e:#}")))?;
+        for (i, spec) in entry.specs().enumerate() {
+            let model = match &entry.source {
+                ModelSource::Script(path) if i == 0 => resolve_script(path, dir, run),
+                _ => resolve(spec, dir, run),
+            };
+            let model = model.map_err(|e| at(format!("{e:#}")))?;
             parts.push(match scales {
                 Some(s) => widened(model, s),
                 None => model,

@@ -112,7 +112,10 @@ impl<'a> Ctx<'a> {
         what: &str,
     ) -> anyhow::Result<u64> {
         let v = *value.get_ref();
-        let msg = format!("{v} is not a {what} (at least {least})");
+        let msg = format!(
+            "{} is not a {what} (at least {least})",
+            crate::digits::shown(v)
+        );
         self.ensure(
             v >= least as f64 && v <= u64::MAX as f64,
             value.span(),

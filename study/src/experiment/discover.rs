@@ -34,6 +34,9 @@ pub struct DiscoverSpec {
     /// Polish an accepted model before the next step; `None`: the level's default (off at
     /// force level, on at trajectory level).
     pub polish: Option<bool>,
+    /// Line of `[discover]` in the file (1-based; 0 for settings built in code).
+    #[serde(skip)]
+    pub line: usize,
 }
 
 /// `base = "a + b + …"` as its terms, trimmed; an empty term is an error.
