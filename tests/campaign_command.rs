@@ -263,7 +263,7 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
             let at = line_of("\"fitt\"", &t);
             (
                 t,
-                format!(":{at}: `campaign.command`: unknown variant `fitt`"),
+                format!(":{at}: `campaign.command`: unknown value `fitt`"),
                 "unknown command".into(),
             )
         },
@@ -276,7 +276,7 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
             std::fs::write(dir.join("bad.toml"), "[system]\nm = 7.65\nstifnes = 3\n").unwrap();
             (
                 t,
-                "bad.toml:3: `system`: unknown field `stifnes`".into(),
+                "bad.toml:3: `system`: unknown key `stifnes`".into(),
                 "experiment that does not parse".into(),
             )
         },
@@ -856,7 +856,10 @@ fn a_condition_named_as_a_column_of_the_table_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let file = first_records(tmp.path(), 1);
     let text = std::fs::read_to_string(&file).unwrap();
-    let at = text[..text.find("conditions = ").unwrap()].matches('\n').count() + 1;
+    let at = text[..text.find("conditions = ").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
     for (name, says) in [
         ("model", "`model` is a column campaign.csv always has"),
         ("rms", "`rms` is a column campaign.csv always has"),
@@ -886,7 +889,8 @@ fn a_unit_whose_results_file_was_deleted_runs_again() {
     let run = campaign(&file, &out, &[]);
     assert!(run.status.success(), "{}", stderr(&run));
     assert!(
-        stdout(&run).contains("its fit.json is missing from") || stderr(&run).contains("its fit.json is missing from"),
+        stdout(&run).contains("its fit.json is missing from")
+            || stderr(&run).contains("its fit.json is missing from"),
         "{}{}",
         stdout(&run),
         stderr(&run)

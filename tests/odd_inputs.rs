@@ -237,8 +237,14 @@ fn a_script_that_is_a_folder_or_not_a_rhai_file_is_named_as_such() {
     std::fs::write(dir.path().join("notes.toml"), "x = 1\n").unwrap();
     for (script, says) in [
         ("dir.csv", "dir.csv: is a folder, not a script"),
-        ("notes.toml", "notes.toml: is not a rhai script (its name does not end in .rhai)"),
-        ("nowhere.txt", "nowhere.txt: no such file, and not a rhai script's name"),
+        (
+            "notes.toml",
+            "notes.toml: is not a rhai script (its name does not end in .rhai)",
+        ),
+        (
+            "nowhere.txt",
+            "nowhere.txt: no such file, and not a rhai script's name",
+        ),
     ] {
         let exp = on_the_sweep(
             dir.path(),

@@ -69,6 +69,7 @@ impl Registry {
         }
         stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
             name: spec.to_string(),
+            did_you_mean: stf_core::names::did_you_mean(spec, stf_models::names()),
             known: stf_models::names().join(", "),
         })
     }

@@ -277,9 +277,9 @@ fn plan<'a>(campaign: &'a Campaign, out: &Path, force: bool) -> Result<Vec<Pendi
             Some(u) if u.status == UnitStatus::Failed => {
                 Some("it failed last time: rerun".to_string())
             }
-            Some(_) if missing.is_some() => missing.map(|file| {
-                format!("its {file} is missing from {}: rerun", dir.display())
-            }),
+            Some(_) if missing.is_some() => {
+                missing.map(|file| format!("its {file} is missing from {}: rerun", dir.display()))
+            }
             Some(_) => {
                 say!("{}: unchanged since its last run, skipped", name(unit));
                 continue;

@@ -58,9 +58,9 @@ pub fn parameter_columns(exp: &Experiment, discovers: bool) -> BTreeMap<String, 
     if discovers {
         for listing in stf_plugins::registry::Registry::new().list() {
             for p in &listing.params {
-                names
-                    .entry(p.name.to_string())
-                    .or_insert_with(|| format!("a parameter of {}, which discovery may add", listing.name));
+                names.entry(p.name.to_string()).or_insert_with(|| {
+                    format!("a parameter of {}, which discovery may add", listing.name)
+                });
             }
         }
     }

@@ -358,10 +358,11 @@ fn record_command(
 ) -> Result<CommandName> {
     match table.get("command") {
         Some(v) => CommandName::deserialize(v.get_ref().clone()).map_err(|e| {
+            let written = v.get_ref().to_string();
             place.error(
                 v.span().start,
                 &format!("{key}.command"),
-                e.message().trim_end(),
+                crate::experiment::plain_words::plain(e.message().trim_end(), &written),
             )
         }),
         None => defaults.command.ok_or_else(|| {
@@ -437,7 +438,10 @@ fn describe(v: &toml::Value) -> String {
 
 /// Every unit's experiment parsed once (each file once), and checked for what its command
 /// needs; an error names the campaign's line and key, then the experiment's own.
-fn check_experiments<'u>(units: &'u [Unit], place: &Place) -> Result<HashMap<&'u Path, Experiment>> {
+fn check_experiments<'u>(
+    units: &'u [Unit],
+    place: &Place,
+) -> Result<HashMap<&'u Path, Experiment>> {
     let mut parsed: HashMap<&Path, Experiment> = HashMap::new();
     for (i, unit) in units.iter().enumerate() {
         let key = format!("records[{i}]");
@@ -578,7 +582,7 @@ mod tests {
         );
         assert!(
             message(&rec("file = \"r.csv\"\nc = 1\ncommand = \"simulate\"\n"))
-                .starts_with(":9: `records[0].command`: unknown variant `simulate`")
+                .starts_with(":9: `records[0].command`: unknown value `simulate`")
         );
         let m = message(&rec(
             "file = \"r.csv\"\nc = 1\nexperiment = \"none.toml\"\n",
@@ -663,6 +667,6 @@ mod tests {
                 .starts_with(":3: `campaign.units.a`: an empty unit")
         );
         assert!(message("[campaign]\nexperimnt = \"e.toml\"\n")
-            .starts_with(":2: `campaign`: unknown field `experimnt`"));
+            .starts_with(":2: `campaign`: unknown key `experimnt`"));
     }
 }

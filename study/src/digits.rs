@@ -37,6 +37,12 @@ pub fn shown(x: f64) -> String {
     }
 }
 
+/// `x` to six significant digits for a message (`0.0054` for 0.005399999999999849), as
+/// [`shown`].
+pub fn brief(x: f64) -> String {
+    shown(format!("{x:.5e}").parse().unwrap_or(x))
+}
+
 /// The times `t` run over, for a message: `from 0 to 70 s` (`none`, for no samples).
 pub fn time_span(t: &[f64]) -> String {
     match (t.first(), t.last()) {
@@ -138,6 +144,8 @@ mod tests {
         assert_eq!(shown(0.1 + 0.2), "0.3");
         assert_eq!(shown(-0.0), "0");
         assert_eq!(shown(-1234567.0), "-1.234567e6");
+        assert_eq!(brief(0.005399999999999849), "0.0054");
+        assert_eq!(brief(1.0 / 0.005), "200");
     }
 
     #[test]

@@ -132,8 +132,14 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
             );
         }
     }
-    let kinematics = Kinematics::from_record(&record, &exp.kinematics)
-        .with_context(|| format!("cannot derive the kinematics of {}", file.display()))?;
+    let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
+        anyhow!(
+            "{}:{}: `[data]`: {}",
+            exp.path.display(),
+            exp.data_line,
+            kinematics_error(&e, &file.display().to_string())
+        )
+    })?;
     let level = match asked.or(exp.fit.level) {
         Some(l) => l,
         None if record.f_stf.is_some() && (!exp.models.is_empty() || exp.discover.is_some()) => {
@@ -497,6 +503,31 @@ pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics
         .initial(x0, v0)
 }
 
+/// Why the kinematics of the record `file` cannot be derived, with the fix where there is
+/// one: a time column that is not uniform names the `[data] rate` that would replace it.
+pub fn kinematics_error(e: &stf_core::numerics::derivative::FilterError, file: &str) -> String {
+    use crate::digits::brief;
+    use stf_core::numerics::derivative::FilterError;
+    match e {
+        FilterError::NonUniform {
+            index,
+            time,
+            step,
+            mean,
+        } => format!(
+            "the times of {file} are not uniform: the step from sample {index} (t = {} s) is \
+             {} s against a mean of {} s (more than 0.1 % off); if the record was sampled at \
+             a fixed rate, give it in [data]: `rate = {}` (samples/s; the times are then t0 \
+             + i/rate, and the t column is not read), or resample the record uniformly",
+            brief(*time),
+            brief(*step),
+            brief(*mean),
+            brief(1.0 / mean)
+        ),
+        e => format!("cannot derive the kinematics of {file}: {e}"),
+    }
+}
+
 /// Configure and fit every model of the experiment, in parallel (bounds widened where the
 /// record needs it: [`FitData::scales`]).
 pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Result<Vec<ModelFit>> {
@@ -513,19 +544,20 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Res
         }
         vec![None]
     } else {
-        exp.models
+        // Every entry's mistakes at once, as the file's own.
+        let (ok, errors): (Vec<_>, Vec<_>) = exp
+            .models
             .iter()
             .map(|m| {
-                configure_for(
-                    std::slice::from_ref(m),
-                    &exp.path,
-                    &exp.dir,
-                    &exp.scripts,
-                    Some(&scales),
-                )
-                .map(Some)
+                let entry = std::slice::from_ref(m);
+                configure_for(entry, &exp.path, &exp.dir, &exp.scripts, Some(&scales))
             })
-            .collect::<Result<_>>()?
+            .partition(Result::is_ok);
+        if !errors.is_empty() {
+            let errors = errors.into_iter().filter_map(Result::err).collect();
+            return Err(crate::experiment::Mistakes::of(&exp.path, errors));
+        }
+        ok.into_iter().map(|c| c.ok()).collect()
     };
     let calls = crate::script_plan::fit_calls(&configured, data.record.len(), data.level);
     crate::script_plan::check(exp, calls, "this fit", progress)?;

@@ -75,12 +75,8 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
             return Err(spec.error("validate.window", msg));
         }
     }
-    let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
-        spec.error(
-            key,
-            format!("cannot derive the kinematics of {}: {e}", spec.given),
-        )
-    })?;
+    let kinematics = Kinematics::from_record(&record, &exp.kinematics)
+        .map_err(|e| spec.error(key, crate::fitting::kinematics_error(&e, &spec.given)))?;
     let data = FitData {
         record,
         kinematics,

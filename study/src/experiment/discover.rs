@@ -115,8 +115,8 @@ mod tests {
             parse("\n[discover]\nbase = \"viscous\"\nlevel = \"forces\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:4: `discover.level`: unknown variant `forces`")
-                && msg.contains("`force` or `trajectory`"),
+            msg.starts_with("exp.toml:4: `discover.level`: unknown value `forces`")
+                && msg.contains("one of: force, trajectory"),
             "{msg}"
         );
     }
@@ -138,7 +138,7 @@ mod tests {
             parse("\n[discover]\nbase = \"viscous\"\npolish = \"yes\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:4: `discover.polish`: invalid type"),
+            msg.starts_with("exp.toml:4: `discover.polish`: expected true or false"),
             "{msg}"
         );
     }

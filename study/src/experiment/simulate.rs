@@ -10,10 +10,10 @@ use serde::Deserialize;
 use stf_core::simulate::{count_text, sample_count, DEFAULT_MAX_SAMPLES};
 use toml::Spanned;
 
-use crate::digits::shown;
 use super::drive::{self, Chirp, Drive, RawConstant, RawFree, RawProfile, RawSweep};
 use super::models::{self, ModelEntry, RawModel};
 use super::Ctx;
+use crate::digits::shown;
 
 /// `[simulate]` as written.
 #[derive(Debug, Deserialize)]
@@ -365,8 +365,8 @@ mod tests {
             parse(&format!("[simulate]\n{chirp}, hold = \"step\" }}\n")).unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:2: `simulate.chirp.hold`: unknown variant `step`")
-                && msg.contains("`linear` or `zoh`"),
+            msg.starts_with("exp.toml:2: `simulate.chirp.hold`: unknown value `step`")
+                && msg.contains("one of: linear, zoh"),
             "{msg}"
         );
     }
