@@ -100,6 +100,21 @@ pub fn with_error(value: f64, error: f64) -> String {
     format!("{} ± {}", show(value, last), show(error, last))
 }
 
+/// A CSV cell of `x`: [`carried`] in Rust's shortest form (`1`, `0.000155`, never
+/// `0.00015500000000000003`), a negative zero as `0`. For `#[serde(serialize_with)]`.
+pub fn csv_number<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    let x = if *x == 0.0 { 0.0 } else { carried(*x) };
+    s.collect_str(&x)
+}
+
+/// [`csv_number`] of an optional value (an empty cell for none).
+pub fn csv_optional<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match x {
+        Some(x) => csv_number(x, s),
+        None => s.serialize_none(),
+    }
+}
+
 /// Every floating-point number of `value`, recursively, rounded by [`carried`]; integers
 /// untouched.
 pub fn tidy_json(value: &mut Value) {
@@ -146,6 +161,31 @@ mod tests {
         assert_eq!(shown(-1234567.0), "-1.234567e6");
         assert_eq!(brief(0.005399999999999849), "0.0054");
         assert_eq!(brief(1.0 / 0.005), "200");
+    }
+
+    #[test]
+    fn csv_cells_carry_15_digits_and_no_negative_zero() {
+        #[derive(serde::Serialize)]
+        struct Row {
+            #[serde(serialize_with = "csv_number")]
+            a: f64,
+            #[serde(serialize_with = "csv_number")]
+            b: f64,
+            #[serde(serialize_with = "csv_optional")]
+            c: Option<f64>,
+            #[serde(serialize_with = "csv_optional")]
+            d: Option<f64>,
+        }
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(Row {
+            a: 0.000155 + 1e-20,
+            b: -0.0,
+            c: Some(0.1 + 0.2),
+            d: None,
+        })
+        .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(text, "a,b,c,d\n0.000155,0,0.3,\n");
     }
 
     #[test]
