@@ -44,6 +44,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// List the force models (built-in and scripts) with their parameters.
+    #[command(after_help = MODELS_HELP)]
     Models {
         /// Validate this script and print its parameters instead.
         #[arg(long, value_name = "SCRIPT")]
@@ -55,24 +56,92 @@ enum Command {
     /// Write a synthetic record from the experiment's [simulate] section.
     ///
     /// `--out` is the record to write (CSV); a JSON sidecar is written beside it.
+    #[command(after_help = SIMULATE_HELP)]
     Simulate(Run),
     /// Calibrate every model of the experiment against its record.
     ///
     /// `--out` is the folder for fit.json and fitted.csv (replaced as a whole).
+    #[command(after_help = FIT_HELP)]
     Fit(Run),
     /// Fit every model, then compare them regime by regime.
     ///
     /// `--out` is the folder for compare.json, compare.md, compare.csv and the fit results
     /// (replaced as a whole).
+    #[command(after_help = COMPARE_HELP)]
     Compare(Run),
     /// Find, name and add the effect the base model misses; show the gap shrink.
     ///
     /// The experiment needs a [discover] section; `--out` is the folder for discovery.json,
     /// the report and figures (replaced as a whole).
+    #[command(after_help = DISCOVER_HELP)]
     Discover(Run),
     /// Run fit, compare or discover on every record of a campaign file, then tabulate.
+    #[command(after_help = CAMPAIGN_HELP)]
     Campaign(CampaignArgs),
 }
+
+/// Where every key of an experiment file is described.
+macro_rules! key_reference {
+    () => {
+        "Every key of an experiment file, with its default: README.md, section \"Experiment \
+         files\"; the bundled examples are in experiments/."
+    };
+}
+
+const MODELS_HELP: &str = concat!(
+    "Examples:\n",
+    "  stf-lab models\n",
+    "  stf-lab models --check models/scripts/power_law.rhai\n\n",
+    "A script model is a .rhai file with fn params() and fn force(p, t, x, v, z): README.md, \
+     section \"Force models\"."
+);
+
+const SIMULATE_HELP: &str = concat!(
+    "Example:\n",
+    "  stf-lab simulate experiments/paper_sweep.toml --out sweep.csv\n\n",
+    "A minimal experiment:\n",
+    "  [simulate]\n",
+    "  sweep = { w0 = 2.35, alpha = 0.047, t0 = 50.0, t1 = 200.0 }\n",
+    "  rate = 1000.0\n\n",
+    key_reference!()
+);
+
+const FIT_HELP: &str = concat!(
+    "Example:\n",
+    "  stf-lab fit experiments/power_law_fit.toml --out out/fit\n\n",
+    "A minimal experiment:\n",
+    "  [data]\n",
+    "  file = \"record.csv\"        # columns t, phi, x and optionally f_stf\n",
+    "  [[models]]\n",
+    "  name = \"power_law\"\n",
+    "  params = { K = 2.0, n = { value = 1.2, min = 1.0, max = 4.0 } }\n\n",
+    key_reference!()
+);
+
+const COMPARE_HELP: &str = concat!(
+    "Example:\n",
+    "  stf-lab compare experiments/jamming_compare.toml --out out/compare\n\n",
+    "The experiment lists two or more [[models]]; [regimes] sets the thresholds.\n\n",
+    key_reference!()
+);
+
+const DISCOVER_HELP: &str = concat!(
+    "Example:\n",
+    "  stf-lab discover experiments/discovery.toml --out out/discover\n\n",
+    "The experiment needs:\n",
+    "  [discover]\n",
+    "  base = \"power_law\"          # the model to start from\n\n",
+    key_reference!()
+);
+
+const CAMPAIGN_HELP: &str = concat!(
+    "Example:\n",
+    "  stf-lab campaign experiments/campaign/campaign.toml --out out/campaign\n\n",
+    "A campaign file: [campaign] experiment = \"fit.toml\", command = \"fit\", conditions = \
+     [\"concentration\"], then a [[records]] table per record (file = \"r1.csv\", \
+     concentration = 0.4). Its keys: README.md, section \"Campaigns: many records, one \
+     command\"; the experiment's: section \"Experiment files\"."
+);
 
 /// What `simulate`, `fit`, `compare` and `discover` take.
 #[derive(Args)]

@@ -263,7 +263,7 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
             let at = line_of("\"fitt\"", &t);
             (
                 t,
-                format!(":{at}: `campaign.command`: unknown variant `fitt`"),
+                format!(":{at}: `campaign.command`: unknown value `fitt`"),
                 "unknown command".into(),
             )
         },
@@ -276,7 +276,7 @@ fn bad_campaign_input_is_refused_before_any_unit_starts() {
             std::fs::write(dir.join("bad.toml"), "[system]\nm = 7.65\nstifnes = 3\n").unwrap();
             (
                 t,
-                "bad.toml:3: `system`: unknown field `stifnes`".into(),
+                "bad.toml:3: `system`: unknown key `stifnes`".into(),
                 "experiment that does not parse".into(),
             )
         },
@@ -848,4 +848,53 @@ fn user_files_among_the_campaign_figures_are_named_and_kept() {
         std::fs::read(out.join("figures/mynotes.txt")).unwrap(),
         b"mine"
     );
+}
+
+#[test]
+fn a_condition_named_as_a_column_of_the_table_is_refused() {
+    // `model`, `rms`, `status` are columns campaign.csv always has; `n` is power_law's.
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 1);
+    let text = std::fs::read_to_string(&file).unwrap();
+    let at = text[..text.find("conditions = ").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    for (name, says) in [
+        ("model", "`model` is a column campaign.csv always has"),
+        ("rms", "`rms` is a column campaign.csv always has"),
+        ("status", "`status` is a column campaign.csv always has"),
+        ("K_std_error", "`K_std_error` ends in `_std_error`"),
+        ("n", "`n` is a parameter of power_law in"),
+    ] {
+        let t = text
+            .replace("\"concentration\"", &format!("\"{name}\""))
+            .replace("concentration = ", &format!("{name} = "));
+        let expected = format!(":{at}: `campaign.conditions[1]`: {says}");
+        assert_refused_before_any_unit(&file, tmp.path(), &t, name, &expected);
+        let e = stderr(&campaign(&file, &tmp.path().join("out"), &[]));
+        assert!(e.contains("choose another name"), "{e}");
+    }
+}
+
+#[test]
+fn a_unit_whose_results_file_was_deleted_runs_again() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = first_records(tmp.path(), 1);
+    let out = tmp.path().join("out");
+    assert!(campaign(&file, &out, &[]).status.success());
+    let unit = out.join("units/001-a1_c1");
+    std::fs::remove_file(unit.join("fit.json")).unwrap();
+    // It failed on every rerun ("cannot read …/fit.json"), skipped as unchanged.
+    let run = campaign(&file, &out, &[]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(
+        stdout(&run).contains("its fit.json is missing from")
+            || stderr(&run).contains("its fit.json is missing from"),
+        "{}{}",
+        stdout(&run),
+        stderr(&run)
+    );
+    assert!(unit.join("fit.json").is_file());
+    assert_eq!(rows(&out).iter().filter(|r| r["status"] == "ok").count(), 2);
 }

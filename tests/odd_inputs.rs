@@ -174,3 +174,87 @@ fn a_window_of_three_values_is_refused() {
         "{msg}"
     );
 }
+
+/// `[data] file` = the bundled power-law sweep, then `rest`.
+fn on_the_sweep(dir: &Path, rest: &str) -> PathBuf {
+    let record = root().join("experiments/records/power_law_sweep.csv");
+    experiment(
+        dir,
+        &format!("[data]\nfile = {:?}\n{rest}", record.display().to_string()),
+    )
+}
+
+/// `stf-lab COMMAND EXP --out DIR/out`: its failure message.
+fn fails_on(command: &str, exp: &Path) -> String {
+    let out = exp.parent().unwrap().join("out");
+    fails(&[
+        command.as_ref(),
+        exp.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
+}
+
+#[test]
+fn a_window_beyond_the_record_is_shown_with_short_numbers_and_the_record_s_times() {
+    // It printed 1e300 as a number of 301 digits.
+    let dir = tempfile::tempdir().unwrap();
+    let exp = on_the_sweep(
+        dir.path(),
+        "window = [1e300, 1e301]\n\n[[models]]\nname = \"viscous\"\n",
+    );
+    let msg = fails_on("fit", &exp);
+    assert!(
+        msg.contains("exp.toml:1: `data.window` [1e300, 1e301] keeps 0 samples of")
+            && msg.contains("whose times run from 0 to 60 s"),
+        "{msg}"
+    );
+    assert!(!msg.contains("0000000000"), "{msg}");
+}
+
+#[test]
+fn a_holdout_longer_than_the_record_names_its_key() {
+    // It said "bad discovery data: 56 whole cycles hold out none at one in 1000000000".
+    let dir = tempfile::tempdir().unwrap();
+    let exp = on_the_sweep(
+        dir.path(),
+        "\n[discover]\nbase = \"viscous\"\ncandidates = [\"power_law\"]\nholdout_every = 1e9\n",
+    );
+    let msg = fails_on("discover", &exp);
+    assert!(
+        msg.contains("exp.toml:4: `discover.holdout_every`: holdout_every = 1000000000 holds out none of the record's")
+            && msg.contains("give holdout_every at most"),
+        "{msg}"
+    );
+    assert!(!msg.contains("bad discovery data"), "{msg}");
+}
+
+#[test]
+fn a_script_that_is_a_folder_or_not_a_rhai_file_is_named_as_such() {
+    // Both said "unknown model `dir.csv`; built-in models: …".
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("dir.csv")).unwrap();
+    std::fs::write(dir.path().join("notes.toml"), "x = 1\n").unwrap();
+    for (script, says) in [
+        ("dir.csv", "dir.csv: is a folder, not a script"),
+        (
+            "notes.toml",
+            "notes.toml: is not a rhai script (its name does not end in .rhai)",
+        ),
+        (
+            "nowhere.txt",
+            "nowhere.txt: no such file, and not a rhai script's name",
+        ),
+    ] {
+        let exp = on_the_sweep(
+            dir.path(),
+            &format!("\n[[models]]\nscript = \"{script}\"\n"),
+        );
+        let msg = fails_on("fit", &exp);
+        assert!(
+            msg.contains("exp.toml:4: `models[0]`: ") && msg.contains(says),
+            "{script}: {msg}"
+        );
+        assert!(!msg.contains("unknown model"), "{msg}");
+    }
+}

@@ -38,6 +38,7 @@ pub mod data;
 pub mod discovery;
 pub mod fit;
 mod model_error;
+pub mod names;
 pub mod numerics;
 pub mod physics;
 pub mod regimes;

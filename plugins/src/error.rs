@@ -35,10 +35,13 @@ impl fmt::Display for ScriptLocation {
 #[derive(Debug, Error)]
 pub enum ScriptError {
     /// The file could not be read.
-    #[error("{path}: cannot read the script: {error}")]
+    #[error("{path}: cannot read the script: {error}{did_you_mean}")]
     Read {
         /// The script's path.
         path: String,
+        /// ` (did you mean `m.rhai`?)` for a missing script with a file of a close name
+        /// beside it, else empty.
+        did_you_mean: String,
         /// The I/O error (shown in the message, so not also a `source` that an error chain
         /// would print a second time).
         error: std::io::Error,
@@ -92,13 +95,25 @@ pub enum ScriptError {
         /// The cost of a call, the calls the run needs and the limit.
         message: String,
     },
+    /// A file given as a script (`script = "…"`) that is not one: a folder, or a file whose
+    /// name does not end in `.rhai`.
+    #[error("{path}: {why}")]
+    NotAScript {
+        /// The path as given, resolved.
+        path: String,
+        /// What it is instead, and what to give.
+        why: String,
+    },
     /// A name is neither a built-in model nor a script path.
     #[error(
-        "unknown model `{name}`; built-in models: {known}; or give a script path ending in .rhai"
+        "unknown model `{name}`{did_you_mean}; built-in models: {known}; or give a script path \
+         ending in .rhai"
     )]
     UnknownModel {
         /// The name asked for.
         name: String,
+        /// ` (did you mean `power_law`?)` when a built-in's name is a typo away, else empty.
+        did_you_mean: String,
         /// The known names, comma separated.
         known: String,
     },

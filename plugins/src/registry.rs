@@ -69,8 +69,38 @@ impl Registry {
         }
         stf_models::find(spec).ok_or_else(|| ScriptError::UnknownModel {
             name: spec.to_string(),
+            did_you_mean: stf_core::names::did_you_mean(spec, stf_models::names()),
             known: stf_models::names().join(", "),
         })
+    }
+
+    /// The script model at `path` (relative to `base_dir` unless absolute), given as a script
+    /// (`script = "…"`): a path that is a folder, or a file whose name does not end in
+    /// `.rhai`, is named as such rather than looked up as a built-in's name.
+    pub fn resolve_script(
+        &self,
+        path: &str,
+        base_dir: &Path,
+    ) -> Result<Arc<dyn ForceModel>, ScriptError> {
+        let full = base_dir.join(path.trim());
+        let not = |why: &str| ScriptError::NotAScript {
+            path: full.display().to_string(),
+            why: why.to_string(),
+        };
+        if full.is_dir() {
+            return Err(not(
+                "is a folder, not a script: give the path of a rhai script (a file ending in .rhai)",
+            ));
+        }
+        if !path.trim().ends_with(".rhai") {
+            return Err(not(if full.exists() {
+                "is not a rhai script (its name does not end in .rhai): give a script's path, \
+                 or `name = \"…\"` for a built-in model"
+            } else {
+                "no such file, and not a rhai script's name (a script's ends in .rhai)"
+            }));
+        }
+        self.resolve(path, base_dir)
     }
 
     /// Every built-in model, then every script of the script directory (sorted by file name).

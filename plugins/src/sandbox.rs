@@ -81,6 +81,8 @@ fn build_engine() -> Engine {
         .disable_symbol("import")
         .disable_symbol("eval")
         .set_strict_variables(true)
+        // `p.nn` for `p.n` is an error naming `nn`, not `()` failing later in `**`.
+        .set_fail_on_invalid_map_property(true)
         .set_max_call_levels(MAX_CALL_LEVELS)
         .set_max_expr_depths(MAX_EXPR_DEPTHS.0, MAX_EXPR_DEPTHS.1)
         .set_max_string_size(MAX_STRING_SIZE)

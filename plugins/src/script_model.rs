@@ -165,6 +165,11 @@ impl ScriptModel {
         let source = read_file_to_string(path, limit).map_err(|e| match e {
             BoundedError::Io(error) => ScriptError::Read {
                 path: shown.clone(),
+                did_you_mean: if error.kind() == std::io::ErrorKind::NotFound {
+                    stf_core::names::nearby_file(path)
+                } else {
+                    String::new()
+                },
                 error,
             },
             too_large => ScriptError::TooLarge {
@@ -429,7 +434,7 @@ impl ScriptModel {
             .fetch_add(used, Ordering::Relaxed)
             .saturating_add(used);
         let value = result
-            .map_err(|e| describe(*e, fname, &self.limits, used))
+            .map_err(|e| describe(*e, fname, &self.limits, used, &self.specs))
             .map_err(|e| CallError {
                 line: e.line.or_else(|| self.line_of(fname)),
                 message: e.message,
@@ -723,7 +728,13 @@ fn run_budget_message(limits: &ScriptLimits) -> String {
 
 /// A runtime error as line + message, from the innermost function call that failed; `used`
 /// is the operations the call performed.
-fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u64) -> CallError {
+fn describe(
+    mut err: EvalAltResult,
+    fname: &str,
+    limits: &ScriptLimits,
+    used: u64,
+    params: &[ParamSpec],
+) -> CallError {
     let mut line = err.position().line();
     let mut callee = fname.to_string();
     while let EvalAltResult::ErrorInFunctionCall(name, _, inner, pos) = err {
@@ -755,6 +766,13 @@ fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u6
         EvalAltResult::ErrorStackOverflow(_) => {
             format!("stopped: more than {MAX_CALL_LEVELS} nested calls (endless recursion?)")
         }
+        EvalAltResult::ErrorPropertyNotFound(name, _) => unknown_property(name, params),
+        EvalAltResult::ErrorFunctionNotFound(signature, _) => {
+            format!(
+                "Function not found: {signature}{}",
+                function_hint(signature)
+            )
+        }
         _ => {
             let _ = err.take_position();
             err.to_string()
@@ -763,6 +781,33 @@ fn describe(mut err: EvalAltResult, fname: &str, limits: &ScriptLimits, used: u6
     CallError {
         line,
         message: format!("{message} (in fn {callee})"),
+    }
+}
+
+/// A map key the script reads that is not there: a parameter's name mistyped (`p.nn`).
+fn unknown_property(name: &str, params: &[ParamSpec]) -> String {
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    format!(
+        "`{name}` is not a parameter of this script{}: its parameters (from fn params) are {}",
+        stf_core::names::did_you_mean(name, names.iter().copied()),
+        if names.is_empty() {
+            "none".to_string()
+        } else {
+            names.join(", ")
+        }
+    )
+}
+
+/// The fix for a function rhai does not have, where there is a usual one: `**` for powers;
+/// an operand that is `()` (nothing) is named as such.
+fn function_hint(signature: &str) -> String {
+    let name = signature.split([' ', '(']).next().unwrap_or_default();
+    if ["pow", "powf", "powi", "math::pow"].contains(&name) {
+        format!(": rhai has no `{name}`; `**` is the power operator (`v.abs() ** p.n`)")
+    } else if signature.contains("()") {
+        ": one of its operands is () (nothing): a variable or a function without a value?".into()
+    } else {
+        String::new()
     }
 }
 

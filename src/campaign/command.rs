@@ -21,8 +21,9 @@ use anyhow::{bail, Context, Error, Result};
 
 use crate::campaign::runner::{Pending, Runner};
 use crate::campaign::slurm_script::{Job, SlurmOptions, SLURM};
-use crate::campaign::unit::UnitStatus;
-use crate::campaign::unit::{inputs_hash, read_unit_json, run_one, run_one_observed, unit_dir};
+use crate::campaign::unit::{
+    inputs_hash, read_unit_json, results_missing, run_one, run_one_observed, unit_dir, UnitStatus,
+};
 use crate::campaign::{global, out_dir, report, table, Campaign, Unit};
 use crate::campaign::{slurm, slurm_plan, slurm_script};
 use crate::say;
@@ -342,11 +343,17 @@ fn plan<'a>(campaign: &'a Campaign, out: &Path, force: bool) -> Result<Vec<Pendi
         let dir = unit_dir(out, unit);
         let hash = inputs_hash(unit)?;
         let last = read_unit_json(&dir);
+        let missing = last.as_ref().and_then(|u| results_missing(&dir, u));
         let reason = match &last {
             _ if force => None,
             None => None,
-            Some(u) if u.inputs_hash != hash => Some("its inputs changed: rerun"),
-            Some(u) if u.status == UnitStatus::Failed => Some("it failed last time: rerun"),
+            Some(u) if u.inputs_hash != hash => Some("its inputs changed: rerun".to_string()),
+            Some(u) if u.status == UnitStatus::Failed => {
+                Some("it failed last time: rerun".to_string())
+            }
+            Some(_) if missing.is_some() => {
+                missing.map(|file| format!("its {file} is missing from {}: rerun", dir.display()))
+            }
             Some(_) => {
                 say!("{}: unchanged since its last run, skipped", name(unit));
                 continue;

@@ -112,7 +112,8 @@ impl Campaign {
             Some(table) => table_units(table, &raw.records, &conditions, &defaults, &place)?,
             None => toml_units(&header, &raw.records, &conditions, &defaults, &place)?,
         };
-        check_experiments(&units, &place)?;
+        let experiments = check_experiments(&units, &place)?;
+        check_parameter_clash(&header, &units, &experiments, &place)?;
         let default_experiment = defaults.experiment.map(|e| place.dir.join(e.get_ref()));
         let global = raw
             .global
@@ -233,6 +234,9 @@ fn check_conditions(header: &Spanned<RawHeader>, path: &Path, text: &str) -> Res
             return Err(at(&format!(
                 "`{name}` is a record key, not a condition: choose another name"
             )));
+        }
+        if let Some(clash) = super::condition_names::fixed_clash(&name) {
+            return Err(at(&clash));
         }
         if names.contains(&name) {
             return Err(at(&format!("`{name}` is listed twice")));
@@ -364,10 +368,11 @@ fn record_command(
 ) -> Result<CommandName> {
     match table.get("command") {
         Some(v) => CommandName::deserialize(v.get_ref().clone()).map_err(|e| {
+            let written = v.get_ref().to_string();
             place.error(
                 v.span().start,
                 &format!("{key}.command"),
-                e.message().trim_end(),
+                crate::experiment::plain_words::plain(e.message().trim_end(), &written),
             )
         }),
         None => defaults.command.ok_or_else(|| {
@@ -443,7 +448,10 @@ fn describe(v: &toml::Value) -> String {
 
 /// Every unit's experiment parsed once (each file once), and checked for what its command
 /// needs; an error names the campaign's line and key, then the experiment's own.
-fn check_experiments(units: &[Unit], place: &Place) -> Result<()> {
+fn check_experiments<'u>(
+    units: &'u [Unit],
+    place: &Place,
+) -> Result<HashMap<&'u Path, Experiment>> {
     let mut parsed: HashMap<&Path, Experiment> = HashMap::new();
     for (i, unit) in units.iter().enumerate() {
         let key = format!("records[{i}]");
@@ -475,6 +483,43 @@ fn check_experiments(units: &[Unit], place: &Place) -> Result<()> {
                 "`discover` needs a [discover] section (base = \"…\") in {}",
                 unit.experiment.display()
             )));
+        }
+    }
+    Ok(parsed)
+}
+
+/// No condition is named as a parameter some unit may write as a column of `campaign.csv`
+/// (`super::condition_names`): the error names the condition, the parameter's model and the
+/// experiment.
+fn check_parameter_clash(
+    header: &Spanned<RawHeader>,
+    units: &[Unit],
+    experiments: &HashMap<&Path, Experiment>,
+    place: &Place,
+) -> Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for unit in units {
+        if !seen.insert((unit.experiment.as_path(), unit.command)) {
+            continue;
+        }
+        let exp = &experiments[unit.experiment.as_path()];
+        let columns =
+            super::condition_names::parameter_columns(exp, unit.command == CommandName::Discover);
+        for (i, c) in header.get_ref().conditions.iter().enumerate() {
+            let name = c.get_ref().trim();
+            if let Some(what) = columns.get(name) {
+                return Err(error_at(
+                    place.path,
+                    line_of(place.text, c.span().start),
+                    &format!("campaign.conditions[{i}]"),
+                    format!(
+                        "`{name}` is {what} in {}: campaign.csv has a column of that name for \
+                         it, and a condition of that name would make a second one; choose \
+                         another name (e.g. `{name}_condition`)",
+                        unit.experiment.display()
+                    ),
+                ));
+            }
         }
     }
     Ok(())
@@ -547,7 +592,7 @@ mod tests {
         );
         assert!(
             message(&rec("file = \"r.csv\"\nc = 1\ncommand = \"simulate\"\n"))
-                .starts_with(":9: `records[0].command`: unknown variant `simulate`")
+                .starts_with(":9: `records[0].command`: unknown value `simulate`")
         );
         let m = message(&rec(
             "file = \"r.csv\"\nc = 1\nexperiment = \"none.toml\"\n",
@@ -632,6 +677,6 @@ mod tests {
                 .starts_with(":3: `campaign.units.a`: an empty unit")
         );
         assert!(message("[campaign]\nexperimnt = \"e.toml\"\n")
-            .starts_with(":2: `campaign`: unknown field `experimnt`"));
+            .starts_with(":2: `campaign`: unknown key `experimnt`"));
     }
 }

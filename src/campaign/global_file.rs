@@ -421,7 +421,7 @@ mod tests {
             fit,
             "model = \"power_law\"\nlevel = \"motion\"\n",
         ));
-        assert!(m.contains("unknown variant `motion`"), "{m}");
+        assert!(m.contains("unknown value `motion`"), "{m}");
     }
 
     #[test]
@@ -450,6 +450,6 @@ mod tests {
             )
         );
         assert!(message("model = \"power_law\"\nshraed = [\"n\"]\n")
-            .starts_with(":16: `global`: unknown field `shraed`"));
+            .starts_with(":16: `global`: unknown key `shraed`"));
     }
 }

@@ -11,6 +11,7 @@
 //! shown first in the report ([`global_report`]).
 
 pub mod command;
+pub mod condition_names;
 pub mod figure_series;
 pub mod file;
 pub mod global;

@@ -180,7 +180,10 @@ fn unit(number: usize, row: &Row, columns: &Columns, defaults: &RowDefaults) -> 
         Some(c) => CommandName::deserialize(serde::de::value::StrDeserializer::<
             serde::de::value::Error,
         >::new(c))
-        .map_err(|e| at(columns.command.unwrap_or(0), e.to_string()))?,
+        .map_err(|e| {
+            let msg = crate::experiment::plain_words::plain(&e.to_string(), c);
+            at(columns.command.unwrap_or(0), msg)
+        })?,
         None => defaults.command.ok_or_else(|| {
             at(
                 columns.file,
@@ -280,7 +283,7 @@ mod tests {
         );
         assert!(message("c,d\n1,2\n").starts_with(":1: `file`: missing column"));
         assert!(message("file,c,d,command\nr.csv,1,2,simulate\n")
-            .starts_with(":2: `command`: unknown variant `simulate`"));
+            .starts_with(":2: `command`: unknown value `simulate`"));
         assert!(
             message("file,c,d\nr.csv,1\n").starts_with(":2: "),
             "{}",

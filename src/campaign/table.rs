@@ -144,38 +144,48 @@ pub fn param_names(rows: &[CampaignRow]) -> Vec<String> {
     names
 }
 
+/// The columns of `campaign.csv` before the conditions.
+const LEADING_COLUMNS: [&str; 4] = ["unit", "record", "command", "status"];
+/// The column of the model's name, after the conditions.
+const MODEL_COLUMN: &str = "model";
+/// The columns after the parameters.
+const TRAILING_COLUMNS: [&str; 12] = [
+    "rms",
+    "rms_unit",
+    "aic",
+    "bic",
+    "converged",
+    "best",
+    "warnings",
+    "validation_rms",
+    "effects",
+    "gap_before",
+    "wall_seconds",
+    "error",
+];
+/// What a parameter's standard-error column adds to its name.
+pub const STD_ERROR_SUFFIX: &str = "_std_error";
+
+/// Whether `name` is a column `campaign.csv` always has (`unit`, `status`, `model`, `rms` …),
+/// which a condition of that name would duplicate.
+pub fn is_fixed_column(name: &str) -> bool {
+    LEADING_COLUMNS.contains(&name) || name == MODEL_COLUMN || TRAILING_COLUMNS.contains(&name)
+}
+
 /// `campaign.csv`: `unit, record, command, status, <conditions…>, model, <param>,
 /// <param>_std_error …, rms, rms_unit, aic, bic, converged, best, warnings, validation_rms,
 /// effects, gap_before, wall_seconds, error` (lists joined with `;`).
 pub fn write_csv(path: &Path, table: &CampaignJson) -> Result<()> {
     let names = param_names(&table.rows);
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = ["unit", "record", "command", "status"]
-        .map(String::from)
-        .to_vec();
+    let mut header: Vec<String> = LEADING_COLUMNS.map(String::from).to_vec();
     header.extend(table.conditions.iter().cloned());
-    header.push("model".into());
+    header.push(MODEL_COLUMN.into());
     for n in &names {
         header.push(n.clone());
-        header.push(format!("{n}_std_error"));
+        header.push(format!("{n}{STD_ERROR_SUFFIX}"));
     }
-    header.extend(
-        [
-            "rms",
-            "rms_unit",
-            "aic",
-            "bic",
-            "converged",
-            "best",
-            "warnings",
-            "validation_rms",
-            "effects",
-            "gap_before",
-            "wall_seconds",
-            "error",
-        ]
-        .map(String::from),
-    );
+    header.extend(TRAILING_COLUMNS.map(String::from));
     w.write_record(&header)?;
     for r in &table.rows {
         w.write_record(csv_row(r, &table.conditions, &names))?;

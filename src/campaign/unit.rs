@@ -88,9 +88,19 @@ pub fn inputs_hash(unit: &Unit) -> Result<String> {
     unit_hash(unit, &exp)
 }
 
-/// Whether `dir` holds a finished run of a unit whose inputs hash to `hash`.
+/// Whether `dir` holds a finished run of a unit whose inputs hash to `hash`, its results
+/// file included (one deleted by hand makes the unit run again).
 pub fn is_current(dir: &Path, hash: &str) -> bool {
-    read_unit_json(dir).is_some_and(|u| u.status == UnitStatus::Ok && u.inputs_hash == hash)
+    read_unit_json(dir).is_some_and(|u| {
+        u.status == UnitStatus::Ok && u.inputs_hash == hash && results_missing(dir, &u).is_none()
+    })
+}
+
+/// The results file of a unit that finished `ok` in `dir`, if it is no longer there (deleted
+/// by hand): the campaign table cannot read the unit, so it runs again.
+pub fn results_missing(dir: &Path, unit: &UnitJson) -> Option<&'static str> {
+    let file = super::unit_results::results_file(unit.command);
+    (unit.status == UnitStatus::Ok && !dir.join(file).is_file()).then_some(file)
 }
 
 /// Run unit `number` of `campaign` into its folder under `out` (skipped, without `force`,

@@ -122,11 +122,21 @@ pub struct ModelResult {
     pub gap_before: Option<f64>,
 }
 
+/// The file of `command`'s results in a unit's folder, which the campaign table reads.
+pub fn results_file(command: CommandName) -> &'static str {
+    match command {
+        CommandName::Fit => "fit.json",
+        CommandName::Compare => "compare.json",
+        CommandName::Discover => "discovery.json",
+    }
+}
+
 /// The results of a unit that ran `command` into `dir`, one per model.
 pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
+    let json = dir.join(results_file(command));
     match command {
         CommandName::Fit => {
-            let file: FitFile = read_json(&dir.join("fit.json"))?;
+            let file: FitFile = read_json(&json)?;
             let units = param_units(&dir.join("params.csv"));
             let mut models = with_best_by_aic(file.models);
             for m in &mut models {
@@ -138,7 +148,7 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
             Ok(models)
         }
         CommandName::Compare => {
-            let file: CompareFile = read_json(&dir.join("compare.json"))?;
+            let file: CompareFile = read_json(&json)?;
             let best = file.best.overall;
             Ok(file
                 .models
@@ -151,7 +161,7 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
                 .collect())
         }
         CommandName::Discover => {
-            let d: DiscoveryFile = read_json(&dir.join("discovery.json"))?;
+            let d: DiscoveryFile = read_json(&json)?;
             Ok(vec![ModelResult {
                 model: Some(d.final_model.name),
                 params: params(&d.final_model.params, &d.final_model.std_errors, &[]),

@@ -15,7 +15,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use stf_core::regimes::{Classification, Comparison, CycleFeatures, MetricRanking, Regime};
 
-use crate::digits::fixed;
+use crate::digits::{csv_number, csv_optional, fixed};
 use crate::report::Table;
 use crate::writing::write_atomic;
 
@@ -140,16 +140,27 @@ struct CycleRow<'a> {
     source: &'a str,
     cycle: usize,
     regime: &'static str,
+    #[serde(serialize_with = "csv_number")]
     t_mid_s: f64,
+    #[serde(serialize_with = "csv_number")]
     omega_rad_s: f64,
+    #[serde(serialize_with = "csv_number")]
     amplitude_m: f64,
+    #[serde(serialize_with = "csv_number")]
     energy_j: f64,
+    #[serde(serialize_with = "csv_number")]
     c_eq_ns_m: f64,
+    #[serde(serialize_with = "csv_number")]
     phase_x_deg: f64,
+    #[serde(serialize_with = "csv_number")]
     phase_v_deg: f64,
+    #[serde(serialize_with = "csv_number")]
     duty: f64,
+    #[serde(serialize_with = "csv_number")]
     peak_force_n: f64,
+    #[serde(serialize_with = "csv_number")]
     rms_force_n: f64,
+    #[serde(serialize_with = "csv_optional")]
     force_rms_error_n: Option<f64>,
 }
 

@@ -24,6 +24,33 @@ pub fn carried(x: f64) -> f64 {
     format!("{x:.14e}").parse().unwrap_or(x)
 }
 
+/// `x` in a message: at most 15 significant digits ([`carried`]), plain between 10⁻³ and
+/// 10⁶ and in exponent form outside (`1e300`, not a number of 301 digits; `2.5e-7`).
+pub fn shown(x: f64) -> String {
+    let x = carried(x);
+    if x == 0.0 {
+        "0".into()
+    } else if !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `x` to six significant digits for a message (`0.0054` for 0.005399999999999849), as
+/// [`shown`].
+pub fn brief(x: f64) -> String {
+    shown(format!("{x:.5e}").parse().unwrap_or(x))
+}
+
+/// The times `t` run over, for a message: `from 0 to 70 s` (`none`, for no samples).
+pub fn time_span(t: &[f64]) -> String {
+    match (t.first(), t.last()) {
+        (Some(&a), Some(&b)) => format!("from {} to {} s", shown(a), shown(b)),
+        _ => "none".into(),
+    }
+}
+
 /// `x` with `decimals` decimals for a person to read, never as a negative zero ("-0.0" for
 /// -0.04 at one decimal reads as a sign the value does not have).
 pub fn fixed(x: f64, decimals: usize) -> String {
@@ -73,6 +100,21 @@ pub fn with_error(value: f64, error: f64) -> String {
     format!("{} ± {}", show(value, last), show(error, last))
 }
 
+/// A CSV cell of `x`: [`carried`] in Rust's shortest form (`1`, `0.000155`, never
+/// `0.00015500000000000003`), a negative zero as `0`. For `#[serde(serialize_with)]`.
+pub fn csv_number<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    let x = if *x == 0.0 { 0.0 } else { carried(*x) };
+    s.collect_str(&x)
+}
+
+/// [`csv_number`] of an optional value (an empty cell for none).
+pub fn csv_optional<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match x {
+        Some(x) => csv_number(x, s),
+        None => s.serialize_none(),
+    }
+}
+
 /// Every floating-point number of `value`, recursively, rounded by [`carried`]; integers
 /// untouched.
 pub fn tidy_json(value: &mut Value) {
@@ -106,6 +148,44 @@ mod tests {
         assert_eq!(with_error(1234.5678, 0.0), "1234.57 ± 0");
         assert_eq!(with_error(1234.5678, f64::NAN), "1234.57 ± NaN");
         assert_eq!(with_error(-0.0001, 1e-9), "-1.000000e-4 ± 1.0e-9");
+    }
+
+    #[test]
+    fn a_number_in_a_message_is_short() {
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(1e301), "1e301");
+        assert_eq!(shown(2.5e-7), "2.5e-7");
+        assert_eq!(shown(70.0), "70");
+        assert_eq!(shown(0.1 + 0.2), "0.3");
+        assert_eq!(shown(-0.0), "0");
+        assert_eq!(shown(-1234567.0), "-1.234567e6");
+        assert_eq!(brief(0.005399999999999849), "0.0054");
+        assert_eq!(brief(1.0 / 0.005), "200");
+    }
+
+    #[test]
+    fn csv_cells_carry_15_digits_and_no_negative_zero() {
+        #[derive(serde::Serialize)]
+        struct Row {
+            #[serde(serialize_with = "csv_number")]
+            a: f64,
+            #[serde(serialize_with = "csv_number")]
+            b: f64,
+            #[serde(serialize_with = "csv_optional")]
+            c: Option<f64>,
+            #[serde(serialize_with = "csv_optional")]
+            d: Option<f64>,
+        }
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(Row {
+            a: 0.000155 + 1e-20,
+            b: -0.0,
+            c: Some(0.1 + 0.2),
+            d: None,
+        })
+        .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        assert_eq!(text, "a,b,c,d\n0.000155,0,0.3,\n");
     }
 
     #[test]

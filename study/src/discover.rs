@@ -128,7 +128,14 @@ impl DiscoverInputs {
         let setup = refit.as_ref().map(|(_, setup)| setup);
         let found = discover_at(data, setup, (base, &candidates, &cycles), settings);
         job.finish();
-        let found = found?;
+        let found = found.map_err(|e| match e {
+            DiscoveryError::NoHoldout { .. } => anyhow::Error::new(e).context(format!(
+                "{}:{}: `discover.holdout_every`",
+                exp.path.display(),
+                self.spec.line
+            )),
+            e => e.into(),
+        })?;
         let wall_s = started.elapsed().as_secs_f64();
         let score = self
             .validation

@@ -69,9 +69,12 @@ fn kind_of(e: &(dyn std::error::Error + 'static)) -> Option<ErrorKind> {
     } else if e.is::<RecordError>() || e.is::<BoundedError>() {
         Some(ErrorKind::Record)
     } else if let Some(script) = e.downcast_ref::<ScriptError>() {
-        // A name no model has is a mistake of the settings; a script that fails is the model's.
+        // A name no model has, or a script path that is not one, is a mistake of the
+        // settings; a script that fails is the model's.
         Some(match script {
-            ScriptError::UnknownModel { .. } => ErrorKind::Experiment,
+            ScriptError::UnknownModel { .. }
+            | ScriptError::NotAScript { .. }
+            | ScriptError::Read { .. } => ErrorKind::Experiment,
             _ => ErrorKind::Model,
         })
     } else if e.is::<ModelError>() {

@@ -30,8 +30,10 @@ mod finite;
 mod fit;
 mod identify;
 mod integrator;
+pub mod mistakes;
 mod models;
 mod output;
+pub mod plain_words;
 pub mod raw_drive;
 mod regimes;
 mod scripts;
@@ -45,6 +47,7 @@ pub use discover::DiscoverSpec;
 pub use drive::{Chirp, Drive};
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
+pub use mistakes::Mistakes;
 pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
 pub use output::OutputSpec;
 pub use raw_drive::RawDrive;
@@ -61,7 +64,7 @@ struct RawExperiment {
     #[serde(default)]
     models: Vec<Spanned<models::RawModel>>,
     simulate: Option<Spanned<simulate::RawSimulate>>,
-    discover: Option<DiscoverSpec>,
+    discover: Option<Spanned<DiscoverSpec>>,
     fit: Option<Spanned<fit::RawFit>>,
     filter: Option<Spanned<filter::RawFilter>>,
     #[serde(default)]
@@ -162,21 +165,27 @@ impl Experiment {
         Self::parse(path, &text)
     }
 
-    /// Validate the text of an experiment file that lives at `path`.
+    /// Validate the text of an experiment file that lives at `path`. Every mistake is
+    /// reported at once ([`mistakes::Mistakes`]): each value the reading refuses, then each
+    /// section's error.
     pub fn parse(path: &Path, text: &str) -> Result<Experiment> {
-        // Before deserialising, which refuses a number beyond a double's range without its key.
-        if let Some((key, at)) = finite::first_non_finite(text) {
-            return Err(error_at(
-                path,
-                line_of(text, at),
-                &key,
-                "NaN, infinity and numbers beyond a double's range (±1.8e308) are not \
-                 accepted: give a finite number",
-            ));
-        }
         let cx = Ctx { file: path, text };
-        let raw: RawExperiment = toml::from_str(text).map_err(|e| cx.deserialize_error(&e))?;
-        Self::check(raw, &cx)
+        // NaN and infinities are refused first, with their key (deserialising refuses a
+        // number beyond a double's range without it).
+        let mut read = mistakes::read_all::<RawExperiment>(&cx, text);
+        let mut errors = std::mem::take(&mut read.errors);
+        if let Some(raw) = read.raw.take() {
+            let cx = Ctx {
+                file: path,
+                text: &read.text,
+            };
+            match Self::check(raw, &cx) {
+                Ok(exp) if errors.is_empty() => return Ok(exp),
+                Ok(_) => {}
+                Err(more) => errors.extend(more.into_iter().filter(|e| !read.follows(e))),
+            }
+        }
+        Err(Mistakes::of(path, errors))
     }
 
     /// Settings for `record` built in code, no experiment file: every section at its default
@@ -199,7 +208,8 @@ impl Experiment {
             file: &record,
             text: &text,
         };
-        let mut exp = Self::check(RawExperiment::default(), &cx)?;
+        let mut exp = Self::check(RawExperiment::default(), &cx)
+            .map_err(|errors| Mistakes::of(&record, errors))?;
         exp.data_file = Some(record);
         Ok(exp)
     }
@@ -223,23 +233,48 @@ impl Experiment {
         self
     }
 
-    /// The sections of `raw`, checked in turn; `cx` is the file they come from.
-    fn check(raw: RawExperiment, cx: &Ctx) -> Result<Experiment> {
+    /// The sections of `raw`, checked in turn, every section's error kept; `cx` is the file
+    /// they come from.
+    fn check(raw: RawExperiment, cx: &Ctx) -> Result<Experiment, Vec<anyhow::Error>> {
         let dir = folder_of(cx.file);
-        let system = system::check(raw.system.as_ref(), cx)?;
-        let integrator = integrator::check(raw.integrator.as_ref(), cx)?;
-        let models = models::check(&raw.models, "models", cx)?;
-        let simulate = simulate::check(raw.simulate.as_ref(), cx)?;
-        let fit = fit::check(raw.fit.as_ref(), cx)?;
-        let kinematics = filter::check(raw.filter.as_ref(), cx)?;
-        let identify = identify::check(&raw.identify, cx, &dir)?;
-        let regimes = regimes::check(raw.regimes.as_ref(), cx)?;
-        let data = data_layout::parse(cx, raw.data.as_ref(), &dir)?;
-        let kinematics =
-            filter::with_drive(kinematics, raw.filter.as_ref(), raw.data.as_ref(), cx)?;
+        let mut errors = Vec::new();
+        let e = &mut errors;
+        let system = keep(e, system::check(raw.system.as_ref(), cx));
+        let integrator = keep(e, integrator::check(raw.integrator.as_ref(), cx));
+        let models = keep(e, models::check(&raw.models, "models", cx));
+        let simulate = keep(e, simulate::check(raw.simulate.as_ref(), cx));
+        let fit = keep(e, fit::check(raw.fit.as_ref(), cx));
+        let kinematics = keep(e, filter::check(raw.filter.as_ref(), cx)).and_then(|k| {
+            let drive = filter::with_drive(k, raw.filter.as_ref(), raw.data.as_ref(), cx);
+            keep(e, drive)
+        });
+        let identify = keep(e, identify::check(&raw.identify, cx, &dir));
+        let regimes = keep(e, regimes::check(raw.regimes.as_ref(), cx));
+        let data = keep(e, data_layout::parse(cx, raw.data.as_ref(), &dir));
+        let validate = keep(e, validate::spec(raw.validate.as_ref(), cx, &dir));
+        let scripts = keep(e, scripts::run(raw.scripts.as_ref(), cx));
+        let (
+            Some(system),
+            Some(integrator),
+            Some(models),
+            Some(simulate),
+            Some(fit),
+            Some(kinematics),
+            Some(identify),
+            Some(regimes),
+            Some(data),
+            Some(validate),
+            Some(scripts),
+        ) = (
+            system, integrator, models, simulate, fit, kinematics, identify, regimes, data,
+            validate, scripts,
+        )
+        else {
+            return Err(errors);
+        };
         Ok(Experiment {
-            validate: validate::spec(raw.validate.as_ref(), cx, &dir)?,
-            scripts: scripts::run(raw.scripts.as_ref(), cx)?,
+            validate,
+            scripts,
             path: cx.file.to_path_buf(),
             data_window: data.window,
             data_layout: data.layout,
@@ -257,9 +292,21 @@ impl Experiment {
             integrator,
             models,
             simulate,
-            discover: raw.discover,
+            discover: raw.discover.map(|d| {
+                let line = cx.line(d.span().start);
+                DiscoverSpec {
+                    line,
+                    ..d.into_inner()
+                }
+            }),
         })
     }
+}
+
+/// The value of `r`, or none with its error added to `errors`: how a check goes on past a
+/// section's error to report the next section's too.
+fn keep<T>(errors: &mut Vec<anyhow::Error>, r: Result<T>) -> Option<T> {
+    r.map_err(|e| errors.push(e)).ok()
 }
 
 /// `text` parsed as the experiment file `exp.toml`: what the tests of every section check.

@@ -26,6 +26,7 @@ use stf_core::fit::{
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
 
+use crate::digits::shown;
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
 use crate::observer::{fit_message, jobs_message, Job, Observer};
@@ -116,11 +117,16 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     let record_warnings = crate::plausibility::check(exp, file, &record)
         .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
     if let Some((t0, t1)) = exp.data_window {
+        let span = crate::digits::time_span(&record.t);
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
             bail!(
-                "{}: `data.window` [{t0}, {t1}] keeps {} samples of {}",
+                "{}:{}: `data.window` [{}, {}] keeps {} samples of {}, whose times run {span}: \
+                 give a window of at least 10 samples within them",
                 exp.path.display(),
+                exp.data_line,
+                shown(t0),
+                shown(t1),
                 record.len(),
                 file.display()
             );
@@ -128,9 +134,10 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
     }
     let mut kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
         anyhow!(
-            "cannot derive the kinematics of {}: {e}{}",
-            file.display(),
-            rate_hint(&e)
+            "{}:{}: `[data]`: {}",
+            exp.path.display(),
+            exp.data_line,
+            kinematics_error(&e, &file.display().to_string())
         )
     })?;
     let level = match asked.or(exp.fit.level) {
@@ -189,20 +196,6 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         system_estimate,
         record_warnings,
     })
-}
-
-/// The fix for a time column that is not uniform (nor uniform within its rounding): a
-/// constant sample rate in `[data]`, at the column's mean step and from its first stamp.
-pub fn rate_hint(e: &stf_core::numerics::derivative::FilterError) -> String {
-    match e {
-        stf_core::numerics::derivative::FilterError::NonUniform { mean, .. } => format!(
-            "; if the rig sampled at a constant rate, give it in `[data]`: `rate = {:.6}` (Hz, \
-             the column's mean step; with `t0` = the first time stamp, s), and the time column \
-             is not read",
-            1.0 / mean
-        ),
-        _ => String::new(),
-    }
 }
 
 /// The terminal line saying where the oscillator came from, if the record gave it.
@@ -581,6 +574,31 @@ pub fn oscillator_fit(exp: &Experiment, system: OscillatorParams, k: &Kinematics
         .initial(x0, v0)
 }
 
+/// Why the kinematics of the record `file` cannot be derived, with the fix where there is
+/// one: a time column that is not uniform names the `[data] rate` that would replace it.
+pub fn kinematics_error(e: &stf_core::numerics::derivative::FilterError, file: &str) -> String {
+    use crate::digits::brief;
+    use stf_core::numerics::derivative::FilterError;
+    match e {
+        FilterError::NonUniform {
+            index,
+            time,
+            step,
+            mean,
+        } => format!(
+            "the times of {file} are not uniform: the step from sample {index} (t = {} s) is \
+             {} s against a mean of {} s (more than 0.1 % off); if the record was sampled at \
+             a fixed rate, give it in [data]: `rate = {}` (samples/s; the times are then t0 \
+             + i/rate, and the t column is not read), or resample the record uniformly",
+            brief(*time),
+            brief(*step),
+            brief(*mean),
+            brief(1.0 / mean)
+        ),
+        e => format!("cannot derive the kinematics of {file}: {e}"),
+    }
+}
+
 /// Configure and fit every model of the experiment, in parallel (bounds widened where the
 /// record needs it: [`FitData::scales`]).
 pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Result<Vec<ModelFit>> {
@@ -597,19 +615,20 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Res
         }
         vec![None]
     } else {
-        exp.models
+        // Every entry's mistakes at once, as the file's own.
+        let (ok, errors): (Vec<_>, Vec<_>) = exp
+            .models
             .iter()
             .map(|m| {
-                configure_for(
-                    std::slice::from_ref(m),
-                    &exp.path,
-                    &exp.dir,
-                    &exp.scripts,
-                    Some(&scales),
-                )
-                .map(Some)
+                let entry = std::slice::from_ref(m);
+                configure_for(entry, &exp.path, &exp.dir, &exp.scripts, Some(&scales))
             })
-            .collect::<Result<_>>()?
+            .partition(Result::is_ok);
+        if !errors.is_empty() {
+            let errors = errors.into_iter().filter_map(Result::err).collect();
+            return Err(crate::experiment::Mistakes::of(&exp.path, errors));
+        }
+        ok.into_iter().map(|c| c.ok()).collect()
     };
     let calls = crate::script_plan::fit_calls(&configured, data.record.len(), data.level);
     crate::script_plan::check(exp, calls, "this fit", progress)?;

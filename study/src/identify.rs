@@ -85,8 +85,10 @@ pub fn identify(exp: &Experiment, progress: &dyn Observer) -> Result<Identificat
     for (i, stage) in exp.identify.iter().enumerate() {
         stage_start(exp, i, &mut system);
         let record = crate::fitting::read_record(exp, &stage.data)?;
-        let k = Kinematics::from_record(&record, &exp.kinematics)
-            .with_context(|| format!("cannot derive the kinematics of {}", stage.data.display()))?;
+        let k = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
+            let file = stage.data.display().to_string();
+            anyhow::anyhow!("{}", crate::fitting::kinematics_error(&e, &file))
+        })?;
         let mut fit = oscillator_fit(exp, system, &k).settings(exp.fit.settings.clone());
         let mut free: Vec<_> = stage
             .free

@@ -17,7 +17,7 @@ use stf_core::physics::model_sum::{neutral_amplitude, ModelSum};
 use stf_plugins::ScriptRun;
 
 use crate::experiment::context::place;
-use crate::experiment::{error_at, ModelEntry, ParamGiven};
+use crate::experiment::{error_at, ModelEntry, ModelSource, ParamGiven};
 
 /// A model ready to plug into the oscillator.
 #[derive(Clone)]
@@ -91,6 +91,12 @@ pub fn resolve(spec: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceM
     Ok(stf_plugins::registry::Registry::in_run(run.clone()).resolve(spec, dir)?)
 }
 
+/// [`resolve`] for a path given as a script (`script = "…"`): a folder or a file that is not
+/// a `.rhai` script is named as such.
+pub fn resolve_script(path: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn ForceModel>> {
+    Ok(stf_plugins::registry::Registry::in_run(run.clone()).resolve_script(path, dir)?)
+}
+
 /// Build one model from experiment entries: the parts of every entry are summed (one entry
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
 /// are applied. `file` is the experiment file, `dir` its folder, `run` where scripts load.
@@ -105,10 +111,13 @@ pub fn configure_for(
 ) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
-        for spec in entry.specs() {
+        for (i, spec) in entry.specs().enumerate() {
+            let model = match &entry.source {
+                ModelSource::Script(path) if i == 0 => resolve_script(path, dir, run),
+                _ => resolve(spec, dir, run),
+            };
             // The cause stays typed (a script's error is a model error to a front end).
-            let model = resolve(spec, dir, run)
-                .map_err(|e| e.context(place(file, entry.line, &entry.key)))?;
+            let model = model.map_err(|e| e.context(place(file, entry.line, &entry.key)))?;
             parts.push(match scales {
                 Some(s) => widened(model, s),
                 None => model,
@@ -120,10 +129,13 @@ pub fn configure_for(
         anyhow!("{}:{}: {}", file.display(), line, e)
     })?;
     let mut params: Vec<FitParam> = sum.params().iter().map(FitParam::from_spec).collect();
-    for entry in entries {
-        for given in &entry.params {
-            apply(&mut params, &sum, entry, given, file)?;
-        }
+    let errors: Vec<anyhow::Error> = entries
+        .iter()
+        .flat_map(|entry| entry.params.iter().map(move |given| (entry, given)))
+        .filter_map(|(entry, given)| apply(&mut params, &sum, entry, given, file).err())
+        .collect();
+    if !errors.is_empty() {
+        return Err(crate::experiment::Mistakes::of(file, errors));
     }
     Ok(ConfiguredModel {
         parts: sum.parts().to_vec(),
@@ -153,20 +165,48 @@ fn apply(
     let i = sum.param_index(name).ok_or_else(|| {
         let known: Vec<&str> = sum.params().iter().map(|s| s.name.as_str()).collect();
         at(format!(
-            "`{}` has no parameter `{name}`; its parameters: {}",
+            "`{}` has no parameter `{name}`{}; its parameters: {}",
             sum.name(),
+            stf_core::names::did_you_mean(name, known.iter().copied()),
             known.join(", ")
         ))
     })?;
     let p = &mut params[i];
     given.set.apply(p);
     if !(p.value.is_finite() && p.min <= p.value && p.value <= p.max) {
-        return Err(at(format!(
-            "{} lies outside its bounds [{}, {}]",
-            p.value, p.min, p.max
-        )));
+        return Err(at(out_of_bounds(name, p)));
     }
     Ok(())
+}
+
+/// Why `p`'s value is refused, and the fix: the bounds widened in the same entry, with a
+/// bound past the value (`K = { value = 50, max = 100 }`).
+fn out_of_bounds(name: &str, p: &FitParam) -> String {
+    use crate::digits::shown;
+    let past = |x: f64, up: bool| match (x == 0.0, (x > 0.0) == up) {
+        (true, _) => {
+            if up {
+                1.0
+            } else {
+                -1.0
+            }
+        }
+        (false, true) => 2.0 * x,
+        (false, false) => x / 2.0,
+    };
+    let widened = if p.value > p.max {
+        format!("max = {}", shown(past(p.value, true)))
+    } else {
+        format!("min = {}", shown(past(p.value, false)))
+    };
+    format!(
+        "{} lies outside its bounds [{}, {}]: give a start value within them, or widen them \
+         in this entry: `{name} = {{ value = {}, {widened} }}`",
+        shown(p.value),
+        shown(p.min),
+        shown(p.max),
+        shown(p.value)
+    )
 }
 
 #[cfg(test)]
@@ -204,7 +244,10 @@ mod tests {
             msg.contains("exp.toml:3") && msg.contains("models[0].params.k"),
             "{msg}"
         );
-        assert!(msg.contains("K, n"), "{msg}");
+        assert!(
+            msg.contains("(did you mean `K`?); its parameters: K, n"),
+            "{msg}"
+        );
     }
 
     #[test]
@@ -219,7 +262,11 @@ mod tests {
             msg.contains("exp.toml:3") && msg.contains("models[0].params.n"),
             "{msg}"
         );
-        assert!(msg.contains("outside its bounds"), "{msg}");
+        assert!(
+            msg.contains("0.5 lies outside its bounds [1, ")
+                && msg.contains("widen them in this entry: `n = { value = 0.5, min = 0.25 }`"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -23,6 +23,7 @@ use stf_core::fit::TrajectoryFit;
 use stf_core::physics::excitation::Excitation;
 use stf_core::regimes::{classify, rms_by_regime, Cycle, Regime};
 
+use crate::digits::shown;
 use crate::experiment::{Experiment, FitLevel, ValidateSpec};
 use crate::fitting::{cycles_of, read_record, FitData, ModelFit, Predictor};
 
@@ -60,26 +61,22 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         .map_err(|e| spec.error(key, format!("{e:#}")))?;
     check_columns(exp, spec, &record, estimation)?;
     if let Some((t0, t1)) = spec.window {
+        let span = crate::digits::time_span(&record.t);
         record = record.slice_time(t0, t1);
         if record.len() < 10 {
             let msg = format!(
-                "[{t0}, {t1}] keeps {} samples of {}",
+                "[{}, {}] keeps {} samples of {}, whose times run {span}: give a window of at \
+                 least 10 samples within them",
+                shown(t0),
+                shown(t1),
                 record.len(),
                 spec.given
             );
             return Err(spec.error("validate.window", msg));
         }
     }
-    let kinematics = Kinematics::from_record(&record, &exp.kinematics).map_err(|e| {
-        spec.error(
-            key,
-            format!(
-                "cannot derive the kinematics of {}: {e}{}",
-                spec.given,
-                crate::fitting::rate_hint(&e)
-            ),
-        )
-    })?;
+    let kinematics = Kinematics::from_record(&record, &exp.kinematics)
+        .map_err(|e| spec.error(key, crate::fitting::kinematics_error(&e, &spec.given)))?;
     let data = FitData {
         record,
         kinematics,

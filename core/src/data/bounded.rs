@@ -131,7 +131,11 @@ pub fn not_readable_kind(path: &Path) -> Option<&'static str> {
 /// `/dev/zero` included).
 pub fn record_path_problem(path: &Path) -> Option<String> {
     let Ok(meta) = std::fs::metadata(path) else {
-        return Some(format!("no such record: {}", path.display()));
+        return Some(format!(
+            "no such record: {}{}",
+            path.display(),
+            crate::names::nearby_file(path)
+        ));
     };
     if meta.is_file() {
         return None;

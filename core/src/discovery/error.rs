@@ -15,6 +15,18 @@ pub enum DiscoveryError {
     /// The data cannot be analysed (lengths differ, too few cycles, …).
     #[error("bad discovery data: {0}")]
     BadData(String),
+    /// Holding out every `every`-th whole cycle holds out none: the record has fewer.
+    #[error(
+        "holdout_every = {every} holds out none of the record's {cycles} whole cycles (one in \
+         {every} is held out to score each effect): give holdout_every at most {cycles}, or \
+         leave it out (the default holds out one cycle in 4)"
+    )]
+    NoHoldout {
+        /// Whole cycles of the record.
+        cycles: usize,
+        /// One cycle in this many is held out.
+        every: usize,
+    },
     /// Two candidates share a name, or a candidate has the base model's name.
     #[error("candidate `{0}` is listed twice or is the base model itself")]
     DuplicateCandidate(String),

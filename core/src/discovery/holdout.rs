@@ -46,10 +46,10 @@ impl HoldoutSplit {
             }
         }
         if holdout_cycles == 0 {
-            return Err(DiscoveryError::BadData(format!(
-                "{} whole cycles hold out none at one in {every}: the record is too short",
-                cycles.len()
-            )));
+            return Err(DiscoveryError::NoHoldout {
+                cycles: cycles.len(),
+                every,
+            });
         }
         let (holdout, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| held[i]);
         Ok(HoldoutSplit {

@@ -1,7 +1,8 @@
 //! Where an experiment file's errors point: [`Ctx`] holds the file and its text, and every
 //! error about a value reads `FILE:LINE: `KEY`: MSG` ([`error_at`]). Errors from serde (an
-//! unknown key, a wrong type, an unknown variant of a serde enum, which lists the accepted
-//! ones) take the same form through [`Ctx::deserialize_error`], with the key path `toml` records.
+//! unknown key, a wrong type, an unknown value of a serde enum, which lists the accepted
+//! ones) take the same form through [`Ctx::deserialize_error`], with the key path `toml` records
+//! (each array of tables' index added) and serde's words in the file's ([`super::plain_words`]).
 
 use std::ops::Range;
 use std::path::Path;
@@ -118,7 +119,10 @@ impl<'a> Ctx<'a> {
         what: &str,
     ) -> anyhow::Result<u64> {
         let v = *value.get_ref();
-        let msg = format!("{v} is not a {what} (at least {least})");
+        let msg = format!(
+            "{} is not a {what} (at least {least})",
+            crate::digits::shown(v)
+        );
         self.ensure(
             v >= least as f64 && v <= u64::MAX as f64,
             value.span(),
@@ -142,11 +146,64 @@ impl<'a> Ctx<'a> {
             return anyhow::anyhow!("{}: {}{hint}", self.file.display(), shorten(msg));
         };
         let line = line_of(self.text, span.start);
+        let written = self.text.get(span.clone()).unwrap_or_default();
+        let msg = &super::plain_words::plain(msg, written);
         match key_path(e) {
-            Some(key) => error_at(self.file, line, &key, msg),
+            Some(key) => error_at(self.file, line, &indexed(self.text, &key, span.start), msg),
             None => anyhow::anyhow!("{}:{}: {}", self.file.display(), line, shorten(msg)),
         }
     }
+}
+
+/// `path` with the index of each array of tables it passes through (`models[1].params.K`
+/// for toml's `models.params.K`): the item of the array that starts last before `offset`.
+fn indexed(text: &str, path: &str, offset: usize) -> String {
+    use toml::de::{DeTable, DeValue};
+    let Ok(doc) = DeTable::parse(text) else {
+        return path.to_string();
+    };
+    let mut table = doc.get_ref();
+    let mut out = Vec::new();
+    let mut parts = path.split('.');
+    while let Some(part) = parts.next() {
+        let found = table.iter().find(|(k, _)| k.get_ref() == part);
+        let Some((_, value)) = found else {
+            out.push(part.to_string());
+            out.extend(parts.map(str::to_string));
+            break;
+        };
+        match value.get_ref() {
+            DeValue::Array(items) => {
+                let at = items
+                    .iter()
+                    .enumerate()
+                    .rfind(|(_, v)| v.span().start <= offset);
+                match at {
+                    Some((i, v)) if v.get_ref().is_table() => {
+                        out.push(format!("{part}[{i}]"));
+                        if let DeValue::Table(t) = v.get_ref() {
+                            table = t;
+                        }
+                    }
+                    _ => {
+                        out.push(part.to_string());
+                        out.extend(parts.map(str::to_string));
+                        break;
+                    }
+                }
+            }
+            DeValue::Table(t) => {
+                out.push(part.to_string());
+                table = t;
+            }
+            _ => {
+                out.push(part.to_string());
+                out.extend(parts.map(str::to_string));
+                break;
+            }
+        }
+    }
+    out.join(".")
 }
 
 /// The dotted key path `toml` records on a deserialisation error (`fit.level`; a table's
@@ -174,9 +231,9 @@ mod tests {
         let msg = message(&format!("[system]\n{key} = 1.0\n"));
         assert!(msg.len() < 2_000, "{} bytes", msg.len());
         assert!(msg.starts_with("exp.toml:2: `system`: "), "{}", &msg[..200]);
-        // The word shown cut is the key with its quotes and comma.
+        // The word shown cut is the key with its quotes.
         assert!(
-            msg.contains("unknown field `kkkk") && msg.contains("…(5000003 bytes)…"),
+            msg.contains("unknown key `kkkk") && msg.contains("…(5000002 bytes)…"),
             "{msg}"
         );
         // Short text is shown whole; multibyte text is cut on a character boundary.
@@ -205,21 +262,25 @@ mod tests {
     fn a_serde_error_names_the_line_and_the_key_path() {
         assert_eq!(
             message("[fit]\n\nlevel = \"forc\"\n"),
-            "exp.toml:3: `fit.level`: unknown variant `forc`, expected `force` or `trajectory`"
+            "exp.toml:3: `fit.level`: unknown value `forc` (did you mean `force`?) (one of: force, trajectory)"
         );
         assert_eq!(
             message("[system]\nm = 7.65\nk = \"stiff\"\n"),
-            "exp.toml:3: `system.k`: invalid type: string \"stiff\", expected f64"
+            "exp.toml:3: `system.k`: expected a number, found the string \"stiff\""
         );
         // A key unknown in a table names the table; at the top level, no key.
         let msg = message("[system]\nm = 7.65\nstifnes = 3.0\n");
         assert!(
-            msg.starts_with("exp.toml:3: `system`: unknown field `stifnes`, expected one of"),
+            msg.starts_with(
+                "exp.toml:3: `system`: unknown key `stifnes` (keys here: preset, m, k,"
+            ),
             "{msg}"
         );
         let msg = message("\nsystm = 3.0\n");
         assert!(
-            msg.starts_with("exp.toml:2: unknown field `systm`, expected one of"),
+            msg.starts_with(
+                "exp.toml:2: unknown key `systm` (did you mean `system`?) (keys here: data,"
+            ),
             "{msg}"
         );
     }

@@ -34,6 +34,9 @@ pub struct DiscoverSpec {
     /// Polish an accepted model before the next step; `None`: the level's default (off at
     /// force level, on at trajectory level).
     pub polish: Option<bool>,
+    /// Line of `[discover]` in the file (1-based; 0 for settings built in code).
+    #[serde(skip)]
+    pub line: usize,
 }
 
 /// `base = "a + b + …"` as its terms, trimmed; an empty term is an error.
@@ -112,8 +115,8 @@ mod tests {
             parse("\n[discover]\nbase = \"viscous\"\nlevel = \"forces\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:4: `discover.level`: unknown variant `forces`")
-                && msg.contains("`force` or `trajectory`"),
+            msg.starts_with("exp.toml:4: `discover.level`: unknown value `forces`")
+                && msg.contains("one of: force, trajectory"),
             "{msg}"
         );
     }
@@ -135,7 +138,7 @@ mod tests {
             parse("\n[discover]\nbase = \"viscous\"\npolish = \"yes\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:4: `discover.polish`: invalid type"),
+            msg.starts_with("exp.toml:4: `discover.polish`: expected true or false"),
             "{msg}"
         );
     }

@@ -170,8 +170,8 @@ mod tests {
             parse("[filter]\nboundary = \"edge\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:2: `filter.boundary`: unknown variant `edge`")
-                && msg.contains("`shifted` or `zero`"),
+            msg.starts_with("exp.toml:2: `filter.boundary`: unknown value `edge`")
+                && msg.contains("one of: shifted, zero"),
             "{msg}"
         );
         let msg = format!(

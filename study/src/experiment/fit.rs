@@ -188,13 +188,13 @@ mod tests {
     #[test]
     fn an_unknown_name_names_file_line_key_and_the_known_ones() {
         for (text, key, known) in [
-            ("level = \"forc\"", "fit.level", "`force` or `trajectory`"),
-            ("initial = \"guess\"", "fit.initial", "`fit` or `record`"),
-            ("solver = \"newton\"", "fit.solver", "`nelder_mead`"),
+            ("level = \"forc\"", "fit.level", "one of: force, trajectory"),
+            ("initial = \"guess\"", "fit.initial", "one of: fit, record"),
+            ("solver = \"newton\"", "fit.solver", "nelder_mead"),
         ] {
             let msg = format!("{:#}", parse(&format!("\n[fit]\n{text}\n")).unwrap_err());
             assert!(
-                msg.starts_with(&format!("exp.toml:3: `{key}`: unknown variant"))
+                msg.starts_with(&format!("exp.toml:3: `{key}`: unknown value"))
                     && msg.contains(known),
                 "{msg}"
             );

@@ -108,8 +108,8 @@ mod tests {
             parse(&format!("{stage}preset = \"forcd\"\n")).unwrap_err()
         );
         assert!(
-            msg.starts_with("dir/exp.toml:4: `identify.preset`: unknown variant `forcd`")
-                && msg.contains("`forced` or `free`"),
+            msg.starts_with("dir/exp.toml:4: `identify[0].preset`: unknown value `forcd`")
+                && msg.contains("one of: forced, free"),
             "{msg}"
         );
     }

@@ -100,7 +100,7 @@ mod tests {
             parse("[integrator]\nmethod = \"euler\"\n").unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:2: `integrator.method`: unknown variant `euler`"),
+            msg.starts_with("exp.toml:2: `integrator.method`: unknown value `euler`"),
             "{msg}"
         );
         let e = parse("[integrator]\nmethod = \"auto\"\n").unwrap();

@@ -14,13 +14,40 @@ use toml::Spanned;
 use super::Ctx;
 
 /// A parameter value as written: a number, or a table with value / min / max / fixed.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(untagged)]
+#[derive(Clone, Debug)]
 enum RawParam {
     /// Just the value.
     Value(f64),
     /// Value with bounds and a fixed/free switch.
     Table(ParamOverride),
+}
+
+/// Read by hand rather than as an untagged enum, whose error ("data did not match any
+/// variant") names neither what was expected nor which key of a table was wrong.
+impl<'de> Deserialize<'de> for RawParam {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = RawParam;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or a table { value, min, max, fixed }")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<RawParam, E> {
+                Ok(RawParam::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<RawParam, E> {
+                Ok(RawParam::Value(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<RawParam, E> {
+                Ok(RawParam::Value(v as f64))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<RawParam, A::Error> {
+                let table = serde::de::value::MapAccessDeserializer::new(map);
+                ParamOverride::deserialize(table).map(RawParam::Table)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// What an entry sets of a parameter — its table form as written (`{ value, min, max,

@@ -129,7 +129,7 @@ mod tests {
             ),
             (
                 "[scripts]\nrun_operations = 2.5e30\n",
-                "`scripts.run_operations`: 2500000",
+                "`scripts.run_operations`: 2.5e30 is not a count",
             ),
             ("[scripts]\ndeadline = 1.0\n", "deadline"),
         ] {

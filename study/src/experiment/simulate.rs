@@ -13,6 +13,7 @@ use toml::Spanned;
 use super::drive::{self, Chirp, Drive, RawConstant, RawFree, RawProfile, RawSweep};
 use super::models::{self, ModelEntry, RawModel};
 use super::Ctx;
+use crate::digits::shown;
 
 /// `[simulate]` as written.
 #[derive(Debug, Deserialize)]
@@ -84,7 +85,7 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
     let (span, s) = (s.span(), s.get_ref());
     let checked = the_drive(s, cx, span.clone())?;
     let (t0, t1, mut as_json) = (checked.t0, checked.t1, checked.as_json);
-    let order = format!("t1 = {t1} must exceed t0 = {t0}");
+    let order = format!("t1 = {} must exceed t0 = {}", shown(t1), shown(t0));
     cx.ensure(t1 > t0, span.clone(), "simulate", order)?;
     cx.ensure(
         s.rate > 0.0,
@@ -138,9 +139,11 @@ fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64
     };
     let count = sample_count(t0, t1, s.rate);
     let asked = format!(
-        "{} samples/s from t0 = {t0} to t1 = {t1} s asks for {} samples, over the limit of \
+        "{} samples/s from t0 = {} to t1 = {} s asks for {} samples, over the limit of \
          {limit} (`simulate.max_samples`; a run holds about 140 bytes a sample)",
-        s.rate,
+        shown(s.rate),
+        shown(t0),
+        shown(t1),
         count_text(count)
     );
     cx.ensure(count <= limit as f64, span.clone(), "simulate.rate", asked)?;
@@ -156,10 +159,12 @@ fn sample_limit(cx: &Ctx, span: &Range<usize>, s: &RawSimulate, t0: f64, t1: f64
         };
         let span = s.max_samples.as_ref().map_or(span.clone(), |m| m.span());
         let msg = format!(
-            "{} samples/s from t0 = {t0} to t1 = {t1} s is {} samples, which {why}; the limit \
+            "{} samples/s from t0 = {} to t1 = {} s is {} samples, which {why}; the limit \
              of {limit} samples (`simulate.max_samples`) does not make room for them: lower \
              `rate` or the drive's end time",
-            s.rate,
+            shown(s.rate),
+            shown(t0),
+            shown(t1),
             count_text(count)
         );
         return Err(cx.at(span, key, msg));
@@ -180,7 +185,7 @@ mod tests {
             .to_string();
         assert_eq!(
             msg,
-            "exp.toml:1: `simulate.rate`: 1000000 samples/s from t0 = 0 to t1 = 1000000000 s \
+            "exp.toml:1: `simulate.rate`: 1e6 samples/s from t0 = 0 to t1 = 1e9 s \
              asks for 1.00e15 samples, over the limit of 10000000 (`simulate.max_samples`; a \
              run holds about 140 bytes a sample)"
         );
@@ -218,7 +223,7 @@ mod tests {
         .to_string();
         assert!(
             msg.starts_with(
-                "exp.toml:4: `simulate.max_samples`: 1000000000 samples/s from t0 = 0 \
+                "exp.toml:4: `simulate.max_samples`: 1e9 samples/s from t0 = 0 \
                              to t1 = 10000 s is 1.00e13 samples, which needs about"
             ) && msg.contains("of memory this machine has available")
                 && msg.contains("lower `rate`"),
@@ -360,8 +365,8 @@ mod tests {
             parse(&format!("[simulate]\n{chirp}, hold = \"step\" }}\n")).unwrap_err()
         );
         assert!(
-            msg.starts_with("exp.toml:2: `simulate.chirp.hold`: unknown variant `step`")
-                && msg.contains("`linear` or `zoh`"),
+            msg.starts_with("exp.toml:2: `simulate.chirp.hold`: unknown value `step`")
+                && msg.contains("one of: linear, zoh"),
             "{msg}"
         );
     }

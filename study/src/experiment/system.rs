@@ -107,7 +107,7 @@ mod tests {
     fn an_unknown_preset_or_a_bad_value_names_file_line_key_and_what_is_accepted() {
         let msg = format!("{:#}", parse("[system]\npreset = \"forcd\"\n").unwrap_err());
         assert!(
-            msg.starts_with("exp.toml:2: `system.preset`:") && msg.contains("`forced` or `free`"),
+            msg.starts_with("exp.toml:2: `system.preset`:") && msg.contains("one of: forced, free"),
             "{msg}"
         );
         for (text, key) in [

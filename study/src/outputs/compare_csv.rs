@@ -1,15 +1,16 @@
 //! `compare.csv` of `stf-lab compare`: one row per model and regime the record has cycles in,
 //! the errors of `compare.json`'s `regimes` in a table. Rows are [`CompareRow`]s serialized by
-//! the csv crate; numbers are written in Rust's shortest round-trip form (`1`, `0.0029`), as
-//! they always were.
+//! the csv crate; numbers are written with the digits they carry, in Rust's shortest form
+//! (`1`, `0.0029`, `0.000155` and never `0.00015500000000000003`: [`crate::digits::csv_number`]).
 
 use std::path::Path;
 
 use anyhow::Result;
-use serde::{Serialize, Serializer};
+use serde::Serialize;
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 
 use super::csv_rows;
+use crate::digits::csv_number;
 
 /// One row: a model's errors in one regime.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -21,46 +22,41 @@ pub struct CompareRow<'a> {
     /// Measured cycles in the regime.
     pub cycles: usize,
     /// RMS of the force error (model − measured), N.
-    #[serde(rename = "force_rms_error_N", serialize_with = "shortest")]
+    #[serde(rename = "force_rms_error_N", serialize_with = "csv_number")]
     pub force_rms_error: f64,
     /// `force_rms_error_N` over the measured force's RMS (at least the on-threshold).
-    #[serde(serialize_with = "shortest")]
+    #[serde(serialize_with = "csv_number")]
     pub relative_rms_error: f64,
     /// Mean |Δ∮F dx| per cycle, J.
-    #[serde(rename = "energy_error_J", serialize_with = "shortest")]
+    #[serde(rename = "energy_error_J", serialize_with = "csv_number")]
     pub energy_error: f64,
     /// Mean |Δduty| (on-fraction) per cycle.
-    #[serde(serialize_with = "shortest")]
+    #[serde(serialize_with = "csv_number")]
     pub duty_error: f64,
     /// Mean |Δ peak |F|| per cycle, N.
-    #[serde(rename = "peak_force_error_N", serialize_with = "shortest")]
+    #[serde(rename = "peak_force_error_N", serialize_with = "csv_number")]
     pub peak_force_error: f64,
     /// Fraction of cycles whose model label equals the measured label.
-    #[serde(serialize_with = "shortest")]
+    #[serde(serialize_with = "csv_number")]
     pub label_agreement: f64,
     /// Mean measured ∮F dx per cycle, J.
-    #[serde(rename = "measured_energy_J", serialize_with = "shortest")]
+    #[serde(rename = "measured_energy_J", serialize_with = "csv_number")]
     pub measured_energy: f64,
     /// The same of the model's force, J.
-    #[serde(rename = "model_energy_J", serialize_with = "shortest")]
+    #[serde(rename = "model_energy_J", serialize_with = "csv_number")]
     pub model_energy: f64,
     /// Mean measured equivalent viscous damping, N·s/m.
-    #[serde(rename = "measured_c_eq_Ns_m", serialize_with = "shortest")]
+    #[serde(rename = "measured_c_eq_Ns_m", serialize_with = "csv_number")]
     pub measured_c_eq: f64,
     /// The same of the model's force, N·s/m.
-    #[serde(rename = "model_c_eq_Ns_m", serialize_with = "shortest")]
+    #[serde(rename = "model_c_eq_Ns_m", serialize_with = "csv_number")]
     pub model_c_eq: f64,
     /// Mean |Δphase against x| per cycle, degrees.
-    #[serde(serialize_with = "shortest")]
+    #[serde(serialize_with = "csv_number")]
     pub phase_x_error_deg: f64,
     /// Mean |Δphase against v| per cycle, degrees.
-    #[serde(serialize_with = "shortest")]
+    #[serde(serialize_with = "csv_number")]
     pub phase_v_error_deg: f64,
-}
-
-/// `v` in Rust's shortest round-trip form (`Display`): `1`, not the csv crate's `1.0`.
-fn shortest<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    s.collect_str(v)
 }
 
 impl<'a> CompareRow<'a> {
