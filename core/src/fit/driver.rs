@@ -628,7 +628,7 @@ mod tests {
             let params = [FitParam::new("k", 0.0).bounds(-100.0, 100.0).scale(0.1)];
             for solver in Solver::ALL {
                 let settings = FitSettings::default().solver(solver);
-                let fit = run(&line, &params, &settings, None, false).unwrap();
+                let fit = run(&line, &params, &settings, None, Quantity::Force).unwrap();
                 let p = &fit.params[0];
                 assert_eq!(
                     p.held_by, held,
