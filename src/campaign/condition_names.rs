@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 
 use stf_core::fit::{DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
 
-use super::table::{is_fixed_column, STD_ERROR_SUFFIX};
+use super::csv_columns::{is_fixed_column, STD_ERROR_SUFFIX};
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::configure_for;
 

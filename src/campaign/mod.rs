@@ -12,6 +12,7 @@
 
 pub mod command;
 pub mod condition_names;
+pub mod csv_columns;
 pub mod figure_series;
 pub mod file;
 pub mod global;

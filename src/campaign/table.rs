@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use indexmap::IndexMap;
 use serde::Serialize;
 
+use super::csv_columns::{LEADING_COLUMNS, MODEL_COLUMN, STD_ERROR_SUFFIX, TRAILING_COLUMNS};
 use super::file::{Campaign, CommandName, Unit};
 use super::unit::{read_unit_json, unit_dir, UnitStatus};
 use super::unit_results::{self, ModelResult};
@@ -142,34 +143,6 @@ pub fn param_names(rows: &[CampaignRow]) -> Vec<String> {
         }
     }
     names
-}
-
-/// The columns of `campaign.csv` before the conditions.
-const LEADING_COLUMNS: [&str; 4] = ["unit", "record", "command", "status"];
-/// The column of the model's name, after the conditions.
-const MODEL_COLUMN: &str = "model";
-/// The columns after the parameters.
-const TRAILING_COLUMNS: [&str; 12] = [
-    "rms",
-    "rms_unit",
-    "aic",
-    "bic",
-    "converged",
-    "best",
-    "warnings",
-    "validation_rms",
-    "effects",
-    "gap_before",
-    "wall_seconds",
-    "error",
-];
-/// What a parameter's standard-error column adds to its name.
-pub const STD_ERROR_SUFFIX: &str = "_std_error";
-
-/// Whether `name` is a column `campaign.csv` always has (`unit`, `status`, `model`, `rms` …),
-/// which a condition of that name would duplicate.
-pub fn is_fixed_column(name: &str) -> bool {
-    LEADING_COLUMNS.contains(&name) || name == MODEL_COLUMN || TRAILING_COLUMNS.contains(&name)
 }
 
 /// `campaign.csv`: `unit, record, command, status, <conditions…>, model, <param>,
