@@ -190,12 +190,8 @@ fn on_the_papers_sweep_exactly_the_hidden_effect_is_named() {
 /// The parameters of each built-in candidate, to read a candidate's training RSS against the
 /// current model's from its ΔAIC (N·ln(RSS/N) + 2p).
 fn own_params(name: &str) -> f64 {
-    match name {
-        "viscous" | "added_mass" | "cubic_stiffness" => 1.0,
-        "power_law" | "yield" | "maxwell" => 2.0,
-        "wall_impact" | "jamming_on_off" => 4.0,
-        other => panic!("unknown candidate {other}"),
-    }
+    let model = stf_models::find(name).unwrap_or_else(|| panic!("unknown candidate {name}"));
+    model.params().len() as f64
 }
 
 /// A small Maxwell element hidden beside the power law (c_m 1 N·s/m, τ 0.05 s; t, φ, x
