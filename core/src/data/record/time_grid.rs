@@ -3,8 +3,9 @@
 //! A logger that writes its time column with few digits (0.1 ms at 610.35 Hz, say) makes a
 //! uniformly sampled record look irregular: its steps take two values a rounding quantum `q`
 //! apart (1.6 and 1.7 ms). Such a column is uniform within its rounding when its steps take at
-//! most three values, each next one `q` above the last, `q` at most half the mean step, and
-//! every stamp lies within `q` of the least-squares line through them. The
+//! most three values, each next one `q` above the last, `q` at most half the mean step, every
+//! stamp lies on the grid of `q` from the first, and within `q` of the least-squares line
+//! through them. The
 //! reader then replaces the stamps by that line, `t_i = a + b·i`. Anything else — jitter,
 //! dropped samples (steps of one and two periods), a gap — is left as it is, for the sample-
 //! rate check of the kinematics to refuse.
@@ -51,6 +52,15 @@ pub(crate) fn regular_within_rounding(t: &[f64]) -> Option<Vec<f64>> {
         return None;
     }
     let q = quantum(steps(), mean)?;
+    // Rounded stamps lie on the rounding's own grid; a stamp moved off it (a logger's jitter,
+    // one sample written late) is not rounding, however few step values it makes.
+    let on_grid = t.iter().all(|&ti| {
+        let k = (ti - t[0]) / q;
+        (k - k.round()).abs() <= 0.01
+    });
+    if !on_grid {
+        return None;
+    }
     let (a, b) = line(t);
     let worst = t
         .iter()
@@ -130,6 +140,11 @@ mod tests {
     fn uniform_jittered_and_gapped_stamps_are_left_alone() {
         let uniform: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
         assert!(regular_within_rounding(&uniform).is_none());
+        // One stamp written 0.3 ms late among 10 ms steps: three step values 0.3 ms apart,
+        // but off any grid of 0.3 ms.
+        let mut late = uniform.clone();
+        late[50] += 0.0003;
+        assert!(regular_within_rounding(&late).is_none());
         // One sample dropped: steps of one and two periods.
         let mut gapped = uniform.clone();
         gapped.remove(50);
