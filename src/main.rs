@@ -83,8 +83,8 @@ enum Command {
 /// Where every key of an experiment file is described.
 macro_rules! key_reference {
     () => {
-        "Every key of an experiment file, with its default: README.md, section \"Experiment \
-         files\"; the bundled examples are in experiments/."
+        "Every key of an experiment file, with its default: docs/experiments.md; the bundled \
+         examples are in experiments/."
     };
 }
 
@@ -92,8 +92,8 @@ const MODELS_HELP: &str = concat!(
     "Examples:\n",
     "  stf-lab models\n",
     "  stf-lab models --check models/scripts/power_law.rhai\n\n",
-    "A script model is a .rhai file with fn params() and fn force(p, t, x, v, z): README.md, \
-     section \"Force models\"."
+    "A script model is a .rhai file with fn params() and fn force(p, t, x, v, z): \
+     docs/models.md."
 );
 
 const SIMULATE_HELP: &str = concat!(
@@ -139,8 +139,8 @@ const CAMPAIGN_HELP: &str = concat!(
     "  stf-lab campaign experiments/campaign/campaign.toml --out out/campaign\n\n",
     "A campaign file: [campaign] experiment = \"fit.toml\", command = \"fit\", conditions = \
      [\"concentration\"], then a [[records]] table per record (file = \"r1.csv\", \
-     concentration = 0.4). Its keys: README.md, section \"Campaigns: many records, one \
-     command\"; the experiment's: section \"Experiment files\"."
+     concentration = 0.4). Its keys: docs/campaigns.md; the experiment's: \
+     docs/experiments.md."
 );
 
 /// What `simulate`, `fit`, `compare` and `discover` take.

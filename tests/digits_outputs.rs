@@ -1,6 +1,6 @@
 //! The digits of a bundled example's tables: every number of `compare.csv` and `cycles.csv`
-//! carries at most 15 significant digits (the README's promise: no `0.00015500000000000003`),
-//! and none is written `-0`, `-0.0` or with an exponent `e0`.
+//! carries at most 15 significant digits (the promise of docs/commands.md: no
+//! `0.00015500000000000003`), and none is written `-0`, `-0.0` or with an exponent `e0`.
 
 mod common;
 

@@ -275,6 +275,13 @@ fn every_command_s_help_shows_an_example_and_where_the_keys_are() {
             help.contains("Example") && help.contains(&format!("stf-lab {command} ")),
             "{command}: {help}"
         );
-        assert!(help.contains("README.md, section \""), "{command}: {help}");
+        assert!(help.contains("docs/"), "{command}: {help}");
+        // The page it names is there.
+        let page = help
+            .split_whitespace()
+            .find(|w| w.starts_with("docs/"))
+            .unwrap()
+            .trim_end_matches(['.', ';', ',']);
+        assert!(root().join(page).is_file(), "{command}: {page}");
     }
 }

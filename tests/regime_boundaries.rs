@@ -218,7 +218,7 @@ fn boundaries_land_within_a_tenth_of_a_rad_s_of_the_truths_crossings() {
 /// Jamming with a higher critical speed, whose force is on for about half of each cycle
 /// through the resonance and after it: its zero-force share crosses ½ at a shallow angle
 /// (≈ 0.05 per rad/s), so the crossing is ill-conditioned in the truth itself. Known not to
-/// meet 0.1 rad/s (see the README); kept, unloosened, as the measurement:
+/// meet 0.1 rad/s (see docs/compare.md); kept, unloosened, as the measurement:
 /// `cargo test --release --test regime_boundaries -- --ignored --nocapture`.
 #[test]
 #[ignore]

@@ -122,8 +122,8 @@ class Experiment:
 
     @classmethod
     def build(cls, base_dir=".", *, models=(), **sections):
-        """An experiment from the keys of an experiment file (see the README's "Experiment
-        files"), checked as a file is.
+        """An experiment from the keys of an experiment file (see docs/experiments.md),
+        checked as a file is.
 
         ``models`` lists the models to fit: names (``"viscous"``), sums
         (``"power_law + added_mass"``), rhai script paths, each alone or as ``(spec, params)``

@@ -458,8 +458,8 @@ window = [0.0, 5.0]
 "#;
 
     proptest::proptest! {
-        /// Any text is an experiment or an error, never a panic. Long run (documented in the
-        /// README): `PROPTEST_CASES=1000000 cargo test --release --bin stf-lab never_panics`.
+        /// Any text is an experiment or an error, never a panic. Long run (documented in
+        /// docs/robustness.md): `PROPTEST_CASES=1000000 cargo test --release --bin stf-lab never_panics`.
         #[test]
         fn the_parser_never_panics_on_any_text(text in "\\PC{0,400}") {
             let _ = parse(&text);
