@@ -368,26 +368,34 @@ impl ScriptModel {
 
     /// Time evaluations of the force (with the rates) at `p`, `s` on the path calls take:
     /// one, or for a fast one as many as fit in [`TIMING_SECONDS`] (at most
-    /// [`TIMING_CALLS`]), their mean kept as the script's cost of a call. Only the first
-    /// counts against the run's operations, so what a load uses stays the same every time.
+    /// [`TIMING_CALLS`]), the median of their times kept as the script's cost of a call. The
+    /// median, not the mean: on a busy machine one call pre-empted for a time slice (a few
+    /// ms) made the mean of a 20 ms window 1.3 ms a call for a script of microseconds, and
+    /// the run was refused as over its time limit. Only the first call counts against the
+    /// run's operations, so what a load uses stays the same every time.
     fn time_force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), CallError> {
         let ops = &self.run_used.operations;
         let clock = Instant::now();
-        self.eval_force(p, s, dz)?;
-        let after_first = ops.load(Ordering::Relaxed);
-        let mut calls = 1u32;
-        let mut spent = clock.elapsed().as_secs_f64();
-        while calls < TIMING_CALLS && spent < TIMING_SECONDS {
+        let mut times = Vec::new();
+        let mut last = 0.0;
+        let mut after_first = None;
+        while times.len() < TIMING_CALLS as usize && (times.is_empty() || last < TIMING_SECONDS) {
             self.eval_force(p, s, dz)?;
-            calls += 1;
-            spent = clock.elapsed().as_secs_f64();
+            after_first.get_or_insert_with(|| ops.load(Ordering::Relaxed));
+            let now = clock.elapsed().as_secs_f64();
+            times.push(now - last);
+            last = now;
         }
+        let after_first = after_first.unwrap_or_else(|| ops.load(Ordering::Relaxed));
         let _ = ops.fetch_sub(
             ops.load(Ordering::Relaxed).saturating_sub(after_first),
             Ordering::Relaxed,
         );
-        let nanos = (spent * 1e9 / f64::from(calls)).round() as u64;
-        self.run_used.call_nanos.store(nanos, Ordering::Relaxed);
+        times.sort_by(f64::total_cmp);
+        let median = times.get(times.len() / 2).copied().unwrap_or(last);
+        self.run_used
+            .call_nanos
+            .store((median * 1e9).round() as u64, Ordering::Relaxed);
         Ok(())
     }
 
