@@ -49,11 +49,11 @@ pub const TWO_COLUMNS: u32 = 1200;
 /// The smallest text a figure may carry, printed at [`MM_PER_PX`]: 8 pt.
 pub const MIN_TEXT_PT: f64 = 8.0;
 
-/// Width × height of a one-panel figure, pixels: one column (85 × 60 mm). Loops, the frequency
-/// response, errors by regime.
+/// Width × height of a one-panel figure, pixels: one column (85 × 60 mm). Loops, error bars.
 pub const SIZE: (u32, u32) = (ONE_COLUMN, 420);
-/// Width × height of a signal over time, pixels: two columns (170 × 71 mm), so its cycles
-/// have room.
+/// Width × height of a wide one-panel figure, pixels: two columns (170 × 71 mm). Signals over
+/// time (their cycles need the room), the frequency response (its regimes' names), errors by
+/// regime (its groups' names).
 pub const SIZE_WIDE: (u32, u32) = (TWO_COLUMNS, 500);
 /// Width × height of the time history's four stacked panels, pixels: two columns (170 ×
 /// 142 mm).
