@@ -65,7 +65,7 @@ impl TimeHistoryPlot {
         let (w, h) = chart.plotting_area().dim_in_pixel();
         let ticks = (
             (w / 120).clamp(3, 10) as usize,
-            (h / 50).clamp(2, 5) as usize,
+            (h / 36).clamp(3, 6) as usize,
         );
         draw_mesh_with(&mut chart, desc, Some(ticks), axis_desc_style())?;
         let colour = series_colour(usize::from(last));
