@@ -9,9 +9,10 @@ mod common;
 use std::path::Path;
 
 use common::{read_json, root, run_ok};
-use stf_lab::report::stray_coloured_pixels;
+use stf_lab::report::{print_problems, stray_coloured_pixels, MIN_TEXT_PT};
 
-/// Every figure under `dir/figures`: its PNG clean, its tick labels never `-0`.
+/// Every figure under `dir/figures`: its PNG clean, its tick labels never `-0`, every text at
+/// least 8 pt at the print width the SVG states and inside the canvas.
 fn check_figures(dir: &Path) -> usize {
     let mut count = 0;
     for entry in std::fs::read_dir(dir.join("figures")).unwrap() {
@@ -21,6 +22,13 @@ fn check_figures(dir: &Path) -> usize {
             let png = std::fs::read(path.with_extension("png")).unwrap();
             let stray = stray_coloured_pixels(&svg, &png, 3.0).unwrap();
             assert_eq!(stray, 0, "{}: {stray} stray pixels", path.display());
+            let problems = print_problems(&svg, MIN_TEXT_PT).unwrap();
+            assert!(
+                problems.is_empty(),
+                "{}: {}",
+                path.display(),
+                problems.join("; ")
+            );
             let texts: Vec<&str> = svg.lines().map(str::trim).collect();
             for bad in ["-0", "-0.0", "-0.00", "-0.000"] {
                 assert!(!texts.contains(&bad), "{}: a {bad} tick", path.display());

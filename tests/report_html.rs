@@ -170,8 +170,8 @@ fn build_report(dir: &Path) -> PathBuf {
     let mut figs = Section::new("Figures");
     figs.figures.push(FigureRef::new(
         history,
-        "Displacement, velocity and acceleration (left axes) against the STF force (right \
-         axes); black dots mark the force's maxima, circles its minima.",
+        "Displacement, velocity, acceleration and the STF force over time, a panel each; \
+         black dots mark the force's maxima, circles its minima.",
     ));
     figs.figures.push(FigureRef::new(
         loop_v,

@@ -207,7 +207,8 @@ pub fn regime_section(
             fig,
             format!(
                 "Measured against fitted STF force in each {} (on y = x where they agree), and \
-                 the residual's distribution against the normal curve of the force noise.",
+                 the residual's (measured − fitted) distribution against the normal curve of \
+                 the force noise; residuals beyond the axis's ends are left off.",
                 words.group
             ),
         ));

@@ -57,7 +57,7 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
     let th = time_history(dir, "time_history", &motion, f)?;
     s.figures.push(FigureRef::new(
         th,
-        "Displacement, velocity and acceleration against the STF force; extrema of F_STF marked.",
+        "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked.",
     ));
     for (name, label, series) in [
         ("hysteresis_x", "displacement x, mm", milli(&k.x)),

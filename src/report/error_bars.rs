@@ -13,8 +13,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, draw_mesh, legend_strip, msg, one_panel, render, title_style, Draw,
-    FigureFiles, Swatch, SIZE,
+    axis_desc_style, draw_mesh, legend_strip, msg, one_panel, render, titled, Draw, FigureFiles,
+    Swatch, SIZE,
 };
 use super::plot_range::{finite_bounds, padded_range};
 use super::series_csv::Column;
@@ -75,7 +75,7 @@ impl Draw for ErrorBarPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let (xr, yr) = self.ranges().ok_or("no finite point")?;
         let x_span = xr.end - xr.start;
-        let root = root.titled(self.title, title_style()).map_err(msg)?;
+        let root = titled(root, self.title)?;
         let mut legend: Vec<(String, Swatch)> = self
             .series
             .iter()
@@ -213,7 +213,7 @@ mod tests {
             &series,
         )
         .unwrap();
-        assert!(std::fs::metadata(&files.png).unwrap().len() > 1000);
+        crate::report::test_signals::assert_prints_well(&files, SIZE);
         let csv = std::fs::read_to_string(&files.csv).unwrap();
         assert!(
             csv.starts_with("F0 = 0.035: concentration,F0 = 0.035: K,"),
@@ -247,5 +247,6 @@ mod tests {
         assert_eq!(csv.lines().count(), 12, "{csv}");
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         assert!(svg.contains("law"), "the curve's legend");
+        crate::report::test_signals::assert_prints_well(&files, SIZE);
     }
 }

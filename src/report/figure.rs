@@ -37,10 +37,27 @@ pub const MEASURED_LINE: RGBColor = RGBColor(110, 110, 110);
 /// Width of a measured signal's line, pixels (the models' lines are 2).
 pub const MEASURED_WIDTH: u32 = 1;
 
-/// Width × height of a one-panel figure, pixels.
-pub const SIZE: (u32, u32) = (1000, 600);
-/// Width × height of a figure with three stacked panels, pixels.
-pub const SIZE_TALL: (u32, u32) = (1000, 1000);
+/// Millimetres of print per pixel of a figure: 600 px print 85 mm wide (one journal column),
+/// 1 200 px 170 mm (two columns). Every figure is drawn at this one scale, so its text sizes,
+/// in pixels, are the same printed size in every figure; the SVG carries its physical width
+/// (`width="85mm"`) and the PNG is drawn at twice the pixels ([`super::raster`]).
+pub const MM_PER_PX: f64 = 85.0 / 600.0;
+/// Width of a one-column figure (85 mm), pixels.
+pub const ONE_COLUMN: u32 = 600;
+/// Width of a two-column figure (170 mm), pixels.
+pub const TWO_COLUMNS: u32 = 1200;
+/// The smallest text a figure may carry, printed at [`MM_PER_PX`]: 8 pt.
+pub const MIN_TEXT_PT: f64 = 8.0;
+
+/// Width × height of a one-panel figure, pixels: one column (85 × 60 mm). Loops, error bars.
+pub const SIZE: (u32, u32) = (ONE_COLUMN, 420);
+/// Width × height of a wide one-panel figure, pixels: two columns (170 × 71 mm). Signals over
+/// time (their cycles need the room), the frequency response (its regimes' names), errors by
+/// regime (its groups' names).
+pub const SIZE_WIDE: (u32, u32) = (TWO_COLUMNS, 500);
+/// Width × height of the time history's four stacked panels, pixels: two columns (170 ×
+/// 142 mm).
+pub const SIZE_TALL: (u32, u32) = (TWO_COLUMNS, 1000);
 
 /// The builder of a one-panel chart filling `root`: the margins and label areas every
 /// full-width figure uses.
@@ -51,9 +68,20 @@ pub fn one_panel<'a, 'b, DB: DrawingBackend>(
     builder
         .margin(10)
         .margin_right(30)
-        .x_label_area_size(50)
-        .y_label_area_size(90);
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA);
     builder
+}
+
+/// Height under a chart for its tick labels and the x axis's description, pixels.
+pub const X_LABEL_AREA: u32 = 62;
+/// Width left of a chart for its tick labels and the y axis's description, pixels.
+pub const Y_LABEL_AREA: u32 = 104;
+
+/// How many tick labels an axis `pixels` long carries: one per `spacing` pixels, 3 to 10, so
+/// labels at print size never crowd.
+fn tick_count(pixels: u32, spacing: u32) -> usize {
+    (pixels / spacing).clamp(3, 10) as usize
 }
 
 /// A chart on plain `f64` axes.
@@ -85,6 +113,8 @@ pub fn draw_mesh_with<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let (x, y) = (chart.x_range(), chart.y_range());
     let (xs, ys) = (x.end - x.start, y.end - y.start);
+    let (w, h) = chart.plotting_area().dim_in_pixel();
+    let labels = labels.unwrap_or((tick_count(w, 120), tick_count(h, 60)));
     let x_ticks = |v: &f64| tick_label(*v, xs);
     let y_ticks = |v: &f64| tick_label(*v, ys);
     let mut mesh = chart.configure_mesh();
@@ -96,28 +126,30 @@ pub fn draw_mesh_with<DB: DrawingBackend>(
         .y_label_formatter(&y_ticks)
         .axis_desc_style(desc_style)
         .label_style(tick_style())
-        .light_line_style(WHITE.mix(0.0));
-    if let Some((nx, ny)) = labels {
-        mesh.x_labels(nx).y_labels(ny);
-    }
+        .light_line_style(WHITE.mix(0.0))
+        .x_labels(labels.0)
+        .y_labels(labels.1);
     mesh.draw().map_err(msg)
 }
 
-/// Title text style.
+// Text sizes as plotters takes them: its SVG writes `font-size` = size / 1.24, so 26 is 21 px,
+// 8.4 pt at [`MM_PER_PX`]; 25 would be the least for 8 pt.
+
+/// Title text style (9.7 pt printed).
 pub fn title_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 30).into_font())
+}
+/// Axis description (quantity and unit) style (8.7 pt printed).
+pub fn axis_desc_style() -> TextStyle<'static> {
+    TextStyle::from((FAMILY, 27).into_font())
+}
+/// Tick label style (8.4 pt printed).
+pub fn tick_style() -> TextStyle<'static> {
     TextStyle::from((FAMILY, 26).into_font())
 }
-/// Axis description (quantity and unit) style.
-pub fn axis_desc_style() -> TextStyle<'static> {
-    TextStyle::from((FAMILY, 19).into_font())
-}
-/// Tick label style.
-pub fn tick_style() -> TextStyle<'static> {
-    TextStyle::from((FAMILY, 15).into_font())
-}
-/// Legend text style.
+/// Legend text style (8.4 pt printed).
 pub fn legend_style() -> TextStyle<'static> {
-    TextStyle::from((FAMILY, 16).into_font())
+    TextStyle::from((FAMILY, 26).into_font())
 }
 
 /// Draw `chart`'s legend at `position` in the house style (legend text, a white box with a
@@ -152,7 +184,7 @@ pub enum Swatch {
 }
 
 /// Height of one row of a legend strip, pixels.
-const STRIP_ROW: i32 = 26;
+const STRIP_ROW: i32 = 34;
 
 /// Draw a legend across the top of `area`, its entries left to right, centred, in as many
 /// rows as the width needs, and return the area below it: for figures whose legend would
@@ -224,12 +256,43 @@ pub fn msg<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-/// `root` under the figure's `title`, in the title style: the area below it.
+/// `root` under the figure's `title`, in the title style, broken at spaces into as many
+/// centred lines as the width needs (a title is never clipped): the area below it.
 pub fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
 ) -> Result<DrawingArea<DB, Shift>, String> {
-    root.titled(title, title_style()).map_err(msg)
+    let style = title_style();
+    let width = root.dim_in_pixel().0.saturating_sub(20);
+    let fits = |line: &str| {
+        root.estimate_text_size(line, &style)
+            .map(|(w, _)| w <= width)
+            .map_err(msg)
+    };
+    let mut lines: Vec<String> = Vec::new();
+    for word in title.split(' ') {
+        match lines.last_mut() {
+            Some(line) if fits(&format!("{line} {word}"))? => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    let line_height = root.estimate_text_size("Ag", &style).map_err(msg)?.1 as i32 + 6;
+    let (strip, rest) = root.split_vertically(line_height * lines.len() as i32 + 10);
+    let centre = strip.dim_in_pixel().0 as i32 / 2;
+    let text = style.pos(plotters::style::text_anchor::Pos::new(
+        plotters::style::text_anchor::HPos::Center,
+        plotters::style::text_anchor::VPos::Top,
+    ));
+    for (i, line) in lines.into_iter().enumerate() {
+        let at = (centre, 6 + line_height * i as i32);
+        strip
+            .draw(&Text::new(line, at, text.clone()))
+            .map_err(msg)?;
+    }
+    Ok(rest)
 }
 
 /// The builder of one small panel of a grid of panels, `caption` above it if given.
@@ -240,8 +303,9 @@ pub fn small_panel<'a, 'b, DB: DrawingBackend>(
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(8)
-        .x_label_area_size(42)
-        .y_label_area_size(62);
+        .margin_right(22)
+        .x_label_area_size(X_LABEL_AREA - 4)
+        .y_label_area_size(Y_LABEL_AREA - 14);
     if let Some(c) = caption {
         builder.caption(c, legend_style());
     }
@@ -375,6 +439,7 @@ pub fn render(
     };
     let mut svg = String::new();
     draw_on(SVGBackend::with_string(&mut svg, size), plot).map_err(failed(&files.svg))?;
+    let svg = with_print_size(&svg, size);
     write_atomic(&files.svg, svg.as_bytes())?;
 
     let png = svg_to_png(&svg).map_err(failed(&files.png))?;
@@ -382,6 +447,18 @@ pub fn render(
 
     write_csv(&files.csv, columns)?;
     Ok(files)
+}
+
+/// `svg` (as plotters writes it: `width="W" height="H" viewBox="0 0 W H"`) with its width and
+/// height in millimetres at [`MM_PER_PX`], so it prints at its column's width; the drawing's
+/// own units (the viewBox) stay pixels.
+fn with_print_size(svg: &str, (w, h): (u32, u32)) -> String {
+    let mm = |px: u32| format!("{}mm", tick_label(f64::from(px) * MM_PER_PX, 1.0));
+    svg.replacen(
+        &format!("width=\"{w}\" height=\"{h}\""),
+        &format!("width=\"{}\" height=\"{}\"", mm(w), mm(h)),
+        1,
+    )
 }
 
 /// Check that two series have the same length.
@@ -441,6 +518,15 @@ pub fn tick_label(v: f64, span: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::{finite_runs, tick_label};
+
+    #[test]
+    fn the_svg_carries_its_print_width_in_millimetres() {
+        let svg = r#"<svg width="600" height="420" viewBox="0 0 600 420" xmlns="x">"#;
+        assert_eq!(
+            super::with_print_size(svg, (600, 420)),
+            r#"<svg width="85mm" height="59.5mm" viewBox="0 0 600 420" xmlns="x">"#
+        );
+    }
 
     #[test]
     fn curves_on_earlier_ones_are_found() {

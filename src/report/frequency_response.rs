@@ -13,7 +13,7 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
     axis_desc_style, draw_legend, finite_points, msg, one_panel, render, same_length, tick_label,
-    tick_style, titled, Draw, FigureFiles, SIZE,
+    tick_style, titled, Draw, FigureFiles, SIZE_WIDE,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -266,7 +266,7 @@ pub fn frequency_response(
         curves: plotted,
         changes,
     };
-    render(out_dir, name, SIZE, &plot, &columns)
+    render(out_dir, name, SIZE_WIDE, &plot, &columns)
 }
 
 #[cfg(test)]
@@ -314,7 +314,7 @@ mod tests {
         let smoothing = Smoothing::default();
         let curves = [measured.clone(), without.clone(), with];
         let files = frequency_response(dir.path(), "frf", &curves, changes, &smoothing).unwrap();
-        let cols = assert_rendered(&files, SIZE);
+        let cols = assert_rendered(&files, SIZE_WIDE);
         assert_eq!(cols.len(), 9);
         // One legend entry per curve (its trend and its maxima share it), regimes named.
         let svg = std::fs::read_to_string(&files.svg).unwrap();

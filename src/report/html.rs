@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::document::{FigureRef, Report, Table};
+use super::raster::PNG_SCALE;
 use super::ReportError;
 use crate::writing::atomic::write_atomic;
 use base64::Engine;
@@ -142,8 +143,12 @@ fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<()
         path: figure.files.png.clone(),
         source,
     })?;
+    // The PNG has PNG_SCALE pixels per drawing unit: shown at its drawing's size, sharp.
     let size = png_size(&png)
-        .map(|(w, h)| format!(" width=\"{w}\" height=\"{h}\""))
+        .map(|(w, h)| {
+            let shown = |px: u32| (px as f32 / PNG_SCALE).round() as u32;
+            format!(" width=\"{}\" height=\"{}\"", shown(w), shown(h))
+        })
         .unwrap_or_default();
     let _ = writeln!(
         out,

@@ -10,7 +10,7 @@ use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
     axis_desc_style, draw_mesh, finite_runs, msg, render, require_finite, same_length, tick_label,
-    tick_style, titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL,
+    tick_style, titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -19,7 +19,7 @@ use super::ReportError;
 /// How many colour steps the line and the colour bar use.
 const COLOUR_STEPS: usize = 256;
 /// Width of the colour bar's strip (bar 28 px, then ticks and the axis label), pixels.
-const COLOUR_BAR_WIDTH: u32 = 150;
+const COLOUR_BAR_WIDTH: u32 = 165;
 
 struct HysteresisPlot {
     label: String,
@@ -55,15 +55,16 @@ impl Draw for HysteresisPlot {
         let x_range = padded_range(&self.x).ok_or_else(|| no_data(&self.label))?;
         let f_range = padded_range(&self.f).ok_or_else(|| no_data(F_LABEL))?;
         let t_range = exact_range(&self.t).ok_or_else(|| no_data(T_LABEL))?;
-        let title = format!("Hysteresis: F_STF against {}, coloured by time", self.label);
+        let quantity = self.label.split(',').next().unwrap_or(&self.label);
+        let title = format!("F_STF against {quantity}");
         let root = titled(root, &title)?;
         let (width, _) = root.dim_in_pixel();
         let (main, bar) = root.split_horizontally(width.saturating_sub(COLOUR_BAR_WIDTH));
 
         let mut chart = ChartBuilder::on(&main)
             .margin(10)
-            .x_label_area_size(50)
-            .y_label_area_size(90)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
         draw_mesh(
@@ -86,7 +87,7 @@ impl Draw for HysteresisPlot {
         let mut colour_bar = ChartBuilder::on(&bar)
             .margin(10)
             .margin_left(15)
-            .x_label_area_size(50)
+            .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(0)
             .right_y_label_area_size(COLOUR_BAR_WIDTH - 15 - 10 - 28)
             .build_cartesian_2d(0.0..1.0, t_range.clone())

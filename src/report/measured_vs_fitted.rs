@@ -13,7 +13,7 @@ use super::envelope::{band, buckets_for, dense, envelope};
 use super::figure::{
     axis_desc_style, draw_line, draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg,
     one_panel, render, require_finite, same_as_earlier, same_length, titled, Chart2d, Draw,
-    FigureFiles, Swatch, MEASURED_GREY, MEASURED_LINE, MEASURED_WIDTH, SIZE, T_LABEL,
+    FigureFiles, Swatch, MEASURED_GREY, MEASURED_LINE, MEASURED_WIDTH, SIZE_WIDE, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -208,7 +208,7 @@ pub fn measured_vs_model(
             f.clone(),
         )
     }));
-    render(out_dir, name, SIZE, &plot, &columns)
+    render(out_dir, name, SIZE_WIDE, &plot, &columns)
 }
 
 #[cfg(test)]
@@ -231,7 +231,7 @@ mod tests {
             &[("linear", &linear), ("power law", &quadratic)],
         )
         .unwrap();
-        let cols = assert_rendered(&files, SIZE);
+        let cols = assert_rendered(&files, SIZE_WIDE);
         assert_eq!(column(&cols, "measured F_STF, N"), &s.f[..]);
         assert_eq!(column(&cols, "power law: fitted F_STF, N"), &quadratic[..]);
         let svg = std::fs::read_to_string(&files.svg).unwrap();
@@ -255,7 +255,7 @@ mod tests {
             &[("base", &x_mm)],
         )
         .unwrap();
-        let cols = assert_rendered(&files, SIZE);
+        let cols = assert_rendered(&files, SIZE_WIDE);
         assert_eq!(column(&cols, "measured x, mm"), &x_mm[..]);
         assert_eq!(column(&cols, "base: simulated x, mm"), &x_mm[..]);
         let svg = std::fs::read_to_string(&files.svg).unwrap();

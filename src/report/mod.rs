@@ -41,6 +41,7 @@ mod markdown;
 mod measured_vs_fitted;
 mod parity;
 mod plot_range;
+mod print_check;
 mod raster;
 mod regime_errors;
 mod regime_windows;
@@ -54,6 +55,7 @@ pub use document::{FigureRef, Report, Section, Table};
 pub use error::ReportError;
 pub use error_bars::{error_bars, error_bars_with_curve, Curve, ErrorPoint, ErrorSeries};
 pub use extrema::{extrema, Extremum, ExtremumKind};
+pub use figure::MIN_TEXT_PT;
 pub use figure::{milli, FigureFiles};
 pub use frequency_response::{frequency_response, FrfCurve, FrfRole, RegimeChange};
 pub use html::write_html;
@@ -64,7 +66,8 @@ pub use measured_vs_fitted::{
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
 pub use parity::{parity, ParityQuantity, SampleGroup};
-pub use raster::{stray_coloured_pixels, svg_to_png};
+pub use print_check::{print_problems, printed_texts, PrintedText};
+pub use raster::{stray_coloured_pixels, svg_to_png, PNG_SCALE};
 pub use regime_errors::regime_errors;
 pub use regime_windows::{regime_windows, RegimeWindow, WindowSeries};
 pub use series_csv::{read_csv_columns, Column};

@@ -14,8 +14,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_union, pick};
 use super::figure::{
     draw_line, draw_mesh, finite_points, legend_strip, model_entries_flagged, msg, render,
-    same_as_earlier, same_length, small_panel, tick_label, tick_style, titled, Draw, FigureFiles,
-    Swatch,
+    same_as_earlier, same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch,
+    ONE_COLUMN, TWO_COLUMNS,
 };
 use super::plot_range::padded_range;
 use super::series_csv::Column;
@@ -176,11 +176,9 @@ impl ParityPlot<'_> {
         let mut chart = small_panel(area, None)
             .build_cartesian_2d(range.clone(), 0.0..top)
             .map_err(msg)?;
-        let x_desc = format!(
-            "residual (measured − fitted) {}; beyond ±{}: off the plot",
-            self.quantity.label,
-            tick_label(range.end, span)
-        );
+        // Short enough for a third of two columns; the axis's ends say where residuals are
+        // left off.
+        let x_desc = format!("residual {}", self.quantity.label);
         draw_mesh(&mut chart, (x_desc, "density"), Some((5, 4)), tick_style())?;
         for (i, h) in histograms.iter().enumerate() {
             let steps = h.iter().enumerate().flat_map(|(b, d)| {
@@ -356,7 +354,12 @@ pub fn parity(
         .map(|g| plotted_group(g, measured, models, quantity.noise_sigma))
         .collect();
     let columns = parity_columns(quantity, measured, models, &plotted);
-    let size = (480 * plotted.len() as u32 + 40, 900);
+    let width = if plotted.len() > 1 {
+        TWO_COLUMNS
+    } else {
+        ONE_COLUMN
+    };
+    let size = (width, 800);
     let plot = ParityPlot {
         quantity,
         groups: plotted.into_iter().map(|(g, _)| g).collect(),
@@ -395,7 +398,7 @@ mod tests {
             ("linear", linear.as_slice()),
         ];
         let files = parity(dir.path(), "parity", &quantity, &s.f, &models, &groups).unwrap();
-        let cols = assert_rendered(&files, (1000, 900));
+        let cols = assert_rendered(&files, (TWO_COLUMNS, 800));
         assert_eq!(column(&cols, "measured F_STF, N"), &s.f[..]);
         assert_eq!(column(&cols, "linear F_STF, N"), &linear[..]);
         assert_eq!(column(&cols, "group")[1_500], 2.0);
@@ -428,7 +431,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let models = [("power law", model.as_slice())];
         let files = parity(dir.path(), "parity", &quantity, &f, &models, &groups).unwrap();
-        let cols = assert_rendered(&files, (1000, 900));
+        let cols = assert_rendered(&files, (TWO_COLUMNS, 800));
         let measured = column(&cols, "measured F_STF, N");
         assert!(
             measured.len() <= 2 * MAX_SCATTER_POINTS,

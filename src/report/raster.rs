@@ -4,7 +4,8 @@
 //! a loop or a noisy trace turns back on itself the join's offset lines meet far away, and the
 //! PNG showed long straight spikes across the plot (the SVG, stroked by the browser, was
 //! clean). resvg strokes with a miter limit and anti-aliases, and reads the same embedded font
-//! ([`super::font`]) the SVG names, so no system font is needed.
+//! ([`super::font`]) the SVG names, so no system font is needed. The PNG has twice the pixels
+//! of the SVG's drawing units (its viewBox), sharp on a HiDPI screen and in print.
 //!
 //! ```no_run
 //! # fn main() -> Result<(), String> {
@@ -19,7 +20,7 @@ use resvg::{tiny_skia, usvg};
 
 use super::font::{DEJAVU_SANS, FAMILY};
 
-fn options() -> &'static usvg::Options<'static> {
+pub(super) fn options() -> &'static usvg::Options<'static> {
     static OPTIONS: OnceLock<usvg::Options<'static>> = OnceLock::new();
     OPTIONS.get_or_init(|| {
         let mut fonts = usvg::fontdb::Database::new();
@@ -38,22 +39,44 @@ fn options() -> &'static usvg::Options<'static> {
     })
 }
 
-/// Rasterise an SVG document (at its own size, white where it draws nothing) to PNG bytes.
+/// PNG pixels per unit of the SVG's drawing (its viewBox).
+pub const PNG_SCALE: f32 = 2.0;
+
+/// The drawing's size in its own units: the root's viewBox (plotters writes `viewBox="0 0 W
+/// H"`), else `size`.
+pub(super) fn drawing_size(svg: &str, size: usvg::Size) -> (f32, f32) {
+    let view_box = svg
+        .split_once("viewBox=\"")
+        .and_then(|(_, rest)| rest.split_once('"'))
+        .map(|(v, _)| {
+            v.split_whitespace()
+                .filter_map(|n| n.parse::<f32>().ok())
+                .collect()
+        })
+        .filter(|v: &Vec<f32>| v.len() == 4 && v[2] > 0.0 && v[3] > 0.0);
+    view_box.map_or((size.width(), size.height()), |v| (v[2], v[3]))
+}
+
+/// Rasterise an SVG document at [`PNG_SCALE`] pixels per drawing unit (a 600-unit-wide figure
+/// is a 1 200-pixel PNG, whatever physical width the SVG states), white where it draws
+/// nothing, to PNG bytes.
 pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
     let tree = usvg::Tree::from_str(svg, options()).map_err(|e| e.to_string())?;
-    let size = tree.size().to_int_size();
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
-        .ok_or_else(|| format!("an empty image ({}×{})", size.width(), size.height()))?;
+    let (w, h) = drawing_size(svg, tree.size());
+    let (pw, ph) = ((w * PNG_SCALE).round(), (h * PNG_SCALE).round());
+    let mut pixmap = tiny_skia::Pixmap::new(pw as u32, ph as u32)
+        .ok_or_else(|| format!("an empty image ({pw}×{ph})"))?;
     pixmap.fill(tiny_skia::Color::WHITE);
+    let size = tree.size();
     resvg::render(
         &tree,
-        tiny_skia::Transform::identity(),
+        tiny_skia::Transform::from_scale(pw / size.width(), ph / size.height()),
         &mut pixmap.as_mut(),
     );
     pixmap.encode_png().map_err(|e| e.to_string())
 }
 
-/// How many strongly coloured pixels of `png` lie more than `margin` pixels outside every
+/// How many strongly coloured pixels of `png` lie more than `margin` drawing units outside every
 /// coloured shape of `svg` (each shape's stroked bounding box): stray marks such as the
 /// spikes the bitmap backend drew at sharp joins. Text and axes are black or grey, so they
 /// are not counted. A check for tests (a figure's PNG against its SVG).
@@ -63,6 +86,10 @@ pub fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> Result<usize
     collect_coloured_boxes(tree.root(), &mut boxes);
     let image = tiny_skia::Pixmap::decode_png(png).map_err(|e| format!("PNG: {e}"))?;
     let width = image.width() as usize;
+    // PNG pixels in the units the shapes' boxes are in (the SVG's size), and the margin.
+    let per_pixel = tree.size().width() / image.width() as f32;
+    let (w, _) = drawing_size(svg, tree.size());
+    let margin = margin * tree.size().width() / w;
     Ok(image
         .pixels()
         .iter()
@@ -76,7 +103,10 @@ pub fn stray_coloured_pixels(svg: &str, png: &[u8], margin: f32) -> Result<usize
             hi - lo > 80
         })
         .filter(|(i, _)| {
-            let (x, y) = ((i % width) as f32 + 0.5, (i / width) as f32 + 0.5);
+            let (x, y) = (
+                ((i % width) as f32 + 0.5) * per_pixel,
+                ((i / width) as f32 + 0.5) * per_pixel,
+            );
             !boxes.iter().any(|b: &tiny_skia::Rect| {
                 x >= b.left() - margin
                     && x <= b.right() + margin
@@ -132,5 +162,17 @@ mod tests {
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         let png = std::fs::read(&files.png).unwrap();
         assert_eq!(stray_coloured_pixels(&svg, &png, 3.0), Ok(0));
+    }
+
+    #[test]
+    fn the_png_has_twice_the_pixels_of_the_drawing_whatever_its_print_width() {
+        let svg = r##"<svg width="85mm" height="42.5mm" viewBox="0 0 600 300" xmlns="http://www.w3.org/2000/svg"><rect x="300" y="0" width="300" height="300" fill="#0000FF"/></svg>"##;
+        let png = tiny_skia::Pixmap::decode_png(&svg_to_png(svg).unwrap()).unwrap();
+        assert_eq!((png.width(), png.height()), (1200, 600));
+        // The drawing fills the PNG at that scale: the blue square is its right half.
+        let at = |x: u32, y: u32| png.pixel(x, y).unwrap().demultiply();
+        assert_eq!((at(598, 300).blue(), at(598, 300).red()), (255, 255));
+        assert_eq!((at(602, 300).blue(), at(602, 300).red()), (255, 0));
+        assert_eq!(at(1199, 599).blue(), 255);
     }
 }

@@ -8,8 +8,8 @@ use plotters::prelude::*;
 
 use super::colour::series_colour;
 use super::figure::{
-    axis_desc_style, draw_legend, msg, one_panel, render, tick_label, tick_style, titled, Draw,
-    FigureFiles, SIZE,
+    axis_desc_style, legend_strip, msg, one_panel, render, tick_label, tick_style, titled, Draw,
+    FigureFiles, Swatch, SIZE_WIDE,
 };
 use super::series_csv::Column;
 use super::ReportError;
@@ -32,6 +32,14 @@ impl Draw for RegimeErrorPlot<'_> {
             * 1.15;
         let n_groups = self.groups.len();
         let root = titled(root, "Errors of each model, regime by regime")?;
+        // The legend above the bars: inside, it would cover the tallest.
+        let entries: Vec<(String, Swatch)> = self
+            .models
+            .iter()
+            .enumerate()
+            .map(|(m, (label, _))| (label.to_string(), Swatch::Line(series_colour(m), 14)))
+            .collect();
+        let root = legend_strip(&root, &entries)?;
         let mut chart = one_panel(&root)
             .build_cartesian_2d(0.0..n_groups as f64, 0.0..top)
             .map_err(msg)?;
@@ -48,6 +56,7 @@ impl Draw for RegimeErrorPlot<'_> {
                 }
             })
             .disable_x_mesh()
+            .y_labels(6)
             .y_desc(self.y_label)
             .y_label_formatter(&|v| tick_label(*v, top))
             .x_desc("regime")
@@ -57,7 +66,7 @@ impl Draw for RegimeErrorPlot<'_> {
             .map_err(msg)?;
         let n_models = self.models.len().max(1) as f64;
         let width = 0.8 / n_models;
-        for (m, (label, values)) in self.models.iter().enumerate() {
+        for (m, (_, values)) in self.models.iter().enumerate() {
             let colour = series_colour(m);
             let bars = values
                 .iter()
@@ -67,15 +76,9 @@ impl Draw for RegimeErrorPlot<'_> {
                     let x0 = g as f64 + 0.1 + m as f64 * width;
                     Rectangle::new([(x0, 0.0), (x0 + width * 0.9, v)], colour.filled())
                 });
-            chart
-                .draw_series(bars)
-                .map_err(msg)?
-                .label(*label)
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 6), (x + 18, y + 6)], colour.filled())
-                });
+            chart.draw_series(bars).map_err(msg)?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+        Ok(())
     }
 }
 
@@ -106,7 +109,7 @@ pub fn regime_errors(
             .map(|(l, v)| Column::new(format!("{l}: {y_label}"), v.clone())),
     )
     .collect();
-    render(out_dir, name, SIZE, &plot, &columns)
+    render(out_dir, name, SIZE_WIDE, &plot, &columns)
 }
 
 #[cfg(test)]
@@ -127,7 +130,7 @@ mod tests {
             "relative force RMS error",
         )
         .unwrap();
-        assert!(std::fs::metadata(&files.png).unwrap().len() > 1000);
+        crate::report::test_signals::assert_prints_well(&files, SIZE_WIDE);
         assert!(std::fs::read_to_string(&files.svg)
             .unwrap()
             .contains("relative force RMS error"));

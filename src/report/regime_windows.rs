@@ -14,7 +14,7 @@ use super::decimate::{decimate_ranges, pick};
 use super::figure::{
     draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg, render, same_as_earlier,
     same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL,
-    MEASURED_LINE, MEASURED_WIDTH,
+    MEASURED_LINE, MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -179,7 +179,12 @@ pub fn regime_windows(
             .iter()
             .map(|(label, m)| Column::new(format!("F_STF {label}, N"), pick(m, &rows))),
     );
-    let size = (500 * windows.len() as u32 + 20, 1500);
+    let width = if windows.len() > 1 {
+        TWO_COLUMNS
+    } else {
+        ONE_COLUMN
+    };
+    let size = (width, 1300);
     let plot = WindowsPlot {
         series: *s,
         windows: windows.into_iter().zip(kept).collect(),
@@ -226,7 +231,7 @@ mod tests {
         ];
         let dir = tempfile::tempdir().unwrap();
         let files = regime_windows(dir.path(), "windows", &series, &windows).unwrap();
-        let cols = assert_rendered(&files, (1020, 1500));
+        let cols = assert_rendered(&files, (TWO_COLUMNS, 1300));
         let t = column(&cols, "t, s");
         assert_eq!(t.len(), 1_250);
         assert_eq!(t[500], s.t[2_000]);
@@ -235,6 +240,46 @@ mod tests {
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         assert!(svg.contains("\nearly\n") && svg.contains("\nlate\n"));
         assert!(!svg.contains("\nempty\n"));
+    }
+
+    #[test]
+    fn model_loops_are_drawn_over_the_measured_ones_which_are_thin_and_grey() {
+        let s = damped_sine(3_000, 6.0);
+        let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<f64>>();
+        let (x, v) = (mm(&s.x), mm(&s.v));
+        let a: Vec<f64> = s.v.iter().map(|v| 20.0 * v + 400.0 * v * v.abs()).collect();
+        let b: Vec<f64> = s.v.iter().map(|v| 30.0 * v).collect();
+        let models = [("power law", a.as_slice()), ("linear", b.as_slice())];
+        let series = WindowSeries {
+            t: &s.t,
+            x_mm: &x,
+            v_mm: &v,
+            a: &s.a,
+            f: &s.f,
+            models: &models,
+        };
+        let windows: Vec<RegimeWindow> = [(0, 500), (1_000, 1_500), (2_000, 2_750)]
+            .iter()
+            .map(|&(start, end)| RegimeWindow {
+                name: format!("from {start}"),
+                start,
+                end,
+            })
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files = regime_windows(dir.path(), "windows", &series, &windows).unwrap();
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        // Data lines: the measured force 1 px grey, each model's 2 px in its colour (the
+        // legend's marks are wider and left out).
+        use crate::report::test_signals::{hex, stroke_order};
+        let kinds = [
+            ("#6E6E6E".to_string(), 1),
+            (hex(series_colour(0)), 2),
+            (hex(series_colour(1)), 2),
+        ];
+        // In each of the 12 panels the measured line first, then the models over it in turn.
+        let order = stroke_order(&svg, &kinds);
+        assert_eq!(order, [0, 1, 2].repeat(12), "drawing order by kind");
     }
 
     #[test]
@@ -260,7 +305,7 @@ mod tests {
         }];
         let dir = tempfile::tempdir().unwrap();
         let files = regime_windows(dir.path(), "windows", &series, &windows).unwrap();
-        let cols = assert_rendered(&files, (520, 1500));
+        let cols = assert_rendered(&files, (ONE_COLUMN, 1300));
         let t = column(&cols, "t, s");
         assert!(t.len() <= MAX_POINTS_PER_WINDOW, "{} rows", t.len());
         let measured = column(&cols, "F_STF measured, N");

@@ -51,13 +51,21 @@ pub fn damped_sine(n: usize, duration: f64) -> Signals {
     Signals { t, x, v, a, f }
 }
 
-/// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works), the
-/// PNG has the expected size and no coloured mark outside the SVG's coloured shapes; returns the CSV's columns.
+/// Check that a figure's SVG and PNG exist, are non-empty, have text (the font works), every
+/// text at least 8 pt in print and inside the canvas, the PNG has twice the drawing's `size`
+/// and no coloured mark outside the SVG's coloured shapes; returns the CSV's columns.
 #[cfg(test)]
 pub fn assert_rendered(
     files: &super::FigureFiles,
     size: (u32, u32),
 ) -> Vec<super::series_csv::Column> {
+    assert_prints_well(files, size);
+    super::read_csv_columns(&files.csv).unwrap()
+}
+
+/// [`assert_rendered`] but for the CSV: the SVG and PNG.
+#[cfg(test)]
+pub fn assert_prints_well(files: &super::FigureFiles, size: (u32, u32)) {
     let svg = std::fs::read_to_string(&files.svg).unwrap();
     assert!(svg.len() > 1000, "SVG too small: {} bytes", svg.len());
     assert!(
@@ -69,7 +77,14 @@ pub fn assert_rendered(
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let w = u32::from_be_bytes(png[16..20].try_into().unwrap());
     let h = u32::from_be_bytes(png[20..24].try_into().unwrap());
-    assert_eq!((w, h), size);
+    assert_eq!((w, h), (size.0 * 2, size.1 * 2));
+    let problems = super::print_problems(&svg, super::MIN_TEXT_PT).unwrap();
+    assert!(
+        problems.is_empty(),
+        "{}: {}",
+        files.svg.display(),
+        problems.join("; ")
+    );
     let stray = super::raster::stray_coloured_pixels(&svg, &png, 3.0);
     assert_eq!(
         stray,
@@ -84,7 +99,6 @@ pub fn assert_rendered(
         .filter(|n| n.contains(".tmp"))
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
-    super::read_csv_columns(&files.csv).unwrap()
 }
 
 /// The column named `name`.
@@ -95,4 +109,37 @@ pub fn column<'a>(columns: &'a [super::series_csv::Column], name: &str) -> &'a [
         .find(|c| c.name == name)
         .unwrap_or_else(|| panic!("no column {name:?}"))
         .values
+}
+
+/// The strokes of `svg`'s polylines in drawing order, `(colour as #RRGGBB, width)`, those of
+/// `kinds` only, with each run of one kind told once: the order curves are drawn in (a later
+/// one lies on top).
+#[cfg(test)]
+pub fn stroke_order(svg: &str, kinds: &[(String, u32)]) -> Vec<usize> {
+    let attr = |line: &str, name: &str| {
+        let (_, rest) = line.split_once(&format!(" {name}=\""))?;
+        Some(rest.split_once('"')?.0.to_string())
+    };
+    let mut order: Vec<usize> = Vec::new();
+    for line in svg
+        .lines()
+        .filter(|l| l.trim_start().starts_with("<polyline"))
+    {
+        let stroke = (attr(line, "stroke"), attr(line, "stroke-width"));
+        let kind = kinds
+            .iter()
+            .position(|(c, w)| stroke == (Some(c.clone()), Some(w.to_string())));
+        if let Some(k) = kind {
+            if order.last() != Some(&k) {
+                order.push(k);
+            }
+        }
+    }
+    order
+}
+
+/// A colour as plotters' SVG writes it.
+#[cfg(test)]
+pub fn hex(c: plotters::style::RGBColor) -> String {
+    format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
 }

@@ -1,11 +1,10 @@
-//! Time histories: displacement, velocity and acceleration, each in its own panel against the
-//! STF force on a second axis, with the force's extrema (those standing above the noise)
-//! marked, as in the source study.
+//! Time histories: displacement, velocity, acceleration and the STF force, each in its own
+//! panel, stacked on one time axis (a panel per quantity: two axes on one panel overlap and
+//! their envelopes blend), with the force's extrema (those standing above the noise) marked,
+//! as in the source study.
 
 use std::path::Path;
 
-use plotters::chart::DualCoordChartContext;
-use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -14,9 +13,9 @@ use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
-    axis_desc_style, draw_line, draw_mesh_with, finite_runs, legend_strip, milli, model_entries,
-    msg, render, require_finite, same_length, tick_label, tick_style, titled, Draw, FigureFiles,
-    Swatch, F_LABEL, SIZE_TALL, T_LABEL,
+    axis_desc_style, draw_line, draw_mesh_with, finite_runs, legend_strip, milli, msg, render,
+    require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL,
+    T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -35,10 +34,12 @@ pub struct Motion<'a> {
     pub a: &'a [f64],
 }
 
+/// The panels, top to bottom: the three motion quantities, then the STF force.
+const PANELS: usize = 4;
+
 struct TimeHistoryPlot {
     t: Vec<f64>,
-    panels: [(&'static str, Vec<f64>); 3],
-    f: Vec<f64>,
+    panels: [(&'static str, Vec<f64>); PANELS],
     marks: Vec<(f64, f64, ExtremumKind)>,
 }
 
@@ -49,36 +50,31 @@ impl TimeHistoryPlot {
         index: usize,
     ) -> Result<(), String> {
         let (label, y) = &self.panels[index];
+        let last = index == PANELS - 1;
         let no_data = || format!("{label}: no finite value");
         let t_range = exact_range(&self.t).ok_or_else(no_data)?;
         let y_range = padded_range(y).ok_or_else(no_data)?;
-        let f_range = padded_range(&self.f).ok_or_else(|| "F_STF: no finite value".to_string())?;
         let mut chart = ChartBuilder::on(area)
-            .margin(8)
-            .x_label_area_size(if index == 2 { 48 } else { 28 })
-            .y_label_area_size(90)
-            .right_y_label_area_size(80)
-            .build_cartesian_2d(t_range.clone(), y_range.clone())
-            .map_err(msg)?
-            .set_secondary_coord(t_range.clone(), f_range.clone());
-        let desc = ((index == 2).then(|| T_LABEL.into()), label.to_string());
-        draw_mesh_with(&mut chart, desc, None, axis_desc_style())?;
-        let fs = f_range.end - f_range.start;
-        chart
-            .configure_secondary_axes()
-            .y_desc(F_LABEL)
-            .y_label_formatter(&|v| tick_label(*v, fs))
-            .axis_desc_style(axis_desc_style())
-            .label_style(tick_style())
-            .draw()
+            .margin(6)
+            .margin_right(30)
+            .x_label_area_size(if last { X_LABEL_AREA } else { 34 })
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(t_range, y_range)
             .map_err(msg)?;
-
-        self.draw_signals(&mut chart, y)?;
-        if self.marks.len() > MAX_MARKS {
+        let desc = (last.then(|| T_LABEL.into()), label.to_string());
+        let (w, h) = chart.plotting_area().dim_in_pixel();
+        let ticks = (
+            (w / 120).clamp(3, 10) as usize,
+            (h / 36).clamp(3, 6) as usize,
+        );
+        draw_mesh_with(&mut chart, desc, Some(ticks), axis_desc_style())?;
+        let colour = series_colour(usize::from(last));
+        self.draw_signal(&mut chart, y, colour)?;
+        if !last || self.marks.len() > MAX_MARKS {
             return Ok(());
         }
         chart
-            .draw_secondary_series(self.marks.iter().map(|&(t, f, kind)| {
+            .draw_series(self.marks.iter().map(|&(t, f, kind)| {
                 let style = match kind {
                     ExtremumKind::Max => BLACK.filled(),
                     ExtremumKind::Min => BLACK.stroke_width(2),
@@ -89,12 +85,14 @@ impl TimeHistoryPlot {
         Ok(())
     }
 
-    /// The legend the three panels share: the motion (left axis), the force (right axis) and
-    /// the marks of its extrema.
+    /// The legend above the panels, if there is anything to say: the marks of the force's
+    /// extrema, and that signals are drawn as envelopes.
     fn legend_entries(&self) -> Vec<(String, Swatch)> {
-        let suffix = if self.is_dense() { " (envelope)" } else { "" };
-        let lines = ["motion, left axis", &format!("{F_LABEL}, right axis")];
-        let mut entries = model_entries(lines, suffix);
+        let mut entries = Vec::new();
+        if self.is_dense() {
+            let what = "each signal's envelope (its cycles are in the regime windows)";
+            entries.push((what.into(), Swatch::Line(series_colour(0), 3)));
+        }
         if !self.marks.is_empty() && self.marks.len() <= MAX_MARKS {
             entries.push(("F_STF maxima".into(), Swatch::Dot(BLACK)));
             entries.push(("minima".into(), Swatch::Ring));
@@ -104,41 +102,25 @@ impl TimeHistoryPlot {
 
     /// Hundreds of cycles: each signal is drawn as its envelope.
     fn is_dense(&self) -> bool {
-        dense(&self.f) || self.panels.iter().any(|(_, y)| dense(y))
+        self.panels.iter().any(|(_, y)| dense(y))
     }
 
-    /// The motion `y` (primary axis) and the force (secondary): lines, or for hundreds of
-    /// cycles each signal's envelope (the cycles are in the regime windows).
-    fn draw_signals<'a, DB: DrawingBackend + 'a>(
+    /// One signal `y`: a line, or for hundreds of cycles its envelope.
+    fn draw_signal<DB: DrawingBackend>(
         &self,
-        chart: &mut DualCoordChartContext<
-            'a,
-            DB,
-            Cartesian2d<RangedCoordf64, RangedCoordf64>,
-            Cartesian2d<RangedCoordf64, RangedCoordf64>,
-        >,
+        chart: &mut Chart2d<'_, DB>,
         y: &[f64],
+        colour: RGBColor,
     ) -> Result<(), String> {
-        let c_motion = series_colour(0);
-        let c_force = series_colour(1);
         if self.is_dense() {
-            let buckets = buckets_for(y).min(buckets_for(&self.f));
-            let y_band = band(&envelope(&self.t, y, buckets));
+            let buckets = self.panels.iter().map(|(_, y)| buckets_for(y)).min();
+            let y_band = band(&envelope(&self.t, y, buckets.unwrap_or(1)));
             chart
-                .draw_series([Polygon::new(y_band, c_motion.mix(0.45).filled())])
-                .map_err(msg)?;
-            let f_band = band(&envelope(&self.t, &self.f, buckets));
-            chart
-                .draw_secondary_series([Polygon::new(f_band, c_force.mix(0.45).filled())])
+                .draw_series([Polygon::new(y_band, colour.mix(0.6).filled())])
                 .map_err(msg)?;
         } else {
             for run in finite_runs(&self.t, y) {
-                draw_line(chart, run, c_motion.stroke_width(2))?;
-            }
-            for run in finite_runs(&self.t, &self.f) {
-                chart
-                    .draw_secondary_series(LineSeries::new(run, c_force.stroke_width(1)))
-                    .map_err(msg)?;
+                draw_line(chart, run, colour.stroke_width(2))?;
             }
         }
         Ok(())
@@ -150,17 +132,22 @@ const MAX_MARKS: usize = 80;
 
 impl Draw for TimeHistoryPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let root = titled(root, "Motion against the STF force")?;
-        let root = legend_strip(&root, &self.legend_entries())?;
-        for (i, area) in root.split_evenly((3, 1)).iter().enumerate() {
+        let root = titled(root, "Motion and STF force over time")?;
+        let entries = self.legend_entries();
+        let root = if entries.is_empty() {
+            root
+        } else {
+            legend_strip(&root, &entries)?
+        };
+        for (i, area) in root.split_evenly((PANELS, 1)).iter().enumerate() {
             self.panel(area, i)?;
         }
         Ok(())
     }
 }
 
-/// Draw x (in mm), v (mm/s) and a (m/s²) against F_STF over time (three panels, F_STF on
-/// the right axis, its extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
+/// Draw x (in mm), v (mm/s), a (m/s²) and F_STF over time (four panels on one time axis,
+/// F_STF's extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
 /// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
 pub fn time_history(
     out_dir: &Path,
@@ -191,8 +178,8 @@ pub fn time_history(
             ("displacement x, mm", milli(&pick(x, &keep))),
             ("velocity v, mm/s", milli(&pick(v, &keep))),
             ("acceleration a, m/s²", pick(a, &keep)),
+            (F_LABEL, pick(f_stf, &keep)),
         ],
-        f: pick(f_stf, &keep),
         marks: marks_full
             .iter()
             .map(|e| (t[e.index], f_stf[e.index], e.kind))
@@ -204,7 +191,7 @@ pub fn time_history(
         Column::new("x, mm", plot.panels[0].1.clone()),
         Column::new("v, mm/s", plot.panels[1].1.clone()),
         Column::new("a, m/s²", plot.panels[2].1.clone()),
-        Column::new(F_LABEL, plot.f.clone()),
+        Column::new(F_LABEL, plot.panels[3].1.clone()),
         Column::new("F_STF extremum t, s", marks(|m| m.0)),
         Column::new("F_STF extremum, N", marks(|m| m.1)),
         Column::new(
@@ -260,16 +247,19 @@ mod tests {
             kinds.len()
         );
         assert!(kinds.windows(2).all(|w| w[0] == -w[1]));
-        // One legend above the panels, naming the marks too (drawn where it covers no data).
+        // One legend above the panels, naming the marks (drawn where it covers no data); a
+        // panel per quantity, each axis named once, and no second axis on any panel.
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         for label in [
-            "motion, left axis",
-            "F_STF, N, right axis",
             "F_STF maxima",
             "minima",
+            "\nF_STF, N\n",
+            "\nvelocity v, mm/s\n",
         ] {
             assert_eq!(svg.matches(label).count(), 1, "{label}");
         }
+        assert!(!svg.contains("right axis"));
+        assert_eq!(svg.matches("\ntime t, s\n").count(), 1);
     }
 
     #[test]
