@@ -43,6 +43,7 @@ mod parity;
 mod plot_range;
 mod raster;
 mod regime_errors;
+mod regime_time_windows;
 mod regime_windows;
 mod series_csv;
 mod smoothing;
@@ -66,6 +67,7 @@ pub use measured_vs_fitted::{
 pub use parity::{parity, ParityQuantity, SampleGroup};
 pub use raster::{stray_coloured_pixels, svg_to_png};
 pub use regime_errors::regime_errors;
+pub use regime_time_windows::{regime_time_windows, TimeRow};
 pub use regime_windows::{regime_windows, RegimeWindow, WindowSeries};
 pub use series_csv::{read_csv_columns, Column};
 pub use smoothing::{smooth_trend, Smoothing};
