@@ -240,15 +240,19 @@ fn a_shallow_on_off_crossing_is_not_placed_within_a_tenth() {
 }
 
 /// The zero-force level moves the resonance → post-resonance boundary (the force is "zero"
-/// between its pulses below it): on the jamming record with the rig's sensors, at both sweep
+/// between its pulses below it): on an on–off jamming record with the rig's sensors, at both sweep
 /// rates and two seeds, the range the comparison states (the boundary at half, once and twice
 /// the level, each with its ±) holds the boundary found at levels in between (0.7× and 1.4×),
 /// and the onset, which follows the negligible level, moves by less than one cycle.
 #[test]
 fn the_stated_zero_level_range_holds_the_boundary_at_other_levels() {
     use stf_core::regimes::{classify, zero_level_spread};
-    let (_, truth) = CASES[1];
-    println!("| α rad/s² | seed | zero level N | stated range | 0.7× | 1.4× | onset ω |");
+    // The default jamming law stays on to the end of the sweep; with a higher critical speed
+    // it becomes on–off after the resonance (the shallow crossing above).
+    let truth = "[[simulate.truth]]\nname = \"jamming_on_off\"\nparams = { v_c = 0.065 }";
+    println!(
+        "| α rad/s² | seed | zero level N | boundary ± | stated range | 0.7× | 1.4× | onset ω |"
+    );
     for alpha in [0.0333, 0.047] {
         for seed in [1, 2] {
             let case = Case {
@@ -299,9 +303,11 @@ fn the_stated_zero_level_range_holds_the_boundary_at_other_levels() {
                 );
                 found.push(post.omega);
             }
+            let post = base.boundaries.resonance_post.expect("a boundary");
             println!(
-                "| {alpha} | {seed} | {:.4} | {lo:.3}–{hi:.3} | {:.3} | {:.3} | {:.3} |",
-                z.zero_level, found[0], found[1], onset.omega
+                "| {alpha} | {seed} | {:.4} | {:.3} ± {:.3} | {lo:.3}–{hi:.3} | {:.3} | {:.3} | \
+                 {:.3} |",
+                z.zero_level, post.omega, post.uncertainty, found[0], found[1], onset.omega
             );
         }
     }

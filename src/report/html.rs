@@ -211,6 +211,8 @@ fn inline_svg(svg: &str, caption: &str, zoom: bool) -> Option<String> {
         (Some(w), Some(h)) => format!(" style=\"aspect-ratio: {} / {}\"", escape(w), escape(h)),
         _ => String::new(),
     };
+    // An SVG in an HTML page needs no namespace declaration (the page names no address).
+    let rest = rest.replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1);
     let class = if zoom { "figure zoom" } else { "figure" };
     Some(format!(
         "<svg class=\"{class}\" role=\"img\" aria-label=\"{}\"{ratio}{rest}",
@@ -366,7 +368,8 @@ mod tests {
 
     #[test]
     fn a_figure_is_its_svg_inlined_with_its_class() {
-        let svg = "<?xml version=\"1.0\"?>\n<svg width=\"10\" height=\"5\"><line/></svg>";
+        let svg = "<?xml version=\"1.0\"?>\n<svg width=\"10\" height=\"5\" \
+                   xmlns=\"http://www.w3.org/2000/svg\"><line/></svg>";
         let got = inline_svg(svg, "a \"b\"", true).unwrap();
         assert_eq!(
             got,
