@@ -133,7 +133,9 @@ fn the_identification_writes_a_report_and_prints_a_readable_system() {
         .find(|l| l.starts_with("identified system:"))
         .unwrap();
     assert!(!line.contains('{') && line.contains(" N/m"), "{line}");
-    assert_eq!(check_figures(&out), 2);
+    // Each stage over time, and the swept stage's frequency response.
+    assert_eq!(check_figures(&out), 3);
+    assert!(out.join("figures/frequency_response_stage_2.svg").is_file());
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         md.contains("Identified oscillator: m 7.65 kg, k 269.9"),
@@ -168,6 +170,31 @@ fn compare_and_discover_reports_open_with_their_verdicts() {
     );
     assert!(md.contains("The duty of a cycle is"), "duty unexplained");
     assert!(header(&cmp.join("figures/frequency_response.csv")).contains("local maximum of x, mm"));
+    // The resonance window sits at the amplitude peak compare.json states, and says so; the
+    // zero-force level and the boundaries' spread over it are stated in both.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cmp.join("compare.json")).unwrap()).unwrap();
+    let measured = &json["measured"];
+    let peak = measured["resonance"]["peak_omega_rad_s"].as_f64().unwrap();
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("resonance (ω "))
+        .unwrap_or_else(|| panic!("no resonance window:\n{md}"));
+    let span = line["resonance (ω ".len()..]
+        .split(" rad/s")
+        .next()
+        .unwrap();
+    let (lo, hi) = span.split_once('–').unwrap();
+    let (lo, hi): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
+    assert!(
+        lo - 0.01 <= peak && peak <= hi + 0.01,
+        "peak {peak} outside {line}"
+    );
+    assert!(line.contains("around the amplitude peak"), "{line}");
+    let zero = &measured["zero_level"];
+    assert_eq!(zero["zero_level"], measured["on_threshold"]);
+    assert_eq!(zero["at_levels"].as_array().unwrap().len(), 2);
+    assert!(md.contains("zero force level"), "{md}");
 
     for (example, first) in [
         ("experiments/discovery.toml", "Named: `cubic_stiffness`."),

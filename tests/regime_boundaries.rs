@@ -238,3 +238,77 @@ fn a_shallow_on_off_crossing_is_not_placed_within_a_tenth() {
     );
     assert_eq!(failed, 0, "{failed} cases outside {TOLERANCE} rad/s");
 }
+
+/// The zero-force level moves the resonance → post-resonance boundary (the force is "zero"
+/// between its pulses below it): on an on–off jamming record with the rig's sensors, at both sweep
+/// rates and two seeds, the range the comparison states (the boundary at half, once and twice
+/// the level, each with its ±) holds the boundary found at levels in between (0.7× and 1.4×),
+/// and the onset, which follows the negligible level, moves by less than one cycle.
+#[test]
+fn the_stated_zero_level_range_holds_the_boundary_at_other_levels() {
+    use stf_core::regimes::{classify, zero_level_spread};
+    // The default jamming law stays on to the end of the sweep; with a higher critical speed
+    // it becomes on–off after the resonance (the shallow crossing above).
+    let truth = "[[simulate.truth]]\nname = \"jamming_on_off\"\nparams = { v_c = 0.065 }";
+    println!(
+        "| α rad/s² | seed | zero level N | boundary ± | stated range | 0.7× | 1.4× | onset ω |"
+    );
+    for alpha in [0.0333, 0.047] {
+        for seed in [1, 2] {
+            let case = Case {
+                model: "jamming_on_off",
+                truth,
+                alpha,
+                seed,
+            };
+            let dir = tempfile::tempdir().unwrap();
+            let mut exp = Experiment::load(&experiment(dir.path(), &case, true)).unwrap();
+            let data = load_data(&mut exp).unwrap();
+            let base = measured_regimes(&exp, &data).unwrap();
+            let f = data.record.f_stf.clone().unwrap();
+            let sig = data.force_data().with_force(&f);
+            let z = zero_level_spread(&sig, &base.cycles, &exp.regimes, &base).unwrap();
+            assert!((z.zero_level - base.on_threshold).abs() < 1e-15);
+            assert!(z.zero_level_rule.contains("3σ"), "{}", z.zero_level_rule);
+            let [lo, hi] = z.resonance_post_range.expect("a resonance → post boundary");
+            let onset = base.boundaries.pre_resonance.expect("an onset");
+            let cycle = base.cycles.get(onset.cycle).map_or(f64::NAN, |c| {
+                (c.omega - base.cycles[onset.cycle - 1].omega).abs()
+            });
+            let mut found = Vec::new();
+            for factor in [0.7, 1.4] {
+                let th = RegimeThresholds {
+                    noise_sigma: Some(base.noise_sigma),
+                    on_k: exp.regimes.on_k * factor,
+                    on_min: exp.regimes.on_min * factor,
+                    ..exp.regimes.clone()
+                };
+                let c = classify(&sig, base.cycles.clone(), &th).unwrap();
+                let post = c
+                    .boundaries
+                    .resonance_post
+                    .expect("a boundary at this level");
+                assert!(
+                    (lo..=hi).contains(&post.omega),
+                    "α {alpha}, seed {seed}: at {factor}× the boundary is at {:.3}, outside the \
+                     stated {lo:.3}–{hi:.3}",
+                    post.omega
+                );
+                let o = c.boundaries.pre_resonance.expect("an onset").omega;
+                assert!(
+                    (o - onset.omega).abs() <= cycle,
+                    "α {alpha}, seed {seed}: the onset moved from {:.3} to {o:.3} (a cycle is \
+                     {cycle:.3} rad/s)",
+                    onset.omega
+                );
+                found.push(post.omega);
+            }
+            let post = base.boundaries.resonance_post.expect("a boundary");
+            println!(
+                "| {alpha} | {seed} | {:.4} | {:.3} ± {:.3} | {lo:.3}–{hi:.3} | {:.3} | {:.3} | \
+                 {:.3} |",
+                z.zero_level, post.omega, post.uncertainty, found[0], found[1], onset.omega
+            );
+        }
+    }
+}

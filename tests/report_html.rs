@@ -168,11 +168,14 @@ fn build_report(dir: &Path) -> PathBuf {
     });
     r.sections.push(fit);
     let mut figs = Section::new("Figures");
-    figs.figures.push(FigureRef::new(
-        history,
-        "Displacement, velocity, acceleration and the STF force over time, a panel each; \
-         black dots mark the force's maxima, circles its minima.",
-    ));
+    figs.figures.push(
+        FigureRef::new(
+            history,
+            "Displacement, velocity, acceleration and the STF force over time, a panel each; \
+             black dots mark the force's maxima, circles its minima.",
+        )
+        .zoomable(),
+    );
     figs.figures.push(FigureRef::new(
         loop_v,
         "The STF force against velocity; the colour shows time, from dark (start) to yellow \
@@ -196,7 +199,9 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     let page = build_report(&dir);
 
     let html = std::fs::read_to_string(&page).unwrap();
-    assert_eq!(html.matches("<img src=\"data:image/png;base64,").count(), 2);
+    assert_eq!(html.matches("<svg class=\"figure").count(), 2);
+    assert_eq!(html.matches("<svg class=\"figure zoom\"").count(), 1);
+    assert!(!html.contains("<img"), "figures are inline SVG");
     assert!(!html.contains("http://") && !html.contains("https://"));
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("](figures/time_history.png)"), "{md}");
@@ -216,6 +221,91 @@ fn report_html_renders_every_figure_in_headless_chromium() {
     );
     let png = std::fs::read(&shot).unwrap();
     assert!(png.len() > 10_000, "screenshot is {} bytes", png.len());
+}
+
+/// What the test page's injected script saw of the first zoomable figure's `viewBox`, one
+/// line per step: `initial`, after a wheel event zooming in at its middle, after a drag to the
+/// right, after a double-click.
+const ZOOM_PROBE: &str = r#"<script>
+window.addEventListener("load", function () {
+  var svg = document.querySelector("svg.zoom");
+  var r = svg.getBoundingClientRect();
+  var lines = ["initial " + svg.getAttribute("viewBox")];
+  var at = { clientX: r.left + r.width / 2, clientY: r.top + r.height / 2, bubbles: true,
+             cancelable: true };
+  svg.dispatchEvent(new WheelEvent("wheel", Object.assign({ deltaY: -500 }, at)));
+  lines.push("wheel " + svg.getAttribute("viewBox"));
+  svg.dispatchEvent(new PointerEvent("pointerdown", Object.assign({ pointerId: 1 }, at)));
+  at.clientX += 100;
+  svg.dispatchEvent(new PointerEvent("pointermove", Object.assign({ pointerId: 1 }, at)));
+  svg.dispatchEvent(new PointerEvent("pointerup", Object.assign({ pointerId: 1 }, at)));
+  lines.push("drag " + svg.getAttribute("viewBox"));
+  svg.dispatchEvent(new MouseEvent("dblclick", at));
+  lines.push("reset " + svg.getAttribute("viewBox"));
+  var pre = document.createElement("pre");
+  pre.id = "zoom-probe";
+  pre.textContent = lines.join("\n");
+  document.body.appendChild(pre);
+});
+</script>"#;
+
+/// A `viewBox`'s four numbers from the probe's line `step …`.
+fn view_box(probe: &str, step: &str) -> [f64; 4] {
+    let line = probe
+        .lines()
+        .find(|l| l.starts_with(step))
+        .unwrap_or_else(|| panic!("no `{step}` in the zoom probe:\n{probe}"));
+    let v: Vec<f64> = line[step.len()..]
+        .split_whitespace()
+        .map(|w| w.parse().unwrap())
+        .collect();
+    v.try_into().unwrap()
+}
+
+/// The time history's wheel zooms its time axis (x and width of the `viewBox` only), a drag
+/// pans it to earlier times, a double-click resets it: a copy of the page with a probe script
+/// injected, run in headless Chromium.
+#[test]
+fn a_time_history_zooms_pans_and_resets_in_headless_chromium() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().canonicalize().unwrap();
+    let page = build_report(&dir);
+    let Some(chromium) = browser_or_skip() else {
+        return;
+    };
+    let html = std::fs::read_to_string(&page).unwrap();
+    let probed = dir.join("probed.html");
+    std::fs::write(
+        &probed,
+        html.replace("</body>", &format!("{ZOOM_PROBE}</body>")),
+    )
+    .unwrap();
+    let dom = run_chromium(&chromium, &probed, &["--dump-dom".to_string()]);
+    let probe = dom
+        .split("<pre id=\"zoom-probe\">")
+        .nth(1)
+        .and_then(|rest| rest.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no zoom probe in the DOM (a script error?)"));
+    let initial = view_box(probe, "initial ");
+    let wheel = view_box(probe, "wheel ");
+    let drag = view_box(probe, "drag ");
+    let reset = view_box(probe, "reset ");
+    assert!(wheel[2] < 0.5 * initial[2], "zoomed in: {probe}");
+    assert_eq!(
+        (wheel[1], wheel[3]),
+        (initial[1], initial[3]),
+        "time axis only: {probe}"
+    );
+    let middle = initial[0] + initial[2] / 2.0;
+    assert!(
+        (wheel[0] + wheel[2] / 2.0 - middle).abs() < 1.0,
+        "about the pointer: {probe}"
+    );
+    assert!(
+        drag[0] < wheel[0] && (drag[2] - wheel[2]).abs() < 1e-3,
+        "dragged right, earlier times: {probe}"
+    );
+    assert_eq!(reset, initial, "{probe}");
 }
 
 /// Every bundled example's report, as its command writes it, loads in the browser with every
@@ -240,7 +330,11 @@ fn every_bundled_report_lays_out_every_figure_in_headless_chromium() {
         common::run_ok(command, &experiment, &out);
         let page = out.join("report.html").canonicalize().unwrap();
         let html = std::fs::read_to_string(&page).unwrap();
-        let figures = html.matches("<img src=\"data:image/png;base64,").count();
+        let figures = html.matches("<svg class=\"figure").count();
+        assert!(
+            html.contains("<svg class=\"figure zoom\""),
+            "{example}: no zoomable figure"
+        );
         assert!(figures >= 2, "{example}: {figures} figures");
         let dom = run_chromium(&chromium, &page, &["--dump-dom".to_string()]);
         check_layout(&dom, figures);

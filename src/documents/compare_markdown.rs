@@ -1,12 +1,12 @@
 //! `compare.md` of `stf-lab compare`, also printed on the terminal: the record's cycles and
-//! boundaries, each model's relative force RMS error (duty error) per regime with its
+//! boundaries (with how far they move with the zero-force level), each model's relative force RMS error (duty error) per regime with its
 //! simulated resonance peak, the best model per regime, the loop metrics, the on–off
 //! behaviour a model misses and the warnings against its fit. Its `- ` bullets open the
 //! report's regimes section.
 
 use std::fmt::Write as _;
 
-use stf_core::regimes::Regime;
+use stf_core::regimes::{Boundary, Regime, ZeroLevelSpread};
 
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
@@ -19,6 +19,46 @@ pub fn duty_meaning(on_threshold: f64) -> String {
          {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
          zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
          a regime's cycles of |model duty − measured duty|."
+    )
+}
+
+/// How the boundaries move with the zero-force level: the level used, each boundary at half
+/// and twice it, and the range each spans.
+pub fn zero_level_line(z: &ZeroLevelSpread) -> String {
+    let omega = |b: Option<Boundary>| b.map_or("none".to_string(), |b| format!("{:.2}", b.omega));
+    let levels: Vec<String> = z
+        .at_levels
+        .iter()
+        .map(|l| {
+            format!(
+                "at {:.3} N ({}×) onset {}, resonance → post-resonance {}",
+                l.zero_level,
+                l.factor,
+                omega(l.boundaries.pre_resonance),
+                omega(l.boundaries.resonance_post)
+            )
+        })
+        .collect();
+    let range = |name: &str, r: Option<[f64; 2]>| {
+        r.map(|[lo, hi]| format!("the {name} boundary lies within ω {lo:.2}–{hi:.2} rad/s"))
+    };
+    let ranges: Vec<String> = [
+        range("onset", z.pre_resonance_range),
+        range("resonance → post-resonance", z.resonance_post_range),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    format!(
+        "zero force level {:.3} N ({}); recomputed {}: over these levels, with each one's ±, {}",
+        z.zero_level,
+        z.zero_level_rule,
+        levels.join("; "),
+        if ranges.is_empty() {
+            "no boundary is found".to_string()
+        } else {
+            ranges.join(", ")
+        }
     )
 }
 
@@ -41,6 +81,9 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
     );
     for line in crate::documents::compare_loops::boundary_lines(measured) {
         let _ = writeln!(md, "- {line}");
+    }
+    if let Some(z) = &c.zero_level {
+        let _ = writeln!(md, "- {}", zero_level_line(z));
     }
     errors_table(&mut md, c);
     for r in Regime::ALL {

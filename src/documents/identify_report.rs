@@ -1,7 +1,8 @@
 //! The report of the source study's identification (`[[identify]]` stages): a verdict
 //! paragraph (the identified oscillator, each stage's S(μ) against its noise floor, every
 //! warning), the identified parameters with their units, each stage's table, and each stage's
-//! measured displacement against the oscillator simulated with the stage's values.
+//! measured displacement against the oscillator simulated with the stage's values (over time,
+//! and, for a swept stage, as a frequency response).
 
 use std::path::Path;
 
@@ -9,7 +10,11 @@ use anyhow::Result;
 use stf_core::physics::oscillator_params::OscillatorParams;
 
 use crate::documents::standard_report::write_report;
-use crate::report::{measured_vs_model, milli, FigureRef, Section, Table, DISPLACEMENT_MM};
+use crate::report::{
+    frequency_response, measured_vs_model, milli, FigureRef, FrfCurve, FrfRole, Section, Smoothing,
+    Table, DISPLACEMENT_MM,
+};
+use stf_study::compare::response;
 
 pub use stf_study::identify::StageOutcome;
 use stf_study::verdict::identify_verdict as verdict;
@@ -50,16 +55,57 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
             &milli(&s.x),
             &[("identified", &simulated)],
         )?;
-        section.figures.push(FigureRef::new(
-            fig,
-            format!(
-                "Stage {}: measured displacement against the oscillator simulated with the \
+        section.figures.push(
+            FigureRef::new(
+                fig,
+                format!(
+                    "Stage {}: measured displacement against the oscillator simulated with the \
                  stage's identified values.",
-                i + 1
-            ),
-        ));
+                    i + 1
+                ),
+            )
+            .zoomable(),
+        );
+    }
+    if let Some(fig) = stage_frequency_response(i, s, dir)? {
+        section.figures.push(fig);
     }
     Ok(section)
+}
+
+/// A swept stage's frequency response: the local maxima of the measured displacement and of
+/// the oscillator simulated with the stage's values against the rotor speed.
+fn stage_frequency_response(i: usize, s: &StageOutcome, dir: &Path) -> Result<Option<FigureRef>> {
+    let Some(omega) = s.omega.as_deref() else {
+        return Ok(None);
+    };
+    let mut curves = vec![("measured", &s.x, FrfRole::Measured)];
+    if s.simulated.len() == s.x.len() {
+        curves.push(("identified", &s.simulated, FrfRole::Model));
+    }
+    let curves: Vec<FrfCurve> = curves
+        .into_iter()
+        .map(|(label, x, role)| {
+            let r = response(label, &s.t, x, Some(omega));
+            FrfCurve {
+                label: r.label,
+                omega: r.omega,
+                x_peak: r.x_peak,
+                role,
+            }
+        })
+        .collect();
+    let name = format!("frequency_response_stage_{}", i + 1);
+    let fig = frequency_response(dir, &name, &curves, [None, None], &Smoothing::default())?;
+    Ok(Some(FigureRef::new(
+        fig,
+        format!(
+            "Stage {}: frequency response, the local maxima of the measured displacement and of \
+             the oscillator simulated with the stage's values against the rotor speed, with \
+             their smoothed trends.",
+            i + 1
+        ),
+    )))
 }
 
 /// Write `report.html`, `report.md` and the stages' figures into `out`.

@@ -1,21 +1,25 @@
 //! The figures of a record regime by regime: a window of a few cycles in each regime
-//! (pre-resonance, resonance, post-resonance) with the loops F–x, F–v, F–a of every model over
+//! (pre-resonance, resonance, post-resonance) over time, x, v and F_STF measured and modelled
+//! ([`crate::report::regime_time_windows`]), with the loops F–x, F–v, F–a of every model over
 //! the measured ones ([`crate::report::regime_windows`]), and measured against fitted with the
 //! residual's distribution per regime ([`crate::report::parity`]). The regimes are the
-//! record's own (classified on its STF force, as `compare` does); a record without them (no
+//! record's own (classified on its STF force, as `compare` does), and each window sits where
+//! its regime is, with the reason it was chosen ([`super::window_placement`]: the resonance at
+//! the amplitude peak, which is never shown as pre-resonance); a record without them (no
 //! rotor, no STF force to speak of) gets windows at its start, middle and end instead, said in
 //! words that fit it (periods of the motion, thirds of the record: a damper has no regimes).
 
 use std::path::Path;
 
 use anyhow::Result;
-use stf_core::regimes::{classify, Cycle, Regime};
+use stf_core::regimes::{classify, Classification, Cycle, Regime};
 
+use super::window_placement::place_windows;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::report::{
-    milli, parity, regime_windows, FigureRef, ParityQuantity, RegimeWindow, SampleGroup, Section,
-    WindowSeries,
+    milli, parity, regime_time_windows, regime_windows, FigureRef, ParityQuantity, RegimeWindow,
+    SampleGroup, Section, TimeRow, WindowSeries,
 };
 
 /// How many whole cycles a window shows.
@@ -63,8 +67,11 @@ fn stretches(cycles: &[Cycle], labels: Option<&[Regime]>) -> Vec<Stretch> {
         .collect()
 }
 
-/// The record's cycles and, when it has an STF force and a rotor, their regime labels.
-fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Option<Vec<Regime>>)> {
+/// The record's cycles and, when it has an STF force and a rotor, their classification.
+fn labelled_cycles(
+    exp: &Experiment,
+    data: &FitData,
+) -> Result<(Vec<Cycle>, Option<Classification>)> {
     let k = &data.kinematics;
     let cycles = crate::fitting::cycles_of(data)?;
     let rotor = k.phi.is_some() || k.omega.is_some();
@@ -74,7 +81,6 @@ fn labelled_cycles(exp: &Experiment, data: &FitData) -> Result<(Vec<Cycle>, Opti
             classify(&sig, cycles.clone(), &exp.regimes)
                 .ok()
                 .filter(|c| !c.no_stf)
-                .map(|c| c.labels)
         }
         _ => None,
     };
@@ -119,21 +125,38 @@ impl Words {
     }
 }
 
-/// [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch, named with their ω.
-fn windows_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<RegimeWindow> {
-    found
+/// The windows and the sentence saying why each sits where it does: by the regimes
+/// ([`place_windows`]), or [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch.
+fn windows_of(
+    found: &[Stretch],
+    cycles: &[Cycle],
+    classified: Option<&Classification>,
+) -> (Vec<RegimeWindow>, Vec<String>) {
+    let window = |name: String, first: usize, count: usize| RegimeWindow {
+        name,
+        start: cycles[first].start,
+        end: cycles[first + count - 1].end,
+    };
+    if let Some(c) = classified {
+        let placed = place_windows(c, CYCLES_PER_WINDOW);
+        let why = placed.iter().map(|p| format!("{}.", p.why)).collect();
+        let windows = placed
+            .into_iter()
+            .map(|p| window(p.name, p.first, p.count))
+            .collect();
+        return (windows, why);
+    }
+    let windows = found
         .iter()
         .map(|s| {
             let n = CYCLES_PER_WINDOW.min(s.count);
             let first = s.first + (s.count - n) / 2;
             let (a, b) = (&cycles[first], &cycles[first + n - 1]);
-            RegimeWindow {
-                name: format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega),
-                start: a.start,
-                end: b.end,
-            }
+            let name = format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega);
+            window(name, first, n)
         })
-        .collect()
+        .collect();
+    (windows, Vec::new())
 }
 
 /// Every sample of each stretch's cycles.
@@ -151,26 +174,28 @@ fn groups_of(found: &[Stretch], cycles: &[Cycle]) -> Vec<SampleGroup> {
 }
 
 /// The section of regime windows and parity plots for `models` (`(label, fitted STF force)`,
-/// N; none: the measured force alone), or `None` when the record has no STF force or too
-/// few cycles.
+/// N; none: the measured force alone) and `simulated` (`(label, simulated displacement)`, m:
+/// trajectory-level fits), or `None` when the record has no STF force or too few cycles.
 pub fn regime_section(
     exp: &Experiment,
     data: &FitData,
     models: &[(&str, &[f64])],
+    simulated: &[(&str, &[f64])],
     out: &Path,
 ) -> Result<Option<Section>> {
     let Some(f) = data.record.f_stf.as_deref() else {
         return Ok(None);
     };
-    let (cycles, labels) = labelled_cycles(exp, data)?;
-    let found = stretches(&cycles, labels.as_deref());
+    let (cycles, classified) = labelled_cycles(exp, data)?;
+    let labels = classified.as_ref().map(|c| c.labels.as_slice());
+    let found = stretches(&cycles, labels);
     if found.is_empty() {
         return Ok(None);
     }
     let dir = out.join("figures");
     let k = &data.kinematics;
     let (x_mm, v_mm) = (milli(&k.x), milli(&k.v));
-    let windows = windows_of(&found, &cycles);
+    let (windows, why) = windows_of(&found, &cycles, classified.as_ref());
     let series = WindowSeries {
         t: &k.t,
         x_mm: &x_mm,
@@ -182,10 +207,58 @@ pub fn regime_section(
     let rotor = k.phi.is_some() || k.omega.is_some();
     let words = Words::of(labels.is_some(), rotor);
     let mut s = Section::new(words.title);
-    s.paragraphs.push(format!(
-        "{} whole {} from the middle of the longest stretch of each {}, and every sample of it \
-         for measured against fitted.",
-        CYCLES_PER_WINDOW, words.cycles, words.stretch
+    if why.is_empty() {
+        s.paragraphs.push(format!(
+            "{} whole {} from the middle of the longest stretch of each {}, and every sample of \
+             it for measured against fitted.",
+            CYCLES_PER_WINDOW, words.cycles, words.stretch
+        ));
+    } else {
+        s.paragraphs.push(format!(
+            "{CYCLES_PER_WINDOW} whole cycles where each regime is by the study's definitions \
+             (classified on the STF force, as `compare` does), and every sample of the longest \
+             stretch of each regime for measured against fitted. The windows:"
+        ));
+        s.paragraphs.extend(why);
+    }
+    let simulated_mm: Vec<(&str, Vec<f64>)> =
+        simulated.iter().map(|(l, x)| (*l, milli(x))).collect();
+    let rows = [
+        TimeRow {
+            label: "x, mm",
+            measured: &x_mm,
+            models: simulated_mm
+                .iter()
+                .map(|(l, x)| (*l, x.as_slice()))
+                .collect(),
+        },
+        TimeRow {
+            label: "v, mm/s",
+            measured: &v_mm,
+            models: Vec::new(),
+        },
+        TimeRow {
+            label: "F_STF, N",
+            measured: f,
+            models: models.to_vec(),
+        },
+    ];
+    let name = format!("{}_over_time", words.figure);
+    let fig = regime_time_windows(&dir, &name, &k.t, &rows, &windows)?;
+    s.figures.push(FigureRef::new(
+        fig,
+        format!(
+            "A few {} of each {} over time: displacement, velocity and STF force, measured \
+             (grey) and {}.",
+            words.cycles,
+            words.group,
+            match (models.is_empty(), simulated.is_empty()) {
+                (true, true) => "no model",
+                (false, true) => "each model's fitted force over it",
+                (true, false) => "each model's simulated displacement over it",
+                (false, false) => "each model's over it",
+            }
+        ),
     ));
     let fig = regime_windows(&dir, words.figure, &series, &windows)?;
     s.figures.push(FigureRef::new(

@@ -58,7 +58,8 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
     s.figures.push(FigureRef::new(
         th,
         "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked.",
-    ));
+    )
+    .zoomable());
     for (name, label, series) in [
         ("hysteresis_x", "displacement x, mm", milli(&k.x)),
         ("hysteresis_v", "velocity v, mm/s", milli(&k.v)),
@@ -120,10 +121,9 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
         &scaled(data.target()),
         &fitted,
     )?;
-    s.figures.push(FigureRef::new(
-        fig,
-        format!("Measured {what} against each fitted model."),
-    ));
+    s.figures.push(
+        FigureRef::new(fig, format!("Measured {what} against each fitted model.")).zoomable(),
+    );
     Ok(s)
 }
 
@@ -237,10 +237,13 @@ pub fn validation_section(
             &measured,
             &predicted,
         )?;
-        s.figures.push(FigureRef::new(
-            fig,
-            "The validation record against each model's prediction with its fitted parameters.",
-        ));
+        s.figures.push(
+            FigureRef::new(
+                fig,
+                "The validation record against each model's prediction with its fitted parameters.",
+            )
+            .zoomable(),
+        );
     }
     Ok(s)
 }
@@ -307,10 +310,12 @@ fn warning_rules(fits: &[ModelFit]) -> String {
     )
 }
 
-/// A section with the frequency response (local maxima of x against ω) of several runs.
+/// A section with the frequency response (local maxima of x against ω) of several runs, its
+/// figure written as `figures/NAME.*`.
 /// `changes` are the record's changes of regime (pre-resonance → resonance, resonance →
 /// post-resonance), shaded with their uncertainty.
 pub fn frequency_section(
+    name: &str,
     curves: &[FrfCurve],
     changes: [Option<RegimeChange>; 2],
     out: &Path,
@@ -325,13 +330,7 @@ pub fn frequency_section(
          the oscillator without STF is the dashed black line."
             .into(),
     );
-    let fig = frequency_response(
-        &dir,
-        "frequency_response",
-        curves,
-        changes,
-        &Smoothing::default(),
-    )?;
+    let fig = frequency_response(&dir, name, curves, changes, &Smoothing::default())?;
     s.figures.push(FigureRef::new(
         fig,
         "Frequency response of the record and of the oscillator with each fitted model.",

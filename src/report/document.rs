@@ -96,6 +96,9 @@ pub struct FigureRef {
     pub files: FigureFiles,
     /// What the figure shows, for a reader who never ran the tool.
     pub caption: String,
+    /// A time history the page lets the reader zoom (wheel) and pan (drag) along its time
+    /// axis.
+    pub zoom: bool,
 }
 
 impl FigureRef {
@@ -104,6 +107,13 @@ impl FigureRef {
         Self {
             files,
             caption: caption.into(),
+            zoom: false,
         }
+    }
+
+    /// The same figure, zoomable and pannable along its time axis in the HTML page.
+    pub fn zoomable(mut self) -> Self {
+        self.zoom = true;
+        self
     }
 }

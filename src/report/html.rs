@@ -1,16 +1,17 @@
-//! `report.html`: one self-contained page — CSS inline, figures inlined as PNG `data:` URIs,
-//! no script or font from the network — that a reader who never ran the tool can open
-//! anywhere. A tiny inline script writes each figure's laid-out size (and any page error) into
-//! a hidden `<pre id="layout-check">`, which lets a headless browser test check the page.
+//! `report.html`: one self-contained page — CSS inline, each figure's SVG inlined (vector, sharp
+//! at any zoom; its PNG and SVG files stay beside the page), no script or font from the
+//! network — that a reader who never ran the tool can open anywhere. A small inline script lets
+//! the reader zoom the time axis of time histories (wheel), pan it (drag) and reset it
+//! (double-click) by changing the figure's `viewBox` ([`ZOOM`]); another writes each figure's
+//! laid-out size (and any page error) into a hidden `<pre id="layout-check">`, which lets a
+//! headless browser test check the page.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::document::{FigureRef, Report, Table};
-use super::raster::PNG_SCALE;
 use super::ReportError;
 use crate::writing::atomic::write_atomic;
-use base64::Engine;
 
 const STYLE: &str = r#"
 body { font-family: "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; color: #222;
@@ -24,7 +25,10 @@ th { background: #eef3f8; text-align: left; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
 tbody tr:nth-child(even) { background: #f8f8f8; }
 figure { margin: 1.5em 0; }
-figure img { display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }
+figure img, figure svg.figure { display: block; max-width: 100%; height: auto;
+                               border: 1px solid #ddd; }
+figure svg.zoom { cursor: grab; touch-action: none; }
+figure svg.zoomed * { vector-effect: non-scaling-stroke; }
 figcaption { margin-top: .4em; font-size: .95em; }
 figcaption .files { color: #666; font-size: .9em; }
 .warnings { border: 2px solid #d55e00; border-left-width: 8px; background: #fff4e5;
@@ -44,15 +48,74 @@ const LAYOUT_CHECK: &str = r#"
   }
   window.addEventListener("error", function (e) { lines.push("error: " + e.message); show(); });
   window.addEventListener("load", function () {
-    var figures = document.querySelectorAll("figure img, figure svg");
+    var figures = document.querySelectorAll("figure img, figure svg.figure");
     figures.forEach(function (el, i) {
       var r = el.getBoundingClientRect();
+      var svg = el.tagName.toLowerCase() === "svg";
+      var w = svg ? el.width.baseVal.value : el.naturalWidth;
+      var h = svg ? el.height.baseVal.value : el.naturalHeight;
       lines.push("figure " + i + " " + el.tagName.toLowerCase() + " " + Math.round(r.width) +
-        "x" + Math.round(r.height) + " natural " + (el.naturalWidth || 0) + "x" +
-        (el.naturalHeight || 0));
+        "x" + Math.round(r.height) + " natural " + Math.round(w || 0) + "x" +
+        Math.round(h || 0));
     });
     lines.push("figures " + figures.length);
     show();
+  });
+})();
+"#;
+
+/// Zoom and pan along the time axis of every `svg.zoom`: the wheel scales the `viewBox`'s
+/// width around the pointer (1× to 50×), a drag shifts it, a double-click resets it. Only the
+/// horizontal extent changes (`preserveAspectRatio="none"`), so the amplitudes keep their
+/// scale; each text is squeezed back to its own width about its anchor, and strokes keep
+/// their width (`vector-effect`), so labels and lines stay as drawn. The time ticks move with
+/// the data, as they are drawn in its coordinates.
+const ZOOM: &str = r#"
+(function () {
+  function setup(svg) {
+    var vb = svg.viewBox.baseVal;
+    var full = { x: vb.x, y: vb.y, w: vb.width, h: vb.height };
+    svg.setAttribute("preserveAspectRatio", "none");
+    var texts = Array.prototype.map.call(svg.querySelectorAll("text"), function (t) {
+      var x = t.x.baseVal.numberOfItems ? t.x.baseVal.getItem(0).value : 0;
+      return { el: t, x: x, own: t.getAttribute("transform") || "" };
+    });
+    function show(x, w) {
+      w = Math.min(Math.max(w, full.w / 50), full.w);
+      x = Math.min(Math.max(x, full.x), full.x + full.w - w);
+      svg.setAttribute("viewBox", x + " " + full.y + " " + w + " " + full.h);
+      var s = w / full.w;
+      svg.classList.toggle("zoomed", s < 1);
+      texts.forEach(function (t) {
+        var squeeze = "translate(" + t.x + " 0) scale(" + s + " 1) translate(" + -t.x + " 0) ";
+        t.el.setAttribute("transform", s < 1 ? squeeze + t.own : t.own);
+      });
+    }
+    function at(clientX) {
+      var r = svg.getBoundingClientRect();
+      return vb.x + (clientX - r.left) / r.width * vb.width;
+    }
+    svg.addEventListener("wheel", function (e) {
+      e.preventDefault();
+      var w = Math.min(Math.max(vb.width * Math.exp(e.deltaY * 0.002), full.w / 50), full.w);
+      var p = at(e.clientX);
+      show(p - (p - vb.x) * w / vb.width, w);
+    }, { passive: false });
+    var drag = null;
+    svg.addEventListener("pointerdown", function (e) {
+      drag = { from: e.clientX, x: vb.x };
+      try { svg.setPointerCapture(e.pointerId); } catch (err) { /* no such pointer */ }
+    });
+    svg.addEventListener("pointermove", function (e) {
+      if (!drag) { return; }
+      var r = svg.getBoundingClientRect();
+      show(drag.x - (e.clientX - drag.from) / r.width * vb.width, vb.width);
+    });
+    svg.addEventListener("pointerup", function () { drag = null; });
+    svg.addEventListener("dblclick", function () { show(full.x, full.w); });
+  }
+  window.addEventListener("DOMContentLoaded", function () {
+    document.querySelectorAll("svg.zoom").forEach(setup);
   });
 })();
 "#;
@@ -84,13 +147,6 @@ pub fn inline(text: &str) -> String {
             }
         })
         .collect()
-}
-
-/// Width and height from a PNG's header, if it is one.
-fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
-    let header = bytes.strip_prefix(b"\x89PNG\r\n\x1a\n")?;
-    let at = |i: usize| Some(u32::from_be_bytes(header.get(i..i + 4)?.try_into().ok()?));
-    Some((at(8)?, at(12)?))
 }
 
 fn looks_numeric(cell: &str) -> bool {
@@ -138,57 +194,96 @@ fn warnings_html(out: &mut String, warnings: &[String]) {
     out.push_str("</ul>\n</div>\n");
 }
 
+/// The value of attribute `name` in the start tag `tag`.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let from = tag.find(&format!(" {name}=\""))? + name.len() + 3;
+    tag[from..].split('"').next()
+}
+
+/// `svg` (a figure's SVG document) as an element of the page: any XML prolog dropped, the
+/// figure's class (and `zoom` when zoomable), its caption as the accessible name and its
+/// drawn proportions (which a zoom, changing the `viewBox`, must not change) added.
+fn inline_svg(svg: &str, caption: &str, zoom: bool) -> Option<String> {
+    let at = svg.find("<svg")?;
+    let rest = &svg[at + 4..];
+    let tag = &rest[..rest.find('>')?];
+    // The drawing's size in its own units (the viewBox; the width and height state the
+    // print size in mm): shown at that many CSS px, at most the page's width.
+    let drawn = attribute(tag, "viewBox")
+        .and_then(|b| {
+            let v: Vec<f64> = b
+                .split_whitespace()
+                .filter_map(|n| n.parse().ok())
+                .collect();
+            (v.len() == 4).then(|| (v[2], v[3]))
+        })
+        .or_else(|| {
+            Some((
+                attribute(tag, "width")?.parse().ok()?,
+                attribute(tag, "height")?.parse().ok()?,
+            ))
+        });
+    let ratio = match drawn {
+        Some((w, h)) if w > 0.0 && h > 0.0 => {
+            format!(" style=\"width: {w}px; aspect-ratio: {w} / {h}\"")
+        }
+        _ => String::new(),
+    };
+    // An SVG in an HTML page needs no namespace declaration (the page names no address).
+    let rest = rest.replacen(" xmlns=\"http://www.w3.org/2000/svg\"", "", 1);
+    let class = if zoom { "figure zoom" } else { "figure" };
+    Some(format!(
+        "<svg class=\"{class}\" role=\"img\" aria-label=\"{}\"{ratio}{rest}",
+        escape(caption),
+    ))
+}
+
+fn file_name(path: &Path) -> String {
+    escape(&path.file_name().unwrap_or_default().to_string_lossy())
+}
+
 fn figure_html(out: &mut String, number: usize, figure: &FigureRef) -> Result<(), ReportError> {
-    let png = std::fs::read(&figure.files.png).map_err(|source| ReportError::Read {
-        path: figure.files.png.clone(),
+    let path = &figure.files.svg;
+    let svg = std::fs::read_to_string(path).map_err(|source| ReportError::Read {
+        path: path.clone(),
         source,
     })?;
-    // The PNG has PNG_SCALE pixels per drawing unit: shown at its drawing's size, sharp.
-    let size = png_size(&png)
-        .map(|(w, h)| {
-            let shown = |px: u32| (px as f32 / PNG_SCALE).round() as u32;
-            format!(" width=\"{}\" height=\"{}\"", shown(w), shown(h))
-        })
-        .unwrap_or_default();
+    let element =
+        inline_svg(&svg, &figure.caption, figure.zoom).ok_or_else(|| ReportError::Read {
+            path: path.clone(),
+            source: std::io::Error::new(std::io::ErrorKind::InvalidData, "no <svg> element"),
+        })?;
     let _ = writeln!(
         out,
-        "<figure id=\"figure-{number}\">\n<img src=\"data:image/png;base64,{}\" alt=\"{}\"{size}>",
-        base64::engine::general_purpose::STANDARD.encode(&png),
-        escape(&figure.caption)
+        "<figure id=\"figure-{number}\">\n{}",
+        element.trim_end()
     );
+    let how = if figure.zoom {
+        " Wheel over it zooms the time axis, drag pans, double-click resets."
+    } else {
+        ""
+    };
     let _ = writeln!(
         out,
-        "<figcaption><b>Figure {number}.</b> {} <span class=\"files\">Files beside this page: \
-         {} (vector), {} (the plotted data).</span></figcaption>\n</figure>",
+        "<figcaption><b>Figure {number}.</b> {}{how} <span class=\"files\">Files beside this \
+         page: {}, {} (raster), {} (the plotted data).</span></figcaption>\n</figure>",
         escape(&figure.caption),
-        escape(
-            &figure
-                .files
-                .svg
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-        ),
-        escape(
-            &figure
-                .files
-                .csv
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-        ),
+        file_name(&figure.files.svg),
+        file_name(&figure.files.png),
+        file_name(&figure.files.csv),
     );
     Ok(())
 }
 
-/// The HTML text of `report`, with every figure's PNG read and inlined.
+/// The HTML text of `report`, with every figure's SVG read and inlined.
 pub fn to_html(report: &Report) -> Result<String, ReportError> {
     let mut out = String::new();
     let _ = writeln!(
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}</style>\n<script>{LAYOUT_CHECK}</script>\n</head>\n<body>",
+         <title>{}</title>\n<style>{STYLE}</style>\n<script>{LAYOUT_CHECK}</script>\n\
+         <script>{ZOOM}</script>\n</head>\n<body>",
         escape(&report.title)
     );
     let _ = writeln!(out, "<h1>{}</h1>", escape(&report.title));
@@ -213,8 +308,8 @@ pub fn to_html(report: &Report) -> Result<String, ReportError> {
     }
     let _ = writeln!(
         out,
-        "<footer>Written by stf-lab {}. Figures are inlined; their SVG and CSV files sit \
-         beside this page.</footer>\n<pre id=\"layout-check\" hidden></pre>\n</body>\n</html>",
+        "<footer>Written by stf-lab {}. Figures are inlined as vector graphics; their SVG, \
+         PNG and CSV files sit beside this page.</footer>\n<pre id=\"layout-check\" hidden></pre>\n</body>\n</html>",
         env!("CARGO_PKG_VERSION")
     );
     Ok(out)
@@ -286,15 +381,26 @@ mod tests {
         ));
         report.sections.push(s);
         let err = to_html(&report).unwrap_err().to_string();
-        assert!(err.contains("nowhere/f.png"), "{err}");
+        assert!(err.contains("nowhere/f.svg"), "{err}");
     }
 
     #[test]
-    fn reads_png_size_from_header() {
-        let mut header = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
-        header.extend(1000u32.to_be_bytes());
-        header.extend(600u32.to_be_bytes());
-        assert_eq!(png_size(&header), Some((1000, 600)));
-        assert_eq!(png_size(b"GIF89a"), None);
+    fn a_figure_is_its_svg_inlined_with_its_class() {
+        let svg = "<?xml version=\"1.0\"?>\n<svg width=\"10\" height=\"5\" \
+                   xmlns=\"http://www.w3.org/2000/svg\"><line/></svg>";
+        let got = inline_svg(svg, "a \"b\"", true).unwrap();
+        assert_eq!(
+            got,
+            "<svg class=\"figure zoom\" role=\"img\" aria-label=\"a &quot;b&quot;\" \
+             style=\"width: 10px; aspect-ratio: 10 / 5\" width=\"10\" height=\"5\"><line/></svg>"
+        );
+        // A figure sized for print: shown at its drawing's size, not at its 85 mm.
+        let svg = "<svg width=\"85mm\" height=\"59.5mm\" viewBox=\"0 0 600 420\"><line/></svg>";
+        let got = inline_svg(svg, "p", false).unwrap();
+        assert!(
+            got.contains("style=\"width: 600px; aspect-ratio: 600 / 420\""),
+            "{got}"
+        );
+        assert!(inline_svg("<png/>", "c", false).is_none());
     }
 }

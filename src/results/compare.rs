@@ -17,11 +17,12 @@ use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 use stf_study::compare::{response, simulated_response, CompareResult, Compared};
 
 use crate::documents::compare_markdown::{compare_markdown, duty_meaning};
+use crate::documents::frequency_figure::{frf_curve, regime_changes};
 use crate::documents::standard_report::{frequency_section, record_sections, write_report};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::outputs::compare_csv;
-use crate::report::{regime_errors, FigureRef, FrfCurve, FrfRole, RegimeChange, Section, Table};
+use crate::report::{regime_errors, FigureRef, FrfCurve, Section, Table};
 use crate::say;
 use crate::writing::{write_atomic, write_json};
 
@@ -119,17 +120,17 @@ fn write_compare_report(
     }
     curves.extend(c.responses.iter().flatten().map(|r| r.0.clone()));
     let curves: Vec<FrfCurve> = curves.into_iter().map(frf_curve).collect();
-    let change = |b: Option<stf_core::regimes::Boundary>| {
-        b.map(|b| RegimeChange {
-            omega: b.omega,
-            uncertainty: b.uncertainty,
-        })
+    let changes = regime_changes(&c.measured.boundaries);
+    // A record without a rotor speed (a shaker) has no frequency response to draw.
+    let frequency = match data.kinematics.omega {
+        Some(_) => Some(frequency_section(
+            "frequency_response",
+            &curves,
+            changes,
+            out,
+        )?),
+        None => None,
     };
-    let changes = [
-        change(c.measured.boundaries.pre_resonance),
-        change(c.measured.boundaries.resonance_post),
-    ];
-    let frequency = frequency_section(&curves, changes, out)?;
     let fits: Vec<(&str, &stf_core::fit::FitResult)> = c
         .fits
         .iter()
@@ -137,7 +138,8 @@ fn write_compare_report(
         .collect();
     let rows = crate::param_table::rows_of_fits(&c.fits);
     let results = crate::documents::results_table::results_section("Results", &rows, &fits);
-    let mut sections = vec![results, regimes_section(c, md, out)?, frequency];
+    let mut sections = vec![results, regimes_section(c, md, out)?];
+    sections.extend(frequency);
     sections.extend(record_sections(data, &c.fits, out)?);
     let forces: Vec<(&str, &[f64])> = c
         .fits
@@ -145,7 +147,11 @@ fn write_compare_report(
         .map(|f| (f.label.as_str(), f.fitted.as_slice()))
         .collect();
     sections.extend(crate::documents::regime_figures::regime_section(
-        exp, data, &forces, out,
+        exp,
+        data,
+        &forces,
+        &[],
+        out,
     )?);
     let verdict = crate::verdict::compare_verdict(c);
     let record = format!(
@@ -229,20 +235,4 @@ fn per_regime<T>(c: &Compared, value: impl Fn(Option<&RegimeMetrics>) -> T) -> V
     models
         .map(|(f, cmp)| (f.label.as_str(), values(cmp)))
         .collect()
-}
-
-/// A frequency response as the figure draws it: the measured record's, the oscillator's
-/// without STF (dashed) or a model's.
-fn frf_curve(r: stf_study::compare::Response) -> FrfCurve {
-    let role = match r.label.as_str() {
-        "measured" => FrfRole::Measured,
-        "without STF" => FrfRole::Reference,
-        _ => FrfRole::Model,
-    };
-    FrfCurve {
-        label: r.label,
-        omega: r.omega,
-        x_peak: r.x_peak,
-        role,
-    }
 }

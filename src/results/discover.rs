@@ -19,6 +19,7 @@ use anyhow::Result;
 use stf_core::discovery::Discovery;
 use stf_study::discover::Discovered;
 
+use crate::documents::frequency_figure::{response_of, swept_section};
 use crate::documents::standard_report::{record_sections, write_report};
 use crate::experiment::{DiscoverSpec, Experiment, FitLevel};
 use crate::fitting::FitData;
@@ -210,7 +211,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     ];
     for ((name, quantity, caption), measured, curves) in figures {
         let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
-        s.figures.push(FigureRef::new(fig, caption));
+        s.figures.push(FigureRef::new(fig, caption).zoomable());
     }
     let rows = rows_of(
         "final",
@@ -225,9 +226,23 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];
         sections.extend(crate::documents::regime_figures::regime_section(
-            exp, data, &curves, out,
+            exp,
+            data,
+            &curves,
+            &[],
+            out,
         )?);
     }
+    let final_response = match data.level {
+        FitLevel::Trajectory => response_of(data, "final", &after),
+        FitLevel::Force => None,
+    };
+    sections.extend(swept_section(
+        exp,
+        data,
+        final_response.into_iter().collect(),
+        out,
+    )?);
     sections.extend(record_sections(data, &[], out)?);
     let mut intro = vec![discovered.verdict().text];
     intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));

@@ -59,18 +59,20 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
             rec, fits, out,
         )?);
     }
+    sections.extend(frequency_response(exp, data, fits, out)?);
     sections.extend(crate::documents::standard_report::record_sections(
         data, fits, out,
     )?);
-    let forces: Vec<(&str, &[f64])> = match level {
-        FitLevel::Force => fits
-            .iter()
-            .map(|f| (f.label.as_str(), f.fitted.as_slice()))
-            .collect(),
-        FitLevel::Trajectory => Vec::new(),
+    let curves: Vec<(&str, &[f64])> = fits
+        .iter()
+        .map(|f| (f.label.as_str(), f.fitted.as_slice()))
+        .collect();
+    let (forces, simulated) = match level {
+        FitLevel::Force => (curves, Vec::new()),
+        FitLevel::Trajectory => (Vec::new(), curves),
     };
     sections.extend(crate::documents::regime_figures::regime_section(
-        exp, data, &forces, out,
+        exp, data, &forces, &simulated, out,
     )?);
     let mut intro = vec![
         fitted.verdict().text,
@@ -100,6 +102,30 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
         out,
     )?;
     Ok(())
+}
+
+/// The frequency response of a swept record with each fitted model's: at trajectory level the
+/// fitted displacement itself, at force level the oscillator simulated with the model.
+fn frequency_response(
+    exp: &Experiment,
+    data: &FitData,
+    fits: &[ModelFit],
+    out: &Path,
+) -> Result<Option<crate::report::Section>> {
+    use crate::documents::frequency_figure::{response_of, swept_section};
+    if data.kinematics.omega.is_none() {
+        return Ok(None);
+    }
+    let models = fits
+        .iter()
+        .filter_map(|f| match data.level {
+            FitLevel::Trajectory => response_of(data, &f.label, &f.fitted),
+            FitLevel::Force => stf_study::compare::simulated_response(exp, data, Some(f))
+                .ok()
+                .map(|r| r.0),
+        })
+        .collect();
+    swept_section(exp, data, models, out)
 }
 
 /// The terminal summary: one line per model, its warnings under it.

@@ -11,8 +11,8 @@ use serde::Serialize;
 use stf_core::data::response::{local_maxima, peak, Peak};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
-    classify, compare as compare_with, rank_models, rank_on_loops, Boundary, Classification,
-    Comparison, MetricRanking, Ranking,
+    classify, compare as compare_with, rank_models, rank_on_loops, zero_level_spread, Boundary,
+    Classification, Comparison, MetricRanking, Ranking, ZeroLevelSpread,
 };
 use stf_core::simulate::Simulation;
 
@@ -151,6 +151,8 @@ pub struct Compared {
     pub ranking: Ranking,
     /// The models in order on each loop metric.
     pub loop_rankings: Vec<MetricRanking>,
+    /// How the measured boundaries move with the zero-force level (none without STF force).
+    pub zero_level: Option<ZeroLevelSpread>,
 }
 
 impl Compared {
@@ -194,6 +196,18 @@ pub fn compare_fits(
     let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
     let ranking = rank_models(&pairs);
     let loop_rankings = rank_on_loops(&measured, &pairs);
+    let zero_level = match data.record.f_stf.as_deref() {
+        Some(f) if !measured.no_stf => {
+            let force = data.force_data().with_force(f);
+            Some(zero_level_spread(
+                &force,
+                &measured.cycles,
+                &exp.regimes,
+                &measured,
+            )?)
+        }
+        _ => None,
+    };
     Ok(Compared {
         measured,
         fits,
@@ -202,6 +216,7 @@ pub fn compare_fits(
         responses,
         ranking,
         loop_rankings,
+        zero_level,
     })
 }
 

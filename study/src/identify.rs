@@ -44,6 +44,8 @@ pub struct StageOutcome {
     pub x: Vec<f64>,
     /// The displacement simulated with the stage's fitted values, m (empty if it failed).
     pub simulated: Vec<f64>,
+    /// Its rotor speed, rad/s (a swept record; none for free vibration or a shaker).
+    pub omega: Option<Vec<f64>>,
     /// The fit.
     pub result: FitResult,
     /// Its noise floor (the position noise).
@@ -128,6 +130,7 @@ pub fn identify(exp: &Experiment, progress: &dyn Observer) -> Result<Identificat
             simulated: fit.predict(&data, &values).unwrap_or_default(),
             t: record.t.clone(),
             x: record.x.clone(),
+            omega: k.omega.clone(),
             result,
             floor,
             warnings,

@@ -57,6 +57,7 @@ pub mod ranking;
 pub mod regime;
 pub mod rules;
 pub mod thresholds;
+pub mod zero_level;
 
 pub use boundaries::{find_boundaries, Boundaries, Boundary, BoundaryRule};
 pub use classify::{classify, label_cycles, Classification};
@@ -72,3 +73,4 @@ pub use ranking::{rank_models, Ranking, Score};
 pub use regime::Regime;
 pub use rules::{behaviour, place, Behaviour};
 pub use thresholds::RegimeThresholds;
+pub use zero_level::{zero_level_spread, LevelBoundaries, ZeroLevelSpread, ZERO_LEVEL_FACTORS};

@@ -4,7 +4,7 @@
 use serde::Serialize;
 use stf_core::regimes::{
     Boundaries, BoundaryErrors, MetricRanking, PerRegime, Ranking, Regime, RegimeMetrics,
-    RegimeThresholds,
+    RegimeThresholds, ZeroLevelSpread,
 };
 
 use super::fit_json::ModelFitJson;
@@ -54,6 +54,10 @@ pub struct MeasuredJson<'a> {
     pub boundaries: &'a Boundaries,
     /// Each boundary with the rule that placed it, in words.
     pub boundary_notes: Vec<BoundaryNote>,
+    /// The zero-force level used (N, and where it comes from), the boundaries recomputed at
+    /// half and twice it, and the ω range each boundary spans over them (null without STF
+    /// force).
+    pub zero_level: Option<&'a ZeroLevelSpread>,
     /// The record's resonance peak.
     pub resonance: PeakJson,
 }
@@ -135,6 +139,7 @@ impl<'a> CompareJson<'a> {
                 cycles_per_regime,
                 boundaries: &measured.boundaries,
                 boundary_notes: crate::compare::boundary_notes(measured),
+                zero_level: c.zero_level.as_ref(),
                 resonance: PeakJson {
                     peak_x_m: peak.amplitude,
                     peak_omega_rad_s: peak.omega,
