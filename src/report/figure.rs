@@ -307,9 +307,28 @@ pub fn small_panel<'a, 'b, DB: DrawingBackend>(
         .x_label_area_size(X_LABEL_AREA - 4)
         .y_label_area_size(Y_LABEL_AREA - 14);
     if let Some(c) = caption {
-        builder.caption(c, legend_style());
+        builder.caption(heading_within(c, area.dim_in_pixel().0), legend_style());
     }
     builder
+}
+
+/// A panel's heading `name` as it fits `width` px: whole when it does, else without the
+/// reason between its regime and its ω span (`pre-resonance: force negligible, ω 4.1–4.2
+/// rad/s` → `pre-resonance, ω 4.1–4.2 rad/s`; the report's text gives the reason).
+pub fn heading_within(name: &str, width: u32) -> String {
+    let fits = |s: &str| {
+        legend_style()
+            .font
+            .box_size(s)
+            .map_or(true, |(w, _)| w + 16 <= width)
+    };
+    if fits(name) {
+        return name.to_string();
+    }
+    match (name.find(": "), name.rfind(", ω")) {
+        (Some(a), Some(b)) if a < b => format!("{}{}", &name[..a], &name[b..]),
+        _ => name.to_string(),
+    }
 }
 
 /// Draw a line through `points` on `chart` in `style`.
@@ -517,7 +536,19 @@ pub fn tick_label(v: f64, span: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{finite_runs, tick_label};
+    use super::{ensure_registered, finite_runs, heading_within, tick_label};
+
+    #[test]
+    fn a_heading_too_wide_for_its_panel_drops_its_reason_not_its_span() {
+        ensure_registered().unwrap();
+        let name = "pre-resonance: force negligible, ω 4.55–4.82 rad/s";
+        assert_eq!(heading_within(name, 2_000), name);
+        assert_eq!(
+            heading_within(name, 500),
+            "pre-resonance, ω 4.55–4.82 rad/s"
+        );
+        assert_eq!(heading_within("resonance", 10), "resonance");
+    }
 
     #[test]
     fn the_svg_carries_its_print_width_in_millimetres() {
