@@ -56,14 +56,21 @@ pub fn write(exp: &Experiment, result: &CompareResult, out: &Path) -> Result<()>
 /// and its fitted values, its warnings under it (compare.md holds the whole comparison).
 fn print_summary(result: &CompareResult) {
     let (data, c) = (&result.data, &result.compared);
-    say!("{}", crate::verdict::compare_verdict(c));
+    let words = data.words();
+    say!("{}", crate::verdict::compare_verdict(c, data.words()));
     say!(
-        "compared {} model(s) on {} cycles of {} (noise floor σ = {:.4} N); relative force RMS \
-         error per regime, lower is better:",
+        "compared {} model(s) on {} {} of {} (noise floor σ = {:.4} N); relative force RMS \
+         error {}, lower is better:",
         c.fits.len(),
         c.measured.labels.len(),
+        words.cycles,
         data.record.source,
-        c.measured.noise_sigma
+        c.measured.noise_sigma,
+        if words.regimes {
+            "per regime"
+        } else {
+            "over the whole record"
+        }
     );
     let name_width = c
         .fits
@@ -71,13 +78,32 @@ fn print_summary(result: &CompareResult) {
         .map(|f| f.label.chars().count())
         .max()
         .unwrap_or(5);
+    let heads = ["pre-res.", "resonance", "post-res.", "all"];
+    let shown = |cells: &[String]| -> String {
+        if words.regimes {
+            cells
+                .iter()
+                .map(|c| format!("{c:>9}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        } else {
+            format!("{:>12}", cells[3])
+        }
+    };
+    let heads: Vec<String> = if words.regimes {
+        heads.iter().map(|h| h.to_string()).collect()
+    } else {
+        vec![
+            String::new(),
+            String::new(),
+            String::new(),
+            words.all.to_string(),
+        ]
+    };
     say!(
-        "  {:<name_width$}  {:>9} {:>9} {:>9} {:>9}  fitted values",
+        "  {:<name_width$}  {}  fitted values",
         "model",
-        "pre-res.",
-        "resonance",
-        "post-res.",
-        "all"
+        shown(&heads)
     );
     let cell = |m: Option<&RegimeMetrics>| {
         m.map_or("—".to_string(), |m| {
@@ -87,11 +113,8 @@ fn print_summary(result: &CompareResult) {
     for ((label, cells), f) in per_regime(c, cell).into_iter().zip(&c.fits) {
         let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f));
         say!(
-            "  {label:<name_width$}  {:>9} {:>9} {:>9} {:>9}  {}",
-            cells[0],
-            cells[1],
-            cells[2],
-            cells[3],
+            "  {label:<name_width$}  {}  {}",
+            shown(&cells),
             crate::results::shown::values_line(&rows)
         );
         for w in &f.warnings {
@@ -147,10 +170,11 @@ fn write_compare_report(
     sections.extend(crate::documents::regime_figures::regime_section(
         exp, data, &forces, out,
     )?);
-    let verdict = crate::verdict::compare_verdict(c);
+    let verdict = crate::verdict::compare_verdict(c, data.words());
     let record = format!(
-        "{} cycles of {}; noise floor σ = {:.4} N.",
+        "{} {} of {}; noise floor σ = {:.4} N.",
         c.measured.labels.len(),
+        data.words().cycles,
         data.record.source,
         c.measured.noise_sigma
     );
