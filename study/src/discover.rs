@@ -253,10 +253,14 @@ fn discover_at(
             let mut settings = settings.kinematics(&data.kinematics);
             let k = &data.kinematics;
             settings.regimes = k.phi.is_some() || k.omega.is_some();
+            settings.pieces = data.words().cycles;
             discover_force(base, candidates, &data.force_data(), cycles, &settings)
         }
         Some(setup) => {
             let td = data.trajectory_data();
+            let mut settings = settings;
+            settings.x_unit = data.units.x;
+            settings.pieces = data.words().cycles;
             discover_trajectory(base, candidates, &td, cycles, setup, &settings)
         }
     }

@@ -52,7 +52,7 @@ impl ShownUnits {
     /// (no sensor turns it into a length), a length otherwise.
     pub fn of(layout: &ReadOptions) -> ShownUnits {
         match layout.channel(Signal::X).unit {
-            Unit::Volt { gain } if gain == 1.0 => ShownUnits::VOLTAGE,
+            Unit::Volt { gain: 1.0 } => ShownUnits::VOLTAGE,
             _ => ShownUnits::LENGTH,
         }
     }
