@@ -12,14 +12,21 @@ use stf_core::regimes::Regime;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use stf_study::compare::Compared;
+use stf_study::rig_words::RigWords;
 
-/// What the duty and its error are, with the record's on-threshold.
-pub fn duty_meaning(on_threshold: f64) -> String {
+/// What the duty and its error are, with the record's on-threshold, in the words of its rig
+/// (a rotor's cycles and regimes, or the periods of the whole record).
+pub fn duty_meaning(on_threshold: f64, words: RigWords) -> String {
+    let (piece, over) = if words.regimes {
+        ("cycle", "a regime's cycles")
+    } else {
+        ("period", "the record's periods")
+    };
     format!(
-        "The duty of a cycle is the fraction of it in which the STF force is on (|F_STF| above \
+        "The duty of a {piece} is the fraction of it in which the STF force is on (|F_STF| above \
          {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
          zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
-         a regime's cycles of |model duty − measured duty|."
+         {over} of |model duty − measured duty|."
     )
 }
 
@@ -73,7 +80,7 @@ fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) over the whole record; lower is better. {}\n",
-        duty_meaning(c.measured.on_threshold)
+        duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS)
     );
     let _ = writeln!(md, "| model | whole record | peak x ({x_unit}) |");
     let _ = writeln!(md, "|---|---|---|");
@@ -100,7 +107,7 @@ fn errors_table(md: &mut String, c: &Compared) {
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) per regime; lower is better. {}\n",
-        duty_meaning(c.measured.on_threshold)
+        duty_meaning(c.measured.on_threshold, RigWords::ROTOR)
     );
     let _ = writeln!(
         md,

@@ -86,7 +86,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
     if let Some(drive) = &data.kinematics.drive {
         s.paragraphs.push(format!("Drive: {drive}."));
     }
-    s.paragraphs.push(warning_rules(fits));
+    s.paragraphs.push(warning_rules(fits, (unit, scale)));
     let rms = format!("RMS, {unit}");
     let columns = [
         "model",
@@ -283,12 +283,12 @@ fn validation_table(fits: &[ModelFit], unit: &str, scale: f64) -> Table {
 }
 
 /// What the warnings check, with each fit's noise floor.
-fn warning_rules(fits: &[ModelFit]) -> String {
+fn warning_rules(fits: &[ModelFit], (unit, scale): (&str, f64)) -> String {
     let floors: Vec<String> = fits
         .iter()
         .filter_map(|f| {
             f.floor
-                .map(|n| format!("{} {}", f.label, n.quantity.show(n.sigma)))
+                .map(|n| format!("{} {:.4} {unit}", f.label, n.sigma * scale))
         })
         .collect();
     format!(

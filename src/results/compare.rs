@@ -15,6 +15,7 @@ use std::path::Path;
 use anyhow::Result;
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 use stf_study::compare::{response, simulated_response, CompareResult, Compared};
+use stf_study::rig_words::RigWords;
 
 use crate::documents::compare_markdown::{compare_markdown, duty_meaning};
 use crate::documents::standard_report::{frequency_section, record_sections, write_report};
@@ -160,7 +161,12 @@ fn write_compare_report(
         .collect();
     let rows = crate::param_table::rows_of_fits(&c.fits);
     let results = crate::documents::results_table::results_section("Results", &rows, &fits);
-    let mut sections = vec![results, regimes_section(c, md, out)?, frequency];
+    let models = if data.words().regimes {
+        regimes_section(c, md, out)?
+    } else {
+        whole_record_section(c, md)
+    };
+    let mut sections = vec![results, models, frequency];
     sections.extend(record_sections(data, &c.fits, out)?);
     let forces: Vec<(&str, &[f64])> = c
         .fits
@@ -197,7 +203,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         .collect();
     regimes
         .paragraphs
-        .push(duty_meaning(c.measured.on_threshold));
+        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTOR));
     regimes.tables.push(errors_table(c));
     regimes
         .paragraphs
@@ -221,6 +227,36 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         "Relative force RMS error of each model in each regime of the record (lower is better).",
     ));
     Ok(regimes)
+}
+
+/// The report's "Models over the whole record" of a record without a rotor: compare.md's
+/// bullets and each model's relative force RMS error (duty error) over the whole record.
+fn whole_record_section(c: &Compared, md: &str) -> Section {
+    let mut s = Section::new("Models over the whole record");
+    s.paragraphs = md
+        .lines()
+        .filter(|l| l.starts_with("- "))
+        .map(|l| l.trim_start_matches("- ").replace("**", ""))
+        .collect();
+    s.paragraphs
+        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS));
+    let rows = c
+        .fits
+        .iter()
+        .zip(&c.comparisons)
+        .map(|(f, cmp)| {
+            let o = &cmp.overall;
+            vec![
+                f.label.clone(),
+                format!("{:.3} ({:.2})", o.relative_rms_error, o.duty_error),
+            ]
+        })
+        .collect();
+    let caption = "Relative force RMS error over the whole record (on–off duty error in \
+                   brackets); lower is better.";
+    s.tables
+        .push(Table::new(caption, &["model", "whole record"]).with_rows(rows));
+    s
 }
 
 /// The relative force RMS error (duty error) of each model per regime and overall.
