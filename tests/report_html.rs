@@ -139,7 +139,14 @@ fn build_report(dir: &Path) -> PathBuf {
         a: &s.a,
     };
     let figures = dir.join("figures");
-    let history = report::time_history(&figures, "time_history", &motion, &s.f).unwrap();
+    let history = report::time_history(
+        &figures,
+        "time_history",
+        &motion,
+        &s.f,
+        &report::MotionLabels::LENGTH,
+    )
+    .unwrap();
     let loop_v = report::hysteresis(
         &figures,
         "hysteresis_v",

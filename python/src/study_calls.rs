@@ -162,7 +162,7 @@ pub fn compare(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
         &c.comparisons,
     ))?;
     let params_table = json_text(&stf_study::param_table::rows_of_fits(&c.fits))?;
-    let verdict = stf_study::verdict::compare_verdict(c);
+    let verdict = stf_study::verdict::compare_verdict(c, result.data.words());
     let best = best_of(&c.fits);
     let data = result.data;
     Ok(Outcome {

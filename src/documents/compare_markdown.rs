@@ -2,7 +2,8 @@
 //! boundaries (with how far they move with the zero-force level), each model's relative force RMS error (duty error) per regime with its
 //! simulated resonance peak, the best model per regime, the loop metrics, the on–off
 //! behaviour a model misses and the warnings against its fit. Its `- ` bullets open the
-//! report's regimes section.
+//! report's regimes section. A record without a rotor has no regimes: its table is over the
+//! whole record, with no loop metrics by regime.
 
 use std::fmt::Write as _;
 
@@ -11,14 +12,21 @@ use stf_core::regimes::{Boundary, Regime, ZeroLevelSpread};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use stf_study::compare::Compared;
+use stf_study::rig_words::RigWords;
 
-/// What the duty and its error are, with the record's on-threshold.
-pub fn duty_meaning(on_threshold: f64) -> String {
+/// What the duty and its error are, with the record's on-threshold, in the words of its rig
+/// (a rotor's cycles and regimes, or the periods of the whole record).
+pub fn duty_meaning(on_threshold: f64, words: RigWords) -> String {
+    let (piece, over) = if words.regimes {
+        ("cycle", "a regime's cycles")
+    } else {
+        ("period", "the record's periods")
+    };
     format!(
-        "The duty of a cycle is the fraction of it in which the STF force is on (|F_STF| above \
+        "The duty of a {piece} is the fraction of it in which the STF force is on (|F_STF| above \
          {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
          zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
-         a regime's cycles of |model duty − measured duty|."
+         {over} of |model duty − measured duty|."
     )
 }
 
@@ -69,16 +77,22 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
     let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
     let _ = writeln!(
         md,
-        "Record `{}`: {} cycles; noise floor σ = {:.4} N{}.\n",
+        "Record `{}`: {} {}; noise floor σ = {:.4} N{}.\n",
         data.record.source,
         measured.labels.len(),
+        data.words().cycles,
         measured.noise_sigma,
-        if measured.no_stf {
+        if measured.no_stf && data.words().regimes {
             "; the STF force is negligible everywhere (no regimes)"
         } else {
             ""
         }
     );
+    if !data.words().regimes {
+        whole_record_table(&mut md, c, data.units.x);
+        misses_and_warnings(&mut md, c, false);
+        return md;
+    }
     for line in crate::documents::compare_loops::boundary_lines(measured) {
         let _ = writeln!(md, "- {line}");
     }
@@ -99,8 +113,36 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
     }
     let energy = crate::documents::compare_loops::energy_table(&c.labels(), &c.comparisons);
     crate::documents::compare_loops::write_markdown(&mut md, &c.loop_rankings, &energy);
-    misses_and_warnings(&mut md, c);
+    misses_and_warnings(&mut md, c, true);
     md
+}
+
+/// A record without a rotor: each model's relative force RMS error (duty error) over the
+/// whole record and the largest |x| simulated with it, in the record's unit (`x_unit`).
+fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
+    let _ = writeln!(
+        md,
+        "\nRelative force RMS error (duty error) over the whole record; lower is better. {}\n",
+        duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS)
+    );
+    let _ = writeln!(md, "| model | whole record | peak x ({x_unit}) |");
+    let _ = writeln!(md, "|---|---|---|");
+    for ((f, cmp), p) in c.fits.iter().zip(&c.comparisons).zip(c.peaks()) {
+        let o = &cmp.overall;
+        let peak = p.map_or("simulation failed".to_string(), |(x, _)| {
+            format!("{:.2}", x * 1e3)
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {:.3} ({:.2}) | {peak} |",
+            f.label, o.relative_rms_error, o.duty_error
+        );
+    }
+    let _ = writeln!(
+        md,
+        "| *measured* | | {:.2} |\n",
+        c.measured_peak.amplitude * 1e3
+    );
 }
 
 /// The table of relative force RMS error (duty error) per regime and the simulated peak.
@@ -108,7 +150,7 @@ fn errors_table(md: &mut String, c: &Compared) {
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) per regime; lower is better. {}\n",
-        duty_meaning(c.measured.on_threshold)
+        duty_meaning(c.measured.on_threshold, RigWords::ROTOR)
     );
     let _ = writeln!(
         md,
@@ -145,15 +187,23 @@ fn errors_table(md: &mut String, c: &Compared) {
 
 /// The on–off behaviour each model misses (a duty error above 0.2 in a regime), then the
 /// fits not to be trusted as they stand (`*` bullets: the report shows them in its own box).
-fn misses_and_warnings(md: &mut String, c: &Compared) {
+fn misses_and_warnings(md: &mut String, c: &Compared, regimes: bool) {
     for (f, cmp) in c.fits.iter().zip(&c.comparisons) {
-        for r in Regime::ALL {
-            if let Some(m) = cmp.per_regime.get(r).filter(|m| m.duty_error > 0.2) {
+        let groups: Vec<(String, Option<&stf_core::regimes::RegimeMetrics>)> = if regimes {
+            let name = |r: Regime| r.name().replace('_', "-");
+            Regime::ALL
+                .iter()
+                .map(|&r| (name(r), cmp.per_regime.get(r)))
+                .collect()
+        } else {
+            vec![("the whole record".to_string(), Some(&cmp.overall))]
+        };
+        for (group, m) in groups {
+            if let Some(m) = m.filter(|m| m.duty_error > 0.2) {
                 let _ = writeln!(
                     md,
-                    "- {} misses the on–off behaviour in {}: duty {:.2} against the measured {:.2}",
+                    "- {} misses the on–off behaviour in {group}: duty {:.2} against the measured {:.2}",
                     f.label,
-                    r.name().replace('_', "-"),
                     m.model_duty,
                     m.measured_duty
                 );

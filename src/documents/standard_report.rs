@@ -15,8 +15,8 @@ use crate::experiment::FitLevel;
 use crate::fitting::{FitData, ModelFit};
 use crate::report::{
     frequency_response, hysteresis, measured_vs_model, milli, time_history, write_html,
-    write_markdown, FigureRef, FrfCurve, Motion, RegimeChange, Report, Section, Smoothing, Table,
-    DISPLACEMENT_MM, DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
+    write_markdown, FigureRef, FrfCurve, Motion, MotionLabels, RegimeChange, Report, Section,
+    Smoothing, Table, DISPLACEMENT_MM, DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
 };
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
@@ -54,16 +54,17 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
         v: &k.v,
         a: &k.a,
     };
-    let th = time_history(dir, "time_history", &motion, f)?;
+    let labels = MotionLabels::of(&data.units);
+    let th = time_history(dir, "time_history", &motion, f, &labels)?;
     s.figures.push(FigureRef::new(
         th,
         "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked.",
     )
     .zoomable());
     for (name, label, series) in [
-        ("hysteresis_x", "displacement x, mm", milli(&k.x)),
-        ("hysteresis_v", "velocity v, mm/s", milli(&k.v)),
-        ("hysteresis_a", "acceleration a, m/s²", k.a.clone()),
+        ("hysteresis_x", labels.x, milli(&k.x)),
+        ("hysteresis_v", labels.v, milli(&k.v)),
+        ("hysteresis_a", labels.a, k.a.clone()),
     ] {
         let fig = hysteresis(dir, name, (label, &series), f, &k.t)?;
         s.figures.push(FigureRef::new(
@@ -76,7 +77,7 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
 
 /// "Fits": the fitted parameters, the warnings, and the measured signal against each model.
 fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section> {
-    let (unit, scale) = data.level.shown();
+    let (unit, scale) = data.shown();
     let what = data.level.signal().what;
     let mut s = Section::new("Fits");
     s.paragraphs.push(format!(
@@ -86,7 +87,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
     if let Some(drive) = &data.kinematics.drive {
         s.paragraphs.push(format!("Drive: {drive}."));
     }
-    s.paragraphs.push(warning_rules(fits));
+    s.paragraphs.push(warning_rules(fits, (unit, scale)));
     let rms = format!("RMS, {unit}");
     let columns = [
         "model",
@@ -111,7 +112,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
         .collect();
     let quantity = match data.level {
         FitLevel::Force => STF_FORCE,
-        FitLevel::Trajectory => DISPLACEMENT_MM,
+        FitLevel::Trajectory => DISPLACEMENT_MM.in_units(&data.units),
     };
     let fig = measured_vs_model(
         dir,
@@ -163,7 +164,7 @@ pub fn yes_no(flag: bool) -> String {
 
 /// The sentence of the report's intro on the validation record: the best model there.
 pub fn validation_intro(rec: &ValidationRecord, fits: &[ModelFit]) -> String {
-    let (unit, scale) = rec.data.level.shown();
+    let (unit, scale) = rec.data.shown();
     let best = fits
         .iter()
         .filter_map(|f| Some((f, f.validation.as_ref()?.score.as_ref()?)))
@@ -194,7 +195,7 @@ pub fn validation_section(
 ) -> Result<Section> {
     let dir = out.join("figures");
     crate::writing::atomic::ensure_dir(&dir)?;
-    let (unit, scale) = rec.data.level.shown();
+    let (unit, scale) = rec.data.shown();
     let mut s = Section::new("Validation on a second record");
     s.paragraphs.push(format!(
         "Every model scored on {} ({} samples; the estimation record's column mapping, filters \
@@ -226,7 +227,7 @@ pub fn validation_section(
     if !predicted.is_empty() {
         let quantity = match rec.data.level {
             FitLevel::Force => STF_FORCE_VALIDATION,
-            FitLevel::Trajectory => DISPLACEMENT_VALIDATION_MM,
+            FitLevel::Trajectory => DISPLACEMENT_VALIDATION_MM.in_units(&rec.data.units),
         };
         let measured: Vec<f64> = rec.data.target().iter().map(|x| x * scale).collect();
         let fig = measured_vs_model(
@@ -285,12 +286,12 @@ fn validation_table(fits: &[ModelFit], unit: &str, scale: f64) -> Table {
 }
 
 /// What the warnings check, with each fit's noise floor.
-fn warning_rules(fits: &[ModelFit]) -> String {
+fn warning_rules(fits: &[ModelFit], (unit, scale): (&str, f64)) -> String {
     let floors: Vec<String> = fits
         .iter()
         .filter_map(|f| {
             f.floor
-                .map(|n| format!("{} {}", f.label, n.quantity.show(n.sigma)))
+                .map(|n| format!("{} {:.4} {unit}", f.label, n.sigma * scale))
         })
         .collect();
     format!(

@@ -18,6 +18,7 @@ use super::figure::{
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
 use super::ReportError;
+use stf_study::shown_units::ShownUnits;
 
 /// What a measured-vs-modelled figure shows: its title, the quantity with its unit (axis and
 /// CSV columns) and what the model curves are.
@@ -31,6 +32,19 @@ pub struct Quantity {
     pub model_word: &'static str,
     /// Legend and CSV name of the grey band: `measured`, or what stands in its place.
     pub band: &'static str,
+}
+
+impl Quantity {
+    /// The quantity labelled in the record's own units: a displacement of a record whose x is
+    /// a voltage in mV, every other label as it is.
+    pub fn in_units(self, units: &ShownUnits) -> Quantity {
+        let label = match (units.is_voltage(), self.label) {
+            (true, "x, mm") => "x, mV",
+            (true, "x residual, mm") => "x residual, mV",
+            (_, label) => label,
+        };
+        Quantity { label, ..self }
+    }
 }
 
 /// The STF force against each model's fitted force.

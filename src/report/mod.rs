@@ -39,6 +39,7 @@ mod html;
 mod hysteresis;
 mod markdown;
 mod measured_vs_fitted;
+mod motion_labels;
 mod parity;
 mod plot_range;
 mod print_check;
@@ -66,6 +67,7 @@ pub use measured_vs_fitted::{
     measured_vs_model, Quantity, DISPLACEMENT_MM, DISPLACEMENT_RESIDUAL_MM,
     DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_RESIDUAL, STF_FORCE_VALIDATION,
 };
+pub use motion_labels::MotionLabels;
 pub use parity::{parity, ParityQuantity, SampleGroup};
 pub use print_check::{print_problems, printed_texts, PrintedText};
 pub use raster::{stray_coloured_pixels, svg_to_png, PNG_SCALE};

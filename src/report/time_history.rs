@@ -17,6 +17,7 @@ use super::figure::{
     require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL,
     T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
 };
+use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
 use super::ReportError;
@@ -146,14 +147,16 @@ impl Draw for TimeHistoryPlot {
     }
 }
 
-/// Draw x (in mm), v (mm/s), a (m/s²) and F_STF over time (four panels on one time axis,
-/// F_STF's extrema above the noise marked) to `out_dir/name.{svg,png,csv}`. Long records are
+/// Draw x (in mm, or mV for x in volts: `labels`), v (mm/s), a (m/s²) and F_STF over time
+/// (four panels on one time axis, F_STF's extrema above the noise marked) to
+/// `out_dir/name.{svg,png,csv}`. Long records are
 /// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
 pub fn time_history(
     out_dir: &Path,
     name: &str,
     motion: &Motion,
     f_stf: &[f64],
+    labels: &MotionLabels,
 ) -> Result<FigureFiles, ReportError> {
     let Motion { t, x, v, a } = *motion;
     same_length("time history: t and x", t, x)?;
@@ -175,9 +178,9 @@ pub fn time_history(
     let plot = TimeHistoryPlot {
         t: pick(t, &keep),
         panels: [
-            ("displacement x, mm", milli(&pick(x, &keep))),
-            ("velocity v, mm/s", milli(&pick(v, &keep))),
-            ("acceleration a, m/s²", pick(a, &keep)),
+            (labels.x, milli(&pick(x, &keep))),
+            (labels.v, milli(&pick(v, &keep))),
+            (labels.a, pick(a, &keep)),
             (F_LABEL, pick(f_stf, &keep)),
         ],
         marks: marks_full
@@ -188,9 +191,9 @@ pub fn time_history(
     let marks = |of: fn(&(f64, f64, ExtremumKind)) -> f64| plot.marks.iter().map(of).collect();
     let columns = vec![
         Column::new("t, s", plot.t.clone()),
-        Column::new("x, mm", plot.panels[0].1.clone()),
-        Column::new("v, mm/s", plot.panels[1].1.clone()),
-        Column::new("a, m/s²", plot.panels[2].1.clone()),
+        Column::new(labels.x_column, plot.panels[0].1.clone()),
+        Column::new(labels.v_column, plot.panels[1].1.clone()),
+        Column::new(labels.a_column, plot.panels[2].1.clone()),
         Column::new(F_LABEL, plot.panels[3].1.clone()),
         Column::new("F_STF extremum t, s", marks(|m| m.0)),
         Column::new("F_STF extremum, N", marks(|m| m.1)),
@@ -221,7 +224,8 @@ mod tests {
             v: &s.v,
             a: &s.a,
         };
-        let files = time_history(dir.path(), "history", &motion, &s.f).unwrap();
+        let files =
+            time_history(dir.path(), "history", &motion, &s.f, &MotionLabels::LENGTH).unwrap();
         let cols = assert_rendered(&files, SIZE_TALL);
         let t = column(&cols, "t, s");
         let x = column(&cols, "x, mm");
@@ -272,7 +276,7 @@ mod tests {
             a: &s.a,
         };
         let dir = tempfile::tempdir().unwrap();
-        let err = time_history(dir.path(), "h", &motion, &s.f).unwrap_err();
+        let err = time_history(dir.path(), "h", &motion, &s.f, &MotionLabels::LENGTH).unwrap_err();
         assert!(matches!(err, ReportError::LengthMismatch { .. }), "{err}");
     }
 }

@@ -15,6 +15,7 @@ use std::path::Path;
 use anyhow::Result;
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 use stf_study::compare::{response, simulated_response, CompareResult, Compared};
+use stf_study::rig_words::RigWords;
 
 use crate::documents::compare_markdown::{compare_markdown, duty_meaning};
 use crate::documents::frequency_figure::{frf_curve, regime_changes};
@@ -57,14 +58,21 @@ pub fn write(exp: &Experiment, result: &CompareResult, out: &Path) -> Result<()>
 /// and its fitted values, its warnings under it (compare.md holds the whole comparison).
 fn print_summary(result: &CompareResult) {
     let (data, c) = (&result.data, &result.compared);
-    say!("{}", crate::verdict::compare_verdict(c));
+    let words = data.words();
+    say!("{}", crate::verdict::compare_verdict(c, data.words()));
     say!(
-        "compared {} model(s) on {} cycles of {} (noise floor σ = {:.4} N); relative force RMS \
-         error per regime, lower is better:",
+        "compared {} model(s) on {} {} of {} (noise floor σ = {:.4} N); relative force RMS \
+         error {}, lower is better:",
         c.fits.len(),
         c.measured.labels.len(),
+        words.cycles,
         data.record.source,
-        c.measured.noise_sigma
+        c.measured.noise_sigma,
+        if words.regimes {
+            "per regime"
+        } else {
+            "over the whole record"
+        }
     );
     let name_width = c
         .fits
@@ -72,13 +80,32 @@ fn print_summary(result: &CompareResult) {
         .map(|f| f.label.chars().count())
         .max()
         .unwrap_or(5);
+    let heads = ["pre-res.", "resonance", "post-res.", "all"];
+    let shown = |cells: &[String]| -> String {
+        if words.regimes {
+            cells
+                .iter()
+                .map(|c| format!("{c:>9}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        } else {
+            format!("{:>12}", cells[3])
+        }
+    };
+    let heads: Vec<String> = if words.regimes {
+        heads.iter().map(|h| h.to_string()).collect()
+    } else {
+        vec![
+            String::new(),
+            String::new(),
+            String::new(),
+            words.all.to_string(),
+        ]
+    };
     say!(
-        "  {:<name_width$}  {:>9} {:>9} {:>9} {:>9}  fitted values",
+        "  {:<name_width$}  {}  fitted values",
         "model",
-        "pre-res.",
-        "resonance",
-        "post-res.",
-        "all"
+        shown(&heads)
     );
     let cell = |m: Option<&RegimeMetrics>| {
         m.map_or("—".to_string(), |m| {
@@ -88,11 +115,8 @@ fn print_summary(result: &CompareResult) {
     for ((label, cells), f) in per_regime(c, cell).into_iter().zip(&c.fits) {
         let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f));
         say!(
-            "  {label:<name_width$}  {:>9} {:>9} {:>9} {:>9}  {}",
-            cells[0],
-            cells[1],
-            cells[2],
-            cells[3],
+            "  {label:<name_width$}  {}  {}",
+            shown(&cells),
             crate::results::shown::values_line(&rows)
         );
         for w in &f.warnings {
@@ -138,7 +162,12 @@ fn write_compare_report(
         .collect();
     let rows = crate::param_table::rows_of_fits(&c.fits);
     let results = crate::documents::results_table::results_section("Results", &rows, &fits);
-    let mut sections = vec![results, regimes_section(c, md, out)?];
+    let models = if data.words().regimes {
+        regimes_section(c, md, out)?
+    } else {
+        whole_record_section(c, md)
+    };
+    let mut sections = vec![results, models];
     sections.extend(frequency);
     sections.extend(record_sections(data, &c.fits, out)?);
     let forces: Vec<(&str, &[f64])> = c
@@ -153,10 +182,11 @@ fn write_compare_report(
         &[],
         out,
     )?);
-    let verdict = crate::verdict::compare_verdict(c);
+    let verdict = crate::verdict::compare_verdict(c, data.words());
     let record = format!(
-        "{} cycles of {}; noise floor σ = {:.4} N.",
+        "{} {} of {}; noise floor σ = {:.4} N.",
         c.measured.labels.len(),
+        data.words().cycles,
         data.record.source,
         c.measured.noise_sigma
     );
@@ -179,7 +209,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         .collect();
     regimes
         .paragraphs
-        .push(duty_meaning(c.measured.on_threshold));
+        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTOR));
     regimes.tables.push(errors_table(c));
     regimes
         .paragraphs
@@ -203,6 +233,36 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         "Relative force RMS error of each model in each regime of the record (lower is better).",
     ));
     Ok(regimes)
+}
+
+/// The report's "Models over the whole record" of a record without a rotor: compare.md's
+/// bullets and each model's relative force RMS error (duty error) over the whole record.
+fn whole_record_section(c: &Compared, md: &str) -> Section {
+    let mut s = Section::new("Models over the whole record");
+    s.paragraphs = md
+        .lines()
+        .filter(|l| l.starts_with("- "))
+        .map(|l| l.trim_start_matches("- ").replace("**", ""))
+        .collect();
+    s.paragraphs
+        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS));
+    let rows = c
+        .fits
+        .iter()
+        .zip(&c.comparisons)
+        .map(|(f, cmp)| {
+            let o = &cmp.overall;
+            vec![
+                f.label.clone(),
+                format!("{:.3} ({:.2})", o.relative_rms_error, o.duty_error),
+            ]
+        })
+        .collect();
+    let caption = "Relative force RMS error over the whole record (on–off duty error in \
+                   brackets); lower is better.";
+    s.tables
+        .push(Table::new(caption, &["model", "whole record"]).with_rows(rows));
+    s
 }
 
 /// The relative force RMS error (duty error) of each model per regime and overall.

@@ -61,7 +61,7 @@ fn print_summary(
     score: Option<&DiscoveryScore>,
     (entries, wall): (&(String, String), f64),
 ) {
-    let (unit, scale) = data.level.shown();
+    let (unit, scale) = data.shown();
     let effects = if found.effects.is_empty() {
         "none".to_string()
     } else {
@@ -81,13 +81,19 @@ fn print_summary(
             )
         }
         Some(tf) => format!(
-            "effects: {effects}; S {:.4} → {:.4} mm² (noise floor {:.4} mm) in {wall:.1} s",
+            "effects: {effects}; S {:.4} → {:.4} {} (noise floor {:.4} {unit}) in {wall:.1} s",
             tf.s_before_mm2,
             tf.s_after_mm2,
-            found.noise_floor * 1e3,
+            data.units.x_squared,
+            found.noise_floor * scale,
         ),
     };
-    let held_out = held_out_and_validation(found.holdout_cycles, score, unit, scale);
+    let held_out = held_out_and_validation(
+        (found.holdout_cycles, data.words().cycles),
+        score,
+        unit,
+        scale,
+    );
     for step in &found.steps {
         say!("  {}", step.verdict);
     }
@@ -115,12 +121,12 @@ fn print_summary(
 /// final model's errors on the validation record, in one sentence (errors shown in `unit`,
 /// `scale` from SI).
 fn held_out_and_validation(
-    holdout_cycles: usize,
+    (holdout_cycles, cycles): (usize, &str),
     score: Option<&DiscoveryScore>,
     unit: &str,
     scale: f64,
 ) -> String {
-    let held_out = format!("held out: {holdout_cycles} cycles of the record");
+    let held_out = format!("held out: {holdout_cycles} {cycles} of the record");
     match score {
         Some(score) => format!("{held_out}; {}", score.summary(unit, scale)),
         None => held_out,
@@ -175,7 +181,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     let score = discovered.score.as_ref();
     let dir = out.join("figures");
     crate::writing::atomic::ensure_dir(&dir)?;
-    let (unit, scale) = data.level.shown();
+    let (unit, scale) = data.shown();
     let drawn = match data.level {
         FitLevel::Force => &FORCE_DRAWN,
         FitLevel::Trajectory => &TRAJECTORY_DRAWN,
@@ -188,7 +194,12 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     s.paragraphs.extend(found.notes.iter().cloned());
     s.paragraphs.push(format!(
         "{}.",
-        held_out_and_validation(found.holdout_cycles, score, unit, scale)
+        held_out_and_validation(
+            (found.holdout_cycles, data.words().cycles),
+            score,
+            unit,
+            scale
+        )
     ));
     let tables = found
         .steps
@@ -210,6 +221,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         ),
     ];
     for ((name, quantity, caption), measured, curves) in figures {
+        let quantity = quantity.in_units(&data.units);
         let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
         s.figures.push(FigureRef::new(fig, caption).zoomable());
     }
@@ -245,7 +257,13 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     )?);
     sections.extend(record_sections(data, &[], out)?);
     let mut intro = vec![discovered.verdict().text];
-    intro.extend(score.map(|v| format!("Beside the held-out cycles, {}.", v.summary(unit, scale))));
+    intro.extend(score.map(|v| {
+        format!(
+            "Beside the held-out {}, {}.",
+            data.words().cycles,
+            v.summary(unit, scale)
+        )
+    }));
     write_report(
         &format!("Discovery: {}", exp.path.display()),
         intro,

@@ -130,7 +130,7 @@ fn frequency_response(
 
 /// The terminal summary: one line per model, its warnings under it.
 fn print_summary(data: &FitData, fits: &[ModelFit]) {
-    let (unit, scale) = data.level.shown();
+    let (unit, scale) = data.shown();
     say!(
         "fitted {} model(s) at {} level on {} samples of {}",
         fits.len(),
@@ -162,7 +162,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
 /// The validation block: each model's error on the `[validate]` record, per regime where
 /// the record has them.
 fn print_validation(rec: &ValidationRecord, fits: &[ModelFit]) {
-    let (unit, scale) = rec.data.level.shown();
+    let (unit, scale) = rec.data.shown();
     say!(
         "validation on {} ({} samples), fitted parameters held{}:",
         rec.spec.given,

@@ -106,7 +106,7 @@ impl DiscoverInputs {
         let cycles = crate::fitting::cycles_of(data)?;
         let mut settings = settings_of(exp, spec, data.level);
         let job = observer.job("discover");
-        let (unit, scale) = data.level.shown();
+        let (unit, scale) = data.shown();
         settings.observer = discovery_observer(job.clone(), unit, scale);
         // The oscillator refitted with every model, at trajectory level.
         let refit = (data.level == FitLevel::Trajectory).then(|| {
@@ -119,10 +119,11 @@ impl DiscoverInputs {
             format!(" at trajectory level (refitting {})", names.join(", "))
         });
         observer.note(&format!(
-            "discovering from `{}`{refitting} over {} candidates on {} cycles…",
+            "discovering from `{}`{refitting} over {} candidates on {} {}…",
             spec.base_text(),
             candidates.len(),
-            cycles.len()
+            cycles.len(),
+            data.words().cycles
         ));
         let started = Instant::now();
         let setup = refit.as_ref().map(|(_, setup)| setup);
@@ -175,7 +176,7 @@ impl Discovered {
     /// level's unit), the share of the excess explained; at trajectory level S(μ) before and
     /// after.
     pub fn verdict(&self) -> DiscoverVerdict {
-        let (unit, scale) = self.data.level.shown();
+        let (unit, scale) = self.data.shown();
         let f = &self.found;
         let mut verdict = discover_verdict(
             &f.effects,
@@ -186,8 +187,8 @@ impl Discovered {
         );
         if let Some(tf) = &f.trajectory {
             verdict.text = format!(
-                "{} S(μ) {:.4} → {:.4} mm².",
-                verdict.text, tf.s_before_mm2, tf.s_after_mm2
+                "{} S(μ) {:.4} → {:.4} {}.",
+                verdict.text, tf.s_before_mm2, tf.s_after_mm2, self.data.units.x_squared
             );
         }
         verdict
@@ -252,10 +253,14 @@ fn discover_at(
             let mut settings = settings.kinematics(&data.kinematics);
             let k = &data.kinematics;
             settings.regimes = k.phi.is_some() || k.omega.is_some();
+            settings.pieces = data.words().cycles;
             discover_force(base, candidates, &data.force_data(), cycles, &settings)
         }
         Some(setup) => {
             let td = data.trajectory_data();
+            let mut settings = settings;
+            settings.x_unit = data.units.x;
+            settings.pieces = data.words().cycles;
             discover_trajectory(base, candidates, &td, cycles, setup, &settings)
         }
     }
@@ -391,7 +396,14 @@ fn results<'a>(
                 toml_entry.clone(),
                 curves,
             )
-            .with_trajectory(tf, names, system, wall, data.system_estimate);
+            .with_trajectory(
+                tf,
+                names,
+                system,
+                wall,
+                data.system_estimate,
+                data.units.x_si,
+            );
             (doc, system_entry)
         }
     };

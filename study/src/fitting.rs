@@ -30,6 +30,8 @@ use crate::digits::shown;
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
 use crate::observer::{fit_message, jobs_message, Job, Observer};
+use crate::rig_words::RigWords;
+use crate::shown_units::ShownUnits;
 use stf_core::data::record_bounds::DataScales;
 
 /// A record with its kinematics, ready to fit.
@@ -45,9 +47,34 @@ pub struct FitData {
     pub system_estimate: Option<LinearEstimate>,
     /// What looks suspicious about the record ([`crate::plausibility`]), already printed.
     pub record_warnings: Vec<String>,
+    /// The units the record's motion is shown in (mm, or mV for x in volts).
+    pub units: ShownUnits,
 }
 
 impl FitData {
+    /// The unit errors and gaps are shown in, and the factor from the record's values: N at
+    /// force level; at trajectory level the record's own (mm, or mV for x in volts).
+    pub fn shown(&self) -> (&'static str, f64) {
+        match self.level {
+            FitLevel::Force => self.level.shown(),
+            FitLevel::Trajectory => (self.units.x, self.units.scale),
+        }
+    }
+
+    /// The words that fit the record's rig: a rotor's cycles and regimes, or periods of the
+    /// motion over the whole record.
+    pub fn words(&self) -> RigWords {
+        RigWords::of(&self.record)
+    }
+
+    /// The unit of the fitted signal as recorded: N at force level, m (or V) at trajectory level.
+    pub fn si_unit(&self) -> &'static str {
+        match self.level {
+            FitLevel::Force => self.level.signal().si_unit,
+            FitLevel::Trajectory => self.units.x_si,
+        }
+    }
+
     /// The sizes the models' bounds are widened to ([`stf_core::data::record_bounds`]): the measured
     /// force at force level, the force recovered with the oscillator `system` at trajectory
     /// level, along the record's motion.
@@ -195,6 +222,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         level,
         system_estimate,
         record_warnings,
+        units: ShownUnits::of(&exp.data_layout),
     })
 }
 
@@ -410,7 +438,7 @@ fn fit_from_starts(
     configured: Option<&ConfiguredModel>,
     progress: &dyn Job,
 ) -> Result<ModelFit> {
-    let (unit, scale) = data.level.shown();
+    let (unit, scale) = data.shown();
     let observer = |p: stf_core::fit::FitProgress| progress.message(&fit_message(&p, unit, scale));
     let label = configured.map_or("none".to_string(), |c| c.model.name().to_string());
     let predictor = Predictor::build(exp, data, configured)?;

@@ -42,7 +42,7 @@ pub struct ValidationRecord {
 impl ValidationRecord {
     /// The unit of the errors: N at force level, m at trajectory level.
     pub fn unit(&self) -> &'static str {
-        self.data.level.signal().si_unit
+        self.data.si_unit()
     }
 }
 
@@ -83,6 +83,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         level: estimation.level,
         system_estimate: None,
         record_warnings,
+        units: crate::shown_units::ShownUnits::of(&exp.data_layout),
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),

@@ -12,8 +12,8 @@ use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use crate::compare::Compared;
 use crate::identify::StageOutcome;
 
-use crate::experiment::FitLevel;
 use crate::fitting::ModelFit;
+use crate::rig_words::RigWords;
 
 /// AIC differences below this say the data do not prefer one model over the other
 /// (Burnham & Anderson's rule of thumb: ΔAIC < 2, substantial support for both).
@@ -67,8 +67,9 @@ pub struct FitVerdict {
 }
 
 impl FitVerdict {
-    /// The verdict of `fits` at `level`.
-    pub fn new(fits: &[ModelFit], level: FitLevel) -> Self {
+    /// The verdict of `fits`, their errors shown in `shown` (unit, factor from the record's
+    /// values: [`crate::fitting::FitData::shown`]).
+    pub fn new(fits: &[ModelFit], shown: (&str, f64)) -> Self {
         let mut ranked: Vec<&ModelFit> = fits.iter().filter(|f| f.result.aic.is_finite()).collect();
         ranked.sort_by(|a, b| a.result.aic.total_cmp(&b.result.aic));
         let free = |f: &ModelFit| f.result.params.iter().filter(|p| !p.fixed).count();
@@ -96,7 +97,7 @@ impl FitVerdict {
             })
             .collect();
         let lowest_aic = best.result.aic <= ranked[0].result.aic;
-        let text = fit_text(best, lowest_aic, &others, fits, level);
+        let text = fit_text(best, lowest_aic, &others, fits, shown);
         FitVerdict {
             best: Some(best.label.clone()),
             lowest_aic,
@@ -111,7 +112,7 @@ impl crate::fit::Fitted {
     /// The verdict: the best model, how far it is to be trusted, and why (fit.json's
     /// `verdict`; its `text` opens the report).
     pub fn verdict(&self) -> FitVerdict {
-        FitVerdict::new(&self.fits, self.data.level)
+        FitVerdict::new(&self.fits, self.data.shown())
     }
 }
 
@@ -121,9 +122,8 @@ fn fit_text(
     lowest_aic: bool,
     others: &[Behind],
     fits: &[ModelFit],
-    level: FitLevel,
+    (unit, scale): (&str, f64),
 ) -> String {
-    let (unit, scale) = level.shown();
     let mut text = format!(
         "Best fit: `{}`, RMS residual {:.4} {unit}, AIC {:.1}{}.",
         best.label,
@@ -193,7 +193,10 @@ fn trust(best: &ModelFit, fits: &[ModelFit]) -> String {
 /// (compare.json's `ranking`), and whether the best by per-cycle force error is ahead of the
 /// runner-up cycle by cycle (the paired test of `loop_rankings`' `force` metric, cycles
 /// being the independent units).
-pub fn compare_verdict(c: &Compared) -> String {
+pub fn compare_verdict(c: &Compared, words: RigWords) -> String {
+    if !words.regimes {
+        return whole_record_verdict(c);
+    }
     let force = c
         .loop_rankings
         .iter()
@@ -238,6 +241,32 @@ pub fn compare_verdict(c: &Compared) -> String {
          no better than no force), with the best and the runner-up by per-cycle force error \
          compared cycle by cycle: {}.{overall}",
         parts.join("; ")
+    )
+}
+
+/// The verdict of a comparison on a record without a rotor: no regimes, the models ranked by
+/// their relative force RMS error over the whole record.
+fn whole_record_verdict(c: &Compared) -> String {
+    let mut scores: Vec<(&str, f64)> = c
+        .fits
+        .iter()
+        .zip(&c.comparisons)
+        .map(|(f, cmp)| (f.label.as_str(), cmp.overall.relative_rms_error))
+        .filter(|(_, e)| e.is_finite())
+        .collect();
+    if scores.is_empty() {
+        return "No model could be scored on the record.".into();
+    }
+    scores.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let order: Vec<String> = scores
+        .iter()
+        .map(|(m, e)| format!("`{m}` {e:.3}"))
+        .collect();
+    format!(
+        "Models ranked over the whole record (it has no rotor) by their relative force \
+         RMS error (the RMS of model − measured force over the measured force's RMS; 0 is \
+         perfect, 1 is no better than no force): {}.",
+        order.join(" < ")
     )
 }
 

@@ -32,6 +32,7 @@ pub(super) struct Trial {
 }
 
 /// How a level says its residuals: the quantity and the unit of the verdicts.
+#[derive(Clone, Copy)]
 pub(super) struct Said {
     /// What the held-out residual is called (`held-out RMS`, `held-out x RMS`).
     pub quantity: &'static str,
@@ -39,6 +40,24 @@ pub(super) struct Said {
     pub unit: &'static str,
     /// The factor from the residual's SI value to `unit`.
     pub scale: f64,
+    /// What the held-out pieces are called (`cycles`, `periods`).
+    pub pieces: &'static str,
+}
+
+impl Said {
+    /// Said of the record `settings` describe: a displacement in its `x_unit`, the held-out
+    /// pieces by its `pieces`.
+    pub fn of_record(self, settings: &DiscoverySettings) -> Said {
+        Said {
+            unit: if self.unit == "mm" {
+                settings.x_unit
+            } else {
+                self.unit
+            },
+            pieces: settings.pieces,
+            ..self
+        }
+    }
 }
 
 /// Force level: held-out RMS in N.
@@ -46,6 +65,7 @@ pub(super) const FORCE: Said = Said {
     quantity: "held-out RMS",
     unit: "N",
     scale: 1.0,
+    pieces: "cycles",
 };
 
 /// Trajectory level: held-out x RMS in mm.
@@ -53,6 +73,7 @@ pub(super) const DISPLACEMENT: Said = Said {
     quantity: "held-out x RMS",
     unit: "mm",
     scale: 1e3,
+    pieces: "cycles",
 };
 
 /// The level's paired test of two trials' `holdout`, the candidate (second) against the
@@ -311,11 +332,12 @@ pub(super) fn step_on(
     }
 }
 
-/// The units of `step` in words: `48 blocks of ≥ 38 held-out samples` or `16 held-out cycles`.
-fn units(step: &Step) -> String {
+/// The units of `step` in words: `48 blocks of ≥ 38 held-out samples` or `16 held-out cycles`
+/// (`said.pieces`).
+fn units(step: &Step, said: &Said) -> String {
     match step.block_samples {
         Some(l) => format!("{} blocks of ≥ {l} held-out samples", step.effective_n),
-        None => format!("{} held-out cycles", step.effective_n),
+        None => format!("{} held-out {}", step.effective_n, said.pieces),
     }
 }
 
@@ -337,7 +359,7 @@ fn accepted(step: &Step, winner: usize, said: &Said) -> String {
         w.holdout_rms * said.scale,
         said.unit,
         w.gain_z,
-        units(step),
+        units(step, said),
         w.delta_bic,
         100.0 * w.explained_share,
         step.floor.sigma * said.scale,
@@ -358,7 +380,7 @@ fn rejected(step: &Step, said: &Said, settings: &DiscoverySettings) -> String {
         step.current_holdout_rms * said.scale,
         said.unit,
         settings.min_gain_sigma,
-        units(step),
+        units(step, said),
         settings.min_bic_drop,
         100.0 * settings.min_explained,
         step.floor.sigma * said.scale,
@@ -425,7 +447,7 @@ pub(super) fn unresolved(step: &Step, said: &Said) -> Option<String> {
             said.unit,
             100.0 * (step.current_holdout_rms.powi(2) - c.holdout_rms.powi(2)) / excess,
             c.gain_z,
-            units(step)
+            units(step, said)
         ),
         None => format!("{lead} that no candidate of the vocabulary explains"),
     })

@@ -110,7 +110,13 @@ impl<L: Level> Recheck<'_, L> {
         let with = effects.last().map_or("", String::as_str);
         let names = [old_name.as_str(), &new_name, with];
         let settings = self.level.settings();
-        step.verdict = replaced_verdict(&step, names, (&score, tie), L::SAID, settings);
+        step.verdict = replaced_verdict(
+            &step,
+            names,
+            (&score, tie),
+            &L::SAID.of_record(settings),
+            settings,
+        );
         step.accepted = Some(new_name.clone());
         if tie {
             step.tie_with = vec![old_name];

@@ -66,14 +66,14 @@ pub(super) fn discover<L: Level>(
             Ok::<_, DiscoveryError>(choice::decide(
                 &current,
                 scored,
-                L::SAID,
+                &L::SAID.of_record(settings),
                 yardstick,
                 settings,
             ))
         })??;
         notes.push(step.verdict.clone());
         if L::WARNS_UNRESOLVED {
-            notes.extend(choice::unresolved(&step, L::SAID));
+            notes.extend(choice::unresolved(&step, &L::SAID.of_record(settings)));
         }
         effects.extend(step.accepted.clone());
         steps.push(step);
@@ -221,7 +221,7 @@ fn final_refit<L: Level>(
     let refit_rms = rms(&level.residual(&refit)?);
     let start_rms = rms(&level.residual(&current.stage)?);
     if start_rms < refit_rms {
-        let said = L::SAID;
+        let said = L::SAID.of_record(settings);
         notes.push(format!(
             "the whole-record refit ended worse ({:.4} {}) than the training fit it started \
              from ({:.4} {}); the training fit's values are kept",

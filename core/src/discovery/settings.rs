@@ -97,6 +97,18 @@ pub struct DiscoverySettings {
     #[serde(skip)]
     #[setters(skip)]
     pub regimes: bool,
+    /// The unit a displacement is said in at trajectory level: `mm` (default), or `mV` for a
+    /// record whose x is a voltage (the numbers are thousandths of the record's unit either
+    /// way). Set from the record; not read from a file.
+    #[serde(skip)]
+    #[setters(skip)]
+    pub x_unit: &'static str,
+    /// What the held-out pieces of a record are called: a rotor's `cycles` (default), or the
+    /// `periods` of the motion of a record without a rotor. Set from the record; not read from
+    /// a file.
+    #[serde(skip)]
+    #[setters(skip)]
+    pub pieces: &'static str,
     /// Called as the run goes (step, candidate, score): for a live display.
     #[serde(skip)]
     #[setters(skip)]
@@ -122,6 +134,8 @@ impl Default for DiscoverySettings {
             recheck: None,
             polish: None,
             regimes: true,
+            x_unit: "mm",
+            pieces: "cycles",
             observer: Observer::default(),
         }
     }

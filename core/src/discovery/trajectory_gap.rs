@@ -13,22 +13,23 @@ use crate::data::force_data::ForceData;
 use crate::regimes::Cycle;
 
 /// Locate the x residual of `run` (m) over `cycles`, with displacement noise floor `floor`
-/// (m, > 0).
-pub(super) fn locate_x_gap(run: &Run, cycles: &[Cycle], floor: f64) -> GapLocation {
+/// (m, > 0), said in thousandths of the record's unit, `unit` (`mm`, or `mV` for x in volts).
+pub(super) fn locate_x_gap(run: &Run, cycles: &[Cycle], floor: f64, unit: &str) -> GapLocation {
     let s = &run.sim;
     let data = ForceData::new(&s.t, &s.x, &s.v, &s.a, &s.f_stf);
     let mut g = locate_gap(&run.residual, &data, cycles, floor);
     g.breakdowns.retain(|b| b.by != "regime");
-    // The summary in mm.
+    // The summary in thousandths of the record's unit.
     let mm = |v: f64| v * 1e3;
     let head = format!(
-        "x residual {:.4} mm RMS (S = {:.4} mm²) against a noise floor of {:.4} mm ({:.1}×)",
+        "x residual {:.4} {unit} RMS (S = {:.4} {unit}²) against a noise floor of {:.4} {unit} \
+         ({:.1}×)",
         mm(g.rms),
         mm(g.rms) * mm(g.rms),
         mm(floor),
         g.rms / floor
     );
-    let say = |v: f64| format!("{:.4} mm", mm(v));
+    let say = |v: f64| format!("{:.4} {unit}", mm(v));
     g.summary = summary(head, g.rms, floor, &g.breakdowns, "ω and states", say);
     g
 }
@@ -69,7 +70,7 @@ mod tests {
                 omega: std::f64::consts::TAU,
             })
             .collect();
-        let g = locate_x_gap(&run, &cycles, 1e-5);
+        let g = locate_x_gap(&run, &cycles, 1e-5, "mm");
         assert!(g.breakdown("regime").is_none());
         assert!(g.breakdown("|x|").unwrap().contrast > 10.0);
         assert!(g.summary.contains("large |x|"), "{}", g.summary);

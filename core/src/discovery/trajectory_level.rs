@@ -247,7 +247,7 @@ impl Level for TrajectoryLevel<'_> {
         floor: &NoiseFloor,
     ) -> Result<(Vec<f64>, GapLocation), DiscoveryError> {
         let run = stage.run(&self.rig)?;
-        let location = locate_x_gap(&run, self.cycles, floor.sigma);
+        let location = locate_x_gap(&run, self.cycles, floor.sigma, self.settings.x_unit);
         Ok((run.residual, location))
     }
 
@@ -334,8 +334,9 @@ impl Level for TrajectoryLevel<'_> {
         final_name: &str,
         where_after: &str,
     ) -> Vec<String> {
+        let u = self.settings.x_unit;
         vec![format!(
-            "x gap {:.4} mm → {:.4} mm RMS, S {:.4} → {:.4} mm² (noise floor {:.4} mm); final \
+            "x gap {:.4} {u} → {:.4} {u} RMS, S {:.4} → {:.4} {u}² (noise floor {:.4} {u}); final \
              `{final_name}`: {where_after}",
             gap_before * 1e3,
             gap_after * 1e3,

@@ -156,7 +156,7 @@ impl<'a> CompareJson<'a> {
                 overall: c.ranking.best_overall(),
             },
             cycles_csv: "cycles.csv",
-            verdict: crate::verdict::compare_verdict(c),
+            verdict: crate::verdict::compare_verdict(c, data.words()),
         }
     }
 }
@@ -171,7 +171,7 @@ fn models<'a>(data: &'a FitData, c: &'a Compared) -> Vec<ModelComparisonJson<'a>
         .map(|((f, cmp), response)| ModelComparisonJson {
             name: f.name(),
             label: &f.label,
-            fit: ModelFitJson::new(f, data.level),
+            fit: ModelFitJson::new(f, data),
             regimes: &cmp.per_regime,
             overall: &cmp.overall,
             boundary_errors: &cmp.boundary_errors,

@@ -43,7 +43,7 @@ pub struct DiscoveryJson<'a> {
     pub noise_floor: f64,
     /// The floor's parts: `measured`, `propagated`, `sigma`.
     pub noise_floor_parts: &'a NoiseFloor,
-    /// `N` (force level) or `m` (trajectory level).
+    /// `N` (force level) or `m` (trajectory level; `V` for x in volts).
     pub gap_unit: &'static str,
     /// Held-out cycles every step was scored on.
     pub holdout_cycles: usize,
@@ -175,8 +175,9 @@ impl<'a> DiscoveryJson<'a> {
         system: FinalSystemJson,
         wall: f64,
         system_estimate: Option<LinearEstimate>,
+        x_unit: &'static str,
     ) -> Self {
-        self.gap_unit = "m";
+        self.gap_unit = x_unit;
         self.final_model.system = Some(system);
         self.trajectory = Some(TrajectoryJson {
             system_estimate,

@@ -57,11 +57,8 @@ impl<'a> FitJson<'a> {
             drive: &data.kinematics.drive,
             noise_estimate: noise_estimate(data.target()),
             system_estimate: data.system_estimate,
-            models: fits
-                .iter()
-                .map(|f| ModelFitJson::new(f, data.level))
-                .collect(),
-            verdict: FitVerdict::new(fits, data.level),
+            models: fits.iter().map(|f| ModelFitJson::new(f, data)).collect(),
+            verdict: FitVerdict::new(fits, data.shown()),
         }
     }
 }
@@ -93,7 +90,7 @@ pub struct ModelFitJson<'a> {
     pub error_blocks: Option<ErrorBlocks>,
     /// Names of the parameters held at their values.
     pub fixed: Vec<&'a str>,
-    /// `N` (force level) or `m` (trajectory level): the unit of `rms`.
+    /// `N` (force level) or `m` (trajectory level; `V` for x in volts): the unit of `rms`.
     pub rms_unit: &'static str,
     /// Samples fitted.
     pub n_points: usize,
@@ -120,9 +117,9 @@ pub struct ValidationJson<'a> {
 }
 
 impl<'a> ModelFitJson<'a> {
-    /// The JSON of `fit` at `level`.
-    pub fn new(fit: &'a ModelFit, level: FitLevel) -> Self {
-        let r = &fit.result;
+    /// The JSON of `fit` on `data`.
+    pub fn new(fit: &'a ModelFit, data: &FitData) -> Self {
+        let (r, level) = (&fit.result, data.level);
         ModelFitJson {
             name: fit.name(),
             label: &fit.label,
@@ -136,7 +133,7 @@ impl<'a> ModelFitJson<'a> {
                 .filter(|p| p.fixed)
                 .map(|p| p.name.as_str())
                 .collect(),
-            rms_unit: level.signal().si_unit,
+            rms_unit: data.si_unit(),
             n_points: r.n_points,
             n_free: r.n_free,
             failures: r.failures,

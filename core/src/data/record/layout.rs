@@ -71,7 +71,10 @@ impl Signal {
     pub fn unit_list(self) -> &'static str {
         match self {
             Signal::T => "s, ms, us (or µs), min",
-            Signal::X => "m, cm, mm, um (or µm), in, V (with `gain`, metres per volt)",
+            Signal::X => {
+                "m, cm, mm, um (or µm), in, V (with `gain`, metres per volt; alone, a voltage kept \
+                 in volts)"
+            }
             Signal::Phi => "rad, deg, rev, counts (with `per_rev`, encoder counts per revolution)",
             Signal::Omega => "rad/s, rpm, Hz",
             Signal::FStf | Signal::U => "N, kN, mN, lbf, V (with `gain`, newtons per volt)",
@@ -156,7 +159,8 @@ impl Unit {
     }
 
     /// The unit called `name` for `signal`. `counts` needs `per_rev` (counts per revolution)
-    /// and `V` needs `gain` (N or m per V); neither is taken by another unit.
+    /// and `V` needs `gain` (N or m per V), except for `x`, where `V` alone is a voltage kept
+    /// in volts (gain 1: an electronic oscillator's output); neither is taken by another unit.
     pub fn parse(
         signal: Signal,
         name: &str,
@@ -187,6 +191,8 @@ impl Unit {
             (S::FStf | S::U, "kN") => Unit::Kilonewton,
             (S::FStf | S::U, "mN") => Unit::Millinewton,
             (S::FStf | S::U, "lbf") => Unit::PoundForce,
+            // x in volts with no gain: a voltage kept as it is (an electronic oscillator).
+            (S::X, "V") if gain.is_none() => Unit::Volt { gain: 1.0 },
             (S::X | S::FStf | S::U, "V") => Unit::Volt {
                 gain: parameter(name, "gain", gain)?,
             },
@@ -810,12 +816,14 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "unknown unit `furlong` for `x`; known: m, cm, mm, um (or µm), in, V (with `gain`, \
-             metres per volt)"
+             metres per volt; alone, a voltage kept in volts)"
         );
         let e = Unit::parse(Signal::T, "mm", None, None).unwrap_err();
         assert!(e.to_string().contains("known: s, ms, us"), "{e}");
         let e = Unit::parse(Signal::U, "V", None, None).unwrap_err();
         assert!(e.to_string().contains("needs `gain`"), "{e}");
+        let volts = Unit::parse(Signal::X, "V", None, None).unwrap();
+        assert_eq!(volts, Unit::Volt { gain: 1.0 });
         let e = Unit::parse(Signal::Phi, "counts", None, None).unwrap_err();
         assert!(e.to_string().contains("needs `per_rev`"), "{e}");
         let e = Unit::parse(Signal::Phi, "deg", Some(1.0), None).unwrap_err();

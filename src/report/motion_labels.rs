@@ -1,0 +1,54 @@
+//! The labels of a record's motion on figures' axes and in their CSV columns, in the record's
+//! own units: mm, mm/s and m/s² for the trolley's displacement, mV, mV/s and V/s² for an x
+//! that is a voltage (an electronic oscillator's output). The plotted numbers are the same
+//! either way (x and v in thousandths of the record's unit, a in its unit per s²).
+
+use stf_study::shown_units::ShownUnits;
+
+/// Axis labels and CSV column names of x, v and a.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionLabels {
+    /// Axis label of x.
+    pub x: &'static str,
+    /// Axis label of v.
+    pub v: &'static str,
+    /// Axis label of a.
+    pub a: &'static str,
+    /// CSV column of x.
+    pub x_column: &'static str,
+    /// CSV column of v.
+    pub v_column: &'static str,
+    /// CSV column of a.
+    pub a_column: &'static str,
+}
+
+impl MotionLabels {
+    /// The trolley's: x in mm.
+    pub const LENGTH: MotionLabels = MotionLabels {
+        x: "displacement x, mm",
+        v: "velocity v, mm/s",
+        a: "acceleration a, m/s²",
+        x_column: "x, mm",
+        v_column: "v, mm/s",
+        a_column: "a, m/s²",
+    };
+
+    /// A record whose x is a voltage.
+    pub const VOLTAGE: MotionLabels = MotionLabels {
+        x: "x, mV",
+        v: "dx/dt, mV/s",
+        a: "d²x/dt², V/s²",
+        x_column: "x, mV",
+        v_column: "v, mV/s",
+        a_column: "a, V/s²",
+    };
+
+    /// The labels of a record shown in `units`.
+    pub fn of(units: &ShownUnits) -> MotionLabels {
+        if units.is_voltage() {
+            MotionLabels::VOLTAGE
+        } else {
+            MotionLabels::LENGTH
+        }
+    }
+}
