@@ -122,7 +122,10 @@ fn main() {
             for (name, truth) in TRUTH {
                 let (rms, max, cover, mean) = z_stats(&fits, name, truth);
                 let (rms0, _, _, mean0) = z_stats(&plain, name, truth);
-                let (e, e0) = (rms_error(&fits, name, truth), rms_error(&plain, name, truth));
+                let (e, e0) = (
+                    rms_error(&fits, name, truth),
+                    rms_error(&plain, name, truth),
+                );
                 println!(
                     "| {alpha} rad/s² | {rate:.0} Hz | {name} | {rms:.2} | {mean:+.2} | {max:.1} | \
                      {cover:.0} % | {rms0:.2}, {mean0:+.2} | {e:.4} / {e0:.4} | {block} | \

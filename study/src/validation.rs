@@ -83,6 +83,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         level: estimation.level,
         system_estimate: None,
         record_warnings,
+        v_measured: false,
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),

@@ -93,7 +93,11 @@ pub fn correct(
         let mean = draws.iter().map(|d| d[j]).sum::<f64>() / b;
         let spread = draws.iter().map(|d| (d[j] - mean).powi(2)).sum::<f64>() / (b - 1.0);
         let value = (2.0 * p.value - mean).clamp(bounds[j].min, bounds[j].max);
-        moved.push(format!("{} {:+.3}σ", p.name, (value - p.value) / p.std_error));
+        moved.push(format!(
+            "{} {:+.3}σ",
+            p.name,
+            (value - p.value) / p.std_error
+        ));
         p.value = value;
         p.std_error = (p.std_error.powi(2) + spread / b).sqrt();
     }
