@@ -13,7 +13,7 @@
 //! the estimate at none is extrapolated: `θ̂ = 2·θ₁ − mean(θ₂)` (θ₁ the record's fit, θ₂ the
 //! copies'). The standard error adds the extrapolation's own spread, `var(θ₂)/replicates`.
 //! The filter's own attenuation of v is left alone: on the rig's records it moves the
-//! estimates by less than a hundredth of a standard error.
+//! estimates by less than 0.03 of a standard error.
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
