@@ -20,8 +20,8 @@ use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
 use stf_core::fit::Validation;
 use stf_core::fit::{
-    fit_warnings, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor, TrajectoryData,
-    TrajectoryFit,
+    fit_warnings, FilterNoise, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor,
+    TrajectoryData, TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
@@ -49,6 +49,8 @@ pub struct FitData {
     pub record_warnings: Vec<String>,
     /// The units the record's motion is shown in (mm, or mV for x in volts).
     pub units: ShownUnits,
+    /// Whether v is the record's measured `v` column rather than the derivative filter's.
+    pub v_measured: bool,
 }
 
 impl FitData {
@@ -182,13 +184,12 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         );
     }
     let mut record_warnings = record_warnings;
+    let mut v_measured = false;
     if let Some(v) = crate::measured_velocity::read(&exp.data_layout, file, exp.data_window) {
         let name = file.display().to_string();
-        record_warnings.extend(crate::measured_velocity::use_or_warn(
-            &mut kinematics,
-            v,
-            &name,
-        ));
+        let warning = crate::measured_velocity::use_or_warn(&mut kinematics, v, &name);
+        v_measured = warning.is_none();
+        record_warnings.extend(warning);
     }
     let driven = record.phi.is_some() || record.omega.is_some() || record.u.is_some();
     if level == FitLevel::Trajectory && !driven {
@@ -223,6 +224,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         system_estimate,
         record_warnings,
         units: ShownUnits::of(&exp.data_layout),
+        v_measured,
     })
 }
 
@@ -493,7 +495,11 @@ impl Predictor {
     ) -> Result<Predictor> {
         if data.level == FitLevel::Force {
             let c = configured.ok_or_else(|| anyhow!("a force-level fit needs a model"))?;
-            let fit = ForceFit::new(c.model.clone()).settings(exp.fit.settings.clone());
+            let k = &data.kinematics;
+            let noise = (!data.v_measured).then(|| FilterNoise::new(k.motion_filter, k.sigma_x));
+            let fit = ForceFit::new(c.model.clone())
+                .settings(exp.fit.settings.clone())
+                .filter_noise(noise);
             let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
                 let b = offset_reach(data.target());

@@ -84,6 +84,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         system_estimate: None,
         record_warnings,
         units: crate::shown_units::ShownUnits::of(&exp.data_layout),
+        v_measured: false,
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),

@@ -39,11 +39,12 @@ use nalgebra::DMatrix;
 
 use super::driver;
 use super::error::FitError;
+use super::filter_noise::{self, FilterNoise};
 use super::fit_param::{full_values, held, FitParam};
 use super::noise_floor::Quantity;
 use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
-use super::solver::FitSettings;
+use super::solver::{FitSettings, Solver};
 use crate::data::force_data::ForceData;
 use crate::physics::force_model::{ForceModel, ModelState};
 
@@ -58,6 +59,10 @@ pub struct ForceFit {
     /// Settings of the optimiser.
     #[setters(generate)]
     settings: FitSettings,
+    /// How v and a were made from x, for [`ForceFit::fit`] to correct its estimates for
+    /// their noise ([`filter_noise`](super::filter_noise)); `None`: v and a taken as exact.
+    #[setters(generate)]
+    filter_noise: Option<FilterNoise>,
 }
 
 /// Name of the constant force offset parameter, N.
@@ -73,6 +78,7 @@ impl ForceFit {
             unknown: Vec::new(),
             offset: None,
             settings: FitSettings::default(),
+            filter_noise: None,
         }
     }
 
@@ -103,13 +109,38 @@ impl ForceFit {
         all
     }
 
-    /// Run the fit; `observer` is called after every iteration of every solver stage.
+    /// Run the fit; `observer` is called after every iteration of every solver stage. With
+    /// [`ForceFit::filter_noise`] set, the estimates are then corrected for the filter's
+    /// noise in v and a ([`filter_noise::correct`]).
     pub fn fit(
         &self,
         data: &ForceData,
         observer: Option<&(dyn Fn(FitProgress) + Sync)>,
     ) -> Result<FitResult, FitError> {
-        self.fit_rows(data, None, &self.settings, observer)
+        let result = self.fit_rows(data, None, &self.settings, observer)?;
+        match &self.filter_noise {
+            Some(noise) => filter_noise::correct(self, data, noise, result),
+            None => Ok(result),
+        }
+    }
+
+    /// The fit started at `values` (the model's parameters, then the offset), refined by
+    /// Levenberg–Marquardt without a trace and without the filter-noise correction.
+    pub(super) fn started_at(&self, values: &[f64]) -> ForceFit {
+        let mut fit = self.clone();
+        let slots = fit.params.iter_mut().chain(fit.offset.as_mut());
+        for (p, &v) in slots.zip(values) {
+            p.value = v;
+        }
+        fit.filter_noise = None;
+        fit.settings.solver = Solver::Auto;
+        fit.settings.trace = None;
+        fit
+    }
+
+    /// [`ForceFit::fit_rows`] on all samples with the fit's own settings, no observer.
+    pub(super) fn fit_plain(&self, data: &ForceData) -> Result<FitResult, FitError> {
+        self.fit_rows(data, None, &self.settings, None)
     }
 
     /// Fit on the samples `rows` only (strictly increasing; `None`: all) with `settings`

@@ -35,6 +35,7 @@
 mod covariance;
 mod driver;
 mod error;
+mod filter_noise;
 mod fit_param;
 mod force_fit;
 mod levenberg_marquardt;
@@ -54,6 +55,7 @@ mod warning;
 
 pub use driver::HELD_REACH;
 pub use error::FitError;
+pub use filter_noise::{FilterNoise, REPLICATES};
 pub use fit_param::{full_values, BoundSide, FitParam};
 pub use force_fit::{ForceFit, FORCE_OFFSET};
 pub use noise_floor::{NoiseFloor, Quantity};
