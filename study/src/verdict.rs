@@ -31,8 +31,10 @@ pub fn best_by_aic(fits: &[(f64, usize)]) -> Option<usize> {
     let mut near: Vec<usize> = (0..fits.len())
         .filter(|&i| fits[i].0.is_finite() && fits[i].0 - lowest < AIC_TIE)
         .collect();
-    // The lowest AIC first among equally simple ones.
-    near.sort_by(|&a, &b| fits[a].0.total_cmp(&fits[b].0));
+    // The lowest AIC first among equally simple ones, as the verdict shows it (to 0.1): fits
+    // that differ below that (one model fitted from two starts) keep the order listed.
+    let shown = |i: usize| (fits[i].0 * 10.0).round();
+    near.sort_by(|&a, &b| shown(a).total_cmp(&shown(b)));
     near.into_iter().min_by_key(|&i| fits[i].1)
 }
 
@@ -409,6 +411,19 @@ pub fn identify_verdict(stages: &[StageOutcome], system: &OscillatorParams) -> S
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One model fitted from two starts ends a rounding apart: the first listed stays best;
+    /// a lower AIC as shown still wins among equally simple fits, and a simpler fit within
+    /// ΔAIC 2 wins over both.
+    #[test]
+    fn fits_that_differ_below_the_shown_aic_keep_their_order() {
+        assert_eq!(best_by_aic(&[(-100.0, 2), (-100.000_001, 2)]), Some(0));
+        assert_eq!(best_by_aic(&[(-100.0, 2), (-100.3, 2)]), Some(1));
+        assert_eq!(
+            best_by_aic(&[(-100.0, 2), (-101.0, 3), (-90.0, 1)]),
+            Some(0)
+        );
+    }
 
     #[test]
     fn the_paired_test_tells_a_lead_from_a_coin_toss_and_says_when_it_cannot_tell() {
