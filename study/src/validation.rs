@@ -83,6 +83,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         level: estimation.level,
         system_estimate: None,
         record_warnings,
+        channels: crate::channels::Channels::none(),
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),
