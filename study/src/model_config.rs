@@ -29,6 +29,9 @@ pub struct ConfiguredModel {
     pub params: Vec<FitParam>,
     /// The parts summed, in order.
     pub parts: Vec<Arc<dyn ForceModel>>,
+    /// The record's channels its parameters' laws follow (none for constant parameters):
+    /// the model reads them from the record it was configured for.
+    pub channels: Vec<String>,
 }
 
 impl ConfiguredModel {
@@ -62,6 +65,7 @@ impl ConfiguredModel {
             model: Arc::new(sum),
             params,
             parts: rest.to_vec(),
+            channels: self.channels.clone(),
         };
         Some((base, (n_base, neutral)))
     }
@@ -145,6 +149,7 @@ pub fn configure_for(
         return Err(crate::experiment::Mistakes::of(file, errors));
     }
     Ok(ConfiguredModel {
+        channels: crate::channels::named_by(entries),
         parts: sum.parts().to_vec(),
         model: Arc::new(sum),
         params,
