@@ -47,10 +47,7 @@ impl<'de> Deserialize<'de> for RawParam {
         impl<'de> serde::de::Visitor<'de> for Visitor {
             type Value = RawParam;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str(
-                    "a number, a table { value, min, max, fixed } or a law of a channel \
-                     { law, channel, base, gain, exp }",
-                )
+                f.write_str("a number or a table { value, min, max, fixed }")
             }
             fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<RawParam, E> {
                 Ok(RawParam::Value(v))
