@@ -46,6 +46,7 @@ pub fn parameter_columns(exp: &Experiment, discovers: bool) -> BTreeMap<String, 
             &exp.dir,
             &exp.scripts,
             None,
+            &stf_study::channels::Channels::stand_ins_for(std::slice::from_ref(entry)),
         ) {
             let of = entry.specs().collect::<Vec<_>>().join(" + ");
             for p in &model.params {

@@ -161,6 +161,7 @@ fn param_names(exp: &Experiment, entry: &ModelEntry, level: FitLevel) -> Result<
         &exp.dir,
         &exp.scripts,
         None,
+        &stf_study::channels::Channels::stand_ins_for(std::slice::from_ref(entry)),
     )?;
     let trajectory = level == FitLevel::Trajectory;
     let mut names: Vec<String> = configured

@@ -43,7 +43,14 @@ pub fn run(exp_path: &Path, out: &Path, force: bool) -> Result<()> {
 
     let mut staged = StagedFiles::new();
     write_with(&staged.stage(out)?, |w| {
-        record.write_csv(w).map_err(std::io::Error::other)
+        let extra: Vec<(&str, &[f64])> = simulated
+            .channels
+            .iter()
+            .map(|(name, v)| (name.as_str(), v.as_slice()))
+            .collect();
+        record
+            .write_csv_with(&extra, w)
+            .map_err(std::io::Error::other)
     })
     .with_context(|| format!("cannot write {}", out.display()))?;
     let meta = SimulateJson {

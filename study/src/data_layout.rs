@@ -54,6 +54,10 @@ pub struct RawData {
     pub drive: Option<RawDrive>,
     /// Refuse or flag implausible records (`crate::plausibility`); default true.
     plausibility: Option<bool>,
+    /// Measured channels kept beside the signals (columns that laws follow, or that
+    /// discovery tries laws of): `["u_ctrl"]`.
+    #[serde(default)]
+    channels: Vec<String>,
 }
 
 /// A checked `[data]` section.
@@ -69,6 +73,8 @@ pub struct DataSection {
     pub layout: ReadOptions,
     /// Whether records are checked for plausibility (`[data] plausibility`, default true).
     pub plausibility: bool,
+    /// Measured channels the record carries (`[data] channels`), besides those laws name.
+    pub channels: Vec<String>,
 }
 
 /// Validate `[data]` (absent: no record, the default layout).
@@ -101,6 +107,7 @@ pub fn parse(cx: &Ctx, data: Option<&Spanned<RawData>>, dir: &Path) -> Result<Da
         window,
         layout,
         plausibility: raw.plausibility.unwrap_or(true),
+        channels: raw.channels.clone(),
     })
 }
 

@@ -21,6 +21,7 @@ use stf_core::discovery::{
 use stf_core::fit::{
     FitSettings, FittedParam, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE,
 };
+use stf_core::physics::channel_law::{ChannelLaw, Law};
 use stf_core::physics::force_model::ForceModel;
 use stf_core::physics::model_sum::ModelSum;
 use stf_core::physics::oscillator_params::OscParam;
@@ -291,7 +292,38 @@ fn models_of(
             widened(model, &scales),
         ));
     }
+    candidates.extend(law_candidates(exp, spec, data, &scales)?);
     Ok((base, candidates))
+}
+
+/// "P follows channel c" for the record's channels (`[data] channels`): for each part of
+/// the base and each channel, the part again with its amplitude (its first parameter, by the
+/// models' convention) a linear law of the channel, P_gain·c, started at 0 — added to the
+/// base's constant P it is the affine law P + P_gain·c (exactly so for a part linear in its
+/// amplitude: `viscous`, `yield`, …). Named `part.P~channel`; scored and accepted as any
+/// effect.
+fn law_candidates(
+    exp: &Experiment,
+    spec: &DiscoverSpec,
+    data: &FitData,
+    scales: &stf_core::data::record_bounds::DataScales,
+) -> Result<Vec<Candidate>> {
+    let mut out = Vec::new();
+    for part in spec.base.iter().filter(|s| *s != "none") {
+        let model = widened(resolve(part, &exp.dir, &exp.scripts)?, scales);
+        let Some(p) = model.params().first().map(|s| s.name.clone()) else {
+            continue;
+        };
+        for c in data.channels.names() {
+            let Some(channel) = data.channels.get(c) else {
+                continue;
+            };
+            let name = format!("{}.{p}~{c}", model.name());
+            let law = ChannelLaw::new(model.clone(), &p, Law::Linear, channel.clone())?;
+            out.push(Candidate::new(name.clone(), Arc::new(law.named(name))));
+        }
+    }
+    Ok(out)
 }
 
 /// The name of every script of `[discover]`'s base and candidates, with its path as given

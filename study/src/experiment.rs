@@ -48,10 +48,10 @@ pub use drive::{Chirp, Drive};
 pub use fit::{FitLevel, FitSpec};
 pub use identify::StageSpec;
 pub use mistakes::Mistakes;
-pub use models::{ModelEntry, ModelSource, ParamGiven, ParamOverride};
+pub use models::{LawGiven, ModelEntry, ModelSource, ParamGiven, ParamOverride};
 pub use output::OutputSpec;
 pub use raw_drive::RawDrive;
-pub use simulate::SimulateSpec;
+pub use simulate::{SimChannel, SimulateSpec};
 pub use validate::ValidateSpec;
 
 /// The whole file as written: one raw type per section.
@@ -104,6 +104,8 @@ pub struct Experiment {
     pub data_layout: ReadOptions,
     /// Whether records are checked for plausibility (`[data] plausibility`).
     pub data_plausibility: bool,
+    /// Measured channels the record carries (`[data] channels`), besides those laws name.
+    pub data_channels: Vec<String>,
     /// `[fit]`.
     pub fit: FitSpec,
     /// `[filter]`.
@@ -279,6 +281,7 @@ impl Experiment {
             data_window: data.window,
             data_layout: data.layout,
             data_plausibility: data.plausibility,
+            data_channels: data.channels,
             fit,
             kinematics,
             identify,

@@ -26,6 +26,7 @@ use stf_core::fit::{
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
 
+use crate::channels::Channels;
 use crate::digits::shown;
 use crate::experiment::{Experiment, FitLevel};
 use crate::model_config::{configure_for, ConfiguredModel};
@@ -51,6 +52,8 @@ pub struct FitData {
     pub units: ShownUnits,
     /// Whether v is the record's measured `v` column rather than the derivative filter's.
     pub v_measured: bool,
+    /// The measured channels it carries: those the models' laws name and `[data] channels`.
+    pub channels: Channels,
 }
 
 impl FitData {
@@ -143,6 +146,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         );
     }
     let mut record = read_record(exp, file)?;
+    let channels = read_channels(exp, file)?;
     let record_warnings = crate::plausibility::check(exp, file, &record)
         .with_context(|| format!("{}:{}: `[data]`", exp.path.display(), exp.data_line))?;
     if let Some((t0, t1)) = exp.data_window {
@@ -225,7 +229,22 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         record_warnings,
         units: ShownUnits::of(&exp.data_layout),
         v_measured,
+        channels,
     })
+}
+
+/// The channels of the record `file` that `exp` needs: those its models' laws (and its
+/// truth's) name, and `[data] channels`.
+pub fn read_channels(exp: &Experiment, file: &std::path::Path) -> Result<Channels> {
+    let mut names = exp.data_channels.clone();
+    let truth = exp.simulate.iter().flat_map(|s| &s.truth);
+    for name in crate::channels::named_by(exp.models.iter().chain(truth)) {
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    crate::channels::read(&exp.data_layout, file, exp.data_window, &names)
+        .map_err(|e| anyhow!("{}:{}: `[data]`: {e}", exp.path.display(), exp.data_line))
 }
 
 /// The terminal line saying where the oscillator came from, if the record gave it.
@@ -655,7 +674,14 @@ pub fn fit_all(exp: &Experiment, data: &FitData, progress: &dyn Observer) -> Res
             .iter()
             .map(|m| {
                 let entry = std::slice::from_ref(m);
-                configure_for(entry, &exp.path, &exp.dir, &exp.scripts, Some(&scales))
+                configure_for(
+                    entry,
+                    &exp.path,
+                    &exp.dir,
+                    &exp.scripts,
+                    Some(&scales),
+                    &data.channels,
+                )
             })
             .partition(Result::is_ok);
         if !errors.is_empty() {

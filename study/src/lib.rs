@@ -18,6 +18,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![deny(clippy::unwrap_used)]
 
+pub mod channel_laws;
+pub mod channels;
 pub mod compare;
 pub mod data_layout;
 pub mod digits;

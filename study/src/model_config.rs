@@ -16,6 +16,7 @@ use stf_core::physics::model_sum::{neutral_amplitude, ModelSum};
 
 use stf_plugins::ScriptRun;
 
+use crate::channels::Channels;
 use crate::experiment::context::place;
 use crate::experiment::{error_at, ModelEntry, ModelSource, ParamGiven};
 
@@ -28,6 +29,9 @@ pub struct ConfiguredModel {
     pub params: Vec<FitParam>,
     /// The parts summed, in order.
     pub parts: Vec<Arc<dyn ForceModel>>,
+    /// The record's channels its parameters' laws follow (none for constant parameters):
+    /// the model reads them from the record it was configured for.
+    pub channels: Vec<String>,
 }
 
 impl ConfiguredModel {
@@ -61,6 +65,7 @@ impl ConfiguredModel {
             model: Arc::new(sum),
             params,
             parts: rest.to_vec(),
+            channels: self.channels.clone(),
         };
         Some((base, (n_base, neutral)))
     }
@@ -101,13 +106,16 @@ pub fn resolve_script(path: &str, dir: &Path, run: &ScriptRun) -> Result<Arc<dyn
 /// for a `[[models]]` item, all of them for `[[simulate.truth]]`), then each entry's `params`
 /// are applied. `file` is the experiment file, `dir` its folder, `run` where scripts load.
 /// For a record of sizes `scales`, each model's bounds are widened where the record needs it
-/// ([`widened`]) before the entries' own values and bounds apply.
+/// ([`widened`]) before the entries' own values and bounds apply. A parameter given a law
+/// (`F_y = { law = "affine", channel = "u_ctrl" }`) becomes its law of the record's
+/// `channels` (core's `ChannelLaw`, wrapping its part: `crate::channel_laws`): its coefficients take its place.
 pub fn configure_for(
     entries: &[ModelEntry],
     file: &Path,
     dir: &Path,
     run: &ScriptRun,
     scales: Option<&DataScales>,
+    channels: &Channels,
 ) -> Result<ConfiguredModel> {
     let mut parts = Vec::new();
     for entry in entries {
@@ -124,20 +132,24 @@ pub fn configure_for(
             });
         }
     }
+    let laws = crate::channel_laws::wrap(&mut parts, entries, file, channels)?;
     let sum = ModelSum::new(parts).map_err(|e| {
         let line = entries.first().map_or(0, |e| e.line);
         anyhow!("{}:{}: {}", file.display(), line, e)
     })?;
     let mut params: Vec<FitParam> = sum.params().iter().map(FitParam::from_spec).collect();
+    crate::channel_laws::start(&mut params, &sum, &laws);
     let errors: Vec<anyhow::Error> = entries
         .iter()
         .flat_map(|entry| entry.params.iter().map(move |given| (entry, given)))
+        .filter(|(_, given)| given.law.is_none())
         .filter_map(|(entry, given)| apply(&mut params, &sum, entry, given, file).err())
         .collect();
     if !errors.is_empty() {
         return Err(crate::experiment::Mistakes::of(file, errors));
     }
     Ok(ConfiguredModel {
+        channels: crate::channels::named_by(entries),
         parts: sum.parts().to_vec(),
         model: Arc::new(sum),
         params,
@@ -215,7 +227,14 @@ mod tests {
 
     fn models_of(text: &str) -> Result<ConfiguredModel> {
         let exp = crate::experiment::parse_exp(text)?;
-        configure_for(&exp.models, &exp.path, &exp.dir, &exp.scripts, None)
+        configure_for(
+            &exp.models,
+            &exp.path,
+            &exp.dir,
+            &exp.scripts,
+            None,
+            &Channels::none(),
+        )
     }
 
     #[test]

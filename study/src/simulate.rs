@@ -1,7 +1,9 @@
 //! The simulate workflow: the oscillator of an experiment's `[system]`, driven as its
 //! `[simulate]` section says (a rotor's angle, a measured force's chirp, or free vibration),
 //! with its `truth` model plugged in, integrated at the sample times and sampled through the
-//! rig's sensors ([`stf_core::simulate::synthetic`]). [`Simulated`] is what the record, its
+//! rig's sensors ([`stf_core::simulate::synthetic`]), with the force sensor's offset and the
+//! control channels (`[simulate] channels`, which the truth's laws may follow) beside it.
+//! [`Simulated`] is what the record, its
 //! JSON sidecar and the terminal lines are written from.
 
 use std::time::Instant;
@@ -15,6 +17,11 @@ use stf_core::physics::oscillator::Oscillator;
 use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
 
+use std::sync::Arc;
+
+use stf_core::physics::channel_law::MeasuredChannel;
+
+use crate::channels::Channels;
 use crate::experiment::{Drive, Experiment};
 use crate::model_config::configure_for;
 use crate::outputs::simulate_json::{Summary, Truth};
@@ -35,6 +42,8 @@ pub struct Simulated {
     pub wall_s: f64,
     /// What the run shows: its peak, the breakaway, where free motion stops.
     pub summary: Summary,
+    /// The control channels at the sample times, written as columns after the record's.
+    pub channels: Vec<(String, Vec<f64>)>,
 }
 
 /// Simulate the `[simulate]` section of `exp`.
@@ -52,8 +61,24 @@ pub fn simulate(exp: &Experiment) -> Result<Simulated> {
     let free = matches!(spec.drive, Drive::Free);
     let mut osc = Oscillator::new(exp.system, excitation);
     let mut truth_json = Vec::new();
+    let channels: Vec<(String, Vec<f64>)> = spec
+        .channels
+        .iter()
+        .map(|c| (c.name.clone(), c.signal.sample(&times, c.seed)))
+        .collect();
     if !spec.truth.is_empty() {
-        let truth = configure_for(&spec.truth, &exp.path, &exp.dir, &exp.scripts, None)?;
+        let measured = channels
+            .iter()
+            .map(|(name, v)| MeasuredChannel::new(name, times.clone(), v.clone()).map(Arc::new))
+            .collect::<Result<Vec<_>, _>>()?;
+        let truth = configure_for(
+            &spec.truth,
+            &exp.path,
+            &exp.dir,
+            &exp.scripts,
+            None,
+            &Channels::of(measured),
+        )?;
         truth_json.push(Truth {
             model: truth.model.name().to_string(),
             params: truth
@@ -79,8 +104,12 @@ pub fn simulate(exp: &Experiment) -> Result<Simulated> {
     } else {
         SensorNoise::NONE
     };
-    let record = sample_record(&run, &noise, spec.seed, rotor);
+    let mut record = sample_record(&run, &noise, spec.seed, rotor);
+    if let Some(f) = record.f_stf.as_mut() {
+        f.iter_mut().for_each(|v| *v += spec.f_stf_offset);
+    }
     Ok(Simulated {
+        channels,
         summary: summary(&run, free),
         run,
         record,

@@ -85,6 +85,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         record_warnings,
         units: crate::shown_units::ShownUnits::of(&exp.data_layout),
         v_measured: false,
+        channels: crate::channels::Channels::none(),
     };
     Ok(Some(ValidationRecord {
         excitation: Arc::new(data.kinematics.excitation()),
@@ -166,7 +167,13 @@ pub use crate::fitting::ModelValidation;
 
 /// Score one fitted model on the validation record with its fitted values.
 fn score_fit(fit: &ModelFit, rec: &ValidationRecord) -> ModelValidation {
+    let follows = fit.configured.as_ref().map_or(&[][..], |c| &c.channels[..]);
     let scored = match &fit.predictor {
+        _ if !follows.is_empty() => Err(stf_core::fit::FitError::BadData(format!(
+            "it follows the record's channel(s) {}, which a model reads from the record it \
+             was fitted on: scoring it on a second record is not supported yet",
+            follows.join(", ")
+        ))),
         Predictor::Force(f) => f.validate(&rec.data.force_data(), &fit.values),
         Predictor::Trajectory(f) => {
             let (x0, v0) = rec.data.kinematics.initial_state();

@@ -168,6 +168,8 @@ pub struct ChannelLaw {
     /// The inner parameter's bounds: the law's value is clamped into them.
     bounds: (f64, f64),
     specs: Vec<ParamSpec>,
+    /// Its own name, where it stands as an effect of its own ([`ChannelLaw::named`]).
+    name: Option<String>,
 }
 
 impl ChannelLaw {
@@ -209,7 +211,15 @@ impl ChannelLaw {
             law,
             channel,
             specs: all,
+            name: None,
         })
+    }
+
+    /// The same model under its own name (and as a single term), where it stands beside the
+    /// model it wraps in a sum: discovery's "P follows the channel" effect.
+    pub fn named(mut self, name: impl Into<String>) -> Self {
+        self.name = Some(name.into());
+        self
     }
 
     /// The law.
@@ -306,13 +316,16 @@ fn coefficient_specs(p: &ParamSpec, law: Law, channel: &MeasuredChannel) -> Vec<
 
 impl ForceModel for ChannelLaw {
     fn name(&self) -> &str {
-        self.inner.name()
+        self.name.as_deref().unwrap_or_else(|| self.inner.name())
     }
     fn summary(&self) -> &str {
         self.inner.summary()
     }
     fn terms(&self) -> Vec<&str> {
-        self.inner.terms()
+        match &self.name {
+            Some(name) => vec![name.as_str()],
+            None => self.inner.terms(),
+        }
     }
     fn params(&self) -> &[ParamSpec] {
         &self.specs

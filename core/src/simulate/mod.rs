@@ -20,6 +20,7 @@ use crate::numerics::integrate::{integrate_states, Method, Settings, SimError, S
 use crate::physics::oscillator::Oscillator;
 
 mod columns;
+pub mod control;
 pub mod synthetic;
 
 use columns::{Columns, DriveColumns, Rows, PARALLEL_SAMPLES};

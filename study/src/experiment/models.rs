@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use anyhow::Result;
 use serde::Deserialize;
 use stf_core::fit::FitParam;
+use stf_core::physics::channel_law::Law;
 use toml::Spanned;
 
 use super::Ctx;
@@ -18,8 +19,24 @@ use super::Ctx;
 enum RawParam {
     /// Just the value.
     Value(f64),
-    /// Value with bounds and a fixed/free switch.
-    Table(ParamOverride),
+    /// Value with bounds and a fixed/free switch, or a law of a channel.
+    Table(RawTable),
+}
+
+/// A parameter's table as written: `{ value, min, max, fixed }`, or a law of a measured
+/// channel `{ law, channel, base, gain, exp }`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTable {
+    value: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+    fixed: Option<bool>,
+    law: Option<String>,
+    channel: Option<String>,
+    base: Option<f64>,
+    gain: Option<f64>,
+    exp: Option<f64>,
 }
 
 /// Read by hand rather than as an untagged enum, whose error ("data did not match any
@@ -43,7 +60,7 @@ impl<'de> Deserialize<'de> for RawParam {
             }
             fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<RawParam, A::Error> {
                 let table = serde::de::value::MapAccessDeserializer::new(map);
-                ParamOverride::deserialize(table).map(RawParam::Table)
+                RawTable::deserialize(table).map(RawParam::Table)
             }
         }
         d.deserialize_any(Visitor)
@@ -106,6 +123,19 @@ impl ModelSource {
     }
 }
 
+/// A parameter that follows a measured channel, as an entry gives it
+/// (`F_y = { law = "affine", channel = "u_ctrl", base = 20.0, gain = 100.0 }`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LawGiven {
+    /// How the parameter follows the channel.
+    pub law: Law,
+    /// The record's column it follows.
+    pub channel: String,
+    /// Starts of the law's coefficients, in [`Law::coefficients`]' order (`base`, `gain`,
+    /// `exp`, those the law has); `None` keeps the law's default start.
+    pub starts: Vec<Option<f64>>,
+}
+
 /// A parameter as an entry gives it: its name, what it sets and where.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamGiven {
@@ -113,6 +143,9 @@ pub struct ParamGiven {
     pub name: String,
     /// What is set; the rest keeps the model's default.
     pub set: ParamOverride,
+    /// The law of a channel it follows, if any (then `set` is empty: its coefficients are
+    /// parameters of their own).
+    pub law: Option<LawGiven>,
     /// Line of the parameter in the file (1-based).
     pub line: usize,
 }
@@ -181,20 +214,31 @@ fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
         .params
         .iter()
         .map(|(name, v)| {
-            let set = match v.get_ref() {
-                RawParam::Value(value) => ParamOverride {
-                    value: Some(*value),
-                    ..ParamOverride::default()
-                },
-                RawParam::Table(t) => t.clone(),
+            let line = cx.line(v.span().start);
+            let (set, law) = match v.get_ref() {
+                RawParam::Value(value) => (
+                    ParamOverride {
+                        value: Some(*value),
+                        ..ParamOverride::default()
+                    },
+                    None,
+                ),
+                RawParam::Table(t) => {
+                    let key = format!("{key}.params.{name}");
+                    (
+                        table_setting(t),
+                        law_of(t, name).map_err(|m| cx.at(v.span(), &key, m))?,
+                    )
+                }
             };
-            ParamGiven {
+            Ok(ParamGiven {
                 name: name.clone(),
                 set,
-                line: cx.line(v.span().start),
-            }
+                law,
+                line,
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     Ok(ModelEntry {
         source,
         plus: r.plus.clone(),
@@ -202,6 +246,107 @@ fn entry(m: &Spanned<RawModel>, key: String, cx: &Ctx) -> Result<ModelEntry> {
         line: cx.line(m.span().start),
         key,
     })
+}
+
+/// The `{ value, min, max, fixed }` part of a parameter's table.
+fn table_setting(t: &RawTable) -> ParamOverride {
+    ParamOverride {
+        value: t.value,
+        min: t.min,
+        max: t.max,
+        fixed: t.fixed,
+    }
+}
+
+/// The law of a channel a parameter's table gives (`law` and `channel` together), checked:
+/// a known law, no `value`/`min`/`max`/`fixed` beside it (its coefficients are parameters of
+/// their own), only the coefficients the law has.
+fn law_of(t: &RawTable, name: &str) -> std::result::Result<Option<LawGiven>, String> {
+    let coefficients = [("base", t.base), ("gain", t.gain), ("exp", t.exp)];
+    let (law, channel) = match (&t.law, &t.channel) {
+        (None, None) => {
+            return match coefficients.iter().find(|(_, v)| v.is_some()) {
+                Some((k, _)) => Err(format!(
+                    "`{k}` is a start of a law's coefficient: give the law too, e.g. \
+                     `{name} = {{ law = \"affine\", channel = \"u_ctrl\", {k} = … }}`"
+                )),
+                None => Ok(None),
+            }
+        }
+        (Some(_), None) => {
+            return Err(format!(
+                "a law needs the `channel` it follows (a column of the record): \
+                 `{name} = {{ law = \"affine\", channel = \"u_ctrl\" }}`"
+            ))
+        }
+        (None, Some(c)) => {
+            return Err(format!(
+                "following channel `{c}` needs a `law`: one of {}",
+                law_names()
+            ))
+        }
+        (Some(l), Some(c)) => (l, c),
+    };
+    let law = Law::named(law).ok_or_else(|| {
+        format!(
+            "unknown law `{law}`{}; the laws: {}",
+            stf_core::names::did_you_mean(law, LAWS.iter().map(|l| l.name())),
+            law_names()
+        )
+    })?;
+    if let Some(k) = [
+        ("value", t.value.is_some()),
+        ("min", t.min.is_some()),
+        ("max", t.max.is_some()),
+        ("fixed", t.fixed.is_some()),
+    ]
+    .iter()
+    .find_map(|(k, given)| given.then_some(k))
+    {
+        return Err(format!(
+            "`{k}` does not go with a law: its coefficients are parameters of their own \
+             (`{name}_base`, `{name}_gain`, …); set them there, e.g. `{name}_gain = {{ min = 0.0 }}`"
+        ));
+    }
+    let has = law.coefficients();
+    if let Some((k, _)) = coefficients
+        .iter()
+        .find(|(k, v)| v.is_some() && !has.contains(k))
+    {
+        return Err(format!(
+            "the {} law has no `{k}`: its coefficients are {}",
+            law.name(),
+            has.join(", ")
+        ));
+    }
+    if channel.trim().is_empty() {
+        return Err("`channel` is empty: give the record's column it follows".into());
+    }
+    let starts = has
+        .iter()
+        .map(|k| {
+            coefficients
+                .iter()
+                .find(|(c, _)| c == k)
+                .and_then(|(_, v)| *v)
+        })
+        .collect();
+    Ok(Some(LawGiven {
+        law,
+        channel: channel.clone(),
+        starts,
+    }))
+}
+
+/// Every law, in the order the docs list them.
+const LAWS: [Law; 3] = [Law::Linear, Law::Affine, Law::Power];
+
+/// The laws' names, quoted, for messages.
+fn law_names() -> String {
+    LAWS.iter()
+        .map(|l| format!("`{}`", l.name()))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
@@ -246,6 +391,7 @@ mod tests {
                 max: None,
                 fixed: Some(true),
             },
+            law: None,
             line: 4,
         };
         assert_eq!(m.params[1], n);

@@ -1,12 +1,16 @@
 //! The `[simulate]` section of an experiment file: exactly one drive (`crate::experiment`'s
 //! [`Drive`], see `drive.rs`), the sample `rate` and the most samples a run may make
 //! (`max_samples`, checked before anything is allocated), sensor `noise` and its `seed`, the
-//! initial state and the hidden models (`[[simulate.truth]]`).
+//! initial state, the hidden models (`[[simulate.truth]]`), control `channels` written as
+//! columns (a random switch between levels) and a sensor offset of the STF force.
 
 use std::ops::Range;
 
 use anyhow::Result;
 use serde::Deserialize;
+use std::collections::BTreeMap;
+
+use stf_core::simulate::control::RandomLevels;
 use stf_core::simulate::{count_text, sample_count, DEFAULT_MAX_SAMPLES};
 use toml::Spanned;
 
@@ -38,6 +42,32 @@ pub(super) struct RawSimulate {
     truth: Vec<Spanned<RawModel>>,
     /// The most samples the run may make (default `DEFAULT_MAX_SAMPLES`).
     max_samples: Option<Spanned<f64>>,
+    /// Control channels written beside the signals, by name.
+    #[serde(default)]
+    channels: BTreeMap<String, Spanned<RawLevels>>,
+    /// Sensor offsets added to the recorded signals (`f_stf`, N).
+    #[serde(default)]
+    offsets: BTreeMap<String, Spanned<f64>>,
+}
+
+/// A control channel as written: `{ levels = [0.0, 1.0], hold = 2.0, seed = 3 }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawLevels {
+    levels: Vec<f64>,
+    hold: f64,
+    seed: Option<u64>,
+}
+
+/// A control channel of the simulated record: its column's name, its signal and its seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimChannel {
+    /// The column's name.
+    pub name: String,
+    /// The levels it switches between and their mean hold time.
+    pub signal: RandomLevels,
+    /// Its random seed (the channel's own, else the run's plus the channel's place).
+    pub seed: u64,
 }
 
 fn default_rate() -> f64 {
@@ -73,6 +103,10 @@ pub struct SimulateSpec {
     pub v0: f64,
     /// The hidden models.
     pub truth: Vec<ModelEntry>,
+    /// Control channels written as columns (`channels.u_ctrl = { levels, hold }`).
+    pub channels: Vec<SimChannel>,
+    /// Offset added to the recorded STF force, N (`offsets = { f_stf = … }`).
+    pub f_stf_offset: f64,
     /// The section as written, for the sidecar.
     pub as_json: serde_json::Value,
 }
@@ -99,6 +133,16 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
     as_json["seed"] = s.seed.into();
     as_json["x0"] = s.x0.into();
     as_json["v0"] = s.v0.into();
+    let channels = channels(s, cx)?;
+    let f_stf_offset = f_stf_offset(s, cx)?;
+    for c in &channels {
+        as_json["channels"][&c.name] = serde_json::json!({
+            "levels": c.signal.levels, "hold": c.signal.hold, "seed": c.seed
+        });
+    }
+    if f_stf_offset != 0.0 {
+        as_json["offsets"]["f_stf"] = f_stf_offset.into();
+    }
     Ok(Some(SimulateSpec {
         drive: checked.drive,
         t0,
@@ -110,8 +154,73 @@ pub(super) fn check(raw: Option<&Spanned<RawSimulate>>, cx: &Ctx) -> Result<Opti
         x0: s.x0,
         v0: s.v0,
         truth: models::check(&s.truth, "simulate.truth", cx)?,
+        channels,
+        f_stf_offset,
         as_json,
     }))
+}
+
+/// The record's own column names, which a channel may not take.
+const SIGNALS: [&str; 7] = ["t", "x", "phi", "f_stf", "omega", "u", "v"];
+
+/// `[simulate] channels`, checked: a new column name, two or more finite levels, a positive
+/// hold time.
+fn channels(s: &RawSimulate, cx: &Ctx) -> Result<Vec<SimChannel>> {
+    s.channels
+        .iter()
+        .enumerate()
+        .map(|(i, (name, raw))| {
+            let key = format!("simulate.channels.{name}");
+            let r = raw.get_ref();
+            let bad = |msg: String| Err(cx.at(raw.span(), &key, msg));
+            if SIGNALS.contains(&name.as_str()) {
+                return bad(format!(
+                    "`{name}` is one of the record's signals ({}): give the channel another name",
+                    SIGNALS.join(", ")
+                ));
+            }
+            if r.levels.len() < 2 || r.levels.iter().any(|v| !v.is_finite()) {
+                return bad("`levels` needs two or more numbers to switch between".into());
+            }
+            if !(r.hold.is_finite() && r.hold > 0.0) {
+                return bad(format!(
+                    "`hold` = {} must be a positive time, s (the mean time a level is held)",
+                    shown(r.hold)
+                ));
+            }
+            Ok(SimChannel {
+                name: name.clone(),
+                signal: RandomLevels {
+                    levels: r.levels.clone(),
+                    hold: r.hold,
+                },
+                seed: r.seed.unwrap_or(s.seed.wrapping_add(1 + i as u64)),
+            })
+        })
+        .collect()
+}
+
+/// `[simulate] offsets`: only `f_stf` (N), finite.
+fn f_stf_offset(s: &RawSimulate, cx: &Ctx) -> Result<f64> {
+    let mut out = 0.0;
+    for (name, v) in &s.offsets {
+        let key = format!("simulate.offsets.{name}");
+        if name != "f_stf" {
+            return Err(cx.at(
+                v.span(),
+                &key,
+                "only the STF force takes a simulated sensor offset: `offsets = { f_stf = … }` (N)",
+            ));
+        }
+        cx.ensure(
+            v.get_ref().is_finite(),
+            v.span(),
+            &key,
+            "must be a number, N",
+        )?;
+        out = *v.get_ref();
+    }
+    Ok(out)
 }
 
 /// The one drive the section gives, checked.

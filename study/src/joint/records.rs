@@ -45,6 +45,7 @@ pub fn configure(
         &gexp.dir,
         &gexp.scripts,
         Some(scales),
+        &crate::channels::Channels::none(),
     )
 }
 

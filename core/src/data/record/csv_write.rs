@@ -67,9 +67,15 @@ fn columns(record: &Record) -> Vec<(&'static str, &[f64])> {
     columns
 }
 
-/// Write a (validated) record to `out`, a chunk at a time.
-pub(super) fn write(record: &Record, out: &mut impl Write) -> Result<(), RecordError> {
-    write_rows(out, &columns(record)).map_err(|e| {
+/// Write a (validated) record, then the `extra` columns, to `out`, a chunk at a time.
+pub(super) fn write(
+    record: &Record,
+    extra: &[(&str, &[f64])],
+    out: &mut impl Write,
+) -> Result<(), RecordError> {
+    let mut all = columns(record);
+    all.extend_from_slice(extra);
+    write_rows(out, &all).map_err(|e| {
         RecordError::new(
             &record.source,
             format!("cannot write the record as CSV: {e}"),

@@ -285,7 +285,28 @@ impl Record {
     /// ```
     pub fn write_csv(&self, mut out: impl std::io::Write) -> Result<(), RecordError> {
         self.check()?;
-        csv_write::write(self, &mut out)
+        csv_write::write(self, &[], &mut out)
+    }
+
+    /// [`Record::write_csv`] with further columns after the record's own: measured channels
+    /// (a control voltage), each named and as long as `t`.
+    pub fn write_csv_with(
+        &self,
+        extra: &[(&str, &[f64])],
+        mut out: impl std::io::Write,
+    ) -> Result<(), RecordError> {
+        self.check()?;
+        if let Some((name, v)) = extra.iter().find(|(_, v)| v.len() != self.t.len()) {
+            return Err(RecordError::new(
+                &self.source,
+                format!(
+                    "column `{name}` has {} values for {} times",
+                    v.len(),
+                    self.t.len()
+                ),
+            ));
+        }
+        csv_write::write(self, extra, &mut out)
     }
 
     /// Number of samples.
