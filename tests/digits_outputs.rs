@@ -1,8 +1,9 @@
 //! The digits of every bundled example's outputs, as the README promises them: every bundled
 //! experiment (`experiments/*.toml`, run by the command it is written for, and the bundled
 //! campaign) is run and every file it writes is scanned. In tables and JSON (`*.csv`,
-//! `*.json`, the figures' data) a number carries at most 15 significant digits and is never
-//! `-0`, `-0.0` or written with an exponent `e0`; what a person reads (`report.md`,
+//! `*.json`) a number carries at most 15 significant digits and is never `-0`, `-0.0` or
+//! written with an exponent `e0` (a figure's data hold the samples drawn exactly: only the
+//! last two rules); what a person reads (`report.md`,
 //! `compare.md`, the terminal, the printed experiment entries) has no negative zero, no `NaN`,
 //! no exponent where a plain number reads (`1.0004e4 ± 8.1e0` is `10 004 ± 8`) and no number of
 //! more than 15 digits (`K = 6.9063702810500684`). A printed entry pasted into an experiment
@@ -155,6 +156,12 @@ fn scan(out: &Path, terminal: &str) -> usize {
         read += 1;
         problems.extend(match ext {
             "md" | "log" => shown_problems(&name, &text),
+            // A figure's data are the samples drawn, exactly: only their signs and exponents.
+            "csv" if name.starts_with("figures") || name.contains("/figures/") => {
+                let mut found = table_problems(&name, &text);
+                found.retain(|p| !p.ends_with("more than 15 significant digits"));
+                found
+            }
             _ => table_problems(&name, &text),
         });
     }
@@ -287,6 +294,17 @@ fn the_identification_example_s_outputs_carry_the_promised_digits() {
 #[test]
 fn the_compare_example_s_outputs_carry_the_promised_digits() {
     let (_dir, out) = run_and_scan("compare", "jamming_compare.toml");
+    // Each built-in model writes its own law (with its bounds widened to the record or not),
+    // never a named term.
+    let doc = common::read_json(&out.join("compare.json"));
+    for m in doc["models"].as_array().unwrap() {
+        let (name, eq) = (m["name"].as_str().unwrap(), &m["fit"]["equation"]);
+        let eq = eq.as_str().unwrap_or_default();
+        assert!(
+            eq.starts_with("F_STF = ") && !eq.contains(&format!("F_{name}(")),
+            "{name}: {eq}"
+        );
+    }
     for table in ["compare.csv", "cycles.csv"] {
         let text = std::fs::read_to_string(out.join(table)).unwrap();
         assert!(text.split(',').count() > 20, "{table}");
@@ -299,25 +317,14 @@ fn the_trajectory_discovery_example_s_outputs_carry_the_promised_digits() {
 }
 
 #[test]
-fn the_simulation_example_s_outputs_carry_no_negative_zero() {
+fn the_simulation_example_s_summary_carries_the_promised_digits() {
     let dir = tempfile::tempdir().unwrap();
     let record = dir.path().join("sweep.csv");
     let output = common::simulate(&root().join("experiments/paper_sweep.toml"), &record, &[]);
     let output = succeeded(output);
+    // The record itself keeps every double exactly, its sign of zero too (read back, it is
+    // the simulation bit for bit); its JSON and what is printed follow the rules.
     let mut problems = shown_problems("terminal", &String::from_utf8_lossy(&output.stdout));
-    // The record keeps every double exactly (a fit of it reproduces the simulation bit for
-    // bit), so only its signs are checked; its JSON carries 15 digits.
-    for (i, line) in std::fs::read_to_string(&record)
-        .unwrap()
-        .lines()
-        .enumerate()
-    {
-        for cell in line.split(',') {
-            if cell.parse::<f64>() == Ok(0.0) && cell.starts_with('-') {
-                problems.push(format!("sweep.csv:{}: `{cell}`", i + 1));
-            }
-        }
-    }
     let json = std::fs::read_to_string(record.with_extension("json")).unwrap();
     problems.extend(table_problems("sweep.json", &json));
     assert!(problems.is_empty(), "{problems:#?}");

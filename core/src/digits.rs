@@ -53,6 +53,16 @@ pub fn significant(x: f64, n: usize) -> String {
     }
 }
 
+/// A number in Rust's shortest form that reads back exactly, a negative zero as `0`: a
+/// figure's data, which must be the samples drawn (not rounded to [`cell`]'s 15 digits).
+pub fn exact(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        x.to_string()
+    }
+}
+
 /// `x` with `decimals` decimals for a person to read, never as a negative zero ("-0.0" for
 /// -0.04 at one decimal reads as a sign the value does not have).
 pub fn fixed(x: f64, decimals: usize) -> String {
@@ -104,6 +114,12 @@ pub fn grouped(s: &str) -> String {
 /// form. A nonzero value that would round to zero there keeps one significant digit (`0.1`
 /// beside an error of 30 is not `0`).
 fn to_digit(x: f64, last: i32) -> String {
+    to_digit_as(x, last, plain(x))
+}
+
+/// [`to_digit`], plain or in exponent form as `plainly` says (an error beside a value in
+/// exponent form is in exponent form too: `2.50e7 ± 4e5`).
+fn to_digit_as(x: f64, last: i32, plainly: bool) -> String {
     if !x.is_finite() {
         return x.to_string();
     }
@@ -113,7 +129,7 @@ fn to_digit(x: f64, last: i32) -> String {
         x.abs().log10().floor() as i32
     };
     let last = if x != 0.0 && lead < last { lead } else { last };
-    if plain(x) {
+    if plainly || x == 0.0 {
         grouped(&fixed(x, (-last).clamp(0, 12) as usize))
     } else {
         let digits = (lead - last).clamp(0, 12) as usize;
@@ -160,7 +176,13 @@ pub fn with_error(value: f64, error: f64) -> String {
         return format!("{} ± {error}", rounded(value, error));
     }
     let last = last_digit(error);
-    format!("{} ± {}", to_digit(value, last), to_digit(error, last))
+    // Beside a value of a million or more (in exponent form) the error is in exponent form.
+    let plainly = plain(error) && value.abs() < 1e6;
+    format!(
+        "{} ± {}",
+        to_digit(value, last),
+        to_digit_as(error, last, plainly)
+    )
 }
 
 #[cfg(test)]

@@ -34,7 +34,8 @@ impl Column {
     }
 }
 
-/// The CSV text of `columns` (numbers to 15 significant digits, no negative zero: [`stf_core::digits::cell`]; quoting by `csv`).
+/// The CSV text of `columns` (numbers in Rust's shortest exact form, the samples drawn exactly,
+/// a negative zero as `0`: [`stf_core::digits::exact`]; quoting by `csv`).
 pub fn to_csv(columns: &[Column]) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let rows = columns.iter().map(|c| c.values.len()).max().unwrap_or(0);
@@ -45,7 +46,7 @@ pub fn to_csv(columns: &[Column]) -> String {
                 w.write_record(columns.iter().map(|c| {
                     c.values
                         .get(r)
-                        .map(|&v| stf_core::digits::cell(v))
+                        .map(|&v| stf_core::digits::exact(v))
                         .unwrap_or_default()
                 }))
             })

@@ -70,7 +70,7 @@ mod tests {
     fn a_negative_term_is_subtracted_and_a_model_with_state_is_named() {
         let params = [param("c_s", 1.0005, 3.0e-4), param("k_s", -12.3, 0.4)];
         let eq = force_equation(&*model(&["viscous", "linear_spring"]), &params);
-        assert_eq!(eq.as_deref(), Some("F_STF = 1.0005·v − 12.3·x"));
+        assert_eq!(eq.as_deref(), Some("F_STF = 1.00050·v − 12.3·x"));
         let maxwell = model(&["maxwell"]);
         let params: Vec<FittedParam> = maxwell
             .params()

@@ -19,8 +19,6 @@ const CHUNK: usize = 1 << 20;
 /// notation for ordinary magnitudes, exponent notation for very small or large ones (Rust's
 /// `{}` and `{:e}` forms).
 pub(super) fn push_f64(out: &mut Vec<u8>, v: f64, digits: &mut ryu::Buffer) {
-    // A negative zero reads as a sign the value does not have: written `0`.
-    let v = if v == 0.0 { 0.0 } else { v };
     let a = v.abs();
     let plain = a == 0.0 || (1e-4..1e15).contains(&a);
     if !v.is_finite() || (!plain && (1e-5..1e16).contains(&a)) {
