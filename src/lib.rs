@@ -13,8 +13,8 @@
 #![deny(clippy::unwrap_used)]
 
 pub use stf_study::{
-    compare, data_layout, digits, discovery_curves, experiment, fitting, identify, model_config,
-    observer, outputs, param_table, plausibility, validation, verdict,
+    compare, data_layout, digits, discovery_curves, equation, experiment, fitting, identify,
+    model_config, observer, outputs, param_table, plausibility, validation, verdict,
 };
 
 pub mod campaign;

@@ -78,8 +78,20 @@ fn shown(text: &str) -> Vec<(String, f64, f64)> {
         while j < bytes.len() && (bytes[j].is_ascii_digit() || bytes[j] == '.') {
             j += 1;
         }
+        // Digit groups of a long integer part, `19 987`: a space, three digits, then no digit.
+        while !bytes[from..j].contains(&'.')
+            && j + 3 < bytes.len()
+            && bytes[j] == ' '
+            && bytes[j + 1..j + 4].iter().all(char::is_ascii_digit)
+            && bytes.get(j + 4).is_none_or(|c| !c.is_ascii_digit())
+        {
+            j += 4;
+            while j < bytes.len() && (bytes[j].is_ascii_digit() || bytes[j] == '.') {
+                j += 1;
+            }
+        }
         let mut exp = 0i32;
-        let mantissa: String = bytes[from..j].iter().collect();
+        let mantissa: String = bytes[from..j].iter().filter(|c| **c != ' ').collect();
         if j + 1 < bytes.len() && bytes[j] == 'e' {
             let mut k = j + 1;
             if bytes[k] == '-' || bytes[k] == '+' {
@@ -96,7 +108,7 @@ fn shown(text: &str) -> Vec<(String, f64, f64)> {
         if let Ok(m) = mantissa.parse::<f64>() {
             let decimals = mantissa.split('.').nth(1).map_or(0, str::len) as i32;
             let half = 0.5 * 10f64.powi(exp - decimals);
-            let token: String = bytes[from..j].iter().collect();
+            let token: String = bytes[from..j].iter().filter(|c| **c != ' ').collect();
             found.push((token, m * 10f64.powi(exp), half));
         }
         i = j.max(i + 1);
@@ -152,7 +164,16 @@ fn check(command: &str, experiment: &str, json_name: &str) {
     numbers(&json, &mut all);
     relative_errors(&json, &mut all);
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let (verdict, table) = verdict_and_summary(&report);
+    let (verdict, mut table) = verdict_and_summary(&report);
+    // The force as an equation, under "Results" (fit.json's and discovery.json's `equation`).
+    let equations: Vec<&str> = report.lines().filter(|l| l.contains("F_STF = ")).collect();
+    if command != "fit" || experiment != "paper_identification.toml" {
+        assert!(!equations.is_empty(), "{experiment}: no equation");
+    }
+    for line in equations {
+        table.push('\n');
+        table.push_str(line);
+    }
     assert!(!verdict.is_empty(), "{experiment}: no verdict");
     assert!(!table.is_empty(), "{experiment}: no summary table");
     let mut missing = Vec::new();
@@ -195,6 +216,51 @@ fn trajectory_discovery_numbers_trace_to_discovery_json() {
     check("discover", "trajectory_discovery.toml", "discovery.json");
 }
 
+/// The compare report's other rankings: the table of errors per regime with their mean over
+/// the regimes (the one overall score, compare.json's `ranking.overall`) and the line of each
+/// loop metric (each z shown is the one compare.json holds; a test with too few cycles is
+/// "not tested", never a z of NaN).
+#[test]
+fn compare_s_rankings_trace_to_compare_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let exp = common::root().join("experiments/jamming_compare.toml");
+    common::run_ok("compare", &exp, &out);
+    let json = common::read_json(&out.join("compare.json"));
+    let mut all = Vec::new();
+    numbers(&json, &mut all);
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(!report.contains("NaN"), "NaN in the report");
+    let header = "| model | pre-resonance | resonance | post-resonance | mean over regimes |";
+    let rows: Vec<&str> = report
+        .lines()
+        .skip_while(|l| *l != header)
+        .skip(2)
+        .take_while(|l| l.starts_with('|'))
+        .collect();
+    assert_eq!(rows.len(), 4, "the errors table:\n{report}");
+    let lines: Vec<&str> = report.lines().filter(|l| l.starts_with("by ")).collect();
+    assert!(lines.len() >= 5, "the ranking lines");
+    let mut missing = Vec::new();
+    let mut count = 0;
+    for line in rows.iter().chain(&lines) {
+        for (token, x, half) in shown(line) {
+            count += 1;
+            if !traced(x, half, &all) {
+                missing.push(format!("{token} in `{line}`"));
+            }
+        }
+    }
+    assert!(count >= 30, "only {count} numbers read");
+    assert!(
+        missing.is_empty(),
+        "shown but not in compare.json: {missing:#?}"
+    );
+    // One overall score: the verdict's best over the regimes is the table's lowest mean.
+    let best = json["ranking"]["overall"][0]["score"].as_f64().unwrap();
+    assert!(report.contains(&format!("{best:.3}")), "{best}");
+}
+
 #[test]
 fn the_number_reader_sees_signs_exponents_and_skips_labels() {
     let got: Vec<f64> =
@@ -203,6 +269,11 @@ fn the_number_reader_sees_signs_exponents_and_skips_labels() {
             .map(|t| t.1)
             .collect();
     assert_eq!(got, [7151.3, 2.0012e4, 23.0, 0.0025]);
+    let grouped: Vec<f64> = shown("k3 = 19 987 ± 11 over 475 cycles, 10 004.5 ± 0.5")
+        .into_iter()
+        .map(|t| t.1)
+        .collect();
+    assert_eq!(grouped, [19987.0, 11.0, 475.0, 10004.5, 0.5]);
     assert!(traced(0.0200, 0.00005, &[0.0199862]));
     assert!(!traced(0.0200, 0.00005, &[0.0201]));
     assert!(traced(41.69, 0.005, &[0.041689]));

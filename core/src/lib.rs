@@ -35,6 +35,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod data;
+pub mod digits;
 pub mod discovery;
 pub mod fit;
 mod model_error;

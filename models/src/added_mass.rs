@@ -27,6 +27,11 @@ builtin! {
             .same_as("m"),
     ];
     impl {
+        /// The law with its values, `m_a·ẍ`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [m_a] = values else { return None };
+            Some(format!("{m_a}·ẍ"))
+        }
         #[inline]
         fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
             let [m_a] = take(self.name(), p)?;

@@ -24,6 +24,11 @@ builtin! {
         ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "cubic stiffness of the jammed network"),
     ];
     impl {
+        /// The law with its values, `k3·x³`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [k3] = values else { return None };
+            Some(format!("{k3}·x³"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [k3] = take(self.name(), p)?;

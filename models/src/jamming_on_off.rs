@@ -70,6 +70,11 @@ builtin! {
         ParamSpec::new("w", "m/s", 0.002, 1e-4, 0.1, "width of the smooth jamming gate"),
     ];
     impl {
+        /// The law with its values, `k_j·|v|^n_j·sgn v·½(1 + tanh((|v| − v_c)/w))`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [k_j, n_j, v_c, w] = values else { return None };
+            Some(format!("{k_j}·|v|^{n_j}·sgn v·½(1 + tanh((|v| − {v_c})/{w}))"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [k_j, n_j, v_c, w] = take(self.name(), p)?;

@@ -26,6 +26,11 @@ builtin! {
             .same_as("k"),
     ];
     impl {
+        /// The law with its values, `k_s·x`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [k_s] = values else { return None };
+            Some(format!("{k_s}·x"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [k_s] = take(self.name(), p)?;

@@ -27,6 +27,11 @@ builtin! {
         ParamSpec::new("n", "", 1.6, 1.0, 4.0, "flow index; n > 1 is shear thickening"),
     ];
     impl {
+        /// The law with its values, `k·|v|^n·sgn v`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [k, n] = values else { return None };
+            Some(format!("{k}·|v|^{n}·sgn v"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [k, n] = take(self.name(), p)?;

@@ -23,6 +23,11 @@ builtin! {
             .same_as("c"),
     ];
     impl {
+        /// The law with its values, `c_s·v`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [c_s] = values else { return None };
+            Some(format!("{c_s}·v"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [c_s] = take(self.name(), p)?;

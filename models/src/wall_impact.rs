@@ -39,6 +39,11 @@ builtin! {
         ParamSpec::new("c_r", "s/m", 0.5, 0.0, 10.0, "Hunt–Crossley damping factor"),
     ];
     impl {
+        /// The law with its values, `k_w·max(|x| − gap, 0)^p·(1 + 1.5·c_r·v·sgn x)·sgn x`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [k_w, gap, p, c_r] = values else { return None };
+            Some(format!("{k_w}·max(|x| − {gap}, 0)^{p}·(1 + 1.5·{c_r}·v·sgn x)·sgn x"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [k_w, gap, expo, c_r] = take(self.name(), p)?;

@@ -31,6 +31,11 @@ builtin! {
         ParamSpec::new("v_s", "m/s", 1e-3, 1e-6, 0.1, "speed over which sign v is smoothed"),
     ];
     impl {
+        /// The law with its values, `f_y·v/√(v² + (v_s)²)`.
+        fn equation(&self, values: &[String]) -> Option<String> {
+            let [f_y, v_s] = values else { return None };
+            Some(format!("{f_y}·v/√(v² + ({v_s})²)"))
+        }
         #[inline]
         fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
             let [f_y, v_s] = take(self.name(), p)?;

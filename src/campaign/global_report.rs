@@ -78,7 +78,7 @@ fn comparison(g: &GlobalJson) -> Table {
     let row = |name: &str, c: &Criteria, held: Option<f64>| {
         vec![
             name.to_string(),
-            format!("{:.4e}", c.rss),
+            crate::digits::brief(c.rss),
             c.n_params.to_string(),
             format!("{:.1}", c.aic),
             format!("{:.1}", c.bic),

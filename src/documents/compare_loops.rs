@@ -17,6 +17,7 @@ use stf_core::regimes::{Classification, Comparison, CycleFeatures, MetricRanking
 
 use crate::digits::{csv_number, csv_optional, fixed};
 use crate::report::Table;
+use crate::verdict::{not_tested, tested};
 use crate::writing::write_atomic;
 
 /// The on-fraction in words, for reports.
@@ -97,20 +98,17 @@ pub fn ranking_lines(rankings: &[MetricRanking]) -> Vec<String> {
             for r in Regime::ALL {
                 if let Some(rank) = m.per_regime.get(r) {
                     let best = rank.scores.first().map_or("—", |s| s.model.as_str());
-                    let test = rank.test.as_ref().map_or(String::new(), |t| {
-                        if t.cycles < 3 || !t.z.is_finite() {
-                            format!(
-                                ", too few cycles ({}) for a paired test against {}",
-                                t.cycles, t.runner_up
-                            )
-                        } else {
-                            format!(
-                                ", paired z {:.1} against {} over {} cycles",
-                                t.z, t.runner_up, t.cycles
-                            )
+                    let regime = r.name().replace('_', "-");
+                    match &rank.test {
+                        Some(t) if !tested(t) => {
+                            line.push_str(&format!("; {regime} {}", not_tested(t.cycles)));
                         }
-                    });
-                    line.push_str(&format!("; {} {best}{test}", r.name().replace('_', "-")));
+                        Some(t) => line.push_str(&format!(
+                            "; {regime} {best}, paired z {:.1} against {} over {} cycles",
+                            t.z, t.runner_up, t.cycles
+                        )),
+                        None => line.push_str(&format!("; {regime} {best}")),
+                    }
                 }
             }
             line

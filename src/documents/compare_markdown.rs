@@ -149,12 +149,13 @@ fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
 fn errors_table(md: &mut String, c: &Compared) {
     let _ = writeln!(
         md,
-        "\nRelative force RMS error (duty error) per regime; lower is better. {}\n",
+        "\nRelative force RMS error (duty error) per regime and its mean over the regimes, the \
+         score the models are ranked by; lower is better. {}\n",
         duty_meaning(c.measured.on_threshold, RigWords::ROTOR)
     );
     let _ = writeln!(
         md,
-        "| model | pre-resonance | resonance | post-resonance | all cycles | peak x (mm) at ω |"
+        "| model | pre-resonance | resonance | post-resonance | mean over regimes | peak x (mm) at ω |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     for ((f, cmp), p) in c.fits.iter().zip(&c.comparisons).zip(c.peaks()) {
@@ -167,8 +168,12 @@ fn errors_table(md: &mut String, c: &Compared) {
                 None => row.push_str("| — "),
             }
         }
-        let o = &cmp.overall;
-        let _ = write!(row, "| {:.3} ({:.2}) ", o.relative_rms_error, o.duty_error);
+        match c.mean_error(&f.label) {
+            Some(score) => {
+                let _ = write!(row, "| {score:.3} ");
+            }
+            None => row.push_str("| — "),
+        }
         match p {
             Some((x, w)) => {
                 let _ = write!(row, "| {:.2} at {:.2} |", x * 1e3, w);

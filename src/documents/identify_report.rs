@@ -34,13 +34,14 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
         }
     );
     let rows = s.result.params.iter().map(|p| {
-        vec![
-            p.name.clone(),
-            format!("{:.6}", p.value),
-            format!("{:.2e}", p.std_error),
-        ]
+        let value = if p.fixed {
+            format!("{} (held)", stf_study::digits::rounded(p.value, f64::NAN))
+        } else {
+            stf_study::digits::with_error(p.value, p.std_error)
+        };
+        vec![p.name.clone(), value]
     });
-    let columns = ["parameter", "value", "standard error"];
+    let columns = ["parameter", "value ± standard error"];
     section
         .tables
         .push(Table::new(caption, &columns).with_rows(rows.collect()));

@@ -4,7 +4,7 @@
 //! parameter pairs that correlate above 0.5 instead of a warning line per pair.
 
 use stf_core::fit::FitResult;
-use stf_study::digits::{fixed, with_error};
+use stf_study::digits::{fixed, rounded, with_error};
 use stf_study::param_table::ParamRow;
 
 use crate::report::{Section, Table};
@@ -12,10 +12,17 @@ use crate::report::{Section, Table};
 /// Correlations at or above this size (in absolute value) are listed.
 pub const SHOWN_CORRELATION: f64 = 0.5;
 
-/// The section "Results": `rows` (every model's, in order) and the correlations of each of
-/// `fits` (a label and its result).
-pub fn results_section(title: &str, rows: &[ParamRow], fits: &[(&str, &FitResult)]) -> Section {
+/// The section "Results": each model's force as an equation (`equations`: a label and the
+/// equation, as the JSON holds it), `rows` (every model's, in order) and the correlations of
+/// each of `fits` (a label and its result).
+pub fn results_section(
+    title: &str,
+    equations: &[(&str, String)],
+    rows: &[ParamRow],
+    fits: &[(&str, &FitResult)],
+) -> Section {
     let mut s = Section::new(title);
+    s.paragraphs.extend(equation_lines(equations));
     s.tables.push(values_table(rows));
     let pairs = correlated_pairs(fits);
     if !pairs.is_empty() {
@@ -27,6 +34,26 @@ pub fn results_section(title: &str, rows: &[ParamRow], fits: &[(&str, &FitResult
         s.tables.push(table.with_rows(pairs));
     }
     s
+}
+
+/// The equations as paragraphs: one for a single model (`The force: F_STF = …`), one per
+/// model otherwise (`` `power_law`: F_STF = … ``); values rounded to their standard errors.
+fn equation_lines(equations: &[(&str, String)]) -> Vec<String> {
+    match equations {
+        [] => Vec::new(),
+        [(_, eq)] => vec![format!(
+            "The force, values rounded to their standard errors: {eq}"
+        )],
+        _ => std::iter::once(
+            "Each model's force, values rounded to their standard errors:".to_string(),
+        )
+        .chain(
+            equations
+                .iter()
+                .map(|(label, eq)| format!("`{label}`: {eq}")),
+        )
+        .collect(),
+    }
 }
 
 /// Model, parameter, value ± standard error, relative error, unit, note.
@@ -43,10 +70,10 @@ fn values_table(rows: &[ParamRow]) -> Table {
     ];
     let body = rows.iter().map(|r| {
         let (value, relative) = match (r.fixed, r.std_error) {
-            (true, _) => (with_error(r.value, f64::NAN), "—".to_string()),
+            (true, _) => (rounded(r.value, f64::NAN), "—".to_string()),
             (false, Some(se)) => (with_error(r.value, se), relative_error(r.value, se)),
             (false, None) => (
-                format!("{} ± not determined", with_error(r.value, f64::NAN)),
+                format!("{} ± not determined", rounded(r.value, f64::NAN)),
                 "—".into(),
             ),
         };

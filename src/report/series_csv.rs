@@ -34,7 +34,8 @@ impl Column {
     }
 }
 
-/// The CSV text of `columns` (numbers in Rust's shortest exact form; quoting by `csv`).
+/// The CSV text of `columns` (numbers in Rust's shortest exact form, the samples drawn exactly,
+/// a negative zero as `0`: [`stf_core::digits::exact`]; quoting by `csv`).
 pub fn to_csv(columns: &[Column]) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let rows = columns.iter().map(|c| c.values.len()).max().unwrap_or(0);
@@ -42,11 +43,12 @@ pub fn to_csv(columns: &[Column]) -> String {
         .write_record(columns.iter().map(|c| c.name.as_str()))
         .and_then(|()| {
             (0..rows).try_for_each(|r| {
-                w.write_record(
-                    columns
-                        .iter()
-                        .map(|c| c.values.get(r).map(|v| v.to_string()).unwrap_or_default()),
-                )
+                w.write_record(columns.iter().map(|c| {
+                    c.values
+                        .get(r)
+                        .map(|&v| stf_core::digits::exact(v))
+                        .unwrap_or_default()
+                }))
             })
         });
     // Writing into memory cannot fail.

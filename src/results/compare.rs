@@ -80,7 +80,7 @@ fn print_summary(result: &CompareResult) {
         .map(|f| f.label.chars().count())
         .max()
         .unwrap_or(5);
-    let heads = ["pre-res.", "resonance", "post-res.", "all"];
+    let heads = ["pre-res.", "resonance", "post-res.", "mean"];
     let shown = |cells: &[String]| -> String {
         if words.regimes {
             cells
@@ -112,7 +112,17 @@ fn print_summary(result: &CompareResult) {
             format!("{:.3}", m.relative_rms_error)
         })
     };
-    for ((label, cells), f) in per_regime(c, cell).into_iter().zip(&c.fits) {
+    let rows = per_regime(c, cell)
+        .into_iter()
+        .zip(&c.fits)
+        .zip(&c.comparisons);
+    for (((label, mut cells), f), cmp) in rows {
+        // Ranked by the mean over the regimes; a record without regimes by the whole record.
+        cells.push(if words.regimes {
+            mean_cell(c, label)
+        } else {
+            format!("{:.3}", cmp.overall.relative_rms_error)
+        });
         let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f));
         say!(
             "  {label:<name_width$}  {}  {}",
@@ -161,7 +171,9 @@ fn write_compare_report(
         .map(|f| (f.label.as_str(), &f.result))
         .collect();
     let rows = crate::param_table::rows_of_fits(&c.fits);
-    let results = crate::documents::results_table::results_section("Results", &rows, &fits);
+    let equations = crate::results::fit::equations_of(&c.fits);
+    let results =
+        crate::documents::results_table::results_section("Results", &equations, &rows, &fits);
     let models = if data.words().regimes {
         regimes_section(c, md, out)?
     } else {
@@ -220,11 +232,19 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
             &c.labels(),
             &c.comparisons,
         ));
-    let bars = per_regime(c, |m| m.map_or(f64::NAN, |m| m.relative_rms_error));
+    let mut bars = per_regime(c, |m| m.map_or(f64::NAN, |m| m.relative_rms_error));
+    for (label, values) in &mut bars {
+        values.push(c.mean_error(label).unwrap_or(f64::NAN));
+    }
     let fig = regime_errors(
         &out.join("figures"),
         "regime_errors",
-        &["pre-resonance", "resonance", "post-resonance", "all cycles"],
+        &[
+            "pre-resonance",
+            "resonance",
+            "post-resonance",
+            "mean over regimes",
+        ],
         &bars,
         "relative force RMS error",
     )?;
@@ -268,28 +288,35 @@ fn whole_record_section(c: &Compared, md: &str) -> Section {
 /// The relative force RMS error (duty error) of each model per regime and overall.
 fn errors_table(c: &Compared) -> Table {
     let cell = |m: &RegimeMetrics| format!("{:.3} ({:.2})", m.relative_rms_error, m.duty_error);
-    let caption = "Relative force RMS error per regime and over all cycles together (on–off \
-                   duty error in brackets); lower is better.";
+    let caption = "Relative force RMS error per regime (on–off duty error in brackets) and its \
+                   mean over the regimes, the score the models are ranked by; lower is better.";
     let columns = [
         "model",
         "pre-resonance",
         "resonance",
         "post-resonance",
-        "all cycles",
+        "mean over regimes",
     ];
     let rows = per_regime(c, |m| m.map_or("—".to_string(), cell));
     let rows = rows
         .into_iter()
-        .map(|(label, cells)| [vec![label.to_string()], cells].concat());
+        .map(|(label, cells)| [vec![label.to_string()], cells, vec![mean_cell(c, label)]].concat());
     Table::new(caption, &columns).with_rows(rows.collect())
 }
 
-/// Each model's label with `value` of its metrics in each regime (`None`: no cycle there),
-/// then overall.
+/// The score `label` is ranked by over the regimes ([`Compared::mean_error`]), to 3 decimals.
+fn mean_cell(c: &Compared, label: &str) -> String {
+    c.mean_error(label)
+        .map_or("—".to_string(), |s| format!("{s:.3}"))
+}
+
+/// Each model's label with `value` of its metrics in each regime (`None`: no cycle there).
 fn per_regime<T>(c: &Compared, value: impl Fn(Option<&RegimeMetrics>) -> T) -> Vec<(&str, Vec<T>)> {
     let values = |cmp: &Comparison| {
-        let regimes = Regime::ALL.iter().map(|&r| value(cmp.per_regime.get(r)));
-        regimes.chain([value(Some(&cmp.overall))]).collect()
+        Regime::ALL
+            .iter()
+            .map(|&r| value(cmp.per_regime.get(r)))
+            .collect()
     };
     let models = c.fits.iter().zip(&c.comparisons);
     models

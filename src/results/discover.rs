@@ -110,11 +110,19 @@ fn print_summary(
         found.final_model_name,
         crate::results::shown::values_line(&rows)
     );
+    if let Some(eq) = final_equation(found) {
+        say!("  {eq}");
+    }
     say!(
         "final model, as an experiment entry:\n{}{}",
         entries.0,
         entries.1
     );
+}
+
+/// The final force as an equation (discovery.json's `final_model.equation`).
+fn final_equation(found: &Discovery) -> Option<String> {
+    crate::equation::force_equation(&*found.final_model, &found.final_params)
 }
 
 /// The held-out cycles every step was scored on and, with `[validate]`, the base's and the
@@ -233,7 +241,12 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     );
     let title = format!("Final model: {}", found.final_model_name);
     let fits = [("final", &found.final_fit)];
-    let results = crate::documents::results_table::results_section(&title, &rows, &fits);
+    let equations: Vec<(&str, String)> = final_equation(found)
+        .map(|eq| ("final", eq))
+        .into_iter()
+        .collect();
+    let results =
+        crate::documents::results_table::results_section(&title, &equations, &rows, &fits);
     let mut sections = vec![results, s];
     if data.level == FitLevel::Force {
         let curves = [("base", before.as_slice()), ("final", after.as_slice())];

@@ -53,7 +53,9 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
     let level = data.level;
     let results: Vec<(&str, &FitResult)> =
         fits.iter().map(|f| (f.label.as_str(), &f.result)).collect();
-    let mut sections = vec![results_section("Results", &fitted.param_rows(), &results)];
+    let equations = equations_of(fits);
+    let rows = fitted.param_rows();
+    let mut sections = vec![results_section("Results", &equations, &rows, &results)];
     if let Some(rec) = validation {
         sections.push(crate::documents::standard_report::validation_section(
             rec, fits, out,
@@ -128,7 +130,15 @@ fn frequency_response(
     swept_section(exp, data, models, out)
 }
 
-/// The terminal summary: one line per model, its warnings under it.
+/// Each fit's label with its force as an equation (fit.json's `equation`; none for the bare
+/// oscillator).
+pub fn equations_of(fits: &[ModelFit]) -> Vec<(&str, String)> {
+    fits.iter()
+        .filter_map(|f| Some((f.label.as_str(), f.equation()?)))
+        .collect()
+}
+
+/// The terminal summary: one line per model, its equation and warnings under it.
 fn print_summary(data: &FitData, fits: &[ModelFit]) {
     let (unit, scale) = data.shown();
     say!(
@@ -155,6 +165,9 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
                 "  (did not converge)"
             }
         );
+        if let Some(eq) = f.equation() {
+            say!("      {eq}");
+        }
         print_warnings(&f.warnings);
     }
 }

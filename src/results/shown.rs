@@ -56,7 +56,7 @@ mod tests {
         ];
         assert_eq!(
             values_line(&rows),
-            "K = 4.074 ± 0.047 N·(s/m)ⁿ, n = 1.5083 ± 0.0054; 1 held"
+            "K = 4.07 ± 0.05 N·(s/m)ⁿ, n = 1.508 ± 0.005; 1 held"
         );
     }
 }

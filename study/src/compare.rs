@@ -161,6 +161,14 @@ impl Compared {
         self.fits.iter().map(|f| f.label.as_str()).collect()
     }
 
+    /// The score the models are ranked by over the regimes (compare.json's
+    /// `ranking.overall`: the mean of the per-regime relative force RMS errors) of the model
+    /// labelled `label`; the one overall score a report or the terminal shows.
+    pub fn mean_error(&self, label: &str) -> Option<f64> {
+        let overall = &self.ranking.overall;
+        overall.iter().find(|s| s.model == label).map(|s| s.score)
+    }
+
     /// Each model's simulated peak (|x| m, ω rad/s), none where the simulation failed.
     pub fn peaks(&self) -> Vec<Option<(f64, f64)>> {
         self.responses

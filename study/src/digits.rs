@@ -3,6 +3,8 @@
 //! of arithmetic (ω = w0 + 0.047·(t − t0) gave 3.7933700000000004 where 3.79337 was meant),
 //! not information. Outputs round every number to 15 significant digits, which changes a value
 //! by less than 1e-15 of itself and never cuts a measured digit (records carry far fewer).
+//! Numbers for a person (a value rounded to its error, no negative zero) are
+//! [`stf_core::digits`]'s, re-exported here.
 //!
 //! ```
 //! use stf_study::digits::carried;
@@ -10,19 +12,13 @@
 //! assert_eq!(carried(0.1 + 0.2).to_string(), "0.3");
 //! assert_eq!(stf_study::digits::fixed(-0.04, 1), "0.0");
 //! assert_eq!(stf_study::digits::fixed(-0.06, 1), "-0.1");
-//! assert_eq!(stf_study::digits::with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
+//! assert_eq!(stf_study::digits::with_error(1.0004e4, 8.1), "10 004 ± 8");
 //! assert_eq!(stf_study::digits::with_error(3.02331, 0.313), "3.02 ± 0.31");
 //! ```
 
 use serde_json::Value;
 
-/// `x` rounded to 15 significant digits (non-finite values and zero as they are).
-pub fn carried(x: f64) -> f64 {
-    if !x.is_finite() || x == 0.0 {
-        return x;
-    }
-    format!("{x:.14e}").parse().unwrap_or(x)
-}
+pub use stf_core::digits::{carried, cell, fixed, grouped, rounded, signed, with_error};
 
 /// `x` in a message: at most 15 significant digits ([`carried`]), plain between 10⁻³ and
 /// 10⁶ and in exponent form outside (`1e300`, not a number of 301 digits; `2.5e-7`).
@@ -51,60 +47,15 @@ pub fn time_span(t: &[f64]) -> String {
     }
 }
 
-/// `x` with `decimals` decimals for a person to read, never as a negative zero ("-0.0" for
-/// -0.04 at one decimal reads as a sign the value does not have).
-pub fn fixed(x: f64, decimals: usize) -> String {
-    let s = format!("{x:.decimals$}");
-    if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') {
-        return s[1..].to_string();
-    }
-    s
-}
-
 /// `name = value ± error` of a fitted parameter ([`with_error`]).
 pub fn param_with_error(p: &stf_core::fit::FittedParam) -> String {
     format!("{} = {}", p.name, with_error(p.value, p.std_error))
 }
 
-/// `value ± error` for a person to read: the value to the error's second significant digit,
-/// the error to two digits, each in plain notation between 10⁻³ and 10⁶ and in exponent form
-/// outside it (`5.336e-6 ± 2.6e-8`, not `0.00001 ± 2.57e-8`). Without a usable error (zero,
-/// NaN, infinite) the value gets six significant digits and the error is shown as it is.
-pub fn with_error(value: f64, error: f64) -> String {
-    let plain = |x: f64| x == 0.0 || (1e-3..1e6).contains(&x.abs());
-    let show = |x: f64, last: i32| -> String {
-        if !x.is_finite() {
-            return x.to_string();
-        }
-        let lead = if x == 0.0 {
-            last
-        } else {
-            x.abs().log10().floor() as i32
-        };
-        if plain(x) {
-            fixed(x, (-last).clamp(0, 12) as usize)
-        } else {
-            let digits = (lead - last).clamp(0, 12) as usize;
-            format!("{x:.digits$e}")
-        }
-    };
-    if !(error.is_finite() && error > 0.0) {
-        let lead = if value == 0.0 || !value.is_finite() {
-            0
-        } else {
-            value.abs().log10().floor() as i32
-        };
-        return format!("{} ± {error}", show(value, lead - 5));
-    }
-    let last = error.log10().floor() as i32 - 1;
-    format!("{} ± {}", show(value, last), show(error, last))
-}
-
 /// A CSV cell of `x`: [`carried`] in Rust's shortest form (`1`, `0.000155`, never
 /// `0.00015500000000000003`), a negative zero as `0`. For `#[serde(serialize_with)]`.
 pub fn csv_number<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
-    let x = if *x == 0.0 { 0.0 } else { carried(*x) };
-    s.collect_str(&x)
+    s.collect_str(&cell(*x))
 }
 
 /// [`csv_number`] of an optional value (an empty cell for none).
@@ -115,14 +66,14 @@ pub fn csv_optional<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok
     }
 }
 
-/// Every floating-point number of `value`, recursively, rounded by [`carried`]; integers
-/// untouched.
+/// Every floating-point number of `value`, recursively, rounded by [`carried`] (a negative
+/// zero written `0.0`); integers untouched.
 pub fn tidy_json(value: &mut Value) {
     match value {
         Value::Number(n) if n.is_f64() => {
             if let Some(x) = n
                 .as_f64()
-                .and_then(|x| serde_json::Number::from_f64(carried(x)))
+                .and_then(|x| serde_json::Number::from_f64(if x == 0.0 { 0.0 } else { carried(x) }))
             {
                 *n = x;
             }
@@ -136,19 +87,6 @@ pub fn tidy_json(value: &mut Value) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_value_shows_the_digits_its_error_allows() {
-        assert_eq!(with_error(5.3362e-6, 2.57e-8), "5.336e-6 ± 2.6e-8");
-        assert_eq!(with_error(-51.13313, 8.44), "-51.1 ± 8.4");
-        assert_eq!(with_error(0.97819, 9.92e-3), "0.9782 ± 0.0099");
-        assert_eq!(with_error(1.0000432e4, 0.45), "10000.43 ± 0.45");
-        // A value far below its error keeps one digit; no error: six significant digits.
-        assert_eq!(with_error(2e-5, 5e-3), "2e-5 ± 0.0050");
-        assert_eq!(with_error(1234.5678, 0.0), "1234.57 ± 0");
-        assert_eq!(with_error(1234.5678, f64::NAN), "1234.57 ± NaN");
-        assert_eq!(with_error(-0.0001, 1e-9), "-1.000000e-4 ± 1.0e-9");
-    }
 
     #[test]
     fn a_number_in_a_message_is_short() {

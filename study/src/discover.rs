@@ -410,7 +410,10 @@ fn results<'a>(
             let refitted = SystemEntry {
                 system: names
                     .iter()
-                    .filter_map(|n| tf.system_after.get(n).map(|v| (n.clone(), v)))
+                    .filter_map(|n| {
+                        let v = tf.system_after.get(n)?;
+                        Some((n.clone(), crate::digits::carried(v)))
+                    })
                     .collect(),
             };
             let system_entry = refitted

@@ -358,6 +358,13 @@ impl ModelFit {
             .map_or_else(|| "none".to_string(), |c| c.model.name().to_string())
     }
 
+    /// The fitted force as an equation (`F_STF = 4.07·|v|^1.51·sgn v`;
+    /// [`crate::equation::force_equation`]); none for the bare oscillator.
+    pub fn equation(&self) -> Option<String> {
+        let c = self.configured.as_ref()?;
+        crate::equation::force_equation(&*c.model, &self.result.params)
+    }
+
     /// The fitted values of the model's parameters, in its order.
     pub fn model_values(&self) -> Vec<f64> {
         self.configured.as_ref().map_or_else(Vec::new, |c| {

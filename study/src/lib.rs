@@ -25,6 +25,7 @@ pub mod data_layout;
 pub mod digits;
 pub mod discover;
 pub mod discovery_curves;
+pub mod equation;
 pub mod error;
 pub mod experiment;
 pub mod fit;

@@ -146,8 +146,10 @@ fn fit_text(
                 ""
             };
             format!(
-                "`{}` ΔAIC {:+.1}, RMS {:+.1} %{tie}",
-                o.label, o.delta_aic, o.rms_change_percent
+                "`{}` ΔAIC {}, RMS {} %{tie}",
+                o.label,
+                crate::digits::signed(o.delta_aic, 1),
+                crate::digits::signed(o.rms_change_percent, 1)
             )
         })
         .collect();
@@ -272,12 +274,27 @@ fn whole_record_verdict(c: &Compared) -> String {
     )
 }
 
-/// ` (`best` ahead of `runner-up`: paired z Z over N cycles)`, or why it was not tested.
+/// Whether a paired test over `t`'s cycles says anything: at least 3 cycles and a finite z.
+pub fn tested(t: &PairedTest) -> bool {
+    t.cycles >= 3 && t.z.is_finite()
+}
+
+/// `not tested (1 cycle)`: what stands where a paired test had too few cycles to be made
+/// (never a z of NaN, never a best declared on it).
+pub fn not_tested(cycles: usize) -> String {
+    let s = if cycles == 1 { "" } else { "s" };
+    format!("not tested ({cycles} cycle{s})")
+}
+
+/// ` (`best` ahead of `runner-up`: paired z Z over N cycles)`, or ` (`best` against
+/// `runner-up` cycle by cycle: not tested (1 cycle))`.
 fn paired_text(t: &PairedTest) -> String {
-    if t.cycles < 3 || !t.z.is_finite() {
+    if !tested(t) {
         return format!(
-            " (too few cycles, {}, to tell `{}` from `{}` cycle by cycle)",
-            t.cycles, t.best, t.runner_up
+            " (`{}` against `{}` cycle by cycle: {})",
+            t.best,
+            t.runner_up,
+            not_tested(t.cycles)
         );
     }
     let call = if t.z > 3.0 { "ahead" } else { "not told apart" };
@@ -439,7 +456,7 @@ mod tests {
         assert!(paired_text(&test(39, 0.08)).contains("not told apart"));
         let one = paired_text(&test(1, f64::NAN));
         assert!(
-            one.contains("too few cycles, 1,") && !one.contains("NaN"),
+            one.contains("not tested (1 cycle)") && !one.contains("NaN"),
             "{one}"
         );
     }

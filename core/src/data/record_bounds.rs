@@ -161,6 +161,9 @@ impl ForceModel for Widened {
     fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
         self.inner.reduces_to(p, reach)
     }
+    fn equation(&self, values: &[String]) -> Option<String> {
+        self.inner.equation(values)
+    }
 }
 
 #[cfg(test)]

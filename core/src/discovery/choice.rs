@@ -347,7 +347,13 @@ fn accepted(step: &Step, winner: usize, said: &Said) -> String {
     let params: Vec<String> = w
         .params
         .iter()
-        .map(|p| format!("{} = {:.4e} ± {:.1e}", p.name, p.value, p.std_error))
+        .map(|p| {
+            format!(
+                "{} = {}",
+                p.name,
+                crate::digits::with_error(p.value, p.std_error)
+            )
+        })
         .collect();
     format!(
         "add `{}`: {} {:.4} → {:.4} {} (paired z {:.1} over {}), ΔBIC {:.1}, explains \

@@ -156,8 +156,9 @@ impl std::fmt::Display for DriveReport {
             (None, Some(ratio)) => write!(f, "; residual {ratio:.3} quantisation steps"),
             _ => write!(
                 f,
-                "; residual {:.3e} against a scatter of {:.3e}",
-                self.residual_rms, self.scatter
+                "; residual {} against a scatter of {}",
+                crate::digits::significant(self.residual_rms, 4),
+                crate::digits::significant(self.scatter, 4)
             ),
         }
     }

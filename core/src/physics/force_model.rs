@@ -118,6 +118,15 @@ pub trait ForceModel: Send + Sync {
         Ok(false)
     }
 
+    /// The force as the term of an equation, with `values` the parameters' values as a person
+    /// reads them (one per parameter, in order, each already rounded to its standard error):
+    /// `4.01·|v|^1.501·sgn v` for `power_law`. The default names the model with its values,
+    /// `F_maxwell(c_m = 5.2, tau = 0.050)`: what a script or a model with internal state,
+    /// whose law is not one line, writes. `None` when `values` do not match the parameters.
+    fn equation(&self, values: &[String]) -> Option<String> {
+        named_term(self.name(), self.params(), values)
+    }
+
     /// The simpler built-in these fitted values `p` make this model over a record that
     /// reaches `reach`, with that model's values: a wall with no gap and exponent 3 is a cubic
     /// spring, a gate that is open at every speed the record reaches is its ungated law.
@@ -126,6 +135,20 @@ pub trait ForceModel: Send + Sync {
     fn reduces_to(&self, _p: &[f64], _reach: Reach) -> Option<(String, Vec<f64>)> {
         None
     }
+}
+
+/// A model written as a named term with its values, `F_name(a = 1.2, b = 3)`; `None` when
+/// `values` do not match `specs`.
+pub fn named_term(name: &str, specs: &[ParamSpec], values: &[String]) -> Option<String> {
+    if values.len() != specs.len() {
+        return None;
+    }
+    let args: Vec<String> = specs
+        .iter()
+        .zip(values)
+        .map(|(s, v)| format!("{} = {v}", s.name))
+        .collect();
+    Some(format!("F_{name}({})", args.join(", ")))
 }
 
 /// How far a record goes: the largest |x| (m) and |ẋ| (m/s) it reaches.

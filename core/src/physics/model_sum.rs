@@ -146,6 +146,24 @@ impl ForceModel for ModelSum {
         self.parts.iter().flat_map(|p| p.terms()).collect()
     }
 
+    /// The parts' terms joined by `+` (or `−` before a term with a negative coefficient);
+    /// `0` for the zero force.
+    fn equation(&self, values: &[String]) -> Option<String> {
+        if values.len() != self.specs.len() {
+            return None;
+        }
+        let mut text = String::new();
+        for (i, part) in self.parts.iter().enumerate() {
+            let term = part.equation(&values[self.param_offsets[i]..self.param_offsets[i + 1]])?;
+            match (text.is_empty(), term.strip_prefix('-')) {
+                (true, _) => text = term,
+                (false, Some(rest)) => text.push_str(&format!(" − {rest}")),
+                (false, None) => text.push_str(&format!(" + {term}")),
+            }
+        }
+        Some(if text.is_empty() { "0".into() } else { text })
+    }
+
     fn params(&self) -> &[ParamSpec] {
         &self.specs
     }

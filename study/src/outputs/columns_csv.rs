@@ -6,7 +6,7 @@
 
 use anyhow::{Context, Result};
 
-use crate::digits::carried;
+use crate::digits::cell;
 
 /// Columns of one table, left to right; rows as long as the shortest column.
 #[derive(Clone, Debug, Default)]
@@ -34,7 +34,7 @@ impl<'a> Columns<'a> {
         w.write_record(&self.names)?;
         let rows = self.values.iter().map(|c| c.len()).min().unwrap_or(0);
         for i in 0..rows {
-            w.write_record(self.values.iter().map(|c| carried(c[i]).to_string()))?;
+            w.write_record(self.values.iter().map(|c| cell(c[i])))?;
         }
         w.into_inner().context("cannot build a CSV table")
     }

@@ -95,6 +95,9 @@ pub struct TrajectoryJson<'a> {
 pub struct FinalModelJson<'a> {
     /// `a + b + …`.
     pub name: &'a str,
+    /// The final force as an equation, values rounded to their standard errors
+    /// (`F_STF = 4.01·|v|^1.501·sgn v + 19 987·x³`); null if a model cannot write it.
+    pub equation: Option<String>,
     /// The model's fitted values by name (SI units; no offsets or initial state).
     pub params: BTreeMap<String, f64>,
     /// Standard errors of every fitted value by name; null where not determined.
@@ -152,6 +155,7 @@ impl<'a> DiscoveryJson<'a> {
             steps: &found.steps,
             final_model: FinalModelJson {
                 name: &found.final_model_name,
+                equation: crate::equation::force_equation(&*found.final_model, &found.final_params),
                 params: values_by_name(model_params.iter().copied()),
                 std_errors: errors_by_name(&found.final_params, |p| p.std_error),
                 values: errors_by_name(&found.final_params, |p| p.value),

@@ -81,6 +81,9 @@ pub struct ModelFitJson<'a> {
     pub label: &'a str,
     /// `force` or `trajectory`.
     pub level: &'static str,
+    /// The fitted force as an equation, values rounded to their standard errors
+    /// (`F_STF = 4.07·|v|^1.51·sgn v`); null for the bare oscillator.
+    pub equation: Option<String>,
     /// The values, errors, residual, criteria and warnings, as every fit states them.
     #[serde(flatten)]
     pub result: ResultJson<'a>,
@@ -124,6 +127,7 @@ impl<'a> ModelFitJson<'a> {
             name: fit.name(),
             label: &fit.label,
             level: level.name(),
+            equation: fit.equation(),
             result: ResultJson::new(r, fit.floor, &fit.warnings),
             naive_std_errors: errors_by_name(&r.params, |p| p.naive_std_error),
             error_blocks: r.error_blocks,

@@ -4,7 +4,8 @@
 //! `compare` accept as they are. Both are serialized by the toml crates, so any name is
 //! quoted and escaped as TOML needs and every number is a TOML number (`nan`, `1e25`); the
 //! entry goes through `toml_edit` to keep its parameters on one line, as experiment files
-//! write them (`params = { K = 4.0, n = 1.5 }`).
+//! write them (`params = { K = 4.0, n = 1.5 }`). Values carry 15 significant digits
+//! ([`crate::digits::carried`]), as every output does: pasted back, they reproduce the fit.
 
 use indexmap::IndexMap;
 use serde::Serialize;
@@ -41,7 +42,7 @@ impl ModelsEntry {
                 plus: plus.iter().map(|t| t.to_string()).collect(),
                 params: params
                     .into_iter()
-                    .map(|p| (p.name.clone(), p.value))
+                    .map(|p| (p.name.clone(), crate::digits::carried(p.value)))
                     .collect(),
             }],
         }
