@@ -155,8 +155,9 @@ fn candidate_starts(
     if extra == 0 || specs.len() < 2 {
         return starts;
     }
+    // Each grid point evaluates the model along the whole record: in parallel, in order.
     let mut scored: Vec<(Vec<f64>, f64)> = start_grid(&specs[1..])
-        .into_iter()
+        .into_par_iter()
         .filter_map(|point| {
             let mut values = defaults.clone();
             values[1..].copy_from_slice(&point);
@@ -327,8 +328,10 @@ impl<'a> ForceLevel<'a> {
             starts.push(neutral);
             stages.push(stage(&starts[starts.len() - 1]));
         }
+        // The starts are independent fits: in parallel (a costly candidate's starts would
+        // otherwise hold a step's last core alone), kept in their order.
         let trials: Vec<Result<Trial, DiscoveryError>> = stages
-            .iter()
+            .par_iter()
             .map(|s| self.trial(s, self.settings))
             .collect();
         let (evaluations, wall) = trials.iter().flatten().fold((0, 0.0), |(e, w), t| {

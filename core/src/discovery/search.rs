@@ -112,10 +112,23 @@ fn base_fit<L: Level>(
 ) -> Result<BaseFit, DiscoveryError> {
     let start = level.start(base);
     let all: Vec<usize> = (0..level.samples()).collect();
-    let (stage, result) = level.fit(&start, &all, settings)?;
-    let floor = level.floor(&stage)?;
-    let (residual, location) = level.gap(&stage, &floor)?;
-    let current = level.trial(if L::FIRST_FROM_FIT { &stage } else { &start }, settings)?;
+    let whole = || -> Result<_, DiscoveryError> {
+        let (stage, result) = level.fit(&start, &all, settings)?;
+        let floor = level.floor(&stage)?;
+        let gap = level.gap(&stage, &floor)?;
+        Ok((stage, result, floor, gap))
+    };
+    // A training trial from the level's start does not wait for the whole-record fit: the
+    // two run side by side.
+    let (stage, result, floor, (residual, location), current) = if L::FIRST_FROM_FIT {
+        let (stage, result, floor, gap) = whole()?;
+        let current = level.trial(&stage, settings)?;
+        (stage, result, floor, gap, current)
+    } else {
+        let (whole, current) = rayon::join(whole, || level.trial(&start, settings));
+        let (stage, result, floor, gap) = whole?;
+        (stage, result, floor, gap, current?)
+    };
     let base_excess = level.base_excess(&current, &floor)?;
     Ok(BaseFit {
         stage,
