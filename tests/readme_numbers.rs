@@ -30,11 +30,10 @@ fn quoted(name: &str, text: &str) {
     );
 }
 
-/// `value ± error` rounded to the error's second significant digit (`4.074 ± 0.047`,
-/// `19987 ± 11`), as the terminal and the pages write them.
+/// `value ± error` as the terminal and the pages write them (`stf_core::digits::with_error`:
+/// `4.08 ± 0.05`, `19 987 ± 11`).
 fn pm(value: f64, error: f64) -> String {
-    let decimals = (1 - error.abs().log10().floor() as i32).max(0) as usize;
-    format!("{value:.decimals$} ± {error:.decimals$}")
+    stf_core::digits::with_error(value, error)
 }
 
 /// A whole number with its thousands grouped by spaces and a minus sign (`−32 557`).
