@@ -199,7 +199,7 @@ fn run_and_scan(command: &str, experiment: &str) -> (tempfile::TempDir, PathBuf)
 /// The numbers of an equation (digit groups `19 987` joined) with the half-width of the
 /// rounding each was written with.
 fn equation_numbers(equation: &str) -> Vec<(f64, f64)> {
-    let joined = equation.replace(|c: char| c == '\u{a0}', " ");
+    let joined = equation.replace('\u{a0}', " ");
     let mut out = Vec::new();
     let words: Vec<&str> = joined.split(' ').collect();
     let mut i = 0;
