@@ -229,8 +229,13 @@ fn a_fit_that_misses_an_effect_or_sits_on_a_bound_warns() {
         .iter()
         .position(|l| l.trim_start().starts_with("viscous"))
         .unwrap();
+    // Under the model's line: its force as an equation, then its warnings.
     assert!(
-        lines[at + 1].contains("warning: the residual is"),
+        lines[at + 1].trim_start().starts_with("F_STF = "),
+        "{stdout}"
+    );
+    assert!(
+        lines[at + 2].contains("warning: the residual is"),
         "{stdout}"
     );
 }

@@ -18,9 +18,13 @@ def test_a_sigint_during_a_run_raises_interrupted(repo):
     def progress(status, elapsed):
         if not sent:  # the first call, as the run starts: interrupt from another thread
             sent.append(status)
-            threading.Thread(target=os.kill, args=(os.getpid(), signal.SIGINT)).start()
+            # Joined, so the signal is pending before the run can end: on a busy machine a
+            # thread left to itself was once scheduled only after a short discovery had ended.
+            kill = threading.Thread(target=os.kill, args=(os.getpid(), signal.SIGINT))
+            kill.start()
+            kill.join()
 
-    # A discovery (seconds long), so the signal surely arrives while it runs.
+    # A discovery (seconds long), with the signal sent as it starts.
     with pytest.raises(stf_lab.Interrupted) as e:
         stf_lab.discover("experiments/discovery.toml", progress=progress)
     assert isinstance(e.value, KeyboardInterrupt)
