@@ -27,6 +27,7 @@ use std::sync::Arc;
 
 use crate::physics::force_model::{ForceModel, ModelError, ModelState, Reach};
 use crate::physics::param_spec::ParamSpec;
+use crate::physics::track::Track;
 
 /// An upper bound below this many typical sizes is too tight for the record.
 pub const ROOM: f64 = 10.0;
@@ -157,6 +158,26 @@ impl ForceModel for Widened {
         grad: &mut [f64],
     ) -> Result<bool, ModelError> {
         self.inner.gradient(p, s, a, grad)
+    }
+    fn mass_and_force_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        rows: Option<&[usize]>,
+        mass: &mut [f64],
+        force: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.inner.mass_and_force_along(p, track, rows, mass, force)
+    }
+    fn gradient_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        a: &[f64],
+        rows: Option<&[usize]>,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        self.inner.gradient_along(p, track, a, rows, grad)
     }
     fn reduces_to(&self, p: &[f64], reach: Reach) -> Option<(String, Vec<f64>)> {
         self.inner.reduces_to(p, reach)

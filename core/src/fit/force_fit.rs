@@ -46,7 +46,8 @@ use super::objective::Residuals;
 use super::result::{FitProgress, FitResult};
 use super::solver::{FitSettings, Solver};
 use crate::data::force_data::ForceData;
-use crate::physics::force_model::{ForceModel, ModelState};
+use crate::physics::force_model::ForceModel;
+use crate::physics::track::Track;
 
 /// A force-level calibration of one STF model (a [`crate::physics::model_sum::ModelSum`] is one model).
 #[derive(Clone, Setters)]
@@ -220,6 +221,15 @@ impl ForceResiduals<'_> {
     fn row(&self, k: usize) -> usize {
         self.rows.map_or(k, |r| r[k])
     }
+
+    /// The kinematics the model is evaluated along.
+    fn track(&self) -> Track<'_> {
+        Track {
+            t: self.data.t,
+            x: self.data.x,
+            v: self.data.v,
+        }
+    }
 }
 
 impl Residuals for ForceResiduals<'_> {
@@ -233,21 +243,16 @@ impl Residuals for ForceResiduals<'_> {
         let p = &full[..n_model];
         let offset = full.get(n_model).copied().unwrap_or(0.0);
         let d = &self.data;
-        let m = self.model;
-        let err = |e: crate::physics::force_model::ModelError| e.to_string();
-        if m.n_internal() == 0 {
-            for k in 0..self.len() {
-                let i = self.row(k);
-                let s = d.state(i, &[]);
-                let (ma, f) = m.mass_and_force(p, &s, &mut []).map_err(err)?;
-                sink(k, d.f[i] - (ma * d.a[i] + f + offset));
-            }
-            return Ok(());
+        let n = self.len();
+        let (mut mass, mut force) = (vec![0.0; n], vec![0.0; n]);
+        self.model
+            .mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
+            .map_err(|e| e.to_string())?;
+        for k in 0..n {
+            let i = self.row(k);
+            sink(k, d.f[i] - (mass[k] * d.a[i] + force[k] + offset));
         }
-        integrate_state(m, p, d, self.rows, &mut |k, i, ma, f| {
-            sink(k, d.f[i] - (ma * d.a[i] + f + offset));
-        })
-        .map_err(err)
+        Ok(())
     }
 
     /// Exact for models that give their [`ForceModel::gradient`]: built-ins without state,
@@ -264,92 +269,25 @@ impl Residuals for ForceResiduals<'_> {
             Err(e) => return Some(Err(e)),
         };
         let p = &full[..n_model];
-        // Column of each free parameter among all (the offset is the last).
-        let free: Vec<usize> = (0..self.all.len())
-            .filter(|&j| !self.all[j].fixed)
-            .collect();
-        let mut grad = vec![0.0; n_model];
-        // A placeholder state: only memoryless parts give their gradient.
-        let state = vec![0.0; m.n_internal()];
-        let d = &self.data;
-        for k in 0..self.len() {
-            let i = self.row(k);
-            let s = d.state(i, &state);
-            match m.gradient(p, &s, d.a[i], &mut grad) {
-                Ok(true) => {}
-                Ok(false) => return None,
-                Err(e) => return Some(Err(e.to_string())),
-            }
-            for (c, &j) in free.iter().enumerate() {
-                jac[(k, c)] = -grad.get(j).copied().unwrap_or(1.0);
+        let n = self.len();
+        let mut grad = vec![0.0; n * n_model];
+        match m.gradient_along(p, &self.track(), self.data.a, self.rows, &mut grad) {
+            Ok(true) => {}
+            Ok(false) => return None,
+            Err(e) => return Some(Err(e.to_string())),
+        }
+        // Column of each free parameter among all (the offset, the last, has slope 1).
+        let free = (0..self.all.len()).filter(|&j| !self.all[j].fixed);
+        for (c, j) in free.enumerate() {
+            let mut column = jac.column_mut(c);
+            if j < n_model {
+                for (out, g) in column.iter_mut().zip(&grad[j * n..(j + 1) * n]) {
+                    *out = -g;
+                }
+            } else {
+                column.fill(-1.0);
             }
         }
         Some(Ok(()))
     }
-}
-
-/// Integrate the internal state of `m` (parameters `p`) along the kinematics of `d` with one
-/// RK4 step per sample interval, calling `each(k, i, m_a, f)` at the `k`-th of the samples
-/// `rows` (strictly increasing; `None`: all), sample `i`, with the added mass and the rest of
-/// the force there; elsewhere only the state's rates are evaluated.
-fn integrate_state(
-    m: &dyn ForceModel,
-    p: &[f64],
-    d: &ForceData,
-    rows: Option<&[usize]>,
-    each: &mut dyn FnMut(usize, usize, f64, f64),
-) -> Result<(), crate::physics::force_model::ModelError> {
-    let nz = m.n_internal();
-    // z, stage rates k1..k4, stage state.
-    let mut buf = vec![0.0; 6 * nz];
-    let (z, rest) = buf.split_at_mut(nz);
-    let (k1, rest) = rest.split_at_mut(nz);
-    let (k2, rest) = rest.split_at_mut(nz);
-    let (k3, rest) = rest.split_at_mut(nz);
-    let (k4, zs) = rest.split_at_mut(nz);
-    m.initial_internal(p, z);
-    let last = d.t.len() - 1;
-    let mut next = 0;
-    for i in 0..=last {
-        let s = d.state(i, z);
-        let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
-        if let Some(k) = k {
-            let (ma, f) = m.mass_and_force(p, &s, k1)?;
-            each(k, i, ma, f);
-            next += 1;
-        } else {
-            m.rates(p, &s, k1)?;
-        }
-        if i == last {
-            break;
-        }
-        let h = d.t[i + 1] - d.t[i];
-        let (tm, xm, vm) = (
-            0.5 * (d.t[i] + d.t[i + 1]),
-            0.5 * (d.x[i] + d.x[i + 1]),
-            0.5 * (d.v[i] + d.v[i + 1]),
-        );
-        // The intermediate stages need only the rates, not the force.
-        for j in 0..nz {
-            zs[j] = z[j] + 0.5 * h * k1[j];
-        }
-        m.rates(p, &midpoint(tm, xm, vm, zs), k2)?;
-        for j in 0..nz {
-            zs[j] = z[j] + 0.5 * h * k2[j];
-        }
-        m.rates(p, &midpoint(tm, xm, vm, zs), k3)?;
-        for j in 0..nz {
-            zs[j] = z[j] + h * k3[j];
-        }
-        let se = d.state(i + 1, zs);
-        m.rates(p, &se, k4)?;
-        for j in 0..nz {
-            z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
-        }
-    }
-    Ok(())
-}
-
-fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
-    ModelState { t, x, v, z }
 }

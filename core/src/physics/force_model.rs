@@ -29,6 +29,7 @@
 //! ```
 
 use crate::physics::param_spec::ParamSpec;
+use crate::physics::track::{self, Track};
 
 /// The state a force model sees: time, displacement, velocity and its own internal variables.
 #[derive(Clone, Copy, Debug)]
@@ -116,6 +117,38 @@ pub trait ForceModel: Send + Sync {
         _grad: &mut [f64],
     ) -> Result<bool, ModelError> {
         Ok(false)
+    }
+
+    /// Along a whole record: adds the added mass and the rest of the force at the `k`-th of
+    /// `rows` (strictly increasing; `None`: every sample) to `mass[k]` and `force[k]`,
+    /// integrating the internal state along every sample (one RK4 step a sample interval).
+    /// The provided version ([`track::mass_and_force_along`]) calls this model's own methods
+    /// directly; a sum hands each part the record ([`crate::physics::track`]). A model that
+    /// wraps another without changing its parameters should forward it.
+    fn mass_and_force_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        rows: Option<&[usize]>,
+        mass: &mut [f64],
+        force: &mut [f64],
+    ) -> Result<(), ModelError> {
+        track::mass_and_force_along(self, p, track, rows, mass, force)
+    }
+
+    /// Along a whole record: [`ForceModel::gradient`] at the `k`-th of `rows` (`None`: every
+    /// sample), acceleration `a[i]` at sample `i`, parameter `j`'s entry written to
+    /// `grad[j·n + k]` (`n` results); `Ok(false)` when the model gives none. Provided by
+    /// [`track::gradient_along`]; a sum leaves NaN in the columns of its parts with state.
+    fn gradient_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        a: &[f64],
+        rows: Option<&[usize]>,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        track::gradient_along(self, p, track, a, rows, grad)
     }
 
     /// The force as the term of an equation, with `values` the parameters' values as a person

@@ -10,3 +10,4 @@ pub mod oscillator;
 pub mod oscillator_params;
 pub mod param_spec;
 pub mod resistance;
+pub mod track;

@@ -10,6 +10,7 @@ use std::sync::Arc;
 
 use crate::physics::force_model::{ForceModel, ModelError, ModelState};
 use crate::physics::param_spec::ParamSpec;
+use crate::physics::track::Track;
 
 /// The factor of its default that an added term's amplitude (its first parameter, by the
 /// models' convention) starts at when the term starts neutral: a millionth of its default's
@@ -224,6 +225,47 @@ impl ForceModel for ModelSum {
             part.rates(self.part_slices(i, p), &local, &mut dz[states])?;
         }
         Ok(())
+    }
+
+    /// Each part along the whole record in turn, its added mass and force added in the
+    /// parts' order (as [`ForceModel::mass_and_force`] adds them sample by sample).
+    fn mass_and_force_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        rows: Option<&[usize]>,
+        mass: &mut [f64],
+        force: &mut [f64],
+    ) -> Result<(), ModelError> {
+        for (i, part) in self.parts.iter().enumerate() {
+            part.mass_and_force_along(self.part_slices(i, p), track, rows, mass, force)?;
+        }
+        Ok(())
+    }
+
+    /// Each memoryless part's columns from its own gradient along the record; NaN in the
+    /// columns of a part with state or without a gradient (differenced by the fitter).
+    fn gradient_along(
+        &self,
+        p: &[f64],
+        track: &Track,
+        a: &[f64],
+        rows: Option<&[usize]>,
+        grad: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        let n = track.len_at(rows);
+        let mut any = false;
+        for (i, part) in self.parts.iter().enumerate() {
+            let (start, end) = (self.param_offsets[i], self.param_offsets[i + 1]);
+            let own = &mut grad[start * n..end * n];
+            let given = self.states(i).is_empty()
+                && part.gradient_along(&p[start..end], track, a, rows, own)?;
+            if !given {
+                own.fill(f64::NAN);
+            }
+            any |= given;
+        }
+        Ok(any)
     }
 
     fn gradient(
