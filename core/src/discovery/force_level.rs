@@ -115,23 +115,27 @@ fn candidate_starts(
     let fit = ForceFit::new(model.clone());
     let mut doubled = defaults.clone();
     doubled[0] *= 2.0;
-    let (Ok(f1), Ok(f2)) = (fit.predict(data, &defaults), fit.predict(data, &doubled)) else {
+    // The model at the subset's samples only, one value a row of it.
+    let along = |values: &[f64]| fit.predict_rows(data, values, Some(subset));
+    let (Ok(f1), Ok(f2)) = (along(&defaults), along(&doubled)) else {
         return vec![defaults];
     };
     // Against the largest force: `predict` returns measured − residual, whose rounding is
     // relative to the measured force, not to a force near zero.
-    let largest = subset.iter().map(|&i| f2[i].abs()).fold(0.0, f64::max);
-    let proportional = subset
+    let largest = f2.iter().map(|f| f.abs()).fold(0.0, f64::max);
+    let proportional = f1
         .iter()
-        .all(|&i| (f2[i] - 2.0 * f1[i]).abs() <= 1e-9 * largest);
+        .zip(&f2)
+        .all(|(f1, f2)| (f2 - 2.0 * f1).abs() <= 1e-9 * largest);
     if !proportional || first.default == 0.0 {
         return vec![defaults];
     }
-    // The start from `values` (first parameter at its default) whose force is `f`, and the
-    // residual sum of squares it leaves; `None` when the force is zero on the subset.
+    // The start from `values` (first parameter at its default) whose force at the subset's
+    // samples is `f`, and the residual sum of squares it leaves; `None` when that force is
+    // zero.
     let project = |values: &[f64], f: &[f64]| -> Option<(Vec<f64>, f64)> {
-        let (rf, ff) = subset.iter().fold((0.0, 0.0), |(rf, ff), &i| {
-            (rf + r[i] * f[i], ff + f[i] * f[i])
+        let (rf, ff) = subset.iter().zip(f).fold((0.0, 0.0), |(rf, ff), (&i, &f)| {
+            (rf + r[i] * f, ff + f * f)
         });
         if !(ff > 0.0 && ff.is_finite() && rf.is_finite()) {
             return None;
@@ -161,7 +165,7 @@ fn candidate_starts(
         .filter_map(|point| {
             let mut values = defaults.clone();
             values[1..].copy_from_slice(&point);
-            let f = fit.predict(data, &values).ok()?;
+            let f = along(&values).ok()?;
             project(&values, &f)
         })
         .collect();

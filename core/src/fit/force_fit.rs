@@ -189,17 +189,29 @@ impl ForceFit {
     /// The modelled force (with the offset, if any) at every sample for the full parameter
     /// vector `values` (the model's parameters, then the offset), along the kinematics.
     pub fn predict(&self, data: &ForceData, values: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.predict_rows(data, values, None)
+    }
+
+    /// [`ForceFit::predict`] at the samples `rows` only (strictly increasing; `None`: every
+    /// sample), one value a row; a model with internal state is still integrated along every
+    /// sample.
+    pub fn predict_rows(
+        &self,
+        data: &ForceData,
+        values: &[f64],
+        rows: Option<&[usize]>,
+    ) -> Result<Vec<f64>, FitError> {
         data.check_increasing()?;
         let all = held(&self.params(), values)?;
         let problem = ForceResiduals {
             model: self.model.as_ref(),
             data: *data,
             all: &all,
-            rows: None,
+            rows,
         };
-        let mut out = data.f.to_vec();
+        let mut out: Vec<f64> = (0..problem.len()).map(|k| data.f[problem.row(k)]).collect();
         problem
-            .residuals(&[], &mut |i, r| out[i] -= r)
+            .residuals(&[], &mut |k, r| out[k] -= r)
             .map_err(FitError::BadData)?;
         Ok(out)
     }
