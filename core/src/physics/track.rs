@@ -176,3 +176,153 @@ pub fn gradient_along<M: ForceModel + ?Sized>(
     }
     Ok(true)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::model_sum::ModelSum;
+    use crate::physics::param_spec::ParamSpec;
+    use std::sync::Arc;
+
+    /// `c·v^3 + m_a` as added mass: memoryless, with a gradient.
+    struct Cubic(Vec<ParamSpec>);
+    impl ForceModel for Cubic {
+        fn name(&self) -> &str {
+            "cubic"
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.0
+        }
+        fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
+            Ok(p[1])
+        }
+        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
+            Ok(p[0] * s.v.powi(3))
+        }
+        fn gradient(
+            &self,
+            _p: &[f64],
+            s: &ModelState,
+            a: f64,
+            grad: &mut [f64],
+        ) -> Result<bool, ModelError> {
+            grad[..2].copy_from_slice(&[s.v.powi(3), a]);
+            Ok(true)
+        }
+    }
+
+    /// A force relaxing towards `c·v` with time constant `tau`: one internal state.
+    struct Relax(&'static str, Vec<ParamSpec>);
+    impl ForceModel for Relax {
+        fn name(&self) -> &str {
+            self.0
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.1
+        }
+        fn n_internal(&self) -> usize {
+            1
+        }
+        fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+            dz[0] = (p[0] * s.v - s.z[0]) / p[1];
+            Ok(s.z[0])
+        }
+    }
+
+    fn spec(name: &str) -> ParamSpec {
+        ParamSpec::new(name, "", 1.0, 0.0, 10.0, "")
+    }
+
+    /// The sum's force sample by sample, its states integrated together (RK4 a sample
+    /// interval): what a fit computed before models were evaluated along the record.
+    fn sample_by_sample(m: &dyn ForceModel, p: &[f64], tr: &Track, rows: &[usize]) -> Vec<f64> {
+        let nz = m.n_internal();
+        let (mut z, mut k1, mut k2, mut k3, mut k4, mut zs) = (
+            vec![0.0; nz],
+            vec![0.0; nz],
+            vec![0.0; nz],
+            vec![0.0; nz],
+            vec![0.0; nz],
+            vec![0.0; nz],
+        );
+        m.initial_internal(p, &mut z);
+        let mut out = Vec::new();
+        let last = tr.t.len() - 1;
+        for i in 0..=last {
+            let (ma, f) = m.mass_and_force(p, &tr.state(i, &z), &mut k1).unwrap();
+            if rows.contains(&i) {
+                out.push(ma * 0.5 + f);
+            }
+            if i == last {
+                break;
+            }
+            let h = tr.t[i + 1] - tr.t[i];
+            let mid = |z: &[f64]| -> (f64, f64, f64, Vec<f64>) {
+                (
+                    0.5 * (tr.t[i] + tr.t[i + 1]),
+                    0.5 * (tr.x[i] + tr.x[i + 1]),
+                    0.5 * (tr.v[i] + tr.v[i + 1]),
+                    z.to_vec(),
+                )
+            };
+            let rates = |z: &[f64], k: &mut [f64]| {
+                let (t, x, v, z) = mid(z);
+                m.rates(p, &ModelState { t, x, v, z: &z }, k).unwrap();
+            };
+            for j in 0..nz {
+                zs[j] = z[j] + 0.5 * h * k1[j];
+            }
+            rates(&zs, &mut k2);
+            for j in 0..nz {
+                zs[j] = z[j] + 0.5 * h * k2[j];
+            }
+            rates(&zs, &mut k3);
+            for j in 0..nz {
+                zs[j] = z[j] + h * k3[j];
+            }
+            m.rates(p, &tr.state(i + 1, &zs), &mut k4).unwrap();
+            for j in 0..nz {
+                z[j] += h / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_sum_along_the_record_is_the_sum_sample_by_sample_to_the_bit() {
+        let parts: Vec<Arc<dyn ForceModel>> = vec![
+            Arc::new(Relax("slow", vec![spec("c1"), spec("tau1")])),
+            Arc::new(Cubic(vec![spec("c"), spec("m_a")])),
+            Arc::new(Relax("fast", vec![spec("c2"), spec("tau2")])),
+        ];
+        let sum = ModelSum::new(parts).unwrap();
+        let p = [3.0, 0.2, 1.7, 0.4, 0.9, 0.03];
+        let n = 500;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t.iter().map(|t| 0.01 * (40.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.4 * (40.0 * t).cos()).collect();
+        let track = Track {
+            t: &t,
+            x: &x,
+            v: &v,
+        };
+        let rows: Vec<usize> = (0..n).filter(|i| i % 3 != 1).collect();
+        let want = sample_by_sample(&sum, &p, &track, &rows);
+        let (mut mass, mut force) = (vec![0.0; rows.len()], vec![0.0; rows.len()]);
+        sum.mass_and_force_along(&p, &track, Some(&rows), &mut mass, &mut force)
+            .unwrap();
+        let got: Vec<f64> = mass.iter().zip(&force).map(|(m, f)| m * 0.5 + f).collect();
+        assert_eq!(got, want);
+        // The gradient: the memoryless part's columns, NaN for the parts with state.
+        let a = vec![0.5; n];
+        let mut grad = vec![0.0; rows.len() * p.len()];
+        assert!(sum
+            .gradient_along(&p, &track, &a, Some(&rows), &mut grad)
+            .unwrap());
+        let k = rows.len();
+        assert!(grad[..2 * k].iter().all(|g| g.is_nan()));
+        assert_eq!(grad[2 * k + 7], v[rows[7]].powi(3));
+        assert_eq!(grad[3 * k + 7], 0.5);
+        assert!(grad[4 * k..].iter().all(|g| g.is_nan()));
+    }
+}
