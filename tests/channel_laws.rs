@@ -156,7 +156,7 @@ fn discovery_names_the_channel_law_only_where_the_parameter_follows_the_channel(
         simulate_ok(&make_path, &dir.path().join("r.csv"));
         std::fs::write(&exp, DISCOVER).unwrap();
         let out = dir.path().join("out");
-        run_ok("discover", &exp, &out);
+        let printed = run_ok("discover", &exp, &out);
         let json = read_json(&out.join("discovery.json"));
         let named = json["effects"]
             .as_array()
@@ -164,7 +164,35 @@ fn discovery_names_the_channel_law_only_where_the_parameter_follows_the_channel(
             .iter()
             .any(|e| e == "yield.F_y~u_ctrl");
         assert_eq!(named, follows, "seed {seed}: effects {}", json["effects"]);
+        if follows {
+            pasted_back_fits(dir.path(), &printed.stdout, &json, seed);
+        }
     }
+}
+
+/// The entry `discover` printed for a law effect (on the terminal and in `discovery.json`),
+/// pasted as it is into an experiment on the same record, loads and fits: the effect
+/// `yield.F_y~u_ctrl` is printed as the law it adds up to, `F_y = { law = "affine", channel =
+/// "u_ctrl", base = …, gain = … }`, and the refit recovers the truth's gain.
+fn pasted_back_fits(dir: &Path, stdout: &[u8], json: &serde_json::Value, seed: u64) {
+    let entry = json["final_model"]["experiment_entry"].as_str().unwrap();
+    assert!(
+        entry.contains("F_y = { law = \"affine\", channel = \"u_ctrl\", base = ")
+            && !entry.contains('~'),
+        "seed {seed}: {entry}"
+    );
+    let stdout = String::from_utf8_lossy(stdout);
+    let shown = stdout
+        .split("final model, as an experiment entry:\n")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no entry printed: {stdout}"));
+    assert!(shown.starts_with(entry), "{shown}");
+    let refit = dir.join("refit.toml");
+    std::fs::write(&refit, format!("[data]\nfile = \"r.csv\"\n\n{entry}")).unwrap();
+    run_ok("fit", &refit, &dir.join("refit"));
+    let fitted = &read_json(&dir.join("refit/fit.json"))["models"][0];
+    let gain = fitted["params"]["F_y_gain"].as_f64().unwrap();
+    assert!((gain / 1.5 - 1.0).abs() < 0.15, "seed {seed}: F_y_gain {gain}\n{fitted}");
 }
 
 /// `exp.toml` in a fresh folder with `text`, and the message of `command` on it.
