@@ -1,6 +1,6 @@
 //! A model parameter that follows a measured channel of the record, end to end: `simulate`
-//! makes a damper-like record — the rotor rig swept 3 → 9 rad/s through resonance (60 s at
-//! 200 Hz, the rig's sensors), its STF force `viscous + yield` with the yield force
+//! makes a damper-like record — the rotor rig swept 3 → 9 rad/s through resonance (in 60 s or
+//! 30 s at 200 Hz, the rig's sensors), its STF force `viscous + yield` with the yield force
 //! F_y = 0.5 + 1.5·u N following a random two-level control channel `u_ctrl` (each level held
 //! 3 s on average), a force sensor offset of 50 N (a hundred times the yield force at u = 0) —
 //! and writes `u_ctrl` as a column; `fit` reads it back through the law's syntax
@@ -14,18 +14,24 @@ use std::path::Path;
 
 use common::{read_json, run, run_ok, simulate_ok};
 
-/// The experiment that makes the record (`seed`) and fits it at `level` with the law.
-fn experiment(seed: u64, level: &str) -> String {
+/// The sweep rates the laws are checked at, rad/s²: the rotor swept 3 → 9 rad/s in 60 s or
+/// in 30 s.
+const RATES: [f64; 2] = [0.1, 0.2];
+
+/// The experiment that makes the record (`seed`, swept at `alpha` rad/s² from 3 to 9 rad/s)
+/// and fits it at `level` with the law.
+fn experiment(seed: u64, level: &str, alpha: f64) -> String {
     let fit = match level {
         "force" => "offset = true",
         _ => "level = \"trajectory\"",
     };
+    let t1 = 6.0 / alpha;
     format!(
         r#"[data]
 file = "r.csv"
 
 [simulate]
-sweep = {{ w0 = 3.0, alpha = 0.1, t0 = 0.0, t1 = 60.0 }}
+sweep = {{ w0 = 3.0, alpha = {alpha}, t0 = 0.0, t1 = {t1} }}
 rate = 200.0
 noise = true
 seed = {seed}
@@ -72,7 +78,7 @@ fn within_3_se(model: &serde_json::Value, name: &str, truth: f64, seed: u64) {
 fn simulate_writes_the_control_channel_beside_the_signals() {
     let dir = tempfile::tempdir().unwrap();
     let exp = dir.path().join("exp.toml");
-    std::fs::write(&exp, experiment(1, "force")).unwrap();
+    std::fs::write(&exp, experiment(1, "force", 0.1)).unwrap();
     simulate_ok(&exp, &dir.path().join("r.csv"));
     let u = common::csv_column(&dir.path().join("r.csv"), "u_ctrl");
     assert!(u.iter().all(|&v| v == 0.0 || v == 1.0));
@@ -89,9 +95,9 @@ fn simulate_writes_the_control_channel_beside_the_signals() {
 
 #[test]
 fn a_yield_force_following_a_control_channel_is_recovered_at_force_level() {
-    for seed in [1, 2] {
+    for (seed, alpha) in [(1, RATES[0]), (2, RATES[1])] {
         let dir = tempfile::tempdir().unwrap();
-        let text = experiment(seed, "force");
+        let text = experiment(seed, "force", alpha);
         let constant = format!("{text}\n[[models]]\nname = \"viscous\"\nplus = [\"yield\"]\n");
         let json = simulated_and_fitted(dir.path(), &constant);
         let (law, flat) = (&json["models"][0], &json["models"][1]);
@@ -113,14 +119,21 @@ fn a_yield_force_following_a_control_channel_is_recovered_at_force_level() {
 
 /// About 13 s a fit in release on this machine: run with `--ignored`. The values come back
 /// within 1 % (measured, seed 1: F_y_base 0.49936, F_y_gain 1.5011, c_s 5.0145), but their
-/// trajectory-level standard errors are several times too small here (F_y_base 0.49936 ±
-/// 8.6e-7, c_s 5.0145 ± 0.0020: 750 and 7 SE off), so the check is on the values.
+/// trajectory-level standard errors are far too small at the default `rtol` 1e-7 (F_y_base
+/// 0.49936 ± 8.6e-7, c_s 5.0145 ± 0.0020: 750 and 7 SE off), so the check is on the values.
+/// Measured cause: the forward-difference Jacobian's column of F_y_base is the integrator's
+/// noise there (the naive error is as small, 2.9e-6); with `[integrator] rtol = 1e-10` the
+/// same fit gives F_y_base 0.49945 ± 2.2e-4 and c_s 5.012 ± 0.006, and with the encoder off
+/// (x noise only) 0.49976 ± 2.5e-4 at the default rtol. At the faster sweep (`RATES[1]`,
+/// seed 2) the fit at the default rtol fails outright (RMS 0.66 mm, c_s on a bound) where
+/// `rtol = 1e-10` reaches 0.059 mm with F_y_base 0.511 ± 0.011, F_y_gain 1.495 ± 0.009,
+/// c_s 5.4 ± 1.1: so this test stays at one rate until the Jacobian is above that noise.
 #[test]
 #[ignore]
 fn a_yield_force_following_a_control_channel_is_recovered_at_trajectory_level() {
     for seed in [1, 2] {
         let dir = tempfile::tempdir().unwrap();
-        let json = simulated_and_fitted(dir.path(), &experiment(seed, "trajectory"));
+        let json = simulated_and_fitted(dir.path(), &experiment(seed, "trajectory", RATES[0]));
         let law = &json["models"][0];
         for (name, truth) in [("F_y_base", 0.5), ("F_y_gain", 1.5), ("c_s", 5.0)] {
             let got = law["params"][name].as_f64().unwrap();
@@ -132,39 +145,89 @@ fn a_yield_force_following_a_control_channel_is_recovered_at_trajectory_level() 
     }
 }
 
-/// The discovery experiment of the record `r.csv`, its channel declared.
-const DISCOVER: &str = "[data]\nfile = \"r.csv\"\nchannels = [\"u_ctrl\"]\n\n\
+/// The discovery experiment of the record `r.csv`, its channel declared, the force offset
+/// fitted.
+const DISCOVER: &str = "[data]\nfile = \"r.csv\"\nchannels = [\"u_ctrl\"]\n\n[fit]\noffset = true\n\n\
                         [discover]\nbase = \"viscous + yield\"\ncandidates = [\"cubic_stiffness\"]\n";
 
-/// On records without the force offset: with the 50 N offset and `[fit] offset = true`,
-/// discovery's base fit of `viscous + yield` stays far from its optimum (held-out RMS 0.91 N
-/// against 0.28 N for the same model inside the candidate's sum, measured on seed 1), and any
-/// candidate — the law or `cubic_stiffness` — is then accepted for the base's misfit.
+/// Damper-like records with a large force offset (50 or 150 N, a hundred times the yield
+/// force) fitted with `[fit] offset = true`, two seeds at two sweep rates: where F_y follows
+/// the control channel the law is named; where it is constant nothing is. (The offset started
+/// at 0, unbounded, at a scale of 0.1 N, once left the base's fit far from its optimum —
+/// held-out RMS 0.91 N against 0.28 N — and the law or `cubic_stiffness` was then named for
+/// the base's misfit.)
 #[test]
 fn discovery_names_the_channel_law_only_where_the_parameter_follows_the_channel() {
-    for (seed, follows) in [(1, true), (2, true), (1, false), (2, false)] {
-        let dir = tempfile::tempdir().unwrap();
-        let mut make = experiment(seed, "force").replace("offsets = { f_stf = 50.0 }\n", "");
-        if !follows {
-            make = make.replace(
-                "F_y = { law = \"affine\", channel = \"u_ctrl\", base = 0.5, gain = 1.5 }",
-                "F_y = 1.25",
-            );
+    let cases = [
+        (1, RATES[0], 50.0),
+        (2, RATES[0], 150.0),
+        (1, RATES[1], 150.0),
+        (2, RATES[1], 50.0),
+    ];
+    for (seed, alpha, offset) in cases {
+        for follows in [true, false] {
+            let dir = tempfile::tempdir().unwrap();
+            let mut make = experiment(seed, "force", alpha)
+                .replace("f_stf = 50.0", &format!("f_stf = {offset}"));
+            if !follows {
+                make = make.replace(
+                    "F_y = { law = \"affine\", channel = \"u_ctrl\", base = 0.5, gain = 1.5 }",
+                    "F_y = 1.25",
+                );
+            }
+            let (make_path, exp) = (dir.path().join("make.toml"), dir.path().join("exp.toml"));
+            std::fs::write(&make_path, make).unwrap();
+            simulate_ok(&make_path, &dir.path().join("r.csv"));
+            std::fs::write(&exp, DISCOVER).unwrap();
+            let out = dir.path().join("out");
+            let printed = run_ok("discover", &exp, &out);
+            let json = read_json(&out.join("discovery.json"));
+            let case =
+                format!("seed {seed}, sweep {alpha} rad/s², offset {offset} N, follows {follows}");
+            let named = json["effects"].as_array().unwrap();
+            let expected = if follows {
+                vec!["yield.F_y~u_ctrl"]
+            } else {
+                vec![]
+            };
+            assert_eq!(named, &expected, "{case}: effects {}", json["effects"]);
+            if follows {
+                pasted_back_fits(dir.path(), &printed.stdout, &json, &case);
+            }
         }
-        let (make_path, exp) = (dir.path().join("make.toml"), dir.path().join("exp.toml"));
-        std::fs::write(&make_path, make).unwrap();
-        simulate_ok(&make_path, &dir.path().join("r.csv"));
-        std::fs::write(&exp, DISCOVER).unwrap();
-        let out = dir.path().join("out");
-        run_ok("discover", &exp, &out);
-        let json = read_json(&out.join("discovery.json"));
-        let named = json["effects"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|e| e == "yield.F_y~u_ctrl");
-        assert_eq!(named, follows, "seed {seed}: effects {}", json["effects"]);
     }
+}
+
+/// The entry `discover` printed for a law effect (on the terminal and in `discovery.json`),
+/// pasted as it is into an experiment on the same record, loads and fits: the effect
+/// `yield.F_y~u_ctrl` is printed as the law it adds up to, `F_y = { law = "affine", channel =
+/// "u_ctrl", base = …, gain = … }`, and the refit recovers the truth's gain.
+fn pasted_back_fits(dir: &Path, stdout: &[u8], json: &serde_json::Value, case: &str) {
+    let entry = json["final_model"]["experiment_entry"].as_str().unwrap();
+    assert!(
+        entry.contains("F_y = { law = \"affine\", channel = \"u_ctrl\", base = ")
+            && !entry.contains('~'),
+        "{case}: {entry}"
+    );
+    let stdout = String::from_utf8_lossy(stdout);
+    let shown = stdout
+        .split("final model, as an experiment entry:\n")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no entry printed: {stdout}"));
+    assert!(shown.starts_with(entry), "{shown}");
+    let refit = dir.join("refit.toml");
+    std::fs::write(
+        &refit,
+        format!("[data]\nfile = \"r.csv\"\n\n[fit]\noffset = true\n\n{entry}"),
+    )
+    .unwrap();
+    run_ok("fit", &refit, &dir.join("refit"));
+    let fitted = &read_json(&dir.join("refit/fit.json"))["models"][0];
+    let gain = fitted["params"]["F_y_gain"].as_f64().unwrap();
+    assert!(
+        (gain / 1.5 - 1.0).abs() < 0.15,
+        "{case}: F_y_gain {gain}\n{fitted}"
+    );
 }
 
 /// `exp.toml` in a fresh folder with `text`, and the message of `command` on it.

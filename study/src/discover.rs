@@ -33,7 +33,7 @@ use crate::fitting::{load_data_at, oscillator_fit, system_param, FitData};
 use crate::model_config::resolve;
 use crate::observer::{discovery_observer, Observer};
 use crate::outputs::discovery_json::{DiscoveryJson, FinalSystemJson};
-use crate::outputs::models_entry::{ModelsEntry, SystemEntry};
+use crate::outputs::models_entry::SystemEntry;
 use crate::validation::{DiscoveryScore, ValidationRecord};
 use crate::verdict::{discover_verdict, DiscoverVerdict};
 
@@ -377,22 +377,12 @@ fn results<'a>(
     };
     let model_params: Vec<&FittedParam> = found.final_params.iter().filter(|p| !own(p)).collect();
     // The final model as an experiment's `[[models]]` entry that `fit` and `compare` accept
-    // as it is (TOML).
-    // A script's term is named by its path, which an experiment loads it by.
-    let terms: Vec<&str> = found
-        .final_model
-        .terms()
-        .into_iter()
-        .map(|t| {
-            script_paths
-                .iter()
-                .find(|(name, _)| name == t)
-                .map_or(t, |(_, path)| path.as_str())
-        })
-        .collect();
-    let toml_entry = ModelsEntry::new(&terms, model_params.iter().copied())
-        .to_toml()
-        .context("cannot write the final model as an experiment entry")?;
+    // as it is (TOML): scripts by their paths, a channel law in the law's syntax.
+    let terms = found.final_model.terms();
+    let toml_entry =
+        crate::discovered_entry::final_entry(exp, &terms, &model_params, script_paths)?
+            .to_toml()
+            .context("cannot write the final model as an experiment entry")?;
     let (doc, system_entry) = match &found.trajectory {
         None => {
             let all: Vec<&FittedParam> = found.final_params.iter().collect();

@@ -24,6 +24,7 @@ pub mod compare;
 pub mod data_layout;
 pub mod digits;
 pub mod discover;
+pub mod discovered_entry;
 pub mod discovery_curves;
 pub mod equation;
 pub mod error;

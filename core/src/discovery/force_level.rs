@@ -39,7 +39,16 @@ impl SearchModel {
     /// as it is. (This used to move values 1 % of the width below an upper bound, so a refit
     /// from a training fit with `p` = 3 started elsewhere; the stall it worked around was the
     /// transform moving interior starts, now fixed.)
-    fn force_fit(&self, settings: &DiscoverySettings) -> Result<ForceFit, DiscoveryError> {
+    ///
+    /// The offset `f_off` (with `settings.fit_offset`) is bounded by ± `reach` (twice the
+    /// record's largest |force|) and scaled to a thousandth of it, as a plain fit bounds it:
+    /// unbounded at a scale of 0.1 N, a 120 N offset cost Levenberg–Marquardt so many damped
+    /// steps that the base's fit stopped far from its optimum.
+    fn force_fit(
+        &self,
+        settings: &DiscoverySettings,
+        reach: f64,
+    ) -> Result<ForceFit, DiscoveryError> {
         let model = self.model()?;
         let mut fit = started_fit(&model, &self.values).settings(settings.fit.clone());
         if settings.fit_offset {
@@ -48,7 +57,10 @@ impl SearchModel {
                 .get(model.params().len())
                 .copied()
                 .unwrap_or(0.0);
-            fit = fit.offset(FitParam::new(FORCE_OFFSET, start));
+            let offset = FitParam::new(FORCE_OFFSET, start.clamp(-reach, reach))
+                .bounds(-reach, reach)
+                .scale(1e-3 * reach);
+            fit = fit.offset(offset);
         }
         Ok(fit)
     }
@@ -284,6 +296,8 @@ pub(super) struct ForceLevel<'a> {
     split: HoldoutSplit,
     sensor: f64,
     settings: &'a DiscoverySettings,
+    /// The offset's bound: twice the largest |measured force| (1 N for a record of zeros).
+    offset_reach: f64,
 }
 
 impl<'a> ForceLevel<'a> {
@@ -296,12 +310,18 @@ impl<'a> ForceLevel<'a> {
     ) -> Result<Self, DiscoveryError> {
         let sensor = settings.floor_of(data.f, "force", "N")?;
         let split = HoldoutSplit::new(data.t.len(), cycles, settings.holdout_every)?;
+        let largest = data
+            .f
+            .iter()
+            .filter(|f| f.is_finite())
+            .fold(0.0_f64, |m, f| m.max(f.abs()));
         Ok(ForceLevel {
             data,
             cycles,
             split,
             sensor,
             settings,
+            offset_reach: if largest > 0.0 { 2.0 * largest } else { 1.0 },
         })
     }
 
@@ -379,19 +399,37 @@ impl Level for ForceLevel<'_> {
         &self.split
     }
 
+    /// The base's defaults, and the offset (if fitted) at the mean of the measured force less
+    /// the base's at its defaults: the offset's least-squares value for them, so a large sensor
+    /// offset is not left for the fit to walk to.
+    fn start(&self, base: &Arc<dyn ForceModel>) -> SearchModel {
+        let mut start = SearchModel::at_defaults(base, &[], self.settings.fit_offset);
+        if self.settings.fit_offset {
+            let r = self.residual(&start).unwrap_or_default();
+            let finite: Vec<f64> = r.into_iter().filter(|v| v.is_finite()).collect();
+            if !finite.is_empty() {
+                let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+                if let Some(off) = start.values.last_mut() {
+                    *off = mean.clamp(-self.offset_reach, self.offset_reach);
+                }
+            }
+        }
+        start
+    }
+
     fn fit(
         &self,
         stage: &SearchModel,
         subset: &[usize],
         settings: &DiscoverySettings,
     ) -> Result<(SearchModel, FitResult), DiscoveryError> {
-        let fit = stage.force_fit(settings)?;
+        let fit = stage.force_fit(settings, self.offset_reach)?;
         stage.fitted(fit.fit_rows(self.data, Some(subset), &settings.fit, None))
     }
 
     /// Measured minus modelled force at every sample.
     fn residual(&self, stage: &SearchModel) -> Result<Vec<f64>, DiscoveryError> {
-        let fit = stage.force_fit(self.settings)?;
+        let fit = stage.force_fit(self.settings, self.offset_reach)?;
         let predicted = fit
             .predict(self.data, &stage.values)
             .map_err(|e| stage.fit_error(e))?;
@@ -415,7 +453,7 @@ impl Level for ForceLevel<'_> {
         let Some(motion) = self.settings.motion_noise else {
             return Ok(NoiseFloor::force(self.sensor, 0.0));
         };
-        let fit = stage.force_fit(self.settings)?;
+        let fit = stage.force_fit(self.settings, self.offset_reach)?;
         fit.noise_floor(self.data, &stage.values, self.sensor, motion)
             .map_err(|e| stage.fit_error(e))
     }

@@ -28,7 +28,35 @@ pub struct ModelEntryToml {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub plus: Vec<String>,
     /// Parameter values by name, in the model's order, SI units.
-    pub params: IndexMap<String, f64>,
+    pub params: IndexMap<String, EntryValue>,
+}
+
+/// A parameter's value in an entry: a number, or a law of a measured channel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum EntryValue {
+    /// A constant.
+    Value(f64),
+    /// `{ law = "affine", channel = "u", base = …, gain = … }`.
+    Law(LawEntry),
+}
+
+/// A parameter that follows a channel, as an experiment gives it: the law's name, its
+/// channel and its coefficients' values (those the law has).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LawEntry {
+    /// `linear`, `affine` or `power`.
+    pub law: &'static str,
+    /// The record's column.
+    pub channel: String,
+    /// P_base (not for the linear law).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base: Option<f64>,
+    /// P_gain.
+    pub gain: f64,
+    /// P_exp (the power law's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exp: Option<f64>,
 }
 
 impl ModelsEntry {
@@ -42,8 +70,24 @@ impl ModelsEntry {
                 plus: plus.iter().map(|t| t.to_string()).collect(),
                 params: params
                     .into_iter()
-                    .map(|p| (p.name.clone(), crate::digits::carried(p.value)))
+                    .map(|p| {
+                        let value = EntryValue::Value(crate::digits::carried(p.value));
+                        (p.name.clone(), value)
+                    })
                     .collect(),
+            }],
+        }
+    }
+
+    /// The entry of the model whose terms are `terms` with the values `params` as they are
+    /// (by name, laws included).
+    pub fn with_values(terms: &[&str], params: IndexMap<String, EntryValue>) -> Self {
+        let (name, plus) = terms.split_first().unwrap_or((&"none", &[]));
+        ModelsEntry {
+            models: [ModelEntryToml {
+                name: name.to_string(),
+                plus: plus.iter().map(|t| t.to_string()).collect(),
+                params,
             }],
         }
     }
@@ -110,6 +154,27 @@ mod tests {
         assert_eq!(
             zero.to_toml().unwrap(),
             "[[models]]\nname = \"none\"\nparams = {}\n"
+        );
+    }
+
+    #[test]
+    fn a_law_is_an_inline_table_in_the_params() {
+        let law = LawEntry {
+            law: "affine",
+            channel: "u_ctrl".into(),
+            base: Some(0.5),
+            gain: 1.5,
+            exp: None,
+        };
+        let params = [
+            ("c_s".to_string(), EntryValue::Value(5.0)),
+            ("F_y".to_string(), EntryValue::Law(law)),
+        ];
+        let e = ModelsEntry::with_values(&["viscous", "yield"], params.into_iter().collect());
+        assert_eq!(
+            e.to_toml().unwrap(),
+            "[[models]]\nname = \"viscous\"\nplus = [\"yield\"]\nparams = { c_s = 5.0, F_y = \
+             { law = \"affine\", channel = \"u_ctrl\", base = 0.5, gain = 1.5 } }\n"
         );
     }
 
