@@ -9,7 +9,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{read_json, root, run_ok, simulate_ok, stf_lab, succeeded};
+use common::{read_json, root, run_json, simulate_ok, stf_lab, succeeded};
 use serde_json::Value;
 
 /// A page of the documentation, relative to the project folder.
@@ -115,8 +115,7 @@ fn the_first_command_prints_what_the_readme_shows() {
 #[test]
 fn the_fit_walk_through_shows_the_fitted_values() {
     let (_dir, dir) = out("fit");
-    run_ok("fit", &example("power_law_fit.toml"), &dir);
-    let fit = read_json(&dir.join("fit.json"));
+    let fit = run_json("fit", &example("power_law_fit.toml"), &dir, "fit.json");
     let models = fit["models"].as_array().unwrap();
     let pl = models
         .iter()
@@ -144,8 +143,12 @@ fn the_fit_walk_through_shows_the_fitted_values() {
 #[test]
 fn the_compare_example_s_regimes_and_z_values_are_the_pages() {
     let (_dir, dir) = out("cmp");
-    run_ok("compare", &example("jamming_compare.toml"), &dir);
-    let c = read_json(&dir.join("compare.json"));
+    let c = run_json(
+        "compare",
+        &example("jamming_compare.toml"),
+        &dir,
+        "compare.json",
+    );
     let cycles = &c["measured"]["cycles_per_regime"];
     assert_eq!(
         num(cycles, "post_resonance"),
@@ -259,8 +262,12 @@ fn resonance_duties_after_peak(cycles: &Path) -> Vec<f64> {
 #[test]
 fn the_discovery_examples_name_what_the_pages_say() {
     let (_dir, dir) = out("disc");
-    run_ok("discover", &example("discovery.toml"), &dir);
-    let d = read_json(&dir.join("discovery.json"));
+    let d = run_json(
+        "discover",
+        &example("discovery.toml"),
+        &dir,
+        "discovery.json",
+    );
     assert_eq!(d["effects"], serde_json::json!(["cubic_stiffness"]));
     let gap = format!(
         "went from {:.4} to {:.4} N against a noise floor of {:.4} N",
@@ -308,8 +315,12 @@ fn the_discovery_examples_name_what_the_pages_say() {
     );
 
     let (_dir, dir) = out("tdisc");
-    run_ok("discover", &example("trajectory_discovery.toml"), &dir);
-    let t = read_json(&dir.join("discovery.json"));
+    let t = run_json(
+        "discover",
+        &example("trajectory_discovery.toml"),
+        &dir,
+        "discovery.json",
+    );
     assert_eq!(t["effects"], serde_json::json!(["cubic_stiffness"]));
     let s = format!(
         "S(μ) {:.4} → {:.4} mm²",
@@ -343,8 +354,12 @@ fn the_discovery_examples_name_what_the_pages_say() {
 #[test]
 fn the_identification_example_gives_the_benchmark_page_s_figures() {
     let (_dir, dir) = out("id");
-    run_ok("fit", &example("paper_identification.toml"), &dir);
-    let id = read_json(&dir.join("fit.json"));
+    let id = run_json(
+        "fit",
+        &example("paper_identification.toml"),
+        &dir,
+        "fit.json",
+    );
     let stages = id["stages"].as_array().unwrap();
     let (s1, s2) = (num(&stages[0], "s_mm2"), num(&stages[1], "s_mm2"));
     let dt = num(&stages[1], "params/delta_T");
