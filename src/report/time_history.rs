@@ -231,18 +231,23 @@ pub fn time_history(
 mod tests {
     use super::*;
     use crate::report::figure::SIZE_TALL;
-    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+    use crate::report::test_signals::{assert_rendered, column, damped_sine, Signals};
+
+    /// The motion of the signals `s`.
+    fn motion_of(s: &Signals) -> Motion<'_> {
+        Motion {
+            t: &s.t,
+            x: &s.x,
+            v: &s.v,
+            a: &s.a,
+        }
+    }
 
     #[test]
     fn renders_a_long_damped_sine_decimated_with_its_extrema() {
         let s = damped_sine(60_000, 10.0);
         let dir = tempfile::tempdir().unwrap();
-        let motion = Motion {
-            t: &s.t,
-            x: &s.x,
-            v: &s.v,
-            a: &s.a,
-        };
+        let motion = motion_of(&s);
         let files = time_history(
             dir.path(),
             "history",
@@ -297,12 +302,7 @@ mod tests {
     fn without_a_force_the_motion_alone_is_drawn() {
         let s = damped_sine(6_000, 10.0);
         let dir = tempfile::tempdir().unwrap();
-        let motion = Motion {
-            t: &s.t,
-            x: &s.x,
-            v: &s.v,
-            a: &s.a,
-        };
+        let motion = motion_of(&s);
         let files =
             time_history(dir.path(), "history", &motion, None, &MotionLabels::LENGTH).unwrap();
         let cols = assert_rendered(&files, SIZE_TALL);
@@ -319,10 +319,8 @@ mod tests {
     fn mismatched_lengths_are_an_error() {
         let s = damped_sine(100, 1.0);
         let motion = Motion {
-            t: &s.t,
             x: &s.x[..50],
-            v: &s.v,
-            a: &s.a,
+            ..motion_of(&s)
         };
         let dir = tempfile::tempdir().unwrap();
         let err =
