@@ -18,10 +18,10 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use std::time::{Duration, Instant};
 
-use common::slurm::{job_ids, logs, slurm, text, wait_for};
+use common::slurm::{collected, job_ids, logs, scancel, slurm, submitted, text, wait_for};
 use common::{read_json, root, stf_lab};
 
 /// Three records of the bundled campaign (three concentrations, three amplitudes) copied into
@@ -147,17 +147,9 @@ fn a_campaign_through_single_node_slurm_gives_the_local_run_s_outputs() {
     let cluster = tmp.path().join("cluster");
     let env = [("SLURM_CONF", conf.as_os_str())];
     let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
-    let run = campaign(&file, &cluster, &flags, &env);
-    assert!(
-        run.status.success(),
-        "{}{}",
-        text(&run.stdout),
-        text(&run.stderr)
-    );
-    let (units, collect) = job_ids(&text(&run.stdout));
+    let (_, units, collect) = submitted(&campaign(&file, &cluster, &flags, &env));
     assert_eq!(units.len(), 1, "three units fit one array");
-    let state = wait_for(&collect, &cluster, &conf);
-    assert_eq!(state, "COMPLETED", "{}", logs(&cluster, &conf));
+    collected(&collect, &cluster, &conf, "COMPLETED");
     assert_eq!(wait_for(&units[0], &cluster, &conf), "COMPLETED");
 
     let names = results(&local);
@@ -206,23 +198,11 @@ fn a_unit_failing_on_the_cluster_is_named_by_the_collect_job() {
     let file = small_campaign(&tmp.path().join("campaign"), true);
     let out = tmp.path().join("out");
     let env = [("SLURM_CONF", conf.as_os_str())];
-    let run = campaign(&file, &out, &["--slurm", "--time", "00:10:00"], &env);
-    assert!(
-        run.status.success(),
-        "{}{}",
-        text(&run.stdout),
-        text(&run.stderr)
-    );
-    let (units, collect) = job_ids(&text(&run.stdout));
-    assert_eq!(
-        wait_for(&collect, &out, &conf),
-        "FAILED",
-        "{}",
-        logs(&out, &conf)
-    );
+    let flags = ["--slurm", "--time", "00:10:00"];
+    let (_, units, collect) = submitted(&campaign(&file, &out, &flags, &env));
+    let log = collected(&collect, &out, &conf, "FAILED");
     // Three tasks ran their unit, the fourth failed; the collect job ran all the same.
     assert_eq!(wait_for(&units[0], &out, &conf), "COMPLETED,FAILED");
-    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
     assert!(
         log.contains("1 of 4 unit(s) failed") && log.contains("unit 4 (records/broken.csv): "),
         "{log}"
@@ -489,28 +469,15 @@ fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
     let out = tmp.path().join("out");
     let env = [("SLURM_CONF", conf.as_os_str())];
     let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
-    let run = campaign(&file, &out, &flags, &env);
-    let said = text(&run.stdout);
-    assert!(run.status.success(), "{said}{}", text(&run.stderr));
-    let (units, collect) = job_ids(&said);
+    let (said, units, collect) = submitted(&campaign(&file, &out, &flags, &env));
     assert_eq!(units.len(), 2, "{said}");
     assert!(
         said.contains("4 unit(s) in 4 task(s) of at most 1 unit(s) ([slurm] units_per_task), 2 array(s) of at most 3 task(s) ([slurm] max_array_size)"),
         "{said}"
     );
     // The scheduler kills task 2 of the first array (unit 3) before it runs.
-    let cancel = Command::new("scancel")
-        .arg(format!("{}_2", units[0]))
-        .env("SLURM_CONF", &conf)
-        .output()
-        .unwrap();
-    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
-    assert_eq!(
-        wait_for(&collect, &out, &conf),
-        "FAILED",
-        "{}",
-        logs(&out, &conf)
-    );
+    scancel(&format!("{}_2", units[0]), &conf);
+    let log = collected(&collect, &out, &conf, "FAILED");
     // (squeue may no longer list a task cancelled while it waited.)
     let states = wait_for(&units[0], &out, &conf);
     assert!(
@@ -518,7 +485,6 @@ fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
         "{states}"
     );
     assert_eq!(wait_for(&units[1], &out, &conf), "COMPLETED");
-    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
     assert!(
         log.contains("1 of 4 unit(s) failed")
             && log.contains("unit 3 (records/a3_c3.csv): it did not finish: no unit.json in"),
@@ -535,18 +501,10 @@ fn arrays_split_within_max_array_size_and_a_cancelled_task_is_rerun_alone() {
     assert_eq!(finished.len(), 3, "{finished:?}");
 
     // Submitted again: only unit 3 goes to Slurm; the finished units are not touched.
-    let again = campaign(&file, &out, &flags, &env);
-    let said = text(&again.stdout);
-    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    let (said, units, collect) = submitted(&campaign(&file, &out, &flags, &env));
     assert!(said.contains("1 unit(s) in 1 task(s)"), "{said}");
-    let (units, collect) = job_ids(&said);
     assert_eq!(units.len(), 1, "{said}");
-    assert_eq!(
-        wait_for(&collect, &out, &conf),
-        "COMPLETED",
-        "{}",
-        logs(&out, &conf)
-    );
+    collected(&collect, &out, &conf, "COMPLETED");
     let now = unit_stamps(&out);
     assert_eq!(now.len(), 4, "{now:?}");
     for stamp in &finished {
@@ -623,10 +581,7 @@ fn a_running_task_killed_by_the_scheduler_is_named_with_slurm_s_reason() {
     let out = tmp.path().join("out");
     let env = [("SLURM_CONF", conf.as_os_str())];
     let flags = ["--slurm", "--time", "00:10:00", "--mem", "500M"];
-    let run = campaign(&file, &out, &flags, &env);
-    let said = text(&run.stdout);
-    assert!(run.status.success(), "{said}{}", text(&run.stderr));
-    let (units, collect) = job_ids(&said);
+    let (_, units, collect) = submitted(&campaign(&file, &out, &flags, &env));
     // The task writes unit 1's log as it starts the unit: then it is running, with three
     // units (each a process of its own) ahead of it.
     let started = Instant::now();
@@ -638,19 +593,8 @@ fn a_running_task_killed_by_the_scheduler_is_named_with_slurm_s_reason() {
         );
         std::thread::sleep(Duration::from_millis(20));
     }
-    let cancel = Command::new("scancel")
-        .arg(format!("{}_0", units[0]))
-        .env("SLURM_CONF", &conf)
-        .output()
-        .unwrap();
-    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
-    assert_eq!(
-        wait_for(&collect, &out, &conf),
-        "FAILED",
-        "{}",
-        logs(&out, &conf)
-    );
-    let log = std::fs::read_to_string(out.join("slurm/collect.log")).unwrap();
+    scancel(&format!("{}_0", units[0]), &conf);
+    let log = collected(&collect, &out, &conf, "FAILED");
     assert!(
         log.contains("it did not finish: no unit.json in")
             && log.contains("Slurm stopped its task: \"JOB ")
@@ -661,20 +605,12 @@ fn a_running_task_killed_by_the_scheduler_is_named_with_slurm_s_reason() {
     assert!(finished.len() < 3, "{finished:?}");
 
     // Submitted again: the units the kill stopped run; a unit that had finished stays as it was.
-    let again = campaign(&file, &out, &flags, &env);
-    let said = text(&again.stdout);
-    assert!(again.status.success(), "{said}{}", text(&again.stderr));
+    let (said, _, collect) = submitted(&campaign(&file, &out, &flags, &env));
     assert!(
         said.contains(&format!("{} unit(s) in 1 task(s)", 3 - finished.len())),
         "{said}"
     );
-    let (_, collect) = job_ids(&said);
-    assert_eq!(
-        wait_for(&collect, &out, &conf),
-        "COMPLETED",
-        "{}",
-        logs(&out, &conf)
-    );
+    collected(&collect, &out, &conf, "COMPLETED");
     let now = unit_stamps(&out);
     assert_eq!(now.len(), 3, "{now:?}");
     for stamp in &finished {

@@ -2,18 +2,14 @@
 
 mod common;
 
-use common::{read_json, root, run_ok};
+use common::{bundled_experiment, root, run_json, write_file};
 
 #[test]
 fn the_truth_ranks_first_and_viscous_misses_the_on_off_force() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("cmp");
-    let _ = run_ok(
-        "compare",
-        &root().join("experiments/jamming_compare.toml"),
-        &dir,
-    );
-    let doc = read_json(&dir.join("compare.json"));
+    let experiment = root().join("experiments/jamming_compare.toml");
+    let doc = run_json("compare", &experiment, &dir, "compare.json");
     assert_eq!(doc["best"]["overall"], "jamming_on_off");
     assert_eq!(doc["best"]["resonance"], "jamming_on_off");
     assert_eq!(doc["measured"]["no_stf"], false);
@@ -102,17 +98,10 @@ fn the_truth_ranks_first_and_viscous_misses_the_on_off_force() {
 #[test]
 fn the_amplitude_criterion_remains_as_an_option() {
     let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(root().join("experiments/jamming_compare.toml")).unwrap();
-    let record = root().join("experiments/records/jamming_sweep.csv");
-    let text = text.replace(
-        "file = \"records/jamming_sweep.csv\"",
-        &format!("file = {:?}", record.display().to_string()),
-    ) + "\n[regimes]\namplitude_rule = true\n";
-    let exp = dir.path().join("amplitude.toml");
-    std::fs::write(&exp, text).unwrap();
+    let text = bundled_experiment("jamming_compare.toml") + "\n[regimes]\namplitude_rule = true\n";
+    let exp = write_file(dir.path(), "amplitude.toml", &text);
     let out = dir.path().join("cmp");
-    let _ = run_ok("compare", &exp, &out);
-    let doc = read_json(&out.join("compare.json"));
+    let doc = run_json("compare", &exp, &out, "compare.json");
     let bounds = &doc["measured"]["boundaries"];
     for b in ["pre_resonance", "resonance_post"] {
         assert_eq!(bounds[b]["rule"], "amplitude", "{bounds}");
@@ -131,21 +120,11 @@ fn the_amplitude_criterion_remains_as_an_option() {
 #[test]
 fn compare_runs_on_the_bundled_chirp_record() {
     let out = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(root().join("experiments/trajectory_discovery.toml"))
-        .unwrap()
-        .replace(
-            "records/trajectory_discovery.csv",
-            &root()
-                .join("experiments/records/trajectory_discovery.csv")
-                .display()
-                .to_string(),
-        )
-        + "\n[[models]]\nname = \"viscous\"\n";
-    let exp = out.path().join("chirp.toml");
-    std::fs::write(&exp, text).unwrap();
+    let text =
+        bundled_experiment("trajectory_discovery.toml") + "\n[[models]]\nname = \"viscous\"\n";
+    let exp = write_file(out.path(), "chirp.toml", &text);
     let dir = out.path().join("cmp");
-    let _ = run_ok("compare", &exp, &dir);
-    let doc = read_json(&dir.join("compare.json"));
+    let doc = run_json("compare", &exp, &dir, "compare.json");
     let models = doc["models"].as_array().unwrap();
     assert_eq!(models.len(), 1);
     assert_eq!(models[0]["name"], "viscous");

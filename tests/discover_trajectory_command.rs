@@ -134,6 +134,18 @@ fn the_bundled_example_names_the_cubic_spring() {
     assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
     let k3 = doc["final_model"]["params"]["k3"].as_f64().unwrap();
     assert!((k3 / 1e4 - 1.0).abs() < 0.05, "k3 = {k3}");
+    // At trajectory level the lab reads no STF force (the record's column is the simulation's,
+    // not a sensor's): the record's time history is its motion, with no F_STF panel, marks
+    // or loops.
+    let history = std::fs::read_to_string(out.join("figures/time_history.csv")).unwrap();
+    let header = history.lines().next().unwrap();
+    assert!(
+        header.contains("x, mm") && !header.contains("F_STF"),
+        "{header}"
+    );
+    let svg = std::fs::read_to_string(out.join("figures/time_history.svg")).unwrap();
+    assert!(!svg.contains("F_STF maxima"));
+    assert!(!out.join("figures/hysteresis_x.csv").exists());
     // The report shows the x residual before and after, in mm: the final one is smaller.
     let csv = std::fs::read_to_string(out.join("figures/discovery_x_residual.csv")).unwrap();
     let mut lines = csv.lines();

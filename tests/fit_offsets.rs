@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{read_json, run, run_ok, simulate_ok};
+use common::{damper_record, run, run_json, simulate_ok};
 
 /// The shaker rig of `experiments/trajectory_discovery.toml` (a chirp force through
 /// resonance, x noise 0.05 mm quantised to 0.01 mm) with a cubic spring and `f_off` hidden in
@@ -37,12 +37,9 @@ fn a_constant_force_offset_is_fitted_with_its_standard_error() {
         std::fs::write(&fit_path, fit).unwrap();
         simulate_ok(&make_path, &dir.path().join("r.csv"));
         let out = dir.path().join("fit");
-        run_ok("fit", &fit_path, &out);
-        let model = &read_json(&out.join("fit.json"))["models"][0];
-        let (got, se) = (
-            model["params"]["f_off"].as_f64().unwrap(),
-            model["std_errors"]["f_off"].as_f64().unwrap(),
-        );
+        let fit = run_json("fit", &fit_path, &out, "fit.json");
+        let model = &fit["models"][0];
+        let (got, se) = value_and_error(model, "f_off");
         let k3 = model["params"]["k3"].as_f64().unwrap();
         assert!(
             (got - 0.3).abs() < 0.03 && (got - 0.3).abs() < 3.0 * se.max(1e-3),
@@ -54,8 +51,8 @@ fn a_constant_force_offset_is_fitted_with_its_standard_error() {
         let with_x_off = with_x_off.replace("[fit]\n", "[fit]\noffset = true\n");
         std::fs::write(&fit_path, with_x_off).unwrap();
         let out_x = dir.path().join("fit_x");
-        run_ok("fit", &fit_path, &out_x);
-        let model_x = &read_json(&out_x.join("fit.json"))["models"][0];
+        let fit_x = run_json("fit", &fit_path, &out_x, "fit.json");
+        let model_x = &fit_x["models"][0];
         let (rms_f, rms_x) = (
             model["rms"].as_f64().unwrap(),
             model_x["rms"].as_f64().unwrap(),
@@ -121,8 +118,7 @@ fn a_linear_base_finds_the_spring_and_leaves_out_the_duplicate_of_c() {
     let path = dir.path().join("discover.toml");
     std::fs::write(&path, discover).unwrap();
     let out = dir.path().join("d");
-    run_ok("discover", &path, &out);
-    let found = read_json(&out.join("discovery.json"));
+    let found = run_json("discover", &path, &out, "discovery.json");
     assert_eq!(
         found["effects"],
         serde_json::json!(["cubic_stiffness"]),
@@ -138,16 +134,7 @@ fn a_linear_base_finds_the_spring_and_leaves_out_the_duplicate_of_c() {
 /// with a force sensor's offset of −124 N added to F_STF, and the experiment that fits it at
 /// force level with `offset = true`; `extra` goes into the model's entry.
 fn damper(dir: &std::path::Path, seed: u64, f1: f64, extra: &str) -> std::path::PathBuf {
-    let make = format!(
-        "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
-         [simulate]\nchirp = {{ f0 = 0.5, f1 = {f1}, amplitude = 600.0, t1 = 10.0 }}\n\
-         rate = 1000.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"viscous\"\n\
-         params = {{ c_s = 800.0 }}\n\n[[simulate.truth]]\nname = \"yield\"\n\
-         params = {{ F_y = {{ value = 150.0, max = 1000.0 }} }}\n"
-    );
-    let make_path = dir.join("make.toml");
-    std::fs::write(&make_path, make).unwrap();
-    simulate_ok(&make_path, &dir.join("r.csv"));
+    damper_record(dir, seed, f1);
     let text = std::fs::read_to_string(dir.join("r.csv")).unwrap();
     let mut lines = text.lines();
     let header = lines.next().unwrap();
@@ -167,6 +154,14 @@ fn damper(dir: &std::path::Path, seed: u64, f1: f64, extra: &str) -> std::path::
     let fit_path = dir.join("fit.toml");
     std::fs::write(&fit_path, fit).unwrap();
     fit_path
+}
+
+/// A fitted model's value of `name` and its standard error.
+fn value_and_error(model: &serde_json::Value, name: &str) -> (f64, f64) {
+    (
+        model["params"][name].as_f64().unwrap(),
+        model["std_errors"][name].as_f64().unwrap(),
+    )
 }
 
 /// The rows of `params.csv` as (parameter, at_bound).
@@ -191,12 +186,9 @@ fn a_large_force_offset_is_recovered_inside_bounds_that_follow_the_force() {
         let dir = tempfile::tempdir().unwrap();
         let fit_path = damper(dir.path(), seed, f1, "");
         let out = dir.path().join("fit");
-        run_ok("fit", &fit_path, &out);
-        let model = &read_json(&out.join("fit.json"))["models"][0];
-        let (got, se) = (
-            model["params"]["f_off"].as_f64().unwrap(),
-            model["std_errors"]["f_off"].as_f64().unwrap(),
-        );
+        let fit = run_json("fit", &fit_path, &out, "fit.json");
+        let model = &fit["models"][0];
+        let (got, se) = value_and_error(model, "f_off");
         assert!(
             (got + 124.0).abs() < 2.0 && (got + 124.0).abs() < 4.0 * se,
             "seed {seed}: f_off {got} ± {se}, truth −124\n{model}"
@@ -228,8 +220,8 @@ fn a_parameter_held_by_a_bound_is_flagged() {
         "params = { F_y = { value = 20.0, max = 100.0 } }\n",
     );
     let out = dir.path().join("fit");
-    run_ok("fit", &fit_path, &out);
-    let model = &read_json(&out.join("fit.json"))["models"][0];
+    let fit = run_json("fit", &fit_path, &out, "fit.json");
+    let model = &fit["models"][0];
     let held: Vec<&serde_json::Value> = model["warnings"]
         .as_array()
         .unwrap()

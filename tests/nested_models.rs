@@ -7,21 +7,12 @@
 
 mod common;
 
-use common::{read_json, run_ok, simulate_ok};
+use common::{damper_record, run_json};
 
 /// The damper record of `seed` on a chirp 0.5 → `f1` Hz, and the experiment fitting both
 /// sums to it at force level.
 fn damper(dir: &std::path::Path, seed: u64, f1: f64) -> std::path::PathBuf {
-    let make = format!(
-        "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
-         [simulate]\nchirp = {{ f0 = 0.5, f1 = {f1}, amplitude = 600.0, t1 = 10.0 }}\n\
-         rate = 1000.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"viscous\"\n\
-         params = {{ c_s = 800.0 }}\n\n[[simulate.truth]]\nname = \"yield\"\n\
-         params = {{ F_y = {{ value = 150.0, max = 1000.0 }} }}\n"
-    );
-    let make_path = dir.join("make.toml");
-    std::fs::write(&make_path, make).unwrap();
-    simulate_ok(&make_path, &dir.join("r.csv"));
+    damper_record(dir, seed, f1);
     let fit = "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\n\
                delta_T = 0.0\n\n[fit]\nlevel = \"force\"\n\n[[models]]\nname = \"viscous\"\n\
                plus = [\"yield\"]\n\n[[models]]\nname = \"viscous\"\n\
@@ -39,8 +30,7 @@ fn a_sum_with_one_more_term_never_ends_worse_than_the_sum_it_contains() {
         let dir = tempfile::tempdir().unwrap();
         let fit_path = damper(dir.path(), seed, f1);
         let out = dir.path().join("fit");
-        run_ok("fit", &fit_path, &out);
-        let models = read_json(&out.join("fit.json"))["models"].clone();
+        let models = run_json("fit", &fit_path, &out, "fit.json")["models"].clone();
         let rms = |i: usize| models[i]["rms"].as_f64().unwrap();
         assert!(
             rms(1) <= rms(0) * (1.0 + 1e-6),

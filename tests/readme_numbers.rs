@@ -9,7 +9,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{read_json, root, run_ok, simulate_ok, stf_lab, succeeded};
+use common::{read_json, root, run_json, simulate_ok, stf_lab, succeeded};
 use serde_json::Value;
 
 /// A page of the documentation, relative to the project folder.
@@ -79,6 +79,14 @@ fn example(file: &str) -> PathBuf {
     root().join("experiments").join(file)
 }
 
+/// `stf-lab COMMAND` on the bundled example `file` into a fresh folder: the folder's guard,
+/// the folder and its JSON result `result`.
+fn example_result(command: &str, file: &str, result: &str) -> (tempfile::TempDir, PathBuf, Value) {
+    let (guard, dir) = out(command);
+    let value = run_json(command, &example(file), &dir, result);
+    (guard, dir, value)
+}
+
 #[test]
 fn the_first_command_prints_what_the_readme_shows() {
     let (_dir, record) = out("sweep.csv");
@@ -114,9 +122,7 @@ fn the_first_command_prints_what_the_readme_shows() {
 
 #[test]
 fn the_fit_walk_through_shows_the_fitted_values() {
-    let (_dir, dir) = out("fit");
-    run_ok("fit", &example("power_law_fit.toml"), &dir);
-    let fit = read_json(&dir.join("fit.json"));
+    let (_dir, _, fit) = example_result("fit", "power_law_fit.toml", "fit.json");
     let models = fit["models"].as_array().unwrap();
     let pl = models
         .iter()
@@ -143,9 +149,7 @@ fn the_fit_walk_through_shows_the_fitted_values() {
 
 #[test]
 fn the_compare_example_s_regimes_and_z_values_are_the_pages() {
-    let (_dir, dir) = out("cmp");
-    run_ok("compare", &example("jamming_compare.toml"), &dir);
-    let c = read_json(&dir.join("compare.json"));
+    let (_dir, dir, c) = example_result("compare", "jamming_compare.toml", "compare.json");
     let cycles = &c["measured"]["cycles_per_regime"];
     assert_eq!(
         num(cycles, "post_resonance"),
@@ -258,9 +262,7 @@ fn resonance_duties_after_peak(cycles: &Path) -> Vec<f64> {
 
 #[test]
 fn the_discovery_examples_name_what_the_pages_say() {
-    let (_dir, dir) = out("disc");
-    run_ok("discover", &example("discovery.toml"), &dir);
-    let d = read_json(&dir.join("discovery.json"));
+    let (_dir, _, d) = example_result("discover", "discovery.toml", "discovery.json");
     assert_eq!(d["effects"], serde_json::json!(["cubic_stiffness"]));
     let gap = format!(
         "went from {:.4} to {:.4} N against a noise floor of {:.4} N",
@@ -307,9 +309,7 @@ fn the_discovery_examples_name_what_the_pages_say() {
         ),
     );
 
-    let (_dir, dir) = out("tdisc");
-    run_ok("discover", &example("trajectory_discovery.toml"), &dir);
-    let t = read_json(&dir.join("discovery.json"));
+    let (_dir, _, t) = example_result("discover", "trajectory_discovery.toml", "discovery.json");
     assert_eq!(t["effects"], serde_json::json!(["cubic_stiffness"]));
     let s = format!(
         "S(μ) {:.4} → {:.4} mm²",
@@ -342,9 +342,7 @@ fn the_discovery_examples_name_what_the_pages_say() {
 
 #[test]
 fn the_identification_example_gives_the_benchmark_page_s_figures() {
-    let (_dir, dir) = out("id");
-    run_ok("fit", &example("paper_identification.toml"), &dir);
-    let id = read_json(&dir.join("fit.json"));
+    let (_dir, _, id) = example_result("fit", "paper_identification.toml", "fit.json");
     let stages = id["stages"].as_array().unwrap();
     let (s1, s2) = (num(&stages[0], "s_mm2"), num(&stages[1], "s_mm2"));
     let dt = num(&stages[1], "params/delta_T");

@@ -8,24 +8,16 @@ mod common;
 
 use std::path::Path;
 
-use common::{read_json, root, run_ok};
+use common::{bundled_experiment, read_json, run_ok, write_file};
 
 /// The bundled shaker experiment with its record read in volts (x in V, u in V read as N),
 /// and `extra` appended; written in `dir`.
 fn volt_experiment(dir: &Path, extra: &str) -> std::path::PathBuf {
-    let record = root().join("experiments/records/trajectory_discovery.csv");
-    let text = std::fs::read_to_string(root().join("experiments/trajectory_discovery.toml"))
-        .unwrap()
-        .replace(
-            "file = \"records/trajectory_discovery.csv\"",
-            &format!(
-                "file = \"{}\"\nunits = {{ x = \"V\", u = {{ unit = \"V\", gain = 1.0 }} }}",
-                record.display()
-            ),
-        );
-    let exp = dir.join("volts.toml");
-    std::fs::write(&exp, format!("{text}\n{extra}")).unwrap();
-    exp
+    let text = bundled_experiment("trajectory_discovery.toml").replace(
+        "trajectory_discovery.csv\"",
+        "trajectory_discovery.csv\"\nunits = { x = \"V\", u = { unit = \"V\", gain = 1.0 } }",
+    );
+    write_file(dir, "volts.toml", &format!("{text}\n{extra}"))
 }
 
 /// Every word of `text` that names a length unit or a rotor's regime.
@@ -86,18 +78,9 @@ fn a_record_in_volts_is_shown_in_millivolts_everywhere() {
 #[test]
 fn a_record_in_metres_is_still_shown_in_millimetres() {
     let tmp = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(root().join("experiments/trajectory_discovery.toml"))
-        .unwrap()
-        .replace(
-            "records/trajectory_discovery.csv",
-            &root()
-                .join("experiments/records/trajectory_discovery.csv")
-                .display()
-                .to_string(),
-        );
-    let exp = tmp.path().join("metres.toml");
-    let text = text + "\n[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\n";
-    std::fs::write(&exp, text).unwrap();
+    let text = bundled_experiment("trajectory_discovery.toml")
+        + "\n[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\n";
+    let exp = write_file(tmp.path(), "metres.toml", &text);
     let out = tmp.path().join("fit");
     let said = terminal(&run_ok("fit", &exp, &out));
     assert!(said.contains(" mm"), "{said}");

@@ -143,7 +143,7 @@ fn build_report(dir: &Path) -> PathBuf {
         &figures,
         "time_history",
         &motion,
-        &s.f,
+        Some(&s.f),
         &report::MotionLabels::LENGTH,
     )
     .unwrap();

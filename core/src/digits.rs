@@ -39,15 +39,22 @@ pub fn cell(x: f64) -> String {
 }
 
 /// `x` to `n` significant digits (at least 1) for a person to read, plain between 10⁻³ and
-/// 10⁶ (`0.001017`) and in exponent form outside (`8.78e-4`), trailing zeros dropped.
+/// 10⁶ (`0.001017`, `12 345.7`: [`grouped`]) and in exponent form outside (`8.78e-4`),
+/// trailing zeros dropped.
 pub fn significant(x: f64, n: usize) -> String {
     let digits = n.max(1) - 1;
     let x: f64 = format!("{x:.digits$e}").parse().unwrap_or(x);
     if !x.is_finite() || plain(x) {
-        fixed(x, 12)
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_string()
+        let lead = if x == 0.0 || !x.is_finite() {
+            0
+        } else {
+            x.abs().log10().floor() as i32
+        };
+        let s = fixed(x, (digits as i32 - lead).clamp(0, 12) as usize);
+        match s.contains('.') {
+            true => grouped(s.trim_end_matches('0').trim_end_matches('.')),
+            false => grouped(&s),
+        }
     } else {
         format!("{x:e}")
     }
@@ -172,17 +179,20 @@ pub fn rounded(value: f64, error: f64) -> String {
 /// error (zero, NaN, infinite) the value gets six significant digits and the error is shown
 /// as it is.
 pub fn with_error(value: f64, error: f64) -> String {
+    let (value, error) = value_and_error(value, error);
+    format!("{value} ± {error}")
+}
+
+/// `value` and `error` as [`with_error`] writes them on either side of its `±`
+/// (`("4.01", "0.06")`), for a sentence that names them apart.
+pub fn value_and_error(value: f64, error: f64) -> (String, String) {
     if !(error.is_finite() && error > 0.0) {
-        return format!("{} ± {error}", rounded(value, error));
+        return (rounded(value, error), error.to_string());
     }
     let last = last_digit(error);
     // Beside a value of a million or more (in exponent form) the error is in exponent form.
     let plainly = plain(error) && value.abs() < 1e6;
-    format!(
-        "{} ± {}",
-        to_digit(value, last),
-        to_digit_as(error, last, plainly)
-    )
+    (to_digit(value, last), to_digit_as(error, last, plainly))
 }
 
 #[cfg(test)]
@@ -208,6 +218,10 @@ mod tests {
         assert_eq!(with_error(-0.0001, 1e-9), "-1.000000e-4 ± 1.0e-9");
         assert_eq!(with_error(-4.5e-6, 3.3e-6), "-4.5e-6 ± 3.3e-6");
         assert_eq!(with_error(2.5e7, 4.0e5), "2.50e7 ± 4e5");
+        assert_eq!(
+            value_and_error(1.5184e-4, 5.60e-4),
+            ("2e-4".into(), "6e-4".into())
+        );
     }
 
     #[test]
@@ -244,6 +258,9 @@ mod tests {
         assert_eq!(significant(1234.5678, 6), "1234.57");
         assert_eq!(significant(-0.0, 3), "0");
         assert_eq!(significant(2.5e7, 2), "2.5e7");
+        assert_eq!(significant(12345.678, 6), "12 345.7");
+        assert_eq!(significant(20000.0, 3), "20 000");
+        assert_eq!(significant(0.1 + 0.2, 6), "0.3");
     }
 
     #[test]

@@ -6,6 +6,10 @@
 //!
 //! A macro rather than a trait with default methods: `ForceModel` (in core) needs `params`
 //! to lend a slice the model owns, and a trait cannot add fields to a struct.
+//!
+//! [`linear_builtin!`] declares, on top of it, a model linear in its one parameter,
+//! `F = c·φ(state)` (`viscous`, `linear_spring`, `cubic_stiffness`): its equation, force and
+//! gradient all come from the one law.
 
 /// Declare a built-in model:
 ///
@@ -67,4 +71,71 @@ macro_rules! builtin {
     };
 }
 
+/// Declare a built-in model linear in its one parameter `c`, `F = c·φ(state)`:
+///
+/// ```text
+/// linear_builtin! {
+///     /// Doc of the struct.
+///     Viscous: "viscous", "Newtonian drag F = c_s·v",
+///     param ParamSpec::new("c_s", "N·s/m", 2.0, 0.0, 1e4, "damping coefficient");
+///     law "v", |c, s| c * s.v;
+/// }
+/// ```
+///
+/// makes the model of [`builtin!`] whose force is the law at the parameter's value, whose
+/// gradient is the law at `c = 1` (exactly φ: 1·y = y in floating point, so the law may
+/// multiply `c` in first, as `c * x * x * x` does) and whose equation is `value·symbol`
+/// (`2.01·v`).
+macro_rules! linear_builtin {
+    (
+        $(#[$attr:meta])*
+        $ty:ident: $name:literal, $summary:literal,
+        param $spec:expr;
+        law $symbol:literal, |$c:ident, $s:ident| $law:expr;
+    ) => {
+        $crate::builtin::builtin! {
+            $(#[$attr])*
+            $ty: $name, $summary,
+            params [$spec];
+            impl {
+                /// The law with its value, `value·symbol`.
+                fn equation(&self, values: &[String]) -> Option<String> {
+                    let [c] = values else { return None };
+                    Some(format!("{c}·{}", $symbol))
+                }
+                #[inline]
+                fn force(
+                    &self,
+                    p: &[f64],
+                    s: &stf_core::physics::force_model::ModelState,
+                    _dz: &mut [f64],
+                ) -> Result<f64, stf_core::physics::force_model::ModelError> {
+                    let [c] = $crate::values::take(self.name(), p)?;
+                    Ok(Self::law(c, s))
+                }
+                fn gradient(
+                    &self,
+                    p: &[f64],
+                    s: &stf_core::physics::force_model::ModelState,
+                    _a: f64,
+                    grad: &mut [f64],
+                ) -> Result<bool, stf_core::physics::force_model::ModelError> {
+                    $crate::values::take::<1>(self.name(), p)?;
+                    grad[0] = Self::law(1.0, s);
+                    Ok(true)
+                }
+            }
+        }
+
+        impl $ty {
+            /// The force at coefficient `c` in state `s`.
+            #[inline]
+            fn law($c: f64, $s: &stf_core::physics::force_model::ModelState) -> f64 {
+                $law
+            }
+        }
+    };
+}
+
 pub(crate) use builtin;
+pub(crate) use linear_builtin;

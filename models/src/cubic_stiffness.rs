@@ -10,49 +10,23 @@
 //! |---|---|---|---|---|
 //! | `k3` | N/m³ | 1e5 | [0, 1e9] | cubic stiffness (0.1 N at 1 cm, 7.4 N at 42 mm) |
 
-use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
-use crate::builtin::builtin;
-use crate::values::take;
+use crate::builtin::linear_builtin;
 
-builtin! {
+linear_builtin! {
     /// Cubic (Duffing) stiffness; see the [module doc](self).
     CubicStiffness: "cubic_stiffness",
     "elastic jammed network F = k3·x³",
-    params [
-        ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "cubic stiffness of the jammed network"),
-    ];
-    impl {
-        /// The law with its values, `k3·x³`.
-        fn equation(&self, values: &[String]) -> Option<String> {
-            let [k3] = values else { return None };
-            Some(format!("{k3}·x³"))
-        }
-        #[inline]
-        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-            let [k3] = take(self.name(), p)?;
-            Ok(k3 * s.x * s.x * s.x)
-        }
-        fn gradient(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            _a: f64,
-            grad: &mut [f64],
-        ) -> Result<bool, ModelError> {
-            take::<1>(self.name(), p)?;
-            grad[0] = s.x * s.x * s.x;
-            Ok(true)
-        }
-    }
+    param ParamSpec::new("k3", "N/m³", 1e5, 0.0, 1e9, "cubic stiffness of the jammed network");
+    law "x³", |k3, s| k3 * s.x * s.x * s.x;
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use stf_core::physics::force_model::ForceModel;
+    use stf_core::physics::force_model::{ForceModel, ModelState};
 
     #[test]
     fn force_is_k3_x_cubed_whatever_the_velocity() {
@@ -69,5 +43,24 @@ mod tests {
             -1.6,
             max_relative = 1e-12
         );
+    }
+
+    #[test]
+    fn force_gradient_and_equation_follow_the_one_law() {
+        let m = CubicStiffness::new();
+        let x = 0.0123456789;
+        let s = ModelState {
+            t: 0.0,
+            x,
+            v: 0.0,
+            z: &[],
+        };
+        let k3 = 3.3e5;
+        assert_eq!(m.force(&[k3], &s, &mut []).unwrap(), k3 * x * x * x);
+        let mut grad = [f64::NAN];
+        assert!(m.gradient(&[k3], &s, 0.0, &mut grad).unwrap());
+        assert_eq!(grad[0], x * x * x);
+        assert_eq!(m.equation(&["19 987".into()]).as_deref(), Some("19 987·x³"));
+        assert!(m.force(&[], &s, &mut []).is_err());
     }
 }

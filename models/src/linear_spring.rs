@@ -11,49 +11,23 @@
 //! |---|---|---|---|---|
 //! | `k_s` | N/m | 10 | [0, 1e6] | stiffness the element adds (widened to the record's F/X) |
 
-use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
 
-use crate::builtin::builtin;
-use crate::values::take;
+use crate::builtin::linear_builtin;
 
-builtin! {
+linear_builtin! {
     /// Linear spring; see the [module doc](self).
     LinearSpring: "linear_spring",
     "elastic element F = k_s·x (an accumulator, a clamp)",
-    params [
-        ParamSpec::new("k_s", "N/m", 10.0, 0.0, 1e6, "stiffness the element adds")
-            .same_as("k"),
-    ];
-    impl {
-        /// The law with its values, `k_s·x`.
-        fn equation(&self, values: &[String]) -> Option<String> {
-            let [k_s] = values else { return None };
-            Some(format!("{k_s}·x"))
-        }
-        #[inline]
-        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-            let [k_s] = take(self.name(), p)?;
-            Ok(k_s * s.x)
-        }
-        fn gradient(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            _a: f64,
-            grad: &mut [f64],
-        ) -> Result<bool, ModelError> {
-            take::<1>(self.name(), p)?;
-            grad[0] = s.x;
-            Ok(true)
-        }
-    }
+    param ParamSpec::new("k_s", "N/m", 10.0, 0.0, 1e6, "stiffness the element adds")
+        .same_as("k");
+    law "x", |k_s, s| k_s * s.x;
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stf_core::physics::force_model::ForceModel;
+    use stf_core::physics::force_model::{ForceModel, ModelState};
 
     #[test]
     fn force_is_k_s_x_whatever_the_velocity() {

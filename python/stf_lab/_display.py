@@ -1,11 +1,13 @@
 """How results show themselves in a notebook: small HTML tables and figures.
 
 A :class:`Figure` holds the lab's own picture (the report's SVG and its PNG, drawn by the Rust
-side), shows inline in Jupyter and saves to a file (``.svg`` or ``.png`` by extension).
+side), shows inline in Jupyter — its SVG, as the HTML report does — and saves to a file
+(``.svg`` or ``.png`` by extension).
 """
 
 import base64
 import os
+import re
 from html import escape
 
 __all__ = ["Figure", "html_table", "fmt"]
@@ -59,10 +61,23 @@ class Figure:
         return self.png
 
     def html(self, width="100%"):
-        """An ``<img>`` of the PNG, inline (base64), for a result's HTML."""
-        data = base64.b64encode(self.png).decode("ascii")
-        return (f'<img alt="{escape(self.name)}" style="max-width:{width}" '
-                f'src="data:image/png;base64,{data}"/>')
+        """The SVG inline, for a result's HTML, as the HTML report shows it: sharp at any zoom,
+        at its drawing's size (its ``viewBox``, in CSS px; the SVG's width and height state its
+        print size in mm), at most ``width``. A figure without an ``<svg>`` element shows its
+        PNG."""
+        at = self.svg.find("<svg")
+        if at < 0:
+            data = base64.b64encode(self.png).decode("ascii")
+            return (f'<img alt="{escape(self.name)}" style="max-width:{width}" '
+                    f'src="data:image/png;base64,{data}"/>')
+        svg = self.svg[at:]
+        tag = svg[:svg.find(">")]
+        size = re.search(r' viewBox="[-\d.]+ [-\d.]+ ([\d.]+) ([\d.]+)"', tag)
+        style = f"max-width:{width}; height:auto"
+        if size:
+            w, h = size.groups()
+            style = f"width:{w}px; max-width:{width}; height:auto; aspect-ratio:{w} / {h}"
+        return svg.replace("<svg", f'<svg role="img" aria-label="{escape(self.name)}" style="{style}"', 1)
 
     def __repr__(self):
         return f"Figure({self.name!r}: {len(self.svg)} characters of SVG, {len(self.png)} bytes of PNG)"

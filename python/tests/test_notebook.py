@@ -23,7 +23,9 @@ def test_the_html_shows_verdict_parameters_and_figure(result):
     html = result._repr_html_()
     assert result.verdict.split(":")[0] in html
     assert "<th>std. error</th>" in html and "N·(s/m)ⁿ" in html
-    assert "data:image/png;base64," in html
+    # The figure is its SVG inline, shown at its drawing's size, not a PNG.
+    assert '<svg role="img" aria-label="measured_vs_fitted" style="width:' in html
+    assert "data:image/png;base64," not in html and "<?xml" not in html
     assert html.count("<tr>") >= len(result.models) + 4
 
 

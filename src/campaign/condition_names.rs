@@ -11,8 +11,8 @@ use std::collections::BTreeMap;
 use stf_core::fit::{DISPLACEMENT_OFFSET, FORCE_OFFSET, INITIAL_STATE};
 
 use super::csv_columns::{is_fixed_column, STD_ERROR_SUFFIX};
-use crate::experiment::{Experiment, FitLevel};
-use crate::model_config::configure_for;
+use crate::experiment::{Experiment, FitLevel, ModelEntry};
+use crate::model_config::{configure_for, ConfiguredModel};
 
 /// Why `name` cannot be a condition's name, if it cannot: a column of `campaign.csv` that
 /// every campaign has, or a parameter's standard-error column.
@@ -32,6 +32,17 @@ pub fn fixed_clash(name: &str) -> Option<String> {
     }
 }
 
+/// `entry` of `exp` configured alone, as a record's run configures it (no data scales; each
+/// channel a parameter follows stood in for): its parameters, in the order its values take.
+pub(super) fn configure_entry(
+    exp: &Experiment,
+    entry: &ModelEntry,
+) -> anyhow::Result<ConfiguredModel> {
+    let one = std::slice::from_ref(entry);
+    let channels = stf_study::channels::Channels::stand_ins_for(one);
+    configure_for(one, &exp.path, &exp.dir, &exp.scripts, None, &channels)
+}
+
 /// The parameters a run of `exp` may write as columns of `campaign.csv`, each with where it
 /// comes from (`a parameter of power_law`): its models' parameters, the oscillator's
 /// parameters it fits, its offset and initial state; with `discovers`, every built-in
@@ -40,14 +51,7 @@ pub fn parameter_columns(exp: &Experiment, discovers: bool) -> BTreeMap<String, 
     let mut names = BTreeMap::new();
     for entry in &exp.models {
         // A model that does not resolve fails its unit with its own message.
-        if let Ok(model) = configure_for(
-            std::slice::from_ref(entry),
-            &exp.path,
-            &exp.dir,
-            &exp.scripts,
-            None,
-            &stf_study::channels::Channels::stand_ins_for(std::slice::from_ref(entry)),
-        ) {
+        if let Ok(model) = configure_entry(exp, entry) {
             let of = entry.specs().collect::<Vec<_>>().join(" + ");
             for p in &model.params {
                 names

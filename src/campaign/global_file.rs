@@ -27,9 +27,9 @@ use anyhow::Result;
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::condition_names::configure_entry;
 use super::units::Unit;
 use crate::experiment::{error_at, line_of, Experiment, FitLevel, ModelEntry};
-use crate::model_config::configure_for;
 
 /// A law as written: `{ condition = "…", reference = … }`.
 #[derive(Debug, Deserialize)]
@@ -155,14 +155,7 @@ fn find_entry<'e>(exp: &'e Experiment, model: &Spanned<String>, at: &At) -> Resu
 /// then the offset with `[fit] offset`; at trajectory level the initial state `x0`, `v0`
 /// (when fitted) is left out: it is each record's own.
 fn param_names(exp: &Experiment, entry: &ModelEntry, level: FitLevel) -> Result<Vec<String>> {
-    let configured = configure_for(
-        std::slice::from_ref(entry),
-        &exp.path,
-        &exp.dir,
-        &exp.scripts,
-        None,
-        &stf_study::channels::Channels::stand_ins_for(std::slice::from_ref(entry)),
-    )?;
+    let configured = configure_entry(exp, entry)?;
     let trajectory = level == FitLevel::Trajectory;
     let mut names: Vec<String> = configured
         .params

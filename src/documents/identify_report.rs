@@ -35,7 +35,7 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
     );
     let rows = s.result.params.iter().map(|p| {
         let value = if p.fixed {
-            format!("{} (held)", stf_study::digits::rounded(p.value, f64::NAN))
+            format!("{} (held)", p.shown_value())
         } else {
             stf_study::digits::with_error(p.value, p.std_error)
         };

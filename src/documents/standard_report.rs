@@ -21,22 +21,25 @@ use crate::report::{
 use crate::validation::ValidationRecord;
 use stf_core::regimes::Regime;
 
-/// A section of the figures of a record and its fits.
+/// A section of the figures of a record and its fits. The STF force is drawn where the work
+/// reads it, at force level: at trajectory level (a rig without a force sensor, or one whose
+/// force is not used) the record is its motion alone.
 pub fn record_sections(data: &FitData, fits: &[ModelFit], out: &Path) -> Result<Vec<Section>> {
     let dir = out.join("figures");
     crate::writing::atomic::ensure_dir(&dir)?;
-    let mut sections = Vec::new();
-    if let Some(f) = data.record.f_stf.as_deref() {
-        sections.push(record_section(data, f, &dir)?);
-    }
+    let force = match data.level {
+        FitLevel::Force => data.record.f_stf.as_deref(),
+        FitLevel::Trajectory => None,
+    };
+    let mut sections = vec![record_section(data, force, &dir)?];
     if !fits.is_empty() {
         sections.push(fits_section(data, fits, &dir)?);
     }
     Ok(sections)
 }
 
-/// "The record": its time history and hysteresis loops of the STF force `f`.
-fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
+/// "The record": its time history and, with the STF force `f`, its hysteresis loops.
+fn record_section(data: &FitData, f: Option<&[f64]>, dir: &Path) -> Result<Section> {
     let k = &data.kinematics;
     let mut s = Section::new("The record");
     s.paragraphs.push(format!(
@@ -56,11 +59,13 @@ fn record_section(data: &FitData, f: &[f64], dir: &Path) -> Result<Section> {
     };
     let labels = MotionLabels::of(&data.units);
     let th = time_history(dir, "time_history", &motion, f, &labels)?;
-    s.figures.push(FigureRef::new(
-        th,
-        "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked.",
-    )
-    .zoomable());
+    let caption = if f.is_some() {
+        "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked."
+    } else {
+        "Displacement, velocity and acceleration over time, a panel each (no STF force is read at trajectory level)."
+    };
+    s.figures.push(FigureRef::new(th, caption).zoomable());
+    let Some(f) = f else { return Ok(s) };
     for (name, label, series) in [
         ("hysteresis_x", labels.x, milli(&k.x)),
         ("hysteresis_v", labels.v, milli(&k.v)),

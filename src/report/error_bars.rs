@@ -224,6 +224,26 @@ mod tests {
         assert!(none.is_err());
     }
 
+    /// Values whose bars span 4.6–5.4 (K against concentration) get three labelled ticks on
+    /// their axis at least, not the one `5` of plotters' step of 0.5.
+    #[test]
+    fn a_narrow_range_of_values_gets_three_labelled_ticks_at_least() {
+        let dir = tempfile::tempdir().unwrap();
+        let series = vec![ErrorSeries {
+            label: "F0 = 0.035".into(),
+            points: vec![(0.36, 5.0, 0.4), (0.40, 5.02, 0.38)],
+        }];
+        let files = error_bars(dir.path(), "k", "K", ("concentration", "K"), &series).unwrap();
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        let y_ticks: Vec<f64> = svg
+            .split('\n')
+            .filter_map(|l| l.trim().parse::<f64>().ok())
+            .filter(|v| (4.5..5.5).contains(v))
+            .collect();
+        assert!(y_ticks.len() >= 3, "{y_ticks:?}");
+        crate::report::test_signals::assert_prints_well(&files, SIZE);
+    }
+
     #[test]
     fn a_curve_is_drawn_over_the_points_and_kept_in_the_csv() {
         let dir = tempfile::tempdir().unwrap();

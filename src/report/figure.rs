@@ -84,6 +84,16 @@ fn tick_count(pixels: u32, spacing: u32) -> usize {
     (pixels / spacing).clamp(3, 10) as usize
 }
 
+/// The number of labels to ask plotters for on an axis over `range`, `wanted` or more: raised
+/// until its round steps give three ticks at least (over 4.6–5.4, four labels step by 0.5 and
+/// label only `5`; five step by 0.2).
+fn at_least_three_ticks(range: std::ops::Range<f64>, wanted: usize) -> usize {
+    let coord = plotters::coord::types::RangedCoordf64::from(range);
+    (wanted..wanted + 10)
+        .find(|&n| coord.key_points(n).len() >= 3)
+        .unwrap_or(wanted)
+}
+
 /// A chart on plain `f64` axes.
 pub type Chart2d<'a, DB> = ChartContext<
     'a,
@@ -115,6 +125,10 @@ pub fn draw_mesh_with<DB: DrawingBackend>(
     let (xs, ys) = (x.end - x.start, y.end - y.start);
     let (w, h) = chart.plotting_area().dim_in_pixel();
     let labels = labels.unwrap_or((tick_count(w, 120), tick_count(h, 60)));
+    let labels = (
+        at_least_three_ticks(x.clone(), labels.0),
+        at_least_three_ticks(y.clone(), labels.1),
+    );
     let x_ticks = |v: &f64| tick_label(*v, xs);
     let y_ticks = |v: &f64| tick_label(*v, ys);
     let mut mesh = chart.configure_mesh();
@@ -548,6 +562,20 @@ mod tests {
             "pre-resonance, ω 4.55–4.82 rad/s"
         );
         assert_eq!(heading_within("resonance", 10), "resonance");
+    }
+
+    #[test]
+    fn an_axis_gets_three_ticks_at_least() {
+        use plotters::prelude::Ranged;
+        let ticks = |range: std::ops::Range<f64>, n| {
+            plotters::coord::types::RangedCoordf64::from(range).key_points(n)
+        };
+        // Four labels over 4.6–5.4 step by 0.5: the one tick `5`.
+        assert_eq!(ticks(4.6..5.4, 4), [5.0]);
+        let n = super::at_least_three_ticks(4.6..5.4, 4);
+        assert!(ticks(4.6..5.4, n).len() >= 3, "{n}");
+        // An axis with enough ticks keeps its count.
+        assert_eq!(super::at_least_three_ticks(0.0..10.0, 4), 4);
     }
 
     #[test]

@@ -9,14 +9,13 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::colour::series_colour;
-use super::decimate::{decimate_ranges, pick};
+use super::decimate::pick;
 use super::figure::{
-    draw_mesh, draw_runs, legend_strip, msg, render, same_length, small_panel, tick_style, titled,
-    Draw, FigureFiles, Swatch, MEASURED_LINE, MEASURED_WIDTH, T_LABEL,
+    draw_mesh, draw_runs, legend_strip, msg, render, small_panel, tick_style, titled, Draw,
+    FigureFiles, Swatch, MEASURED_LINE, MEASURED_WIDTH, T_LABEL,
 };
 use super::plot_range::{exact_range, padded_range};
-use super::regime_windows::{RegimeWindow, MAX_POINTS_PER_WINDOW};
-use super::series_csv::Column;
+use super::regime_windows::{cut_windows, RegimeWindow};
 use super::ReportError;
 
 /// One row of the figure: a quantity measured and as each model has it (a model without it
@@ -107,69 +106,43 @@ pub fn regime_time_windows(
     rows: &[TimeRow],
     windows: &[RegimeWindow],
 ) -> Result<FigureFiles, ReportError> {
+    const FIGURE: &str = "regime time windows";
+    if rows.is_empty() {
+        return Err(ReportError::no_data(format!(
+            "{FIGURE}: no window of at least two samples"
+        )));
+    }
     let mut labels: Vec<&str> = Vec::new();
+    let mut named: Vec<(String, &[f64])> = Vec::new();
     for row in rows {
-        same_length(
-            &format!("regime time windows: t and {}", row.label),
-            t,
-            row.measured,
-        )?;
+        named.push((row.label.to_string(), row.measured));
         for (label, m) in &row.models {
-            same_length(&format!("regime time windows: t and {label}"), t, m)?;
+            named.push((label.to_string(), m));
             if !labels.contains(label) {
                 labels.push(label);
             }
         }
     }
-    let windows: Vec<RegimeWindow> = windows
-        .iter()
-        .filter(|w| w.start + 2 <= w.end && w.end <= t.len())
-        .cloned()
-        .collect();
-    if windows.is_empty() || rows.is_empty() {
-        return Err(ReportError::no_data(
-            "regime time windows: no window of at least two samples",
-        ));
-    }
-    let all: Vec<&[f64]> = rows
-        .iter()
-        .flat_map(|r| std::iter::once(r.measured).chain(r.models.iter().map(|m| m.1)))
-        .collect();
-    let ranges: Vec<_> = windows.iter().map(|w| w.start..w.end).collect();
-    let kept = decimate_ranges(&all, &ranges, MAX_POINTS_PER_WINDOW * windows.len());
-    let picked: Vec<usize> = kept.iter().flatten().copied().collect();
-    let mut columns = vec![
-        Column::numbered("window", kept.iter().map(Vec::len)),
-        Column::new("t, s", pick(t, &picked)),
-    ];
+    let mut cut = cut_windows(FIGURE, t, &named, windows, rows.len())?;
     for row in rows {
-        columns.push(Column::new(
-            format!("{} measured", row.label),
-            pick(row.measured, &picked),
-        ));
+        cut.push_column(format!("{} measured", row.label), row.measured);
         for (label, m) in &row.models {
-            columns.push(Column::new(
-                format!("{} {label}", row.label),
-                pick(m, &picked),
-            ));
+            cut.push_column(format!("{} {label}", row.label), m);
         }
     }
-    let size = (
-        500 * windows.len() as u32 + 20,
-        330 * rows.len() as u32 + 100,
-    );
     let plot = TimePlot {
         t,
         rows,
         labels,
-        windows: windows.into_iter().zip(kept).collect(),
+        windows: cut.windows,
     };
-    render(out_dir, name, size, &plot, &columns)
+    render(out_dir, name, cut.size, &plot, &cut.columns)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::figure::TWO_COLUMNS;
     use crate::report::test_signals::{assert_rendered, column, damped_sine};
 
     #[test]
@@ -205,12 +178,17 @@ mod tests {
                 start: 2_000,
                 end: 2_300,
             },
+            RegimeWindow {
+                name: "later".into(),
+                start: 2_500,
+                end: 2_700,
+            },
         ];
         let dir = tempfile::tempdir().unwrap();
         let files = regime_time_windows(dir.path(), "w", &s.t, &rows, &windows).unwrap();
-        let cols = assert_rendered(&files, (1020, 1090));
+        let cols = assert_rendered(&files, (TWO_COLUMNS, 1000));
         let t = column(&cols, "t, s");
-        assert_eq!(t.len(), 700);
+        assert_eq!(t.len(), 900);
         assert_eq!(t[400], s.t[2_000]);
         assert_eq!(column(&cols, "F_STF, N power law")[1], model[1]);
         assert_eq!(column(&cols, "x, m trajectory")[400], simulated[2_000]);

@@ -52,6 +52,80 @@ pub struct WindowSeries<'a> {
 /// The most samples a window keeps (its series decimated together, every extreme kept).
 pub const MAX_POINTS_PER_WINDOW: usize = 4_000;
 
+/// Height of one row of a window figure's panels, pixels (plus [`WINDOW_GRID_MARGIN`]).
+const WINDOW_ROW_HEIGHT: u32 = 300;
+/// Height of a window figure's title and legend, pixels.
+const WINDOW_GRID_MARGIN: u32 = 100;
+
+/// The windows a figure draws, cut from a record's series by [`cut_windows`].
+pub(super) struct WindowCut {
+    /// Each window of at least two samples within the record, with the samples it draws
+    /// (increasing indices into the series).
+    pub windows: Vec<(RegimeWindow, Vec<usize>)>,
+    /// Every window's samples drawn, window after window: the CSV's rows.
+    rows: Vec<usize>,
+    /// The CSV's columns: the window's number, the time, s, and those pushed
+    /// ([`WindowCut::push_column`]).
+    pub columns: Vec<Column>,
+    /// The figure's width × height, pixels: a column wide for one window, two for more, a
+    /// row of panels [`WINDOW_ROW_HEIGHT`] high.
+    pub size: (u32, u32),
+}
+
+impl WindowCut {
+    /// Add the CSV column `name` of `series`' samples drawn.
+    pub fn push_column(&mut self, name: impl Into<String>, series: &[f64]) {
+        self.columns
+            .push(Column::new(name, pick(series, &self.rows)));
+    }
+}
+
+/// Cut `windows` from the `series` (each named, for the error when its length is not that of
+/// `t`) for a `figure` of `panel_rows` rows of panels: the windows of at least two samples
+/// within the record, the series decimated together within each (every extreme kept). No
+/// such window is an error.
+pub(super) fn cut_windows(
+    figure: &str,
+    t: &[f64],
+    series: &[(String, &[f64])],
+    windows: &[RegimeWindow],
+    panel_rows: usize,
+) -> Result<WindowCut, ReportError> {
+    for (what, v) in series {
+        same_length(&format!("{figure}: t and {what}"), t, v)?;
+    }
+    let windows: Vec<RegimeWindow> = windows
+        .iter()
+        .filter(|w| w.start + 2 <= w.end && w.end <= t.len())
+        .cloned()
+        .collect();
+    if windows.is_empty() {
+        return Err(ReportError::no_data(format!(
+            "{figure}: no window of at least two samples"
+        )));
+    }
+    let all: Vec<&[f64]> = series.iter().map(|(_, v)| *v).collect();
+    let ranges: Vec<_> = windows.iter().map(|w| w.start..w.end).collect();
+    let kept = decimate_ranges(&all, &ranges, MAX_POINTS_PER_WINDOW * windows.len());
+    let rows: Vec<usize> = kept.iter().flatten().copied().collect();
+    let columns = vec![
+        Column::numbered("window", kept.iter().map(Vec::len)),
+        Column::new("t, s", pick(t, &rows)),
+    ];
+    let width = if windows.len() > 1 {
+        TWO_COLUMNS
+    } else {
+        ONE_COLUMN
+    };
+    let height = WINDOW_ROW_HEIGHT * panel_rows as u32 + WINDOW_GRID_MARGIN;
+    Ok(WindowCut {
+        windows: windows.into_iter().zip(kept).collect(),
+        rows,
+        columns,
+        size: (width, height),
+    })
+}
+
 struct WindowsPlot<'a> {
     series: WindowSeries<'a>,
     /// Each window with the samples it draws (increasing indices into the series).
@@ -145,51 +219,26 @@ pub fn regime_windows(
     windows: &[RegimeWindow],
 ) -> Result<FigureFiles, ReportError> {
     let s = series;
-    for (what, v) in [("x", s.x_mm), ("v", s.v_mm), ("a", s.a), ("F_STF", s.f)] {
-        same_length(&format!("regime windows: t and {what}"), s.t, v)?;
-    }
-    for (label, m) in s.models {
-        same_length(&format!("regime windows: t and {label}"), s.t, m)?;
-    }
-    let windows: Vec<RegimeWindow> = windows
-        .iter()
-        .filter(|w| w.start + 2 <= w.end && w.end <= s.t.len())
-        .cloned()
-        .collect();
-    if windows.is_empty() {
-        return Err(ReportError::no_data(
-            "regime windows: no window of at least two samples",
-        ));
-    }
-    let mut all: Vec<&[f64]> = vec![s.x_mm, s.v_mm, s.a, s.f];
-    all.extend(s.models.iter().map(|(_, m)| *m));
-    let ranges: Vec<_> = windows.iter().map(|w| w.start..w.end).collect();
-    let kept = decimate_ranges(&all, &ranges, MAX_POINTS_PER_WINDOW * windows.len());
-    let rows: Vec<usize> = kept.iter().flatten().copied().collect();
-    let mut columns = vec![
-        Column::numbered("window", kept.iter().map(Vec::len)),
-        Column::new("t, s", pick(s.t, &rows)),
-        Column::new("x, mm", pick(s.x_mm, &rows)),
-        Column::new("v, mm/s", pick(s.v_mm, &rows)),
-        Column::new("a, m/s²", pick(s.a, &rows)),
-        Column::new("F_STF measured, N", pick(s.f, &rows)),
+    let mut named: Vec<(String, &[f64])> = vec![
+        ("x".into(), s.x_mm),
+        ("v".into(), s.v_mm),
+        ("a".into(), s.a),
+        ("F_STF".into(), s.f),
     ];
-    columns.extend(
-        s.models
-            .iter()
-            .map(|(label, m)| Column::new(format!("F_STF {label}, N"), pick(m, &rows))),
-    );
-    let width = if windows.len() > 1 {
-        TWO_COLUMNS
-    } else {
-        ONE_COLUMN
-    };
-    let size = (width, 1300);
+    named.extend(s.models.iter().map(|(label, m)| (label.to_string(), *m)));
+    let mut cut = cut_windows("regime windows", s.t, &named, windows, 4)?;
+    cut.push_column("x, mm", s.x_mm);
+    cut.push_column("v, mm/s", s.v_mm);
+    cut.push_column("a, m/s²", s.a);
+    cut.push_column("F_STF measured, N", s.f);
+    for (label, m) in s.models {
+        cut.push_column(format!("F_STF {label}, N"), m);
+    }
     let plot = WindowsPlot {
         series: *s,
-        windows: windows.into_iter().zip(kept).collect(),
+        windows: cut.windows,
     };
-    render(out_dir, name, size, &plot, &columns)
+    render(out_dir, name, cut.size, &plot, &cut.columns)
 }
 
 #[cfg(test)]

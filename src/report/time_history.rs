@@ -1,7 +1,7 @@
 //! Time histories: displacement, velocity, acceleration and the STF force, each in its own
 //! panel, stacked on one time axis (a panel per quantity: two axes on one panel overlap and
 //! their envelopes blend), with the force's extrema (those standing above the noise) marked,
-//! as in the source study.
+//! as in the source study. Without a measured force, the three motion panels alone.
 
 use std::path::Path;
 
@@ -35,12 +35,12 @@ pub struct Motion<'a> {
     pub a: &'a [f64],
 }
 
-/// The panels, top to bottom: the three motion quantities, then the STF force.
-const PANELS: usize = 4;
-
 struct TimeHistoryPlot {
     t: Vec<f64>,
-    panels: [(&'static str, Vec<f64>); PANELS],
+    /// Top to bottom: the three motion quantities, then the STF force if it is measured.
+    panels: Vec<(&'static str, Vec<f64>)>,
+    /// Whether the last panel is the STF force.
+    force: bool,
     marks: Vec<(f64, f64, ExtremumKind)>,
 }
 
@@ -51,7 +51,7 @@ impl TimeHistoryPlot {
         index: usize,
     ) -> Result<(), String> {
         let (label, y) = &self.panels[index];
-        let last = index == PANELS - 1;
+        let last = index == self.panels.len() - 1;
         let no_data = || format!("{label}: no finite value");
         let t_range = exact_range(&self.t).ok_or_else(no_data)?;
         let y_range = padded_range(y).ok_or_else(no_data)?;
@@ -69,7 +69,7 @@ impl TimeHistoryPlot {
             (h / 36).clamp(3, 6) as usize,
         );
         draw_mesh_with(&mut chart, desc, Some(ticks), axis_desc_style())?;
-        let colour = series_colour(usize::from(last));
+        let colour = series_colour(usize::from(last && self.force));
         self.draw_signal(&mut chart, y, colour)?;
         if !last || self.marks.len() > MAX_MARKS {
             return Ok(());
@@ -133,78 +133,97 @@ const MAX_MARKS: usize = 80;
 
 impl Draw for TimeHistoryPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let root = titled(root, "Motion and STF force over time")?;
+        let title = if self.force {
+            "Motion and STF force over time"
+        } else {
+            "Motion over time"
+        };
+        let root = titled(root, title)?;
         let entries = self.legend_entries();
         let root = if entries.is_empty() {
             root
         } else {
             legend_strip(&root, &entries)?
         };
-        for (i, area) in root.split_evenly((PANELS, 1)).iter().enumerate() {
+        for (i, area) in root.split_evenly((self.panels.len(), 1)).iter().enumerate() {
             self.panel(area, i)?;
         }
         Ok(())
     }
 }
 
-/// Draw x (in mm, or mV for x in volts: `labels`), v (mm/s), a (m/s²) and F_STF over time
-/// (four panels on one time axis, F_STF's extrema above the noise marked) to
-/// `out_dir/name.{svg,png,csv}`. Long records are
-/// decimated keeping every series' extremes; the CSV holds the plotted samples and the marks.
+/// Draw x (in mm, or mV for x in volts: `labels`), v (mm/s), a (m/s²) and, if it is
+/// measured, F_STF over time (a panel each on one time axis, F_STF's extrema above the noise
+/// marked) to `out_dir/name.{svg,png,csv}`. Long records are decimated keeping every series'
+/// extremes; the CSV holds the plotted samples and the marks.
 pub fn time_history(
     out_dir: &Path,
     name: &str,
     motion: &Motion,
-    f_stf: &[f64],
+    f_stf: Option<&[f64]>,
     labels: &MotionLabels,
 ) -> Result<FigureFiles, ReportError> {
     let Motion { t, x, v, a } = *motion;
     same_length("time history: t and x", t, x)?;
     same_length("time history: t and v", t, v)?;
     same_length("time history: t and a", t, a)?;
-    same_length("time history: t and F_STF", t, f_stf)?;
-    require_finite("time history", &[("t", t), ("x", x), ("F_STF", f_stf)])?;
+    let mut series = vec![x, v, a];
+    if let Some(f) = f_stf {
+        same_length("time history: t and F_STF", t, f)?;
+        require_finite("time history", &[("F_STF", f)])?;
+        series.push(f);
+    }
+    require_finite("time history", &[("t", t), ("x", x)])?;
 
     // More extrema than a plot can mark are neither drawn nor written.
-    let mut marks_full = extrema(f_stf, noise_delta(f_stf));
+    let mut marks_full = f_stf.map_or_else(Vec::new, |f| extrema(f, noise_delta(f)));
     if marks_full.len() > MAX_MARKS {
         marks_full.clear();
     }
-    let mut keep = decimate_union(&[x, v, a, f_stf], MAX_POINTS_PER_LINE);
+    let mut keep = decimate_union(&series, MAX_POINTS_PER_LINE);
     keep.extend(marks_full.iter().map(|e| e.index));
     keep.sort_unstable();
     keep.dedup();
 
+    let mut panels = vec![
+        (labels.x, milli(&pick(x, &keep))),
+        (labels.v, milli(&pick(v, &keep))),
+        (labels.a, pick(a, &keep)),
+    ];
+    let mut columns = vec![
+        Column::new("t, s", pick(t, &keep)),
+        Column::new(labels.x_column, panels[0].1.clone()),
+        Column::new(labels.v_column, panels[1].1.clone()),
+        Column::new(labels.a_column, panels[2].1.clone()),
+    ];
+    let marks: Vec<(f64, f64, ExtremumKind)> = f_stf.map_or_else(Vec::new, |f| {
+        marks_full
+            .iter()
+            .map(|e| (t[e.index], f[e.index], e.kind))
+            .collect()
+    });
+    if let Some(f) = f_stf {
+        panels.push((F_LABEL, pick(f, &keep)));
+        let of = |g: fn(&(f64, f64, ExtremumKind)) -> f64| marks.iter().map(g).collect();
+        columns.extend([
+            Column::new(F_LABEL, panels[3].1.clone()),
+            Column::new("F_STF extremum t, s", of(|m| m.0)),
+            Column::new("F_STF extremum, N", of(|m| m.1)),
+            Column::new(
+                "F_STF extremum kind (1 max, -1 min)",
+                of(|m| match m.2 {
+                    ExtremumKind::Max => 1.0,
+                    ExtremumKind::Min => -1.0,
+                }),
+            ),
+        ]);
+    }
     let plot = TimeHistoryPlot {
         t: pick(t, &keep),
-        panels: [
-            (labels.x, milli(&pick(x, &keep))),
-            (labels.v, milli(&pick(v, &keep))),
-            (labels.a, pick(a, &keep)),
-            (F_LABEL, pick(f_stf, &keep)),
-        ],
-        marks: marks_full
-            .iter()
-            .map(|e| (t[e.index], f_stf[e.index], e.kind))
-            .collect(),
+        force: f_stf.is_some(),
+        marks,
+        panels,
     };
-    let marks = |of: fn(&(f64, f64, ExtremumKind)) -> f64| plot.marks.iter().map(of).collect();
-    let columns = vec![
-        Column::new("t, s", plot.t.clone()),
-        Column::new(labels.x_column, plot.panels[0].1.clone()),
-        Column::new(labels.v_column, plot.panels[1].1.clone()),
-        Column::new(labels.a_column, plot.panels[2].1.clone()),
-        Column::new(F_LABEL, plot.panels[3].1.clone()),
-        Column::new("F_STF extremum t, s", marks(|m| m.0)),
-        Column::new("F_STF extremum, N", marks(|m| m.1)),
-        Column::new(
-            "F_STF extremum kind (1 max, -1 min)",
-            marks(|m| match m.2 {
-                ExtremumKind::Max => 1.0,
-                ExtremumKind::Min => -1.0,
-            }),
-        ),
-    ];
     render(out_dir, name, SIZE_TALL, &plot, &columns)
 }
 
@@ -212,20 +231,31 @@ pub fn time_history(
 mod tests {
     use super::*;
     use crate::report::figure::SIZE_TALL;
-    use crate::report::test_signals::{assert_rendered, column, damped_sine};
+    use crate::report::test_signals::{assert_rendered, column, damped_sine, Signals};
+
+    /// The motion of the signals `s`.
+    fn motion_of(s: &Signals) -> Motion<'_> {
+        Motion {
+            t: &s.t,
+            x: &s.x,
+            v: &s.v,
+            a: &s.a,
+        }
+    }
 
     #[test]
     fn renders_a_long_damped_sine_decimated_with_its_extrema() {
         let s = damped_sine(60_000, 10.0);
         let dir = tempfile::tempdir().unwrap();
-        let motion = Motion {
-            t: &s.t,
-            x: &s.x,
-            v: &s.v,
-            a: &s.a,
-        };
-        let files =
-            time_history(dir.path(), "history", &motion, &s.f, &MotionLabels::LENGTH).unwrap();
+        let motion = motion_of(&s);
+        let files = time_history(
+            dir.path(),
+            "history",
+            &motion,
+            Some(&s.f),
+            &MotionLabels::LENGTH,
+        )
+        .unwrap();
         let cols = assert_rendered(&files, SIZE_TALL);
         let t = column(&cols, "t, s");
         let x = column(&cols, "x, mm");
@@ -266,17 +296,35 @@ mod tests {
         assert_eq!(svg.matches("\ntime t, s\n").count(), 1);
     }
 
+    /// A record without a measured force: the three motion panels, no force column, no marks
+    /// and no legend naming F_STF's maxima.
+    #[test]
+    fn without_a_force_the_motion_alone_is_drawn() {
+        let s = damped_sine(6_000, 10.0);
+        let dir = tempfile::tempdir().unwrap();
+        let motion = motion_of(&s);
+        let files =
+            time_history(dir.path(), "history", &motion, None, &MotionLabels::LENGTH).unwrap();
+        let cols = assert_rendered(&files, SIZE_TALL);
+        let names: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
+        assert!(!names.iter().any(|n| n.contains("F_STF")), "{names:?}");
+        assert_eq!(column(&cols, "x, mm").len(), s.t.len());
+        let svg = std::fs::read_to_string(&files.svg).unwrap();
+        assert!(!svg.contains("F_STF") && !svg.contains("minima"));
+        assert!(svg.contains("\nMotion over time\n"));
+        assert_eq!(svg.matches("\ntime t, s\n").count(), 1);
+    }
+
     #[test]
     fn mismatched_lengths_are_an_error() {
         let s = damped_sine(100, 1.0);
         let motion = Motion {
-            t: &s.t,
             x: &s.x[..50],
-            v: &s.v,
-            a: &s.a,
+            ..motion_of(&s)
         };
         let dir = tempfile::tempdir().unwrap();
-        let err = time_history(dir.path(), "h", &motion, &s.f, &MotionLabels::LENGTH).unwrap_err();
+        let err =
+            time_history(dir.path(), "h", &motion, Some(&s.f), &MotionLabels::LENGTH).unwrap_err();
         assert!(matches!(err, ReportError::LengthMismatch { .. }), "{err}");
     }
 }

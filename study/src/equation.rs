@@ -1,14 +1,12 @@
 //! The force a fit or a discovery ends with, written as an equation, as a sparse-regression
 //! tool prints its model: `F_STF = 4.01·|v|^1.501·sgn v + 19 987·x³`. Each value is rounded to
-//! its standard error ([`crate::digits::rounded`]: the digits the results table shows), a held
+//! its standard error ([`FittedParam::shown_value`]: the digits the results table shows), a held
 //! value or one without an error to six significant digits; each model writes its own term
 //! ([`ForceModel::equation`]), a script or a model with internal state as a named term,
 //! `F_maxwell(c_m = 5.2, tau = 0.050)`.
 
 use stf_core::fit::FittedParam;
 use stf_core::physics::force_model::ForceModel;
-
-use crate::digits::rounded;
 
 /// `F_STF = …` of `model` with the fitted `params` (found by the model's parameter names;
 /// others, such as an offset, are left out). `None` when a parameter of the model has no
@@ -19,8 +17,7 @@ pub fn force_equation(model: &dyn ForceModel, params: &[FittedParam]) -> Option<
         .iter()
         .map(|spec| {
             let p = params.iter().find(|p| p.name == spec.name)?;
-            let error = if p.fixed { f64::NAN } else { p.std_error };
-            Some(rounded(p.value, error))
+            Some(p.shown_value())
         })
         .collect();
     Some(format!("F_STF = {}", model.equation(&values?)?))
@@ -31,17 +28,6 @@ mod tests {
     use super::*;
     use std::sync::Arc;
     use stf_core::physics::model_sum::ModelSum;
-
-    fn param(name: &str, value: f64, std_error: f64) -> FittedParam {
-        FittedParam {
-            name: name.into(),
-            value,
-            std_error,
-            naive_std_error: f64::NAN,
-            fixed: false,
-            held_by: None,
-        }
-    }
 
     fn model(names: &[&str]) -> Arc<dyn ForceModel> {
         let parts: Vec<Arc<dyn ForceModel>> = names
@@ -54,10 +40,10 @@ mod tests {
     #[test]
     fn a_sum_is_written_term_by_term_with_values_rounded_to_their_errors() {
         let params = [
-            param("K", 4.0108, 0.060),
-            param("n", 1.50138, 0.0074),
-            param("k3", 19986.76, 11.3),
-            param("f_off", 0.001, 0.0001),
+            FittedParam::free("K", 4.0108, 0.060),
+            FittedParam::free("n", 1.50138, 0.0074),
+            FittedParam::free("k3", 19986.76, 11.3),
+            FittedParam::free("f_off", 0.001, 0.0001),
         ];
         let eq = force_equation(&*model(&["power_law", "cubic_stiffness"]), &params);
         assert_eq!(
@@ -68,14 +54,17 @@ mod tests {
 
     #[test]
     fn a_negative_term_is_subtracted_and_a_model_with_state_is_named() {
-        let params = [param("c_s", 1.0005, 3.0e-4), param("k_s", -12.3, 0.4)];
+        let params = [
+            FittedParam::free("c_s", 1.0005, 3.0e-4),
+            FittedParam::free("k_s", -12.3, 0.4),
+        ];
         let eq = force_equation(&*model(&["viscous", "linear_spring"]), &params);
         assert_eq!(eq.as_deref(), Some("F_STF = 1.00050·v − 12.3·x"));
         let maxwell = model(&["maxwell"]);
         let params: Vec<FittedParam> = maxwell
             .params()
             .iter()
-            .map(|s| param(&s.name, s.default, 0.1 * s.default))
+            .map(|s| FittedParam::free(&s.name, s.default, 0.1 * s.default))
             .collect();
         let eq = force_equation(&*maxwell, &params).unwrap_or_default();
         assert!(

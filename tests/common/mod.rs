@@ -4,7 +4,7 @@
 
 pub mod slurm;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// The program under test.
@@ -30,6 +30,45 @@ pub fn run(command: &str, experiment: &Path, out: &Path) -> Output {
 /// The same, asserting success (the failure message is the program's).
 pub fn run_ok(command: &str, experiment: &Path, out: &Path) -> Output {
     succeeded(run(command, experiment, out))
+}
+
+/// [`run_ok`], then the JSON result `file` of `out` (`fit.json`, `discovery.json`, …).
+pub fn run_json(command: &str, experiment: &Path, out: &Path, file: &str) -> serde_json::Value {
+    run_ok(command, experiment, out);
+    read_json(&out.join(file))
+}
+
+/// The bundled experiment `experiments/NAME` as text, its record's path made absolute (so it
+/// runs from any folder).
+pub fn bundled_experiment(name: &str) -> String {
+    let records = root().join("experiments/records").display().to_string();
+    std::fs::read_to_string(root().join("experiments").join(name))
+        .unwrap()
+        .replace(
+            "file = \"records/",
+            &format!("file = \"{}/", records.replace('\\', "\\\\")),
+        )
+}
+
+/// `text` written to `dir/name`: the file's path.
+pub fn write_file(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Simulate into `dir/r.csv` a damper-like shaker record: viscous + yield (`c_s` 800 N·s/m,
+/// `F_y` 150 N: a force of hundreds of N), a chirp 0.5 → `f1` Hz over 10 s at 1 kHz, the
+/// rig's sensors on with `seed`.
+pub fn damper_record(dir: &Path, seed: u64, f1: f64) {
+    let make = format!(
+        "[data]\nfile = \"r.csv\"\n\n[system]\npreset = \"forced\"\nT = 0.0\ndelta_T = 0.0\n\n\
+         [simulate]\nchirp = {{ f0 = 0.5, f1 = {f1}, amplitude = 600.0, t1 = 10.0 }}\n\
+         rate = 1000.0\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\nname = \"viscous\"\n\
+         params = {{ c_s = 800.0 }}\n\n[[simulate.truth]]\nname = \"yield\"\n\
+         params = {{ F_y = {{ value = 150.0, max = 1000.0 }} }}\n"
+    );
+    simulate_ok(&write_file(dir, "make.toml", &make), &dir.join("r.csv"));
 }
 
 /// `stf-lab simulate EXPERIMENT --out RECORD`, then the `extra` flags.

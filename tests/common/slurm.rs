@@ -88,6 +88,32 @@ pub fn job_ids(stdout: &str) -> (Vec<String>, String) {
     (units, first_word(collect))
 }
 
+/// What a submitting run printed, asserting it succeeded, with its job ids ([`job_ids`]):
+/// `(stdout, units jobs, collect job)`.
+pub fn submitted(run: &std::process::Output) -> (String, Vec<String>, String) {
+    let said = text(&run.stdout);
+    assert!(run.status.success(), "{said}{}", text(&run.stderr));
+    let (units, collect) = job_ids(&said);
+    (said, units, collect)
+}
+
+/// Wait for the collect job `collect` of the campaign in `out` to end in `state` (the logs
+/// if it does not); the collect job's log (empty if it wrote none).
+pub fn collected(collect: &str, out: &Path, conf: &Path, state: &str) -> String {
+    assert_eq!(wait_for(collect, out, conf), state, "{}", logs(out, conf));
+    std::fs::read_to_string(out.join("slurm/collect.log")).unwrap_or_default()
+}
+
+/// Cancel the Slurm job or array task `id` (`123_2`), as the scheduler would.
+pub fn scancel(id: &str, conf: &Path) {
+    let cancel = Command::new("scancel")
+        .arg(id)
+        .env("SLURM_CONF", conf)
+        .output()
+        .unwrap();
+    assert!(cancel.status.success(), "{}", text(&cancel.stderr));
+}
+
 /// What a campaign's Slurm jobs and the test cluster logged, for a failure's message.
 pub fn logs(out: &Path, conf: &Path) -> String {
     let mut said = String::new();

@@ -283,14 +283,7 @@ mod tests {
     fn of_ties_the_fewest_parameters_win_before_the_lower_bic() {
         let s = DiscoverySettings::default();
         let e = noise(500, 4);
-        let param = |name: &str| crate::fit::FittedParam {
-            name: name.into(),
-            value: 1.0,
-            std_error: 0.1,
-            naive_std_error: 0.1,
-            fixed: false,
-            held_by: None,
-        };
+        let param = |name: &str| crate::fit::FittedParam::free(name, 1.0, 0.1);
         // Same held-out residuals: a tie. The four-parameter one has the lower BIC.
         let mut four = score("four", 1.0, 20.0, -540.0, -340.0);
         four.params = ["a", "b", "c", "d"].map(param).to_vec();
@@ -335,14 +328,7 @@ mod tests {
                 score("simple", rms(&other), 20.0, -520.0, -320.0),
                 score("rich", rms(&best), 20.0, -540.0, -340.0),
             ];
-            let param = |name: &str| crate::fit::FittedParam {
-                name: name.into(),
-                value: 1.0,
-                std_error: 0.1,
-                naive_std_error: 0.1,
-                fixed: false,
-                held_by: None,
-            };
+            let param = |name: &str| crate::fit::FittedParam::free(name, 1.0, 0.1);
             scores[0].params = vec![param("a")];
             scores[1].params = vec![param("a"), param("b")];
             for sc in &mut scores {

@@ -428,14 +428,7 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
         .iter()
         .filter_map(|q| {
             if q.fixed {
-                return Some(FittedParam {
-                    name: q.name.clone(),
-                    value: q.value,
-                    std_error: 0.0,
-                    naive_std_error: 0.0,
-                    fixed: true,
-                    held_by: None,
-                });
+                return Some(FittedParam::held(&q.name, q.value));
             }
             let e = errors?;
             let (k, &value) = free.next()?;

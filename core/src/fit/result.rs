@@ -85,6 +85,37 @@ pub struct FittedParam {
     pub held_by: Option<BoundSide>,
 }
 
+impl FittedParam {
+    /// A free parameter ended at `value` with standard error `std_error` (the classical one
+    /// the same), held by no bound.
+    pub fn free(name: &str, value: f64, std_error: f64) -> Self {
+        FittedParam {
+            name: name.into(),
+            value,
+            std_error,
+            naive_std_error: std_error,
+            fixed: false,
+            held_by: None,
+        }
+    }
+
+    /// A parameter held at `value` (its standard errors zero).
+    pub fn held(name: &str, value: f64) -> Self {
+        FittedParam {
+            fixed: true,
+            ..Self::free(name, value, 0.0)
+        }
+    }
+
+    /// The value for a person to read: rounded to its standard error
+    /// ([`crate::digits::rounded`]), a held value or one without an error to six
+    /// significant digits.
+    pub fn shown_value(&self) -> String {
+        let error = if self.fixed { f64::NAN } else { self.std_error };
+        crate::digits::rounded(self.value, error)
+    }
+}
+
 /// The blocks of consecutive samples over which the standard errors' residuals were taken as
 /// correlated: the cluster-robust covariance sums each block's scores before squaring them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

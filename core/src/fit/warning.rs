@@ -11,7 +11,8 @@
 //! | [`FitWarning::Correlated`] | two free parameters correlate beyond [`CORRELATION_LIMIT`] in magnitude |
 //!
 //! Each warning's [`Display`](std::fmt::Display) is one sentence that says what is wrong and
-//! what to try; serialized, it is an object with a `kind` and the data
+//! what to try, its numbers written by [`crate::digits`] as the reports and the terminal write
+//! them; serialized, it is an object with a `kind` and the data
 //! ([`FitWarning::stated`] adds the `message`).
 
 use serde::Serialize;
@@ -20,6 +21,7 @@ use thiserror::Error;
 use super::fit_param::{BoundSide, FitParam};
 use super::noise_floor::{NoiseFloor, Quantity};
 use super::result::{Convergence, FitResult};
+use crate::digits::{significant, value_and_error};
 
 /// Parameters whose value is near zero by nature (offsets, the initial state): their error
 /// is not compared with their value.
@@ -67,9 +69,11 @@ pub enum FitWarning {
     },
     /// A free parameter ended on one of its bounds: the data push it there or beyond.
     #[error(
-        "{param} ended on its {} bound ({value:.5} at {bound}): the data push it \
-         there or beyond — widen the bound of {param} or fix it",
-        .side.name()
+        "{param} ended on its {} bound ({} at {}): the data push it there or beyond — \
+         widen the bound of {param} or fix it",
+        .side.name(),
+        significant(*.value, 6),
+        significant(*.bound, 6)
     )]
     OnBound {
         /// Parameter.
@@ -154,12 +158,14 @@ fn not_converged(convergence: &Convergence) -> String {
     }
 }
 
-/// The sentence of [`FitWarning::Undetermined`], with the error if it is finite.
+/// The sentence of [`FitWarning::Undetermined`], with the error if it is finite (the value
+/// rounded to it, as the results table shows them).
 fn undetermined(param: &str, value: f64, std_error: f64) -> String {
     if std_error.is_finite() {
+        let (value, error) = value_and_error(value, std_error);
         format!(
-            "{param} = {value:.4e} has a standard error of {std_error:.2e}, larger \
-             than itself: the data do not determine {param} — fix it or drop its term"
+            "{param} = {value} has a standard error of {error}, larger than itself: the \
+             data do not determine {param} — fix it or drop its term"
         )
     } else {
         format!(
@@ -273,22 +279,14 @@ mod tests {
     use super::*;
     use crate::fit::FittedParam;
 
-    fn param(name: &str, value: f64, std_error: f64) -> FittedParam {
-        FittedParam {
-            name: name.into(),
-            value,
-            std_error,
-            naive_std_error: std_error,
-            fixed: false,
-            held_by: None,
-        }
-    }
-
     /// A converged two-parameter fit with RMS 0.02, K = 4 ± 0.05, n = 1.5 ± 0.006,
     /// correlation `c`.
     fn result(c: f64) -> FitResult {
         FitResult {
-            params: vec![param("K", 4.0, 0.05), param("n", 1.5, 0.006)],
+            params: vec![
+                FittedParam::free("K", 4.0, 0.05),
+                FittedParam::free("n", 1.5, 0.006),
+            ],
             correlation: vec![vec![1.0, c], vec![c, 1.0]],
             n_points: 1000,
             n_free: 2,
@@ -368,6 +366,12 @@ mod tests {
                 side: BoundSide::Lower
             }]
         );
+        assert!(
+            w[0].to_string()
+                .starts_with("n ended on its lower bound (1.0001 at 1): the data push it"),
+            "{}",
+            w[0]
+        );
         assert!(w[0].to_string().contains("widen the bound of n or fix it"));
         // 1 % of its size from the bound is inside.
         r.params[1].value = 1.012;
@@ -395,11 +399,27 @@ mod tests {
     #[test]
     fn a_standard_error_above_the_value_or_not_finite_is_flagged() {
         let mut r = result(0.0);
-        r.params[0].std_error = 4.1;
+        r.params[0].std_error = 5.2;
         r.params[1].std_error = f64::INFINITY;
         let w = fit_warnings(&r, &bounds(), None);
         assert_eq!(kinds(&w), ["undetermined", "undetermined"]);
-        assert!(w[0].to_string().contains("larger than itself"));
+        assert!(
+            w[0].to_string()
+                .starts_with("K = 4 has a standard error of 5, larger than itself"),
+            "{}",
+            w[0]
+        );
+        let small = FitWarning::Undetermined {
+            param: "m_a".into(),
+            value: 1.5184e-4,
+            std_error: 5.60e-4,
+        };
+        assert!(
+            small
+                .to_string()
+                .starts_with("m_a = 2e-4 has a standard error of 6e-4, larger than itself"),
+            "{small}"
+        );
         assert!(w[1].to_string().contains("no finite standard error"));
         r.params[0].std_error = f64::NAN;
         r.params[1].std_error = 1.5;

@@ -78,14 +78,7 @@ mod tests {
             correlation: Vec<Vec<f64>>,
             std_errors: BTreeMap<String, f64>,
         }
-        let param = |name: &str, std_error| FittedParam {
-            name: name.into(),
-            value: 1.5,
-            std_error,
-            naive_std_error: f64::NAN,
-            fixed: false,
-            held_by: None,
-        };
+        let param = |name: &str, std_error| FittedParam::free(name, 1.5, std_error);
         let doc = Doc {
             aic: f64::NEG_INFINITY,
             correlation: vec![vec![1.0, f64::NAN]],

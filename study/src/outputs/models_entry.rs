@@ -124,14 +124,7 @@ mod tests {
     use super::*;
 
     fn param(name: &str, value: f64) -> FittedParam {
-        FittedParam {
-            name: name.into(),
-            value,
-            std_error: f64::NAN,
-            naive_std_error: f64::NAN,
-            fixed: false,
-            held_by: None,
-        }
+        FittedParam::free(name, value, f64::NAN)
     }
 
     #[test]
