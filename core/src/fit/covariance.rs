@@ -300,8 +300,7 @@ fn block_sums_test(scores: &DMatrix<f64>, g: usize) -> Vec<f64> {
 /// lags and negatively beyond (its correlations sum to zero), and a sensor's white noise
 /// beside it can hide that from the test. Block sums over less than a window then count the
 /// short lags' share and miss the long lags' cancelling one: on the rig's records at 200 Hz
-/// (window 21) blocks of 16 samples gave a K 7 % less sure than blocks of 64 or the spread
-/// over 200 noise seeds said.
+/// (window 21) blocks of 16 samples made K's error about 5 % wider than blocks of 64.
 pub fn blocks(jac: &DMatrix<f64>, r: &[f64], span: usize) -> ErrorBlocks {
     let (n, p) = jac.shape();
     if r.len() != n || n == 0 {
