@@ -89,6 +89,15 @@ fn a_record_in_metres_is_still_shown_in_millimetres() {
         read_json(&out.join("fit.json"))["models"][0]["rms_unit"],
         "m"
     );
+    let units = param_units(&out.join("params.csv"));
+    assert!(
+        units.iter().any(|(p, u)| p == "c_s" && u == "N·s/m"),
+        "{units:?}"
+    );
+    assert!(
+        units.iter().any(|(p, u)| p == "x0" && u == "m"),
+        "{units:?}"
+    );
 }
 
 #[test]
@@ -105,6 +114,8 @@ fn discovery_on_a_rotorless_record_in_volts_speaks_of_periods_and_millivolts() {
         "{:?} in\n{said}",
         wrong_words(&said)
     );
+    // The final model's parameters in the record's units: k3 in 1/V², m in s².
+    assert!(said.contains(" 1/V²") && !said.contains("N/m"), "{said}");
     let doc = read_json(&out.join("discovery.json"));
     assert_eq!(doc["gap_unit"], "V");
     assert_eq!(doc["effects"], serde_json::json!(["cubic_stiffness"]));
@@ -152,4 +163,145 @@ fn compare_on_a_rotorless_record_ranks_over_the_whole_record() {
         .unwrap()
         .to_string();
     assert!(verdict.contains("over the whole record"), "{verdict}");
+}
+
+/// `(parameter, unit)` of every row of a `params.csv`.
+fn param_units(path: &Path) -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (p, u) = (at("parameter"), at("unit"));
+    lines
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            (cells[p].to_string(), cells[u].to_string())
+        })
+        .collect()
+}
+
+/// The symbols of a unit (`N·s/V` → N, s, V).
+fn symbols(unit: &str) -> Vec<&str> {
+    unit.split(|c: char| !c.is_alphanumeric() || "ⁿ⁰¹²³⁴⁵⁶⁷⁸⁹".contains(c))
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+/// On a record whose x and drive are both voltages read as they are (an electronic
+/// oscillator), lengths are V and forces V: no parameter's unit says m, mm, N or kg, and the
+/// oscillator's equation fixes each (c_s in s, k3 in 1/V², the initial state in V and V/s).
+#[test]
+fn parameters_on_a_record_in_volts_are_in_volts_not_metres() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = volt_experiment(
+        tmp.path(),
+        "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n\n[output]\nreport = true\n",
+    );
+    let out = tmp.path().join("fit");
+    let said = terminal(&run_ok("fit", &exp, &out));
+    let units = param_units(&out.join("params.csv"));
+    for (p, u) in &units {
+        let wrong: Vec<&str> = symbols(u)
+            .into_iter()
+            .filter(|s| ["m", "mm", "N", "kg"].contains(s))
+            .collect();
+        assert!(wrong.is_empty(), "{p} in {u}: {units:?}");
+    }
+    let expected = [("c_s", "s"), ("k3", "1/V²"), ("x0", "V"), ("v0", "V/s")];
+    for (p, u) in expected {
+        assert!(
+            units.iter().any(|(q, v)| q == p && v == u),
+            "{p} not in {u}: {units:?}"
+        );
+    }
+    assert!(said.contains(" 1/V²") && said.contains(" V/s"), "{said}");
+    assert!(!said.contains("N·s/m") && !said.contains("N/m"), "{said}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("| k3 | ") && md.contains(" | 1/V² |"), "{md}");
+    assert!(!md.contains("N/m") && !md.contains("| m |"), "{md}");
+}
+
+/// At force level the force is the STF force's own unit (N here, x still in volts): a power
+/// law's K is in N·(s/V)ⁿ, a viscous term in N·s/V, and the RMS in N.
+#[test]
+fn force_level_parameters_on_a_record_in_volts_keep_newtons_for_the_force() {
+    let tmp = tempfile::tempdir().unwrap();
+    let exp = volt_experiment(
+        tmp.path(),
+        "[fit]\nlevel = \"force\"\n\n[[models]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n\n[[models]]\nname = \"power_law\"\n",
+    );
+    let out = tmp.path().join("fit");
+    let said = terminal(&run_ok("fit", &exp, &out));
+    let units = param_units(&out.join("params.csv"));
+    for (p, u) in [("c_s", "N·s/V"), ("k3", "N/V³"), ("K", "N·(s/V)ⁿ")] {
+        assert!(
+            units.iter().any(|(q, v)| q == p && v == u),
+            "{p} not in {u}: {units:?}"
+        );
+    }
+    assert!(said.contains("N·(s/V)ⁿ") && !said.contains("s/m"), "{said}");
+    assert_eq!(
+        read_json(&out.join("fit.json"))["models"][0]["rms_unit"],
+        "N"
+    );
+}
+
+/// A campaign of records in volts: the joint fit's RMS in mV (its RSS in V²), each record's
+/// RMS in mV and its parameters' units in volts, in the JSON, the table and the report.
+#[test]
+fn a_campaign_on_records_in_volts_speaks_of_millivolts_and_volts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let record = root().join("experiments/records/trajectory_discovery.csv");
+    for name in ["a.csv", "b.csv", "c.csv"] {
+        std::fs::copy(&record, tmp.path().join(name)).unwrap();
+    }
+    let exp = volt_experiment(
+        tmp.path(),
+        "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n",
+    );
+    let campaign = tmp.path().join("campaign.toml");
+    std::fs::write(
+        &campaign,
+        format!(
+            "[campaign]\nexperiment = \"{}\"\ncommand = \"fit\"\nconditions = [\"gain\"]\n\n\
+             [[records]]\nfile = \"a.csv\"\ngain = 1.0\n\n[[records]]\nfile = \"b.csv\"\ngain = 1.1\n\n\
+             [[records]]\nfile = \"c.csv\"\ngain = 1.2\n\n\
+             [global]\nmodel = \"viscous + cubic_stiffness\"\nshared = [\"c_s\", \"k3\"]\n\
+             holdout = \"c.csv\"\nlevel = \"trajectory\"\n",
+            exp.display()
+        ),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let run = common::stf_lab()
+        .args(["campaign", "--jobs", "1", "--out"])
+        .arg(&out)
+        .arg(&campaign)
+        .output()
+        .unwrap();
+    let said = terminal(&run);
+    assert!(run.status.success(), "{said}");
+    assert!(
+        wrong_words(&said).is_empty(),
+        "{:?} in\n{said}",
+        wrong_words(&said)
+    );
+    let g = read_json(&out.join("global.json"));
+    assert_eq!(g["rms_unit"], "mV");
+    assert!(
+        g["verdict"].as_str().unwrap().contains(" mV"),
+        "{}",
+        g["verdict"]
+    );
+    let table = read_json(&out.join("campaign.json"));
+    let row = &table["rows"][0];
+    assert_eq!(row["params"]["k3"]["unit"], "1/V²", "{row}");
+    assert_eq!(row["params"]["x0"]["unit"], "V", "{row}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("| RSS, V² |") && md.contains(" mV |"), "{md}");
+    assert!(
+        wrong_words(&md).is_empty() && !md.contains("m²"),
+        "{:?} in report.md",
+        wrong_words(&md)
+    );
 }

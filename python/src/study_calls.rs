@@ -117,7 +117,17 @@ pub fn fit(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
 pub fn identify(exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
     let watch = Watch::new(run);
     let found = prelude::identify(&exp, &watch)?;
-    let doc = IdentificationJson::new(&exp.path, &exp.identify, &found.stages, found.system);
+    let units = stf_study::shown_units::ShownUnits::of(
+        &exp.data_layout,
+        stf_study::experiment::FitLevel::Trajectory,
+    );
+    let doc = IdentificationJson::new(
+        &exp.path,
+        &exp.identify,
+        &found.stages,
+        found.system,
+        &units,
+    );
     let json = json_text(&doc)?;
     let rows: Vec<_> = found
         .stages
@@ -129,6 +139,7 @@ pub fn identify(exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
                 &o.result,
                 None,
                 &o.warnings,
+                &units,
             )
         })
         .collect();
@@ -161,7 +172,10 @@ pub fn compare(mut exp: Experiment, run: &Run) -> Result<Outcome, StudyError> {
         &labels,
         &c.comparisons,
     ))?;
-    let params_table = json_text(&stf_study::param_table::rows_of_fits(&c.fits))?;
+    let params_table = json_text(&stf_study::param_table::rows_of_fits(
+        &c.fits,
+        &result.data.units,
+    ))?;
     let verdict = stf_study::verdict::compare_verdict(c, result.data.words());
     let best = best_of(&c.fits);
     let data = result.data;

@@ -85,10 +85,11 @@ fn comparison(g: &GlobalJson) -> Table {
             held.map_or("—".into(), |h| format!("{h:.5} {unit}")),
         ]
     };
-    let rss_unit = if g.level == "trajectory" {
-        "m²"
-    } else {
-        "N²"
+    // The RSS stays in the records' SI units: those of the shown RMS without its milli.
+    let rss_unit = match unit.as_str() {
+        "mm" => "m²".to_string(),
+        "mV" => "V²".to_string(),
+        u => format!("{u}²"),
     };
     let h = g.holdout.as_ref();
     Table {

@@ -33,7 +33,8 @@ pub fn write(
     let ok_units = table.units - table.failed;
     doc.intro.push(format!(
         "stf-lab ran the {} unit(s) of {}: {ok_units} wrote results, {} failed. A row per \
-         record and model; parameters in SI units, ± one standard error (block-robust).",
+         record and model; parameters in SI units (lengths and forces in V on a record in \
+         volts, as its params.csv gives them), ± one standard error (block-robust).",
         table.units, table.campaign, table.failed
     ));
     if !table.stale_units.is_empty() {
@@ -247,7 +248,7 @@ fn table_of(table: &CampaignJson) -> Table {
                 })
                 .collect();
             let rms = match (r.result.rms, &r.result.rms_unit) {
-                (Some(v), Some(u)) => format!("{v:.4} {u}"),
+                (Some(v), Some(u)) => shown_rms(v, u),
                 _ => String::new(),
             };
             cells.extend([
@@ -271,5 +272,15 @@ fn table_of(table: &CampaignJson) -> Table {
         caption,
         columns,
         rows,
+    }
+}
+
+/// An RMS `value` in its record's SI `unit` as the lab shows it: a displacement in mm (m), a
+/// voltage in mV (V), a force in N.
+fn shown_rms(value: f64, unit: &str) -> String {
+    match unit {
+        "m" => format!("{:.4} mm", value * 1e3),
+        "V" => format!("{:.4} mV", value * 1e3),
+        u => format!("{value:.4} {u}"),
     }
 }

@@ -87,8 +87,8 @@ pub struct ParamValue {
     pub value: f64,
     /// Its block-robust standard error; null where not determined or held.
     pub std_error: Option<f64>,
-    /// Its SI unit (empty: dimensionless), as `params.csv` gives it; null where unknown
-    /// (`compare`, `discover`).
+    /// Its unit as `params.csv` gives it (SI, lengths and forces in the record's own units;
+    /// empty: dimensionless); null where unknown (`compare`, `discover`).
     pub unit: Option<String>,
 }
 

@@ -15,6 +15,7 @@ use crate::report::{
     Table, DISPLACEMENT_MM,
 };
 use stf_study::compare::response;
+use stf_study::shown_units::ShownUnits;
 
 pub use stf_study::identify::StageOutcome;
 use stf_study::verdict::identify_verdict as verdict;
@@ -114,6 +115,7 @@ pub fn write_identification_report(
     experiment: &Path,
     stages: &[StageOutcome],
     system: &OscillatorParams,
+    units: &ShownUnits,
     out: &Path,
 ) -> Result<()> {
     let dir = out.join("figures");
@@ -125,7 +127,7 @@ pub fn write_identification_report(
         .collect::<Result<Vec<_>>>()?;
     write_report(
         &format!("Identification: {}", experiment.display()),
-        vec![verdict(stages, system)],
+        vec![verdict(stages, system, units)],
         sections,
         out,
     )

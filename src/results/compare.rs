@@ -123,7 +123,7 @@ fn print_summary(result: &CompareResult) {
         } else {
             format!("{:.3}", cmp.overall.relative_rms_error)
         });
-        let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f));
+        let rows = crate::param_table::rows_of_fits(std::slice::from_ref(f), &data.units);
         say!(
             "  {label:<name_width$}  {}  {}",
             shown(&cells),
@@ -170,7 +170,7 @@ fn write_compare_report(
         .iter()
         .map(|f| (f.label.as_str(), &f.result))
         .collect();
-    let rows = crate::param_table::rows_of_fits(&c.fits);
+    let rows = crate::param_table::rows_of_fits(&c.fits, &data.units);
     let equations = crate::results::fit::equations_of(&c.fits);
     let results =
         crate::documents::results_table::results_section("Results", &equations, &rows, &fits);

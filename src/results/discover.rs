@@ -104,6 +104,7 @@ fn print_summary(
         &found.final_fit,
         Some(found.final_model.as_ref()),
         &[],
+        &data.units,
     );
     say!(
         "final model `{}`: {}",
@@ -238,6 +239,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         &found.final_fit,
         Some(found.final_model.as_ref()),
         &[],
+        &data.units,
     );
     let title = format!("Final model: {}", found.final_model_name);
     let fits = [("final", &found.final_fit)];

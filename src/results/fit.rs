@@ -24,6 +24,7 @@ use crate::say;
 use crate::validation::ValidationRecord;
 use crate::writing::{write_atomic, write_json};
 use stf_core::regimes::Regime;
+use stf_study::shown_units::ShownUnits;
 
 /// Write the fit's results into `out` (fit.json, params.csv, fitted.csv and, with
 /// `[output] report`, the report) and print its summary.
@@ -152,7 +153,7 @@ fn print_summary(data: &FitData, fits: &[ModelFit]) {
         say!("  {drive}");
     }
     for f in fits {
-        let rows = rows_of_fits(std::slice::from_ref(f));
+        let rows = rows_of_fits(std::slice::from_ref(f), &data.units);
         say!(
             "  {:<24} rms {:.4} {unit}  AIC {:.1}  {}{}",
             f.label,
@@ -225,12 +226,19 @@ fn print_warnings(warnings: &[FitWarning]) {
 }
 
 /// The terminal line of identification stage `i`, its warnings under it.
-fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitWarning]) {
+fn print_stage(
+    i: usize,
+    stage: &StageSpec,
+    result: &FitResult,
+    warnings: &[FitWarning],
+    units: &ShownUnits,
+) {
     say!(
-        "stage {} ({}): S(μ) = {:.4} mm², {}{}",
+        "stage {} ({}): S(μ) = {:.4} {}, {}{}",
         i + 1,
         stage.data.display(),
         result.s_mm2.unwrap_or(f64::NAN),
+        units.x_squared,
         result
             .params
             .iter()
@@ -250,21 +258,25 @@ fn print_stage(i: usize, stage: &StageSpec, result: &FitResult, warnings: &[FitW
 /// stage and the oscillator found.
 pub fn write_identification(exp: &Experiment, out: &Path, found: &Identification) -> Result<()> {
     let (system, outcomes) = (&found.system, &found.stages);
+    let units = ShownUnits::of(&exp.data_layout, FitLevel::Trajectory);
     for (i, (stage, o)) in exp.identify.iter().zip(outcomes).enumerate() {
-        print_stage(i, stage, &o.result, &o.warnings);
+        print_stage(i, stage, &o.result, &o.warnings, &units);
     }
-    let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system);
+    let doc = IdentificationJson::new(&exp.path, &exp.identify, outcomes, *system, &units);
     write_json(&out.join("fit.json"), &doc)?;
     let rows: Vec<ParamRow> = outcomes
         .iter()
         .enumerate()
-        .flat_map(|(i, o)| rows_of(&format!("stage {}", i + 1), &o.result, None, &o.warnings))
+        .flat_map(|(i, o)| {
+            let label = format!("stage {}", i + 1);
+            rows_of(&label, &o.result, None, &o.warnings, &units)
+        })
         .collect();
     let params = out.join("params.csv");
     write_atomic(&params, &params_csv(&params, &rows)?)?;
-    say!("identified system: {}", system_line(system));
+    say!("identified system: {}", system_line(system, &units));
     if exp.output.report {
-        write_identification_report(&exp.path, outcomes, system, out)?;
+        write_identification_report(&exp.path, outcomes, system, &units, out)?;
     }
     Ok(())
 }

@@ -73,7 +73,7 @@ pub fn warn_about(data: &FitData, observer: &dyn Observer) {
 impl Fitted {
     /// The rows of `params.csv`.
     pub fn param_rows(&self) -> Vec<ParamRow> {
-        rows_of_fits(&self.fits)
+        rows_of_fits(&self.fits, &self.data.units)
     }
 
     /// `fitted.csv`: t, the measured signal (`f_stf` or `x`) and each model's fit of it

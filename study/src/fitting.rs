@@ -60,10 +60,7 @@ impl FitData {
     /// The unit errors and gaps are shown in, and the factor from the record's values: N at
     /// force level; at trajectory level the record's own (mm, or mV for x in volts).
     pub fn shown(&self) -> (&'static str, f64) {
-        match self.level {
-            FitLevel::Force => self.level.shown(),
-            FitLevel::Trajectory => (self.units.x, self.units.scale),
-        }
+        self.units.at_level(self.level)
     }
 
     /// The words that fit the record's rig: a rotor's cycles and regimes, or periods of the
@@ -75,7 +72,7 @@ impl FitData {
     /// The unit of the fitted signal as recorded: N at force level, m (or V) at trajectory level.
     pub fn si_unit(&self) -> &'static str {
         match self.level {
-            FitLevel::Force => self.level.signal().si_unit,
+            FitLevel::Force => self.units.force_si,
             FitLevel::Trajectory => self.units.x_si,
         }
     }
@@ -227,7 +224,7 @@ pub fn load_data_at(exp: &mut Experiment, asked: Option<FitLevel>) -> Result<Fit
         level,
         system_estimate,
         record_warnings,
-        units: ShownUnits::of(&exp.data_layout),
+        units: ShownUnits::of(&exp.data_layout, level),
         v_measured,
         channels,
     })

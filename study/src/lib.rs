@@ -38,6 +38,7 @@ pub mod model_config;
 pub mod observer;
 pub mod outputs;
 pub mod param_table;
+pub mod param_units;
 pub mod plausibility;
 pub mod plausible_scale;
 pub mod prelude;

@@ -17,6 +17,8 @@ use stf_core::physics::force_model::ForceModel;
 
 use crate::digits::carried;
 use crate::fitting::ModelFit;
+use crate::param_units::in_record_units;
+use crate::shown_units::ShownUnits;
 
 /// One row of the table.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -29,7 +31,8 @@ pub struct ParamRow {
     pub value: f64,
     /// Standard error; empty when the data do not determine it (or when held).
     pub std_error: Option<f64>,
-    /// SI unit; empty for a dimensionless parameter.
+    /// Unit: SI, with lengths and forces in the record's own units ([`in_record_units`]: V
+    /// for a length on a record whose x is in volts); empty for a plain number.
     pub unit: String,
     /// Held at its value, not fitted.
     pub fixed: bool,
@@ -53,12 +56,14 @@ fn system_unit(name: &str) -> Option<&'static str> {
     })
 }
 
-/// The rows of one fit: `result`'s parameters, units from `model`'s specs or the oscillator's.
+/// The rows of one fit: `result`'s parameters, units from `model`'s specs or the oscillator's
+/// on a record shown in `units`.
 pub fn rows_of(
     label: &str,
     result: &FitResult,
     model: Option<&dyn ForceModel>,
     warnings: &[FitWarning],
+    units: &ShownUnits,
 ) -> Vec<ParamRow> {
     result
         .params
@@ -69,6 +74,7 @@ pub fn rows_of(
                 .map(|s| s.unit.clone());
             let unit = spec_unit
                 .or_else(|| system_unit(&p.name).map(str::to_string))
+                .map(|u| in_record_units(&u, units))
                 .unwrap_or_default();
             let at_bound = warnings
                 .iter()
@@ -86,12 +92,12 @@ pub fn rows_of(
         .collect()
 }
 
-/// The rows of every model fit, in order.
-pub fn rows_of_fits(fits: &[ModelFit]) -> Vec<ParamRow> {
+/// The rows of every model fit, in order, on a record shown in `units`.
+pub fn rows_of_fits(fits: &[ModelFit], units: &ShownUnits) -> Vec<ParamRow> {
     fits.iter()
         .flat_map(|f| {
             let model = f.configured.as_ref().map(|c| c.model.as_ref());
-            rows_of(&f.label, &f.result, model, &f.warnings)
+            rows_of(&f.label, &f.result, model, &f.warnings, units)
         })
         .collect()
 }

@@ -83,7 +83,7 @@ pub fn load(exp: &Experiment, estimation: &FitData) -> Result<Option<ValidationR
         level: estimation.level,
         system_estimate: None,
         record_warnings,
-        units: crate::shown_units::ShownUnits::of(&exp.data_layout),
+        units: crate::shown_units::ShownUnits::of(&exp.data_layout, estimation.level),
         v_measured: false,
         channels: crate::channels::Channels::none(),
     };

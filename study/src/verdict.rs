@@ -13,7 +13,9 @@ use crate::compare::Compared;
 use crate::identify::StageOutcome;
 
 use crate::fitting::ModelFit;
+use crate::param_units::in_record_units;
 use crate::rig_words::RigWords;
+use crate::shown_units::ShownUnits;
 
 /// AIC differences below this say the data do not prefer one model over the other
 /// (Burnham & Anderson's rule of thumb: ΔAIC < 2, substantial support for both).
@@ -382,30 +384,42 @@ fn significant(x: f64, digits: i32) -> String {
     }
 }
 
-/// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`.
-pub fn system_line(system: &OscillatorParams) -> String {
+/// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`, units on a
+/// record shown in `units`.
+pub fn system_line(system: &OscillatorParams, units: &ShownUnits) -> String {
     OscParam::ALL
         .into_iter()
         .filter(|p| !p.is_offset() || system[*p] != 0.0)
-        .map(|p| format!("{p} {} {}", significant(system[p], 6), p.unit()))
+        .map(|p| {
+            let unit = in_record_units(p.unit(), units);
+            format!("{p} {} {unit}", significant(system[p], 6))
+                .trim_end()
+                .to_string()
+        })
         .collect::<Vec<_>>()
         .join(", ")
 }
 
 /// The verdict of an identification (its fit.json's `verdict`): what was identified, how
 /// close each stage came to its noise floor (each stage's `floor_mm2` and `s_over_floor`),
-/// and whether any warning stands.
-pub fn identify_verdict(stages: &[StageOutcome], system: &OscillatorParams) -> String {
+/// and whether any warning stands; units on a record shown in `units`.
+pub fn identify_verdict(
+    stages: &[StageOutcome],
+    system: &OscillatorParams,
+    units: &ShownUnits,
+) -> String {
     let fits: Vec<String> = stages
         .iter()
         .enumerate()
         .map(|(i, s)| {
             format!(
-                "stage {} ({}) S(μ) = {:.4} mm² against the position noise's {:.4} mm² ({:.1}×)",
+                "stage {} ({}) S(μ) = {:.4} {} against the position noise's {:.4} {} ({:.1}×)",
                 i + 1,
                 s.record,
                 s.result.s_mm2.unwrap_or(f64::NAN),
+                units.x_squared,
                 s.floor_mm2(),
+                units.x_squared,
                 s.s_over_floor()
             )
         })
@@ -413,7 +427,7 @@ pub fn identify_verdict(stages: &[StageOutcome], system: &OscillatorParams) -> S
     let warned: usize = stages.iter().map(|s| s.warnings.len()).sum();
     format!(
         "Identified oscillator: {}. {}. {}",
-        system_line(system),
+        system_line(system, units),
         fits.join("; "),
         if warned == 0 {
             "No stage carries a warning: every stage converged, its free parameters determined, \

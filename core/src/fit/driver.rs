@@ -347,7 +347,13 @@ impl Chain<'_> {
         let p = self.free.len();
         let errors = if p > 0 {
             let jac = jacobian(obj, self.free, &x, &r0, self.settings);
-            Some(standard_errors(&jac, &r0, rss, &mut log))
+            Some(standard_errors(
+                &jac,
+                &r0,
+                rss,
+                obj.correlation_span(),
+                &mut log,
+            ))
         } else {
             None
         };
@@ -517,10 +523,17 @@ struct Errors {
     step: Vec<f64>,
 }
 
-/// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`);
-/// a line in `log` when the blocks are too few for the errors to be sure.
-fn standard_errors(jac: &DMatrix<f64>, r: &[f64], rss: f64, log: &mut Vec<String>) -> Errors {
-    let blocks = covariance::blocks(jac, r);
+/// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`),
+/// known to be correlated over `span` samples; a line in `log` when the blocks are too few
+/// for the errors to be sure.
+fn standard_errors(
+    jac: &DMatrix<f64>,
+    r: &[f64],
+    rss: f64,
+    span: usize,
+    log: &mut Vec<String>,
+) -> Errors {
+    let blocks = covariance::blocks(jac, r, span);
     if !blocks.settled {
         log.push(format!(
             "standard errors: the residuals are correlated over about the whole record (even \

@@ -61,7 +61,9 @@ pub struct ForceFit {
     #[setters(generate)]
     settings: FitSettings,
     /// How v and a were made from x, for [`ForceFit::fit`] to correct its estimates for
-    /// their noise ([`filter_noise`](super::filter_noise)); `None`: v and a taken as exact.
+    /// their noise ([`filter_noise`](super::filter_noise)) and to take the blocks of its
+    /// standard errors at least twice the filter's window long; `None`: v and a taken as
+    /// exact.
     #[setters(generate)]
     filter_noise: Option<FilterNoise>,
 }
@@ -182,6 +184,7 @@ impl ForceFit {
             data: *data,
             all: &all,
             rows,
+            span: self.filter_noise.map_or(1, |n| n.filter.window()),
         };
         driver::run(&problem, &all, settings, observer, Quantity::Force)
     }
@@ -208,6 +211,7 @@ impl ForceFit {
             data: *data,
             all: &all,
             rows,
+            span: 1,
         };
         let mut out: Vec<f64> = (0..problem.len()).map(|k| data.f[problem.row(k)]).collect();
         problem
@@ -226,6 +230,9 @@ struct ForceResiduals<'a> {
     /// The samples whose residuals count (strictly increasing), or `None` for all. A model
     /// with internal state is still integrated along every sample.
     rows: Option<&'a [usize]>,
+    /// Samples over which the kinematics' noise is correlated: the derivative filter's
+    /// window (1: v and a taken as exact).
+    span: usize,
 }
 
 impl ForceResiduals<'_> {
@@ -247,6 +254,10 @@ impl ForceResiduals<'_> {
 impl Residuals for ForceResiduals<'_> {
     fn len(&self) -> usize {
         self.rows.map_or(self.data.t.len(), <[usize]>::len)
+    }
+
+    fn correlation_span(&self) -> usize {
+        self.span
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {

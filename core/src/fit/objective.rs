@@ -35,6 +35,14 @@ pub trait Residuals: Sync {
     fn jacobian(&self, _x: &[f64], _jac: &mut DMatrix<f64>) -> Option<Result<(), String>> {
         None
     }
+
+    /// Samples over which the residuals are known to be correlated, whatever their own
+    /// autocorrelation shows (a derivative filter's window, when the model reads its output):
+    /// the blocks of the robust standard errors are at least twice this long. 1 (the
+    /// default): nothing known beyond the residuals.
+    fn correlation_span(&self) -> usize {
+        1
+    }
 }
 
 /// ln of the cost that stands for a failed evaluation in the optimisers (cost 1e300).
@@ -101,6 +109,11 @@ impl<'a> Objective<'a> {
     /// Number of residuals.
     pub fn len(&self) -> usize {
         self.problem.len()
+    }
+
+    /// The problem's [`Residuals::correlation_span`].
+    pub fn correlation_span(&self) -> usize {
+        self.problem.correlation_span()
     }
 
     /// The transforms of the free parameters.

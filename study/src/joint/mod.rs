@@ -2,7 +2,8 @@
 //! the global model at the global fit's level ([`records`]: the per-record alternative, as
 //! `fit` would fit it), then all training records fitted jointly ([`fit`]), and the two
 //! compared ([`GlobalJson`], written to `DIR/global.json`; RMS values in N at force level,
-//! in mm at trajectory level, `rms_unit`):
+//! at trajectory level in mm, or mV for records whose x is in volts, `rms_unit`; parameters'
+//! units in the records' own units, as `params.csv` gives them):
 //!
 //! - over the training records: total RSS, parameters, AIC and BIC of each (the per-record
 //!   side sums the records' RSS, samples and free parameters; both use
@@ -27,6 +28,8 @@ use serde::Serialize;
 use stf_core::fit::{FitResult, INITIAL_STATE};
 
 use crate::experiment::{Experiment, FitLevel};
+use crate::param_units::in_record_units;
+use crate::shown_units::ShownUnits;
 
 pub mod fit;
 pub mod prediction_cache;
@@ -110,7 +113,7 @@ pub struct Criteria {
     pub n_points: usize,
     /// Free parameters.
     pub n_params: usize,
-    /// RMS residual, in `rms_unit` (N or mm).
+    /// RMS residual, in `rms_unit` (N, or mm or mV).
     pub rms: f64,
     /// N·ln(RSS/N) + 2p.
     pub aic: f64,
@@ -181,7 +184,8 @@ pub struct GlobalJson {
     pub level: String,
     /// A condition's unit, where `campaign.units` gives one.
     pub condition_units: std::collections::BTreeMap<String, String>,
-    /// The unit of every RMS: `N` (force level) or `mm` (trajectory level).
+    /// The unit of every RMS: `N` (force level) or `mm` (trajectory level; `mV` for records
+    /// whose x is in volts).
     pub rms_unit: String,
     /// Parameters shared by every record.
     pub shared: Vec<String>,
@@ -270,26 +274,30 @@ fn joint_fit(campaign: &JointInputs) -> Result<GlobalJson> {
         FitLevel::Force => gexp.fit.settings.clone(),
     };
     let result = global_fit::fit(&layout, &joint, &settings, spec.level)?;
-    let holdout = spec
-        .holdout
-        .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result))
-        .transpose()?;
     let units = Units {
         model: configured.model.clone(),
         conditions: campaign.condition_units.clone(),
+        record: loaded.first().map_or_else(ShownUnits::default, |l| l.units),
     };
+    let shown = units.record.at_level(spec.level).1;
+    let holdout = spec
+        .holdout
+        .map(|h| holdout_json(spec, &loaded[h], &training, &layout, &result, shown))
+        .transpose()?;
     Ok(assemble(
         spec, &units, &loaded, &training, &layout, result, holdout,
     ))
 }
 
-/// The held-out record predicted by the global fit and by the per-record alternative.
+/// The held-out record predicted by the global fit and by the per-record alternative, RMS
+/// values times `shown` (from the record's values to the shown ones).
 fn holdout_json(
     spec: &GlobalSpec,
     held: &Loaded,
     training: &[&Loaded],
     layout: &global_fit::Layout,
     result: &FitResult,
+    shown: f64,
 ) -> Result<HoldoutJson> {
     let theta: Vec<f64> = result.params.iter().map(|p| p.value).collect();
     let columns = layout.sources.first().map_or(0, Vec::len);
@@ -315,7 +323,6 @@ fn holdout_json(
             own_state(held, k).unwrap_or_else(|| mean(nearest.iter().map(|l| l.own.values[k])))
         })
         .collect();
-    let shown = spec.level.shown().1;
     Ok(HoldoutJson {
         record: held.unit.record_given.clone(),
         global_rms: shown * global_fit::rms_of(&held.joint, &global_values)?,
@@ -379,7 +386,7 @@ fn assemble(
     result: FitResult,
     holdout: Option<HoldoutJson>,
 ) -> GlobalJson {
-    let shown = spec.level.shown();
+    let shown = units.record.at_level(spec.level);
     let global = Criteria::of(
         result.rss,
         result.n_points,
@@ -393,7 +400,7 @@ fn assemble(
         .as_ref()
         .is_none_or(|h| h.global_rms <= h.per_record_rms);
     let supported = delta_bic < 0.0 && better_held;
-    let verdict = verdict_text(supported, delta_bic, holdout.as_ref(), spec.level);
+    let verdict = verdict_text(supported, delta_bic, holdout.as_ref(), spec.level, shown.0);
     let caveats = all_caveats(spec, training, &global, &per_record, holdout.as_ref());
     GlobalJson {
         model: spec.model.clone(),
@@ -432,16 +439,19 @@ struct Units {
     model: std::sync::Arc<dyn stf_core::physics::force_model::ForceModel>,
     /// `campaign.units`.
     conditions: std::collections::BTreeMap<String, String>,
+    /// The records' units (the first record's).
+    record: ShownUnits,
 }
 
 impl Units {
-    /// The unit of the model's parameter `name` (empty if it has none or is not the model's).
+    /// The unit of the model's parameter `name` on the records (empty if it has none or is
+    /// not the model's).
     fn param(&self, name: &str) -> String {
         self.model
             .params()
             .iter()
             .find(|s| s.name == name)
-            .map_or_else(String::new, |s| s.unit.clone())
+            .map_or_else(String::new, |s| in_record_units(&s.unit, &self.record))
     }
 }
 
@@ -527,14 +537,14 @@ impl HoldoutJson {
     }
 }
 
-/// The verdict in a sentence.
+/// The verdict in a sentence, RMS values in `unit`.
 fn verdict_text(
     supported: bool,
     delta_bic: f64,
     holdout: Option<&HoldoutJson>,
     level: FitLevel,
+    unit: &str,
 ) -> String {
-    let (unit, _) = level.shown();
     let (signal, digits) = match level {
         FitLevel::Force => ("force", 5),
         FitLevel::Trajectory => ("displacement", 4),
@@ -652,6 +662,7 @@ mod tests {
             -117.6,
             Some(&holdout(0.019757, 0.019767)),
             FitLevel::Force,
+            "N",
         );
         assert!(said.contains("(a tie: within 1 %)"), "{said}");
         let said = verdict_text(
@@ -659,6 +670,7 @@ mod tests {
             -137.7,
             Some(&holdout(0.02038, 0.04556)),
             FitLevel::Force,
+            "N",
         );
         assert!(!said.contains("tie"), "{said}");
     }

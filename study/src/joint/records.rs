@@ -22,6 +22,7 @@ use super::Unit;
 use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{self, ModelFit, Predictor};
 use crate::model_config::{configure_for, ConfiguredModel};
+use crate::shown_units::ShownUnits;
 
 /// A record loaded and fitted alone.
 pub struct Loaded<'c> {
@@ -31,6 +32,8 @@ pub struct Loaded<'c> {
     pub joint: JointRecord,
     /// Its own fit of the global model.
     pub own: ModelFit,
+    /// The units its motion and parameters are shown in.
+    pub units: ShownUnits,
 }
 
 /// The global model configured for data of `scales` (bounds widened to them).
@@ -100,7 +103,12 @@ pub fn load_one<'c>(spec: &GlobalSpec, gexp: &Experiment, unit: &'c Unit) -> Res
         conditions: unit.conditions.clone(),
         cache: PredictionCache::default(),
     };
-    Ok(Loaded { unit, joint, own })
+    Ok(Loaded {
+        unit,
+        joint,
+        own,
+        units: data.units,
+    })
 }
 
 /// The force offset a force-level fit frees with `[fit] offset = true`.

@@ -29,12 +29,13 @@ pub struct IdentificationJson<'a> {
 
 impl<'a> IdentificationJson<'a> {
     /// The document of the stages `specs` that came out as `outcomes` and ended with
-    /// `system`.
+    /// `system`, on records shown in `units`.
     pub fn new(
         experiment: &std::path::Path,
         specs: &[StageSpec],
         outcomes: &'a [StageOutcome],
         system: OscillatorParams,
+        units: &crate::shown_units::ShownUnits,
     ) -> Self {
         let warnings = outcomes
             .iter()
@@ -64,7 +65,7 @@ impl<'a> IdentificationJson<'a> {
                 rms: outcomes.last().map(|s| s.result.rms),
                 warnings,
             }],
-            verdict: crate::verdict::identify_verdict(outcomes, &system),
+            verdict: crate::verdict::identify_verdict(outcomes, &system, units),
         }
     }
 }
