@@ -6,7 +6,6 @@
 //! from the derivative filter. Rigs driven by a shaker use a measured force `u` (N) instead.
 
 use crate::numerics::interpolate::{Hermite, Linear};
-use crate::numerics::trig;
 use crate::physics::oscillator_params::OscillatorParams;
 
 /// How the rotor angle φ(t) is given.
@@ -188,7 +187,7 @@ impl Excitation {
             Excitation::Rotor(angle) => {
                 let (phi, omega) = angle.at(t);
                 (
-                    p.f0 * omega * omega * trig::sin(phi - p.phi_off),
+                    p.f0 * omega * omega * (phi - p.phi_off).sin(),
                     Some((phi, omega)),
                 )
             }

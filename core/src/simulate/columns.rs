@@ -6,7 +6,6 @@
 //! and is evaluated while the integration runs.
 
 use crate::numerics::integrate::SimError;
-use crate::numerics::trig;
 use crate::physics::excitation::Excitation;
 use crate::physics::oscillator::Oscillator;
 use crate::physics::oscillator_params::OscillatorParams;
@@ -89,11 +88,14 @@ impl DriveColumns {
                 omega: None,
             };
         };
-        // Angle and speed first, then the force over both columns in one vectorised pass (the
-        // same values as `Excitation::force_and_angle` at each time).
+        // Angle and speed first, then the force over both columns (the same values as
+        // `Excitation::force_and_angle` at each time, without tuples to unzip).
         let (phi, omega): (Vec<f64>, Vec<f64>) = times.iter().map(|&t| angle.at(t)).unzip();
-        let mut force = vec![0.0; times.len()];
-        trig::rotor_force(p.f0, p.phi_off, &phi, &omega, &mut force);
+        let force = phi
+            .iter()
+            .zip(&omega)
+            .map(|(&phi, &w)| p.f0 * w * w * (phi - p.phi_off).sin())
+            .collect();
         DriveColumns {
             force,
             phi: Some(phi),
