@@ -34,15 +34,20 @@ impl<'r> Rows<'r> {
     /// first model error ends it.
     pub(super) fn fill(&self, osc: &Oscillator, mut out: Columns) -> Result<(), SimError> {
         let mut dz = vec![0.0; osc.n_internal()];
+        let [x, v, a, f_stf, z @ ..] = out.0.as_mut_slice() else {
+            unreachable!("the columns start with x, v, a and F_STF")
+        };
         let rows = self
             .states
             .chunks_exact(self.dim)
             .zip(self.times)
             .zip(self.drive);
+        // The four kinematic columns by name, the internal states (if any) in a loop: no
+        // per-sample iteration over a list of columns where there is no model.
         for (i, ((y, &t), &d)) in rows.enumerate() {
             let f = osc.forces_with_drive(t, y, d, &mut dz)?;
-            let values = [y[0], y[1], f.a, f.f_stf].into_iter();
-            for (column, value) in out.0.iter_mut().zip(values.chain(y[2..].iter().copied())) {
+            (x[i], v[i], a[i], f_stf[i]) = (y[0], y[1], f.a, f.f_stf);
+            for (column, &value) in z.iter_mut().zip(&y[2..]) {
                 column[i] = value;
             }
         }
@@ -76,24 +81,21 @@ pub(super) struct DriveColumns {
 
 impl DriveColumns {
     pub(super) fn at(excitation: &Excitation, p: &OscillatorParams, times: &[f64]) -> Self {
-        let rotor = times
-            .first()
-            .is_some_and(|&t| excitation.angle(t).is_some());
-        if !rotor {
+        let Excitation::Rotor(angle) = excitation else {
             return DriveColumns {
                 force: times.iter().map(|&t| excitation.force(t, p)).collect(),
                 phi: None,
                 omega: None,
             };
-        }
-        let ((force, phi), omega) = times
+        };
+        // Angle and speed first, then the force over both columns (the same values as
+        // `Excitation::force_and_angle` at each time, without tuples to unzip).
+        let (phi, omega): (Vec<f64>, Vec<f64>) = times.iter().map(|&t| angle.at(t)).unzip();
+        let force = phi
             .iter()
-            .map(|&t| {
-                let (d, angle) = excitation.force_and_angle(t, p);
-                let (phi, w) = angle.unwrap_or((0.0, 0.0));
-                ((d, phi), w)
-            })
-            .unzip();
+            .zip(&omega)
+            .map(|(&phi, &w)| p.f0 * w * w * (phi - p.phi_off).sin())
+            .collect();
         DriveColumns {
             force,
             phi: Some(phi),
