@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{bundled_experiment, read_json, run_ok, write_file};
+use common::{bundled_experiment, read_json, root, run_ok, write_file};
 
 /// The bundled shaker experiment with its record read in volts (x in V, u in V read as N),
 /// and `extra` appended; written in `dir`.
