@@ -146,9 +146,10 @@ fn candidate_starts(
     // samples is `f`, and the residual sum of squares it leaves; `None` when that force is
     // zero.
     let project = |values: &[f64], f: &[f64]| -> Option<(Vec<f64>, f64)> {
-        let (rf, ff) = subset.iter().zip(f).fold((0.0, 0.0), |(rf, ff), (&i, &f)| {
-            (rf + r[i] * f, ff + f * f)
-        });
+        let (rf, ff) = subset
+            .iter()
+            .zip(f)
+            .fold((0.0, 0.0), |(rf, ff), (&i, &f)| (rf + r[i] * f, ff + f * f));
         if !(ff > 0.0 && ff.is_finite() && rf.is_finite()) {
             return None;
         }
