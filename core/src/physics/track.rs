@@ -115,29 +115,11 @@ fn integrate<M: ForceModel + ?Sized>(
         for j in 0..nz {
             zs[j] = z[j] + 0.5 * h * k1[j];
         }
-        m.rates(
-            p,
-            &ModelState {
-                t: tm,
-                x: xm,
-                v: vm,
-                z: zs,
-            },
-            k2,
-        )?;
+        m.rates(p, &midpoint(tm, xm, vm, zs), k2)?;
         for j in 0..nz {
             zs[j] = z[j] + 0.5 * h * k2[j];
         }
-        m.rates(
-            p,
-            &ModelState {
-                t: tm,
-                x: xm,
-                v: vm,
-                z: zs,
-            },
-            k3,
-        )?;
+        m.rates(p, &midpoint(tm, xm, vm, zs), k3)?;
         for j in 0..nz {
             zs[j] = z[j] + h * k3[j];
         }
@@ -147,6 +129,11 @@ fn integrate<M: ForceModel + ?Sized>(
         }
     }
     Ok(())
+}
+
+/// The state at an interval's midpoint: kinematics `t`, `x`, `v` with stage state `z`.
+fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
+    ModelState { t, x, v, z }
 }
 
 /// The provided [`ForceModel::gradient_along`]: the gradient of `m`'s whole force
