@@ -28,6 +28,8 @@
 //! assert_eq!(f, 1.0);
 //! ```
 
+use std::sync::Arc;
+
 use crate::physics::param_spec::ParamSpec;
 use crate::physics::track::{self, Track};
 
@@ -61,6 +63,14 @@ pub trait ForceModel: Send + Sync {
     /// the zero force). The text `a + b` is only their display.
     fn terms(&self) -> Vec<&str> {
         vec![self.name()]
+    }
+
+    /// The models this one adds up, when it is a sum
+    /// ([`crate::physics::model_sum::ModelSum`]), in order: an integration calls them one by
+    /// one ([`crate::physics::resolved_model`]) rather than through the sum. `None` (the
+    /// default) for any other model, a wrapper included.
+    fn summands(&self) -> Option<&[Arc<dyn ForceModel>]> {
+        None
     }
 
     /// The parameters, in the order in which their values are passed as `p`.

@@ -10,4 +10,5 @@ pub mod oscillator;
 pub mod oscillator_params;
 pub mod param_spec;
 pub mod resistance;
+pub mod resolved_model;
 pub mod track;

@@ -165,6 +165,10 @@ impl ForceModel for ModelSum {
         Some(if text.is_empty() { "0".into() } else { text })
     }
 
+    fn summands(&self) -> Option<&[Arc<dyn ForceModel>]> {
+        Some(&self.parts)
+    }
+
     fn params(&self) -> &[ParamSpec] {
         &self.specs
     }

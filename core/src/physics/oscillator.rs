@@ -5,7 +5,8 @@
 //! ```
 //!
 //! The state is `[x, v, z…]`. The model's added mass `m_a` is moved to the left-hand side; a
-//! non-positive effective mass is an error, not a NaN.
+//! non-positive effective mass is an error, not a NaN. The model is resolved once when it is
+//! plugged in ([`ResolvedModel`]): a sum's parts are called one by one at every evaluation.
 
 use std::sync::Arc;
 
@@ -15,6 +16,7 @@ use crate::physics::excitation::Excitation;
 use crate::physics::force_model::{ForceModel, ModelError, ModelState};
 use crate::physics::oscillator_params::OscillatorParams;
 use crate::physics::resistance::{bearing_resistance, bearing_resistance_slope};
+use crate::physics::resolved_model::ResolvedModel;
 
 /// The forces acting at one instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -37,6 +39,8 @@ pub struct Oscillator {
     /// What drives it.
     pub excitation: Arc<Excitation>,
     model: Option<Arc<dyn ForceModel>>,
+    /// The model as the right-hand side calls it.
+    resolved: Option<ResolvedModel>,
     model_params: Vec<f64>,
 }
 
@@ -52,6 +56,7 @@ impl Oscillator {
             params,
             excitation,
             model: None,
+            resolved: None,
             model_params: Vec::new(),
         }
     }
@@ -72,6 +77,7 @@ impl Oscillator {
                 ),
             ));
         }
+        self.resolved = Some(ResolvedModel::new(&model));
         self.model = Some(model);
         self.model_params = values;
         Ok(self)
@@ -123,7 +129,7 @@ impl Oscillator {
         let (x, v) = (y[0], y[1]);
         let p = &self.params;
         let f_r = bearing_resistance(p, v);
-        let (m_a, f) = match &self.model {
+        let (m_a, f) = match &self.resolved {
             None => (0.0, 0.0),
             Some(model) => {
                 let s = ModelState {
