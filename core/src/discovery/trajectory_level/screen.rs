@@ -116,13 +116,19 @@ impl TrajectoryLevel<'_> {
     ) -> ForceScreen {
         let train = &self.split.train;
         let hint = self.setup.force_hint.as_ref();
-        let hinted: Vec<Option<(SearchModel, f64)>> = withs
-            .par_iter()
-            .map(|w| hint.and_then(|h| w.force_started(&self.rig, h, train)))
-            .collect();
-        let reference = hint
-            .and_then(|h| current.stage.force_started(&self.rig, h, train))
-            .map(|(_, rms)| rms);
+        // The current model's own fit, the reference, runs beside the candidates'.
+        let (hinted, reference) = rayon::join(
+            || -> Vec<Option<(SearchModel, f64)>> {
+                withs
+                    .par_iter()
+                    .map(|w| hint.and_then(|h| w.force_started(&self.rig, h, train)))
+                    .collect()
+            },
+            || {
+                hint.and_then(|h| current.stage.force_started(&self.rig, h, train))
+                    .map(|(_, rms)| rms)
+            },
+        );
         let gains: Vec<Option<f64>> = hinted
             .iter()
             .map(|h| Some(reference? * reference? - h.as_ref()?.1.powi(2)))
