@@ -105,7 +105,7 @@ impl TrajectoryLevel<'_> {
 /// Where a fit scouted on `scout` continues on the whole record: `stage` fitted on the scout
 /// if that lowers the whole record's RMS at the samples `train`, else `stage` (one
 /// simulation of each); with its mean square on the scout's training samples (m²) and its RMS
-/// at `train` (m).
+/// at `train` (m). The simulation of `stage` runs beside the scout fit.
 pub(in crate::discovery) fn scouted(
     stage: SearchModel,
     scout: &Scout,
@@ -116,8 +116,11 @@ pub(in crate::discovery) fn scouted(
         s.residual(rig)
             .map_or(f64::INFINITY, |r| rms_over(&r, train))
     };
-    let before = train_rms(&stage);
-    if let Ok((fitted, fit)) = stage.fit_simulated(scout, setup, &scout.train, settings) {
+    let (before, fitted) = rayon::join(
+        || train_rms(&stage),
+        || stage.fit_simulated(scout, setup, &scout.train, settings),
+    );
+    if let Ok((fitted, fit)) = fitted {
         let after = train_rms(&fitted);
         if after < before {
             return (fitted, fit.rms * fit.rms, after);
