@@ -426,6 +426,99 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
     assert!(csv.lines().next().unwrap().contains("global law"), "{csv}");
 }
 
+/// A campaign of 4 `simulate` records (the rig's sensors on, two sweep rates, four seeds) of
+/// a yield force F_y = 0.1 + 0.1·voltage N at voltages 0–3 V, fitted with `yield` and a
+/// `[global]` section whose `laws` line is `law`.
+fn yield_campaign(dir: &Path, law: &str) -> PathBuf {
+    let mut records = String::new();
+    for v in 0..4 {
+        let alpha = if v % 2 == 0 { 0.3 } else { 0.2 };
+        let truth = format!(
+            "[system]\npreset = \"forced\"\nF0 = 0.0462\n\n[simulate]\n\
+             sweep = {{ w0 = 3.0, alpha = {alpha}, t0 = 0.0, t1 = 20.0 }}\nrate = 100.0\n\
+             noise = true\nseed = {}\n\n[[simulate.truth]]\nname = \"yield\"\n\
+             params = {{ F_y = {} }}\n",
+            300 + v,
+            0.1 + 0.1 * v as f64
+        );
+        let sim = dir.join(format!("r{v}.toml"));
+        std::fs::write(&sim, truth).unwrap();
+        let run = stf_lab()
+            .arg("simulate")
+            .arg(&sim)
+            .arg("--out")
+            .arg(dir.join(format!("r{v}.csv")))
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", stderr(&run));
+        records.push_str(&format!(
+            "[[records]]\nfile = \"r{v}.csv\"\nvoltage = {v}.0\n\n"
+        ));
+    }
+    std::fs::write(
+        dir.join("yield.toml"),
+        "[data]\nfile = \"r0.csv\"\n\n[[models]]\nname = \"yield\"\n",
+    )
+    .unwrap();
+    let file = dir.join("campaign.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "[campaign]\nexperiment = \"yield.toml\"\ncommand = \"fit\"\n\
+             conditions = [\"voltage\"]\nunits = {{ voltage = \"V\" }}\n\n{records}\
+             [global]\nmodel = \"yield\"\nshared = [\"v_s\"]\n{law}\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+#[test]
+fn an_affine_global_law_with_an_offset_is_recovered_from_a_zero_condition_up() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = yield_campaign(
+        tmp.path(),
+        "laws = { F_y = { condition = \"voltage\", law = \"affine\" } }",
+    );
+    let out = tmp.path().join("out");
+    let run = campaign(&file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let g = read_json(&out.join("global.json"));
+    let (base, base_se) = global_param(&g, "F_y_base");
+    let (gain, gain_se) = global_param(&g, "F_y_gain");
+    println!("F_y_base = {base} ± {base_se} (0.1), F_y_gain = {gain} ± {gain_se} (0.1)");
+    assert!(
+        (base - 0.1).abs() < 3.0 * base_se,
+        "F_y_base = {base} ± {base_se}"
+    );
+    assert!(
+        (gain - 0.1).abs() < 3.0 * gain_se,
+        "F_y_gain = {gain} ± {gain_se}"
+    );
+    assert!(base_se < 0.02 && gain_se < 0.01, "{base_se}, {gain_se}");
+    let law = &g["laws"][0];
+    assert_eq!(law["law"], "affine");
+    assert_eq!(law["reference"], 1.0);
+    assert!(law.get("exponent").is_none(), "{law}");
+    let k = law["coefficients"].as_array().unwrap();
+    assert_eq!(k.len(), 2);
+    assert_eq!(
+        (&k[0]["name"], &k[0]["unit"]),
+        (&"F_y_base".into(), &"N".into())
+    );
+    assert_eq!(
+        (&k[1]["name"], &k[1]["unit"]),
+        (&"F_y_gain".into(), &"N/V".into())
+    );
+    assert_eq!(k[1]["value"].as_f64().unwrap(), gain);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("with F_y = F_y_base + F_y_gain·voltage"),
+        "{md}"
+    );
+    assert!(out.join("figures/global_F_y_vs_voltage.png").is_file());
+}
+
 /// The parameter `name` of global.json's θ: value and standard error.
 fn global_param(g: &serde_json::Value, name: &str) -> (f64, f64) {
     let p = g["params"]
@@ -566,6 +659,16 @@ fn bad_global_input_is_refused_before_any_unit_starts() {
             "laws = { K =",
             "laws = { c =",
             "`global.laws.c`: `power_law` has no parameter `c`",
+        ),
+        (
+            "reference = 0.40 }",
+            "law = \"cubic\" }",
+            "`global.laws.K.law`: unknown law `cubic`: one of linear, affine, power",
+        ),
+        (
+            "reference = 0.40 }",
+            "law = \"power\" }",
+            "`global.laws.K.reference`: missing: a `power` law divides the condition",
         ),
     ]
     .into_iter()

@@ -1,6 +1,8 @@
 //! The `[global]` section of a campaign file: which model is fitted jointly to all records,
-//! which of its parameters are shared by every record, which follow a power law over a
-//! condition (`P = P0·(c/reference)^P_p`), and which record is held out. Parsed into a raw
+//! which of its parameters are shared by every record, which follow a law of a condition
+//! (`P = P0·(c/reference)^P_p`, or with `law = "linear" | "affine" | "power"` the channel
+//! laws of x = c/reference: `P_gain·x`, `P_base + P_gain·x`, `P_base + P_gain·|x|^P_exp`), and
+//! which record is held out. Parsed into a raw
 //! serde type and checked into a trusted [`GlobalSpec`] before any unit starts; every error
 //! names the campaign file, the line and the key, as the rest of the campaign file
 //! (`super::file`).
@@ -10,6 +12,7 @@
 //! model = "power_law"            # one of the experiment's [[models]] (a sum: "a + b")
 //! shared = ["n"]                 # one value for every record
 //! laws = { K = { condition = "concentration", reference = 0.40 } }
+//! # or: laws = { F_y = { condition = "voltage", law = "affine" } }  # F_y_base + F_y_gain·c
 //! holdout = "records/a2_c2.csv"  # a record of the list, left out of every fit
 //! level = "trajectory"           # force | trajectory; default: the experiment's [fit] level, else force
 //! ```
@@ -31,12 +34,13 @@ use super::condition_names::configure_entry;
 use super::units::Unit;
 use crate::experiment::{error_at, line_of, Experiment, FitLevel, ModelEntry};
 
-/// A law as written: `{ condition = "…", reference = … }`.
+/// A law as written: `{ condition = "…", reference = … }`, optionally `law = "affine"`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawLaw {
     condition: String,
-    reference: f64,
+    reference: Option<f64>,
+    law: Option<String>,
 }
 
 /// `[global]` as written.
@@ -52,7 +56,7 @@ pub(super) struct RawGlobal {
     level: Option<FitLevel>,
 }
 
-pub use stf_study::joint::spec::{GlobalSpec, Law};
+pub use stf_study::joint::spec::{Form, GlobalSpec, Law};
 
 /// Where errors point: the campaign file and its text.
 pub(super) struct At<'a> {
@@ -105,7 +109,9 @@ pub(super) fn check(
         .iter()
         .map(|(param, law)| {
             let law = check_law(param, law, &names, &shared, conditions, at)?;
-            check_positive(units, &law.condition, &format!("global.laws.{param}"), at)?;
+            if law.form.is_none() {
+                check_positive(units, &law.condition, &format!("global.laws.{param}"), at)?;
+            }
             Ok(law)
         })
         .collect::<Result<Vec<_>>>()?;
@@ -266,17 +272,53 @@ fn check_law(
             ),
         ));
     }
-    if !(law.reference.is_finite() && law.reference > 0.0) {
+    let form = law_form(law.law.as_deref(), &key, offset, at)?;
+    let reference = match (law.reference, form) {
+        (Some(r), _) => r,
+        (None, Some(Form::Linear | Form::Affine)) => 1.0,
+        (None, Some(f)) => {
+            return Err(at.error(
+                offset,
+                &format!("{key}.reference"),
+                format!(
+                    "missing: a `{}` law divides the condition by a positive `reference`",
+                    f.name()
+                ),
+            ))
+        }
+        (None, None) => {
+            return Err(at.error(
+                offset,
+                &format!("{key}.reference"),
+                "missing: the power law P0·(c/reference)^P_p needs a positive `reference` \
+                 (or give `law = \"linear\"`, `\"affine\"` or `\"power\"`)",
+            ))
+        }
+    };
+    if !(reference.is_finite() && reference > 0.0) {
         return Err(at.error(
             offset,
             &format!("{key}.reference"),
-            format!("a positive number, found {}", law.reference),
+            format!("a positive number, found {reference}"),
         ));
     }
     Ok(Law {
         param: param.to_string(),
         condition: law.condition.clone(),
-        reference: law.reference,
+        reference,
+        form,
+    })
+}
+
+/// The form named by a law's `law` key (none: the power law without offset).
+fn law_form(name: Option<&str>, key: &str, offset: usize, at: &At) -> Result<Option<Form>> {
+    let Some(name) = name else { return Ok(None) };
+    Form::named(name).map(Some).ok_or_else(|| {
+        at.error(
+            offset,
+            &format!("{key}.law"),
+            format!("unknown law `{name}`: one of linear, affine, power"),
+        )
     })
 }
 

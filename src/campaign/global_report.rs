@@ -1,7 +1,7 @@
 //! The "Global fit" section at the top of the campaign report, from `global.json`
 //! ([`GlobalJson`]): the verdict and its caveats, the joint fit's parameters ± standard
 //! errors, the comparison table (RSS, parameters, AIC, BIC; held-out RMS both ways), and per
-//! law a figure of the records' own fitted values (± one standard error, one colour per value
+//! law its fitted formula and a figure of the records' own fitted values (± one standard error, one colour per value
 //! of the other conditions, the held-out record apart) with the fitted law drawn over them.
 
 use std::path::Path;
@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::Result;
 
 use super::global::{Criteria, GlobalJson, LawJson};
+use super::global_file::Form;
 use crate::digits::{carried, with_error};
 use crate::report::{self, Curve, ErrorSeries, FigureRef, Section, Table};
 
@@ -34,12 +35,7 @@ pub fn section(g: &GlobalJson, figures: &Path) -> Result<Section> {
         },
         g.laws
             .iter()
-            .map(|l| format!(
-                ", with {p} = {p}0·({c}/{r})^{p}_p",
-                p = l.param,
-                c = l.condition,
-                r = carried(l.reference)
-            ))
+            .map(|l| format!(", with {}", formula(l, |name, _, _| name.to_string())))
             .collect::<String>(),
         g.holdout
             .as_ref()
@@ -48,12 +44,8 @@ pub fn section(g: &GlobalJson, figures: &Path) -> Result<Section> {
     ));
     for law in &g.laws {
         s.paragraphs.push(format!(
-            "{p} = ({c})·({cond}/{r})^({e}) (± one block-robust standard error).",
-            p = law.param,
-            c = with_error(law.coefficient, law.coefficient_std_error),
-            cond = law.condition,
-            r = carried(law.reference),
-            e = with_error(law.exponent, law.exponent_std_error),
+            "{} (± one block-robust standard error).",
+            formula(law, |_, v, e| format!("({})", with_error(v, e)))
         ));
     }
     s.warnings = g.caveats.iter().map(|c| capitalised(c) + ".").collect();
@@ -142,6 +134,62 @@ fn params_table(g: &GlobalJson) -> Table {
     }
 }
 
+/// A law's coefficients in order: (name, value, standard error); the form (none: the power law
+/// without offset).
+fn coefficients(law: &LawJson) -> (Option<Form>, Vec<(String, f64, f64)>) {
+    let form = law.law.as_deref().and_then(Form::named);
+    let list = match (&law.coefficients, form) {
+        (Some(c), Some(_)) => c
+            .iter()
+            .map(|c| (c.name.clone(), c.value, c.std_error))
+            .collect(),
+        _ => vec![
+            (
+                format!("{}0", law.param),
+                law.coefficient.unwrap_or(f64::NAN),
+                law.coefficient_std_error.unwrap_or(f64::NAN),
+            ),
+            (
+                format!("{}_p", law.param),
+                law.exponent.unwrap_or(f64::NAN),
+                law.exponent_std_error.unwrap_or(f64::NAN),
+            ),
+        ],
+    };
+    (form, list)
+}
+
+/// The law written out, each coefficient shown by `shown(name, value, error)`:
+/// `K = K0·(c/0.4)^K_p`, `F_y = F_y_base + F_y_gain·voltage`.
+fn formula(law: &LawJson, shown: impl Fn(&str, f64, f64) -> String) -> String {
+    let (form, k) = coefficients(law);
+    let k: Vec<String> = k.iter().map(|(n, v, e)| shown(n, *v, *e)).collect();
+    let ratio = format!("({}/{})", law.condition, carried(law.reference));
+    let x = if law.reference == 1.0 {
+        law.condition.clone()
+    } else {
+        ratio.clone()
+    };
+    let rhs = match form {
+        None => format!("{}·{ratio}^{}", k[0], k[1]),
+        Some(Form::Linear) => format!("{}·{x}", k[0]),
+        Some(Form::Affine) => format!("{} + {}·{x}", k[0], k[1]),
+        Some(Form::Power) => format!("{} + {}·|{x}|^{}", k[0], k[1], k[2]),
+    };
+    format!("{} = {rhs}", law.param)
+}
+
+/// The fitted law's value at condition `c`.
+fn law_at(law: &LawJson, c: f64) -> f64 {
+    let (form, k) = coefficients(law);
+    let values: Vec<f64> = k.iter().map(|(_, v, _)| *v).collect();
+    let x = c / law.reference;
+    match form {
+        None => values[0] * x.powf(values[1]),
+        Some(form) => form.value(&values, x),
+    }
+}
+
 /// The records' own values of `law.param` against its condition, with the law over them.
 fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
     let mut series: Vec<ErrorSeries> = Vec::new();
@@ -183,18 +231,11 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
     let points = (0..CURVE_POINTS)
         .map(|i| {
             let x = lo + (hi - lo) * i as f64 / (CURVE_POINTS - 1) as f64;
-            (x, law.coefficient * (x / law.reference).powf(law.exponent))
+            (x, law_at(law, x))
         })
         .collect();
     let curve = Curve {
-        label: format!(
-            "global law: {} = {:.4}·({}/{})^{:.4}",
-            law.param,
-            law.coefficient,
-            law.condition,
-            carried(law.reference),
-            law.exponent
-        ),
+        label: format!("global law: {}", formula(law, |_, v, _| format!("{v:.4}"))),
         points,
     };
     let name = format!("global_{}_vs_{}", law.param, law.condition)

@@ -24,10 +24,11 @@ use stf_core::fit::{
     fit_residuals, fit_trajectory_residuals, full_values, FitError, FitParam, FitResult, ForceFit,
     Residuals, TrajectoryData, TrajectoryFit, FORCE_OFFSET,
 };
+use stf_core::physics::channel_law::EXPONENT_BOUNDS;
 use stf_core::physics::force_model::ForceModel;
 
 use super::prediction_cache::PredictionCache;
-use super::spec::Law;
+use super::spec::{Form, Law};
 use crate::experiment::FitLevel;
 
 /// Where one value of a record's parameter vector comes from.
@@ -46,6 +47,18 @@ pub enum Source {
         /// Index of the law in `GlobalSpec::laws`.
         law: usize,
     },
+    /// A law with a form ([`Form`]) of `x`, the record's condition over the reference, its
+    /// coefficients θ's entries from `first` on (in [`Form::coefficients`]' order).
+    Form {
+        /// The law's form.
+        form: Form,
+        /// Index of its first coefficient in θ.
+        first: usize,
+        /// The record's condition / the law's reference.
+        x: f64,
+        /// Index of the law in `GlobalSpec::laws`.
+        law: usize,
+    },
 }
 
 impl Source {
@@ -59,8 +72,14 @@ impl Source {
                 ratio,
                 ..
             } => theta[coefficient] * ratio.powf(theta[exponent]),
+            Source::Form { form, first, x, .. } => form_value(form, theta, first, x),
         }
     }
+}
+
+/// The value of `form` at `x`, its coefficients θ's entries from `first` on.
+pub fn form_value(form: Form, theta: &[f64], first: usize, x: f64) -> f64 {
+    form.value(&theta[first..first + form.coefficients().len()], x)
 }
 
 /// How a record's signal is predicted.
@@ -167,6 +186,15 @@ pub fn coefficient_name(p: &str) -> String {
     format!("{p}0")
 }
 
+/// The names of a law's coefficients of form `form` for parameter `p` (`F_y_base`,
+/// `F_y_gain`, `F_y_exp`: as the records' own channel laws name them).
+pub fn form_names(form: Form, p: &str) -> Vec<String> {
+    form.coefficients()
+        .iter()
+        .map(|suffix| format!("{p}_{suffix}"))
+        .collect()
+}
+
 /// θ's layout for the `shared` parameters and the `laws` over `records` (each named by its
 /// unit number; their [`JointRecord::params`] name the same parameters in the same order,
 /// start values and bounds configured). `starts` gives per record the values its own fit
@@ -224,6 +252,9 @@ impl Layout {
         records: &[(usize, &JointRecord)],
         column: &[f64],
     ) {
+        if let Some(form) = law.form {
+            return self.push_form(index, law, form, p, records, column);
+        }
         let (c0, expo) = law_start(law, p, records, column);
         let i = self.params.len();
         self.params
@@ -243,6 +274,92 @@ impl Layout {
             });
         }
     }
+}
+
+impl Layout {
+    /// θ's entries for law `index` of form `form` of parameter `p` (its widest bounds):
+    /// the base within P's bounds, the gain within ± P's range over the records' largest
+    /// |x|, the exponent within [`EXPONENT_BOUNDS`] from 1; started from the least-squares
+    /// line of the records' own values `column` against x.
+    fn push_form(
+        &mut self,
+        index: usize,
+        law: &Law,
+        form: Form,
+        p: &FitParam,
+        records: &[(usize, &JointRecord)],
+        column: &[f64],
+    ) {
+        let xs: Vec<f64> = records
+            .iter()
+            .map(|(_, r)| law.ratio(r.condition(&law.condition)))
+            .collect();
+        let (base, gain) = form_start(form, &xs, column);
+        let reach = xs.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let range = p.max - p.min;
+        let spread = match form {
+            Form::Power => reach
+                .powf(EXPONENT_BOUNDS.0)
+                .min(reach.powf(EXPONENT_BOUNDS.1)),
+            _ => reach,
+        };
+        let g = if spread > 0.0 && range.is_finite() {
+            10.0 * range / spread
+        } else {
+            f64::INFINITY
+        };
+        let first = self.params.len();
+        for (suffix, name) in form.coefficients().iter().zip(form_names(form, &p.name)) {
+            let param = match *suffix {
+                "base" => clamped(p.clone(), base).named(name),
+                "gain" => {
+                    let start = if gain.is_finite() {
+                        gain.clamp(-g, g)
+                    } else {
+                        0.0
+                    };
+                    FitParam::new(name, start).bounds(-g, g)
+                }
+                _ => FitParam::new(name, 1.0)
+                    .bounds(EXPONENT_BOUNDS.0, EXPONENT_BOUNDS.1)
+                    .scale(1.0),
+            };
+            self.params.push(param);
+            self.roles.push(if *suffix == "exp" {
+                "law exponent"
+            } else {
+                "law coefficient"
+            });
+        }
+        for (j, x) in xs.into_iter().enumerate() {
+            self.sources[j].push(Source::Form {
+                form,
+                first,
+                x,
+                law: index,
+            });
+        }
+    }
+}
+
+/// A law of form `form`'s start: base and gain of the least-squares line of the values `ys`
+/// against `xs` (through 0 for a linear law; against |x| for a power law, exponent 1).
+fn form_start(form: Form, xs: &[f64], ys: &[f64]) -> (f64, f64) {
+    let xs: Vec<f64> = match form {
+        Form::Power => xs.iter().map(|x| x.abs()).collect(),
+        _ => xs.to_vec(),
+    };
+    let n = xs.len().max(1) as f64;
+    if form == Form::Linear {
+        let sxx: f64 = xs.iter().map(|x| x * x).sum();
+        let sxy: f64 = xs.iter().zip(ys).map(|(x, y)| x * y).sum();
+        return (0.0, if sxx > 0.0 { sxy / sxx } else { 0.0 });
+    }
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let sxx: f64 = xs.iter().map(|x| (x - mx).powi(2)).sum();
+    let sxy: f64 = xs.iter().zip(ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let gain = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    (my - gain * mx, gain)
 }
 
 /// `p` with the widest bounds among `all` (the same parameter on every record).
@@ -465,6 +582,7 @@ mod tests {
             param: "a".into(),
             condition: "c".into(),
             reference: 2.0,
+            form: None,
         }];
         let starts = vec![vec![1.0, 1.0]; 3];
         let layout = layout(&["b".into()], &laws, &numbered, &starts);
@@ -478,6 +596,56 @@ mod tests {
             assert!((v - truth).abs() < 1e-6, "{name} = {v}");
         }
         assert_eq!(result.n_points, 1200);
+    }
+
+    #[test]
+    fn an_affine_law_with_an_offset_is_recovered_including_at_a_zero_condition() {
+        // a = 2 + 1.5·c, b = 0.7 on every record; one record at c = 0.
+        let records: Vec<JointRecord> = [0.0, 1.0, 3.0]
+            .iter()
+            .map(|&c| record(c, 2.0 + 1.5 * c, 0.7))
+            .collect();
+        let numbered: Vec<(usize, &JointRecord)> = records.iter().enumerate().collect();
+        let laws = [Law {
+            param: "a".into(),
+            condition: "c".into(),
+            reference: 1.0,
+            form: Some(Form::Affine),
+        }];
+        let starts = vec![vec![1.0, 1.0]; 3];
+        let layout = layout(&["b".into()], &laws, &numbered, &starts);
+        let names: Vec<&str> = layout.params.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["a_base", "a_gain", "b"]);
+        let refs: Vec<&JointRecord> = records.iter().collect();
+        let result = fit(&layout, &refs, &Default::default(), FitLevel::Force).unwrap();
+        for (name, truth) in [("a_base", 2.0), ("a_gain", 1.5), ("b", 0.7)] {
+            let v = result.value(name).unwrap();
+            assert!((v - truth).abs() < 1e-6, "{name} = {v}");
+        }
+    }
+
+    #[test]
+    fn a_power_law_with_an_offset_is_recovered() {
+        // a = 1 + 2·(c/2)^1.5.
+        let records: Vec<JointRecord> = [1.0, 2.0, 3.0, 4.0]
+            .iter()
+            .map(|&c| record(c, 1.0 + 2.0 * (c / 2.0_f64).powf(1.5), 0.7))
+            .collect();
+        let numbered: Vec<(usize, &JointRecord)> = records.iter().enumerate().collect();
+        let laws = [Law {
+            param: "a".into(),
+            condition: "c".into(),
+            reference: 2.0,
+            form: Some(Form::Power),
+        }];
+        let starts: Vec<Vec<f64>> = records.iter().map(|_| vec![1.0, 0.7]).collect();
+        let layout = layout(&["b".into()], &laws, &numbered, &starts);
+        let refs: Vec<&JointRecord> = records.iter().collect();
+        let result = fit(&layout, &refs, &Default::default(), FitLevel::Force).unwrap();
+        for (name, truth) in [("a_base", 1.0), ("a_gain", 2.0), ("a_exp", 1.5)] {
+            let v = result.value(name).unwrap();
+            assert!((v - truth).abs() < 1e-5, "{name} = {v}");
+        }
     }
 
     #[test]

@@ -81,7 +81,8 @@ pub struct GlobalParam {
     pub std_error: f64,
 }
 
-/// A fitted law `param = coefficient·(condition/reference)^exponent`.
+/// A fitted law: `param = coefficient·(condition/reference)^exponent`, or with a form
+/// (`law`) the form's `coefficients`.
 #[derive(Clone, Debug, Serialize)]
 pub struct LawJson {
     /// The model's parameter.
@@ -94,14 +95,40 @@ pub struct LawJson {
     pub unit: String,
     /// The condition's unit, where `campaign.units` gives one.
     pub condition_unit: Option<String>,
-    /// The parameter at the reference, with its standard error.
-    pub coefficient: f64,
+    /// The parameter at the reference (the power law without offset; absent for a law with a
+    /// form).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coefficient: Option<f64>,
     /// Standard error of the coefficient.
-    pub coefficient_std_error: f64,
-    /// The exponent, with its standard error.
-    pub exponent: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coefficient_std_error: Option<f64>,
+    /// The exponent (the power law without offset).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exponent: Option<f64>,
     /// Standard error of the exponent.
-    pub exponent_std_error: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exponent_std_error: Option<f64>,
+    /// The law's form (`linear`, `affine`, `power`: with `coefficients`), absent for the power
+    /// law without offset.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law: Option<String>,
+    /// A law with a form: its coefficients (`P_base`, `P_gain`, `P_exp`) with their errors.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coefficients: Option<Vec<LawCoefficient>>,
+}
+
+/// A coefficient of a law with a form.
+#[derive(Clone, Debug, Serialize)]
+pub struct LawCoefficient {
+    /// `F_y_base`, `F_y_gain`, `F_y_exp`.
+    pub name: String,
+    /// Best value.
+    pub value: f64,
+    /// Block-robust standard error.
+    pub std_error: f64,
+    /// Its SI unit: the parameter's (base), the parameter's per unit of x (gain), none
+    /// (exponent).
+    pub unit: String,
 }
 
 /// Fit statistics of one side of the comparison, over the training records.
@@ -313,6 +340,12 @@ fn holdout_json(
                 let ratio = held.joint.condition(&law.condition) / law.reference;
                 theta[*coefficient] * ratio.powf(theta[*exponent])
             }
+            Source::Form {
+                form, first, law, ..
+            } => {
+                let x = spec.laws[*law].ratio(held.joint.condition(&spec.laws[*law].condition));
+                global_fit::form_value(*form, &theta, *first, x)
+            }
             _ => own_state(held, k)
                 .unwrap_or_else(|| mean(layout.sources.iter().map(|s| s[k].value(&theta)))),
         })
@@ -470,24 +503,61 @@ fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalPara
         .collect()
 }
 
-/// Each law's coefficient and exponent with their errors.
+/// Each law's coefficients with their errors.
 fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJson> {
     spec.laws
         .iter()
         .filter_map(|l| {
-            let c = result.param(&global_fit::coefficient_name(&l.param))?;
-            let e = result.param(&global_fit::exponent_name(&l.param))?;
-            Some(LawJson {
+            let unit = units.param(&l.param);
+            let mut json = LawJson {
                 param: l.param.clone(),
                 condition: l.condition.clone(),
                 reference: l.reference,
-                unit: units.param(&l.param),
                 condition_unit: units.conditions.get(&l.condition).cloned(),
-                coefficient: c.value,
-                coefficient_std_error: c.std_error,
-                exponent: e.value,
-                exponent_std_error: e.std_error,
-            })
+                coefficient: None,
+                coefficient_std_error: None,
+                exponent: None,
+                exponent_std_error: None,
+                law: None,
+                coefficients: None,
+                unit: unit.clone(),
+            };
+            let Some(form) = l.form else {
+                let c = result.param(&global_fit::coefficient_name(&l.param))?;
+                let e = result.param(&global_fit::exponent_name(&l.param))?;
+                json.coefficient = Some(c.value);
+                json.coefficient_std_error = Some(c.std_error);
+                json.exponent = Some(e.value);
+                json.exponent_std_error = Some(e.std_error);
+                return Some(json);
+            };
+            let x_unit = match (&json.condition_unit, l.reference == 1.0) {
+                (Some(u), true) => u.clone(),
+                _ => String::new(),
+            };
+            let coefficients = form
+                .coefficients()
+                .iter()
+                .zip(global_fit::form_names(form, &l.param))
+                .map(|(suffix, name)| {
+                    let p = result.param(&name)?;
+                    let unit = match *suffix {
+                        "base" => unit.clone(),
+                        "gain" if x_unit.is_empty() => unit.clone(),
+                        "gain" => format!("{unit}/{x_unit}"),
+                        _ => String::new(),
+                    };
+                    Some(LawCoefficient {
+                        value: p.value,
+                        std_error: p.std_error,
+                        name,
+                        unit,
+                    })
+                })
+                .collect::<Option<Vec<_>>>()?;
+            json.law = Some(form.name().to_string());
+            json.coefficients = Some(coefficients);
+            Some(json)
         })
         .collect()
 }

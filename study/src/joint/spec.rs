@@ -1,18 +1,32 @@
 //! A checked `[global]` section of a campaign: the model, the parameters shared by every
-//! record, those that follow a power law of a condition, the held-out record and the level.
+//! record, those that follow a law of a condition, the held-out record and the level.
 //! The campaign file's reader (the program's `campaign/global_file.rs`) builds it.
 
 use crate::experiment::{FitLevel, ModelEntry};
 
-/// A parameter made a power law of a condition: `param = param0·(condition/reference)^p`.
+pub use stf_core::physics::channel_law::Law as Form;
+
+/// A parameter made a law of a condition c: without a `form`,
+/// `param = param0·(c/reference)^param_p`; with one, the channel law of x = c/reference
+/// (`linear` P_gain·x, `affine` P_base + P_gain·x, `power` P_base + P_gain·|x|^P_exp).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Law {
     /// The model's parameter (`K`).
     pub param: String,
     /// The condition it follows (a name of `campaign.conditions`).
     pub condition: String,
-    /// The condition's reference value, at which the parameter is `param0`.
+    /// The condition's reference value: c is divided by it (1 for a linear or affine law
+    /// given none).
     pub reference: f64,
+    /// The law's form (`law = "…"`); `None`: the power law without offset.
+    pub form: Option<Form>,
+}
+
+impl Law {
+    /// The law's variable at condition value `c`: c/reference.
+    pub fn ratio(&self, c: f64) -> f64 {
+        c / self.reference
+    }
 }
 
 /// A checked `[global]` section.
