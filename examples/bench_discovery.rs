@@ -352,12 +352,13 @@ fn run_silverbox(dir: &Path) -> Result<String> {
         serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
     Ok(format!(
         "| trajectory, Silverbox layout (u, x in V), 87 000 samples, cubic_stiffness hidden, [validate] 22 000 | \
-         {wall:.1} s | {cpu:.1} s | {:.2} | {before:.1} | effects {}; gap {:.4e} → {:.4e} V; validation {} |",
+         {wall:.1} s | {cpu:.1} s | {:.2} | {before:.1} | effects {}; gap {:.4e} → {:.4e} V; validation RMS {:.4e} → {:.4e} V |",
         cpu / wall,
         json["effects"],
         json["gap_before"].as_f64().unwrap_or(f64::NAN),
         json["gap_after"].as_f64().unwrap_or(f64::NAN),
-        json["validation"],
+        json["validation"]["rms_before"].as_f64().unwrap_or(f64::NAN),
+        json["validation"]["rms_after"].as_f64().unwrap_or(f64::NAN),
     ))
 }
 
