@@ -4,6 +4,7 @@
 //! cargo run --release --example bench_discovery                 # force level
 //! cargo run --release --example bench_discovery -- --trajectory # and trajectory level
 //! cargo run --release --example bench_discovery -- --shaker     # a 10⁵-sample shaker record
+//! cargo run --release --example bench_discovery -- --silverbox  # 87 000 samples in volts
 //! cargo run --release --example bench_discovery -- --only yield  # the cases whose label holds it
 //! ```
 //!
@@ -18,8 +19,15 @@
 //! only (`[discover] level = "trajectory"`). `--shaker` runs trajectory-level discovery alone
 //! on a shaker rig's record of 100 001 samples (the bundled `trajectory_discovery` rig: a
 //! measured drive force `u`, a 0.5 → 1.5 Hz chirp over 500 s at 200 Hz, truth `viscous` with
-//! a `cubic_stiffness` hidden, base `viscous`, every default candidate). Timings depend on
-//! what else runs on the machine.
+//! a `cubic_stiffness` hidden, base `viscous`, every default candidate). `--silverbox` runs the
+//! README's recommended trajectory-level discovery (`experiments/public_records/silverbox.toml`:
+//! no `[system]`, the oscillator estimated from the record, `[fit] system = ["m", "k", "c",
+//! "f_off"]`, `base = "none"`, every default candidate, `[validate]`) on a record in the
+//! Silverbox's layout: columns `u, x` in volts, no time column, 610.35 Hz, 87 000 samples
+//! (142.5 s); an electronic Duffing oscillator like the Silverbox (m 5.33e-6, c 2.24e-4, k 1.02,
+//! resonance 69.7 Hz: 8.8 samples a period, a cubic spring k3 3.8 hidden) driven by a 0.02 V
+//! chirp from 10 to 120 Hz, seed 5; the validation record is a 36 s chirp down from 120 to 10 Hz
+//! at 0.025 V, seed 6. Timings depend on what else runs on the machine.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -239,6 +247,121 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, f64, String)> {
     ))
 }
 
+/// The Silverbox-layout case's oscillator: an electronic Duffing oscillator in volts.
+const SILVERBOX_SYSTEM: &str =
+    "[system]\npreset = \"forced\"\nm = 5.33e-6\nc = 2.24e-4\nk = 1.02\nT = 0.0\ndelta_T = 0.0\n";
+/// The Silverbox's sample rate, Hz (10⁷/2¹⁴).
+const SILVERBOX_RATE: f64 = 610.3515625;
+
+/// The experiment file that simulates a Silverbox-layout record: `samples` samples of a chirp
+/// from `f0` to `f1` Hz of `amplitude` V, with the rig's sensors and `seed`.
+fn silverbox_simulation(
+    record: &str,
+    samples: usize,
+    (f0, f1, amplitude): (f64, f64, f64),
+    seed: u64,
+) -> String {
+    let t1 = (samples - 1) as f64 / SILVERBOX_RATE;
+    format!(
+        "[data]\nfile = \"{record}\"\n\n{SILVERBOX_SYSTEM}\n[simulate]\n\
+         chirp = {{ f0 = {f0}, f1 = {f1}, amplitude = {amplitude}, t1 = {t1} }}\n\
+         rate = {SILVERBOX_RATE}\nnoise = true\nseed = {seed}\n\n[[simulate.truth]]\n\
+         name = \"cubic_stiffness\"\nparams = {{ k3 = 3.8 }}\n"
+    )
+}
+
+/// The discovery experiment of the Silverbox-layout case: `silverbox.toml`'s settings.
+fn silverbox_discovery(estimation: &str, validation: &str) -> String {
+    format!(
+        "[data]\nfile = \"{estimation}\"\nrate = {SILVERBOX_RATE}\n\
+         units = {{ x = \"V\", u = {{ unit = \"V\", gain = 1.0 }} }}\n\n\
+         [fit]\nlevel = \"trajectory\"\nsystem = [\"m\", \"k\", \"c\", \"f_off\"]\n\n\
+         [discover]\nbase = \"none\"\nlevel = \"trajectory\"\n\n\
+         [validate]\nfile = \"{validation}\"\n\n[output]\nreport = false\n"
+    )
+}
+
+/// Simulate a Silverbox-layout record into `dir/name` (unless it is there): the simulated
+/// record's `u` and `x` columns as they were written, without its time and STF force.
+fn silverbox_record(
+    dir: &Path,
+    name: &str,
+    samples: usize,
+    chirp: (f64, f64, f64),
+    seed: u64,
+) -> Result<()> {
+    let path = dir.join(name);
+    if path.exists() {
+        return Ok(());
+    }
+    let raw = format!("raw_{name}");
+    let exp = dir.join(format!("simulate_{name}.toml"));
+    std::fs::write(&exp, silverbox_simulation(&raw, samples, chirp, seed))?;
+    stf_lab::commands::simulate::run(&exp, &dir.join(&raw), true)?;
+    let mut reader = csv::Reader::from_path(dir.join(&raw))?;
+    let header = reader.headers()?.clone();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("no {name} column in {raw}"))
+    };
+    let (iu, ix) = (col("u")?, col("x")?);
+    let mut text = String::from("u,x\n");
+    let mut rows = 0;
+    for row in reader.records() {
+        let row = row?;
+        text.push_str(&format!("{},{}\n", &row[iu], &row[ix]));
+        rows += 1;
+    }
+    anyhow::ensure!(rows == samples, "{raw}: {rows} samples, expected {samples}");
+    std::fs::write(&path, text)?;
+    Ok(())
+}
+
+/// The Silverbox-layout case (`--silverbox`): the table row.
+fn run_silverbox(dir: &Path) -> Result<String> {
+    silverbox_record(
+        dir,
+        "silverbox_estimation.csv",
+        87_000,
+        (10.0, 120.0, 0.02),
+        5,
+    )?;
+    silverbox_record(
+        dir,
+        "silverbox_validation.csv",
+        22_000,
+        (120.0, 10.0, 0.025),
+        6,
+    )?;
+    let exp = dir.join("silverbox_discovery.toml");
+    std::fs::write(
+        &exp,
+        silverbox_discovery("silverbox_estimation.csv", "silverbox_validation.csv"),
+    )?;
+    let out = dir.join("silverbox");
+    let before = load();
+    let clock = Instant::now();
+    let cpu = cpu_seconds();
+    let loaded = stf_lab::experiment::Experiment::load(&exp)?;
+    stf_lab::commands::discover::run_experiment(loaded, &out, true, true)?;
+    let wall = clock.elapsed().as_secs_f64();
+    let cpu = cpu_seconds() - cpu;
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
+    Ok(format!(
+        "| trajectory, Silverbox layout (u, x in V), 87 000 samples, cubic_stiffness hidden, [validate] 22 000 | \
+         {wall:.1} s | {cpu:.1} s | {:.2} | {before:.1} | effects {}; gap {:.4e} → {:.4e} V; validation RMS {:.4e} → {:.4e} V |",
+        cpu / wall,
+        json["effects"],
+        json["gap_before"].as_f64().unwrap_or(f64::NAN),
+        json["gap_after"].as_f64().unwrap_or(f64::NAN),
+        json["validation"]["rms_before"].as_f64().unwrap_or(f64::NAN),
+        json["validation"]["rms_after"].as_f64().unwrap_or(f64::NAN),
+    ))
+}
+
 fn main() -> Result<()> {
     let trajectory = std::env::args().any(|a| a == "--trajectory");
     let shaker = std::env::args().any(|a| a == "--shaker");
@@ -246,7 +369,12 @@ fn main() -> Result<()> {
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     // The commands print their own summaries as they go; the table comes last.
     let mut rows = Vec::new();
-    let cases: Vec<&Case> = if shaker {
+    if std::env::args().any(|a| a == "--silverbox") {
+        rows.push(run_silverbox(&dir)?);
+    }
+    let cases: Vec<&Case> = if std::env::args().any(|a| a == "--silverbox") {
+        vec![]
+    } else if shaker {
         vec![&SHAKER]
     } else {
         CASES

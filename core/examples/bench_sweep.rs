@@ -3,10 +3,11 @@
 //!
 //! `cargo run --release -p stf-core --example bench_sweep [repeats]`
 //!
-//! Prints, for each method, the best wall time of `repeats` runs (default 5; 20× as many for the
-//! fast methods) of `integrate` alone and of a whole `Simulation::run` (which also evaluates the
-//! drive and the forces at every sample, on a second thread where the run is long), each with
-//! its mean CPU time; the right-hand-side calls and steps, and the largest |Δx| against the
+//! Prints, for each method, the median and the best wall time of `repeats` runs (default 5; 40×
+//! as many for the fast methods) of `integrate` alone and of a whole `Simulation::run` (which
+//! also evaluates the drive and the forces at every sample, on a second thread where the run is
+//! long), each with its mean CPU time, and the machine's load average before the runs (on a
+//! shared machine the median moves with the load; the best run is the figure to compare); the right-hand-side calls and steps, and the largest |Δx| against the
 //! reference (Dormand–Prince at rtol 1e-11, atol 1e-13) and between the two methods. Then, for sweep variants
 //! (α 0.03; F0 ×0.8; α 0.06 with F0 ×1.2 and T ×0.8), the default method's work and its largest
 //! |Δx| against a tight reference of each (one run each, untimed). Last, the sweep driven by the
@@ -40,22 +41,50 @@ fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
-/// Best wall time of `repeats` runs, mean CPU time per run, and the last result.
-fn best_of<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, f64, T) {
-    let mut best = f64::INFINITY;
+/// The machine's one-minute load average, or NaN.
+fn load() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(f64::NAN)
+}
+
+/// Wall times of a repeated run, s.
+struct Timing {
+    best: f64,
+    median: f64,
+    /// Mean CPU time per run.
+    cpu: f64,
+}
+
+/// The wall times of `repeats` runs, and the last result.
+fn timed<T>(repeats: usize, mut f: impl FnMut() -> T) -> (Timing, T) {
+    let mut walls = Vec::with_capacity(repeats.max(1));
     let mut last = None;
     let cpu0 = cpu_seconds();
     for _ in 0..repeats.max(1) {
         let start = Instant::now();
         let r = f();
-        best = best.min(start.elapsed().as_secs_f64());
+        walls.push(start.elapsed().as_secs_f64());
         last = Some(r);
     }
-    let cpu = (cpu_seconds() - cpu0) / repeats.max(1) as f64;
+    let cpu = (cpu_seconds() - cpu0) / walls.len() as f64;
+    walls.sort_by(f64::total_cmp);
+    let timing = Timing {
+        best: walls[0],
+        median: walls[walls.len() / 2],
+        cpu,
+    };
     match last {
-        Some(r) => (best, cpu, r),
+        Some(r) => (timing, r),
         None => unreachable!("at least one repeat"),
     }
+}
+
+/// Best wall time of `repeats` runs, mean CPU time per run, and the last result.
+fn best_of<T>(repeats: usize, f: impl FnMut() -> T) -> (f64, f64, T) {
+    let (t, r) = timed(repeats, f);
+    (t.best, t.cpu, r)
 }
 
 fn max_dx_mm(a: &Solution, b: &Solution) -> f64 {
@@ -91,32 +120,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     let mut rows = Vec::new();
+    println!("load average before the timed runs: {:.2}", load());
     for method in [Method::Dopri5, Method::Auto, Method::Rodas4] {
         let settings = Settings::default().method(method);
-        // Cheap methods get more repeats so that the CPU-time mean resolves the 10 ms tick.
+        // Cheap methods get more repeats so that the CPU-time mean resolves the 10 ms tick
+        // and the median is that of many runs.
         let reps = if method == Method::Dopri5 {
             repeats
         } else {
-            20 * repeats
+            40 * repeats
         };
-        let (t_int, cpu_int, sol) =
-            best_of(reps, || integrate(&osc, times[0], &y0, &times, &settings));
+        let (int, sol) = timed(reps, || integrate(&osc, times[0], &y0, &times, &settings));
         let sol = sol?;
-        let (t_sim, cpu_sim, run) = best_of(reps, || {
+        let (sim, run) = timed(reps, || {
             Simulation::new(&osc)
                 .settings(settings.clone())
                 .run_at(&times)
         });
         run?;
+        let (t_int, t_sim) = (int.best, sim.best);
         println!(
-            "{:<7} (rtol {:.0e}): integrate {:8.2} ms (CPU {:8.2} ms), Simulation::run {:8.2} ms (CPU {:8.2} ms), \
+            "{:<7} (rtol {:.0e}, {reps} runs): integrate median {:8.2} ms, best {:8.2} ms (CPU {:8.2} ms), \
+             Simulation::run median {:8.2} ms, best {:8.2} ms (CPU {:8.2} ms), \
              {:>9} RHS calls, {:>7} accepted, {:>6} rejected, max |Δx| vs reference {:.2e} mm",
             method.name(),
             settings.rtol,
+            int.median * 1e3,
             t_int * 1e3,
-            cpu_int * 1e3,
+            int.cpu * 1e3,
+            sim.median * 1e3,
             t_sim * 1e3,
-            cpu_sim * 1e3,
+            sim.cpu * 1e3,
             sol.stats.rhs_calls,
             sol.stats.accepted,
             sol.stats.rejected,

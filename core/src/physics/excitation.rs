@@ -168,7 +168,7 @@ pub enum Excitation {
 impl Excitation {
     /// The driving force at time `t`, N, for the oscillator's unbalance `F0` (kg·m) and drive
     /// offsets: `F0·ω²·sin(φ − phi_off)` for a rotor, `u(t) − u_off` for a measured force.
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, t: f64, p: &OscillatorParams) -> f64 {
         match self {
             Excitation::None => 0.0,
@@ -181,7 +181,7 @@ impl Excitation {
     /// and speed `(φ, ω)` if a rotor drives the oscillator: one evaluation of the angle for all
     /// three (the same values as [`Excitation::force`], [`Excitation::phi`],
     /// [`Excitation::omega`]).
-    #[inline]
+    #[inline(always)]
     pub fn force_and_angle(&self, t: f64, p: &OscillatorParams) -> (f64, Option<(f64, f64)>) {
         match self {
             Excitation::Rotor(angle) => {
