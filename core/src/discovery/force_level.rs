@@ -330,41 +330,38 @@ impl<'a> ForceLevel<'a> {
     /// those run from the stages `stage(start)` for each of candidate `c`'s starts
     /// ([`candidate_starts`] against the residual `r`), and from the first of them
     /// [`SearchModel::released`] when a parameter of it sits on a bound: the multi-start of a
-    /// candidate, screened. Every start first runs a round of [`SCREENING_ITERATIONS`]
-    /// Levenberg–Marquardt iterations; a start that converged in it is done, and of those that
-    /// did not only the leader (the lowest RMS) runs on to convergence, from where its round
-    /// ended. (The leader runs on even when it trails a converged start: after a round the
-    /// starts that will end lowest may still trail by a third — a yield added to a power law
-    /// pinned at n = 1, 0.45 N after the round for 0.347 N at the end, against a converged
-    /// 0.350 N.) Its evaluations and wall time are those of all the runs; the first run's error
-    /// if every run fails.
+    /// candidate. Its evaluations and wall time are those of all the runs; the first run's
+    /// error if every run fails.
     fn best_trial(
         &self,
         c: &Candidate,
         r: &[f64],
         stage: impl Fn(&[f64]) -> SearchModel,
     ) -> Result<Trial, DiscoveryError> {
-        let stages = self.start_stages(c, r, stage);
+        let train = &self.split.train;
+        let mut starts =
+            candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
+        let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
+        if let Some(released) = stages.first().and_then(SearchModel::released) {
+            stages.push(released);
+        }
+        // The neutral start: the current model's optimum with the candidate's amplitude at
+        // next to nothing, so that no candidate ends worse than the model it extends.
+        if let Some(amp) = neutral_amplitude(c.model.as_ref()) {
+            let mut neutral: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
+            neutral[0] = amp;
+            starts.push(neutral);
+            stages.push(stage(&starts[starts.len() - 1]));
+        }
         // The starts are independent fits: in parallel (a costly candidate's starts would
         // otherwise hold a step's last core alone), kept in their order.
-        let round_settings = self
-            .settings
-            .levenberg_marquardt(Some(SCREENING_ITERATIONS));
-        let mut trials: Vec<Result<Trial, DiscoveryError>> = stages
+        let trials: Vec<Result<Trial, DiscoveryError>> = stages
             .par_iter()
-            .map(|s| self.trial(s, &round_settings))
+            .map(|s| self.trial(s, self.settings))
             .collect();
-        let (mut evaluations, mut wall) = spent(&trials);
-        if let Some(lead) = leader(&trials) {
-            if let Ok(from) = &trials[lead] {
-                let run_on = self.trial(&from.stage, self.settings);
-                if let Ok(t) = &run_on {
-                    evaluations += t.train.evaluations;
-                    wall += t.train.wall_seconds;
-                }
-                trials[lead] = run_on;
-            }
-        }
+        let (evaluations, wall) = trials.iter().flatten().fold((0, 0.0), |(e, w), t| {
+            (e + t.train.evaluations, w + t.train.wall_seconds)
+        });
         let failed = |t: &Trial| matches!(t.train.convergence, Convergence::Failed { .. });
         let best = trials
             .into_iter()
@@ -380,31 +377,6 @@ impl<'a> ForceLevel<'a> {
         Ok(best)
     }
 
-    /// The stages of candidate `c`'s multi-start: `stage(start)` for each of its starts
-    /// ([`candidate_starts`] against the residual `r`), the first of them
-    /// [`SearchModel::released`] when a parameter of it sits on a bound, and the neutral start.
-    fn start_stages(
-        &self,
-        c: &Candidate,
-        r: &[f64],
-        stage: impl Fn(&[f64]) -> SearchModel,
-    ) -> Vec<SearchModel> {
-        let train = &self.split.train;
-        let starts = candidate_starts(&c.model, self.data, train, r, self.settings.extra_starts);
-        let mut stages: Vec<SearchModel> = starts.iter().map(|s| stage(s)).collect();
-        if let Some(released) = stages.first().and_then(SearchModel::released) {
-            stages.push(released);
-        }
-        // The neutral start: the current model's optimum with the candidate's amplitude at
-        // next to nothing, so that no candidate ends worse than the model it extends.
-        if let Some(amp) = neutral_amplitude(c.model.as_ref()) {
-            let mut neutral: Vec<f64> = c.model.params().iter().map(|s| s.default).collect();
-            neutral[0] = amp;
-            stages.push(stage(&neutral));
-        }
-        stages
-    }
-
     /// The blocks of the paired test for a model whose residual is `r` (every sample).
     fn blocks(&self, r: &[f64]) -> Blocks {
         Blocks::new(
@@ -412,33 +384,6 @@ impl<'a> ForceLevel<'a> {
             block_length(r, &self.split, self.settings.filter_window),
         )
     }
-}
-
-/// Levenberg–Marquardt iterations of the screening round of a candidate's multi-start
-/// ([`ForceLevel::best_trial`]). Most starts of a candidate end within 1e-5 of one another in
-/// RMS; running every one to convergence spent most of a step's evaluations on the same
-/// optimum.
-const SCREENING_ITERATIONS: u64 = 10;
-
-/// The evaluations and wall time of the runs that did not fail.
-fn spent(trials: &[Result<Trial, DiscoveryError>]) -> (u64, f64) {
-    trials.iter().flatten().fold((0, 0.0), |(e, w), t| {
-        (e + t.train.evaluations, w + t.train.wall_seconds)
-    })
-}
-
-/// The start a screening round leaves to run on (by index): the unconverged one with the
-/// lowest RMS; `None` when every start converged.
-fn leader(trials: &[Result<Trial, DiscoveryError>]) -> Option<usize> {
-    let rms = |t: &Trial| t.train.rms;
-    let done = |t: &Trial| t.train.convergence.converged();
-    let (lead, _) = trials
-        .iter()
-        .enumerate()
-        .filter_map(|(i, t)| t.as_ref().ok().map(|t| (i, t)))
-        .filter(|(_, t)| !done(t) && rms(t).is_finite())
-        .min_by(|a, b| rms(a.1).total_cmp(&rms(b.1)))?;
-    Some(lead)
 }
 
 impl Level for ForceLevel<'_> {
