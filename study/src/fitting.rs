@@ -20,8 +20,8 @@ use stf_core::data::kinematics::Kinematics;
 use stf_core::data::record::Record;
 use stf_core::fit::Validation;
 use stf_core::fit::{
-    fit_warnings, FilterNoise, FitError, FitParam, FitResult, FitWarning, ForceFit, NoiseFloor,
-    TrajectoryData, TrajectoryFit,
+    fit_warnings, offset_param, FilterNoise, FitError, FitParam, FitResult, FitWarning, ForceFit,
+    NoiseFloor, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
@@ -525,8 +525,7 @@ impl Predictor {
                 .filter_noise(noise);
             let mut fit = c.params.iter().cloned().fold(fit, ForceFit::param);
             if exp.fit.offset {
-                let b = offset_reach(data.target());
-                fit = fit.offset(FitParam::new("f_off", 0.0).bounds(-b, b).scale(1e-3 * b));
+                fit = fit.offset(offset_param(FORCE_OFFSET, data.target(), 0.0));
             }
             return Ok(Predictor::Force(fit));
         }
@@ -541,12 +540,7 @@ impl Predictor {
             free.push(system_param(param, &exp.system, k));
         }
         if exp.fit.offset {
-            let b = offset_reach(&data.record.x);
-            free.push(
-                FitParam::new("x_off", 0.0)
-                    .bounds(-b, b)
-                    .scale(1e-3_f64.min(0.1 * b)),
-            );
+            free.push(offset_param(DISPLACEMENT_OFFSET, &data.record.x, 0.0));
         }
         if exp.fit.fit_initial {
             free.extend(k.initial_state_params());
@@ -602,22 +596,6 @@ impl Predictor {
         sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
             .transpose()
-    }
-}
-
-/// The bounds ± this of an offset of the measured `signal`: twice its largest |value|. A
-/// record is its signal plus the offset, and the signal swings about zero, so the offset is
-/// never larger than the record's largest |value| (a damper's −124 N offset on a force of
-/// hundreds of N lies well inside; a fixed ±100 N stopped it at −99.93).
-fn offset_reach(signal: &[f64]) -> f64 {
-    let largest = signal
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold(0.0_f64, |m, v| m.max(v.abs()));
-    if largest > 0.0 {
-        2.0 * largest
-    } else {
-        1.0
     }
 }
 

@@ -228,6 +228,15 @@ pub struct DiscoveryScore {
     pub samples: usize,
     /// Whether the initial state was fitted to the record (trajectory level only).
     pub initial_fitted: Option<bool>,
+    /// The record's own offset (`f_off` N, `x_off` m) as fitted on it with the final model,
+    /// if the discovery fitted one: an offset belongs to the sensor, so it is fitted again on
+    /// the record, every model value held.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+    /// Whether that offset (with either model) ended at or is held by a bound (± twice the
+    /// record's largest |value|): the errors are then biased.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub offset_on_bound: bool,
     /// Why the models could not be scored, if they could not.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -257,6 +266,9 @@ impl DiscoveryScore {
             samples: rec.data.record.len(),
             initial_fitted: (rec.data.level == FitLevel::Trajectory)
                 .then(|| after.as_ref().is_some_and(|a| a.initial_fitted)),
+            offset: after.as_ref().and_then(|a| a.offset),
+            offset_on_bound: before.as_ref().is_some_and(|b| b.offset_on_bound)
+                || after.as_ref().is_some_and(|a| a.offset_on_bound),
             error,
             predicted_after: after.map(|a| a.predicted).unwrap_or_default(),
         }

@@ -3,11 +3,15 @@
 //! only say it of that record.
 //!
 //! At force level ([`Discovery::validate`]) each model predicts the STF force from the other
-//! record's kinematics with its fitted values and offset. At trajectory level
+//! record's kinematics with its fitted values. An offset the discovery fitted belongs to the
+//! sensor: it is fitted again on the other record as every offset is (from the least-squares
+//! value, bounds from that record's scale: [`ForceFit::validate`]), so a record whose sensor
+//! reads 150 N off is scored on the model's error, not on the two records' difference. At trajectory level
 //! ([`Discovery::validate_trajectory`]) each is simulated with the oscillator as refitted with
 //! it, driven by the other record's drive, from that record's initial state — refitted on it
 //! when the discovery fitted `x0`, `v0`, else its estimate less the offset — everything else
-//! as fitted ([`crate::fit::TrajectoryFit::validate`]).
+//! as fitted but the displacement offset, fitted again on that record
+//! ([`crate::fit::TrajectoryFit::validate`]).
 
 use std::sync::Arc;
 
@@ -70,8 +74,7 @@ fn trajectory_score(
     let mut held = Vec::new();
     for name in std::iter::once(DISPLACEMENT_OFFSET).chain(INITIAL_STATE) {
         if let Some(v) = value_of(params, name) {
-            let fixed = name == DISPLACEMENT_OFFSET;
-            fit = fit.free(FitParam::new(name, v).fixed(fixed));
+            fit = fit.free(FitParam::new(name, v));
             held.push(v);
         }
     }

@@ -346,14 +346,11 @@ impl Chain<'_> {
         };
         let p = self.free.len();
         let errors = if p > 0 {
-            let jac = jacobian(obj, self.free, &x, &r0, self.settings);
-            Some(standard_errors(
-                &jac,
-                &r0,
-                rss,
-                obj.correlation_span(),
-                &mut log,
-            ))
+            let (jac, rise) = jacobian(obj, self.free, &x, &r0, self.settings);
+            noisy_columns(self.free, &rise, &mut log);
+            let mut errors = standard_errors(&jac, &r0, rss, obj.correlation_span(), &mut log);
+            errors.rise = rise;
+            Some(errors)
         } else {
             None
         };
@@ -445,34 +442,46 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
                 naive_std_error: e.naive[k],
                 fixed: false,
                 held_by: held_by(q, value, e.step[k]),
+                noisy_column: (e.rise[k] < NOISY_COLUMN).then_some(e.rise[k]),
             })
         })
         .collect()
 }
 
 /// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
-/// exact where the problem gives one, else by forward differences.
+/// exact where the problem gives one, else by forward differences; and how far each column
+/// stands above the residuals' noise (see [`forward_difference`]).
+///
+/// The difference steps are sized to where the fit ended: `fd_step` (up to
+/// [`MAX_FD_STEP`]) times the larger of the parameter's typical size and its |value|. A
+/// parameter that started near zero — an added term's amplitude started neutral, at a
+/// millionth of its default — has a typical size of its start (2e-7 N for a yield force),
+/// and steps of that size at an end of 0.5 N changed the simulated x less than the
+/// integrator's own noise: the column was that noise, and the standard error 250 times too
+/// small.
 fn jacobian(
     obj: &Objective,
     free: &[&FitParam],
     x: &[f64],
     r0: &[f64],
     settings: &FitSettings,
-) -> DMatrix<f64> {
+) -> (DMatrix<f64>, Vec<f64>) {
     let (n, p) = (r0.len(), free.len());
     let mut jac = DMatrix::<f64>::zeros(n, p);
     let exact = obj
         .jacobian_user(x, &mut jac)
         .unwrap_or_else(|| vec![false; p]);
     if exact.iter().all(|&e| e) {
-        return jac;
+        return (jac, vec![f64::INFINITY; p]);
     }
-    let mut steps: Vec<f64> = free
+    let size: Vec<f64> = free
         .iter()
-        .map(|q| settings.fd_step * q.effective_scale())
+        .zip(x)
+        .map(|(q, v)| q.effective_scale().max(v.abs()))
         .collect();
+    let mut steps: Vec<f64> = size.iter().map(|s| settings.fd_step * s).collect();
     // Steps above the residuals' noise (a noisy column would make a noisy standard
-    // error), at most MAX_FD_STEP scales and short enough that one side stays in bounds.
+    // error), at most MAX_FD_STEP sizes and short enough that one side stays in bounds.
     let probe: Vec<f64> = free
         .iter()
         .zip(x)
@@ -493,15 +502,12 @@ fn jacobian(
         noise,
         max: free
             .iter()
+            .zip(&size)
             .zip(&steps)
-            .map(|(q, h)| {
-                (MAX_FD_STEP * q.effective_scale())
-                    .min(0.49 * (q.max - q.min))
-                    .max(*h)
-            })
+            .map(|((q, s), h)| (MAX_FD_STEP * s).min(0.49 * (q.max - q.min)).max(*h))
             .collect(),
     };
-    forward_difference(
+    let rise = forward_difference(
         x,
         r0,
         &mut steps,
@@ -511,7 +517,30 @@ fn jacobian(
         &exact,
         &mut jac,
     );
-    jac
+    (jac, rise)
+}
+
+/// A difference column that stands less than this many times above the residuals' noise
+/// (its rms change over theirs) at the longest step allowed makes its parameter's standard
+/// error uncertain (the noise then makes ≳ 15 % of the column): the fit says so.
+pub const NOISY_COLUMN: f64 = 10.0;
+
+/// A line in `log` naming the parameters (of `free`) whose difference columns stood less than
+/// [`NOISY_COLUMN`] times above the residuals' noise (`rise`).
+fn noisy_columns(free: &[&FitParam], rise: &[f64], log: &mut Vec<String>) {
+    let noisy: Vec<String> = free
+        .iter()
+        .zip(rise)
+        .filter(|(_, r)| **r < NOISY_COLUMN)
+        .map(|(q, r)| format!("{} ({r:.1}×)", q.name))
+        .collect();
+    if !noisy.is_empty() {
+        log.push(format!(
+            "standard errors: the difference columns of {} stand less than {NOISY_COLUMN}× \
+             above the residuals' noise: their errors are uncertain",
+            noisy.join(", ")
+        ));
+    }
 }
 
 /// The standard errors of a fit: robust over blocks chosen from the residuals, and naive.
@@ -521,6 +550,8 @@ struct Errors {
     blocks: ErrorBlocks,
     /// The Gauss–Newton step from the end, per free parameter.
     step: Vec<f64>,
+    /// How far each free parameter's difference column stood above the residuals' noise.
+    rise: Vec<f64>,
 }
 
 /// Standard errors from the Jacobian `jac` and the residuals `r` (sum of squares `rss`),
@@ -552,6 +583,7 @@ fn standard_errors(
         naive: covariance::from_jacobian(jac, rss).std_errors,
         blocks,
         step: covariance::gauss_newton_step(jac, r),
+        rise: vec![f64::INFINITY; jac.ncols()],
     }
 }
 

@@ -73,6 +73,10 @@ pub struct StepFloor {
 /// longer step (up to `floor.max[j]`); the steps used are written back to `steps`, so a
 /// caller that keeps them starts the next Jacobian from there. Columns marked in `exact` are
 /// left as they are (known exactly). The columns are computed in parallel.
+///
+/// Returns how far each column's change stands above the noise (its rms change over
+/// `floor.noise`; infinite for an exact column or noiseless residuals): a column below
+/// [`SIGNAL_TO_NOISE`] is partly noise, one below 1 mostly noise.
 #[allow(clippy::too_many_arguments)]
 pub fn forward_difference(
     x: &[f64],
@@ -83,7 +87,7 @@ pub fn forward_difference(
     eval: Eval,
     exact: &[bool],
     jac: &mut DMatrix<f64>,
-) {
+) -> Vec<f64> {
     let todo: Vec<usize> = (0..steps.len())
         .filter(|&j| !exact.get(j).copied().unwrap_or(false))
         .collect();
@@ -95,10 +99,17 @@ pub fn forward_difference(
             (j, h, col)
         })
         .collect();
+    let mut rise = vec![f64::INFINITY; steps.len()];
+    let n = r0.len().max(1) as f64;
     for (j, h, col) in columns {
+        let change = h * (col.iter().map(|c| c * c).sum::<f64>() / n).sqrt();
+        if floor.noise > 0.0 {
+            rise[j] = change / floor.noise;
+        }
         steps[j] = h;
         jac.column_mut(j).copy_from_slice(&col);
     }
+    rise
 }
 
 /// Column `j` of the forward-difference Jacobian from a step of `h0`, lengthened (up to

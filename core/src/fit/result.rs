@@ -83,6 +83,12 @@ pub struct FittedParam {
     /// Gauss–Newton step from the end would cross the bound. `None`: free to move either way.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub held_by: Option<BoundSide>,
+    /// How far this free parameter's difference column stood above the residuals' noise
+    /// (rms change over rms noise) at the longest step allowed, when that was less than
+    /// [`NOISY_COLUMN`](super::NOISY_COLUMN): its standard error is then uncertain (a
+    /// simulation's noise at its `rtol`). `None`: the column stood clear of the noise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noisy_column: Option<f64>,
 }
 
 impl FittedParam {
@@ -96,6 +102,7 @@ impl FittedParam {
             naive_std_error: std_error,
             fixed: false,
             held_by: None,
+            noisy_column: None,
         }
     }
 

@@ -6,9 +6,12 @@
 //! by the other record's drive (set it with [`TrajectoryFit::excitation`]) from that record's
 //! own initial state: refitted on it when `x0`, `v0` are free parameters of the fit (the
 //! initial state belongs to a record, not to the model), else its estimate as given to
-//! [`TrajectoryFit::initial`]; every other value stays as fitted, the offset included. Both
-//! give a [`Validation`]: the RMS of measured − predicted and that RMS over the RMS of the
-//! measured signal.
+//! [`TrajectoryFit::initial`]; every other value stays as fitted. An offset the fit fitted
+//! (`f_off`, `x_off`) belongs to the sensor, not to the model: it is fitted again on the
+//! other record, every model value held, by the rule of every fitted offset
+//! ([`super::offset`]: from the least-squares value, within bounds from that record's scale,
+//! flagged when it ends at or is held by a bound). Both give a [`Validation`]: the RMS of
+//! measured − predicted and that RMS over the RMS of the measured signal.
 //!
 //! ```
 //! use std::sync::Arc;
@@ -39,8 +42,13 @@ use serde::Serialize;
 
 use super::error::FitError;
 use super::fit_param::{held, FitParam};
-use super::force_fit::ForceFit;
-use super::trajectory_fit::{initial_state_params, TrajectoryData, TrajectoryFit, INITIAL_STATE};
+use super::force_fit::{ForceFit, FORCE_OFFSET};
+use super::offset::{least_squares_offset, offset_param};
+use super::result::FitResult;
+use super::trajectory_fit::{
+    initial_state_params, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, INITIAL_STATE,
+};
+use super::warning::{fit_warnings, FitWarning};
 use crate::data::force_data::ForceData;
 
 /// A fitted model's error on a record it was not fitted to.
@@ -58,6 +66,14 @@ pub struct Validation {
     pub initial: Option<[f64; 2]>,
     /// Whether that state was fitted to the record (with every other value held).
     pub initial_fitted: bool,
+    /// The record's own offset (`f_off` N, `x_off` m), fitted on it with every model value
+    /// held; none when the fit fitted no offset.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<f64>,
+    /// Whether that offset ended at or is held by a bound of its box (± twice the record's
+    /// largest |value|): the score is then biased.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub offset_on_bound: bool,
     /// The prediction at every sample (not serialized).
     #[serde(skip)]
     pub predicted: Vec<f64>,
@@ -75,8 +91,22 @@ impl Validation {
             samples: measured.len(),
             initial: None,
             initial_fitted: false,
+            offset: None,
+            offset_on_bound: false,
             predicted,
         }
+    }
+}
+
+impl Validation {
+    /// This score with the record's own `offset` (fitted on it, flagged `on_bound`): the
+    /// measured RMS is then that of the signal less the offset, about which it swings.
+    fn with_offset(mut self, measured: &[f64], offset: f64, on_bound: bool) -> Self {
+        self.measured_rms = rms(measured.iter().map(|m| m - offset));
+        self.normalised = self.rms / self.measured_rms;
+        self.offset = Some(offset);
+        self.offset_on_bound = on_bound;
+        self
     }
 }
 
@@ -92,11 +122,39 @@ fn rms(values: impl Iterator<Item = f64>) -> f64 {
 
 impl ForceFit {
     /// Score the fitted `values` (as for [`ForceFit::predict`]: the model's parameters, then
-    /// the offset) on another record's kinematics and force.
+    /// the offset) on another record's kinematics and force; an offset is fitted again on
+    /// that record (see the module's doc).
     pub fn validate(&self, data: &ForceData, values: &[f64]) -> Result<Validation, FitError> {
-        let predicted = self.predict(data, values)?;
-        Ok(Validation::of(data.f, predicted))
+        let params = self.params();
+        if !params.iter().any(|p| p.name == FORCE_OFFSET) {
+            return Ok(Validation::of(data.f, self.predict(data, values)?));
+        }
+        let mut bare = held(&params, values)?;
+        let last = bare.len() - 1;
+        bare[last].value = 0.0;
+        let without: Vec<f64> = bare.iter().map(|p| p.value).collect();
+        let start = least_squares_offset(data.f, &self.predict(data, &without)?);
+        bare[last] = offset_param(FORCE_OFFSET, data.f, start);
+        let refit = bare[..last]
+            .iter()
+            .cloned()
+            .fold(self.clone().filter_noise(None), ForceFit::param)
+            .offset(bare[last].clone());
+        let result = refit.fit_plain(data)?;
+        let offset = result.value(FORCE_OFFSET).unwrap_or(start);
+        let mut all = without;
+        all[last] = offset;
+        let flagged = on_bound(&result, &refit.params(), FORCE_OFFSET);
+        let score = Validation::of(data.f, self.predict(data, &all)?);
+        Ok(score.with_offset(data.f, offset, flagged))
     }
+}
+
+/// Whether the fit `result` of `params` flags `name` as ending at or held by a bound.
+fn on_bound(result: &FitResult, params: &[FitParam], name: &str) -> bool {
+    fit_warnings(result, params, None)
+        .iter()
+        .any(|w| matches!(w, FitWarning::OnBound { param, .. } if param == name))
 }
 
 /// The largest |x − mean| of `x`.
@@ -124,24 +182,38 @@ impl TrajectoryFit {
             .initial
             .unwrap_or((data.x.first().copied().unwrap_or(0.0), 0.0));
         let start = initial_state_params(x0, v0, x_span(data.x), v_span(data));
-        let held: Vec<_> = given
+        let mut held: Vec<_> = given
             .iter()
             .map(|p| match INITIAL_STATE.iter().position(|n| *n == p.name) {
                 Some(i) if refit => start[i].clone(),
                 _ => FitParam::new(&p.name, p.value).fixed(true),
             })
             .collect();
+        let offset_at = held.iter().position(|p| p.name == DISPLACEMENT_OFFSET);
+        if let Some(k) = offset_at {
+            held[k].value = 0.0;
+            let bare: Vec<f64> = held.iter().map(|p| p.value).collect();
+            let (x, _) = self.with_free(held.clone()).simulate(data, &bare)?;
+            let start = least_squares_offset(data.x, &x);
+            held[k] = offset_param(DISPLACEMENT_OFFSET, data.x, start);
+        }
         let held_fit = self.with_free(held.clone());
-        let values: Vec<f64> = if refit {
+        let (values, on_bound_now) = if refit || offset_at.is_some() {
             let result = held_fit.fit(data, None)?;
-            held.iter()
+            let flagged = on_bound(&result, &held, DISPLACEMENT_OFFSET);
+            let values = held
+                .iter()
                 .map(|p| result.value(&p.name).unwrap_or(p.value))
-                .collect()
+                .collect();
+            (values, flagged)
         } else {
-            values.to_vec()
+            (values.to_vec(), false)
         };
         let (predicted, initial) = held_fit.simulate(data, &values)?;
         let mut score = Validation::of(data.x, predicted);
+        if let Some(k) = offset_at {
+            score = score.with_offset(data.x, values[k], on_bound_now);
+        }
         score.initial = Some(initial);
         score.initial_fitted = refit;
         Ok(score)

@@ -9,6 +9,7 @@
 //! | [`FitWarning::OnBound`] | a free parameter ends within [`NEAR_BOUND`] of its typical size (or of the box, if narrower) from a bound |
 //! | [`FitWarning::Undetermined`] | a free parameter's standard error exceeds its \|value\|, or is not finite |
 //! | [`FitWarning::Correlated`] | two free parameters correlate beyond [`CORRELATION_LIMIT`] in magnitude |
+//! | [`FitWarning::NoisyError`] | a free parameter's difference column stood less than [`crate::fit::NOISY_COLUMN`] times above the residuals' noise |
 //!
 //! Each warning's [`Display`](std::fmt::Display) is one sentence that says what is wrong and
 //! what to try, its numbers written by [`crate::digits`] as the reports and the terminal write
@@ -108,6 +109,19 @@ pub enum FitWarning {
         /// Their correlation.
         correlation: f64,
     },
+    /// A free parameter's standard error rests on a difference column that hardly stands
+    /// above the residuals' own noise (a simulation's, at its tolerance): it is uncertain.
+    #[error(
+        "the standard error of {param} is uncertain: its effect on the residuals stands only \
+         {rise:.1}× above the simulation's own noise — tighten `[integrator] rtol` (e.g. \
+         1e-10) and fit again"
+    )]
+    NoisyError {
+        /// Parameter.
+        param: String,
+        /// Its column's rms change over the residuals' rms noise.
+        rise: f64,
+    },
 }
 
 /// A warning with its sentence, as written to `fit.json`: `kind`, `message` and the data.
@@ -129,6 +143,7 @@ impl FitWarning {
             FitWarning::OnBound { .. } => "on_bound",
             FitWarning::Undetermined { .. } => "undetermined",
             FitWarning::Correlated { .. } => "correlated",
+            FitWarning::NoisyError { .. } => "noisy_error",
         }
     }
 
@@ -216,6 +231,14 @@ pub fn fit_warnings(
                 param: p.name.clone(),
                 value: p.value,
                 std_error: p.std_error,
+            });
+        }
+    }
+    for p in &free {
+        if let Some(rise) = p.noisy_column {
+            out.push(FitWarning::NoisyError {
+                param: p.name.clone(),
+                rise,
             });
         }
     }
