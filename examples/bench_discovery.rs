@@ -188,6 +188,19 @@ fn load() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// Run the discovery experiment `exp` into `out`: its wall and CPU seconds and the
+/// `discovery.json` it wrote.
+fn timed_discovery(exp: &Path, out: &Path) -> Result<(f64, f64, serde_json::Value)> {
+    let clock = Instant::now();
+    let cpu = cpu_seconds();
+    let loaded = stf_lab::experiment::Experiment::load(exp)?;
+    stf_lab::commands::discover::run_experiment(loaded, out, true, true)?;
+    let wall = clock.elapsed().as_secs_f64();
+    let cpu = cpu_seconds() - cpu;
+    let json = serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
+    Ok((wall, cpu, json))
+}
+
 /// Simulate the case's record, run discovery on it; the wall and CPU time of the discovery
 /// and what it named.
 fn run(case: &Case, dir: &Path) -> Result<(f64, f64, String)> {
@@ -213,15 +226,7 @@ fn run(case: &Case, dir: &Path) -> Result<(f64, f64, String)> {
     if !dir.join(&record).exists() {
         stf_lab::commands::simulate::run(&exp, &dir.join(&record), true)?;
     }
-    let out = dir.join(&stem);
-    let clock = Instant::now();
-    let cpu = cpu_seconds();
-    let loaded = stf_lab::experiment::Experiment::load(&exp)?;
-    stf_lab::commands::discover::run_experiment(loaded, &out, true, true)?;
-    let wall = clock.elapsed().as_secs_f64();
-    let cpu = cpu_seconds() - cpu;
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
+    let (wall, cpu, json) = timed_discovery(&exp, &dir.join(&stem))?;
     let effects: Vec<String> = json["effects"]
         .as_array()
         .map(|a| {
@@ -340,16 +345,8 @@ fn run_silverbox(dir: &Path) -> Result<String> {
         &exp,
         silverbox_discovery("silverbox_estimation.csv", "silverbox_validation.csv"),
     )?;
-    let out = dir.join("silverbox");
     let before = load();
-    let clock = Instant::now();
-    let cpu = cpu_seconds();
-    let loaded = stf_lab::experiment::Experiment::load(&exp)?;
-    stf_lab::commands::discover::run_experiment(loaded, &out, true, true)?;
-    let wall = clock.elapsed().as_secs_f64();
-    let cpu = cpu_seconds() - cpu;
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("discovery.json"))?)?;
+    let (wall, cpu, json) = timed_discovery(&exp, &dir.join("silverbox"))?;
     Ok(format!(
         "| trajectory, Silverbox layout (u, x in V), 87 000 samples, cubic_stiffness hidden, [validate] 22 000 | \
          {wall:.1} s | {cpu:.1} s | {:.2} | {before:.1} | effects {}; gap {:.4e} → {:.4e} V; validation RMS {:.4e} → {:.4e} V |",
