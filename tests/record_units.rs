@@ -305,3 +305,51 @@ fn a_campaign_on_records_in_volts_speaks_of_millivolts_and_volts() {
         wrong_words(&md)
     );
 }
+
+/// A `[global]` law over records read in different units (one in metres, one in volts) is
+/// refused, naming both records and their units, instead of reporting one law in a mixture.
+#[test]
+fn a_joint_fit_over_records_in_metres_and_volts_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let record = root().join("experiments/records/trajectory_discovery.csv");
+    for name in ["a.csv", "b.csv", "c.csv"] {
+        std::fs::copy(&record, tmp.path().join(name)).unwrap();
+    }
+    let models = "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n";
+    let volts = volt_experiment(tmp.path(), models);
+    let metres = write_file(
+        tmp.path(),
+        "metres.toml",
+        &format!(
+            "{}\n{models}",
+            bundled_experiment("trajectory_discovery.toml")
+        ),
+    );
+    let campaign = write_file(
+        tmp.path(),
+        "campaign.toml",
+        &format!(
+            "[campaign]\nexperiment = \"{}\"\ncommand = \"fit\"\nconditions = [\"gain\"]\n\n\
+             [[records]]\nfile = \"a.csv\"\ngain = 1.0\n\n[[records]]\nfile = \"b.csv\"\ngain = 1.1\n\n\
+             [[records]]\nfile = \"c.csv\"\ngain = 1.2\nexperiment = \"{}\"\n\n\
+             [global]\nmodel = \"viscous + cubic_stiffness\"\nshared = [\"c_s\", \"k3\"]\n\
+             level = \"trajectory\"\n",
+            metres.display(),
+            volts.display()
+        ),
+    );
+    let out = tmp.path().join("out");
+    let run = common::stf_lab()
+        .args(["campaign", "--jobs", "1", "--out"])
+        .arg(&out)
+        .arg(&campaign)
+        .output()
+        .unwrap();
+    let said = terminal(&run);
+    assert!(!run.status.success(), "{said}");
+    assert!(
+        said.contains("record a.csv is in m and N while record c.csv is in V and V"),
+        "{said}"
+    );
+    assert!(!out.join("global.json").exists(), "{said}");
+}

@@ -269,6 +269,7 @@ fn joint_fit(campaign: &JointInputs) -> Result<GlobalJson> {
         .par_iter()
         .map(|u| load_one(spec, &gexp, u).with_context(|| at(u)))
         .collect::<Result<_>>()?;
+    same_units(campaign, &loaded)?;
     let is_training = |i: usize| Some(i) != spec.holdout;
     let scales = union_scales(
         loaded
@@ -314,6 +315,31 @@ fn joint_fit(campaign: &JointInputs) -> Result<GlobalJson> {
     Ok(assemble(
         spec, &units, &loaded, &training, &layout, result, holdout,
     ))
+}
+
+/// Every record of a joint fit in the same units: one law's coefficients cannot be read in
+/// metres for one record and in volts for another (the joint fit would take the first
+/// record's units for all and report a mixture as one number).
+fn same_units(campaign: &JointInputs, loaded: &[Loaded]) -> Result<()> {
+    let Some(first) = loaded.first() else {
+        return Ok(());
+    };
+    let units = |l: &Loaded| (l.units.x_si, l.units.force_si);
+    match loaded.iter().find(|l| units(l) != units(first)) {
+        None => Ok(()),
+        Some(other) => bail!(
+            "{}: `[global]` fits one law over every record, but record {} is in {} and {} \
+             while record {} is in {} and {} (x and force); read them in the same units \
+             (`[data] units` in their experiments)",
+            campaign.path.display(),
+            first.unit.record_given,
+            first.units.x_si,
+            first.units.force_si,
+            other.unit.record_given,
+            other.units.x_si,
+            other.units.force_si,
+        ),
+    }
 }
 
 /// The held-out record predicted by the global fit and by the per-record alternative, RMS
