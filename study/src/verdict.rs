@@ -370,20 +370,6 @@ pub fn discover_verdict(
     }
 }
 
-/// `x` with `digits` significant digits, trailing zeros dropped (`269.935`, `0.0461989`).
-fn significant(x: f64, digits: i32) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return x.to_string();
-    }
-    let decimals = (digits - 1 - x.abs().log10().floor() as i32).max(0) as usize;
-    let s = format!("{x:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
-}
-
 /// The oscillator's parameters as a readable line: `m 7.65 kg, k 267.9 N/m, …`, units on a
 /// record shown in `units`.
 pub fn system_line(system: &OscillatorParams, units: &ShownUnits) -> String {
@@ -392,7 +378,7 @@ pub fn system_line(system: &OscillatorParams, units: &ShownUnits) -> String {
         .filter(|p| !p.is_offset() || system[*p] != 0.0)
         .map(|p| {
             let unit = in_record_units(p.unit(), units);
-            format!("{p} {} {unit}", significant(system[p], 6))
+            format!("{p} {} {unit}", stf_core::digits::significant(system[p], 6))
                 .trim_end()
                 .to_string()
         })
