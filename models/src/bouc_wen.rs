@@ -40,7 +40,6 @@
 
 use stf_core::physics::force_model::{ModelError, ModelState, Reach, NEGLIGIBLE_SHARE};
 use stf_core::physics::param_spec::ParamSpec;
-use stf_core::physics::sensitivity::StatePartials;
 
 use crate::builtin::builtin;
 use crate::values::take;
@@ -78,37 +77,6 @@ builtin! {
             let w = w.clamp(-1.0, 1.0);
             *rate = (s.v - beta * s.v.abs() * w - (1.0 - beta) * s.v * w.abs()) / x_bw;
             Ok(f_bw * w)
-        }
-        /// The partials of the law in w, the clamp's slope 1 inside [−1, 1] and 0 beyond.
-        fn state_partials(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            _a: f64,
-            dz: &mut [f64],
-            d: &mut StatePartials,
-        ) -> Result<bool, ModelError> {
-            self.force(p, s, dz)?;
-            let [f_bw, x_bw, beta] = take(self.name(), p)?;
-            let w = s.z[0];
-            let wc = w.clamp(-1.0, 1.0);
-            let slope = if (-1.0..=1.0).contains(&w) { 1.0 } else { 0.0 };
-            let sign = if wc > 0.0 {
-                1.0
-            } else if wc < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            d.force_p.copy_from_slice(&[wc, 0.0, 0.0]);
-            d.force_z[0] = f_bw * slope;
-            d.rate_z[0] = slope * (-beta * s.v.abs() - (1.0 - beta) * s.v * sign) / x_bw;
-            d.rate_p.copy_from_slice(&[
-                0.0,
-                -dz[0] / x_bw,
-                (-s.v.abs() * wc + s.v * wc.abs()) / x_bw,
-            ]);
-            Ok(true)
         }
         /// A loop narrower than 5 % of the stroke is `yield`; a yield displacement that the
         /// stroke never reaches (20 times it) is a `linear_spring` of the initial stiffness.

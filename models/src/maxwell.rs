@@ -22,7 +22,6 @@
 
 use stf_core::physics::force_model::{ModelError, ModelState};
 use stf_core::physics::param_spec::ParamSpec;
-use stf_core::physics::sensitivity::StatePartials;
 
 use crate::builtin::builtin;
 use crate::values::take;
@@ -57,23 +56,6 @@ builtin! {
             };
             *rate = (c_m * s.v - f) / tau;
             Ok(f)
-        }
-        /// The force is the state; its rate is linear in it.
-        fn state_partials(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            _a: f64,
-            dz: &mut [f64],
-            d: &mut StatePartials,
-        ) -> Result<bool, ModelError> {
-            self.force(p, s, dz)?;
-            let [_, tau] = take(self.name(), p)?;
-            d.force_p.fill(0.0);
-            d.force_z[0] = 1.0;
-            d.rate_z[0] = -1.0 / tau;
-            d.rate_p.copy_from_slice(&[s.v / tau, -dz[0] / tau]);
-            Ok(true)
         }
     }
 }

@@ -27,7 +27,6 @@ use std::sync::Arc;
 
 use crate::physics::force_model::{ForceModel, ModelError, ModelState, Reach};
 use crate::physics::param_spec::ParamSpec;
-use crate::physics::sensitivity::StatePartials;
 use crate::physics::track::Track;
 
 /// An upper bound below this many typical sizes is too tight for the record.
@@ -159,16 +158,6 @@ impl ForceModel for Widened {
         grad: &mut [f64],
     ) -> Result<bool, ModelError> {
         self.inner.gradient(p, s, a, grad)
-    }
-    fn state_partials(
-        &self,
-        p: &[f64],
-        s: &ModelState,
-        a: f64,
-        dz: &mut [f64],
-        d: &mut StatePartials,
-    ) -> Result<bool, ModelError> {
-        self.inner.state_partials(p, s, a, dz, d)
     }
     fn mass_and_force_along(
         &self,

@@ -31,7 +31,6 @@
 use std::sync::Arc;
 
 use crate::physics::param_spec::ParamSpec;
-use crate::physics::sensitivity::StatePartials;
 use crate::physics::track::{self, Track};
 
 /// The state a force model sees: time, displacement, velocity and its own internal variables.
@@ -117,34 +116,15 @@ pub trait ForceModel: Send + Sync {
     /// The gradient of the whole force `m_a·a + f` with respect to the parameters at state
     /// `s` and acceleration `a`, written to `grad` (one entry per parameter); `Ok(false)` when
     /// the model does not provide it (the default), and the fitter differences instead. Only
-    /// models without internal state provide it (a model with state gives its
-    /// [`ForceModel::state_partials`] instead); a sum gives its memoryless parts' entries and
-    /// leaves NaN in those of its parts with state.
+    /// models without internal state provide it (a state would need its sensitivities); a sum
+    /// gives its memoryless parts' entries and leaves NaN in those of its parts with state,
+    /// which the fitter differences.
     fn gradient(
         &self,
         _p: &[f64],
         _s: &ModelState,
         _a: f64,
         _grad: &mut [f64],
-    ) -> Result<bool, ModelError> {
-        Ok(false)
-    }
-
-    /// The partial derivatives of a model with internal state at state `s` and acceleration
-    /// `a`, from which its exact gradient along a record is integrated
-    /// ([`crate::physics::sensitivity`]): writes the state's rates to `dz`, exactly as
-    /// [`ForceModel::force`] does, and the partials of the whole force and of the rates with
-    /// respect to the parameters and the state to `d`. `Ok(false)` (the default) when the
-    /// model does not give them, and the fitter differences its columns instead. The
-    /// sensitivities start at zero: a model whose initial state depends on its parameters
-    /// must not give them.
-    fn state_partials(
-        &self,
-        _p: &[f64],
-        _s: &ModelState,
-        _a: f64,
-        _dz: &mut [f64],
-        _d: &mut StatePartials,
     ) -> Result<bool, ModelError> {
         Ok(false)
     }
@@ -166,13 +146,10 @@ pub trait ForceModel: Send + Sync {
         track::mass_and_force_along(self, p, track, rows, mass, force)
     }
 
-    /// Along a whole record: the gradient of the whole force at the `k`-th of `rows` (`None`:
-    /// every sample), acceleration `a[i]` at sample `i`, parameter `j`'s entry written to
+    /// Along a whole record: [`ForceModel::gradient`] at the `k`-th of `rows` (`None`: every
+    /// sample), acceleration `a[i]` at sample `i`, parameter `j`'s entry written to
     /// `grad[j·n + k]` (`n` results); `Ok(false)` when the model gives none. Provided by
-    /// [`track::gradient_along`]: [`ForceModel::gradient`] at every sample for a model
-    /// without state, the state's sensitivities integrated along the record from
-    /// [`ForceModel::state_partials`] for one with state; a sum leaves NaN in the columns of
-    /// its parts that give none.
+    /// [`track::gradient_along`]; a sum leaves NaN in the columns of its parts with state.
     fn gradient_along(
         &self,
         p: &[f64],

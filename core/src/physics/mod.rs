@@ -11,5 +11,4 @@ pub mod oscillator_params;
 pub mod param_spec;
 pub mod resistance;
 pub mod resolved_model;
-pub mod sensitivity;
 pub mod track;

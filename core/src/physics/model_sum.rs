@@ -247,9 +247,8 @@ impl ForceModel for ModelSum {
         Ok(())
     }
 
-    /// Each part's columns from its own gradient along the record (the parts' states are
-    /// independent, so a part with state integrates its own sensitivities); NaN in the
-    /// columns of a part without a gradient (differenced by the fitter).
+    /// Each memoryless part's columns from its own gradient along the record; NaN in the
+    /// columns of a part with state or without a gradient (differenced by the fitter).
     fn gradient_along(
         &self,
         p: &[f64],
@@ -263,7 +262,8 @@ impl ForceModel for ModelSum {
         for (i, part) in self.parts.iter().enumerate() {
             let (start, end) = (self.param_offsets[i], self.param_offsets[i + 1]);
             let own = &mut grad[start * n..end * n];
-            let given = part.gradient_along(&p[start..end], track, a, rows, own)?;
+            let given = self.states(i).is_empty()
+                && part.gradient_along(&p[start..end], track, a, rows, own)?;
             if !given {
                 own.fill(f64::NAN);
             }

@@ -13,7 +13,6 @@
 //! added masses and forces add in the parts' order, so the results are the same to the bit.
 
 use crate::physics::force_model::{ForceModel, ModelError, ModelState};
-use crate::physics::sensitivity;
 
 /// The kinematics a model is evaluated along: time (s), displacement (m) and velocity (m/s)
 /// at every sample, of equal lengths, time strictly increasing.
@@ -141,8 +140,7 @@ fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
 /// (`m_a·a + f`) at the `k`-th of `rows` (`None`: every sample), with acceleration `a[i]` at
 /// sample `i`, written column by column to `grad` (parameter `j`'s entry at `k` in
 /// `grad[j·n + k]`, `n` results); `Ok(false)` as soon as `m` gives no gradient at a sample.
-/// A model with internal state integrates its state's sensitivities along the record
-/// ([`sensitivity::gradient_along`]).
+/// The model's internal state is taken as zero (only models without state give one).
 pub fn gradient_along<M: ForceModel + ?Sized>(
     m: &M,
     p: &[f64],
@@ -151,14 +149,12 @@ pub fn gradient_along<M: ForceModel + ?Sized>(
     rows: Option<&[usize]>,
     grad: &mut [f64],
 ) -> Result<bool, ModelError> {
-    if m.n_internal() > 0 {
-        return sensitivity::gradient_along(m, p, track, a, rows, grad);
-    }
     let n = track.len_at(rows);
+    let zeros = vec![0.0; m.n_internal()];
     let mut g = vec![0.0; m.params().len()];
     for k in 0..n {
         let i = rows.map_or(k, |r| r[k]);
-        if !m.gradient(p, &track.state(i, &[]), a[i], &mut g)? {
+        if !m.gradient(p, &track.state(i, &zeros), a[i], &mut g)? {
             return Ok(false);
         }
         for (j, gj) in g.iter().enumerate() {
