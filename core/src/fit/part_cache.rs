@@ -12,8 +12,10 @@
 //! residuals are the same to the bit, so the fit takes the same steps and ends at the same
 //! point.
 //!
-//! Only a sum of single terms is cached (a part that is itself a sum adds its own parts one
-//! by one, and their total added at once would round differently).
+//! Only a sum of single terms is cached: a part of one term (a model, or a sum of one model,
+//! as a base named alone is) adds its force once a sample, while a part that is a sum of
+//! several adds its own parts one by one, and their total added at once would round
+//! differently.
 
 use std::collections::VecDeque;
 use std::ops::Range;
@@ -45,7 +47,7 @@ impl PartCache {
     /// internal state among them (the parts whose columns are differenced); `None` otherwise.
     pub(super) fn of(model: &dyn ForceModel) -> Option<Self> {
         let summands = model.summands()?;
-        let single = |p: &Arc<dyn ForceModel>| p.summands().is_none() && p.terms().len() == 1;
+        let single = |p: &Arc<dyn ForceModel>| p.terms().len() == 1;
         if summands.len() < 2 || model.n_internal() == 0 || !summands.iter().all(single) {
             return None;
         }
@@ -180,10 +182,13 @@ mod tests {
         ParamSpec::new(name, "", 1.0, -10.0, 10.0, "")
     }
 
+    /// Two parts with state around a memoryless law, itself a sum of one term (as a base
+    /// named alone is).
     fn sum() -> ModelSum {
+        let law: Arc<dyn ForceModel> = Arc::new(Law(vec![spec("c"), spec("n"), spec("m_a")]));
         ModelSum::new(vec![
             Arc::new(Relax("slow", vec![spec("c1"), spec("tau1")])),
-            Arc::new(Law(vec![spec("c"), spec("n"), spec("m_a")])),
+            Arc::new(ModelSum::new(vec![law]).unwrap()),
             Arc::new(Relax("fast", vec![spec("c2"), spec("tau2")])),
         ])
         .unwrap()
@@ -264,6 +269,18 @@ mod tests {
         ])
         .unwrap();
         assert!(PartCache::of(&nested).is_none());
+        // A sum of one term as a part (a base named alone) adds once a sample: kept.
+        let one = ModelSum::new(vec![
+            Arc::new(
+                ModelSum::new(vec![
+                    Arc::new(Law(vec![spec("c"), spec("n"), spec("m_a")])) as Arc<dyn ForceModel>
+                ])
+                .unwrap(),
+            ) as Arc<dyn ForceModel>,
+            Arc::new(Relax("other", vec![spec("c3"), spec("tau3")])),
+        ])
+        .unwrap();
+        assert!(PartCache::of(&one).is_some());
         assert!(PartCache::of(&sum()).is_some());
     }
 }
