@@ -43,6 +43,7 @@ use super::filter_noise::{self, FilterNoise};
 use super::fit_param::{full_values, held, FitParam};
 use super::noise_floor::Quantity;
 use super::objective::Residuals;
+use super::part_cache::PartCache;
 use super::result::{FitProgress, FitResult};
 use super::solver::{FitSettings, Solver};
 use crate::data::force_data::ForceData;
@@ -185,6 +186,7 @@ impl ForceFit {
             all: &all,
             rows,
             span: self.filter_noise.map_or(1, |n| n.filter.window()),
+            parts: PartCache::of(self.model.as_ref()),
         };
         driver::run(&problem, &all, settings, observer, Quantity::Force)
     }
@@ -212,6 +214,7 @@ impl ForceFit {
             all: &all,
             rows,
             span: 1,
+            parts: None,
         };
         let mut out: Vec<f64> = (0..problem.len()).map(|k| data.f[problem.row(k)]).collect();
         problem
@@ -233,6 +236,9 @@ struct ForceResiduals<'a> {
     /// Samples over which the kinematics' noise is correlated: the derivative filter's
     /// window (1: v and a taken as exact).
     span: usize,
+    /// The parts' contributions kept between evaluations (a sum with state: its difference
+    /// columns evaluate only the part they change).
+    parts: Option<PartCache>,
 }
 
 impl ForceResiduals<'_> {
@@ -268,9 +274,16 @@ impl Residuals for ForceResiduals<'_> {
         let d = &self.data;
         let n = self.len();
         let (mut mass, mut force) = (vec![0.0; n], vec![0.0; n]);
-        self.model
-            .mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
-            .map_err(|e| e.to_string())?;
+        match &self.parts {
+            Some(parts) => {
+                parts.mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
+            }
+            None => {
+                self.model
+                    .mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
+            }
+        }
+        .map_err(|e| e.to_string())?;
         for k in 0..n {
             let i = self.row(k);
             sink(k, d.f[i] - (mass[k] * d.a[i] + force[k] + offset));

@@ -44,6 +44,7 @@ mod noise_floor;
 mod objective;
 mod observer;
 mod offset;
+mod part_cache;
 mod residual_jacobian;
 mod result;
 mod same_term;
