@@ -127,8 +127,11 @@ fn candidate_starts(
     let fit = ForceFit::new(model.clone());
     let mut doubled = defaults.clone();
     doubled[0] *= 2.0;
+    if data.check_increasing().is_err() {
+        return vec![defaults];
+    }
     // The model at the subset's samples only, one value a row of it.
-    let along = |values: &[f64]| fit.predict_rows(data, values, Some(subset));
+    let along = |values: &[f64]| fit.predict_checked_rows(data, values, Some(subset));
     let (Ok(f1), Ok(f2)) = (along(&defaults), along(&doubled)) else {
         return vec![defaults];
     };

@@ -207,6 +207,18 @@ impl ForceFit {
         rows: Option<&[usize]>,
     ) -> Result<Vec<f64>, FitError> {
         data.check_increasing()?;
+        self.predict_checked_rows(data, values, rows)
+    }
+
+    /// [`ForceFit::predict_rows`] on `data` that [`ForceData::check_increasing`] has passed:
+    /// a start grid predicts the same record at many points, and checking its 150 000 samples'
+    /// finiteness at each was 1.6 % of a force-level discovery.
+    pub(crate) fn predict_checked_rows(
+        &self,
+        data: &ForceData,
+        values: &[f64],
+        rows: Option<&[usize]>,
+    ) -> Result<Vec<f64>, FitError> {
         let all = held(&self.params(), values)?;
         let problem = ForceResiduals {
             model: self.model.as_ref(),
