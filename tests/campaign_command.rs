@@ -430,34 +430,64 @@ fn the_global_fit_recovers_the_law_and_beats_per_record_fits_on_the_held_out_rec
 /// a yield force F_y = 0.1 + 0.1·voltage N at voltages 0–3 V, fitted with `yield` and a
 /// `[global]` section whose `laws` line is `law`.
 fn yield_campaign(dir: &Path, law: &str) -> PathBuf {
+    let truth = YieldTruth {
+        voltages: &[0.0, 1.0, 2.0, 3.0],
+        f_y: &|v| 0.1 + 0.1 * v,
+        seed: 300,
+        rates: [0.3, 0.2],
+        level: "force",
+    };
+    yield_campaign_of(dir, law, &truth)
+}
+
+/// The records of a yield campaign: one per voltage, F_y a function of it, seeds from `seed`
+/// on, the sweep rates (rad/s², 3 → 9 rad/s) alternating from the first; the records fitted
+/// (and the `[global]` fit run) at `level`.
+struct YieldTruth<'a> {
+    voltages: &'a [f64],
+    f_y: &'a dyn Fn(f64) -> f64,
+    seed: u64,
+    rates: [f64; 2],
+    level: &'a str,
+}
+
+/// [`yield_campaign`] of `truth`: 20 s records at 100 Hz of the forced rig (F0 0.0462 kg·m).
+fn yield_campaign_of(dir: &Path, law: &str, truth: &YieldTruth) -> PathBuf {
     let mut records = String::new();
-    for v in 0..4 {
-        let alpha = if v % 2 == 0 { 0.3 } else { 0.2 };
-        let truth = format!(
+    for (i, &v) in truth.voltages.iter().enumerate() {
+        let alpha = truth.rates[i % 2];
+        let make = format!(
             "[system]\npreset = \"forced\"\nF0 = 0.0462\n\n[simulate]\n\
              sweep = {{ w0 = 3.0, alpha = {alpha}, t0 = 0.0, t1 = 20.0 }}\nrate = 100.0\n\
              noise = true\nseed = {}\n\n[[simulate.truth]]\nname = \"yield\"\n\
              params = {{ F_y = {} }}\n",
-            300 + v,
-            0.1 + 0.1 * v as f64
+            truth.seed + i as u64,
+            (truth.f_y)(v)
         );
-        let sim = dir.join(format!("r{v}.toml"));
-        std::fs::write(&sim, truth).unwrap();
+        let sim = dir.join(format!("r{i}.toml"));
+        std::fs::write(&sim, make).unwrap();
         let run = stf_lab()
             .arg("simulate")
             .arg(&sim)
             .arg("--out")
-            .arg(dir.join(format!("r{v}.csv")))
+            .arg(dir.join(format!("r{i}.csv")))
             .output()
             .unwrap();
         assert!(run.status.success(), "{}", stderr(&run));
         records.push_str(&format!(
-            "[[records]]\nfile = \"r{v}.csv\"\nvoltage = {v}.0\n\n"
+            "[[records]]\nfile = \"r{i}.csv\"\nvoltage = {v:?}\n\n"
         ));
     }
+    // At trajectory level the records' own oscillator is simulated: the rig as it was set.
+    let rig = match truth.level {
+        "trajectory" => {
+            "[system]\npreset = \"forced\"\nF0 = 0.0462\n\n[fit]\nlevel = \"trajectory\"\n\n"
+        }
+        _ => "",
+    };
     std::fs::write(
         dir.join("yield.toml"),
-        "[data]\nfile = \"r0.csv\"\n\n[[models]]\nname = \"yield\"\n",
+        format!("{rig}[data]\nfile = \"r0.csv\"\n\n[[models]]\nname = \"yield\"\n"),
     )
     .unwrap();
     let file = dir.join("campaign.toml");
@@ -471,6 +501,24 @@ fn yield_campaign(dir: &Path, law: &str) -> PathBuf {
     )
     .unwrap();
     file
+}
+
+/// Run the campaign `file` into `dir/out` and read its `global.json`.
+fn global_of(file: &Path, dir: &Path) -> serde_json::Value {
+    let out = dir.join("out");
+    let run = campaign(file, &out, &["--quiet"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    read_json(&out.join("global.json"))
+}
+
+/// Each of `truth`'s coefficients of `g` within 3 standard errors; their z, printed.
+fn within_3_se(g: &serde_json::Value, truth: &[(&str, f64)], case: &str) {
+    for &(name, want) in truth {
+        let (got, se) = global_param(g, name);
+        let z = (got - want) / se;
+        println!("{case}: {name} = {got} ± {se} (truth {want}), z {z:.2}");
+        assert!(z.abs() < 3.0, "{case}: {name} = {got} ± {se}, truth {want}");
+    }
 }
 
 #[test]
@@ -517,6 +565,63 @@ fn an_affine_global_law_with_an_offset_is_recovered_from_a_zero_condition_up() {
         "{md}"
     );
     assert!(out.join("figures/global_F_y_vs_voltage.png").is_file());
+}
+
+/// A power law with an offset, F_y = 0.1 + 0.1·V^1.5 N at V = 0, 0.5, 1, 1.5, 2, recovered
+/// at force level on two sets of records (two seeds each, the two sweep rates swapped
+/// between them), each coefficient within 3 standard errors.
+#[test]
+fn a_global_power_law_with_an_offset_is_recovered_on_records_with_the_rigs_sensors() {
+    let law = "laws = { F_y = { condition = \"voltage\", law = \"power\", reference = 1.0 } }";
+    for (seed, rates) in [(400, [0.3, 0.2]), (500, [0.2, 0.3])] {
+        let tmp = tempfile::tempdir().unwrap();
+        let truth = YieldTruth {
+            voltages: &[0.0, 0.5, 1.0, 1.5, 2.0],
+            f_y: &|v: f64| 0.1 + 0.1 * v.powf(1.5),
+            seed,
+            rates,
+            level: "force",
+        };
+        let g = global_of(&yield_campaign_of(tmp.path(), law, &truth), tmp.path());
+        assert_eq!(g["laws"][0]["law"], "power");
+        let case = format!("seeds from {seed}, sweeps {rates:?} rad/s²");
+        within_3_se(
+            &g,
+            &[("F_y_base", 0.1), ("F_y_gain", 0.1), ("F_y_exp", 1.5)],
+            &case,
+        );
+    }
+}
+
+/// An affine `[global]` law at trajectory level: the records fitted from x alone (their
+/// oscillator simulated), F_y = 0.1 + 0.1·V N at V = 0–3 on two seeds' records at two sweep
+/// rates, each coefficient within 3 standard errors.
+#[test]
+fn an_affine_global_law_is_recovered_at_trajectory_level() {
+    let law = "laws = { F_y = { condition = \"voltage\", law = \"affine\" } }";
+    let tmp = tempfile::tempdir().unwrap();
+    let truth = YieldTruth {
+        voltages: &[0.0, 1.0, 2.0, 3.0],
+        f_y: &|v| 0.1 + 0.1 * v,
+        seed: 600,
+        rates: [0.3, 0.2],
+        level: "trajectory",
+    };
+    let g = global_of(&yield_campaign_of(tmp.path(), law, &truth), tmp.path());
+    assert_eq!(
+        (g["level"].as_str(), g["laws"][0]["law"].as_str()),
+        (Some("trajectory"), Some("affine"))
+    );
+    within_3_se(
+        &g,
+        &[("F_y_base", 0.1), ("F_y_gain", 0.1)],
+        "trajectory level",
+    );
+    let rms = g["global"]["rms"].as_f64().unwrap();
+    assert!(
+        rms < 0.07,
+        "global RMS {rms} mm: near the x noise (0.05 mm)"
+    );
 }
 
 /// The parameter `name` of global.json's θ: value and standard error.

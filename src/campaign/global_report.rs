@@ -179,15 +179,44 @@ fn formula(law: &LawJson, shown: impl Fn(&str, f64, f64) -> String) -> String {
     format!("{} = {rhs}", law.param)
 }
 
-/// The fitted law's value at condition `c`.
-fn law_at(law: &LawJson, c: f64) -> f64 {
+/// The fitted law's value at condition `c`: a law with a form clamped into the parameter's
+/// bounds, as the fit clamps it; and whether it was.
+fn law_at(law: &LawJson, c: f64) -> (f64, bool) {
     let (form, k) = coefficients(law);
     let values: Vec<f64> = k.iter().map(|(_, v, _)| *v).collect();
     let x = c / law.reference;
     match form {
-        None => values[0] * x.powf(values[1]),
-        Some(form) => form.value(&values, x),
+        None => (values[0] * x.powf(values[1]), false),
+        Some(form) => {
+            let v = form.value(&values, x);
+            let (lo, hi) = (
+                law.min.unwrap_or(f64::NEG_INFINITY),
+                law.max.unwrap_or(f64::INFINITY),
+            );
+            let held = v.clamp(lo, hi);
+            (held, held != v)
+        }
     }
+}
+
+/// The curve's legend: the law's formula, and where its value was clamped into the
+/// parameter's bounds along the figure, which bound.
+fn curve_label(law: &LawJson, clamped: bool) -> String {
+    let text = format!("global law: {}", formula(law, |_, v, _| format!("{v:.4}")));
+    if !clamped {
+        return text;
+    }
+    let bound = |b: Option<f64>| b.map_or_else(|| "∞".to_string(), |v| format!("{v}"));
+    let unit = if law.unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {}", law.unit)
+    };
+    format!(
+        "{text}, clamped into [{}, {}]{unit} as in the fit",
+        bound(law.min),
+        bound(law.max)
+    )
 }
 
 /// The records' own values of `law.param` against its condition, with the law over them.
@@ -228,15 +257,16 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
     series.sort_by_key(|s| s.label == "held out");
     let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let points = (0..CURVE_POINTS)
+    let along: Vec<(f64, (f64, bool))> = (0..CURVE_POINTS)
         .map(|i| {
             let x = lo + (hi - lo) * i as f64 / (CURVE_POINTS - 1) as f64;
             (x, law_at(law, x))
         })
         .collect();
+    let clamped = along.iter().any(|(_, (_, held))| *held);
     let curve = Curve {
-        label: format!("global law: {}", formula(law, |_, v, _| format!("{v:.4}"))),
-        points,
+        label: curve_label(law, clamped),
+        points: along.into_iter().map(|(x, (y, _))| (x, y)).collect(),
     };
     let name = format!("global_{}_vs_{}", law.param, law.condition)
         .chars()
@@ -258,8 +288,57 @@ fn law_figure(g: &GlobalJson, law: &LawJson, dir: &Path) -> Result<FigureRef> {
         files,
         format!(
             "Each record's own fitted {} (± one standard error) against {}, and the law the \
-             global fit found (black).",
-            law.param, law.condition
+             global fit found (black){}.",
+            law.param,
+            law.condition,
+            if clamped {
+                ", held within the parameter's bounds where it leaves them, as in the fit"
+            } else {
+                ""
+            }
         ),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use stf_study::joint::LawCoefficient;
+
+    fn affine(base: f64, gain: f64) -> LawJson {
+        let k = |name: &str, value: f64| LawCoefficient {
+            name: name.into(),
+            value,
+            std_error: 0.01,
+            unit: "N".into(),
+        };
+        LawJson {
+            param: "F_y".into(),
+            condition: "voltage".into(),
+            reference: 1.0,
+            unit: "N".into(),
+            condition_unit: Some("V".into()),
+            coefficient: None,
+            coefficient_std_error: None,
+            exponent: None,
+            exponent_std_error: None,
+            law: Some("affine".into()),
+            coefficients: Some(vec![k("F_y_base", base), k("F_y_gain", gain)]),
+            min: Some(0.0),
+            max: Some(50.0),
+        }
+    }
+
+    #[test]
+    fn the_curve_is_clamped_into_the_bounds_as_the_fit_clamps_it_and_says_so() {
+        let law = affine(-1.0, 2.0);
+        assert_eq!(law_at(&law, 0.0), (0.0, true));
+        assert_eq!(law_at(&law, 1.0), (1.0, false));
+        let label = curve_label(&law, true);
+        assert!(
+            label.ends_with("clamped into [0, 50] N as in the fit"),
+            "{label}"
+        );
+        assert!(!curve_label(&affine(0.5, 2.0), false).contains("clamped"));
+    }
 }

@@ -58,6 +58,8 @@ pub enum Source {
         x: f64,
         /// Index of the law in `GlobalSpec::laws`.
         law: usize,
+        /// The parameter's (widest) bounds, which the law's value is clamped into.
+        bounds: (f64, f64),
     },
 }
 
@@ -72,14 +74,25 @@ impl Source {
                 ratio,
                 ..
             } => theta[coefficient] * ratio.powf(theta[exponent]),
-            Source::Form { form, first, x, .. } => form_value(form, theta, first, x),
+            Source::Form {
+                form,
+                first,
+                x,
+                bounds,
+                ..
+            } => form_value(form, theta, first, x, bounds),
         }
     }
 }
 
-/// The value of `form` at `x`, its coefficients θ's entries from `first` on.
-pub fn form_value(form: Form, theta: &[f64], first: usize, x: f64) -> f64 {
+/// The value of `form` at `x`, its coefficients θ's entries from `first` on, clamped into
+/// the parameter's `bounds` — as a record's own channel law clamps it
+/// ([`stf_core::physics::channel_law::ChannelLaw`]): the model never sees a value its
+/// parameter may not take.
+pub fn form_value(form: Form, theta: &[f64], first: usize, x: f64, bounds: (f64, f64)) -> f64 {
+    let (lo, hi) = bounds;
     form.value(&theta[first..first + form.coefficients().len()], x)
+        .clamp(lo, hi)
 }
 
 /// How a record's signal is predicted.
@@ -174,6 +187,16 @@ pub struct Layout {
     pub roles: Vec<&'static str>,
     /// Per training record, the sources of its values (model's parameters, then offset).
     pub sources: Vec<Vec<Source>>,
+}
+
+impl Layout {
+    /// The bounds the value of law `index` (a law with a form) is clamped into.
+    pub fn form_bounds(&self, index: usize) -> Option<(f64, f64)> {
+        self.sources.iter().flatten().find_map(|s| match *s {
+            Source::Form { law, bounds, .. } if law == index => Some(bounds),
+            _ => None,
+        })
+    }
 }
 
 /// The name of a law's exponent for parameter `p`.
@@ -337,6 +360,7 @@ impl Layout {
                 first,
                 x,
                 law: index,
+                bounds: (p.min, p.max),
             });
         }
     }

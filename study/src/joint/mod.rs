@@ -115,6 +115,13 @@ pub struct LawJson {
     /// A law with a form: its coefficients (`P_base`, `P_gain`, `P_exp`) with their errors.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coefficients: Option<Vec<LawCoefficient>>,
+    /// A law with a form: the parameter's lower bound, which its value is clamped to (absent
+    /// where unbounded), as in the fit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// Its upper bound, likewise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
 }
 
 /// A coefficient of a law with a form.
@@ -367,10 +374,14 @@ fn holdout_json(
                 theta[*coefficient] * ratio.powf(theta[*exponent])
             }
             Source::Form {
-                form, first, law, ..
+                form,
+                first,
+                law,
+                bounds,
+                ..
             } => {
                 let x = spec.laws[*law].ratio(held.joint.condition(&spec.laws[*law].condition));
-                global_fit::form_value(*form, &theta, *first, x)
+                global_fit::form_value(*form, &theta, *first, x, *bounds)
             }
             _ => own_state(held, k)
                 .unwrap_or_else(|| mean(layout.sources.iter().map(|s| s[k].value(&theta)))),
@@ -472,7 +483,7 @@ fn assemble(
             .map(|l| l.unit.record_given.clone())
             .collect(),
         params: theta_json(&result, layout),
-        laws: laws_json(spec, &result, units),
+        laws: laws_json(spec, &result, units, layout),
         global,
         per_record,
         delta_bic,
@@ -530,10 +541,16 @@ fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalPara
 }
 
 /// Each law's coefficients with their errors.
-fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJson> {
+fn laws_json(
+    spec: &GlobalSpec,
+    result: &FitResult,
+    units: &Units,
+    layout: &global_fit::Layout,
+) -> Vec<LawJson> {
     spec.laws
         .iter()
-        .filter_map(|l| {
+        .enumerate()
+        .filter_map(|(index, l)| {
             let unit = units.param(&l.param);
             let mut json = LawJson {
                 param: l.param.clone(),
@@ -546,6 +563,8 @@ fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJso
                 exponent_std_error: None,
                 law: None,
                 coefficients: None,
+                min: None,
+                max: None,
                 unit: unit.clone(),
             };
             let Some(form) = l.form else {
@@ -583,6 +602,10 @@ fn laws_json(spec: &GlobalSpec, result: &FitResult, units: &Units) -> Vec<LawJso
                 .collect::<Option<Vec<_>>>()?;
             json.law = Some(form.name().to_string());
             json.coefficients = Some(coefficients);
+            if let Some((lo, hi)) = layout.form_bounds(index) {
+                json.min = lo.is_finite().then_some(lo);
+                json.max = hi.is_finite().then_some(hi);
+            }
             Some(json)
         })
         .collect()
