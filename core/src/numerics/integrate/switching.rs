@@ -348,7 +348,8 @@ impl<'a> Run<'a> {
     fn watch_stiffness(&mut self, h_lambda: f64, t_prev: f64) -> Result<(), SimError> {
         self.explicit_accepted += 1;
         let mut stiff_now = false;
-        if self.explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
+        let reads_stiff = h_lambda > STIFF_H_LAMBDA;
+        if reads_stiff || self.explicit_accepted.is_multiple_of(JACOBIAN_CHECK_EVERY) {
             self.calls += self
                 .sys
                 .jacobian(self.t, &self.y, &self.f0, &mut self.jac)?;
@@ -356,7 +357,7 @@ impl<'a> Run<'a> {
             stiff_now = self.jacobian_stiff && rho_h > JACOBIAN_STIFF_RHO_H;
             self.jacobian_stiff = rho_h > JACOBIAN_STIFF_RHO_H;
         }
-        if h_lambda > STIFF_H_LAMBDA {
+        if reads_stiff {
             self.calm_count = 0;
             self.stiff_count += 1;
         } else {
