@@ -17,9 +17,9 @@
 
 /// `π/2` in parts: the first 33 bits, the next 33 bits, the rest (fdlibm's `pio2_1`, `pio2_2`,
 /// `pio2_2t`).
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17e0;
-const PIO2_2: f64 = 6.077_100_506_303_965_976_6e-11;
-const PIO2_2T: f64 = 2.022_266_248_795_950_631_54e-21;
+const PIO2_1: f64 = 1.5707963267341256;
+const PIO2_2: f64 = 6.077100506303966e-11;
+const PIO2_2T: f64 = 2.0222662487959506e-21;
 /// Below this magnitude `k < 2²⁰` and the reduction is exact but for one rounding.
 const REDUCTION_LIMIT: f64 = 1e5;
 
@@ -46,12 +46,12 @@ pub fn sin(x: f64) -> f64 {
 /// `sin r` for `|r| ≤ π/4` (fdlibm's `__kernel_sin` without the tail of `r`).
 #[inline(always)]
 fn kernel_sin(r: f64) -> f64 {
-    const S1: f64 = -1.666_666_666_666_663_243_48e-1;
-    const S2: f64 = 8.333_333_333_322_489_461_24e-3;
-    const S3: f64 = -1.984_126_982_985_794_931_34e-4;
-    const S4: f64 = 2.755_731_370_707_006_767_89e-6;
-    const S5: f64 = -2.505_076_025_340_686_341_95e-8;
-    const S6: f64 = 1.589_690_995_211_550_102_21e-10;
+    const S1: f64 = -0.16666666666666632;
+    const S2: f64 = 0.00833333333332249;
+    const S3: f64 = -0.0001984126982985795;
+    const S4: f64 = 2.7557313707070068e-06;
+    const S5: f64 = -2.5050760253406863e-08;
+    const S6: f64 = 1.58969099521155e-10;
     let z = r * r;
     let v = z * r;
     let p = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
@@ -61,12 +61,12 @@ fn kernel_sin(r: f64) -> f64 {
 /// `cos r` for `|r| ≤ π/4` (fdlibm's `__kernel_cos` without the tail of `r`).
 #[inline(always)]
 fn kernel_cos(r: f64) -> f64 {
-    const C1: f64 = 4.166_666_666_666_660_190_37e-2;
-    const C2: f64 = -1.388_888_888_887_410_957_49e-3;
-    const C3: f64 = 2.480_158_728_947_672_941_78e-5;
-    const C4: f64 = -2.755_731_435_139_066_330_35e-7;
-    const C5: f64 = 2.087_572_321_298_174_827_90e-9;
-    const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+    const C1: f64 = 0.0416666666666666;
+    const C2: f64 = -0.001388888888887411;
+    const C3: f64 = 2.480158728947673e-05;
+    const C4: f64 = -2.7557314351390663e-07;
+    const C5: f64 = 2.087572321298175e-09;
+    const C6: f64 = -1.1359647557788195e-11;
     let z = r * r;
     let p = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
     let hz = 0.5 * z;
