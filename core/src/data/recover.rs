@@ -8,6 +8,7 @@
 //! The velocity and acceleration come from the derivative filter; its noise passes straight
 //! into the recovered force (m·σ_a), which is why [`recovery_noise`] reports that floor.
 
+use crate::physics::excitation::Excitation;
 use crate::physics::oscillator_params::OscillatorParams;
 use crate::physics::resistance::bearing_resistance;
 
@@ -33,7 +34,7 @@ pub fn recover_force(
 pub fn rotor_drive(p: &OscillatorParams, phi: &[f64], omega: &[f64]) -> Vec<f64> {
     phi.iter()
         .zip(omega)
-        .map(|(&phi, &w)| p.f0 * w * w * (phi - p.phi_off).sin())
+        .map(|(&phi, &w)| Excitation::rotor_force(p, phi, w))
         .collect()
 }
 

@@ -6,6 +6,7 @@
 //! from the derivative filter. Rigs driven by a shaker use a measured force `u` (N) instead.
 
 use crate::numerics::interpolate::{Hermite, Linear};
+use crate::numerics::sine;
 use crate::physics::oscillator_params::OscillatorParams;
 
 /// How the rotor angle φ(t) is given.
@@ -186,13 +187,17 @@ impl Excitation {
         match self {
             Excitation::Rotor(angle) => {
                 let (phi, omega) = angle.at(t);
-                (
-                    p.f0 * omega * omega * (phi - p.phi_off).sin(),
-                    Some((phi, omega)),
-                )
+                (Self::rotor_force(p, phi, omega), Some((phi, omega)))
             }
             _ => (self.force(t, p), None),
         }
+    }
+
+    /// The rotor's force `F0·ω²·sin(φ − phi_off)`, N, at angle `phi` and speed `omega` (the
+    /// one formula of every rotor drive; the sine is [`sine::sin`]).
+    #[inline(always)]
+    pub fn rotor_force(p: &OscillatorParams, phi: f64, omega: f64) -> f64 {
+        p.f0 * omega * omega * sine::sin(phi - p.phi_off)
     }
 
     /// The first time after `t` at which the driving force stops being smooth (the next knot of

@@ -15,7 +15,7 @@ use crate::numerics::integrate::{OdeSystem, SimError};
 use crate::physics::excitation::Excitation;
 use crate::physics::force_model::{ForceModel, ModelError, ModelState};
 use crate::physics::oscillator_params::OscillatorParams;
-use crate::physics::resistance::{bearing_resistance, bearing_resistance_slope};
+use crate::physics::resistance::{bearing_resistance_parts, bearing_resistance_slope};
 use crate::physics::resolved_model::ResolvedModel;
 
 /// The forces acting at one instant.
@@ -128,7 +128,7 @@ impl Oscillator {
     ) -> Result<Forces, SimError> {
         let (x, v) = (y[0], y[1]);
         let p = &self.params;
-        let f_r = bearing_resistance(p, v);
+        let (viscous, dry, smooth_speed) = bearing_resistance_parts(p, v);
         let (m_a, f) = match &self.resolved {
             None => (0.0, 0.0),
             Some(model) => {
@@ -148,7 +148,12 @@ impl Oscillator {
         if !(mass > 0.0) {
             return Err(SimError::NonPositiveMass { time: t, mass });
         }
-        let a = (drive - p.f_off - p.k * x - f_r - f) / mass;
+        // 1/mass and everything but the friction's last division are ready before the square
+        // root of the velocity is: the acceleration waits for that root, one division, one
+        // product and one subtraction.
+        let inv_mass = 1.0 / mass;
+        let a =
+            (drive - p.f_off - p.k * x - viscous - f) * inv_mass - (dry * inv_mass) / smooth_speed;
         if !a.is_finite() {
             return Err(SimError::NonFinite {
                 time: t,
@@ -158,7 +163,7 @@ impl Oscillator {
         Ok(Forces {
             a,
             f_stf: m_a * a + f,
-            f_r,
+            f_r: viscous + dry / smooth_speed,
             drive,
         })
     }

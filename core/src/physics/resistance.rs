@@ -17,8 +17,19 @@ pub fn smoothing_velocity(p: &OscillatorParams) -> f64 {
 /// Bearing resistance F_R(v), N.
 #[inline]
 pub fn bearing_resistance(p: &OscillatorParams, v: f64) -> f64 {
+    let (viscous, dry, smooth_speed) = bearing_resistance_parts(p, v);
+    viscous + dry / smooth_speed
+}
+
+/// The parts of F_R(v) = `viscous + dry / smooth_speed`: `c·v`, `(T + ΔT/(1 + η|v|))·v` and
+/// `sqrt(v² + ε²)`, N, N·m/s and m/s. The right-hand side divides `dry` by the smoothed speed
+/// last, so that only the square root and that division follow the velocity in its chain of
+/// dependent operations (the rest runs beside them).
+#[inline(always)]
+pub fn bearing_resistance_parts(p: &OscillatorParams, v: f64) -> (f64, f64, f64) {
     let eps = smoothing_velocity(p);
-    p.c * v + (p.t_friction + p.delta_t / (1.0 + p.eta * v.abs())) * v / (v * v + eps * eps).sqrt()
+    let dry = (p.t_friction + p.delta_t / (1.0 + p.eta * v.abs())) * v;
+    (p.c * v, dry, (v * v + eps * eps).sqrt())
 }
 
 /// dF_R/dv, N·s/m (for implicit integrators and sensitivity estimates).

@@ -94,7 +94,7 @@ impl DriveColumns {
         let force = phi
             .iter()
             .zip(&omega)
-            .map(|(&phi, &w)| p.f0 * w * w * (phi - p.phi_off).sin())
+            .map(|(&phi, &w)| Excitation::rotor_force(p, phi, w))
             .collect();
         DriveColumns {
             force,

@@ -12,12 +12,18 @@
 //! distance and are accepted. The cap is lifted once it would be smaller than half the step
 //! that crossed the last reversal (the width of the smoothing band in time, learned from the
 //! run; before the first crossing nothing is capped), so the band itself is crossed in an
-//! error-controlled step. The cap only ever shortens a step: the error control decides as before.
+//! error-controlled step — of at most [`CROSSING_GROWTH`] times the last crossing step: the
+//! error controller, after the small steps of the approach, proposes a larger one, which the
+//! band rejects (error estimates near 10; 1 rejection a reversal on the paper's sweep). The
+//! margin above 1 lets the learned width grow again from one reversal to the next (at 1 it
+//! could only shrink). The cap only ever shortens a step: the error control decides as before.
 
 /// Fraction of the predicted time to the zero that the next step may cover.
 const APPROACH_FRACTION: f64 = 0.6;
-/// No cap below this fraction of the last step that crossed a zero.
+/// No cap below this fraction of the last step that crossed a zero ...
 const FLOOR_OF_CROSSING: f64 = 0.5;
+/// ... where the step is at most this multiple of that crossing step.
+const CROSSING_GROWTH: f64 = 1.1;
 
 /// What the integrator knows about the switching component `j` of the state.
 #[derive(Clone, Copy, Debug)]
@@ -49,7 +55,8 @@ impl Approach {
     }
 
     /// The next step size: `h_next` (the error controller's proposal), capped at the
-    /// approach fraction of the predicted time to the zero of component `j`. `(y, f)` is the
+    /// approach fraction of the predicted time to the zero of component `j`, or, that close to
+    /// the zero, at the crossing growth times the last crossing step. `(y, f)` is the
     /// state and its derivative at the new step start, `f_old_j` the derivative of component
     /// `j` one step (`h`) earlier (for its rate of change).
     pub(super) fn cap(&self, h_next: f64, y: &[f64], f: &[f64], f_old_j: f64, h: f64) -> f64 {
@@ -59,10 +66,10 @@ impl Approach {
         }
         let tau = time_to_zero(v, a, (a - f_old_j) / h);
         let capped = APPROACH_FRACTION * tau;
-        if h_next > capped && capped > FLOOR_OF_CROSSING * self.h_cross {
-            capped
+        if capped > FLOOR_OF_CROSSING * self.h_cross {
+            h_next.min(capped)
         } else {
-            h_next
+            h_next.min(CROSSING_GROWTH * self.h_cross)
         }
     }
 }
@@ -114,8 +121,10 @@ mod tests {
         assert_eq!(ap.cap(1e-4, &y, &f, -1.0, 1e-2), 1e-4);
         // Moving away from zero: no cap.
         assert_eq!(ap.cap(1.0, &y, &[1e-3, 1.0], 1.0, 1e-2), 1.0);
-        // Closer to the zero than the floor: the step may cross.
+        // Closer to the zero than the floor: the step may cross, at most a little longer than
+        // the last crossing step.
         let near = [0.0, 1e-6];
-        assert_eq!(ap.cap(1.0, &near, &f, -1.0, 1e-2), 1.0);
+        assert_eq!(ap.cap(1.0, &near, &f, -1.0, 1e-2), CROSSING_GROWTH * 1e-5);
+        assert_eq!(ap.cap(1e-6, &near, &f, -1.0, 1e-2), 1e-6);
     }
 }

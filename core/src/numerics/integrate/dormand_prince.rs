@@ -49,6 +49,9 @@ const D7: f64 = 69997945.0 / 29380423.0;
 pub(super) struct Trial {
     /// Scaled RMS error estimate (accept if ≤ 1); infinite if a stage was not finite.
     pub err: f64,
+    /// Its square, the mean of the squared scaled errors (infinite with it), from which the
+    /// step-size controller takes its root without waiting for the square root.
+    pub err_squared: f64,
     /// Stiffness indicator h·λ (0 if undefined).
     pub h_lambda: f64,
 }
@@ -144,14 +147,22 @@ impl DormandPrince {
             num += (k7[i] - k6[i]) * (k7[i] - k6[i]);
             den += (yn[i] - ys[i]) * (yn[i] - ys[i]);
         }
-        let err = (sum / n as f64).sqrt();
-        let err = if err.is_finite() { err } else { f64::INFINITY };
+        let err_squared = sum / n as f64;
+        let (err, err_squared) = if err_squared.is_finite() {
+            (err_squared.sqrt(), err_squared)
+        } else {
+            (f64::INFINITY, f64::INFINITY)
+        };
         let h_lambda = if den > 0.0 {
             h.abs() * (num / den).sqrt()
         } else {
             0.0
         };
-        Ok(Trial { err, h_lambda })
+        Ok(Trial {
+            err,
+            err_squared,
+            h_lambda,
+        })
     }
 
     /// Keep the dense output of the last trial step from `(y, f0)` (call when accepting it).
