@@ -236,8 +236,7 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
         .into_par_iter()
         .map(|((name, quantity, caption), measured, curves)| {
             let quantity = quantity.in_units(&data.units);
-            let fig =
-                measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
+            let fig = measured_vs_model(&dir, name, quantity, &data.record.t, &measured, &curves)?;
             Ok(FigureRef::new(fig, caption).zoomable())
         })
         .collect::<Result<Vec<_>>>()?;
