@@ -174,10 +174,31 @@ mod tests {
         use crate::physics::oscillator_params::OscillatorParams;
         use crate::simulate::Simulation;
 
+        /// `m_a = p[1]`, `f = p[0]·v + z` with `ż = p[0]·x − z`: smooth for either sign of v.
+        struct Lin(&'static str, Vec<ParamSpec>);
+        impl ForceModel for Lin {
+            fn name(&self) -> &str {
+                self.0
+            }
+            fn params(&self) -> &[ParamSpec] {
+                &self.1
+            }
+            fn n_internal(&self) -> usize {
+                1
+            }
+            fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
+                Ok(p[1])
+            }
+            fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+                dz[0] = p[0] * s.x - s.z[0];
+                Ok(p[0] * s.v + s.z[0])
+            }
+        }
         let spec = |n: &str, unit: &str| ParamSpec::new(n, unit, 0.5, 0.0, 10.0, "");
-        let a: Arc<dyn ForceModel> =
-            Arc::new(Part2("a", vec![spec("c", "N·s/m"), spec("m", "kg")], true));
-        let sum: Arc<dyn ForceModel> = Arc::new(ModelSum::new(vec![a, part("b", false)]).unwrap());
+        let lin = |name: &'static str| -> Arc<dyn ForceModel> {
+            Arc::new(Lin(name, vec![spec("c", "N·s/m"), spec("m", "kg")]))
+        };
+        let sum: Arc<dyn ForceModel> = Arc::new(ModelSum::new(vec![lin("a"), lin("b")]).unwrap());
         // A 95 kg axis pushed by 60 N: the added mass's bound is raised, so the sum is wrapped.
         let axis = DataScales {
             force: 60.0,
