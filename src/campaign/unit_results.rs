@@ -24,6 +24,8 @@ struct ModelFit {
     fixed: Vec<String>,
     rms: f64,
     rms_unit: String,
+    #[serde(default)]
+    param_units: BTreeMap<String, String>,
     aic: Option<f64>,
     bic: Option<f64>,
     n_free: usize,
@@ -142,7 +144,9 @@ pub fn read(command: CommandName, dir: &Path) -> Result<Vec<ModelResult>> {
             for m in &mut models {
                 for (name, p) in &mut m.params {
                     let key = (m.model.clone().unwrap_or_default(), name.clone());
-                    p.unit = units.get(&key).cloned();
+                    if let Some(unit) = units.get(&key) {
+                        p.unit = Some(unit.clone());
+                    }
                 }
             }
             Ok(models)
@@ -223,8 +227,12 @@ fn with_best_by_aic(models: Vec<ModelFit>) -> Vec<ModelResult> {
 }
 
 fn of_fit(m: ModelFit) -> ModelResult {
+    let mut values = params(&m.params, &m.std_errors, &m.fixed);
+    for (name, p) in &mut values {
+        p.unit = m.param_units.get(name).filter(|u| !u.is_empty()).cloned();
+    }
     ModelResult {
-        params: params(&m.params, &m.std_errors, &m.fixed),
+        params: values,
         model: Some(m.label),
         rms: Some(m.rms),
         rms_unit: Some(m.rms_unit),

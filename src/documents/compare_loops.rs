@@ -19,6 +19,8 @@ use crate::digits::{csv_number, csv_optional, fixed};
 use crate::report::Table;
 use crate::verdict::{not_tested, tested};
 use crate::writing::write_atomic;
+use stf_study::param_units::in_record_units;
+use stf_study::shown_units::ShownUnits;
 
 /// The on-fraction in words, for reports.
 pub const DUTY_EXPLAINED: &str = "On-fraction (duty): the share of each cycle in which the force is on, |F| above the on-threshold (3 σ of the force noise, at least 0.05 N), lone noise samples ignored and gaps under 5 % of the cycle bridged; 1 for a damper, small for spikes with zero force between them.";
@@ -53,8 +55,22 @@ pub fn boundary_lines(c: &Classification) -> Vec<String> {
     lines
 }
 
-/// Per-regime energy and loop metrics: measured, then each model (`labels` with `comparisons`).
-pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
+/// The units of the energy per cycle (a thousandth of force × x), of c_eq (force per
+/// velocity) and of the peak force on a record shown in `units`: mJ, N·s/m and N for the
+/// trolley; on a record in volts, the record's own (mN·V, N·s/V and N for x in volts).
+fn loop_units(units: &ShownUnits) -> (String, String, &'static str) {
+    let energy = if units.x_si == "m" && units.force_si == "N" {
+        "mJ".to_string()
+    } else {
+        format!("m{}", in_record_units("N·m", units))
+    };
+    (energy, in_record_units("N·s/m", units), units.force_si)
+}
+
+/// Per-regime energy and loop metrics: measured, then each model (`labels` with
+/// `comparisons`), in the record's units (`units`).
+pub fn energy_table(labels: &[&str], comparisons: &[Comparison], units: &ShownUnits) -> Table {
+    let (energy, c_eq, force) = loop_units(units);
     let cell = |c: &Comparison, r: Regime, model: bool| {
         c.per_regime.get(r).map_or("—".to_string(), |m| {
             let pick = |measured: f64, modelled: f64| if model { modelled } else { measured };
@@ -65,7 +81,7 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
                 "no phase".to_string()
             };
             format!(
-                "{} mJ · c_eq {} · {phase} · duty {} · {} N",
+                "{} {energy} · c_eq {} · {phase} · duty {} · {} {force}",
                 fixed(pick(m.measured_energy, m.model_energy) * 1e3, 2),
                 fixed(pick(m.measured_c_eq, m.model_c_eq), 1),
                 fixed(pick(m.measured_duty, m.model_duty), 2),
@@ -81,7 +97,13 @@ pub fn energy_table(labels: &[&str], comparisons: &[Comparison]) -> Table {
     let models = labels.iter().zip(comparisons).map(|(l, c)| row(l, c, true));
     let rows = measured.into_iter().chain(models).collect();
     let columns = ["source", "pre-resonance", "resonance", "post-resonance"];
-    Table::new("Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area), equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in N·s/m, the phase of the force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak force.", &columns).with_rows(rows)
+    let caption = format!(
+        "Per regime, the mean per cycle of: energy dissipated ∮F dx (the F–x loop's area) in \
+         {energy}, equivalent viscous damping c_eq = ∮F dx/(π·ω·X²) in {c_eq}, the phase of the \
+         force's fundamental against x (90°: a damper, 0°: a spring), on-fraction and peak \
+         force in {force}."
+    );
+    Table::new(caption, &columns).with_rows(rows)
 }
 
 /// One line per loop metric: the best model overall and in each regime, with the test.

@@ -77,11 +77,12 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
     let _ = writeln!(md, "# Model comparison: {}\n", exp.path.display());
     let _ = writeln!(
         md,
-        "Record `{}`: {} {}; noise floor σ = {:.4} N{}.\n",
+        "Record `{}`: {} {}; noise floor σ = {:.4} {}{}.\n",
         data.record.source,
         measured.labels.len(),
         data.words().cycles,
         measured.noise_sigma,
+        data.units.force_si,
         if measured.no_stf && data.words().regimes {
             "; the STF force is negligible everywhere (no regimes)"
         } else {
@@ -99,7 +100,7 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
     if let Some(z) = &c.zero_level {
         let _ = writeln!(md, "- {}", zero_level_line(z));
     }
-    errors_table(&mut md, c);
+    errors_table(&mut md, c, data.units.x);
     for r in Regime::ALL {
         if let Some(b) = c.ranking.best_in(r) {
             let _ = writeln!(md, "- best in {}: **{b}**", r.name().replace('_', "-"));
@@ -111,7 +112,8 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
             "- best over the regimes (mean of the per-regime errors): **{b}**"
         );
     }
-    let energy = crate::documents::compare_loops::energy_table(&c.labels(), &c.comparisons);
+    let energy =
+        crate::documents::compare_loops::energy_table(&c.labels(), &c.comparisons, &data.units);
     crate::documents::compare_loops::write_markdown(&mut md, &c.loop_rankings, &energy);
     misses_and_warnings(&mut md, c, true);
     md
@@ -146,7 +148,7 @@ fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
 }
 
 /// The table of relative force RMS error (duty error) per regime and the simulated peak.
-fn errors_table(md: &mut String, c: &Compared) {
+fn errors_table(md: &mut String, c: &Compared, x_unit: &str) {
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) per regime and its mean over the regimes, the \
@@ -155,7 +157,7 @@ fn errors_table(md: &mut String, c: &Compared) {
     );
     let _ = writeln!(
         md,
-        "| model | pre-resonance | resonance | post-resonance | mean over regimes | peak x (mm) at ω |"
+        "| model | pre-resonance | resonance | post-resonance | mean over regimes | peak x ({x_unit}) at ω |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     for ((f, cmp), p) in c.fits.iter().zip(&c.comparisons).zip(c.peaks()) {

@@ -77,6 +77,7 @@ pub fn swept_section(
         "frequency_response",
         &curves,
         changes,
+        data.units.x,
         out,
     )?))
 }

@@ -21,12 +21,13 @@ pub use stf_study::identify::StageOutcome;
 use stf_study::verdict::identify_verdict as verdict;
 pub use stf_study::verdict::system_line;
 
-fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
+fn stage_section(i: usize, s: &StageOutcome, units: &ShownUnits, dir: &Path) -> Result<Section> {
     let mut section = Section::new(format!("Stage {}: {}", i + 1, s.record));
     let caption = format!(
-        "Stage {} values (± standard error); S(μ) = {:.4} mm², {} evaluations, {}.",
+        "Stage {} values (± standard error); S(μ) = {:.4} {}, {} evaluations, {}.",
         i + 1,
         s.result.s_mm2.unwrap_or(f64::NAN),
+        units.x_squared,
         s.result.evaluations,
         if s.result.convergence.converged() {
             "converged"
@@ -52,7 +53,7 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
         let fig = measured_vs_model(
             dir,
             &format!("stage_{}", i + 1),
-            DISPLACEMENT_MM,
+            DISPLACEMENT_MM.in_units(units),
             &s.t,
             &milli(&s.x),
             &[("identified", &simulated)],
@@ -69,7 +70,7 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
             .zoomable(),
         );
     }
-    if let Some(fig) = stage_frequency_response(i, s, dir)? {
+    if let Some(fig) = stage_frequency_response(i, s, units.x, dir)? {
         section.figures.push(fig);
     }
     Ok(section)
@@ -77,7 +78,12 @@ fn stage_section(i: usize, s: &StageOutcome, dir: &Path) -> Result<Section> {
 
 /// A swept stage's frequency response: the local maxima of the measured displacement and of
 /// the oscillator simulated with the stage's values against the rotor speed.
-fn stage_frequency_response(i: usize, s: &StageOutcome, dir: &Path) -> Result<Option<FigureRef>> {
+fn stage_frequency_response(
+    i: usize,
+    s: &StageOutcome,
+    x_unit: &str,
+    dir: &Path,
+) -> Result<Option<FigureRef>> {
     let Some(omega) = s.omega.as_deref() else {
         return Ok(None);
     };
@@ -98,7 +104,8 @@ fn stage_frequency_response(i: usize, s: &StageOutcome, dir: &Path) -> Result<Op
         })
         .collect();
     let name = format!("frequency_response_stage_{}", i + 1);
-    let fig = frequency_response(dir, &name, &curves, [None, None], &Smoothing::default())?;
+    let smoothing = Smoothing::default();
+    let fig = frequency_response(dir, &name, &curves, [None, None], &smoothing, x_unit)?;
     Ok(Some(FigureRef::new(
         fig,
         format!(
@@ -123,7 +130,7 @@ pub fn write_identification_report(
     let sections = stages
         .iter()
         .enumerate()
-        .map(|(i, s)| stage_section(i, s, &dir))
+        .map(|(i, s)| stage_section(i, s, units, &dir))
         .collect::<Result<Vec<_>>>()?;
     write_report(
         &format!("Identification: {}", experiment.display()),

@@ -18,8 +18,8 @@ use super::window_placement::place_windows;
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use crate::report::{
-    milli, parity, regime_time_windows, regime_windows, FigureRef, ParityQuantity, RegimeWindow,
-    SampleGroup, Section, TimeRow, WindowSeries,
+    milli, parity, regime_time_windows, regime_windows, FigureRef, MotionLabels, ParityQuantity,
+    RegimeWindow, SampleGroup, Section, TimeRow, WindowSeries,
 };
 
 /// How many whole cycles a window shows.
@@ -126,11 +126,14 @@ impl Words {
 }
 
 /// The windows and the sentence saying why each sits where it does: by the regimes
-/// ([`place_windows`]), or [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch.
+/// ([`place_windows`]), or [`CYCLES_PER_WINDOW`] cycles from the middle of each stretch,
+/// named by the rotor's speed over them (`t`: none, a record without a rotor) or else by
+/// their time.
 fn windows_of(
     found: &[Stretch],
     cycles: &[Cycle],
     classified: Option<&Classification>,
+    (x_unit, t): (&str, Option<&[f64]>),
 ) -> (Vec<RegimeWindow>, Vec<String>) {
     let window = |name: String, first: usize, count: usize| RegimeWindow {
         name,
@@ -138,7 +141,7 @@ fn windows_of(
         end: cycles[first + count - 1].end,
     };
     if let Some(c) = classified {
-        let placed = place_windows(c, CYCLES_PER_WINDOW);
+        let placed = place_windows(c, CYCLES_PER_WINDOW, x_unit);
         let why = placed.iter().map(|p| format!("{}.", p.why)).collect();
         let windows = placed
             .into_iter()
@@ -152,7 +155,15 @@ fn windows_of(
             let n = CYCLES_PER_WINDOW.min(s.count);
             let first = s.first + (s.count - n) / 2;
             let (a, b) = (&cycles[first], &cycles[first + n - 1]);
-            let name = format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega);
+            let name = match t {
+                None => format!("{}, ω {:.2}–{:.2} rad/s", s.name, a.omega, b.omega),
+                Some(t) => format!(
+                    "{}, t {:.2}–{:.2} s",
+                    s.name,
+                    t[a.start],
+                    t[(b.end - 1).min(t.len() - 1)]
+                ),
+            };
             window(name, first, n)
         })
         .collect();
@@ -195,7 +206,15 @@ pub fn regime_section(
     let dir = out.join("figures");
     let k = &data.kinematics;
     let (x_mm, v_mm) = (milli(&k.x), milli(&k.v));
-    let (windows, why) = windows_of(&found, &cycles, classified.as_ref());
+    let rotor = k.phi.is_some() || k.omega.is_some();
+    let named_by = (data.units.x, (!rotor).then_some(k.t.as_slice()));
+    let (windows, why) = windows_of(&found, &cycles, classified.as_ref(), named_by);
+    let words = Words::of(labels.is_some(), rotor);
+    let motion = MotionLabels::of(&data.units);
+    let title = format!(
+        "A few {} of each {}: the STF force over time and against x, v, a",
+        words.cycles, words.group
+    );
     let series = WindowSeries {
         t: &k.t,
         x_mm: &x_mm,
@@ -203,9 +222,9 @@ pub fn regime_section(
         a: &k.a,
         f,
         models,
+        labels: motion,
+        title: &title,
     };
-    let rotor = k.phi.is_some() || k.omega.is_some();
-    let words = Words::of(labels.is_some(), rotor);
     let mut s = Section::new(words.title);
     if why.is_empty() {
         s.paragraphs.push(format!(
@@ -225,7 +244,7 @@ pub fn regime_section(
         simulated.iter().map(|(l, x)| (*l, milli(x))).collect();
     let rows = [
         TimeRow {
-            label: "x, mm",
+            label: motion.x_column,
             measured: &x_mm,
             models: simulated_mm
                 .iter()
@@ -233,7 +252,7 @@ pub fn regime_section(
                 .collect(),
         },
         TimeRow {
-            label: "v, mm/s",
+            label: motion.v_column,
             measured: &v_mm,
             models: Vec::new(),
         },
@@ -244,7 +263,11 @@ pub fn regime_section(
         },
     ];
     let name = format!("{}_over_time", words.figure);
-    let fig = regime_time_windows(&dir, &name, &k.t, &rows, &windows)?;
+    let title = format!(
+        "A few {} of each {} over time: measured and modelled",
+        words.cycles, words.group
+    );
+    let fig = regime_time_windows(&dir, &name, &title, &k.t, &rows, &windows)?;
     s.figures.push(FigureRef::new(
         fig,
         format!(
@@ -273,6 +296,7 @@ pub fn regime_section(
         let groups = groups_of(&found, &cycles);
         let quantity = ParityQuantity {
             label: "F_STF, N".into(),
+            group: words.group,
             noise_sigma: Some(stf_core::numerics::derivative::noise_estimate(f).sigma),
         };
         let fig = parity(&dir, "parity", &quantity, f, models, &groups)?;

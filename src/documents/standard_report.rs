@@ -44,12 +44,13 @@ fn record_section(data: &FitData, f: Option<&[f64]>, dir: &Path) -> Result<Secti
     let mut s = Section::new("The record");
     s.paragraphs.push(format!(
         "{} samples of {}; v and a from a polynomial filter of order {} over {} samples \
-         (acceleration noise ≈ {:.3} m/s²).",
+         (acceleration noise ≈ {:.3} {}).",
         data.record.len(),
         data.record.source,
         k.motion_filter.order(),
         k.motion_filter.window(),
-        k.sigma_a
+        k.sigma_a,
+        MotionLabels::of(&data.units).a_unit
     ));
     let motion = Motion {
         t: &k.t,
@@ -320,10 +321,12 @@ fn warning_rules(fits: &[ModelFit], (unit, scale): (&str, f64)) -> String {
 /// figure written as `figures/NAME.*`.
 /// `changes` are the record's changes of regime (pre-resonance → resonance, resonance →
 /// post-resonance), shaded with their uncertainty.
+/// The maxima are in `x_unit` (the record's: `mm`, or `mV` for x in volts).
 pub fn frequency_section(
     name: &str,
     curves: &[FrfCurve],
     changes: [Option<RegimeChange>; 2],
+    x_unit: &str,
     out: &Path,
 ) -> Result<Section> {
     let dir = out.join("figures");
@@ -336,7 +339,7 @@ pub fn frequency_section(
          the oscillator without STF is the dashed black line."
             .into(),
     );
-    let fig = frequency_response(&dir, name, curves, changes, &Smoothing::default())?;
+    let fig = frequency_response(&dir, name, curves, changes, &Smoothing::default(), x_unit)?;
     s.figures.push(FigureRef::new(
         fig,
         "Frequency response of the record and of the oscillator with each fitted model.",

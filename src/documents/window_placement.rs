@@ -76,14 +76,15 @@ fn largest(c: &Classification, keep: impl Fn(usize) -> bool) -> Option<usize> {
 }
 
 /// The windows of `per_window` cycles each, in the order pre-resonance,
-/// resonance (or amplitude peak), post-resonance; see the [module doc](self).
-pub fn place_windows(c: &Classification, per_window: usize) -> Vec<Placement> {
+/// resonance (or amplitude peak), post-resonance; see the [module doc](self). Amplitudes are
+/// said in `x_unit` (thousandths of the record's unit of x: `mm`, or `mV` for x in volts).
+pub fn place_windows(c: &Classification, per_window: usize, x_unit: &str) -> Vec<Placement> {
     let n = c.features.len().min(c.labels.len()).min(c.cycles.len());
     let Some(peak) = largest(c, |i| i < n) else {
         return Vec::new();
     };
     let omega = |i: usize| c.features[i].omega;
-    let mm = |i: usize| c.features[i].amplitude * 1e3;
+    let milli = |i: usize| c.features[i].amplitude * 1e3;
     let label = |i: usize| c.labels[i];
     let span = |(first, count): (usize, usize)| {
         format!(
@@ -116,19 +117,19 @@ pub fn place_windows(c: &Classification, per_window: usize) -> Vec<Placement> {
     match label(peak) {
         Regime::Resonance => {
             let why = format!(
-                "around the amplitude peak ({:.1} mm at ω {:.2} rad/s), where the force is on \
+                "around the amplitude peak ({:.1} {x_unit} at ω {:.2} rad/s), where the force is on \
                  for most of the cycle",
-                mm(peak),
+                milli(peak),
                 omega(peak)
             );
             out.push(placed("resonance", "amplitude peak", why, w));
         }
         Regime::PreResonance => {
             let why = format!(
-                "the largest amplitude ({:.1} mm at ω {:.2} rad/s), where the force stays \
+                "the largest amplitude ({:.1} {x_unit} at ω {:.2} rad/s), where the force stays \
                  negligible (its peak ≤ {:.2} N): no resonance by the force definition, and \
                  not pre-resonance either, since the motion is at its largest",
-                mm(peak),
+                milli(peak),
                 omega(peak),
                 c.negligible_level
             );
@@ -140,9 +141,9 @@ pub fn place_windows(c: &Classification, per_window: usize) -> Vec<Placement> {
         if let Some(r) = largest(c, |i| i < n && label(i) == Regime::Resonance) {
             let why = format!(
                 "around the largest amplitude among the cycles whose force is on for most of \
-                 the cycle ({:.1} mm at ω {:.2} rad/s; the record's peak, at ω {:.2} rad/s, is \
+                 the cycle ({:.1} {x_unit} at ω {:.2} rad/s; the record's peak, at ω {:.2} rad/s, is \
                  not resonance)",
-                mm(r),
+                milli(r),
                 omega(r),
                 omega(peak)
             );
@@ -230,7 +231,7 @@ mod tests {
     fn resonance_lasting_to_the_end_is_shown_at_the_amplitude_peak() {
         // No post-resonance: the resonance run is cycles 8..40, its middle at cycle 24.
         let labels: Vec<Regime> = (0..40).map(|i| if i < 8 { Pre } else { Res }).collect();
-        let w = place_windows(&peaked(&labels), 3);
+        let w = place_windows(&peaked(&labels), 3, "mm");
         let names: Vec<&str> = w.iter().map(|p| p.regime.as_str()).collect();
         assert_eq!(names, ["pre-resonance", "resonance"]);
         assert_eq!((w[1].first, w[1].count), (11, 3), "{w:?}");
@@ -253,7 +254,7 @@ mod tests {
                 _ => Post,
             })
             .collect();
-        let w = place_windows(&peaked(&labels), 3);
+        let w = place_windows(&peaked(&labels), 3, "mm");
         let names: Vec<&str> = w.iter().map(|p| p.regime.as_str()).collect();
         assert_eq!(
             names,
@@ -282,8 +283,8 @@ mod tests {
 
     #[test]
     fn a_short_record_gets_the_cycles_it_has() {
-        let w = place_windows(&peaked(&[Res, Res]), 3);
+        let w = place_windows(&peaked(&[Res, Res]), 3, "mm");
         assert_eq!((w[0].first, w[0].count), (0, 2));
-        assert!(place_windows(&peaked(&[]), 3).is_empty());
+        assert!(place_windows(&peaked(&[]), 3, "mm").is_empty());
     }
 }

@@ -65,6 +65,8 @@ struct PlottedCurve {
 }
 
 struct FrequencyResponsePlot {
+    /// The axis label of the maxima: `local maximum of x, mm` (or mV).
+    y_desc: String,
     curves: Vec<PlottedCurve>,
     /// Pre-resonance → resonance and resonance → post-resonance, where the record has them.
     changes: [Option<RegimeChange>; 2],
@@ -187,7 +189,7 @@ impl Draw for FrequencyResponsePlot {
         chart
             .configure_mesh()
             .x_desc("rotor speed ω, rad/s")
-            .y_desc("local maximum of x, mm")
+            .y_desc(self.y_desc.as_str())
             .x_label_formatter(&|v| tick_label(*v, ws))
             .y_label_formatter(&|v| tick_label(*v, xs))
             .axis_desc_style(axis_desc_style())
@@ -213,13 +215,15 @@ impl Draw for FrequencyResponsePlot {
 /// Draw the local maxima of x against ω for each curve, with each curve's smoothed trend
 /// (outliers replaced by the mean of their neighbours, then a moving average, per
 /// `smoothing`), to `out_dir/name.{svg,png,csv}`. The CSV has three columns per curve: ω, the
-/// maxima and the trend, as plotted.
+/// maxima and the trend, as plotted, in `x_unit` (`mm`, or `mV` for a record in volts: the
+/// maxima are drawn in thousandths of the record's unit either way).
 pub fn frequency_response(
     out_dir: &Path,
     name: &str,
     curves: &[FrfCurve],
     changes: [Option<RegimeChange>; 2],
     smoothing: &Smoothing,
+    x_unit: &str,
 ) -> Result<FigureFiles, ReportError> {
     let mut plotted = Vec::with_capacity(curves.len());
     for c in curves {
@@ -255,14 +259,15 @@ pub fn frequency_response(
             [
                 Column::new(format!("{}: ω, rad/s", c.label), c.omega.clone()),
                 Column::new(
-                    format!("{}: local maximum of x, mm", c.label),
+                    format!("{}: local maximum of x, {x_unit}", c.label),
                     c.x_peak.clone(),
                 ),
-                Column::new(format!("{}: trend, mm", c.label), c.trend.clone()),
+                Column::new(format!("{}: trend, {x_unit}", c.label), c.trend.clone()),
             ]
         })
         .collect();
     let plot = FrequencyResponsePlot {
+        y_desc: format!("local maximum of x, {x_unit}"),
         curves: plotted,
         changes,
     };
@@ -313,7 +318,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let smoothing = Smoothing::default();
         let curves = [measured.clone(), without.clone(), with];
-        let files = frequency_response(dir.path(), "frf", &curves, changes, &smoothing).unwrap();
+        let files =
+            frequency_response(dir.path(), "frf", &curves, changes, &smoothing, "mm").unwrap();
         let cols = assert_rendered(&files, SIZE_WIDE);
         assert_eq!(cols.len(), 9);
         // One legend entry per curve (its trend and its maxima share it), regimes named.
@@ -349,8 +355,15 @@ mod tests {
     #[test]
     fn no_curve_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
-        let err = frequency_response(dir.path(), "f", &[], [None, None], &Smoothing::default())
-            .unwrap_err();
+        let err = frequency_response(
+            dir.path(),
+            "f",
+            &[],
+            [None, None],
+            &Smoothing::default(),
+            "mm",
+        )
+        .unwrap_err();
         assert!(matches!(err, ReportError::NoData { .. }), "{err}");
     }
 }

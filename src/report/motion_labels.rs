@@ -20,6 +20,12 @@ pub struct MotionLabels {
     pub v_column: &'static str,
     /// CSV column of a.
     pub a_column: &'static str,
+    /// Unit of x as shown: `mm` or `mV`.
+    pub x_unit: &'static str,
+    /// Unit of v as shown: `mm/s` or `mV/s`.
+    pub v_unit: &'static str,
+    /// Unit of a as shown: `m/s²` or `V/s²`.
+    pub a_unit: &'static str,
 }
 
 impl MotionLabels {
@@ -31,6 +37,9 @@ impl MotionLabels {
         x_column: "x, mm",
         v_column: "v, mm/s",
         a_column: "a, m/s²",
+        x_unit: "mm",
+        v_unit: "mm/s",
+        a_unit: "m/s²",
     };
 
     /// A record whose x is a voltage.
@@ -41,6 +50,9 @@ impl MotionLabels {
         x_column: "x, mV",
         v_column: "v, mV/s",
         a_column: "a, V/s²",
+        x_unit: "mV",
+        v_unit: "mV/s",
+        a_unit: "V/s²",
     };
 
     /// The labels of a record shown in `units`.

@@ -38,6 +38,9 @@ pub struct ParityQuantity {
     pub label: String,
     /// The noise floor σ, drawn as the normal curve under the histograms.
     pub noise_sigma: Option<f64>,
+    /// What a group of samples is, for the title: `regime`, or `third of the record` for a
+    /// record without regimes.
+    pub group: &'static str,
 }
 
 const BINS: usize = 40;
@@ -220,8 +223,11 @@ impl ParityPlot<'_> {
 
 impl Draw for ParityPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let title = "Measured against fitted, and the residual's distribution, by regime";
-        let root = legend_strip(&titled(root, title)?, &self.legend_entries())?;
+        let title = format!(
+            "Measured against fitted, and the residual's distribution, by {}",
+            self.quantity.group
+        );
+        let root = legend_strip(&titled(root, &title)?, &self.legend_entries())?;
         let cells = root.split_evenly((2, self.groups.len()));
         let n = self.groups.len();
         for (k, group) in self.groups.iter().enumerate() {
@@ -390,6 +396,7 @@ mod tests {
         ];
         let quantity = ParityQuantity {
             label: "F_STF, N".into(),
+            group: "regime",
             noise_sigma: Some(0.0015),
         };
         let dir = tempfile::tempdir().unwrap();
@@ -426,6 +433,7 @@ mod tests {
         ];
         let quantity = ParityQuantity {
             label: "F_STF, N".into(),
+            group: "regime",
             noise_sigma: Some(0.0015),
         };
         let dir = tempfile::tempdir().unwrap();

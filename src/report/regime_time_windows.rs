@@ -31,6 +31,7 @@ pub struct TimeRow<'a> {
 }
 
 struct TimePlot<'a> {
+    title: &'a str,
     t: &'a [f64],
     rows: &'a [TimeRow<'a>],
     /// Every model label, in colour order.
@@ -75,7 +76,7 @@ impl TimePlot<'_> {
 
 impl Draw for TimePlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let title = "A few cycles of each regime over time: measured and modelled";
+        let title = self.title;
         let measured = ("measured".to_string(), Swatch::Line(MEASURED_LINE, 2));
         let models = self
             .labels
@@ -98,10 +99,12 @@ impl Draw for TimePlot<'_> {
 
 /// Draw each window of `rows` over time `t` (a column per window, a row per quantity, every
 /// model over the measured series) to `out_dir/name.{svg,png,csv}`. The CSV holds the
-/// window's number with the samples drawn.
+/// window's number with the samples drawn. `title` says what the windows are in words that
+/// fit the rig (a rotor's regimes, or thirds of a record).
 pub fn regime_time_windows(
     out_dir: &Path,
     name: &str,
+    title: &str,
     t: &[f64],
     rows: &[TimeRow],
     windows: &[RegimeWindow],
@@ -131,6 +134,7 @@ pub fn regime_time_windows(
         }
     }
     let plot = TimePlot {
+        title,
         t,
         rows,
         labels,
@@ -185,7 +189,8 @@ mod tests {
             },
         ];
         let dir = tempfile::tempdir().unwrap();
-        let files = regime_time_windows(dir.path(), "w", &s.t, &rows, &windows).unwrap();
+        let files =
+            regime_time_windows(dir.path(), "w", "A few cycles", &s.t, &rows, &windows).unwrap();
         let cols = assert_rendered(&files, (TWO_COLUMNS, 1000));
         let t = column(&cols, "t, s");
         assert_eq!(t.len(), 900);
@@ -210,6 +215,6 @@ mod tests {
             models: Vec::new(),
         }];
         let dir = tempfile::tempdir().unwrap();
-        assert!(regime_time_windows(dir.path(), "w", &s.t, &rows, &[]).is_err());
+        assert!(regime_time_windows(dir.path(), "w", "A few cycles", &s.t, &rows, &[]).is_err());
     }
 }

@@ -16,6 +16,7 @@ use super::figure::{
     same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL,
     MEASURED_LINE, MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
 };
+use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
 use super::ReportError;
@@ -32,7 +33,8 @@ pub struct RegimeWindow {
 }
 
 /// The series the windows are cut from, all of one length: motion in the units people read
-/// (x in mm, v in mm/s, a in m/s²), the measured STF force and each model's (N).
+/// (x in mm, v in mm/s, a in m/s²; mV, mV/s and V/s² for x in volts: `labels`), the measured
+/// STF force and each model's (N).
 #[derive(Clone, Copy, Debug)]
 pub struct WindowSeries<'a> {
     /// Time, s.
@@ -47,6 +49,10 @@ pub struct WindowSeries<'a> {
     pub f: &'a [f64],
     /// Each model's fitted force, N: `(label, force)`.
     pub models: &'a [(&'a str, &'a [f64])],
+    /// The axis labels and CSV columns of x, v and a, in the record's units.
+    pub labels: MotionLabels,
+    /// The figure's title, in words that fit the rig (a rotor's regimes, or thirds of a record).
+    pub title: &'a str,
 }
 
 /// The most samples a window keeps (its series decimated together, every extreme kept).
@@ -189,14 +195,13 @@ impl WindowsPlot<'_> {
 
 impl Draw for WindowsPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let title = "A few cycles of each regime: the STF force over time and against x, v, a";
-        let root = legend_strip(&titled(root, title)?, &self.legend_entries())?;
         let s = &self.series;
+        let root = legend_strip(&titled(root, s.title)?, &self.legend_entries())?;
         let rows: [(&str, &[f64]); 4] = [
             ("time t, s", s.t),
-            ("displacement x, mm", s.x_mm),
-            ("velocity v, mm/s", s.v_mm),
-            ("acceleration a, m/s²", s.a),
+            (s.labels.x, s.x_mm),
+            (s.labels.v, s.v_mm),
+            (s.labels.a, s.a),
         ];
         let cells = root.split_evenly((rows.len(), self.windows.len()));
         for (k, cell) in cells.iter().enumerate() {
@@ -227,9 +232,9 @@ pub fn regime_windows(
     ];
     named.extend(s.models.iter().map(|(label, m)| (label.to_string(), *m)));
     let mut cut = cut_windows("regime windows", s.t, &named, windows, 4)?;
-    cut.push_column("x, mm", s.x_mm);
-    cut.push_column("v, mm/s", s.v_mm);
-    cut.push_column("a, m/s²", s.a);
+    cut.push_column(s.labels.x_column, s.x_mm);
+    cut.push_column(s.labels.v_column, s.v_mm);
+    cut.push_column(s.labels.a_column, s.a);
     cut.push_column("F_STF measured, N", s.f);
     for (label, m) in s.models {
         cut.push_column(format!("F_STF {label}, N"), m);
@@ -260,6 +265,8 @@ mod tests {
             a: &s.a,
             f: &s.f,
             models: &models,
+            labels: MotionLabels::LENGTH,
+            title: "A few cycles of each regime",
         };
         let windows = [
             RegimeWindow {
@@ -306,6 +313,8 @@ mod tests {
             a: &s.a,
             f: &s.f,
             models: &models,
+            labels: MotionLabels::LENGTH,
+            title: "A few cycles of each regime",
         };
         let windows: Vec<RegimeWindow> = [(0, 500), (1_000, 1_500), (2_000, 2_750)]
             .iter()
@@ -346,6 +355,8 @@ mod tests {
             a: &s.a,
             f: &f,
             models: &models,
+            labels: MotionLabels::LENGTH,
+            title: "A few cycles of each regime",
         };
         let windows = [RegimeWindow {
             name: "all".into(),

@@ -16,6 +16,7 @@ use anyhow::Result;
 use stf_core::regimes::{Comparison, Regime, RegimeMetrics};
 use stf_study::compare::{response, simulated_response, CompareResult, Compared};
 use stf_study::rig_words::RigWords;
+use stf_study::shown_units::ShownUnits;
 
 use crate::documents::compare_markdown::{compare_markdown, duty_meaning};
 use crate::documents::frequency_figure::{frf_curve, regime_changes};
@@ -161,6 +162,7 @@ fn write_compare_report(
             "frequency_response",
             &curves,
             changes,
+            data.units.x,
             out,
         )?),
         None => None,
@@ -175,7 +177,7 @@ fn write_compare_report(
     let results =
         crate::documents::results_table::results_section("Results", &equations, &rows, &fits);
     let models = if data.words().regimes {
-        regimes_section(c, md, out)?
+        regimes_section(c, md, &data.units, out)?
     } else {
         whole_record_section(c, md)
     };
@@ -212,7 +214,7 @@ fn write_compare_report(
 
 /// The report's "Models regime by regime": compare.md's bullets, the error and energy
 /// tables and the error of each model in each regime as bars.
-fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
+fn regimes_section(c: &Compared, md: &str, units: &ShownUnits, out: &Path) -> Result<Section> {
     let mut regimes = Section::new("Models regime by regime");
     regimes.paragraphs = md
         .lines()
@@ -231,6 +233,7 @@ fn regimes_section(c: &Compared, md: &str, out: &Path) -> Result<Section> {
         .push(crate::documents::compare_loops::energy_table(
             &c.labels(),
             &c.comparisons,
+            units,
         ));
     let mut bars = per_regime(c, |m| m.map_or(f64::NAN, |m| m.relative_rms_error));
     for (label, values) in &mut bars {

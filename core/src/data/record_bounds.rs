@@ -108,7 +108,9 @@ pub fn widened(model: Arc<dyn ForceModel>, scales: &DataScales) -> Arc<dyn Force
     })
 }
 
-/// A model with other parameter bounds; everything else is the inner model's.
+/// A model with other parameter bounds; everything else is the inner model's, its parts as
+/// a sum included (an integration resolves a widened sum into its parts as it does the sum:
+/// the bounds matter to a fit, never to the force).
 pub struct Widened {
     inner: Arc<dyn ForceModel>,
     specs: Vec<ParamSpec>,
@@ -123,6 +125,9 @@ impl ForceModel for Widened {
     }
     fn terms(&self) -> Vec<&str> {
         self.inner.terms()
+    }
+    fn summands(&self) -> Option<&[Arc<dyn ForceModel>]> {
+        self.inner.summands()
     }
     fn params(&self) -> &[ParamSpec] {
         &self.specs

@@ -68,7 +68,8 @@ pub trait ForceModel: Send + Sync {
     /// The models this one adds up, when it is a sum
     /// ([`crate::physics::model_sum::ModelSum`]), in order: an integration calls them one by
     /// one ([`crate::physics::resolved_model`]) rather than through the sum. `None` (the
-    /// default) for any other model, a wrapper included.
+    /// default) for any other model; a wrapper that changes only bounds (a sum widened to a
+    /// record's scale) forwards its inner model's, one that changes the force does not.
     fn summands(&self) -> Option<&[Arc<dyn ForceModel>]> {
         None
     }

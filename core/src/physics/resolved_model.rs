@@ -164,6 +164,84 @@ mod tests {
         assert_eq!(err.model, "c");
     }
 
+    /// A sum widened to a record's scale (other bounds, same force) resolves to the sum's
+    /// parts, and an oscillator simulated with it is the sum's to the bit.
+    #[test]
+    fn a_widened_sum_resolves_to_the_sum_s_parts_and_simulates_to_the_bit() {
+        use crate::data::record_bounds::{widened, DataScales};
+        use crate::physics::excitation::{Excitation, RotorAngle};
+        use crate::physics::oscillator::Oscillator;
+        use crate::physics::oscillator_params::OscillatorParams;
+        use crate::simulate::Simulation;
+
+        /// `m_a = p[1]`, `f = p[0]·v + z` with `ż = p[0]·x − z`: smooth for either sign of v.
+        struct Lin(&'static str, Vec<ParamSpec>);
+        impl ForceModel for Lin {
+            fn name(&self) -> &str {
+                self.0
+            }
+            fn params(&self) -> &[ParamSpec] {
+                &self.1
+            }
+            fn n_internal(&self) -> usize {
+                1
+            }
+            fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
+                Ok(p[1])
+            }
+            fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+                dz[0] = p[0] * s.x - s.z[0];
+                Ok(p[0] * s.v + s.z[0])
+            }
+        }
+        let spec = |n: &str, unit: &str| ParamSpec::new(n, unit, 0.5, 0.0, 10.0, "");
+        let lin = |name: &'static str| -> Arc<dyn ForceModel> {
+            Arc::new(Lin(name, vec![spec("c", "N·s/m"), spec("m", "kg")]))
+        };
+        let sum: Arc<dyn ForceModel> = Arc::new(ModelSum::new(vec![lin("a"), lin("b")]).unwrap());
+        // A 95 kg axis pushed by 60 N: the added mass's bound is raised, so the sum is wrapped.
+        let axis = DataScales {
+            force: 60.0,
+            x: 0.25,
+            v: 0.5,
+            a: 1.0,
+        };
+        let wide = widened(sum.clone(), &axis);
+        assert_ne!(wide.params(), sum.params(), "the bounds changed");
+        assert!(wide.summands().is_some(), "a widened sum is still a sum");
+        let (of_sum, of_wide) = (ResolvedModel::new(&sum), ResolvedModel::new(&wide));
+        let names = |r: &ResolvedModel| -> Vec<(String, Range<usize>, Range<usize>)> {
+            r.parts
+                .iter()
+                .map(|p| {
+                    (
+                        p.model.name().to_string(),
+                        p.params.clone(),
+                        p.states.clone(),
+                    )
+                })
+                .collect()
+        };
+        assert_eq!(names(&of_wide), names(&of_sum));
+        assert_eq!(of_wide.parts.len(), 2);
+        assert!(of_wide.sum);
+        let p = vec![0.4, 0.02, 0.7, 0.01];
+        let run = |model: &Arc<dyn ForceModel>| {
+            let osc = Oscillator::new(
+                OscillatorParams::FORCED,
+                Excitation::Rotor(RotorAngle::constant(6.0)),
+            )
+            .with_model(model.clone(), p.clone())
+            .unwrap();
+            Simulation::new(&osc).rate(200.0).run(0.0, 3.0).unwrap()
+        };
+        let (want, got) = (run(&sum), run(&wide));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        assert_eq!(bits(&got.x), bits(&want.x));
+        assert_eq!(bits(&got.f_stf), bits(&want.f_stf));
+        assert!(want.x.iter().any(|x| x.abs() > 1e-4), "the rig moved");
+    }
+
     #[test]
     fn a_lone_model_is_called_as_it_is() {
         let lone = part("a", true);

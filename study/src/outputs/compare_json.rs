@@ -11,6 +11,8 @@ use super::fit_json::ModelFitJson;
 use crate::compare::{BoundaryNote, CompareResult, Compared};
 use crate::experiment::Experiment;
 use crate::fitting::FitData;
+use crate::param_units::in_record_units;
+use crate::shown_units::ShownUnits;
 
 /// The whole of `compare.json`.
 #[derive(Serialize)]
@@ -33,6 +35,9 @@ pub struct CompareJson<'a> {
     pub best: Best<'a>,
     /// The per-cycle table beside this file.
     pub cycles_csv: &'static str,
+    /// The record's units of the values here and in `cycles.csv` (whose `_m`, `_j`, `_ns_m`
+    /// and `_n` columns hold them).
+    pub units: CompareUnits,
     /// The report's opening paragraph, written from `ranking` and `loop_rankings`.
     pub verdict: String,
 }
@@ -156,7 +161,40 @@ impl<'a> CompareJson<'a> {
                 overall: c.ranking.best_overall(),
             },
             cycles_csv: "cycles.csv",
+            units: CompareUnits::of(&data.units),
             verdict: crate::verdict::compare_verdict(c, data.words()),
+        }
+    }
+}
+
+/// The units a comparison's values are in: the record's own. On a record of the trolley x in
+/// m, forces in N, energies in J and c_eq in N·s/m; on a record whose x is a voltage kept in
+/// volts, x in V, energies in N·V and c_eq in N·s/V (forces in V too when the STF force is a
+/// voltage read with a gain of 1).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompareUnits {
+    /// Displacements (`peak_x_m`, `amplitude_m`).
+    pub x: &'static str,
+    /// Forces (noise floor, peak forces, force errors).
+    pub force: &'static str,
+    /// Energy per cycle ∮F dx (`energy_j`).
+    pub energy: String,
+    /// Equivalent viscous damping (`c_eq_ns_m`).
+    pub c_eq: String,
+}
+
+impl CompareUnits {
+    /// The units of a record shown in `units`.
+    pub fn of(units: &ShownUnits) -> CompareUnits {
+        let energy = match in_record_units("N·m", units).as_str() {
+            "N·m" => "J".to_string(),
+            other => other.to_string(),
+        };
+        CompareUnits {
+            x: units.x_si,
+            force: units.force_si,
+            energy,
+            c_eq: in_record_units("N·s/m", units),
         }
     }
 }

@@ -95,6 +95,9 @@ pub struct ModelFitJson<'a> {
     pub fixed: Vec<&'a str>,
     /// `N` (force level) or `m` (trajectory level; `V` for x in volts): the unit of `rms`.
     pub rms_unit: &'static str,
+    /// Each parameter's unit by name, as `params.csv` gives it (SI, with lengths and forces
+    /// in the record's own units: V on a record in volts).
+    pub param_units: BTreeMap<String, String>,
     /// Samples fitted.
     pub n_points: usize,
     /// Free parameters.
@@ -138,6 +141,10 @@ impl<'a> ModelFitJson<'a> {
                 .map(|p| p.name.as_str())
                 .collect(),
             rms_unit: data.si_unit(),
+            param_units: crate::param_table::rows_of_fits(std::slice::from_ref(fit), &data.units)
+                .into_iter()
+                .map(|row| (row.parameter, row.unit))
+                .collect(),
             n_points: r.n_points,
             n_free: r.n_free,
             failures: r.failures,

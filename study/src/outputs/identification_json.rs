@@ -25,6 +25,39 @@ pub struct IdentificationJson<'a> {
     pub models: [IdentifiedJson<'a>; 1],
     /// The report's opening paragraph, from `system` and each stage's S(μ) and floor.
     pub verdict: String,
+    /// The units of the values above on the stages' records.
+    pub units: IdentificationUnits,
+}
+
+/// The units of an identification's values, the records' own: x in m (or V for x in volts),
+/// S(μ) and its floor in mm² (or mV²), each parameter of `system` in its unit with lengths
+/// and forces in the records' units.
+#[derive(Serialize)]
+pub struct IdentificationUnits {
+    /// Displacements and the RMS residual (`rms`, `x0`).
+    pub x: &'static str,
+    /// S(μ) and its floor (`s_mm2`, `floor_mm2`).
+    pub s_mm2: &'static str,
+    /// Each oscillator parameter's unit, by name.
+    pub system: std::collections::BTreeMap<String, String>,
+}
+
+impl IdentificationUnits {
+    /// The units on records shown in `units`.
+    pub fn of(units: &crate::shown_units::ShownUnits) -> IdentificationUnits {
+        let system = OscParam::ALL
+            .into_iter()
+            .map(|p| {
+                let unit = crate::param_units::in_record_units(p.unit(), units);
+                (p.to_string(), unit)
+            })
+            .collect();
+        IdentificationUnits {
+            x: units.x_si,
+            s_mm2: units.x_squared,
+            system,
+        }
+    }
 }
 
 impl<'a> IdentificationJson<'a> {
@@ -66,6 +99,7 @@ impl<'a> IdentificationJson<'a> {
                 warnings,
             }],
             verdict: crate::verdict::identify_verdict(outcomes, &system, units),
+            units: IdentificationUnits::of(units),
         }
     }
 }
