@@ -55,6 +55,18 @@ const PIECE_CYCLES: usize = 6;
 /// Fewest pieces for a scout to stand for the record.
 const MIN_PIECES: usize = 3;
 
+/// Relative tolerance a candidate's search integrates the scout's pieces to, at the loosest
+/// (a user's looser `rtol` is kept; see [`Scout::searching`]).
+pub const SCOUT_RTOL: f64 = 1e-5;
+
+/// The scout's search tolerance (temporary override for measurement).
+fn scout_rtol() -> f64 {
+    std::env::var("STF_SCOUT_RTOL")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(SCOUT_RTOL)
+}
+
 /// Short pieces of a record, each a rig of its own, that stand in for it while a candidate's
 /// values are searched for.
 pub(super) struct Scout<'a> {
@@ -121,6 +133,32 @@ impl<'a> Scout<'a> {
     }
 }
 
+impl<'a> Scout<'a> {
+    /// This scout with its pieces integrated to relative tolerance `rtol`.
+    pub fn at(&self, rtol: f64) -> Scout<'a> {
+        let pieces = self
+            .pieces
+            .iter()
+            .map(|p| {
+                let mut piece = p.clone();
+                piece.sim.rtol = rtol;
+                piece
+            })
+            .collect();
+        Scout {
+            pieces,
+            train: self.train.clone(),
+            samples: self.samples,
+        }
+    }
+
+    /// The scout a candidate's search runs on: its pieces integrated to [`SCOUT_RTOL`], or
+    /// the record's own tolerance where that is looser.
+    pub fn searching(&self) -> Scout<'a> {
+        self.at(self.rtol().max(scout_rtol()))
+    }
+}
+
 impl Track for Scout<'_> {
     /// The pieces' residuals joined in order (the pieces simulated in parallel; the first
     /// piece's error in order, if any).
@@ -141,6 +179,15 @@ impl Track for Scout<'_> {
     }
     fn fixes_start(&self) -> bool {
         true
+    }
+    /// None: a scout fit only says where a fit on the whole record starts, and its standard
+    /// errors are never read.
+    fn precise_residual(
+        &self,
+        _: &Arc<dyn ForceModel>,
+        _: &[f64],
+    ) -> Option<Result<Vec<f64>, String>> {
+        None
     }
 }
 

@@ -145,7 +145,8 @@ impl<'a> TrajectoryLevel<'a> {
         let scouts = settings.scout_from > 0 && n >= settings.scout_from;
         let scout = scouts
             .then(|| Scout::new(&rig, cycles, &split.train))
-            .flatten();
+            .flatten()
+            .map(|s| s.searching());
         Ok(TrajectoryLevel {
             data,
             cycles,
@@ -215,7 +216,8 @@ impl Level for TrajectoryLevel<'_> {
             return start;
         };
         let lm = self.settings.levenberg_marquardt(None);
-        scouted(start, scout, (&self.rig, self.setup, &all), &lm).0
+        let scout = scout.at(self.rig.sim.rtol);
+        scouted(start, &scout, (&self.rig, self.setup, &all), &lm).0
     }
 
     fn fit(
