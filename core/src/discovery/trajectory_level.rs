@@ -98,6 +98,8 @@ pub(super) struct TrajectoryLevel<'a> {
     pub(super) osc_start: Vec<f64>,
     /// Whether the force-level screen may rank candidates.
     pub(super) screen: bool,
+    /// The scout of a long record, its pieces at the searches' tolerance
+    /// ([`Scout::searching`]).
     pub(super) scout: Option<Scout<'a>>,
     pub(super) settings: &'a DiscoverySettings,
 }
