@@ -67,7 +67,7 @@ fn fitted(dir: &Path, rtol: f64) -> serde_json::Value {
 fn error_bars_at_a_loose_tolerance_are_those_of_a_tight_one() {
     for (seed, chirp) in [(3, (10.0, 120.0, 0.02)), (4, (15.0, 110.0, 0.025))] {
         let dir = tempfile::tempdir().unwrap();
-        silverbox_record(dir.path(), "r.csv", 12_000, chirp, seed);
+        silverbox_record(dir.path(), "r.csv", 20_000, chirp, seed);
         let (loose, tight) = (fitted(dir.path(), 1e-5), fitted(dir.path(), 1e-9));
         for name in ["m", "k", "c", "k3"] {
             let (a, b) = (
