@@ -11,8 +11,8 @@
 use std::sync::Arc;
 
 use crate::fit::{
-    fit_residuals, full_values, FitError, FitParam, FitResult, FitSettings, Residuals,
-    INITIAL_STATE,
+    error_settings, fit_residuals, full_values, FitError, FitParam, FitResult, FitSettings,
+    Residuals, INITIAL_STATE,
 };
 use crate::numerics::integrate::{integrate, Settings};
 use crate::physics::excitation::Excitation;
@@ -47,6 +47,13 @@ pub(super) trait Track: Sync {
     fn rtol(&self) -> f64;
     /// Whether the initial state `x0`, `v0` has no effect (and must be held fixed).
     fn fixes_start(&self) -> bool;
+    /// [`Track::residual`] from simulations at the tolerances behind standard errors
+    /// ([`crate::fit::error_settings`]), or `None` when the track's are no looser.
+    fn precise_residual(
+        &self,
+        model: &Arc<dyn ForceModel>,
+        values: &[f64],
+    ) -> Option<Result<Vec<f64>, String>>;
 }
 
 impl Track for Rig<'_> {
@@ -67,6 +74,18 @@ impl Track for Rig<'_> {
     }
     fn fixes_start(&self) -> bool {
         self.fixed_start
+    }
+    fn precise_residual(
+        &self,
+        model: &Arc<dyn ForceModel>,
+        values: &[f64],
+    ) -> Option<Result<Vec<f64>, String>> {
+        let sim = error_settings(&self.sim)?;
+        let precise = Rig {
+            sim,
+            ..self.clone()
+        };
+        Some(precise.residual(model, values))
     }
 }
 
@@ -186,6 +205,25 @@ impl Residuals for SubsetProblem<'_> {
             sink(k, residual[i]);
         }
         Ok(())
+    }
+
+    fn precise_residuals(
+        &self,
+        x: &[f64],
+        sink: &mut dyn FnMut(usize, f64),
+    ) -> Option<Result<(), String>> {
+        let full = match full_values(self.params, x) {
+            Ok(full) => full,
+            Err(e) => return Some(Err(e.to_string())),
+        };
+        let residual = match self.track.precise_residual(self.model, &full)? {
+            Ok(r) => r,
+            Err(e) => return Some(Err(e)),
+        };
+        for (k, &i) in self.subset.iter().enumerate() {
+            sink(k, residual[i]);
+        }
+        Some(Ok(()))
     }
 }
 

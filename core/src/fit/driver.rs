@@ -21,7 +21,7 @@ use super::levenberg_marquardt::{BoundStop, MAX_FD_STEP, NOISE_PROBE};
 use super::noise_floor::Quantity;
 use super::objective::{Objective, Residuals};
 use super::observer::Watch;
-use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
+use super::residual_jacobian::{forward_difference, residual_noise, StepFloor, ERROR_RTOL};
 use super::result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
 use super::solver::{FitSettings, Solver};
 use super::stages::{self, StageEnd};
@@ -346,7 +346,29 @@ impl Chain<'_> {
         };
         let p = self.free.len();
         let errors = if p > 0 {
-            let (jac, rise) = jacobian(obj, self.free, &x, &r0, self.settings);
+            // From the problem's precise residuals where it has them (a simulation at a
+            // tighter tolerance than the fit's), the fit's own otherwise.
+            let mut precise = vec![0.0; n];
+            let base = match obj.precise_residuals_user(&x, &mut precise) {
+                Some(Some(_)) => Some(precise.as_slice()),
+                Some(None) => {
+                    log.push(format!(
+                        "standard errors: the precise simulation failed ({}): the Jacobian \
+                         is the fit's own",
+                        obj.last_failure().unwrap_or_default()
+                    ));
+                    None
+                }
+                None => None,
+            };
+            let (jac, rise) = jacobian(
+                obj,
+                self.free,
+                &x,
+                base.unwrap_or(&r0),
+                self.settings,
+                base.is_some(),
+            );
             noisy_columns(self.free, &rise, &mut log);
             let mut errors = standard_errors(&jac, &r0, rss, obj.correlation_span(), &mut log);
             errors.rise = rise;
@@ -449,8 +471,9 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
 }
 
 /// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
-/// exact where the problem gives one, else by forward differences; and how far each column
-/// stands above the residuals' noise (see [`forward_difference`]).
+/// exact where the problem gives one, else by forward differences — of the problem's precise
+/// residuals when `precise` (then `r0` are those), of its own otherwise; and how far each
+/// column stands above the residuals' noise (see [`forward_difference`]).
 ///
 /// The difference steps are sized to where the fit ended: `fd_step` (up to
 /// [`MAX_FD_STEP`]) times the larger of the parameter's typical size and its |value|. A
@@ -465,8 +488,16 @@ fn jacobian(
     x: &[f64],
     r0: &[f64],
     settings: &FitSettings,
+    precise: bool,
 ) -> (DMatrix<f64>, Vec<f64>) {
     let (n, p) = (r0.len(), free.len());
+    let eval = |point: &[f64], out: &mut [f64]| {
+        if precise {
+            matches!(obj.precise_residuals_user(point, out), Some(Some(_)))
+        } else {
+            obj.residuals_user(point, out).is_some()
+        }
+    };
     let mut jac = DMatrix::<f64>::zeros(n, p);
     let exact = obj
         .jacobian_user(x, &mut jac)
@@ -479,7 +510,14 @@ fn jacobian(
         .zip(x)
         .map(|(q, v)| q.effective_scale().max(v.abs()))
         .collect();
-    let mut steps: Vec<f64> = size.iter().map(|s| settings.fd_step * s).collect();
+    // Precise residuals are simulations at `ERROR_RTOL`: their step is the one
+    // `FitSettings::for_simulation` gives that tolerance, where the fit's may be longer.
+    let fd_step = if precise {
+        settings.fd_step.min(ERROR_RTOL.sqrt())
+    } else {
+        settings.fd_step
+    };
+    let mut steps: Vec<f64> = size.iter().map(|s| fd_step * s).collect();
     // Steps above the residuals' noise (a noisy column would make a noisy standard
     // error), at most MAX_FD_STEP sizes and short enough that one side stays in bounds.
     let probe: Vec<f64> = free
@@ -494,10 +532,7 @@ fn jacobian(
             }
         })
         .collect();
-    let noise = residual_noise(x, r0, &probe, &|point, out| {
-        obj.residuals_user(point, out).is_some()
-    })
-    .unwrap_or(0.0);
+    let noise = residual_noise(x, r0, &probe, &eval).unwrap_or(0.0);
     let floor = StepFloor {
         noise,
         max: free
@@ -513,7 +548,7 @@ fn jacobian(
         &mut steps,
         &floor,
         &|j, v| !(v > free[j].min && v < free[j].max),
-        &|point, out| obj.residuals_user(point, out).is_some(),
+        &eval,
         &exact,
         &mut jac,
     );

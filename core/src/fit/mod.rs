@@ -63,6 +63,7 @@ pub use force_fit::{ForceFit, FORCE_OFFSET};
 pub use noise_floor::{NoiseFloor, Quantity};
 pub use objective::Residuals;
 pub use offset::{least_squares_offset, offset_param, offset_reach};
+pub use residual_jacobian::{error_settings, ERROR_ATOL, ERROR_RTOL};
 pub use result::{Convergence, ErrorBlocks, FitProgress, FitResult, FittedParam, SolverStage};
 pub use same_term::check_same_terms;
 pub use solver::{FitSettings, Solver};

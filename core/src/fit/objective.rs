@@ -36,6 +36,19 @@ pub trait Residuals: Sync {
         None
     }
 
+    /// The residuals at free values `x` computed more accurately than [`Residuals::residuals`]
+    /// (a simulation integrated to a tighter tolerance: see
+    /// [`super::residual_jacobian::error_settings`]), for the Jacobian behind the standard
+    /// errors; streamed as `residuals` streams them. `None` (the default): the fit's own
+    /// residuals are accurate enough.
+    fn precise_residuals(
+        &self,
+        _x: &[f64],
+        _sink: &mut dyn FnMut(usize, f64),
+    ) -> Option<Result<(), String>> {
+        None
+    }
+
     /// Samples over which the residuals are known to be correlated, whatever their own
     /// autocorrelation shows (a derivative filter's window, when the model reads its output):
     /// the blocks of the robust standard errors are at least twice this long. 1 (the
@@ -180,6 +193,32 @@ impl<'a> Objective<'a> {
                 *slot = r;
             }
         })
+    }
+
+    /// The problem's precise residuals ([`Residuals::precise_residuals`]) at user values `x`
+    /// written to `out`: `None` when the problem has none, else their sum of squares (`None`
+    /// on failure, counted and remembered).
+    pub fn precise_residuals_user(&self, x: &[f64], out: &mut [f64]) -> Option<Option<f64>> {
+        let mut rss = 0.0;
+        let outcome = self.problem.precise_residuals(x, &mut |i, r| {
+            rss += r * r;
+            if let Some(slot) = out.get_mut(i) {
+                *slot = r;
+            }
+        })?;
+        let tally = &*self.tally;
+        tally.evaluations.fetch_add(1, Ordering::Relaxed);
+        let failure = match outcome {
+            Err(e) => Some(e),
+            Ok(()) if !rss.is_finite() => Some("a residual is not finite".to_string()),
+            Ok(()) => None,
+        };
+        if let Some(reason) = failure {
+            tally.failures.fetch_add(1, Ordering::Relaxed);
+            *lock(&tally.last_failure) = Some(reason);
+            return Some(None);
+        }
+        Some(Some(rss))
     }
 
     /// The exact columns of the Jacobian at user values `x`, written into `jac`: which

@@ -31,6 +31,7 @@ use super::error::FitError;
 use super::fit_param::{full_values, held, FitParam};
 use super::noise_floor::Quantity;
 use super::objective::Residuals;
+use super::residual_jacobian::error_settings;
 use super::result::{FitProgress, FitResult};
 use super::same_term::check_same_terms;
 use super::solver::FitSettings;
@@ -221,7 +222,7 @@ impl TrajectoryFit {
         self.check(data)?;
         let held = self.with_free(held(&self.free, values)?);
         let problem = held.problem(data)?;
-        let (sol, offset, initial) = problem.solve(&[]).map_err(FitError::BadData)?;
+        let (sol, offset, initial) = problem.solve(&[], &self.sim).map_err(FitError::BadData)?;
         let x = sol.states.iter().step_by(sol.dim).map(|x| x + offset);
         Ok((x.collect(), initial))
     }
@@ -330,9 +331,9 @@ struct TrajectoryResiduals<'a> {
 }
 
 impl TrajectoryResiduals<'_> {
-    /// One simulation for the free values `x`: the integrator's solution, the displacement
-    /// offset and the initial state (x0, v0) it started from.
-    fn solve(&self, x: &[f64]) -> Result<(Solution, f64, [f64; 2]), String> {
+    /// One simulation for the free values `x` integrated with `sim`: the integrator's
+    /// solution, the displacement offset and the initial state (x0, v0) it started from.
+    fn solve(&self, x: &[f64], sim: &Settings) -> Result<(Solution, f64, [f64; 2]), String> {
         let fit = self.fit;
         let mut system = fit.system;
         let mut model_values = fit.model.as_ref().map(|(_, v)| v.clone());
@@ -360,8 +361,22 @@ impl TrajectoryResiduals<'_> {
         let (x0, v0) = fit.initial.unwrap_or((d.x[0] - offset, 0.0));
         let (x0, v0) = (initial[0].unwrap_or(x0), initial[1].unwrap_or(v0));
         let y0 = osc.initial_state(x0, v0);
-        let sol = integrate(&osc, d.t[0], &y0, d.t, &fit.sim).map_err(|e| e.to_string())?;
+        let sol = integrate(&osc, d.t[0], &y0, d.t, sim).map_err(|e| e.to_string())?;
         Ok((sol, offset, [x0, v0]))
+    }
+
+    /// Measured − simulated − offset at every sample, the simulation integrated with `sim`.
+    fn stream(
+        &self,
+        x: &[f64],
+        sim: &Settings,
+        sink: &mut dyn FnMut(usize, f64),
+    ) -> Result<(), String> {
+        let (sol, offset, _) = self.solve(x, sim)?;
+        for (i, &xe) in self.data.x.iter().enumerate() {
+            sink(i, xe - sol.states[i * sol.dim] - offset);
+        }
+        Ok(())
     }
 }
 
@@ -371,10 +386,16 @@ impl Residuals for TrajectoryResiduals<'_> {
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
-        let (sol, offset, _) = self.solve(x)?;
-        for (i, &xe) in self.data.x.iter().enumerate() {
-            sink(i, xe - sol.states[i * sol.dim] - offset);
-        }
-        Ok(())
+        self.stream(x, &self.fit.sim, sink)
+    }
+
+    /// At the tolerances of [`error_settings`] when the fit's are looser.
+    fn precise_residuals(
+        &self,
+        x: &[f64],
+        sink: &mut dyn FnMut(usize, f64),
+    ) -> Option<Result<(), String>> {
+        let sim = error_settings(&self.fit.sim)?;
+        Some(self.stream(x, &sim, sink))
     }
 }
