@@ -168,14 +168,7 @@ impl<'a> Objective<'a> {
             rss += r * r;
             sink(i, r);
         });
-        let failure = match outcome {
-            Err(e) => Some(e),
-            Ok(()) if !rss.is_finite() => Some("a residual is not finite".to_string()),
-            Ok(()) => None,
-        };
-        if let Some(reason) = failure {
-            tally.failures.fetch_add(1, Ordering::Relaxed);
-            *lock(&tally.last_failure) = Some(reason);
+        if self.failed(outcome, rss) {
             return None;
         }
         let mean = rss / self.len().max(1) as f64;
@@ -206,19 +199,27 @@ impl<'a> Objective<'a> {
                 *slot = r;
             }
         })?;
-        let tally = &*self.tally;
-        tally.evaluations.fetch_add(1, Ordering::Relaxed);
+        self.tally.evaluations.fetch_add(1, Ordering::Relaxed);
+        if self.failed(outcome, rss) {
+            return Some(None);
+        }
+        Some(Some(rss))
+    }
+
+    /// Whether an evaluation's `outcome` (with residual sum of squares `rss`) failed: an
+    /// error or a residual that is not finite, counted and remembered.
+    fn failed(&self, outcome: Result<(), String>, rss: f64) -> bool {
         let failure = match outcome {
             Err(e) => Some(e),
             Ok(()) if !rss.is_finite() => Some("a residual is not finite".to_string()),
             Ok(()) => None,
         };
-        if let Some(reason) = failure {
-            tally.failures.fetch_add(1, Ordering::Relaxed);
-            *lock(&tally.last_failure) = Some(reason);
-            return Some(None);
-        }
-        Some(Some(rss))
+        let Some(reason) = failure else {
+            return false;
+        };
+        self.tally.failures.fetch_add(1, Ordering::Relaxed);
+        *lock(&self.tally.last_failure) = Some(reason);
+        true
     }
 
     /// The exact columns of the Jacobian at user values `x`, written into `jac`: which
