@@ -25,10 +25,11 @@
 //! whole record). The pieces are simulated in parallel: the candidates run in parallel too,
 //! but a step's last candidate, or the base's scout, would otherwise leave a core idle.
 //!
-//! A candidate's search integrates the pieces at a looser tolerance than the record's
-//! ([`SCOUT_RTOL`]): it only chooses where the candidate's fit on the whole record starts.
-//! The base's scout, which sets where the base's own whole-record fit starts (and so the gap
-//! before), runs at the record's tolerance ([`Scout::at`]).
+//! A candidate's search may integrate the pieces at a looser tolerance than the record's
+//! ([`SCOUT_RTOL`], now the default `rtol`, so no looser): it only chooses where the
+//! candidate's fit on the whole record starts. The base's scout, which sets where the base's
+//! own whole-record fit starts (and so the gap before), runs at the record's tolerance
+//! ([`Scout::at`]).
 
 use std::sync::Arc;
 
@@ -61,11 +62,14 @@ const PIECE_CYCLES: usize = 6;
 const MIN_PIECES: usize = 3;
 
 /// Relative tolerance a candidate's search integrates the scout's pieces to, at the loosest
-/// (a user's looser `rtol` is kept; see [`Scout::searching`]). The search only chooses where a
-/// candidate's fit on the whole record starts, at the record's own tolerance; at 1e-5 a piece
-/// of the Silverbox-layout record is within 4e-6 V of a tight reference, a tenth of the
-/// record's noise, and the searches of the benchmarks' records cost about half as much.
-pub const SCOUT_RTOL: f64 = 1e-5;
+/// (a user's looser `rtol` is kept; see [`Scout::searching`]). At 1e-5 the searches of the
+/// benchmarks' records cost about half as much (trajectory `added_mass` 7.4 s wall, the
+/// Silverbox layout 97.2 s, idle) with the same verdicts there, but on the paper's sweep with
+/// a weak cubic spring hidden (`tests/discover_rotor_trajectory.rs`, its ignored case) the
+/// search ranked `wall_impact` first and discovery named it instead of `cubic_stiffness`; at
+/// the default 1e-7 it names the cubic spring. So the searches keep the record's tolerance
+/// until a looser one is shown to keep that verdict.
+pub const SCOUT_RTOL: f64 = 1e-7;
 
 /// Short pieces of a record, each a rig of its own, that stand in for it while a candidate's
 /// values are searched for.
