@@ -25,11 +25,13 @@
 //! whole record). The pieces are simulated in parallel: the candidates run in parallel too,
 //! but a step's last candidate, or the base's scout, would otherwise leave a core idle.
 //!
-//! A candidate's search may integrate the pieces at a looser tolerance than the record's
-//! ([`SCOUT_RTOL`], now the default `rtol`, so no looser): it only chooses where the
-//! candidate's fit on the whole record starts. The base's scout, which sets where the base's
-//! own whole-record fit starts (and so the gap before), runs at the record's tolerance
-//! ([`Scout::at`]).
+//! A candidate's search screens its starts and ranks them at the record's tolerance, but
+//! their short fits ([`super::trajectory_starts`]) integrate the pieces at [`SCOUT_RTOL`]
+//! ([`Scout::searching`]): a short fit only moves a start towards its basin. The scout fit
+//! that follows, the candidates' ranking by it and the base's own scout all run at the
+//! record's tolerance: near a resonance whose branch a stiffening moves, a fit whose
+//! difference steps are sized for a loose tolerance does not find the branch (see
+//! [`SCOUT_RTOL`]).
 
 use std::sync::Arc;
 
@@ -61,15 +63,16 @@ const PIECE_CYCLES: usize = 6;
 /// Fewest pieces for a scout to stand for the record.
 const MIN_PIECES: usize = 3;
 
-/// Relative tolerance a candidate's search integrates the scout's pieces to, at the loosest
-/// (a user's looser `rtol` is kept; see [`Scout::searching`]). At 1e-5 the searches of the
-/// benchmarks' records cost about half as much (trajectory `added_mass` 7.4 s wall, the
-/// Silverbox layout 97.2 s, idle) with the same verdicts there, but on the paper's sweep with
-/// a weak cubic spring hidden (`tests/discover_rotor_trajectory.rs`, its ignored case) the
-/// search ranked `wall_impact` first and discovery named it instead of `cubic_stiffness`; at
-/// the default 1e-7 it names the cubic spring. So the searches keep the record's tolerance
-/// until a looser one is shown to keep that verdict.
-pub const SCOUT_RTOL: f64 = 1e-7;
+/// Relative tolerance, at the tightest, of a candidate's short fits from its starts on the
+/// scout (a user's looser `rtol` is kept; see [`Scout::searching`]). Measured on the
+/// benchmarks (one run each, load about 2): trajectory `added_mass` hidden 17.3 s CPU against
+/// 19.0 s with every search at the record's tolerance, the Silverbox layout 272 s against
+/// 326 s, the same verdicts and gaps. With the scout fit at 1e-5 as well the Silverbox layout
+/// took 178 s of CPU at idle, but on the paper's sweep with a weak cubic spring hidden
+/// (`tests/discover_rotor_trajectory.rs`, its ignored case) the cubic spring's scout fit
+/// missed the resonance's other branch (it lowered the scout's mean square by 3.4e-7 mm²
+/// against 1.5e-3 mm² at 1e-7) and discovery named `wall_impact`.
+pub const SCOUT_RTOL: f64 = 1e-5;
 
 /// Short pieces of a record, each a rig of its own, that stand in for it while a candidate's
 /// values are searched for.
@@ -156,8 +159,8 @@ impl<'a> Scout<'a> {
         }
     }
 
-    /// The scout a candidate's search runs on: its pieces integrated to [`SCOUT_RTOL`], or
-    /// the record's own tolerance where that is looser.
+    /// The scout a candidate's short fits from its starts run on: its pieces integrated to
+    /// [`SCOUT_RTOL`], or the record's own tolerance where that is looser.
     pub fn searching(&self) -> Scout<'a> {
         self.at(self.rtol().max(SCOUT_RTOL))
     }

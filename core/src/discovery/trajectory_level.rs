@@ -98,7 +98,7 @@ pub(super) struct TrajectoryLevel<'a> {
     pub(super) osc_start: Vec<f64>,
     /// Whether the force-level screen may rank candidates.
     pub(super) screen: bool,
-    /// The scout of a long record, its pieces at the searches' tolerance
+    /// The scout of a long record, its pieces at the record's tolerance
     /// ([`Scout::searching`]).
     pub(super) scout: Option<Scout<'a>>,
     pub(super) settings: &'a DiscoverySettings,
@@ -147,8 +147,7 @@ impl<'a> TrajectoryLevel<'a> {
         let scouts = settings.scout_from > 0 && n >= settings.scout_from;
         let scout = scouts
             .then(|| Scout::new(&rig, cycles, &split.train))
-            .flatten()
-            .map(|s| s.searching());
+            .flatten();
         Ok(TrajectoryLevel {
             data,
             cycles,
@@ -218,8 +217,7 @@ impl Level for TrajectoryLevel<'_> {
             return start;
         };
         let lm = self.settings.levenberg_marquardt(None);
-        let scout = scout.at(self.rig.sim.rtol);
-        scouted(start, &scout, (&self.rig, self.setup, &all), &lm).0
+        scouted(start, scout, (&self.rig, self.setup, &all), &lm).0
     }
 
     fn fit(

@@ -128,11 +128,13 @@ impl SearchModel {
     }
 
     /// The best of `starts` after a short fit of each (`START_ITERS` Levenberg–Marquardt
-    /// iterations on the training samples): the stage a full fit continues from. One start
-    /// is returned as it is.
+    /// iterations on the training samples of `tracks.0`), ranked by their RMS at `train` on
+    /// `tracks.1` (the same samples, at the tolerance the search is ranked at; the fit's own
+    /// RMS when both are one): the stage a full fit continues from. One start is returned as
+    /// it is.
     pub(super) fn started(
         starts: Vec<SearchModel>,
-        track: &dyn Track,
+        tracks: (&dyn Track, &dyn Track),
         setup: &TrajectorySetup,
         train: &[usize],
         settings: &DiscoverySettings,
@@ -140,15 +142,25 @@ impl SearchModel {
         if starts.len() < 2 {
             return starts.into_iter().next();
         }
+        let (fitted_on, ranked_on) = tracks;
+        let same = std::ptr::addr_eq(fitted_on, ranked_on);
         let mut short = settings.levenberg_marquardt(None);
         short.fit = short.fit.max_iters(START_ITERS);
         let mut best: Option<(f64, SearchModel)> = None;
         for start in &starts {
-            let Ok((stage, fit)) = start.fit_simulated(track, setup, train, &short) else {
+            let Ok((stage, fit)) = start.fit_simulated(fitted_on, setup, train, &short) else {
                 continue;
             };
-            if best.as_ref().is_none_or(|(rms, _)| fit.rms < *rms) {
-                best = Some((fit.rms, stage));
+            let rms = if same {
+                fit.rms
+            } else {
+                let Ok(r) = stage.model().map(|m| ranked_on.residual(&m, &stage.values)) else {
+                    continue;
+                };
+                r.map_or(f64::INFINITY, |r| rms_over(&r, train))
+            };
+            if best.as_ref().is_none_or(|(b, _)| rms < *b) {
+                best = Some((rms, stage));
             }
         }
         best.map(|(_, s)| s).or_else(|| starts.into_iter().next())

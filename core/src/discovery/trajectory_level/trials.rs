@@ -14,6 +14,7 @@ use crate::discovery::choice::{self, Trial, Yardstick};
 use crate::discovery::error::DiscoveryError;
 use crate::discovery::level::Level;
 use crate::discovery::score::CandidateScore;
+use crate::discovery::scout::Scout;
 use crate::discovery::search_model::SearchModel;
 use crate::discovery::settings::DiscoverySettings;
 use crate::discovery::trajectory_setup::TrajectorySetup;
@@ -166,8 +167,9 @@ impl TrajectoryLevel<'_> {
     }
 
     /// Where candidate `with`'s trial starts (`with`: the current model with it added at its
-    /// defaults; `hinted`: its force-level start): the best of its starts, fitted on the
-    /// scout when there is one; its mean square on the scout's training samples (m²;
+    /// defaults; `hinted`: its force-level start): the best of its starts (their short fits
+    /// on the scout at [`crate::discovery::scout::SCOUT_RTOL`], when there is a scout),
+    /// fitted on the scout when there is one; its mean square on the scout's training samples (m²;
     /// infinite without a scout) and its RMS on the whole record's training samples (m; NaN
     /// without a scout). Among the starts is the neutral one (the current model's optimum,
     /// the effect at next to nothing: [`SearchModel::neutral`]); where the search on the
@@ -180,12 +182,14 @@ impl TrajectoryLevel<'_> {
         hinted: Option<&SearchModel>,
         current_rms: f64,
     ) -> (SearchModel, f64, f64) {
-        let (track, train): (&dyn Track, &[usize]) = match self.scout.as_ref() {
-            Some(scout) => (scout, &scout.train),
-            None => (&self.rig, &self.split.train),
-        };
+        let searching = self.scout.as_ref().map(Scout::searching);
+        let (track, loose, train): (&dyn Track, &dyn Track, &[usize]) =
+            match (self.scout.as_ref(), searching.as_ref()) {
+                (Some(scout), Some(loose)) => (scout, loose, &scout.train),
+                _ => (&self.rig, &self.rig, &self.split.train),
+            };
         let starts = with.starts(track, train, &self.osc_start, hinted);
-        let stage = SearchModel::started(starts, track, self.setup, train, self.settings)
+        let stage = SearchModel::started(starts, (loose, track), self.setup, train, self.settings)
             .unwrap_or_else(|| with.clone());
         let Some(scout) = self.scout.as_ref() else {
             return (stage, f64::INFINITY, f64::NAN);
