@@ -65,7 +65,7 @@ pub fn mass_and_force_along<M: ForceModel + ?Sized>(
         }
         return Ok(());
     }
-    integrate(m, p, track, rows, &mut |k, ma, f| {
+    integrate(m, p, track, rows, |k, ma, f| {
         mass[k] += ma;
         force[k] += f;
     })
@@ -73,21 +73,63 @@ pub fn mass_and_force_along<M: ForceModel + ?Sized>(
 
 /// Integrate the internal state of `m` along `track`, calling `each(k, m_a, f)` at the
 /// `k`-th of `rows`, as [`mass_and_force_along`] says.
-fn integrate<M: ForceModel + ?Sized>(
+///
+/// A model with one or two internal variables (every built-in) keeps its state and stage
+/// rates in fixed-size arrays: with the model's law inlined they live in registers, not in
+/// memory between the stages, which shortens each step's chain of dependent operations. The
+/// operations and their order are those of any other size, so the results are the same to
+/// the bit.
+fn integrate<M, F>(
     m: &M,
     p: &[f64],
     track: &Track,
     rows: Option<&[usize]>,
-    each: &mut dyn FnMut(usize, f64, f64),
-) -> Result<(), ModelError> {
-    let nz = m.n_internal();
-    // z, stage rates k1..k4, stage state.
-    let mut buf = vec![0.0; 6 * nz];
-    let (z, rest) = buf.split_at_mut(nz);
-    let (k1, rest) = rest.split_at_mut(nz);
-    let (k2, rest) = rest.split_at_mut(nz);
-    let (k3, rest) = rest.split_at_mut(nz);
-    let (k4, zs) = rest.split_at_mut(nz);
+    each: F,
+) -> Result<(), ModelError>
+where
+    M: ForceModel + ?Sized,
+    F: FnMut(usize, f64, f64),
+{
+    match m.n_internal() {
+        1 => {
+            let mut b = [[0.0; 1]; 6];
+            let [z, k1, k2, k3, k4, zs] = &mut b;
+            steps(m, p, track, rows, each, [z, k1, k2, k3, k4, zs])
+        }
+        2 => {
+            let mut b = [[0.0; 2]; 6];
+            let [z, k1, k2, k3, k4, zs] = &mut b;
+            steps(m, p, track, rows, each, [z, k1, k2, k3, k4, zs])
+        }
+        nz => {
+            // z, stage rates k1..k4, stage state.
+            let mut buf = vec![0.0; 6 * nz];
+            let (z, rest) = buf.split_at_mut(nz);
+            let (k1, rest) = rest.split_at_mut(nz);
+            let (k2, rest) = rest.split_at_mut(nz);
+            let (k3, rest) = rest.split_at_mut(nz);
+            let (k4, zs) = rest.split_at_mut(nz);
+            steps(m, p, track, rows, each, [z, k1, k2, k3, k4, zs])
+        }
+    }
+}
+
+/// The RK4 steps of [`integrate`] with the state `z`, the stage rates `k1`..`k4` and the
+/// stage state `zs` in the buffers given (each of the model's number of internal variables).
+#[inline(always)]
+fn steps<M, F>(
+    m: &M,
+    p: &[f64],
+    track: &Track,
+    rows: Option<&[usize]>,
+    mut each: F,
+    [z, k1, k2, k3, k4, zs]: [&mut [f64]; 6],
+) -> Result<(), ModelError>
+where
+    M: ForceModel + ?Sized,
+    F: FnMut(usize, f64, f64),
+{
+    let nz = z.len();
     m.initial_internal(p, z);
     let (t, x, v) = (track.t, track.x, track.v);
     let last = t.len() - 1;
