@@ -317,6 +317,55 @@ mod tests {
         out
     }
 
+    /// `nz` coupled relaxations, each towards the one before (the first towards `c·v`).
+    struct Chain(usize, Vec<ParamSpec>);
+    impl ForceModel for Chain {
+        fn name(&self) -> &str {
+            "chain"
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.1
+        }
+        fn n_internal(&self) -> usize {
+            self.0
+        }
+        fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+            let mut towards = p[0] * s.v;
+            for j in 0..self.0 {
+                dz[j] = (towards - s.z[j]) / (p[1] * (j + 1) as f64);
+                towards = s.z[j];
+            }
+            Ok(s.z[self.0 - 1])
+        }
+    }
+
+    /// Each state size (the fixed-size arrays of one and two variables, the buffer of more)
+    /// integrates as the plain loop does, to the bit.
+    #[test]
+    fn every_state_size_integrates_as_sample_by_sample_to_the_bit() {
+        let n = 400;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t.iter().map(|t| 0.01 * (30.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.3 * (30.0 * t).cos()).collect();
+        let track = Track {
+            t: &t,
+            x: &x,
+            v: &v,
+        };
+        let rows: Vec<usize> = (0..n).filter(|i| i % 4 != 2).collect();
+        for nz in 1..=4 {
+            let m = Chain(nz, vec![spec("c"), spec("tau")]);
+            let p = [2.5, 0.02];
+            let want = sample_by_sample(&m, &p, &track, &rows);
+            let (mut mass, mut force) = (vec![0.0; rows.len()], vec![0.0; rows.len()]);
+            m.mass_and_force_along(&p, &track, Some(&rows), &mut mass, &mut force)
+                .unwrap();
+            let got: Vec<f64> = mass.iter().zip(&force).map(|(m, f)| m * 0.5 + f).collect();
+            assert_eq!(got, want, "{nz} internal variables");
+            assert!(got.iter().any(|f| f.abs() > 1e-3), "{nz}: the state moved");
+        }
+    }
+
     #[test]
     fn a_sum_along_the_record_is_the_sum_sample_by_sample_to_the_bit() {
         let parts: Vec<Arc<dyn ForceModel>> = vec![
