@@ -331,9 +331,9 @@ mod tests {
         }
         fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
             let mut towards = p[0] * s.v;
-            for j in 0..self.0 {
-                dz[j] = (towards - s.z[j]) / (p[1] * (j + 1) as f64);
-                towards = s.z[j];
+            for (j, (rate, &z)) in dz.iter_mut().zip(s.z).enumerate() {
+                *rate = (towards - z) / (p[1] * (j + 1) as f64);
+                towards = z;
             }
             Ok(s.z[self.0 - 1])
         }
