@@ -59,20 +59,31 @@ builtin! {
         fn n_internal(&self) -> usize {
             1
         }
-        #[inline]
+        // The integration along a record calls these at every stage: inlined there with the
+        // law (the trait's provided versions, which they repeat, are not).
+        #[inline(always)]
+        fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+            self.force(p, s, dz).map(|_| ())
+        }
+        #[inline(always)]
+        fn mass_and_force(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            dz: &mut [f64],
+        ) -> Result<(f64, f64), ModelError> {
+            Ok((0.0, self.force(p, s, dz)?))
+        }
+        // Inlined into the integration along a record, whose every step calls it four times:
+        // the errors are built out of line.
+        #[inline(always)]
         fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
             let [f_bw, x_bw, beta] = take(self.name(), p)?;
             if x_bw.is_nan() || x_bw <= 0.0 {
-                return Err(ModelError::new(
-                    self.name(),
-                    format!("yield displacement x_bw must be positive, got {x_bw}"),
-                ));
+                return Err(bad_x_bw(x_bw));
             }
             let (Some(&w), Some(rate)) = (s.z.first(), dz.first_mut()) else {
-                return Err(ModelError::new(
-                    self.name(),
-                    "needs one internal state (the hysteretic displacement) and its rate",
-                ));
+                return Err(no_state());
             };
             let w = w.clamp(-1.0, 1.0);
             *rate = (s.v - beta * s.v.abs() * w - (1.0 - beta) * s.v * w.abs()) / x_bw;
@@ -91,6 +102,26 @@ builtin! {
             }
         }
     }
+}
+
+/// The error of a yield displacement that is not positive.
+#[cold]
+#[inline(never)]
+fn bad_x_bw(x_bw: f64) -> ModelError {
+    ModelError::new(
+        "bouc_wen",
+        format!("yield displacement x_bw must be positive, got {x_bw}"),
+    )
+}
+
+/// The error of a call without the internal state or its rate.
+#[cold]
+#[inline(never)]
+fn no_state() -> ModelError {
+    ModelError::new(
+        "bouc_wen",
+        "needs one internal state (the hysteretic displacement) and its rate",
+    )
 }
 
 #[cfg(test)]

@@ -39,25 +39,56 @@ builtin! {
         fn n_internal(&self) -> usize {
             1
         }
-        #[inline]
+        // The integration along a record calls these at every stage: inlined there with the
+        // law (the trait's provided versions, which they repeat, are not).
+        #[inline(always)]
+        fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
+            self.force(p, s, dz).map(|_| ())
+        }
+        #[inline(always)]
+        fn mass_and_force(
+            &self,
+            p: &[f64],
+            s: &ModelState,
+            dz: &mut [f64],
+        ) -> Result<(f64, f64), ModelError> {
+            Ok((0.0, self.force(p, s, dz)?))
+        }
+        // Inlined into the integration along a record, whose every step calls it four times:
+        // the errors are built out of line.
+        #[inline(always)]
         fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
             let [c_m, tau] = take(self.name(), p)?;
             if tau.is_nan() || tau <= 0.0 {
-                return Err(ModelError::new(
-                    self.name(),
-                    format!("relaxation time tau must be positive, got {tau}"),
-                ));
+                return Err(bad_tau(tau));
             }
             let (Some(&f), Some(rate)) = (s.z.first(), dz.first_mut()) else {
-                return Err(ModelError::new(
-                    self.name(),
-                    "needs one internal state (the force) and its rate",
-                ));
+                return Err(no_state());
             };
             *rate = (c_m * s.v - f) / tau;
             Ok(f)
         }
     }
+}
+
+/// The error of a relaxation time that is not positive.
+#[cold]
+#[inline(never)]
+fn bad_tau(tau: f64) -> ModelError {
+    ModelError::new(
+        "maxwell",
+        format!("relaxation time tau must be positive, got {tau}"),
+    )
+}
+
+/// The error of a call without the internal state or its rate.
+#[cold]
+#[inline(never)]
+fn no_state() -> ModelError {
+    ModelError::new(
+        "maxwell",
+        "needs one internal state (the force) and its rate",
+    )
 }
 
 #[cfg(test)]
