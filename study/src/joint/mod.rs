@@ -115,8 +115,8 @@ pub struct LawJson {
     /// A law with a form: its coefficients (`P_base`, `P_gain`, `P_exp`) with their errors.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coefficients: Option<Vec<LawCoefficient>>,
-    /// A law with a form: the parameter's lower bound, which its value is clamped to (absent
-    /// where unbounded), as in the fit.
+    /// The parameter's lower bound, which the law's value is clamped to (absent where
+    /// unbounded), as in the fit.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min: Option<f64>,
     /// Its upper bound, likewise.
@@ -367,11 +367,12 @@ fn holdout_json(
                 coefficient,
                 exponent,
                 law,
+                bounds,
                 ..
             } => {
                 let law = &spec.laws[*law];
                 let ratio = held.joint.condition(&law.condition) / law.reference;
-                theta[*coefficient] * ratio.powf(theta[*exponent])
+                global_fit::power_value(theta[*coefficient], theta[*exponent], ratio, *bounds)
             }
             Source::Form {
                 form,
@@ -567,6 +568,10 @@ fn laws_json(
                 max: None,
                 unit: unit.clone(),
             };
+            if let Some((lo, hi)) = layout.law_bounds(index) {
+                json.min = lo.is_finite().then_some(lo);
+                json.max = hi.is_finite().then_some(hi);
+            }
             let Some(form) = l.form else {
                 let c = result.param(&global_fit::coefficient_name(&l.param))?;
                 let e = result.param(&global_fit::exponent_name(&l.param))?;
@@ -602,10 +607,6 @@ fn laws_json(
                 .collect::<Option<Vec<_>>>()?;
             json.law = Some(form.name().to_string());
             json.coefficients = Some(coefficients);
-            if let Some((lo, hi)) = layout.form_bounds(index) {
-                json.min = lo.is_finite().then_some(lo);
-                json.max = hi.is_finite().then_some(hi);
-            }
             Some(json)
         })
         .collect()
