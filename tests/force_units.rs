@@ -78,12 +78,26 @@ fn a_force_read_in_volts_is_labelled_in_volts_in_every_figure() {
     let texts = figure_texts(&fit);
     let (labelled, newtons) = force_labels(&texts);
     assert!(newtons.is_empty(), "F_STF in N in {newtons:?}");
-    for name in ["time_history.csv", "hysteresis_x.csv", "measured_vs_fitted.csv"] {
-        assert!(labelled.contains(&name), "{name} not labelled: {labelled:?}");
+    for name in [
+        "time_history.csv",
+        "hysteresis_x.csv",
+        "measured_vs_fitted.csv",
+    ] {
+        assert!(
+            labelled.contains(&name),
+            "{name} not labelled: {labelled:?}"
+        );
     }
-    let header = &texts.iter().find(|(n, _)| n == "hysteresis_v.csv").unwrap().1;
+    let header = &texts
+        .iter()
+        .find(|(n, _)| n == "hysteresis_v.csv")
+        .unwrap()
+        .1;
     assert!(header.contains("F_STF, V"), "{header}");
-    assert_eq!(read_json(&fit.join("fit.json"))["models"][0]["rms_unit"], "V");
+    assert_eq!(
+        read_json(&fit.join("fit.json"))["models"][0]["rms_unit"],
+        "V"
+    );
 
     let disc = tmp.path().join("disc");
     run_ok("discover", &exp, &disc);
@@ -91,7 +105,10 @@ fn a_force_read_in_volts_is_labelled_in_volts_in_every_figure() {
     let texts = figure_texts(&disc);
     let (labelled, newtons) = force_labels(&texts);
     assert!(newtons.is_empty(), "F_STF in N in {newtons:?}");
-    assert!(!labelled.is_empty(), "no force figure in discovery's report");
+    assert!(
+        !labelled.is_empty(),
+        "no force figure in discovery's report"
+    );
 }
 
 #[test]

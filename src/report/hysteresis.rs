@@ -153,8 +153,8 @@ pub fn hysteresis(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::test_signals::{assert_rendered, column, damped_sine};
     use crate::report::figure::F_LABEL;
+    use crate::report::test_signals::{assert_rendered, column, damped_sine};
 
     #[test]
     fn renders_loops_against_x_v_and_a_with_the_plotted_data() {

@@ -13,8 +13,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_ranges, pick};
 use super::figure::{
     draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg, render, same_as_earlier,
-    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch,
-    MEASURED_LINE, MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
+    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, MEASURED_LINE,
+    MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
 };
 use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};

@@ -14,8 +14,8 @@ use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, draw_line, draw_mesh_with, finite_runs, legend_strip, milli, msg, render,
-    require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, SIZE_TALL,
-    T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
+    require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, SIZE_TALL, T_LABEL,
+    X_LABEL_AREA, Y_LABEL_AREA,
 };
 use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};

@@ -727,13 +727,17 @@ mod tests {
         // An offset stopped 0.07 inside a bound of −100 the data push it past is held by it,
         // whatever its typical size; one 10 inside is not.
         for scale in [0.1, 1.0, 100.0] {
-            let off = FitParam::new("f_off", 0.0).bounds(-100.0, 100.0).scale(scale);
+            let off = FitParam::new("f_off", 0.0)
+                .bounds(-100.0, 100.0)
+                .scale(scale);
             assert_eq!(held_by(&off, -99.93, -24.0), Some(BoundSide::Lower));
             assert_eq!(held_by(&off, 99.93, 24.0), Some(BoundSide::Upper));
             assert_eq!(held_by(&off, -90.0, -30.0), None);
         }
         // A one-sided bound away from 0: its own size sets the reach.
-        let k = FitParam::new("k", 1500.0).bounds(1000.0, f64::INFINITY).scale(1.0);
+        let k = FitParam::new("k", 1500.0)
+            .bounds(1000.0, f64::INFINITY)
+            .scale(1.0);
         assert_eq!(held_by(&k, 1010.0, -50.0), Some(BoundSide::Lower));
         assert_eq!(held_by(&k, 1100.0, -150.0), None);
     }

@@ -204,9 +204,7 @@ impl Layout {
     /// The bounds the value of law `index` is clamped into.
     pub fn law_bounds(&self, index: usize) -> Option<(f64, f64)> {
         self.sources.iter().flatten().find_map(|s| match *s {
-            Source::Form { law, bounds, .. } | Source::Law { law, bounds, .. }
-                if law == index =>
-            {
+            Source::Form { law, bounds, .. } | Source::Law { law, bounds, .. } if law == index => {
                 Some(bounds)
             }
             _ => None,

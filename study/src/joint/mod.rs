@@ -79,6 +79,9 @@ pub struct GlobalParam {
     pub value: f64,
     /// Block-robust standard error (as every fit's).
     pub std_error: f64,
+    /// Its unit on the records (the model's parameter's, a law coefficient's as in `laws`;
+    /// empty for a plain number such as an exponent).
+    pub unit: String,
 }
 
 /// A fitted law: `param = coefficient·(condition/reference)^exponent`, or with a form
@@ -473,6 +476,7 @@ fn assemble(
     let supported = delta_bic < 0.0 && better_held;
     let verdict = verdict_text(supported, delta_bic, holdout.as_ref(), spec.level, shown.0);
     let caveats = all_caveats(spec, training, &global, &per_record, holdout.as_ref());
+    let laws = laws_json(spec, &result, units, layout);
     GlobalJson {
         model: spec.model.clone(),
         level: spec.level.name().into(),
@@ -483,8 +487,8 @@ fn assemble(
             .iter()
             .map(|l| l.unit.record_given.clone())
             .collect(),
-        params: theta_json(&result, layout),
-        laws: laws_json(spec, &result, units, layout),
+        params: theta_json(&result, layout, units, &laws),
+        laws,
         global,
         per_record,
         delta_bic,
@@ -527,7 +531,12 @@ impl Units {
 }
 
 /// θ with its roles and standard errors.
-fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalParam> {
+fn theta_json(
+    result: &FitResult,
+    layout: &global_fit::Layout,
+    units: &Units,
+    laws: &[LawJson],
+) -> Vec<GlobalParam> {
     result
         .params
         .iter()
@@ -537,8 +546,35 @@ fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalPara
             role: role.to_string(),
             value: p.value,
             std_error: p.std_error,
+            unit: theta_unit(&p.name, role, units, laws),
         })
         .collect()
+}
+
+/// The unit of θ's entry `name` in `role`: a law's coefficient as `laws` give it, an
+/// exponent none, a shared or per-record parameter (`K@3`) its model parameter's, a force
+/// offset the records' force.
+fn theta_unit(name: &str, role: &str, units: &Units, laws: &[LawJson]) -> String {
+    match role {
+        "law exponent" => String::new(),
+        "law coefficient" => laws
+            .iter()
+            .find_map(|l| {
+                let plain = global_fit::coefficient_name(&l.param) == name;
+                let form = l.coefficients.iter().flatten().find(|c| c.name == name);
+                form.map(|c| c.unit.clone())
+                    .or_else(|| plain.then(|| l.unit.clone()))
+            })
+            .unwrap_or_default(),
+        _ => {
+            let base = name.split('@').next().unwrap_or(name);
+            if base == stf_core::fit::FORCE_OFFSET {
+                in_record_units("N", &units.record)
+            } else {
+                units.param(base)
+            }
+        }
+    }
 }
 
 /// Each law's coefficients with their errors.
