@@ -133,12 +133,30 @@ fn the_identification_writes_a_report_and_prints_a_readable_system() {
         .find(|l| l.starts_with("identified system:"))
         .unwrap();
     assert!(!line.contains('{') && line.contains(" N/m"), "{line}");
+    // Each stage's line gives every value with its unit.
+    let stage = |n: usize| {
+        let head = format!("stage {n} (");
+        stdout
+            .lines()
+            .find(|l| l.starts_with(&head))
+            .unwrap_or_else(|| panic!("no {head} in\n{stdout}"))
+            .to_string()
+    };
+    for unit in [" N/m", " N·s/m", " N"] {
+        assert!(stage(1).contains(unit), "{unit} not in {}", stage(1));
+    }
+    assert!(stage(2).contains(" kg·m"), "{}", stage(2));
     // Each stage over time, and the swept stage's frequency response.
     assert_eq!(check_figures(&out), 3);
     assert!(out.join("figures/frequency_response_stage_2.svg").is_file());
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         md.contains("Identified oscillator: m 7.65 kg, k 269.9"),
+        "{md}"
+    );
+    // Each stage's table has a unit column.
+    assert!(
+        md.contains("| parameter | value ± standard error | unit |") && md.contains("| kg·m |"),
         "{md}"
     );
     let csv = std::fs::read_to_string(out.join("params.csv")).unwrap();

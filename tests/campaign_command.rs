@@ -529,9 +529,30 @@ fn an_affine_global_law_with_an_offset_is_recovered_from_a_zero_condition_up() {
         "laws = { F_y = { condition = \"voltage\", law = \"affine\" } }",
     );
     let out = tmp.path().join("out");
-    let run = campaign(&file, &out, &["--quiet"]);
+    let run = campaign(&file, &out, &[]);
     assert!(run.status.success(), "{}", stderr(&run));
     let g = read_json(&out.join("global.json"));
+    // Every entry of θ with its unit, in global.json and on the terminal's line.
+    let unit_of = |name: &str| {
+        g["params"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == name)
+            .map(|p| p["unit"].as_str().unwrap().to_string())
+    };
+    assert_eq!(unit_of("F_y_base").as_deref(), Some("N"));
+    assert_eq!(unit_of("F_y_gain").as_deref(), Some("N/V"));
+    assert_eq!(unit_of("v_s").as_deref(), Some("m/s"));
+    let said = String::from_utf8_lossy(&run.stdout);
+    let line = said
+        .lines()
+        .find(|l| l.contains("over the records:"))
+        .unwrap_or_else(|| panic!("no line of θ in\n{said}"));
+    assert!(
+        line.contains(" N/V (law coefficient)") && line.contains(" m/s (shared)"),
+        "{line}"
+    );
     let (base, base_se) = global_param(&g, "F_y_base");
     let (gain, gain_se) = global_param(&g, "F_y_gain");
     println!("F_y_base = {base} ± {base_se} (0.1), F_y_gain = {gain} ± {gain_se} (0.1)");

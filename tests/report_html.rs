@@ -151,7 +151,7 @@ fn build_report(dir: &Path) -> PathBuf {
         &figures,
         "hysteresis_v",
         ("velocity v, m/s", &s.v),
-        &s.f,
+        ("F_STF, N", &s.f),
         &s.t,
     )
     .unwrap();

@@ -282,7 +282,12 @@ fn finish(campaign: &Campaign, out: &Path, errors: &BTreeMap<usize, String>) -> 
             .iter()
             .map(|p| {
                 let value = stf_study::digits::with_error(p.value, p.std_error);
-                format!("{} = {value} ({})", p.name, p.role)
+                let unit = if p.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", p.unit)
+                };
+                format!("{} = {value}{unit} ({})", p.name, p.role)
             })
             .collect();
         say!("  {} over the records: {}", g.model, values.join(", "));

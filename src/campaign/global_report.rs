@@ -179,24 +179,22 @@ fn formula(law: &LawJson, shown: impl Fn(&str, f64, f64) -> String) -> String {
     format!("{} = {rhs}", law.param)
 }
 
-/// The fitted law's value at condition `c`: a law with a form clamped into the parameter's
-/// bounds, as the fit clamps it; and whether it was.
+/// The fitted law's value at condition `c`, clamped into the parameter's bounds as the fit
+/// clamps it; and whether it was.
 fn law_at(law: &LawJson, c: f64) -> (f64, bool) {
     let (form, k) = coefficients(law);
     let values: Vec<f64> = k.iter().map(|(_, v, _)| *v).collect();
     let x = c / law.reference;
-    match form {
-        None => (values[0] * x.powf(values[1]), false),
-        Some(form) => {
-            let v = form.value(&values, x);
-            let (lo, hi) = (
-                law.min.unwrap_or(f64::NEG_INFINITY),
-                law.max.unwrap_or(f64::INFINITY),
-            );
-            let held = v.clamp(lo, hi);
-            (held, held != v)
-        }
-    }
+    let v = match form {
+        None => values[0] * x.powf(values[1]),
+        Some(form) => form.value(&values, x),
+    };
+    let (lo, hi) = (
+        law.min.unwrap_or(f64::NEG_INFINITY),
+        law.max.unwrap_or(f64::INFINITY),
+    );
+    let held = v.clamp(lo, hi);
+    (held, held != v)
 }
 
 /// The curve's legend: the law's formula, and where its value was clamped into the
@@ -340,5 +338,23 @@ mod tests {
             "{label}"
         );
         assert!(!curve_label(&affine(0.5, 2.0), false).contains("clamped"));
+    }
+
+    /// The plain law `K0·(c/ref)^K_p` is held within the parameter's bounds too: K0 = 40 at
+    /// reference 1 with exponent 2 passes the upper bound 50 at c = 2 and is held there.
+    #[test]
+    fn the_plain_power_law_is_clamped_into_the_bounds_too() {
+        let law = LawJson {
+            law: None,
+            coefficients: None,
+            coefficient: Some(40.0),
+            coefficient_std_error: Some(0.1),
+            exponent: Some(2.0),
+            exponent_std_error: Some(0.01),
+            ..affine(0.0, 0.0)
+        };
+        assert_eq!(law_at(&law, 1.0), (40.0, false));
+        assert_eq!(law_at(&law, 2.0), (50.0, true));
+        assert!(curve_label(&law, true).ends_with("clamped into [0, 50] N as in the fit"));
     }
 }

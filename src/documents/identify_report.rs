@@ -15,6 +15,7 @@ use crate::report::{
     Table, DISPLACEMENT_MM,
 };
 use stf_study::compare::response;
+use stf_study::param_table::rows_of;
 use stf_study::shown_units::ShownUnits;
 
 pub use stf_study::identify::StageOutcome;
@@ -35,15 +36,17 @@ fn stage_section(i: usize, s: &StageOutcome, units: &ShownUnits, dir: &Path) -> 
             "did not converge"
         }
     );
-    let rows = s.result.params.iter().map(|p| {
+    let label = format!("stage {}", i + 1);
+    let units_of = rows_of(&label, &s.result, None, &s.warnings, units);
+    let rows = s.result.params.iter().zip(&units_of).map(|(p, row)| {
         let value = if p.fixed {
             format!("{} (held)", p.shown_value())
         } else {
             stf_study::digits::with_error(p.value, p.std_error)
         };
-        vec![p.name.clone(), value]
+        vec![p.name.clone(), value, row.unit.clone()]
     });
-    let columns = ["parameter", "value ± standard error"];
+    let columns = ["parameter", "value ± standard error", "unit"];
     section
         .tables
         .push(Table::new(caption, &columns).with_rows(rows.collect()));

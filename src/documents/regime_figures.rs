@@ -257,7 +257,7 @@ pub fn regime_section(
             models: Vec::new(),
         },
         TimeRow {
-            label: "F_STF, N",
+            label: motion.force,
             measured: f,
             models: models.to_vec(),
         },
@@ -295,7 +295,7 @@ pub fn regime_section(
     if !models.is_empty() {
         let groups = groups_of(&found, &cycles);
         let quantity = ParityQuantity {
-            label: "F_STF, N".into(),
+            label: motion.force.into(),
             group: words.group,
             noise_sigma: Some(stf_core::numerics::derivative::noise_estimate(f).sigma),
         };

@@ -72,7 +72,7 @@ fn record_section(data: &FitData, f: Option<&[f64]>, dir: &Path) -> Result<Secti
         ("hysteresis_v", labels.v, milli(&k.v)),
         ("hysteresis_a", labels.a, k.a.clone()),
     ] {
-        let fig = hysteresis(dir, name, (label, &series), f, &k.t)?;
+        let fig = hysteresis(dir, name, (label, &series), (labels.force, f), &k.t)?;
         s.figures.push(FigureRef::new(
             fig,
             format!("Hysteresis loop of F_STF against {label}, coloured by time."),
@@ -117,7 +117,7 @@ fn fits_section(data: &FitData, fits: &[ModelFit], dir: &Path) -> Result<Section
         .map(|f| (f.label.as_str(), scaled(&f.fitted)))
         .collect();
     let quantity = match data.level {
-        FitLevel::Force => STF_FORCE,
+        FitLevel::Force => STF_FORCE.in_units(&data.units),
         FitLevel::Trajectory => DISPLACEMENT_MM.in_units(&data.units),
     };
     let fig = measured_vs_model(
@@ -232,7 +232,7 @@ pub fn validation_section(
         .collect();
     if !predicted.is_empty() {
         let quantity = match rec.data.level {
-            FitLevel::Force => STF_FORCE_VALIDATION,
+            FitLevel::Force => STF_FORCE_VALIDATION.in_units(&rec.data.units),
             FitLevel::Trajectory => DISPLACEMENT_VALIDATION_MM.in_units(&rec.data.units),
         };
         let measured: Vec<f64> = rec.data.target().iter().map(|x| x * scale).collect();

@@ -25,7 +25,9 @@ pub struct FigureFiles {
     pub csv: PathBuf,
 }
 
-/// The STF force axis, as every figure labels it.
+/// The STF force axis of a record in newtons (the figures take the record's own from
+/// [`super::MotionLabels::force`]).
+#[cfg(test)]
 pub const F_LABEL: &str = "F_STF, N";
 /// The time axis, as every figure labels it.
 pub const T_LABEL: &str = "time t, s";

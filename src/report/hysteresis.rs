@@ -10,7 +10,7 @@ use super::colour::viridis;
 use super::decimate::{decimate_union, pick, MAX_POINTS_PER_LINE};
 use super::figure::{
     axis_desc_style, draw_mesh, finite_runs, msg, render, require_finite, same_length, tick_label,
-    tick_style, titled, Draw, FigureFiles, F_LABEL, SIZE, T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
+    tick_style, titled, Draw, FigureFiles, SIZE, T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
 };
 use super::plot_range::{exact_range, padded_range};
 use super::series_csv::Column;
@@ -23,6 +23,7 @@ const COLOUR_BAR_WIDTH: u32 = 165;
 
 struct HysteresisPlot {
     label: String,
+    f_label: String,
     t: Vec<f64>,
     x: Vec<f64>,
     f: Vec<f64>,
@@ -53,7 +54,7 @@ impl Draw for HysteresisPlot {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let no_data = |what: &str| format!("{what}: no finite value");
         let x_range = padded_range(&self.x).ok_or_else(|| no_data(&self.label))?;
-        let f_range = padded_range(&self.f).ok_or_else(|| no_data(F_LABEL))?;
+        let f_range = padded_range(&self.f).ok_or_else(|| no_data(&self.f_label))?;
         let t_range = exact_range(&self.t).ok_or_else(|| no_data(T_LABEL))?;
         let quantity = self.label.split(',').next().unwrap_or(&self.label);
         let title = format!("F_STF against {quantity}");
@@ -69,7 +70,7 @@ impl Draw for HysteresisPlot {
             .map_err(msg)?;
         draw_mesh(
             &mut chart,
-            (self.label.as_str(), F_LABEL),
+            (self.label.as_str(), self.f_label.as_str()),
             None,
             axis_desc_style(),
         )?;
@@ -125,16 +126,18 @@ pub fn hysteresis(
     out_dir: &Path,
     name: &str,
     against: (&str, &[f64]),
-    f_stf: &[f64],
+    force: (&str, &[f64]),
     t: &[f64],
 ) -> Result<FigureFiles, ReportError> {
     let (label, x) = against;
+    let (f_label, f_stf) = force;
     same_length(&format!("hysteresis: {label} and F_STF"), x, f_stf)?;
     same_length("hysteresis: t and F_STF", t, f_stf)?;
     require_finite("hysteresis", &[("t", t), (label, x), ("F_STF", f_stf)])?;
     let keep = decimate_union(&[x, f_stf], MAX_POINTS_PER_LINE);
     let plot = HysteresisPlot {
         label: label.to_string(),
+        f_label: f_label.to_string(),
         t: pick(t, &keep),
         x: pick(x, &keep),
         f: pick(f_stf, &keep),
@@ -142,7 +145,7 @@ pub fn hysteresis(
     let columns = vec![
         Column::new("t, s", plot.t.clone()),
         Column::new(label, plot.x.clone()),
-        Column::new(F_LABEL, plot.f.clone()),
+        Column::new(f_label, plot.f.clone()),
     ];
     render(out_dir, name, SIZE, &plot, &columns)
 }
@@ -150,6 +153,7 @@ pub fn hysteresis(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::figure::F_LABEL;
     use crate::report::test_signals::{assert_rendered, column, damped_sine};
 
     #[test]
@@ -161,7 +165,7 @@ mod tests {
             ("loop_v", "velocity v, m/s", &s.v),
             ("loop_a", "acceleration a, m/s²", &s.a),
         ] {
-            let files = hysteresis(dir.path(), name, (label, y), &s.f, &s.t).unwrap();
+            let files = hysteresis(dir.path(), name, (label, y), (F_LABEL, &s.f), &s.t).unwrap();
             let cols = assert_rendered(&files, SIZE);
             // Short record: nothing decimated, the CSV is the data.
             assert_eq!(column(&cols, "t, s"), &s.t[..]);
@@ -183,7 +187,7 @@ mod tests {
         }
         let dir = tempfile::tempdir().unwrap();
         let label = "acceleration a, m/s²";
-        let files = hysteresis(dir.path(), "loop_a", (label, &a), &s.f, &s.t).unwrap();
+        let files = hysteresis(dir.path(), "loop_a", (label, &a), (F_LABEL, &s.f), &s.t).unwrap();
         let cols = assert_rendered(&files, SIZE);
         let t = column(&cols, "t, s");
         assert!(t.len() <= MAX_POINTS_PER_LINE, "{} rows", t.len());
@@ -194,6 +198,7 @@ mod tests {
         assert!(t[gap] == s.t[30_000] && x[gap].is_nan());
         let plot = HysteresisPlot {
             label: label.into(),
+            f_label: F_LABEL.into(),
             t: s.t.clone(),
             x: a.clone(),
             f: s.f.clone(),
@@ -214,7 +219,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let nan = [f64::NAN; 5];
         let t = [0.0, 1.0, 2.0, 3.0, 4.0];
-        let err = hysteresis(dir.path(), "h", ("x, m", &nan), &t, &t).unwrap_err();
+        let err = hysteresis(dir.path(), "h", ("x, m", &nan), (F_LABEL, &t), &t).unwrap_err();
         assert!(matches!(err, ReportError::NoData { .. }), "{err}");
     }
 }

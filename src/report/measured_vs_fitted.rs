@@ -36,11 +36,15 @@ pub struct Quantity {
 
 impl Quantity {
     /// The quantity labelled in the record's own units: a displacement of a record whose x is
-    /// a voltage in mV, every other label as it is.
+    /// a voltage in mV, the STF force in V where the record's force is a voltage
+    /// ([`ShownUnits::force_si`]), every other label as it is.
     pub fn in_units(self, units: &ShownUnits) -> Quantity {
+        let volts = units.force_si == "V";
         let label = match (units.is_voltage(), self.label) {
             (true, "x, mm") => "x, mV",
             (true, "x residual, mm") => "x residual, mV",
+            (_, "F_STF, N") if volts => "F_STF, V",
+            (_, "F_STF residual, N") if volts => "F_STF residual, V",
             (_, label) => label,
         };
         Quantity { label, ..self }

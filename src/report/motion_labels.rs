@@ -1,7 +1,9 @@
 //! The labels of a record's motion on figures' axes and in their CSV columns, in the record's
 //! own units: mm, mm/s and m/s² for the trolley's displacement, mV, mV/s and V/s² for an x
 //! that is a voltage (an electronic oscillator's output). The plotted numbers are the same
-//! either way (x and v in thousandths of the record's unit, a in its unit per s²).
+//! either way (x and v in thousandths of the record's unit, a in its unit per s²). The STF
+//! force is labelled in the record's unit of force: N, or V where the force is a voltage
+//! read with a gain of 1 ([`ShownUnits::force_si`]).
 
 use stf_study::shown_units::ShownUnits;
 
@@ -26,6 +28,10 @@ pub struct MotionLabels {
     pub v_unit: &'static str,
     /// Unit of a as shown: `m/s²` or `V/s²`.
     pub a_unit: &'static str,
+    /// Axis label and CSV column of the STF force: `F_STF, N` or `F_STF, V`.
+    pub force: &'static str,
+    /// Unit of the STF force: `N` or `V`.
+    pub force_unit: &'static str,
 }
 
 impl MotionLabels {
@@ -40,6 +46,8 @@ impl MotionLabels {
         x_unit: "mm",
         v_unit: "mm/s",
         a_unit: "m/s²",
+        force: "F_STF, N",
+        force_unit: "N",
     };
 
     /// A record whose x is a voltage.
@@ -53,14 +61,43 @@ impl MotionLabels {
         x_unit: "mV",
         v_unit: "mV/s",
         a_unit: "V/s²",
+        force: "F_STF, N",
+        force_unit: "N",
     };
 
     /// The labels of a record shown in `units`.
     pub fn of(units: &ShownUnits) -> MotionLabels {
-        if units.is_voltage() {
+        let motion = if units.is_voltage() {
             MotionLabels::VOLTAGE
         } else {
             MotionLabels::LENGTH
+        };
+        if units.force_si == "V" {
+            MotionLabels {
+                force: "F_STF, V",
+                force_unit: "V",
+                ..motion
+            }
+        } else {
+            motion
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_force_is_labelled_in_the_records_unit_of_force() {
+        assert_eq!(MotionLabels::of(&ShownUnits::LENGTH).force, "F_STF, N");
+        assert_eq!(MotionLabels::of(&ShownUnits::VOLTAGE).force, "F_STF, N");
+        let volts = ShownUnits {
+            force_si: "V",
+            ..ShownUnits::VOLTAGE
+        };
+        let labels = MotionLabels::of(&volts);
+        assert_eq!((labels.force, labels.force_unit), ("F_STF, V", "V"));
+        assert_eq!(labels.x, "x, mV");
     }
 }

@@ -157,8 +157,14 @@ mod tests {
                 .map(|(i, f)| f + if i % 2 == 0 { 0.05 } else { -0.05 })
                 .collect();
         let dir = tempfile::tempdir().unwrap();
-        let files =
-            super::super::hysteresis(dir.path(), "zigzag", ("x, m", &s.x), &zigzag, &s.t).unwrap();
+        let files = super::super::hysteresis(
+            dir.path(),
+            "zigzag",
+            ("x, m", &s.x),
+            ("F_STF, N", &zigzag),
+            &s.t,
+        )
+        .unwrap();
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         let png = std::fs::read(&files.png).unwrap();
         assert_eq!(stray_coloured_pixels(&svg, &png, 3.0), Ok(0));

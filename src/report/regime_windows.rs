@@ -13,8 +13,8 @@ use super::colour::series_colour;
 use super::decimate::{decimate_ranges, pick};
 use super::figure::{
     draw_mesh, draw_runs, legend_strip, model_entries_flagged, msg, render, same_as_earlier,
-    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, F_LABEL,
-    MEASURED_LINE, MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
+    same_length, small_panel, tick_style, titled, Draw, FigureFiles, Swatch, MEASURED_LINE,
+    MEASURED_WIDTH, ONE_COLUMN, TWO_COLUMNS,
 };
 use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};
@@ -164,7 +164,12 @@ impl WindowsPlot<'_> {
         let mut chart = small_panel(area, caption)
             .build_cartesian_2d(x_range.clone(), f_range.clone())
             .map_err(msg)?;
-        draw_mesh(&mut chart, (x_label, F_LABEL), Some((5, 6)), tick_style())?;
+        draw_mesh(
+            &mut chart,
+            (x_label, self.series.labels.force),
+            Some((5, 6)),
+            tick_style(),
+        )?;
         draw_runs(
             &mut chart,
             (&x, &f),
@@ -235,9 +240,10 @@ pub fn regime_windows(
     cut.push_column(s.labels.x_column, s.x_mm);
     cut.push_column(s.labels.v_column, s.v_mm);
     cut.push_column(s.labels.a_column, s.a);
-    cut.push_column("F_STF measured, N", s.f);
+    let unit = s.labels.force_unit;
+    cut.push_column(format!("F_STF measured, {unit}"), s.f);
     for (label, m) in s.models {
-        cut.push_column(format!("F_STF {label}, N"), m);
+        cut.push_column(format!("F_STF {label}, {unit}"), m);
     }
     let plot = WindowsPlot {
         series: *s,

@@ -14,8 +14,8 @@ use super::envelope::{band, buckets_for, dense, envelope};
 use super::extrema::{extrema, noise_delta, ExtremumKind};
 use super::figure::{
     axis_desc_style, draw_line, draw_mesh_with, finite_runs, legend_strip, milli, msg, render,
-    require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, F_LABEL, SIZE_TALL,
-    T_LABEL, X_LABEL_AREA, Y_LABEL_AREA,
+    require_finite, same_length, titled, Chart2d, Draw, FigureFiles, Swatch, SIZE_TALL, T_LABEL,
+    X_LABEL_AREA, Y_LABEL_AREA,
 };
 use super::motion_labels::MotionLabels;
 use super::plot_range::{exact_range, padded_range};
@@ -203,12 +203,15 @@ pub fn time_history(
             .collect()
     });
     if let Some(f) = f_stf {
-        panels.push((F_LABEL, pick(f, &keep)));
+        panels.push((labels.force, pick(f, &keep)));
         let of = |g: fn(&(f64, f64, ExtremumKind)) -> f64| marks.iter().map(g).collect();
         columns.extend([
-            Column::new(F_LABEL, panels[3].1.clone()),
+            Column::new(labels.force, panels[3].1.clone()),
             Column::new("F_STF extremum t, s", of(|m| m.0)),
-            Column::new("F_STF extremum, N", of(|m| m.1)),
+            Column::new(
+                format!("F_STF extremum, {}", labels.force_unit),
+                of(|m| m.1),
+            ),
             Column::new(
                 "F_STF extremum kind (1 max, -1 min)",
                 of(|m| match m.2 {

@@ -225,7 +225,8 @@ fn print_warnings(warnings: &[FitWarning]) {
     }
 }
 
-/// The terminal line of identification stage `i`, its warnings under it.
+/// The terminal line of identification stage `i`, each value with its unit in the record's
+/// units, its warnings under it.
 fn print_stage(
     i: usize,
     stage: &StageSpec,
@@ -233,18 +234,14 @@ fn print_stage(
     warnings: &[FitWarning],
     units: &ShownUnits,
 ) {
+    let rows = rows_of(&format!("stage {}", i + 1), result, None, warnings, units);
     say!(
         "stage {} ({}): S(μ) = {:.4} {}, {}{}",
         i + 1,
         stage.data.display(),
         result.s_mm2.unwrap_or(f64::NAN),
         units.x_squared,
-        result
-            .params
-            .iter()
-            .map(crate::digits::param_with_error)
-            .collect::<Vec<_>>()
-            .join(", "),
+        values_line(&rows),
         if result.convergence.converged() {
             ""
         } else {

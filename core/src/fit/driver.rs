@@ -418,26 +418,24 @@ impl Chain<'_> {
     }
 }
 
-/// How near a bound (as a fraction of the box's width, or of the typical size for a bound on
-/// one side only) a parameter the data push past it counts as held by it. A bounded map
-/// flattens towards its bounds, so a solver stops short of one it is pushed against (an offset
-/// of −124 N stopped at −99.93 in a box of ±100 N, 0.07 % of the width inside).
+/// How near a bound a parameter the data push past it counts as held by it, as a fraction of
+/// the bound's own scale (see [`held_by`]). A bounded map flattens towards its bounds, so a
+/// solver stops short of one it is pushed against (an offset of −124 N stopped at −99.93 in a
+/// box of ±100 N, 0.07 % of the bound inside).
 pub const HELD_REACH: f64 = 0.05;
 
-/// The bound that holds `q` at `value`: within [`HELD_REACH`] of it, and the Gauss–Newton
-/// `step` from there crosses it.
+/// The bound that holds `q` at `value`: within [`HELD_REACH`] of the bound's scale, and the
+/// Gauss–Newton `step` from there crosses it. The bound's scale is the larger of its |value|
+/// and the parameter's typical size, and at most the box's width: so a bound at 0 of a
+/// parameter whose box is wide (`c_s` in [0, 10⁴]) holds it only within a twentieth of its
+/// typical size, never at 12.7 (5 % of the width would reach 500).
 fn held_by(q: &FitParam, value: f64, step: f64) -> Option<BoundSide> {
     let width = q.max - q.min;
-    let reach = HELD_REACH
-        * if width.is_finite() {
-            width
-        } else {
-            q.effective_scale()
-        };
+    let reach = |bound: f64| HELD_REACH * bound.abs().max(q.effective_scale()).min(width);
     let to = value + step;
-    if q.min.is_finite() && to < q.min && value - q.min <= reach {
+    if q.min.is_finite() && to < q.min && value - q.min <= reach(q.min) {
         Some(BoundSide::Lower)
-    } else if q.max.is_finite() && to > q.max && q.max - value <= reach {
+    } else if q.max.is_finite() && to > q.max && q.max - value <= reach(q.max) {
         Some(BoundSide::Upper)
     } else {
         None
@@ -714,5 +712,33 @@ mod tests {
                 assert_eq!(flagged, held.is_some(), "{solver:?}, truth {truth}");
             }
         }
+    }
+
+    /// The rule of [`held_by`] both ways: a parameter is held by a bound it is pushed past
+    /// only when it stopped near it on the bound's scale.
+    #[test]
+    fn a_bound_holds_a_parameter_only_near_it_on_its_own_scale() {
+        // c_s in [0, 1e4], typical size 2: at 12.69 it is far from its bound at 0 even if
+        // the step from there crosses it; at 0.01 it is held.
+        let c_s = FitParam::new("c_s", 2.0).bounds(0.0, 1e4);
+        assert_eq!(held_by(&c_s, 12.6872, -20.0), None);
+        assert_eq!(held_by(&c_s, 0.01, -1.0), Some(BoundSide::Lower));
+        assert_eq!(held_by(&c_s, 0.01, 0.5), None);
+        // An offset stopped 0.07 inside a bound of −100 the data push it past is held by it,
+        // whatever its typical size; one 10 inside is not.
+        for scale in [0.1, 1.0, 100.0] {
+            let off = FitParam::new("f_off", 0.0)
+                .bounds(-100.0, 100.0)
+                .scale(scale);
+            assert_eq!(held_by(&off, -99.93, -24.0), Some(BoundSide::Lower));
+            assert_eq!(held_by(&off, 99.93, 24.0), Some(BoundSide::Upper));
+            assert_eq!(held_by(&off, -90.0, -30.0), None);
+        }
+        // A one-sided bound away from 0: its own size sets the reach.
+        let k = FitParam::new("k", 1500.0)
+            .bounds(1000.0, f64::INFINITY)
+            .scale(1.0);
+        assert_eq!(held_by(&k, 1010.0, -50.0), Some(BoundSide::Lower));
+        assert_eq!(held_by(&k, 1100.0, -150.0), None);
     }
 }

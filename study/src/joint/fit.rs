@@ -36,7 +36,8 @@ use crate::experiment::FitLevel;
 pub enum Source {
     /// θ's `i`-th entry.
     Theta(usize),
-    /// `θ[coefficient]·ratio^θ[exponent]`, `ratio` the record's condition over the reference.
+    /// `θ[coefficient]·ratio^θ[exponent]`, `ratio` the record's condition over the reference,
+    /// clamped into the parameter's bounds.
     Law {
         /// Index of `P0` in θ.
         coefficient: usize,
@@ -46,6 +47,8 @@ pub enum Source {
         ratio: f64,
         /// Index of the law in `GlobalSpec::laws`.
         law: usize,
+        /// The parameter's (widest) bounds, which the law's value is clamped into.
+        bounds: (f64, f64),
     },
     /// A law with a form ([`Form`]) of `x`, the record's condition over the reference, its
     /// coefficients θ's entries from `first` on (in [`Form::coefficients`]' order).
@@ -72,8 +75,9 @@ impl Source {
                 coefficient,
                 exponent,
                 ratio,
+                bounds,
                 ..
-            } => theta[coefficient] * ratio.powf(theta[exponent]),
+            } => power_value(theta[coefficient], theta[exponent], ratio, bounds),
             Source::Form {
                 form,
                 first,
@@ -83,6 +87,13 @@ impl Source {
             } => form_value(form, theta, first, x, bounds),
         }
     }
+}
+
+/// The plain law `P0·ratio^P_p`, clamped into the parameter's `bounds` as a law with a form
+/// is ([`form_value`]): the model never sees a value its parameter may not take.
+pub fn power_value(coefficient: f64, exponent: f64, ratio: f64, bounds: (f64, f64)) -> f64 {
+    let (lo, hi) = bounds;
+    (coefficient * ratio.powf(exponent)).clamp(lo, hi)
 }
 
 /// The value of `form` at `x`, its coefficients θ's entries from `first` on, clamped into
@@ -190,10 +201,12 @@ pub struct Layout {
 }
 
 impl Layout {
-    /// The bounds the value of law `index` (a law with a form) is clamped into.
-    pub fn form_bounds(&self, index: usize) -> Option<(f64, f64)> {
+    /// The bounds the value of law `index` is clamped into.
+    pub fn law_bounds(&self, index: usize) -> Option<(f64, f64)> {
         self.sources.iter().flatten().find_map(|s| match *s {
-            Source::Form { law, bounds, .. } if law == index => Some(bounds),
+            Source::Form { law, bounds, .. } | Source::Law { law, bounds, .. } if law == index => {
+                Some(bounds)
+            }
             _ => None,
         })
     }
@@ -294,6 +307,7 @@ impl Layout {
                 exponent: i + 1,
                 ratio: r.condition(&law.condition) / law.reference,
                 law: index,
+                bounds: (p.min, p.max),
             });
         }
     }
@@ -692,5 +706,35 @@ mod tests {
         assert!((result.value("b@4").unwrap() - 2.0).abs() < 1e-6);
         assert!((result.value("b@5").unwrap() + 1.0).abs() < 1e-6);
         assert!((result.value("a").unwrap() - 1.5).abs() < 1e-6);
+    }
+
+    /// The plain law is clamped into its parameter's bounds ([0, 100] for `a`), as a law
+    /// with a form is: a = 60·(c/2)² leaves them at c = 3 (135), where the records' `a` is
+    /// held at 100; the joint fit recovers the law exactly only if it holds it there too.
+    #[test]
+    fn the_plain_law_is_clamped_into_the_parameters_bounds() {
+        let records: Vec<JointRecord> = [1.0, 2.0, 3.0]
+            .iter()
+            .map(|&c| record(c, (60.0 * (c / 2.0_f64).powi(2)).min(100.0), 0.7))
+            .collect();
+        let numbered: Vec<(usize, &JointRecord)> = records.iter().enumerate().collect();
+        let laws = [Law {
+            param: "a".into(),
+            condition: "c".into(),
+            reference: 2.0,
+            form: None,
+        }];
+        let starts = vec![vec![50.0, 1.0]; 3];
+        let layout = layout(&["b".into()], &laws, &numbered, &starts);
+        assert_eq!(layout.law_bounds(0), Some((0.0, 100.0)));
+        let theta = [60.0, 2.0, 0.7];
+        let values: Vec<f64> = layout.sources.iter().map(|s| s[0].value(&theta)).collect();
+        assert_eq!(values, [15.0, 60.0, 100.0]);
+        let refs: Vec<&JointRecord> = records.iter().collect();
+        let result = fit(&layout, &refs, &Default::default(), FitLevel::Force).unwrap();
+        for (name, truth) in [("a0", 60.0), ("a_p", 2.0), ("b", 0.7)] {
+            let v = result.value(name).unwrap();
+            assert!((v - truth).abs() < 1e-6, "{name} = {v}");
+        }
     }
 }

@@ -79,6 +79,9 @@ pub struct GlobalParam {
     pub value: f64,
     /// Block-robust standard error (as every fit's).
     pub std_error: f64,
+    /// Its unit on the records (the model's parameter's, a law coefficient's as in `laws`;
+    /// empty for a plain number such as an exponent).
+    pub unit: String,
 }
 
 /// A fitted law: `param = coefficient·(condition/reference)^exponent`, or with a form
@@ -115,8 +118,8 @@ pub struct LawJson {
     /// A law with a form: its coefficients (`P_base`, `P_gain`, `P_exp`) with their errors.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coefficients: Option<Vec<LawCoefficient>>,
-    /// A law with a form: the parameter's lower bound, which its value is clamped to (absent
-    /// where unbounded), as in the fit.
+    /// The parameter's lower bound, which the law's value is clamped to (absent where
+    /// unbounded), as in the fit.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub min: Option<f64>,
     /// Its upper bound, likewise.
@@ -367,11 +370,12 @@ fn holdout_json(
                 coefficient,
                 exponent,
                 law,
+                bounds,
                 ..
             } => {
                 let law = &spec.laws[*law];
                 let ratio = held.joint.condition(&law.condition) / law.reference;
-                theta[*coefficient] * ratio.powf(theta[*exponent])
+                global_fit::power_value(theta[*coefficient], theta[*exponent], ratio, *bounds)
             }
             Source::Form {
                 form,
@@ -472,6 +476,7 @@ fn assemble(
     let supported = delta_bic < 0.0 && better_held;
     let verdict = verdict_text(supported, delta_bic, holdout.as_ref(), spec.level, shown.0);
     let caveats = all_caveats(spec, training, &global, &per_record, holdout.as_ref());
+    let laws = laws_json(spec, &result, units, layout);
     GlobalJson {
         model: spec.model.clone(),
         level: spec.level.name().into(),
@@ -482,8 +487,8 @@ fn assemble(
             .iter()
             .map(|l| l.unit.record_given.clone())
             .collect(),
-        params: theta_json(&result, layout),
-        laws: laws_json(spec, &result, units, layout),
+        params: theta_json(&result, layout, units, &laws),
+        laws,
         global,
         per_record,
         delta_bic,
@@ -526,7 +531,12 @@ impl Units {
 }
 
 /// θ with its roles and standard errors.
-fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalParam> {
+fn theta_json(
+    result: &FitResult,
+    layout: &global_fit::Layout,
+    units: &Units,
+    laws: &[LawJson],
+) -> Vec<GlobalParam> {
     result
         .params
         .iter()
@@ -536,8 +546,35 @@ fn theta_json(result: &FitResult, layout: &global_fit::Layout) -> Vec<GlobalPara
             role: role.to_string(),
             value: p.value,
             std_error: p.std_error,
+            unit: theta_unit(&p.name, role, units, laws),
         })
         .collect()
+}
+
+/// The unit of θ's entry `name` in `role`: a law's coefficient as `laws` give it, an
+/// exponent none, a shared or per-record parameter (`K@3`) its model parameter's, a force
+/// offset the records' force.
+fn theta_unit(name: &str, role: &str, units: &Units, laws: &[LawJson]) -> String {
+    match role {
+        "law exponent" => String::new(),
+        "law coefficient" => laws
+            .iter()
+            .find_map(|l| {
+                let plain = global_fit::coefficient_name(&l.param) == name;
+                let form = l.coefficients.iter().flatten().find(|c| c.name == name);
+                form.map(|c| c.unit.clone())
+                    .or_else(|| plain.then(|| l.unit.clone()))
+            })
+            .unwrap_or_default(),
+        _ => {
+            let base = name.split('@').next().unwrap_or(name);
+            if base == stf_core::fit::FORCE_OFFSET {
+                in_record_units("N", &units.record)
+            } else {
+                units.param(base)
+            }
+        }
+    }
 }
 
 /// Each law's coefficients with their errors.
@@ -567,6 +604,10 @@ fn laws_json(
                 max: None,
                 unit: unit.clone(),
             };
+            if let Some((lo, hi)) = layout.law_bounds(index) {
+                json.min = lo.is_finite().then_some(lo);
+                json.max = hi.is_finite().then_some(hi);
+            }
             let Some(form) = l.form else {
                 let c = result.param(&global_fit::coefficient_name(&l.param))?;
                 let e = result.param(&global_fit::exponent_name(&l.param))?;
@@ -602,10 +643,6 @@ fn laws_json(
                 .collect::<Option<Vec<_>>>()?;
             json.law = Some(form.name().to_string());
             json.coefficients = Some(coefficients);
-            if let Some((lo, hi)) = layout.form_bounds(index) {
-                json.min = lo.is_finite().then_some(lo);
-                json.max = hi.is_finite().then_some(hi);
-            }
             Some(json)
         })
         .collect()

@@ -148,7 +148,7 @@ impl<'a> DiscoveryJson<'a> {
             gap_after: found.gap_after,
             noise_floor: found.noise_floor,
             noise_floor_parts: &found.noise_floor_parts,
-            gap_unit: "N",
+            gap_unit: data.units.force_si,
             holdout_cycles: found.holdout_cycles,
             where_before: &found.where_before,
             where_after: &found.where_after,
