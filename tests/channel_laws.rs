@@ -119,15 +119,18 @@ fn a_yield_force_following_a_control_channel_is_recovered_at_force_level() {
     }
 }
 
-/// The law's coefficients at trajectory level, with standard errors that hold: the truth
-/// within 3.5 standard errors of each (measured z at the default `rtol` 1e-7: F_y_base −2.97,
-/// F_y_gain 2.22 for seed 1 at 0.1 rad/s²; −0.07, 0.39 for seed 2; −0.70, −0.74 for seed 1 at
-/// 0.2 rad/s²), the RMS of all z within a factor 3 of 1 (measured 1.5 with c_s). The
-/// difference steps of the errors once had the size of the yield force's neutral start
-/// (2e-7 N), below the integrator's noise: F_y_base was 0.49936 ± 8.6e-7, 750 errors off.
-/// At the faster sweep seed 2 ends in a valley far from the truth (0.66 mm RMS, c_s 12.7: the
-/// refinement crawls from its start along c_s, F_y and v_s and stops; so it does at
-/// `rtol` 1e-10, at 0.059 mm): the fit must then say so, not report small errors silently.
+/// The law's coefficients at trajectory level, with standard errors that hold: in every case
+/// the fit reaches the noise floor and the truth lies within 3.5 standard errors of each
+/// coefficient (measured z at the default `rtol` 1e-7 — c_s, F_y_base, F_y_gain: seed 1 at
+/// 0.1 rad/s² +1.95, −2.59, +2.18; seed 2 +0.04, −0.13, +0.41; seed 1 at 0.2 rad/s² +0.80,
+/// −0.87, −0.75; seed 2 −0.65, +1.47, −1.75: all within 3), the RMS of all z within a factor 3
+/// of 1 (measured 1.4). The difference steps of the errors once had the size of the yield
+/// force's neutral start (2e-7 N), below the integrator's noise: F_y_base was 0.49936 ± 8.6e-7,
+/// 750 errors off. Seed 2 at the faster sweep is the hard case: its initial velocity hardly
+/// moves the residuals (the trolley sticks at the start), its Gauss–Newton component is
+/// thousands of scales, and the step cap shortens every step by it, so the refinement creeps
+/// (about 4 000 evaluations against 300–700 for the others); it once stopped that way in a
+/// valley off the truth (0.66 mm RMS, c_s 12.7).
 #[test]
 fn a_yield_force_following_a_control_channel_is_recovered_at_trajectory_level() {
     let mut z2 = Vec::new();
@@ -141,13 +144,10 @@ fn a_yield_force_following_a_control_channel_is_recovered_at_trajectory_level() 
             .iter()
             .filter_map(|w| w["kind"].as_str())
             .collect();
-        if law["rms"].as_f64().unwrap() > 0.06e-3 {
-            assert!(
-                kinds.contains(&"above_noise_floor"),
-                "seed {seed}, {alpha} rad/s²: a fit off the truth says nothing\n{law}"
-            );
-            continue;
-        }
+        assert!(
+            law["rms"].as_f64().unwrap() < 0.06e-3 && !kinds.contains(&"above_noise_floor"),
+            "seed {seed}, {alpha} rad/s²: the fit ends off the truth\n{law}"
+        );
         for (name, truth) in [("F_y_base", 0.5), ("F_y_gain", 1.5), ("c_s", 5.0)] {
             let got = law["params"][name].as_f64().unwrap();
             let se = law["std_errors"][name].as_f64().unwrap();
@@ -160,7 +160,6 @@ fn a_yield_force_following_a_control_channel_is_recovered_at_trajectory_level() 
         }
         assert!(!kinds.contains(&"noisy_error"), "{law}");
     }
-    assert!(z2.len() >= 9, "fewer than three fits reached the truth");
     let rms_z = (z2.iter().sum::<f64>() / z2.len() as f64).sqrt();
     assert!((1.0 / 3.0..3.0).contains(&rms_z), "RMS of z {rms_z}");
 }
