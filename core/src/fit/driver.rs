@@ -424,18 +424,31 @@ impl Chain<'_> {
 /// box of ±100 N, 0.07 % of the bound inside).
 pub const HELD_REACH: f64 = 0.05;
 
-/// The bound that holds `q` at `value`: within [`HELD_REACH`] of the bound's scale, and the
-/// Gauss–Newton `step` from there crosses it. The bound's scale is the larger of its |value|
-/// and the parameter's typical size, and at most the box's width: so a bound at 0 of a
-/// parameter whose box is wide (`c_s` in [0, 10⁴]) holds it only within a twentieth of its
-/// typical size, never at 12.7 (5 % of the width would reach 500).
+/// The bound that holds `q` at `value`: the Gauss–Newton `step` from there crosses it, and
+/// the parameter is within [`HELD_REACH`] of the bound's own scale (the larger of its |value|
+/// and the typical size, at most the width), or within [`HELD_REACH`] of the box's width (of
+/// its typical size, for a bound on one side only) with a step that would carry it past the
+/// bound by at least its distance from it. So `c_s` in [0, 10⁴] stopped at 12.7 with a step
+/// of −20 is not held (5 % of the width alone would reach 500), while a candidate started
+/// next to nothing (its typical size then tiny) and pushed through 0 still is.
 fn held_by(q: &FitParam, value: f64, step: f64) -> Option<BoundSide> {
     let width = q.max - q.min;
-    let reach = |bound: f64| HELD_REACH * bound.abs().max(q.effective_scale()).min(width);
+    let outer = HELD_REACH
+        * if width.is_finite() {
+            width
+        } else {
+            q.effective_scale()
+        };
+    let near = |bound: f64| HELD_REACH * bound.abs().max(q.effective_scale()).min(width);
+    // Near on the bound's own scale; or within the outer reach, with a step that would carry
+    // it past the bound by at least its distance from it.
+    let held = |distance: f64, bound: f64| {
+        distance <= near(bound) || (distance <= outer && step.abs() >= 2.0 * distance)
+    };
     let to = value + step;
-    if q.min.is_finite() && to < q.min && value - q.min <= reach(q.min) {
+    if q.min.is_finite() && to < q.min && held(value - q.min, q.min) {
         Some(BoundSide::Lower)
-    } else if q.max.is_finite() && to > q.max && q.max - value <= reach(q.max) {
+    } else if q.max.is_finite() && to > q.max && held(q.max - value, q.max) {
         Some(BoundSide::Upper)
     } else {
         None
@@ -732,8 +745,16 @@ mod tests {
                 .scale(scale);
             assert_eq!(held_by(&off, -99.93, -24.0), Some(BoundSide::Lower));
             assert_eq!(held_by(&off, 99.93, 24.0), Some(BoundSide::Upper));
-            assert_eq!(held_by(&off, -90.0, -30.0), None);
+            // 10 inside: not held when the step carries it only 5 past the bound, nor 11
+            // inside (past 5 % of the width) whatever the step.
+            assert_eq!(held_by(&off, -90.0, -15.0), None);
+            assert_eq!(held_by(&off, -89.0, -300.0), None);
         }
+        // A candidate started next to nothing (typical size 1e-6) and pushed through 0 is
+        // held there, far inside a twentieth of its typical size or not.
+        let f_y = FitParam::new("F_y", 1e-6).bounds(0.0, 1e3);
+        assert_eq!(held_by(&f_y, 9e-8, -1e-6), Some(BoundSide::Lower));
+        assert_eq!(held_by(&f_y, 9e-8, 1e-6), None);
         // A one-sided bound away from 0: its own size sets the reach.
         let k = FitParam::new("k", 1500.0)
             .bounds(1000.0, f64::INFINITY)
