@@ -59,21 +59,7 @@ builtin! {
         fn n_internal(&self) -> usize {
             1
         }
-        // The integration along a record calls these at every stage: inlined there with the
-        // law (the trait's provided versions, which they repeat, are not).
-        #[inline(always)]
-        fn rates(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<(), ModelError> {
-            self.force(p, s, dz).map(|_| ())
-        }
-        #[inline(always)]
-        fn mass_and_force(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            dz: &mut [f64],
-        ) -> Result<(f64, f64), ModelError> {
-            Ok((0.0, self.force(p, s, dz)?))
-        }
+        crate::builtin::state_forwards!();
         // Inlined into the integration along a record, whose every step calls it four times:
         // the errors are built out of line.
         #[inline(always)]

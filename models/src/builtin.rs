@@ -137,5 +137,32 @@ macro_rules! linear_builtin {
     };
 }
 
+/// In a state model's `impl` block of [`builtin!`]: `rates` and `mass_and_force` as its
+/// `force` (no mass), forced inline. The integration along a record calls them at every stage;
+/// the trait's provided versions, which they repeat, are not inlined with the law.
+macro_rules! state_forwards {
+    () => {
+        #[inline(always)]
+        fn rates(
+            &self,
+            p: &[f64],
+            s: &stf_core::physics::force_model::ModelState,
+            dz: &mut [f64],
+        ) -> Result<(), stf_core::physics::force_model::ModelError> {
+            self.force(p, s, dz).map(|_| ())
+        }
+        #[inline(always)]
+        fn mass_and_force(
+            &self,
+            p: &[f64],
+            s: &stf_core::physics::force_model::ModelState,
+            dz: &mut [f64],
+        ) -> Result<(f64, f64), stf_core::physics::force_model::ModelError> {
+            Ok((0.0, self.force(p, s, dz)?))
+        }
+    };
+}
+
 pub(crate) use builtin;
 pub(crate) use linear_builtin;
+pub(crate) use state_forwards;
