@@ -121,7 +121,8 @@ impl Draw for HysteresisPlot {
 
 /// Draw F_STF against one motion quantity (`against` = its label with unit, e.g.
 /// `("x, m", &x)`), the loop coloured by time `t` with a colour bar, to
-/// `out_dir/name.{svg,png,csv}`. The CSV holds t, the quantity and F_STF as plotted.
+/// `out_dir/name.{svg,png,csv}`; `force` is F_STF with its label and unit. The CSV holds t,
+/// the quantity and F_STF as plotted.
 pub fn hysteresis(
     out_dir: &Path,
     name: &str,

@@ -15,7 +15,7 @@
 //! let t: Vec<f64> = (0..1000).map(|i| i as f64 * 1e-3).collect();
 //! let x: Vec<f64> = t.iter().map(|t| (20.0 * t).sin() * 1e-3).collect();
 //! let f: Vec<f64> = t.iter().map(|t| (20.0 * t).cos()).collect();
-//! let files = report::hysteresis(Path::new("out"), "loop_x", ("x, m", &x), &f, &t)?;
+//! let files = report::hysteresis(Path::new("out"), "loop_x", ("x, m", &x), ("F_STF, N", &f), &t)?;
 //! let mut report = report::Report::new("Power-law fit");
 //! report.intro.push("What was fitted and how well.".into());
 //! let mut section = report::Section::new("Hysteresis");
