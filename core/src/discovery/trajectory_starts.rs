@@ -130,8 +130,8 @@ impl SearchModel {
     /// The best of `starts` after a short fit of each (`START_ITERS` Levenberg–Marquardt
     /// iterations on the training samples of `tracks.0`), ranked by their RMS at `train` on
     /// `tracks.1` (the same samples, at the tolerance the search is ranked at; the fit's own
-    /// RMS when both are one): the stage a full fit continues from. One start is returned as
-    /// it is.
+    /// RMS when both integrate to one tolerance): the stage a full fit continues from. One
+    /// start is returned as it is.
     pub(super) fn started(
         starts: Vec<SearchModel>,
         tracks: (&dyn Track, &dyn Track),
@@ -143,7 +143,8 @@ impl SearchModel {
             return starts.into_iter().next();
         }
         let (fitted_on, ranked_on) = tracks;
-        let same = std::ptr::addr_eq(fitted_on, ranked_on);
+        // Tracks integrated alike give the fit's own RMS again: no second simulation.
+        let same = fitted_on.rtol() == ranked_on.rtol();
         let mut short = settings.levenberg_marquardt(None);
         short.fit = short.fit.max_iters(START_ITERS);
         let mut best: Option<(f64, SearchModel)> = None;
