@@ -267,9 +267,24 @@ pub fn regime_section(
         "A few {} of each {} over time: measured and modelled",
         words.cycles, words.group
     );
-    let fig = regime_time_windows(&dir, &name, &title, &k.t, &rows, &windows)?;
+    // The three figures are independent files: drawn in parallel, kept in this order.
+    let over_time = || regime_time_windows(&dir, &name, &title, &k.t, &rows, &windows);
+    let loops = || regime_windows(&dir, words.figure, &series, &windows);
+    let parity_of = || -> Result<Option<_>, crate::report::ReportError> {
+        if models.is_empty() {
+            return Ok(None);
+        }
+        let groups = groups_of(&found, &cycles);
+        let quantity = ParityQuantity {
+            label: motion.force.into(),
+            group: words.group,
+            noise_sigma: Some(stf_core::numerics::derivative::noise_estimate(f).sigma),
+        };
+        parity(&dir, "parity", &quantity, f, models, &groups).map(Some)
+    };
+    let ((over_time, loops), parity_fig) = rayon::join(|| rayon::join(over_time, loops), parity_of);
     s.figures.push(FigureRef::new(
-        fig,
+        over_time?,
         format!(
             "A few {} of each {} over time: displacement, velocity and STF force, measured \
              (grey) and {}.",
@@ -283,23 +298,15 @@ pub fn regime_section(
             }
         ),
     ));
-    let fig = regime_windows(&dir, words.figure, &series, &windows)?;
     s.figures.push(FigureRef::new(
-        fig,
+        loops?,
         format!(
             "A few {} of each {}: the STF force over time, and its loops against x, v and a; \
              each model's force over the measured one (grey).",
             words.cycles, words.group
         ),
     ));
-    if !models.is_empty() {
-        let groups = groups_of(&found, &cycles);
-        let quantity = ParityQuantity {
-            label: motion.force.into(),
-            group: words.group,
-            noise_sigma: Some(stf_core::numerics::derivative::noise_estimate(f).sigma),
-        };
-        let fig = parity(&dir, "parity", &quantity, f, models, &groups)?;
+    if let Some(fig) = parity_fig? {
         s.figures.push(FigureRef::new(
             fig,
             format!(

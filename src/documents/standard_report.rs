@@ -19,6 +19,7 @@ use crate::report::{
     Smoothing, Table, DISPLACEMENT_MM, DISPLACEMENT_VALIDATION_MM, STF_FORCE, STF_FORCE_VALIDATION,
 };
 use crate::validation::ValidationRecord;
+use rayon::prelude::*;
 use stf_core::regimes::Regime;
 
 /// A section of the figures of a record and its fits. The STF force is drawn where the work
@@ -59,25 +60,33 @@ fn record_section(data: &FitData, f: Option<&[f64]>, dir: &Path) -> Result<Secti
         a: &k.a,
     };
     let labels = MotionLabels::of(&data.units);
-    let th = time_history(dir, "time_history", &motion, f, &labels)?;
+    let history = || time_history(dir, "time_history", &motion, f, &labels);
+    // The loops are independent files: drawn in parallel with the time history.
+    let loops = || match f {
+        None => Ok(Vec::new()),
+        Some(f) => [
+            ("hysteresis_x", labels.x, milli(&k.x)),
+            ("hysteresis_v", labels.v, milli(&k.v)),
+            ("hysteresis_a", labels.a, k.a.clone()),
+        ]
+        .into_par_iter()
+        .map(|(name, label, series)| {
+            let fig = hysteresis(dir, name, (label, &series), (labels.force, f), &k.t)?;
+            Ok(FigureRef::new(
+                fig,
+                format!("Hysteresis loop of F_STF against {label}, coloured by time."),
+            ))
+        })
+        .collect::<Result<Vec<_>>>(),
+    };
+    let (th, loops) = rayon::join(history, loops);
     let caption = if f.is_some() {
         "Displacement, velocity, acceleration and the STF force over time, a panel each; extrema of F_STF marked."
     } else {
         "Displacement, velocity and acceleration over time, a panel each (no STF force is read at trajectory level)."
     };
-    s.figures.push(FigureRef::new(th, caption).zoomable());
-    let Some(f) = f else { return Ok(s) };
-    for (name, label, series) in [
-        ("hysteresis_x", labels.x, milli(&k.x)),
-        ("hysteresis_v", labels.v, milli(&k.v)),
-        ("hysteresis_a", labels.a, k.a.clone()),
-    ] {
-        let fig = hysteresis(dir, name, (label, &series), (labels.force, f), &k.t)?;
-        s.figures.push(FigureRef::new(
-            fig,
-            format!("Hysteresis loop of F_STF against {label}, coloured by time."),
-        ));
-    }
+    s.figures.push(FigureRef::new(th?, caption).zoomable());
+    s.figures.extend(loops?);
     Ok(s)
 }
 

@@ -73,7 +73,31 @@ pub fn svg_to_png(svg: &str) -> Result<Vec<u8>, String> {
         tiny_skia::Transform::from_scale(pw / size.width(), ph / size.height()),
         &mut pixmap.as_mut(),
     );
-    pixmap.encode_png().map_err(|e| e.to_string())
+    encode_opaque(&pixmap).map_err(|e| e.to_string())
+}
+
+/// PNG bytes of a pixmap drawn over white, as RGB (every pixel is opaque, so the alpha
+/// channel carries nothing) at deflate level 1. tiny-skia's own encoder writes RGBA at the
+/// balanced level (6): on the force-level discovery report of a 150 001-sample record (9
+/// PNGs) that cost 0.35 s more CPU, about a quarter of the report's, for 2.2 MB of PNG
+/// against 3.0 MB; `fdeflate` (the `png` crate's `Fast`) cost the same as level 1 and wrote
+/// 3.9 MB.
+fn encode_opaque(pixmap: &tiny_skia::Pixmap) -> Result<Vec<u8>, png::EncodingError> {
+    let rgb: Vec<u8> = pixmap
+        .pixels()
+        .iter()
+        .flat_map(|p| {
+            let c = p.demultiply();
+            [c.red(), c.green(), c.blue()]
+        })
+        .collect();
+    let mut data = Vec::new();
+    let mut encoder = png::Encoder::new(&mut data, pixmap.width(), pixmap.height());
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_deflate_compression(png::DeflateCompression::Level(1));
+    encoder.write_header()?.write_image_data(&rgb)?;
+    Ok(data)
 }
 
 /// How many strongly coloured pixels of `png` lie more than `margin` drawing units outside every

@@ -183,19 +183,18 @@ fn write_compare_report(
     };
     let mut sections = vec![results, models];
     sections.extend(frequency);
-    sections.extend(record_sections(data, &c.fits, out)?);
     let forces: Vec<(&str, &[f64])> = c
         .fits
         .iter()
         .map(|f| (f.label.as_str(), f.fitted.as_slice()))
         .collect();
-    sections.extend(crate::documents::regime_figures::regime_section(
-        exp,
-        data,
-        &forces,
-        &[],
-        out,
-    )?);
+    // The record's figures and the regime windows are independent files: drawn in parallel.
+    let (record, regimes) = rayon::join(
+        || record_sections(data, &c.fits, out),
+        || crate::documents::regime_figures::regime_section(exp, data, &forces, &[], out),
+    );
+    sections.extend(record?);
+    sections.extend(regimes?);
     let verdict = crate::verdict::compare_verdict(c, data.words());
     let record = format!(
         "{} {} of {}; noise floor σ = {:.4} N.",

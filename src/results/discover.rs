@@ -38,10 +38,15 @@ use crate::writing::{write_atomic, write_json};
 pub fn write(exp: &Experiment, found: &Discovered, out: &Path) -> Result<()> {
     let (doc, entries) = found.json(exp)?;
     write_json(&out.join("discovery.json"), &doc)?;
-    write_atomic(&out.join("discovered.csv"), &found.discovered_csv()?)?;
-    if exp.output.report {
-        report(exp, found, out)?;
-    }
+    // The record-long CSV and the report are independent files: written in parallel.
+    let csv = || write_atomic(&out.join("discovered.csv"), &found.discovered_csv()?);
+    let drawn = || match exp.output.report {
+        true => report(exp, found, out),
+        false => Ok(()),
+    };
+    let (csv, drawn) = rayon::join(csv, drawn);
+    csv?;
+    drawn?;
     say!("{}", found.verdict().text);
     print_summary(
         &found.spec,
@@ -257,27 +262,29 @@ fn report(exp: &Experiment, discovered: &Discovered, out: &Path) -> Result<()> {
     let results =
         crate::documents::results_table::results_section(&title, &equations, &rows, &fits);
     let mut sections = vec![results, s];
-    if data.level == FitLevel::Force {
-        let curves = [("base", before.as_slice()), ("final", after.as_slice())];
-        sections.extend(crate::documents::regime_figures::regime_section(
-            exp,
-            data,
-            &curves,
-            &[],
-            out,
-        )?);
-    }
-    let final_response = match data.level {
-        FitLevel::Trajectory => response_of(data, "final", &after),
-        FitLevel::Force => None,
+    // The regime windows, the frequency response and the record's figures are independent
+    // files: drawn in parallel, joined in the report's order.
+    let regimes = || match data.level {
+        FitLevel::Force => {
+            let curves = [("base", before.as_slice()), ("final", after.as_slice())];
+            crate::documents::regime_figures::regime_section(exp, data, &curves, &[], out)
+        }
+        FitLevel::Trajectory => Ok(None),
     };
-    sections.extend(swept_section(
-        exp,
-        data,
-        final_response.into_iter().collect(),
-        out,
-    )?);
-    sections.extend(record_sections(data, &[], out)?);
+    let swept = || {
+        let final_response = match data.level {
+            FitLevel::Trajectory => response_of(data, "final", &after),
+            FitLevel::Force => None,
+        };
+        swept_section(exp, data, final_response.into_iter().collect(), out)
+    };
+    let ((regimes, swept), record) = rayon::join(
+        || rayon::join(regimes, swept),
+        || record_sections(data, &[], out),
+    );
+    sections.extend(regimes?);
+    sections.extend(swept?);
+    sections.extend(record?);
     let mut intro = vec![discovered.verdict().text];
     intro.extend(score.map(|v| {
         format!(

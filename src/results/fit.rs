@@ -62,10 +62,6 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
             rec, fits, out,
         )?);
     }
-    sections.extend(frequency_response(exp, data, fits, out)?);
-    sections.extend(crate::documents::standard_report::record_sections(
-        data, fits, out,
-    )?);
     let curves: Vec<(&str, &[f64])> = fits
         .iter()
         .map(|f| (f.label.as_str(), f.fitted.as_slice()))
@@ -74,9 +70,24 @@ fn write_fit_report(exp: &Experiment, fitted: &Fitted, out: &Path) -> Result<()>
         FitLevel::Force => (curves, Vec::new()),
         FitLevel::Trajectory => (Vec::new(), curves),
     };
-    sections.extend(crate::documents::regime_figures::regime_section(
-        exp, data, &forces, &simulated, out,
-    )?);
+    // The frequency response, the record's figures and the regime windows are independent
+    // files: drawn in parallel, joined in the report's order.
+    let (swept, (record, regimes)) = rayon::join(
+        || frequency_response(exp, data, fits, out),
+        || {
+            rayon::join(
+                || crate::documents::standard_report::record_sections(data, fits, out),
+                || {
+                    crate::documents::regime_figures::regime_section(
+                        exp, data, &forces, &simulated, out,
+                    )
+                },
+            )
+        },
+    );
+    sections.extend(swept?);
+    sections.extend(record?);
+    sections.extend(regimes?);
     let mut intro = vec![
         fitted.verdict().text,
         format!(
