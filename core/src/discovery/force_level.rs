@@ -21,14 +21,16 @@ use super::choice::{self, Said, Trial, Yardstick};
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
-use super::holdout::HoldoutSplit;
+use super::holdout::{rms_over, HoldoutSplit};
 use super::level::Level;
 use super::score::CandidateScore;
 use super::search;
 use super::search_model::SearchModel;
 use super::settings::DiscoverySettings;
 use crate::data::force_data::ForceData;
-use crate::fit::{Convergence, FitParam, FitResult, ForceFit, NoiseFloor, FORCE_OFFSET};
+use crate::fit::{
+    Convergence, FitParam, FitResult, FitSettings, ForceFit, NoiseFloor, FORCE_OFFSET,
+};
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::physics::model_sum::neutral_amplitude;
 use crate::regimes::Cycle;
@@ -357,27 +359,52 @@ impl<'a> ForceLevel<'a> {
             stages.push(stage(&starts[starts.len() - 1]));
         }
         // The starts are independent fits: in parallel (a costly candidate's starts would
-        // otherwise hold a step's last core alone), kept in their order.
-        let trials: Vec<Result<Trial, DiscoveryError>> = stages
+        // otherwise hold a step's last core alone), kept in their order. They are ranked by
+        // their training RMS alone, so only the one kept is given its standard errors and its
+        // residual at every sample: the same trial as when every start had them.
+        let quick = FitSettings {
+            errors: false,
+            ..self.settings.fit.clone()
+        };
+        let fits: Vec<Result<(SearchModel, FitResult), DiscoveryError>> = stages
             .par_iter()
-            .map(|s| self.trial(s, self.settings))
+            .map(|s| {
+                let fit = s.force_fit(self.settings, self.offset_reach)?;
+                s.fitted(fit.fit_rows(self.data, Some(train), &quick, None))
+            })
             .collect();
-        let (evaluations, wall) = trials.iter().flatten().fold((0, 0.0), |(e, w), t| {
-            (e + t.train.evaluations, w + t.train.wall_seconds)
+        let (evaluations, wall) = fits.iter().flatten().fold((0, 0.0), |(e, w), (_, t)| {
+            (e + t.evaluations, w + t.wall_seconds)
         });
-        let failed = |t: &Trial| matches!(t.train.convergence, Convergence::Failed { .. });
-        let best = trials
-            .into_iter()
-            .reduce(|best, next| match (&best, &next) {
-                (Err(_), Ok(_)) => next,
-                (Ok(b), Ok(t)) if (failed(t), t.train.rms) < (failed(b), b.train.rms) => next,
-                _ => best,
-            });
-        let mut best = best
-            .unwrap_or_else(|| Err(DiscoveryError::BadSettings("no start to fit from".into())))?;
-        best.train.evaluations = evaluations;
-        best.train.wall_seconds = wall;
-        Ok(best)
+        let failed = |t: &FitResult| matches!(t.convergence, Convergence::Failed { .. });
+        let best = (0..fits.len()).reduce(|best, next| match (&fits[best], &fits[next]) {
+            (Err(_), Ok(_)) => next,
+            (Ok((_, b)), Ok((_, t))) if (failed(t), t.rms) < (failed(b), b.rms) => next,
+            _ => best,
+        });
+        let Some(best) = best else {
+            return Err(DiscoveryError::BadSettings("no start to fit from".into()));
+        };
+        let (start, (_, quick_fit)) = match fits.into_iter().nth(best) {
+            Some(Ok(fit)) => (&stages[best], fit),
+            Some(Err(e)) => return Err(e),
+            None => return Err(DiscoveryError::BadSettings("no start to fit from".into())),
+        };
+        let fit = start.force_fit(self.settings, self.offset_reach)?;
+        let spent = (quick_fit.evaluations, quick_fit.wall_seconds);
+        let completed = fit.with_errors_rows(self.data, Some(train), &self.settings.fit, quick_fit);
+        let (stage, mut train_fit) = start.fitted(completed)?;
+        let r = self.residual(&stage)?;
+        let h = rms_over(&r, &self.split.holdout);
+        // Every start's evaluations and time, and the errors' of the one kept.
+        train_fit.evaluations = evaluations + (train_fit.evaluations - spent.0);
+        train_fit.wall_seconds = wall + (train_fit.wall_seconds - spent.1);
+        Ok(Trial {
+            stage,
+            train: train_fit,
+            holdout: self.held_out(&r),
+            holdout_mse: h * h,
+        })
     }
 
     /// The blocks of the paired test for a model whose residual is `r` (every sample).

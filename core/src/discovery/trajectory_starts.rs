@@ -146,7 +146,9 @@ impl SearchModel {
         // Tracks integrated alike give the fit's own RMS again: no second simulation.
         let same = fitted_on.rtol() == ranked_on.rtol();
         let mut short = settings.levenberg_marquardt(None);
-        short.fit = short.fit.max_iters(START_ITERS);
+        // Ranked by their RMS alone: no standard errors (a tight simulation and a difference
+        // column a parameter each).
+        short.fit = short.fit.max_iters(START_ITERS).errors(false);
         let mut best: Option<(f64, SearchModel)> = None;
         for start in &starts {
             let Ok((stage, fit)) = start.fit_simulated(fitted_on, setup, train, &short) else {

@@ -76,10 +76,12 @@ fn run_watched(
         watch: &watch,
         iterations: 0,
         log: Vec::new(),
+        earlier: (0, 0, None),
     };
     let fitted = chain.solve(&u0).and_then(|(u, convergence)| {
         let (u, convergence) = chain.no_worse_than(u0, u, convergence);
-        chain.finish(params, &u, convergence, clock)
+        let x = obj.to_user(&u);
+        chain.finish(params, &x, convergence, clock)
     });
     // The trace is written whatever the end; the fit's own error comes first.
     let written = watch.write_trace();
@@ -123,6 +125,9 @@ struct Chain<'a> {
     watch: &'a Watch,
     iterations: u64,
     log: Vec<String>,
+    /// What an earlier run at the same point already spent (evaluations, failures, the last
+    /// failure): [`with_errors`] completes a fit run without its errors.
+    earlier: (u64, u64, Option<String>),
 }
 
 impl Chain<'_> {
@@ -324,32 +329,32 @@ impl Chain<'_> {
         })
     }
 
-    /// The result at the chain's end `u`: residuals, standard errors and statistics, with
-    /// the chain's iterations and log.
+    /// The result at the chain's end, the user values `x`: residuals, standard errors
+    /// (unless the settings leave them out) and statistics, with the chain's iterations and
+    /// log.
     fn finish(
         self,
         params: &[FitParam],
-        u: &[f64],
+        x: &[f64],
         mut convergence: Convergence,
         clock: Instant,
     ) -> Result<FitResult, FitError> {
         let (obj, mut log) = (self.obj, self.log);
         self.watch.announce(SolverStage::Errors);
         let n = obj.len();
-        let x = obj.to_user(u);
         let mut r0 = vec![0.0; n];
-        let Some(rss) = obj.residuals_user(&x, &mut r0) else {
+        let Some(rss) = obj.residuals_user(x, &mut r0) else {
             return Err(FitError::Solver(format!(
                 "the best point cannot be re-evaluated: {}",
                 obj.last_failure().unwrap_or_default()
             )));
         };
         let p = self.free.len();
-        let errors = if p > 0 {
+        let errors = if p > 0 && self.settings.errors {
             // From the problem's precise residuals where it has them (a simulation at a
             // tighter tolerance than the fit's), the fit's own otherwise.
             let mut precise = vec![0.0; n];
-            let base = match obj.precise_residuals_user(&x, &mut precise) {
+            let base = match obj.precise_residuals_user(x, &mut precise) {
                 Some(Some(_)) => Some(precise.as_slice()),
                 Some(None) => {
                     log.push(format!(
@@ -364,7 +369,7 @@ impl Chain<'_> {
             let (jac, rise) = jacobian(
                 obj,
                 self.free,
-                &x,
+                x,
                 base.unwrap_or(&r0),
                 self.settings,
                 base.is_some(),
@@ -376,16 +381,20 @@ impl Chain<'_> {
         } else {
             None
         };
-        let fitted = fitted_params(params, &x, errors.as_ref());
+        let fitted = match errors {
+            None if p > 0 => unsure_params(params, x),
+            _ => fitted_params(params, x, errors.as_ref()),
+        };
         let nf = n as f64;
         let mean = rss / nf;
         let ln_term = nf * mean.max(f64::MIN_POSITIVE).ln();
-        if obj.failures() > 0 {
-            log.push(format!(
-                "{} evaluations failed and were scored as penalties; last: {}",
-                obj.failures(),
-                obj.last_failure().unwrap_or_default()
-            ));
+        let (evaluations, failures, last_failure) = (
+            self.earlier.0 + obj.evaluations(),
+            self.earlier.1 + obj.failures(),
+            obj.last_failure().or(self.earlier.2),
+        );
+        if failures > 0 {
+            log.push(failed_line(failures, last_failure.as_deref()));
         }
         if !x.iter().all(|v| v.is_finite()) {
             convergence = Convergence::Failed {
@@ -407,9 +416,9 @@ impl Chain<'_> {
             s_mm2: (self.quantity == Quantity::Displacement).then_some(mean * 1e6),
             aic: ln_term + 2.0 * p as f64,
             bic: ln_term + p as f64 * nf.ln(),
-            evaluations: obj.evaluations(),
-            failures: obj.failures(),
-            last_failure: obj.last_failure(),
+            evaluations,
+            failures,
+            last_failure,
             iterations: self.iterations,
             wall_seconds: clock.elapsed().as_secs_f64(),
             convergence,
@@ -479,6 +488,84 @@ fn fitted_params(params: &[FitParam], x: &[f64], errors: Option<&Errors>) -> Vec
             })
         })
         .collect()
+}
+
+/// The free parameters of `params` at the user values `x` with unknown standard errors: a
+/// fit run without them ([`FitSettings::errors`]).
+fn unsure_params(params: &[FitParam], x: &[f64]) -> Vec<FittedParam> {
+    let mut free = x.iter();
+    params
+        .iter()
+        .filter_map(|q| {
+            if q.fixed {
+                return Some(FittedParam::held(&q.name, q.value));
+            }
+            Some(FittedParam {
+                name: q.name.clone(),
+                value: *free.next()?,
+                std_error: f64::NAN,
+                naive_std_error: f64::NAN,
+                fixed: false,
+                held_by: None,
+                noisy_column: None,
+            })
+        })
+        .collect()
+}
+
+/// The log line of a fit whose evaluations failed `failures` times (`last`: the last reason).
+fn failed_line(failures: u64, last: Option<&str>) -> String {
+    format!(
+        "{failures} evaluations failed and were scored as penalties; last: {}",
+        last.unwrap_or_default()
+    )
+}
+
+/// `fitted`, a fit of `problem` run without its standard errors ([`FitSettings::errors`]
+/// off), completed with them at the point where it ended: the same result as the fit run
+/// with them, but for the one more evaluation it counts. A search that ranks many starts by
+/// their RMS computes the errors of the one it keeps only.
+pub fn with_errors(
+    problem: &dyn Residuals,
+    params: &[FitParam],
+    settings: &FitSettings,
+    quantity: Quantity,
+    fitted: FitResult,
+) -> Result<FitResult, FitError> {
+    let settings = FitSettings {
+        errors: true,
+        ..settings.clone()
+    };
+    let free = checked(problem, params, &settings)?;
+    let transforms: Vec<_> = free.iter().map(|p| p.transform()).collect();
+    let obj = Objective::new(problem, transforms.clone());
+    let names: Vec<&str> = free.iter().map(|p| p.name.as_str()).collect();
+    let watch = Watch::new(obj.tally(), None, None, (&names, transforms));
+    let x: Vec<f64> = params
+        .iter()
+        .zip(&fitted.params)
+        .filter(|(q, _)| !q.fixed)
+        .map(|(_, f)| f.value)
+        .collect();
+    let mut log = fitted.log;
+    if fitted.failures > 0 {
+        log.pop();
+    }
+    let elapsed = std::time::Duration::from_secs_f64(fitted.wall_seconds.max(0.0));
+    let clock = Instant::now()
+        .checked_sub(elapsed)
+        .unwrap_or_else(Instant::now);
+    let chain = Chain {
+        obj: &obj,
+        free: &free,
+        settings: &settings,
+        quantity,
+        watch: &watch,
+        iterations: fitted.iterations,
+        log,
+        earlier: (fitted.evaluations, fitted.failures, fitted.last_failure),
+    };
+    chain.finish(params, &x, fitted.convergence, clock)
 }
 
 /// The Jacobian of the residuals `r0` at the user values `x` of the free parameters `free`:
@@ -729,6 +816,42 @@ mod tests {
 
     /// The rule of [`held_by`] both ways: a parameter is held by a bound it is pushed past
     /// only when it stopped near it on the bound's scale.
+    #[test]
+    fn errors_completed_later_are_those_of_a_fit_run_with_them() {
+        let x: Vec<f64> = (0..400).map(|i| (i as f64 * 0.05).sin()).collect();
+        for truth in [-124.0, 37.0] {
+            let y: Vec<f64> = x
+                .iter()
+                .enumerate()
+                .map(|(i, x)| truth * x + 0.1 * ((i * 7919 % 13) as f64 - 6.0))
+                .collect();
+            let line = Line { x: x.clone(), y };
+            let params = [FitParam::new("k", 0.0).bounds(-100.0, 100.0).scale(0.1)];
+            for solver in Solver::ALL {
+                let settings = FitSettings::default().solver(solver);
+                let whole = run(&line, &params, &settings, None, Quantity::Force).unwrap();
+                let quick = settings.clone().errors(false);
+                let bare = run(&line, &params, &quick, None, Quantity::Force).unwrap();
+                assert!(
+                    bare.params[0].std_error.is_nan(),
+                    "{solver:?}: no errors yet"
+                );
+                assert!(bare.evaluations < whole.evaluations, "{solver:?}");
+                let done = with_errors(&line, &params, &quick, Quantity::Force, bare).unwrap();
+                let (a, b) = (&whole.params[0], &done.params[0]);
+                assert_eq!(a.value.to_bits(), b.value.to_bits(), "{solver:?}, {truth}");
+                assert_eq!(a.std_error.to_bits(), b.std_error.to_bits(), "{solver:?}");
+                assert_eq!(a.naive_std_error.to_bits(), b.naive_std_error.to_bits());
+                assert_eq!((a.held_by, a.noisy_column), (b.held_by, b.noisy_column));
+                assert_eq!(whole.rss.to_bits(), done.rss.to_bits());
+                assert_eq!(whole.correlation, done.correlation);
+                assert_eq!(whole.log, done.log);
+                assert_eq!(whole.iterations, done.iterations);
+                assert_eq!(done.evaluations, whole.evaluations + 1, "{solver:?}");
+            }
+        }
+    }
+
     #[test]
     fn a_bound_holds_a_parameter_only_near_it_on_its_own_scale() {
         // c_s in [0, 1e4], typical size 2: at 12.69 it is far from its bound at 0 even if

@@ -180,15 +180,44 @@ impl ForceFit {
             }
         }
         let all = self.params();
-        let problem = ForceResiduals {
+        driver::run(
+            &self.residuals(data, &all, rows),
+            &all,
+            settings,
+            observer,
+            Quantity::Force,
+        )
+    }
+
+    /// `fitted`, a [`ForceFit::fit_rows`] on `rows` run without its standard errors
+    /// ([`FitSettings::errors`] off), completed with them ([`driver::with_errors`]).
+    pub fn with_errors_rows(
+        &self,
+        data: &ForceData,
+        rows: Option<&[usize]>,
+        settings: &FitSettings,
+        fitted: FitResult,
+    ) -> Result<FitResult, FitError> {
+        let all = self.params();
+        let problem = self.residuals(data, &all, rows);
+        driver::with_errors(&problem, &all, settings, Quantity::Force, fitted)
+    }
+
+    /// The residuals of this fit's model (every parameter in `all`) on the samples `rows`.
+    fn residuals<'a>(
+        &'a self,
+        data: &ForceData<'a>,
+        all: &'a [FitParam],
+        rows: Option<&'a [usize]>,
+    ) -> ForceResiduals<'a> {
+        ForceResiduals {
             model: self.model.as_ref(),
             data: *data,
-            all: &all,
+            all,
             rows,
             span: self.filter_noise.map_or(1, |n| n.filter.window()),
             parts: PartCache::of(self.model.as_ref()),
-        };
-        driver::run(&problem, &all, settings, observer, Quantity::Force)
+        }
     }
 
     /// The modelled force (with the offset, if any) at every sample for the full parameter

@@ -55,7 +55,7 @@ mod transform;
 mod validation;
 mod warning;
 
-pub use driver::{HELD_REACH, NOISY_COLUMN};
+pub use driver::{with_errors, HELD_REACH, NOISY_COLUMN};
 pub use error::FitError;
 pub use filter_noise::{FilterNoise, REPLICATES};
 pub use fit_param::{full_values, BoundSide, FitParam};

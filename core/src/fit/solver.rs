@@ -72,6 +72,17 @@ pub struct FitSettings {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[setters(strip_option)]
     pub trace: Option<PathBuf>,
+    /// Whether the fit ends with its standard errors (a Jacobian at the end point and the
+    /// covariance over blocks of residuals); on by default. A search that ranks many starts
+    /// by their RMS leaves them out and completes the one it keeps
+    /// ([`with_errors`](super::with_errors)): its parameters' errors are NaN until then.
+    #[serde(skip, default = "errors_by_default")]
+    pub errors: bool,
+}
+
+/// [`FitSettings::errors`] when read from a file: on.
+fn errors_by_default() -> bool {
+    true
 }
 
 impl Default for FitSettings {
@@ -87,6 +98,7 @@ impl Default for FitSettings {
             particles: 40,
             seed: 1,
             trace: None,
+            errors: true,
         }
     }
 }

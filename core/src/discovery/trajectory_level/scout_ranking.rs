@@ -116,9 +116,14 @@ pub(in crate::discovery) fn scouted(
         s.residual(rig)
             .map_or(f64::INFINITY, |r| rms_over(&r, train))
     };
+    // Only the scout fit's RMS and values are used: no standard errors.
+    let quick = DiscoverySettings {
+        fit: settings.fit.clone().errors(false),
+        ..settings.clone()
+    };
     let (before, fitted) = rayon::join(
         || train_rms(&stage),
-        || stage.fit_simulated(scout, setup, &scout.train, settings),
+        || stage.fit_simulated(scout, setup, &scout.train, &quick),
     );
     if let Ok((fitted, fit)) = fitted {
         let after = train_rms(&fitted);

@@ -37,7 +37,8 @@ impl SearchModel {
         let settings = FitSettings::default()
             .solver(Solver::LevenbergMarquardt)
             .max_iters(40)
-            .tol(1e-6);
+            .tol(1e-6)
+            .errors(false);
         // Every k-th sample, at most `HINT_SAMPLES`: the recovered force is filtered, so a
         // thinned record holds the same information for a start. The model is evaluated at
         // those samples only — a model with internal state too, its state stepped across the
