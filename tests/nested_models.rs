@@ -44,7 +44,8 @@ fn a_sum_with_one_more_term_never_ends_worse_than_the_sum_it_contains() {
 /// The same rule through `compare` on a damper's own record (t, x and the force only, no
 /// rotor, no drive, no `[system]`): the richer sum's training RMS is its base's or lower, to
 /// the same tolerance, on a record where maxwell helps (seed 6, to 4 Hz: 26.707 against
-/// 26.724 N) and on one where it adds nothing (seed 7, to 3 Hz: higher by 4e-8 of itself, the fit's tolerance).
+/// 26.724 N) and on one where it adds nothing (seed 7, to 3 Hz: higher by 4e-8 of itself,
+/// within the fit's tolerance).
 #[test]
 fn compare_on_a_damper_s_own_record_never_ranks_the_richer_sum_worse_in_training() {
     for (seed, f1) in [(6, 4.0), (7, 3.0)] {
