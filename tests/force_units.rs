@@ -122,3 +122,67 @@ fn a_force_in_newtons_keeps_newtons() {
     let (_, newtons) = force_labels(&texts);
     assert!(!newtons.is_empty(), "no figure labels the force in N");
 }
+
+/// The value and unit of the number after `key` in `line` (`rms 68.6186 V` → ("68.6186", "V")).
+fn number_after(line: &str, key: &str) -> Option<(String, String)> {
+    let rest = &line[line.find(key)? + key.len()..];
+    let mut words = rest.split_whitespace();
+    let value = words.next()?.to_string();
+    let unit = words.next()?.trim_end_matches([')', ':', ',']).to_string();
+    Some((value, unit))
+}
+
+/// A fit's warning above the noise floor is written in the unit and scale of the terminal's
+/// summary line above it and of `fit.json`'s `rms_unit`: V for a force read in volts, N for a
+/// force read in kN (shown in SI N, as the summary shows it) or in N; the message stored in
+/// `fit.json` is the sentence the terminal prints.
+#[test]
+fn a_fit_warning_speaks_the_summary_s_unit() {
+    let tmp = tempfile::tempdir().unwrap();
+    damper_record(tmp.path(), 7, 3.0);
+    let cases = [
+        ("{ x = \"V\", f_stf = { unit = \"V\", gain = 1.0 } }", "V"),
+        ("{ f_stf = \"kN\" }", "N"),
+        ("{ x = \"V\" }", "N"),
+    ];
+    for (i, (units, unit)) in cases.into_iter().enumerate() {
+        let exp = write_file(
+            tmp.path(),
+            &format!("w{i}.toml"),
+            &format!(
+                "[data]\nfile = \"r.csv\"\nunits = {units}\n\n[fit]\nlevel = \"force\"\n\n\
+                 [[models]]\nname = \"viscous\"\n"
+            ),
+        );
+        let out = tmp.path().join(format!("w{i}"));
+        let run = run_ok("fit", &exp, &out);
+        let said = String::from_utf8_lossy(&run.stdout).to_string();
+        let summary = said
+            .lines()
+            .find_map(|l| {
+                l.trim_start()
+                    .starts_with("viscous ")
+                    .then(|| number_after(l, " rms "))
+            })
+            .flatten()
+            .unwrap_or_else(|| panic!("{units}: no summary line in\n{said}"));
+        let warning = said
+            .lines()
+            .find(|l| l.contains("warning: the residual is"))
+            .unwrap_or_else(|| panic!("{units}: viscous alone leaves no warning in\n{said}"));
+        let quoted = number_after(warning, "(RMS ").unwrap();
+        let floor = number_after(warning, " against ").unwrap();
+        assert_eq!(summary.1, unit, "{units}: {said}");
+        assert_eq!(quoted, summary, "{units}: {warning}");
+        assert_eq!(floor.1, unit, "{units}: {warning}");
+        let doc = read_json(&out.join("fit.json"));
+        let model = &doc["models"][0];
+        let si = model["rms_unit"].as_str().unwrap();
+        assert_eq!(si, unit, "{units}");
+        let message = model["warnings"][0]["message"].as_str().unwrap();
+        assert!(
+            warning.trim_start().ends_with(message),
+            "{units}: {message} against {warning}"
+        );
+    }
+}

@@ -75,6 +75,43 @@ fn a_record_in_volts_is_shown_in_millivolts_everywhere() {
     );
 }
 
+/// A trajectory-level fit that misses an effect (viscous alone on the shaker) is warned
+/// about in mV on a record in volts — the residual and the floor as the summary shows them,
+/// in the terminal and in `fit.json`'s stored message — and in mm on the same record in
+/// metres.
+#[test]
+fn a_fit_warning_on_a_record_in_volts_is_in_millivolts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let models = "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\n";
+    let volts = volt_experiment(tmp.path(), models);
+    let metres = write_file(
+        tmp.path(),
+        "metres.toml",
+        &format!(
+            "{}\n{models}",
+            bundled_experiment("trajectory_discovery.toml")
+        ),
+    );
+    for (exp, unit) in [(volts, "mV"), (metres, "mm")] {
+        let out = tmp.path().join(unit);
+        let said = terminal(&run_ok("fit", &exp, &out));
+        let warning = said
+            .lines()
+            .find(|l| l.contains("warning: the residual is"))
+            .unwrap_or_else(|| panic!("viscous alone leaves no warning in\n{said}"));
+        assert!(warning.contains(&format!(" {unit} against ")), "{warning}");
+        assert!(warning.contains(&format!(" {unit}): ")), "{warning}");
+        if unit == "mV" {
+            assert!(wrong_words(&said).is_empty(), "{said}");
+        }
+        let message = read_json(&out.join("fit.json"))["models"][0]["warnings"][0]["message"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        assert!(warning.trim_start().ends_with(&message), "{message}");
+    }
+}
+
 #[test]
 fn a_record_in_metres_is_still_shown_in_millimetres() {
     let tmp = tempfile::tempdir().unwrap();

@@ -21,7 +21,8 @@ use stf_core::physics::oscillator::Oscillator;
 use stf_core::physics::oscillator_params::OscillatorParams;
 use stf_core::physics::param_spec::ParamSpec;
 use stf_core::regimes::{
-    classify, compare, cycles_from_phase, rank_models, Classification, Regime, RegimeThresholds,
+    classify, compare, cycles_from_phase, rank_models, Classification, OverallScore, Regime,
+    RegimeThresholds,
 };
 use stf_core::simulate::synthetic::{sample_record, SensorNoise};
 use stf_core::simulate::{Simulation, Trajectory};
@@ -207,7 +208,7 @@ fn comparison_ranks_the_truth_first_and_shows_a_damper_misses_the_on_off_force()
         .map(|(_, f)| compare(&noisy.c, &sig, f, &th).unwrap())
         .collect();
     let named: Vec<(&str, _)> = models.iter().map(|m| m.0).zip(&comparisons).collect();
-    let ranking = rank_models(&named);
+    let ranking = rank_models(&named, OverallScore::MeanOverRegimes);
     for s in &ranking.overall {
         println!("overall {:8} {:.4}", s.model, s.score);
     }

@@ -12,7 +12,7 @@ use stf_core::data::response::{local_maxima, peak, Peak};
 use stf_core::physics::oscillator::Oscillator;
 use stf_core::regimes::{
     classify, compare as compare_with, rank_models, rank_on_loops, zero_level_spread, Boundary,
-    Classification, Comparison, MetricRanking, Ranking, ZeroLevelSpread,
+    Classification, Comparison, MetricRanking, OverallScore, Ranking, ZeroLevelSpread,
 };
 use stf_core::simulate::Simulation;
 
@@ -147,7 +147,8 @@ pub struct Compared {
     pub measured_peak: Peak,
     /// Each model's simulated response and its peak (|x| m, ω rad/s); none if it failed.
     pub responses: Vec<Option<(Response, (f64, f64))>>,
-    /// The models in order of relative force RMS error.
+    /// The models in order of relative force RMS error: per regime, and overall by the mean
+    /// over the regimes (by the whole record on a record with no sweep); the verdict's order.
     pub ranking: Ranking,
     /// The models in order on each loop metric.
     pub loop_rankings: Vec<MetricRanking>,
@@ -161,9 +162,10 @@ impl Compared {
         self.fits.iter().map(|f| f.label.as_str()).collect()
     }
 
-    /// The score the models are ranked by over the regimes (compare.json's
-    /// `ranking.overall`: the mean of the per-regime relative force RMS errors) of the model
-    /// labelled `label`; the one overall score a report or the terminal shows.
+    /// The score the models are ranked by overall (compare.json's `ranking.overall`: the
+    /// mean of the per-regime relative force RMS errors, or on a record with no sweep the
+    /// error over the whole record) of the model labelled `label`; the one overall score a
+    /// report or the terminal shows.
     pub fn mean_error(&self, label: &str) -> Option<f64> {
         let overall = &self.ranking.overall;
         overall.iter().find(|s| s.model == label).map(|s| s.score)
@@ -202,7 +204,13 @@ pub fn compare_fits(
         .collect();
     let labels: Vec<&str> = fits.iter().map(|f| f.label.as_str()).collect();
     let pairs: Vec<(&str, &Comparison)> = labels.iter().copied().zip(comparisons.iter()).collect();
-    let ranking = rank_models(&pairs);
+    // A record with no sweep is ranked over the whole record, as its verdict says.
+    let over = if data.words().regimes {
+        OverallScore::MeanOverRegimes
+    } else {
+        OverallScore::WholeRecord
+    };
+    let ranking = rank_models(&pairs, over);
     let loop_rankings = rank_on_loops(&measured, &pairs);
     let zero_level = match data.record.f_stf.as_deref() {
         Some(f) if !measured.no_stf => {

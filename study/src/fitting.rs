@@ -21,7 +21,7 @@ use stf_core::data::record::Record;
 use stf_core::fit::Validation;
 use stf_core::fit::{
     fit_warnings, offset_param, FilterNoise, FitError, FitParam, FitResult, FitWarning, ForceFit,
-    NoiseFloor, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET,
+    NoiseFloor, ShownIn, TrajectoryData, TrajectoryFit, DISPLACEMENT_OFFSET, FORCE_OFFSET,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 use stf_core::regimes::{PerRegime, RegimeRms};
@@ -577,7 +577,7 @@ impl Predictor {
     /// The record's noise floor for the fit at `values`: the force sensor's (`[regimes]
     /// noise_sigma` or estimated) with the kinematics' propagated through the model at force
     /// level, none if the sensor's could not be estimated; the displacement noise at
-    /// trajectory level.
+    /// trajectory level; shown in the record's own unit ([`FitData::shown`]).
     fn noise_floor(
         &self,
         exp: &Experiment,
@@ -585,17 +585,20 @@ impl Predictor {
         values: &[f64],
     ) -> Result<Option<NoiseFloor>, FitError> {
         let k = &data.kinematics;
+        let (unit, scale) = data.shown();
+        let shown = ShownIn::new(unit, scale);
         let Predictor::Force(fit) = self else {
-            return Ok(Some(NoiseFloor::displacement(k.sigma_x)));
+            return Ok(Some(NoiseFloor::displacement(k.sigma_x).shown_in(shown)));
         };
         let fd = data.force_data();
         let sensor = exp
             .regimes
             .noise_sigma
             .or_else(|| stf_core::regimes::noise_floor(fd.f).ok());
-        sensor
+        let floor = sensor
             .map(|s| fit.noise_floor(&fd, values, s, k.motion_noise()))
-            .transpose()
+            .transpose()?;
+        Ok(floor.map(|f| f.shown_in(shown)))
     }
 }
 

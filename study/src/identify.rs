@@ -6,13 +6,14 @@
 use anyhow::{Context, Result};
 use stf_core::data::kinematics::Kinematics;
 use stf_core::fit::{
-    fit_warnings, FitResult, FitWarning, NoiseFloor, TrajectoryData, TrajectoryFit,
+    fit_warnings, FitResult, FitWarning, NoiseFloor, ShownIn, TrajectoryData, TrajectoryFit,
 };
 use stf_core::physics::oscillator_params::{OscParam, OscillatorParams};
 
-use crate::experiment::Experiment;
+use crate::experiment::{Experiment, FitLevel};
 use crate::fitting::{oscillator_fit, system_param};
 use crate::observer::{fit_message, Observer};
+use crate::shown_units::ShownUnits;
 
 impl StageOutcome {
     /// The position noise floor as a mean square, mm² (S(μ)'s floor).
@@ -84,6 +85,7 @@ pub fn identify(exp: &Experiment, progress: &dyn Observer) -> Result<Identificat
     }
     let mut system = exp.system;
     let mut outcomes = Vec::new();
+    let units = ShownUnits::of(&exp.data_layout, FitLevel::Trajectory);
     for (i, stage) in exp.identify.iter().enumerate() {
         stage_start(exp, i, &mut system);
         let record = crate::fitting::read_record(exp, &stage.data)?;
@@ -102,7 +104,8 @@ pub fn identify(exp: &Experiment, progress: &dyn Observer) -> Result<Identificat
         }
         fit = free.iter().cloned().fold(fit, TrajectoryFit::free);
         let bar = progress.job(&format!("stage {} of {}", i + 1, exp.identify.len()));
-        let observer = |p: stf_core::fit::FitProgress| bar.message(&fit_message(&p, "mm", 1e3));
+        let observer =
+            |p: stf_core::fit::FitProgress| bar.message(&fit_message(&p, units.x, units.scale));
         let data = TrajectoryData {
             t: &record.t,
             x: &record.x,
@@ -122,7 +125,8 @@ pub fn identify(exp: &Experiment, progress: &dyn Observer) -> Result<Identificat
                 system[param] = v;
             }
         }
-        let floor = NoiseFloor::displacement(k.sigma_x);
+        let floor =
+            NoiseFloor::displacement(k.sigma_x).shown_in(ShownIn::new(units.x, units.scale));
         let warnings = fit_warnings(&result, &free, Some(&floor));
         let values: Vec<f64> = result.params.iter().map(|p| p.value).collect();
         outcomes.push(StageOutcome {

@@ -253,21 +253,18 @@ pub fn compare_verdict(c: &Compared, words: RigWords) -> String {
 /// The verdict of a comparison on a record without a rotor: no regimes, the models ranked by
 /// their relative force RMS error over the whole record.
 fn whole_record_verdict(c: &Compared) -> String {
-    let mut scores: Vec<(&str, f64)> = c
-        .fits
+    // The ranking's own order (over the whole record on such a record: compare.json's
+    // `ranking.overall` and `best.overall`).
+    let order: Vec<String> = c
+        .ranking
+        .overall
         .iter()
-        .zip(&c.comparisons)
-        .map(|(f, cmp)| (f.label.as_str(), cmp.overall.relative_rms_error))
-        .filter(|(_, e)| e.is_finite())
+        .filter(|s| s.score.is_finite())
+        .map(|s| format!("`{}` {:.3}", s.model, s.score))
         .collect();
-    if scores.is_empty() {
+    if order.is_empty() {
         return "No model could be scored on the record.".into();
     }
-    scores.sort_by(|a, b| a.1.total_cmp(&b.1));
-    let order: Vec<String> = scores
-        .iter()
-        .map(|(m, e)| format!("`{m}` {e:.3}"))
-        .collect();
     format!(
         "Models ranked over the whole record (it has no rotor) by their relative force \
          RMS error (the RMS of model − measured force over the measured force's RMS; 0 is \

@@ -60,7 +60,7 @@ pub use error::FitError;
 pub use filter_noise::{FilterNoise, REPLICATES};
 pub use fit_param::{full_values, BoundSide, FitParam};
 pub use force_fit::{ForceFit, FORCE_OFFSET};
-pub use noise_floor::{NoiseFloor, Quantity};
+pub use noise_floor::{NoiseFloor, Quantity, ShownIn};
 pub use objective::Residuals;
 pub use offset::{least_squares_offset, offset_param, offset_reach};
 pub use residual_jacobian::{error_settings, ERROR_ATOL, ERROR_RTOL};

@@ -9,6 +9,10 @@
 //! +σ_q and by −σ_q (a central difference at the size of the noise, so a steep power law near
 //! v = 0 is not linearised over a step larger than the noise itself). Trajectory level: the
 //! residual `x_meas − x_sim` carries the position noise σ_x only.
+//!
+//! The floor is kept in SI; the unit it and the residuals are shown in ([`ShownIn`]) is the
+//! caller's to give ([`NoiseFloor::shown_in`]): the record's own (mV for a record in volts, kN
+//! for a force in kN), N or mm when none is given.
 
 use serde::Serialize;
 
@@ -36,12 +40,34 @@ impl Quantity {
         }
     }
 
-    /// `value` (SI) in the unit a reader expects — N, or mm for displacements — with the unit.
-    pub fn show(self, value: f64) -> String {
+    /// The unit a reader expects when the record says nothing else: N, or mm for
+    /// displacements.
+    pub fn shown_in(self) -> ShownIn {
         match self {
-            Quantity::Force => format!("{value:.4} N"),
-            Quantity::Displacement => format!("{:.4} mm", value * 1e3),
+            Quantity::Force => ShownIn::new("N", 1.0),
+            Quantity::Displacement => ShownIn::new("mm", 1e3),
         }
+    }
+}
+
+/// The unit residuals are shown in, and the factor from their SI values to it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ShownIn {
+    /// The unit's symbol (`N`, `kN`, `mm`, `mV`, …).
+    pub unit: &'static str,
+    /// From the SI value to the shown one.
+    pub scale: f64,
+}
+
+impl ShownIn {
+    /// The unit `unit`, a shown value being `scale` × the SI value.
+    pub const fn new(unit: &'static str, scale: f64) -> Self {
+        ShownIn { unit, scale }
+    }
+
+    /// `value` (SI) in this unit, to four decimals, with the unit.
+    pub fn show(self, value: f64) -> String {
+        format!("{:.4} {}", value * self.scale, self.unit)
     }
 }
 
@@ -56,6 +82,9 @@ pub struct NoiseFloor {
     pub measured: f64,
     /// Noise of the kinematics propagated through the model (force level; 0 otherwise).
     pub propagated: f64,
+    /// The unit the floor and the residuals are shown in (not written: the JSON is SI).
+    #[serde(skip)]
+    pub shown: ShownIn,
 }
 
 impl NoiseFloor {
@@ -66,6 +95,7 @@ impl NoiseFloor {
             sigma: sigma_x,
             measured: sigma_x,
             propagated: 0.0,
+            shown: Quantity::Displacement.shown_in(),
         }
     }
 
@@ -76,7 +106,13 @@ impl NoiseFloor {
             sigma: sensor.hypot(propagated),
             measured: sensor,
             propagated,
+            shown: Quantity::Force.shown_in(),
         }
+    }
+
+    /// The floor shown in `shown`, the record's own unit, instead of N or mm.
+    pub fn shown_in(self, shown: ShownIn) -> Self {
+        NoiseFloor { shown, ..self }
     }
 
     /// Whether the floor is a usable yardstick (positive and finite).
@@ -175,7 +211,9 @@ mod tests {
     fn a_trajectory_floor_is_the_position_noise() {
         let floor = NoiseFloor::displacement(5e-5);
         assert_eq!((floor.sigma, floor.propagated), (5e-5, 0.0));
-        assert_eq!(floor.quantity.show(floor.sigma), "0.0500 mm");
+        assert_eq!(floor.shown.show(floor.sigma), "0.0500 mm");
+        let volts = floor.shown_in(ShownIn::new("mV", 1e3));
+        assert_eq!(volts.shown.show(volts.sigma), "0.0500 mV");
         assert!(!NoiseFloor::displacement(0.0).is_usable());
     }
 }

@@ -20,7 +20,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use super::fit_param::{BoundSide, FitParam};
-use super::noise_floor::{NoiseFloor, Quantity};
+use super::noise_floor::{NoiseFloor, Quantity, ShownIn};
 use super::result::{Convergence, FitResult};
 use crate::digits::{significant, value_and_error};
 
@@ -55,12 +55,15 @@ pub enum FitWarning {
     #[error(
         "the residual is {ratio:.1}× the noise floor (RMS {} against {}): the model \
          misses an effect — try `stf-lab discover`",
-        .quantity.show(*.rms),
-        .quantity.show(*.floor)
+        .shown.show(*.rms),
+        .shown.show(*.floor)
     )]
     AboveNoiseFloor {
         /// What the residuals measure.
         quantity: Quantity,
+        /// The unit the sentence shows them in: the noise floor's, the record's own.
+        #[serde(skip)]
+        shown: ShownIn,
         /// RMS residual (N or m).
         rms: f64,
         /// Noise floor σ (N or m).
@@ -210,6 +213,7 @@ pub fn fit_warnings(
         if ratio > RESIDUAL_OVER_FLOOR || ratio.is_nan() {
             out.push(FitWarning::AboveNoiseFloor {
                 quantity: floor.quantity,
+                shown: floor.shown,
                 rms: result.rms,
                 floor: floor.sigma,
                 ratio,
@@ -373,6 +377,17 @@ mod tests {
         assert!(w[0]
             .to_string()
             .contains("RMS 20.0000 mm against 5.0000 mm"));
+        // A record's own unit, given with the floor: a force in kN, a voltage in mV.
+        let mut large = result(0.0);
+        large.rms = 2.0e4;
+        let kilo = NoiseFloor::force(1.2e4, 0.0).shown_in(ShownIn::new("kN", 1e-3));
+        let w = fit_warnings(&large, &bounds(), Some(&kilo));
+        let text = w[0].to_string();
+        assert!(text.contains("RMS 20.0000 kN against 12.0000 kN"), "{text}");
+        let volts = NoiseFloor::displacement(0.005).shown_in(ShownIn::new("mV", 1e3));
+        let w = fit_warnings(&result(0.0), &bounds(), Some(&volts));
+        let text = w[0].to_string();
+        assert!(text.contains("RMS 20.0000 mV against 5.0000 mV"), "{text}");
     }
 
     #[test]

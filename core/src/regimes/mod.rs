@@ -69,7 +69,7 @@ pub use median::median_filter;
 pub use metrics::{compare, BoundaryErrors, Comparison, PerRegime, RegimeMetrics};
 pub use noise::noise_floor;
 pub use prediction::{rms_by_regime, RegimeRms};
-pub use ranking::{rank_models, Ranking, Score};
+pub use ranking::{rank_models, OverallScore, Ranking, Score};
 pub use regime::Regime;
 pub use rules::{behaviour, place, Behaviour};
 pub use thresholds::RegimeThresholds;

@@ -6,8 +6,11 @@
 //! perfect, 1 is as bad as predicting no force at all where there is one. The overall score is
 //! the mean of the per-regime scores over the regimes the measurement has, each regime weighing
 //! the same, so the small forces of post-resonance count as much as the large ones at
-//! resonance (an RMS over the whole record would be decided by the resonance alone). Ties and
-//! NaN scores sort last in a stable order.
+//! resonance (an RMS over the whole record would be decided by the resonance alone). A record
+//! with no sweep (a damper on an actuator, a shaker: no rotor, so no regimes along a sweep)
+//! is ranked overall by each model's error over the whole record instead
+//! ([`OverallScore::WholeRecord`]), the order its verdict gives. Ties and NaN scores sort last
+//! in a stable order.
 //!
 //! [`RegimeMetrics::relative_rms_error`]: super::RegimeMetrics::relative_rms_error
 
@@ -25,10 +28,19 @@ pub struct Score {
     pub score: f64,
 }
 
+/// What a model's overall score is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OverallScore {
+    /// The mean of its per-regime scores, each regime weighing the same (a swept record).
+    MeanOverRegimes,
+    /// Its relative force RMS error over the whole record (a record with no sweep).
+    WholeRecord,
+}
+
 /// Models sorted best first, overall and per regime.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Ranking {
-    /// By the mean per-regime score.
+    /// By the overall score ([`OverallScore`]).
     pub overall: Vec<Score>,
     /// By the score in each regime (`None`: the measurement has no such cycle).
     pub per_regime: PerRegime<Vec<Score>>,
@@ -58,8 +70,9 @@ pub(super) fn sorted(mut v: Vec<Score>) -> Vec<Score> {
     v
 }
 
-/// Rank models from their comparisons with the same measurement (see the [module doc](self)).
-pub fn rank_models(results: &[(&str, &Comparison)]) -> Ranking {
+/// Rank models from their comparisons with the same measurement, overall by `over` (see the
+/// [module doc](self)).
+pub fn rank_models(results: &[(&str, &Comparison)], over: OverallScore) -> Ranking {
     let mut per_regime = PerRegime::default();
     for r in Regime::ALL {
         let scores: Vec<Score> = results
@@ -77,12 +90,15 @@ pub fn rank_models(results: &[(&str, &Comparison)]) -> Ranking {
         .iter()
         .map(|(name, c)| Score {
             model: name.to_string(),
-            score: mean_or(
-                Regime::ALL
-                    .iter()
-                    .filter_map(|&r| c.per_regime.get(r).map(|m| m.relative_rms_error)),
-                f64::NAN,
-            ),
+            score: match over {
+                OverallScore::MeanOverRegimes => mean_or(
+                    Regime::ALL
+                        .iter()
+                        .filter_map(|&r| c.per_regime.get(r).map(|m| m.relative_rms_error)),
+                    f64::NAN,
+                ),
+                OverallScore::WholeRecord => c.overall.relative_rms_error,
+            },
         })
         .collect();
     Ranking {
@@ -148,7 +164,10 @@ mod tests {
         let a = comparison(0.1, 0.8);
         let b = comparison(0.2, 0.4);
         let c = comparison(f64::NAN, 0.9);
-        let r = rank_models(&[("a", &a), ("b", &b), ("c", &c)]);
+        let r = rank_models(
+            &[("a", &a), ("b", &b), ("c", &c)],
+            OverallScore::MeanOverRegimes,
+        );
         assert_eq!(r.best_in(Regime::Resonance), Some("a"));
         assert_eq!(r.best_in(Regime::PostResonance), Some("b"));
         assert_eq!(r.best_in(Regime::PreResonance), None);
@@ -157,5 +176,21 @@ mod tests {
         assert_eq!(r.overall.last().map(|s| s.model.as_str()), Some("c"));
         let res = r.per_regime.resonance.as_ref().unwrap();
         assert_eq!(res.last().map(|s| s.model.as_str()), Some("c"));
+    }
+
+    #[test]
+    fn a_record_without_a_sweep_is_ranked_over_the_whole_record() {
+        // B wins the mean over the regimes, A the whole record; the regimes' own rankings
+        // are the same either way.
+        let (mut a, mut b) = (comparison(0.1, 0.8), comparison(0.2, 0.4));
+        a.overall = metrics(0.15);
+        b.overall = metrics(0.25);
+        let pairs = [("a", &a), ("b", &b)];
+        let mean = rank_models(&pairs, OverallScore::MeanOverRegimes);
+        let whole = rank_models(&pairs, OverallScore::WholeRecord);
+        assert_eq!(mean.best_overall(), Some("b"));
+        assert_eq!(whole.best_overall(), Some("a"));
+        assert_eq!(whole.overall[0].score, 0.15);
+        assert_eq!(mean.per_regime, whole.per_regime);
     }
 }

@@ -34,15 +34,6 @@ impl FitLevel {
         }
     }
 
-    /// The unit errors and gaps are shown in at this level, and the factor from SI: N at
-    /// force level, mm at trajectory level.
-    pub fn shown(self) -> (&'static str, f64) {
-        match self {
-            FitLevel::Force => ("N", 1.0),
-            FitLevel::Trajectory => ("mm", 1e3),
-        }
-    }
-
     /// The measured signal fits aim at.
     pub fn signal(self) -> Signal {
         match self {

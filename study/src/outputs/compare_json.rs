@@ -27,7 +27,9 @@ pub struct CompareJson<'a> {
     pub thresholds: &'a RegimeThresholds,
     /// Each model, in the experiment's order.
     pub models: Vec<ModelComparisonJson<'a>>,
-    /// The models in order of relative force RMS error, per regime and overall.
+    /// The models in order of relative force RMS error, per regime and overall (the mean
+    /// over the regimes; on a record with no sweep, the error over the whole record): the
+    /// order the verdict, the terminal and the report give.
     pub ranking: &'a Ranking,
     /// The models in order on each loop metric, with the paired test behind each place.
     pub loop_rankings: &'a [MetricRanking],
@@ -119,7 +121,8 @@ pub struct Best<'a> {
     pub resonance: Option<&'a str>,
     /// Post-resonance.
     pub post_resonance: Option<&'a str>,
-    /// Over every cycle.
+    /// First in `ranking.overall`: the best by the mean over the regimes, or over the whole
+    /// record on a record with no sweep; the model the verdict names first.
     pub overall: Option<&'a str>,
 }
 
