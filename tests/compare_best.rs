@@ -10,28 +10,20 @@ mod common;
 
 use std::path::Path;
 
-use common::{damper_record, read_json, root, run_ok, simulate_ok, write_file};
+use common::{damper_only_record, read_json, root, run_ok, simulate_ok, write_file};
 use serde_json::Value;
 
 /// A damper record of `common::damper_record` (`seed`, chirp to `f1` Hz) with only t, x and
 /// the force, the force a 5000th of itself before t = 3 s (the damper disengaged), and an
 /// experiment comparing `viscous`, `yield` and `viscous + yield` on it.
 fn disengaged_damper(dir: &Path, seed: u64, f1: f64) -> std::path::PathBuf {
-    damper_record(dir, seed, f1);
-    let text = std::fs::read_to_string(dir.join("r.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let at = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (t, x, f) = (at("t"), at("x"), at("f_stf"));
-    let mut out = String::from("t,x,F\n");
-    for line in lines {
-        let c: Vec<&str> = line.split(',').collect();
-        let time: f64 = c[t].parse().unwrap();
-        let force: f64 = c[f].parse().unwrap();
-        let force = if time < 3.0 { force * 2e-4 } else { force };
-        out.push_str(&format!("{},{},{force}\n", c[t], c[x]));
-    }
-    write_file(dir, "damper.csv", &out);
+    damper_only_record(dir, (seed, f1), "damper.csv", |time, force| {
+        if time < 3.0 {
+            force * 2e-4
+        } else {
+            force
+        }
+    });
     write_file(
         dir,
         "damper.toml",

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{damper_record, read_json, run_ok, write_file};
+use common::{damper_only_record, read_json, run_ok, write_file};
 
 /// Every phrase of `text` that assumes a rotor (`cycles.csv` is a file's name, a contract,
 /// and "no rotor" says the record has none).
@@ -29,18 +29,7 @@ fn rotor_words(text: &str) -> Vec<String> {
 
 /// The damper record of `common::damper_record` with only t, x and the force (named `F`).
 fn damper_only(dir: &Path) -> std::path::PathBuf {
-    damper_record(dir, 5, 3.0);
-    let text = std::fs::read_to_string(dir.join("r.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let at = |n: &str| header.iter().position(|h| *h == n).unwrap();
-    let (t, x, f) = (at("t"), at("x"), at("f_stf"));
-    let mut out = String::from("t,x,F\n");
-    for line in lines {
-        let c: Vec<&str> = line.split(',').collect();
-        out.push_str(&format!("{},{},{}\n", c[t], c[x], c[f]));
-    }
-    write_file(dir, "damper.csv", &out);
+    damper_only_record(dir, (5, 3.0), "damper.csv", |_, force| force);
     write_file(
         dir,
         "damper.toml",

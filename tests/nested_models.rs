@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{damper_record, run_json};
+use common::{damper_only_record, damper_record, run_json};
 
 /// The damper record of `seed` on a chirp 0.5 → `f1` Hz, and the experiment fitting both
 /// sums to it at force level.
@@ -50,18 +50,7 @@ fn a_sum_with_one_more_term_never_ends_worse_than_the_sum_it_contains() {
 fn compare_on_a_damper_s_own_record_never_ranks_the_richer_sum_worse_in_training() {
     for (seed, f1) in [(6, 4.0), (7, 3.0)] {
         let dir = tempfile::tempdir().unwrap();
-        damper_record(dir.path(), seed, f1);
-        let text = std::fs::read_to_string(dir.path().join("r.csv")).unwrap();
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-        let at = |n: &str| header.iter().position(|h| *h == n).unwrap();
-        let (t, x, f) = (at("t"), at("x"), at("f_stf"));
-        let mut csv = String::from("t,x,F\n");
-        for line in lines {
-            let c: Vec<&str> = line.split(',').collect();
-            csv.push_str(&format!("{},{},{}\n", c[t], c[x], c[f]));
-        }
-        std::fs::write(dir.path().join("d.csv"), csv).unwrap();
+        damper_only_record(dir.path(), (seed, f1), "d.csv", |_, force| force);
         let exp = dir.path().join("c.toml");
         std::fs::write(
             &exp,

@@ -6,7 +6,7 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use common::{bundled_experiment, read_json, root, run_ok, write_file};
 
@@ -75,6 +75,21 @@ fn a_record_in_volts_is_shown_in_millivolts_everywhere() {
     );
 }
 
+/// The shaker's experiment with `models`, on its record read in volts
+/// ([`volt_experiment`]) and as bundled, in metres.
+fn volts_and_metres(dir: &Path, models: &str) -> (PathBuf, PathBuf) {
+    let volts = volt_experiment(dir, models);
+    let metres = write_file(
+        dir,
+        "metres.toml",
+        &format!(
+            "{}\n{models}",
+            bundled_experiment("trajectory_discovery.toml")
+        ),
+    );
+    (volts, metres)
+}
+
 /// A trajectory-level fit that misses an effect (viscous alone on the shaker) is warned
 /// about in mV on a record in volts — the residual and the floor as the summary shows them,
 /// in the terminal and in `fit.json`'s stored message — and in mm on the same record in
@@ -83,15 +98,7 @@ fn a_record_in_volts_is_shown_in_millivolts_everywhere() {
 fn a_fit_warning_on_a_record_in_volts_is_in_millivolts() {
     let tmp = tempfile::tempdir().unwrap();
     let models = "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\n";
-    let volts = volt_experiment(tmp.path(), models);
-    let metres = write_file(
-        tmp.path(),
-        "metres.toml",
-        &format!(
-            "{}\n{models}",
-            bundled_experiment("trajectory_discovery.toml")
-        ),
-    );
+    let (volts, metres) = volts_and_metres(tmp.path(), models);
     for (exp, unit) in [(volts, "mV"), (metres, "mm")] {
         let out = tmp.path().join(unit);
         let said = terminal(&run_ok("fit", &exp, &out));
@@ -353,15 +360,7 @@ fn a_joint_fit_over_records_in_metres_and_volts_is_refused() {
         std::fs::copy(&record, tmp.path().join(name)).unwrap();
     }
     let models = "[fit]\nlevel = \"trajectory\"\n\n[[models]]\nname = \"viscous\"\nplus = [\"cubic_stiffness\"]\n";
-    let volts = volt_experiment(tmp.path(), models);
-    let metres = write_file(
-        tmp.path(),
-        "metres.toml",
-        &format!(
-            "{}\n{models}",
-            bundled_experiment("trajectory_discovery.toml")
-        ),
-    );
+    let (volts, metres) = volts_and_metres(tmp.path(), models);
     let campaign = write_file(
         tmp.path(),
         "campaign.toml",

@@ -71,6 +71,36 @@ pub fn damper_record(dir: &Path, seed: u64, f1: f64) {
     simulate_ok(&write_file(dir, "make.toml", &make), &dir.join("r.csv"));
 }
 
+/// [`damper_record`] (`seed`, chirp to `f1` Hz) cut to what a damper rig measures, written to
+/// `dir/name`: columns `t,x,F`, the force `force(t, F)` of the simulated one.
+pub fn damper_only_record(
+    dir: &Path,
+    (seed, f1): (u64, f64),
+    name: &str,
+    force: impl Fn(f64, f64) -> f64,
+) -> std::path::PathBuf {
+    damper_record(dir, seed, f1);
+    let text = std::fs::read_to_string(dir.join("r.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (t, x, f) = (at("t"), at("x"), at("f_stf"));
+    let mut out = String::from("t,x,F\n");
+    for line in lines {
+        let c: Vec<&str> = line.split(',').collect();
+        let (time, measured): (f64, f64) = (c[t].parse().unwrap(), c[f].parse().unwrap());
+        let shown = force(time, measured);
+        // The simulated text as it stands where the force is not changed.
+        let cell = if shown == measured {
+            c[f].to_string()
+        } else {
+            shown.to_string()
+        };
+        out.push_str(&format!("{},{},{cell}\n", c[t], c[x]));
+    }
+    write_file(dir, name, &out)
+}
+
 /// `stf-lab simulate EXPERIMENT --out RECORD`, then the `extra` flags.
 pub fn simulate(experiment: &Path, record: &Path, extra: &[&str]) -> Output {
     stf_lab()

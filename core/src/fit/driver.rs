@@ -788,14 +788,8 @@ mod tests {
     /// inside the same box, as near the bound, is held by nothing.
     #[test]
     fn a_parameter_the_data_push_past_a_bound_is_held_by_it() {
-        let x: Vec<f64> = (0..400).map(|i| (i as f64 * 0.05).sin()).collect();
         for (truth, held) in [(-124.0, Some(BoundSide::Lower)), (-95.0, None)] {
-            let y: Vec<f64> = x
-                .iter()
-                .enumerate()
-                .map(|(i, x)| truth * x + 0.1 * ((i * 7919 % 13) as f64 - 6.0))
-                .collect();
-            let line = Line { x: x.clone(), y };
+            let line = sloped(truth);
             let params = [FitParam::new("k", 0.0).bounds(-100.0, 100.0).scale(0.1)];
             for solver in Solver::ALL {
                 let settings = FitSettings::default().solver(solver);
@@ -814,18 +808,24 @@ mod tests {
         }
     }
 
-    /// The rule of [`held_by`] both ways: a parameter is held by a bound it is pushed past
-    /// only when it stopped near it on the bound's scale.
+    /// 400 samples of a line of slope `truth` through a sine, with a little deterministic
+    /// noise.
+    fn sloped(truth: f64) -> Line {
+        let x: Vec<f64> = (0..400).map(|i| (i as f64 * 0.05).sin()).collect();
+        let y = x
+            .iter()
+            .enumerate()
+            .map(|(i, x)| truth * x + 0.1 * ((i * 7919 % 13) as f64 - 6.0))
+            .collect();
+        Line { x, y }
+    }
+
+    /// A fit run without its standard errors and completed with them later is the fit run
+    /// with them, to the bit, held by its bound or not.
     #[test]
     fn errors_completed_later_are_those_of_a_fit_run_with_them() {
-        let x: Vec<f64> = (0..400).map(|i| (i as f64 * 0.05).sin()).collect();
         for truth in [-124.0, 37.0] {
-            let y: Vec<f64> = x
-                .iter()
-                .enumerate()
-                .map(|(i, x)| truth * x + 0.1 * ((i * 7919 % 13) as f64 - 6.0))
-                .collect();
-            let line = Line { x: x.clone(), y };
+            let line = sloped(truth);
             let params = [FitParam::new("k", 0.0).bounds(-100.0, 100.0).scale(0.1)];
             for solver in Solver::ALL {
                 let settings = FitSettings::default().solver(solver);
@@ -852,6 +852,8 @@ mod tests {
         }
     }
 
+    /// The rule of [`held_by`] both ways: a parameter is held by a bound it is pushed past
+    /// only when it stopped near it on the bound's scale.
     #[test]
     fn a_bound_holds_a_parameter_only_near_it_on_its_own_scale() {
         // c_s in [0, 1e4], typical size 2: at 12.69 it is far from its bound at 0 even if
