@@ -101,7 +101,9 @@ impl TrajectoryLevel<'_> {
     /// fitted, with their gain and rank; otherwise all are fitted. A trajectory fit costs
     /// hundreds of simulations. On a scouted record each candidate's values are searched on
     /// the scout, and when more than [`SCOUT_KEEP`] were searched only the best
-    /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record.
+    /// [`SCOUT_KEEP`] by their scout fit's gain are tried on the whole record; of those, one
+    /// whose gain is under [`super::scout_ranking::SCOUT_SHARE`] of the best one's is not
+    /// (however few were searched: [`left_out`]).
     pub(in crate::discovery) fn scores(
         &self,
         step: usize,
