@@ -178,6 +178,64 @@ fn discovery_on_a_rotorless_record_in_volts_speaks_of_periods_and_millivolts() {
     );
 }
 
+/// A scouted trajectory-level discovery (the search on short pieces of the record) on a
+/// record in volts: the reasons a candidate was not fitted on the whole record are in mV too.
+#[test]
+fn a_scouted_discovery_on_a_record_in_volts_says_why_in_millivolts() {
+    let tmp = tempfile::tempdir().unwrap();
+    // The shaker's chirp ten times as long at half the rate (20 000 samples: past the
+    // default `scout_from`, and long enough for pieces of six periods), simulated into a
+    // record of its own.
+    let record = tmp.path().join("long.csv");
+    let exp = volt_experiment(tmp.path(), "");
+    let text = std::fs::read_to_string(&exp).unwrap();
+    let bundled = text
+        .split('"')
+        .find(|s| s.ends_with("trajectory_discovery.csv"));
+    let text = text
+        .replace(
+            bundled.unwrap(),
+            &record.display().to_string().replace('\\', "/"),
+        )
+        .replace("t1 = 20.0", "t1 = 200.0")
+        .replace("rate = 200.0", "rate = 100.0");
+    std::fs::write(&exp, text).unwrap();
+    run_ok("simulate", &exp, &record);
+    let out = tmp.path().join("disc");
+    let output = run_ok("discover", &exp, &out);
+    let said = terminal(&output);
+    let doc = read_json(&out.join("discovery.json"));
+    assert!(
+        doc["notes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|n| n.as_str().unwrap().starts_with("scouted")),
+        "{:?}",
+        doc["notes"]
+    );
+    let why: Vec<&str> = doc["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["candidates"].as_array().unwrap())
+        .filter_map(|c| c["failure"].as_str())
+        .collect();
+    assert!(
+        why.iter()
+            .any(|w| w.contains("not fitted on the whole record")),
+        "{why:?}"
+    );
+    for w in &why {
+        assert!(wrong_words(w).is_empty(), "{w}");
+    }
+    assert!(
+        wrong_words(&said).is_empty(),
+        "{:?} in\n{said}",
+        wrong_words(&said)
+    );
+}
+
 #[test]
 fn compare_on_a_rotorless_record_ranks_over_the_whole_record() {
     let tmp = tempfile::tempdir().unwrap();

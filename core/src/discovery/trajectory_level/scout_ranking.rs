@@ -30,18 +30,19 @@ pub(in crate::discovery) const SCOUT_SHARE: f64 = 0.2;
 /// (`rank` of `of`, gain in m²) is past [`SCOUT_KEEP`], its gain is under [`SCOUT_SHARE`] of
 /// the best candidate's `best`, or its scout fit (`start_rms`, m) is no better than the
 /// current model's training RMS `current` on the whole record — where the search failed, and
-/// a short polish does not climb out.
+/// a short polish does not climb out. Said in `unit` (`mm`, or `mV` for a record whose x is
+/// a voltage: thousandths of the record's unit either way).
 pub(in crate::discovery) fn left_out(
     scout_rank: Option<(usize, usize, f64)>,
     best: f64,
-    start_rms: f64,
-    current: f64,
+    (start_rms, current): (f64, f64),
+    unit: &str,
 ) -> Option<String> {
     if let Some((r, of, gain)) = scout_rank {
         if r >= SCOUT_KEEP {
             return Some(format!(
                 "not fitted on the whole record: the scout ranks it {} of {of} (it lowers the \
-                 scout's mean square by {:.3e} mm²)",
+                 scout's mean square by {:.3e} {unit}²)",
                 r + 1,
                 gain * 1e6
             ));
@@ -49,7 +50,7 @@ pub(in crate::discovery) fn left_out(
         if best > 0.0 && gain < SCOUT_SHARE * best {
             return Some(format!(
                 "not fitted on the whole record: on the scout it lowers the mean square by \
-                 {:.3e} mm², less than {:.0} % of the best candidate's {:.3e} mm²",
+                 {:.3e} {unit}², less than {:.0} % of the best candidate's {:.3e} {unit}²",
                 gain * 1e6,
                 SCOUT_SHARE * 100.0,
                 best * 1e6
@@ -58,8 +59,8 @@ pub(in crate::discovery) fn left_out(
     }
     (start_rms >= current).then(|| {
         format!(
-            "not fitted on the whole record: its scout fit leaves the training RMS at {:.4} mm, \
-             not below the current model's {:.4} mm",
+            "not fitted on the whole record: its scout fit leaves the training RMS at {:.4} \
+             {unit}, not below the current model's {:.4} {unit}",
             start_rms * 1e3,
             current * 1e3
         )
@@ -147,18 +148,27 @@ mod tests {
     #[test]
     fn a_scouted_candidate_is_left_out_by_rank_by_share_or_by_a_failed_search() {
         let best = 4e-8;
-        let kept = left_out(Some((1, 5, 0.5 * best)), best, 1e-3, 2e-3);
+        let rms = (1e-3, 2e-3);
+        let kept = left_out(Some((1, 5, 0.5 * best)), best, rms, "mm");
         assert_eq!(kept, None);
-        let ranked = left_out(Some((SCOUT_KEEP, 5, 0.9 * best)), best, 1e-3, 2e-3).unwrap();
+        let ranked = left_out(Some((SCOUT_KEEP, 5, 0.9 * best)), best, rms, "mm").unwrap();
         assert!(ranked.contains("ranks it 4 of 5"), "{ranked}");
-        let share = left_out(Some((2, 5, 0.1 * best)), best, 1e-3, 2e-3).unwrap();
+        assert!(ranked.ends_with("3.600e-2 mm²)"), "{ranked}");
+        let share = left_out(Some((2, 5, 0.1 * best)), best, rms, "mm").unwrap();
         assert!(share.contains("less than 20 % of the best"), "{share}");
+        // Three searched: no rank leaves one out, the share still does.
+        let few = left_out(Some((2, 3, 0.1 * best)), best, rms, "mm").unwrap();
+        assert!(few.contains("less than 20 % of the best"), "{few}");
         // No positive gain anywhere: the share rule has nothing to measure against.
-        assert_eq!(left_out(Some((2, 5, -1e-9)), -1e-10, 1e-3, 2e-3), None);
-        let failed = left_out(None, best, 2e-3, 2e-3).unwrap();
+        assert_eq!(left_out(Some((2, 5, -1e-9)), -1e-10, rms, "mm"), None);
+        let failed = left_out(None, best, (2e-3, 2e-3), "mm").unwrap();
         assert!(
             failed.contains("not below the current model's 2.0000 mm"),
             "{failed}"
         );
+        // A record whose x is a voltage is said in mV.
+        let volts = left_out(Some((2, 5, 0.1 * best)), best, rms, "mV").unwrap();
+        assert!(volts.contains("4.000e-3 mV², less than"), "{volts}");
+        assert!(!volts.contains("mm"), "{volts}");
     }
 }

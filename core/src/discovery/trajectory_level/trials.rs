@@ -156,8 +156,8 @@ impl TrajectoryLevel<'_> {
                 if let Some(why) = left_out(
                     scout_rank[i],
                     best_scout_gain,
-                    *start_rms,
-                    current.train.rms,
+                    (*start_rms, current.train.rms),
+                    self.settings.x_unit,
                 ) {
                     return (choice::failed(&c.name, why), None);
                 }
