@@ -2,7 +2,8 @@
 //! V: an electronic rig, or a force sensor left uncalibrated) carries its force in V in every
 //! figure: the axes and CSV columns of the time history, the hysteresis loops, the measured
 //! and fitted force and discovery's residuals say `F_STF, V`, never `F_STF, N`; discovery's
-//! `gap_unit` is `V`. The same record with its force in N keeps `F_STF, N`.
+//! `gap_unit` is `V`; discover's gap lines and compare's noise floor and on-threshold, in the
+//! terminal and in compare.md, say V. The same record with its force in N keeps `F_STF, N`.
 
 mod common;
 
@@ -184,5 +185,55 @@ fn a_fit_warning_speaks_the_summary_s_unit() {
             warning.trim_start().ends_with(message),
             "{units}: {message} against {warning}"
         );
+    }
+}
+
+/// Terminal text of a run (stdout and stderr).
+fn said(output: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
+/// The force numbers a run says, with their unit: the discovery's gaps and floor, the
+/// comparison's noise floor and on-threshold, in the terminal and in compare.md.
+fn force_words(dir: &Path, units: &str) -> Vec<String> {
+    let exp = experiment(dir, units);
+    let disc = said(&run_ok("discover", &exp, &dir.join("disc")));
+    let cmp_out = dir.join("cmp");
+    let cmp = said(&run_ok("compare", &exp, &cmp_out));
+    let md = std::fs::read_to_string(cmp_out.join("compare.md")).unwrap();
+    let mut out = Vec::new();
+    for (text, key) in [
+        (&disc, "`: gap "),
+        (&disc, "(noise floor "),
+        (&cmp, "noise floor σ = "),
+        (&md, "noise floor σ = "),
+        (&md, "|F_STF| above "),
+    ] {
+        let line = text.lines().find(|l| l.contains(key));
+        let line = line.unwrap_or_else(|| panic!("no `{key}` in\n{text}"));
+        let (_, unit) = number_after(line, key).unwrap_or_else(|| panic!("{key}: {line}"));
+        out.push(format!("{key}{}", unit.trim_end_matches(['.', ';', ')'])));
+    }
+    out
+}
+
+#[test]
+fn a_force_read_in_volts_is_said_in_volts_by_discover_and_compare() {
+    let tmp = tempfile::tempdir().unwrap();
+    let volts = force_words(
+        tmp.path(),
+        "{ x = \"V\", f_stf = { unit = \"V\", gain = 1.0 } }",
+    );
+    for w in &volts {
+        assert!(w.ends_with('V'), "{volts:?}");
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let newtons = force_words(tmp.path(), "{ x = \"m\" }");
+    for w in &newtons {
+        assert!(w.ends_with('N'), "{newtons:?}");
     }
 }

@@ -13,10 +13,12 @@ use crate::experiment::Experiment;
 use crate::fitting::FitData;
 use stf_study::compare::Compared;
 use stf_study::rig_words::RigWords;
+use stf_study::shown_units::ShownUnits;
 
-/// What the duty and its error are, with the record's on-threshold, in the words of its rig
-/// (a rotor's cycles and regimes, or the periods of the whole record).
-pub fn duty_meaning(on_threshold: f64, words: RigWords) -> String {
+/// What the duty and its error are, with the record's on-threshold (in the record's force
+/// unit `unit`: N, or V for a force read in volts), in the words of its rig (a rotor's cycles
+/// and regimes, or the periods of the whole record).
+pub fn duty_meaning(on_threshold: f64, words: RigWords, unit: &str) -> String {
     let (piece, over) = if words.regimes {
         ("cycle", "a regime's cycles")
     } else {
@@ -24,22 +26,22 @@ pub fn duty_meaning(on_threshold: f64, words: RigWords) -> String {
     };
     format!(
         "The duty of a {piece} is the fraction of it in which the STF force is on (|F_STF| above \
-         {on_threshold:.3} N, the record's on-threshold): 1 for a force that only passes through \
+         {on_threshold:.3} {unit}, the record's on-threshold): 1 for a force that only passes through \
          zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
          {over} of |model duty − measured duty|."
     )
 }
 
 /// How the boundaries move with the zero-force level: the level used, each boundary at half
-/// and twice it, and the range each spans.
-pub fn zero_level_line(z: &ZeroLevelSpread) -> String {
+/// and twice it, and the range each spans; forces in the record's unit `unit`.
+pub fn zero_level_line(z: &ZeroLevelSpread, unit: &str) -> String {
     let omega = |b: Option<Boundary>| b.map_or("none".to_string(), |b| format!("{:.2}", b.omega));
     let levels: Vec<String> = z
         .at_levels
         .iter()
         .map(|l| {
             format!(
-                "at {:.3} N ({}×) onset {}, resonance → post-resonance {}",
+                "at {:.3} {unit} ({}×) onset {}, resonance → post-resonance {}",
                 l.zero_level,
                 l.factor,
                 omega(l.boundaries.pre_resonance),
@@ -58,7 +60,8 @@ pub fn zero_level_line(z: &ZeroLevelSpread) -> String {
     .flatten()
     .collect();
     format!(
-        "zero force level {:.3} N ({}); recomputed {}: over these levels, with each one's ±, {}",
+        "zero force level {:.3} {unit} ({}); recomputed {}: over these levels, with each one's \
+         ±, {}",
         z.zero_level,
         z.zero_level_rule,
         levels.join("; "),
@@ -90,7 +93,7 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
         }
     );
     if !data.words().regimes {
-        whole_record_table(&mut md, c, data.units.x);
+        whole_record_table(&mut md, c, &data.units);
         misses_and_warnings(&mut md, c, false);
         return md;
     }
@@ -98,9 +101,9 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
         let _ = writeln!(md, "- {line}");
     }
     if let Some(z) = &c.zero_level {
-        let _ = writeln!(md, "- {}", zero_level_line(z));
+        let _ = writeln!(md, "- {}", zero_level_line(z, data.units.force_si));
     }
-    errors_table(&mut md, c, data.units.x);
+    errors_table(&mut md, c, &data.units);
     for r in Regime::ALL {
         if let Some(b) = c.ranking.best_in(r) {
             let _ = writeln!(md, "- best in {}: **{b}**", r.name().replace('_', "-"));
@@ -120,12 +123,13 @@ pub fn compare_markdown(exp: &Experiment, data: &FitData, c: &Compared) -> Strin
 }
 
 /// A record without a rotor: each model's relative force RMS error (duty error) over the
-/// whole record and the largest |x| simulated with it, in the record's unit (`x_unit`).
-fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
+/// whole record and the largest |x| simulated with it, in the record's units.
+fn whole_record_table(md: &mut String, c: &Compared, units: &ShownUnits) {
+    let x_unit = units.x;
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) over the whole record; lower is better. {}\n",
-        duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS)
+        duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS, units.force_si)
     );
     let _ = writeln!(md, "| model | whole record | peak x ({x_unit}) |");
     let _ = writeln!(md, "|---|---|---|");
@@ -148,12 +152,13 @@ fn whole_record_table(md: &mut String, c: &Compared, x_unit: &str) {
 }
 
 /// The table of relative force RMS error (duty error) per regime and the simulated peak.
-fn errors_table(md: &mut String, c: &Compared, x_unit: &str) {
+fn errors_table(md: &mut String, c: &Compared, units: &ShownUnits) {
+    let x_unit = units.x;
     let _ = writeln!(
         md,
         "\nRelative force RMS error (duty error) per regime and its mean over the regimes, the \
          score the models are ranked by; lower is better. {}\n",
-        duty_meaning(c.measured.on_threshold, RigWords::ROTOR)
+        duty_meaning(c.measured.on_threshold, RigWords::ROTOR, units.force_si)
     );
     let _ = writeln!(
         md,

@@ -133,7 +133,7 @@ fn windows_of(
     found: &[Stretch],
     cycles: &[Cycle],
     classified: Option<&Classification>,
-    (x_unit, t): (&str, Option<&[f64]>),
+    (units, t): ((&str, &str), Option<&[f64]>),
 ) -> (Vec<RegimeWindow>, Vec<String>) {
     let window = |name: String, first: usize, count: usize| RegimeWindow {
         name,
@@ -141,7 +141,7 @@ fn windows_of(
         end: cycles[first + count - 1].end,
     };
     if let Some(c) = classified {
-        let placed = place_windows(c, CYCLES_PER_WINDOW, x_unit);
+        let placed = place_windows(c, CYCLES_PER_WINDOW, units);
         let why = placed.iter().map(|p| format!("{}.", p.why)).collect();
         let windows = placed
             .into_iter()
@@ -207,7 +207,8 @@ pub fn regime_section(
     let k = &data.kinematics;
     let (x_mm, v_mm) = (milli(&k.x), milli(&k.v));
     let rotor = k.phi.is_some() || k.omega.is_some();
-    let named_by = (data.units.x, (!rotor).then_some(k.t.as_slice()));
+    let units = (data.units.x, data.units.force_si);
+    let named_by = (units, (!rotor).then_some(k.t.as_slice()));
     let (windows, why) = windows_of(&found, &cycles, classified.as_ref(), named_by);
     let words = Words::of(labels.is_some(), rotor);
     let motion = MotionLabels::of(&data.units);

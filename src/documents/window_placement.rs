@@ -77,8 +77,13 @@ fn largest(c: &Classification, keep: impl Fn(usize) -> bool) -> Option<usize> {
 
 /// The windows of `per_window` cycles each, in the order pre-resonance,
 /// resonance (or amplitude peak), post-resonance; see the [module doc](self). Amplitudes are
-/// said in `x_unit` (thousandths of the record's unit of x: `mm`, or `mV` for x in volts).
-pub fn place_windows(c: &Classification, per_window: usize, x_unit: &str) -> Vec<Placement> {
+/// said in `x_unit` (thousandths of the record's unit of x: `mm`, or `mV` for x in volts),
+/// forces in `force_unit` (the record's: N, or V for a force read in volts).
+pub fn place_windows(
+    c: &Classification,
+    per_window: usize,
+    (x_unit, force_unit): (&str, &str),
+) -> Vec<Placement> {
     let n = c.features.len().min(c.labels.len()).min(c.cycles.len());
     let Some(peak) = largest(c, |i| i < n) else {
         return Vec::new();
@@ -104,7 +109,7 @@ pub fn place_windows(c: &Classification, per_window: usize, x_unit: &str) -> Vec
     let below_peak = |i: usize| label(i) == Regime::PreResonance && omega(i) < omega(peak);
     if let Some((first, len)) = longest_run(n, below_peak) {
         let why = format!(
-            "the force negligible (its peak ≤ {:.2} N), in the middle of the longest such run \
+            "the force negligible (its peak ≤ {:.2} {force_unit}), in the middle of the longest such run \
              below the amplitude peak at ω {:.2} rad/s",
             c.negligible_level,
             omega(peak)
@@ -127,7 +132,7 @@ pub fn place_windows(c: &Classification, per_window: usize, x_unit: &str) -> Vec
         Regime::PreResonance => {
             let why = format!(
                 "the largest amplitude ({:.1} {x_unit} at ω {:.2} rad/s), where the force stays \
-                 negligible (its peak ≤ {:.2} N): no resonance by the force definition, and \
+                 negligible (its peak ≤ {:.2} {force_unit}): no resonance by the force definition, and \
                  not pre-resonance either, since the motion is at its largest",
                 milli(peak),
                 omega(peak),
@@ -231,7 +236,7 @@ mod tests {
     fn resonance_lasting_to_the_end_is_shown_at_the_amplitude_peak() {
         // No post-resonance: the resonance run is cycles 8..40, its middle at cycle 24.
         let labels: Vec<Regime> = (0..40).map(|i| if i < 8 { Pre } else { Res }).collect();
-        let w = place_windows(&peaked(&labels), 3, "mm");
+        let w = place_windows(&peaked(&labels), 3, ("mm", "N"));
         let names: Vec<&str> = w.iter().map(|p| p.regime.as_str()).collect();
         assert_eq!(names, ["pre-resonance", "resonance"]);
         assert_eq!((w[1].first, w[1].count), (11, 3), "{w:?}");
@@ -254,7 +259,7 @@ mod tests {
                 _ => Post,
             })
             .collect();
-        let w = place_windows(&peaked(&labels), 3, "mm");
+        let w = place_windows(&peaked(&labels), 3, ("mm", "N"));
         let names: Vec<&str> = w.iter().map(|p| p.regime.as_str()).collect();
         assert_eq!(
             names,
@@ -274,6 +279,19 @@ mod tests {
         assert!(w[1]
             .why
             .contains("force stays negligible (its peak ≤ 0.20 N)"));
+        // A record whose force is read in volts says its level in volts.
+        let volts = place_windows(&peaked(&labels), 3, ("mV", "V"));
+        assert!(
+            volts[0].why.contains("(its peak ≤ 0.20 V)"),
+            "{:?}",
+            volts[0]
+        );
+        assert!(
+            volts[1].why.contains("(its peak ≤ 0.20 V)"),
+            "{:?}",
+            volts[1]
+        );
+        assert!(!volts[1].why.contains(" N)"), "{:?}", volts[1]);
         assert_eq!(
             w[2].first, 20,
             "the largest resonant amplitude, in its run: {w:?}"
@@ -283,8 +301,8 @@ mod tests {
 
     #[test]
     fn a_short_record_gets_the_cycles_it_has() {
-        let w = place_windows(&peaked(&[Res, Res]), 3, "mm");
+        let w = place_windows(&peaked(&[Res, Res]), 3, ("mm", "N"));
         assert_eq!((w[0].first, w[0].count), (0, 2));
-        assert!(place_windows(&peaked(&[]), 3, "mm").is_empty());
+        assert!(place_windows(&peaked(&[]), 3, ("mm", "N")).is_empty());
     }
 }

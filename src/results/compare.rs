@@ -62,13 +62,14 @@ fn print_summary(result: &CompareResult) {
     let words = data.words();
     say!("{}", crate::verdict::compare_verdict(c, data.words()));
     say!(
-        "compared {} model(s) on {} {} of {} (noise floor σ = {:.4} N); relative force RMS \
+        "compared {} model(s) on {} {} of {} (noise floor σ = {:.4} {}); relative force RMS \
          error {}, lower is better:",
         c.fits.len(),
         c.measured.labels.len(),
         words.cycles,
         data.record.source,
         c.measured.noise_sigma,
+        data.units.force_si,
         if words.regimes {
             "per regime"
         } else {
@@ -179,7 +180,7 @@ fn write_compare_report(
     let models = if data.words().regimes {
         regimes_section(c, md, &data.units, out)?
     } else {
-        whole_record_section(c, md)
+        whole_record_section(c, md, &data.units)
     };
     let mut sections = vec![results, models];
     sections.extend(frequency);
@@ -197,11 +198,12 @@ fn write_compare_report(
     sections.extend(regimes?);
     let verdict = crate::verdict::compare_verdict(c, data.words());
     let record = format!(
-        "{} {} of {}; noise floor σ = {:.4} N.",
+        "{} {} of {}; noise floor σ = {:.4} {}.",
         c.measured.labels.len(),
         data.words().cycles,
         data.record.source,
-        c.measured.noise_sigma
+        c.measured.noise_sigma,
+        data.units.force_si
     );
     write_report(
         &format!("Comparison: {}", exp.path.display()),
@@ -220,9 +222,11 @@ fn regimes_section(c: &Compared, md: &str, units: &ShownUnits, out: &Path) -> Re
         .filter(|l| l.starts_with("- "))
         .map(|l| l.trim_start_matches("- ").replace("**", ""))
         .collect();
-    regimes
-        .paragraphs
-        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTOR));
+    regimes.paragraphs.push(duty_meaning(
+        c.measured.on_threshold,
+        RigWords::ROTOR,
+        units.force_si,
+    ));
     regimes.tables.push(errors_table(c));
     regimes
         .paragraphs
@@ -259,15 +263,18 @@ fn regimes_section(c: &Compared, md: &str, units: &ShownUnits, out: &Path) -> Re
 
 /// The report's "Models over the whole record" of a record without a rotor: compare.md's
 /// bullets and each model's relative force RMS error (duty error) over the whole record.
-fn whole_record_section(c: &Compared, md: &str) -> Section {
+fn whole_record_section(c: &Compared, md: &str, units: &ShownUnits) -> Section {
     let mut s = Section::new("Models over the whole record");
     s.paragraphs = md
         .lines()
         .filter(|l| l.starts_with("- "))
         .map(|l| l.trim_start_matches("- ").replace("**", ""))
         .collect();
-    s.paragraphs
-        .push(duty_meaning(c.measured.on_threshold, RigWords::ROTORLESS));
+    s.paragraphs.push(duty_meaning(
+        c.measured.on_threshold,
+        RigWords::ROTORLESS,
+        units.force_si,
+    ));
     let rows = c
         .fits
         .iter()

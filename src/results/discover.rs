@@ -76,14 +76,17 @@ fn print_summary(
     let summary = match &found.trajectory {
         None => {
             say!(
-                "base `{}`: gap {:.4} N; {}",
+                "base `{}`: gap {:.4} {unit}; {}",
                 spec.base_text(),
-                found.gap_before,
+                found.gap_before * scale,
                 found.where_before.summary
             );
             format!(
-                "effects: {effects}; gap {:.4} N → {:.4} N (noise floor {:.4} N) in {wall:.1} s",
-                found.gap_before, found.gap_after, found.noise_floor,
+                "effects: {effects}; gap {:.4} {unit} → {:.4} {unit} (noise floor {:.4} {unit}) \
+                 in {wall:.1} s",
+                found.gap_before * scale,
+                found.gap_after * scale,
+                found.noise_floor * scale,
             )
         }
         Some(tf) => format!(
