@@ -9,7 +9,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{damper_record, read_json, run_ok, write_file};
+use common::{damper_record, read_json, run_ok, terminal, write_file};
 
 /// The damper record of `common::damper_record` read with `units`, fitted at force level by
 /// `viscous` and `viscous + yield`, discovered from `viscous`, with a report.
@@ -188,22 +188,13 @@ fn a_fit_warning_speaks_the_summary_s_unit() {
     }
 }
 
-/// Terminal text of a run (stdout and stderr).
-fn said(output: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    )
-}
-
 /// The force numbers a run says, with their unit: the discovery's gaps and floor, the
 /// comparison's noise floor and on-threshold, in the terminal and in compare.md.
 fn force_words(dir: &Path, units: &str) -> Vec<String> {
     let exp = experiment(dir, units);
-    let disc = said(&run_ok("discover", &exp, &dir.join("disc")));
+    let disc = terminal(&run_ok("discover", &exp, &dir.join("disc")));
     let cmp_out = dir.join("cmp");
-    let cmp = said(&run_ok("compare", &exp, &cmp_out));
+    let cmp = terminal(&run_ok("compare", &exp, &cmp_out));
     let md = std::fs::read_to_string(cmp_out.join("compare.md")).unwrap();
     let mut out = Vec::new();
     for (text, key) in [

@@ -8,7 +8,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{bundled_experiment, read_json, root, run_ok, write_file};
+use common::{bundled_experiment, read_json, root, run_ok, terminal, write_file};
 
 /// The bundled shaker experiment with its record read in volts (x in V, u in V read as N),
 /// and `extra` appended; written in `dir`.
@@ -29,15 +29,6 @@ fn wrong_words(text: &str) -> Vec<String> {
         })
         .map(str::to_string)
         .collect()
-}
-
-/// Terminal text of a run (stdout and stderr).
-fn terminal(output: &std::process::Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    )
 }
 
 #[test]

@@ -26,9 +26,9 @@ pub fn duty_meaning(on_threshold: f64, words: RigWords, unit: &str) -> String {
     };
     format!(
         "The duty of a {piece} is the fraction of it in which the STF force is on (|F_STF| above \
-         {on_threshold:.3} {unit}, the record's on-threshold): 1 for a force that only passes through \
-         zero, below 1 for on–off spikes with rest between them; the duty error is the mean over \
-         {over} of |model duty − measured duty|."
+         {on_threshold:.3} {unit}, the record's on-threshold): 1 for a force that only passes \
+         through zero, below 1 for on–off spikes with rest between them; the duty error is the \
+         mean over {over} of |model duty − measured duty|."
     )
 }
 

@@ -109,8 +109,8 @@ pub fn place_windows(
     let below_peak = |i: usize| label(i) == Regime::PreResonance && omega(i) < omega(peak);
     if let Some((first, len)) = longest_run(n, below_peak) {
         let why = format!(
-            "the force negligible (its peak ≤ {:.2} {force_unit}), in the middle of the longest such run \
-             below the amplitude peak at ω {:.2} rad/s",
+            "the force negligible (its peak ≤ {:.2} {force_unit}), in the middle of the longest \
+             such run below the amplitude peak at ω {:.2} rad/s",
             c.negligible_level,
             omega(peak)
         );
@@ -132,8 +132,8 @@ pub fn place_windows(
         Regime::PreResonance => {
             let why = format!(
                 "the largest amplitude ({:.1} {x_unit} at ω {:.2} rad/s), where the force stays \
-                 negligible (its peak ≤ {:.2} {force_unit}): no resonance by the force definition, and \
-                 not pre-resonance either, since the motion is at its largest",
+                 negligible (its peak ≤ {:.2} {force_unit}): no resonance by the force \
+                 definition, and not pre-resonance either, since the motion is at its largest",
                 milli(peak),
                 omega(peak),
                 c.negligible_level

@@ -27,6 +27,15 @@ pub fn run(command: &str, experiment: &Path, out: &Path) -> Output {
         .unwrap()
 }
 
+/// Terminal text of a run: its stdout, then its stderr.
+pub fn terminal(output: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
 /// The same, asserting success (the failure message is the program's).
 pub fn run_ok(command: &str, experiment: &Path, out: &Path) -> Output {
     succeeded(run(command, experiment, out))
