@@ -14,6 +14,14 @@ use crate::physics::param_spec::ParamSpec;
 /// [`SearchModel::starts`]).
 pub(super) const SCREEN: [f64; 6] = [1.0, 3.0, 0.3, 0.1, 0.03, 0.01];
 
+/// How near the current model's training RMS a neutral start must begin, relative
+/// ([`SearchModel::neutral_on`]).
+pub(super) const NEUTRAL_RMS_TOL: f64 = 1e-6;
+
+/// The factor a neutral start's amplitude is made smaller by, and the most times.
+const NEUTRAL_SHRINK: f64 = 1e-3;
+const NEUTRAL_SHRINKS: usize = 4;
+
 /// Iterations of the short Levenberg–Marquardt fit that ranks a candidate's starts (see
 /// [`SearchModel::started`]).
 pub(super) const START_ITERS: u64 = 6;
@@ -77,7 +85,6 @@ impl SearchModel {
                 values: best.1,
             });
         }
-        out.extend(self.neutral(osc_start.len()));
         out
     }
 
@@ -95,6 +102,47 @@ impl SearchModel {
             parts: self.parts.clone(),
             values,
         })
+    }
+
+    /// [`SearchModel::neutral`], its amplitude made smaller ([`NEUTRAL_SHRINK`] at a time, at
+    /// most [`NEUTRAL_SHRINKS`] times, never below its lower bound) until its RMS at `train`
+    /// on `track` is within [`NEUTRAL_RMS_TOL`] of the current model's there (the effect at
+    /// zero). A millionth of the default is nothing at the trolley's scale but not on every
+    /// record: on a shaker record in volts (v ≈ 20 V/s) a `power_law` at that amplitude
+    /// added about 1 % of the spring's force, its start sat at 170 times the current model's
+    /// RMS, and its search, re-run from it, ended above the current model, which the neutral
+    /// start is there to prevent. One simulation on `track` for the current model and one a
+    /// try.
+    pub(super) fn neutral_on(
+        &self,
+        n_osc: usize,
+        track: &dyn Track,
+        train: &[usize],
+    ) -> Option<SearchModel> {
+        let mut stage = self.neutral(n_osc)?;
+        let (i, spec) = self.amplitude(n_osc)?;
+        let model = stage.model().ok()?;
+        let rms_at = |values: &[f64]| {
+            let r = track.residual(&model, values).ok()?;
+            Some(rms_over(&r, train)).filter(|v| v.is_finite())
+        };
+        let mut off = stage.values.clone();
+        off[i] = 0.0;
+        let Some(current) = rms_at(&off) else {
+            return Some(stage);
+        };
+        for _ in 0..NEUTRAL_SHRINKS {
+            let at = rms_at(&stage.values);
+            if at.is_some_and(|at| at <= current * (1.0 + NEUTRAL_RMS_TOL)) {
+                break;
+            }
+            let smaller = stage.values[i] * NEUTRAL_SHRINK;
+            if smaller < spec.min {
+                break;
+            }
+            stage.values[i] = smaller;
+        }
+        Some(stage)
     }
 
     /// The current values; the current model on the oscillator `osc_start`; every parameter
@@ -130,17 +178,17 @@ impl SearchModel {
     /// The best of `starts` after a short fit of each (`START_ITERS` Levenberg–Marquardt
     /// iterations on the training samples of `tracks.0`), ranked by their RMS at `train` on
     /// `tracks.1` (the same samples, at the tolerance the search is ranked at; the fit's own
-    /// RMS when both integrate to one tolerance): the stage a full fit continues from. One
-    /// start is returned as it is.
+    /// RMS when both integrate to one tolerance): the stage a full fit continues from, and
+    /// its index among `starts`. One start is returned as it is.
     pub(super) fn started(
         starts: Vec<SearchModel>,
         tracks: (&dyn Track, &dyn Track),
         setup: &TrajectorySetup,
         train: &[usize],
         settings: &DiscoverySettings,
-    ) -> Option<SearchModel> {
+    ) -> Option<(usize, SearchModel)> {
         if starts.len() < 2 {
-            return starts.into_iter().next();
+            return starts.into_iter().next().map(|s| (0, s));
         }
         let (fitted_on, ranked_on) = tracks;
         // Tracks integrated alike give the fit's own RMS again: no second simulation.
@@ -149,8 +197,8 @@ impl SearchModel {
         // Ranked by their RMS alone: no standard errors (a tight simulation and a difference
         // column a parameter each).
         short.fit = short.fit.max_iters(START_ITERS).errors(false);
-        let mut best: Option<(f64, SearchModel)> = None;
-        for start in &starts {
+        let mut best: Option<(f64, usize, SearchModel)> = None;
+        for (k, start) in starts.iter().enumerate() {
             let Ok((stage, fit)) = start.fit_simulated(fitted_on, setup, train, &short) else {
                 continue;
             };
@@ -162,10 +210,11 @@ impl SearchModel {
                 };
                 r.map_or(f64::INFINITY, |r| rms_over(&r, train))
             };
-            if best.as_ref().is_none_or(|(b, _)| rms < *b) {
-                best = Some((rms, stage));
+            if best.as_ref().is_none_or(|(b, _, _)| rms < *b) {
+                best = Some((rms, k, stage));
             }
         }
-        best.map(|(_, s)| s).or_else(|| starts.into_iter().next())
+        best.map(|(_, k, s)| (k, s))
+            .or_else(|| starts.into_iter().next().map(|s| (0, s)))
     }
 }

@@ -141,6 +141,25 @@ pub(in crate::discovery) fn scouted(
     (stage, ms, before)
 }
 
+/// `stage` as it is, as [`scouted`] gives it back when its fit does not lower the whole
+/// record's RMS: its mean square on the scout's training samples and its RMS at `train` on
+/// `rig` (one simulation of each, side by side).
+pub(in crate::discovery) fn unfitted(
+    stage: SearchModel,
+    scout: &Scout,
+    (rig, _, train): (&Rig, &TrajectorySetup, &[usize]),
+) -> (SearchModel, f64, f64) {
+    let (ms, rms) = rayon::join(
+        || scout.mean_square(&stage).unwrap_or(f64::INFINITY),
+        || {
+            stage
+                .residual(rig)
+                .map_or(f64::INFINITY, |r| rms_over(&r, train))
+        },
+    );
+    (stage, ms, rms)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
