@@ -218,3 +218,86 @@ impl SearchModel {
             .or_else(|| starts.into_iter().next().map(|s| (0, s)))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::physics::force_model::{ForceModel, ModelError, ModelState};
+    use crate::physics::model_sum::NEUTRAL_AMPLITUDE;
+
+    /// A force of one parameter named `name`, bounded below by `min`.
+    struct Term(&'static str, Vec<ParamSpec>);
+    impl ForceModel for Term {
+        fn name(&self) -> &str {
+            self.0
+        }
+        fn params(&self) -> &[ParamSpec] {
+            &self.1
+        }
+        fn force(&self, p: &[f64], s: &ModelState, _: &mut [f64]) -> Result<f64, ModelError> {
+            Ok(p[0] * s.v)
+        }
+    }
+
+    fn term(name: &'static str, min: f64) -> Arc<dyn ForceModel> {
+        Arc::new(Term(
+            name,
+            vec![ParamSpec::new("a", "", 1.0, min, 10.0, "")],
+        ))
+    }
+
+    /// A record whose residual is 0.01 at every sample plus `gain` times the added term's
+    /// amplitude (the last value): how far the term moves the simulation.
+    struct Sensitive(f64);
+    impl Track for Sensitive {
+        fn residual(&self, _: &Arc<dyn ForceModel>, values: &[f64]) -> Result<Vec<f64>, String> {
+            Ok(vec![0.01 + self.0 * values[values.len() - 1]; 50])
+        }
+        fn rtol(&self) -> f64 {
+            1e-7
+        }
+        fn fixes_start(&self) -> bool {
+            false
+        }
+        fn precise_residual(
+            &self,
+            _: &Arc<dyn ForceModel>,
+            _: &[f64],
+        ) -> Option<Result<Vec<f64>, String>> {
+            None
+        }
+    }
+
+    #[test]
+    fn a_neutral_start_is_made_smaller_until_the_record_hardly_sees_it() {
+        let train: Vec<usize> = (0..50).step_by(2).collect();
+        let stage = |min: f64| SearchModel {
+            parts: vec![term("base", 0.0), term("extra", min)],
+            values: vec![2.0, 1.0],
+        };
+        let amplitude = |track: &Sensitive, min: f64| {
+            stage(min).neutral_on(0, track, &train).unwrap().values[1]
+        };
+        // Hardly seen at a millionth of the default (1e-7 of the RMS): kept as it is.
+        assert_eq!(amplitude(&Sensitive(1e-3), 0.0), NEUTRAL_AMPLITUDE);
+        // Seen at twice the RMS: a thousandth at a time until within 1e-6 of it
+        // (2e-3, 2e-6, then 2e-9 of the RMS).
+        let small = amplitude(&Sensitive(2e4), 0.0);
+        assert!(
+            (small / (NEUTRAL_AMPLITUDE * 1e-9) - 1.0).abs() < 1e-9,
+            "{small}"
+        );
+        // Never below the lower bound.
+        assert_eq!(amplitude(&Sensitive(2e4), 1e-10), NEUTRAL_AMPLITUDE * 1e-3);
+        // The other values are the current model's.
+        assert_eq!(
+            stage(0.0)
+                .neutral_on(0, &Sensitive(2e4), &train)
+                .unwrap()
+                .values[0],
+            2.0
+        );
+    }
+}
