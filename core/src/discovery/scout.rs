@@ -187,15 +187,6 @@ impl Track for Scout<'_> {
     fn fixes_start(&self) -> bool {
         true
     }
-    /// None: a scout fit only says where a fit on the whole record starts, and its standard
-    /// errors are never read.
-    fn precise_residual(
-        &self,
-        _: &Arc<dyn ForceModel>,
-        _: &[f64],
-    ) -> Option<Result<Vec<f64>, String>> {
-        None
-    }
 }
 
 /// The centres of `count` pieces spread evenly over `n` samples, the one nearest `peak` (if

@@ -261,13 +261,6 @@ mod tests {
         fn fixes_start(&self) -> bool {
             false
         }
-        fn precise_residual(
-            &self,
-            _: &Arc<dyn ForceModel>,
-            _: &[f64],
-        ) -> Option<Result<Vec<f64>, String>> {
-            None
-        }
     }
 
     #[test]

@@ -48,12 +48,16 @@ pub(super) trait Track: Sync {
     /// Whether the initial state `x0`, `v0` has no effect (and must be held fixed).
     fn fixes_start(&self) -> bool;
     /// [`Track::residual`] from simulations at the tolerances behind standard errors
-    /// ([`crate::fit::error_settings`]), or `None` when the track's are no looser.
+    /// ([`crate::fit::error_settings`]), or `None` when the track's are no looser or its
+    /// standard errors are never read (a scout's: it only says where a fit on the whole
+    /// record starts).
     fn precise_residual(
         &self,
-        model: &Arc<dyn ForceModel>,
-        values: &[f64],
-    ) -> Option<Result<Vec<f64>, String>>;
+        _model: &Arc<dyn ForceModel>,
+        _values: &[f64],
+    ) -> Option<Result<Vec<f64>, String>> {
+        None
+    }
 }
 
 impl Track for Rig<'_> {
