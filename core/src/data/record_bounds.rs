@@ -174,6 +174,14 @@ impl ForceModel for Widened {
     ) -> Result<(), ModelError> {
         self.inner.mass_and_force_along(p, track, rows, mass, force)
     }
+    fn mass_and_force_lanes(
+        &self,
+        ps: &[&[f64]],
+        track: &Track,
+        rows: Option<&[usize]>,
+    ) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+        self.inner.mass_and_force_lanes(ps, track, rows)
+    }
     fn gradient_along(
         &self,
         p: &[f64],

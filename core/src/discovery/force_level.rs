@@ -33,6 +33,7 @@ use crate::fit::{
 };
 use crate::physics::force_model::{ForceModel, Reach};
 use crate::physics::model_sum::neutral_amplitude;
+use crate::physics::track::MAX_LANES;
 use crate::regimes::Cycle;
 
 impl SearchModel {
@@ -177,14 +178,27 @@ fn candidate_starts(
     if extra == 0 || specs.len() < 2 {
         return starts;
     }
-    // Each grid point evaluates the model along the whole record: in parallel, in order.
-    let mut scored: Vec<(Vec<f64>, f64)> = start_grid(&specs[1..])
-        .into_par_iter()
-        .filter_map(|point| {
+    // Each grid point evaluates the model along the whole record: in parallel, in order; a
+    // model with state integrated at a few points side by side (`ForceFit::predict_lanes`,
+    // the same values as one by one).
+    let points: Vec<Vec<f64>> = start_grid(&specs[1..])
+        .into_iter()
+        .map(|point| {
             let mut values = defaults.clone();
             values[1..].copy_from_slice(&point);
-            let f = along(&values).ok()?;
-            project(&values, &f)
+            values
+        })
+        .collect();
+    let mut scored: Vec<(Vec<f64>, f64)> = points
+        .par_chunks(MAX_LANES)
+        .flat_map_iter(|chunk| {
+            let forces: Vec<Option<Vec<f64>>> = match fit.predict_lanes(data, chunk, Some(subset)) {
+                Some(forces) => forces.into_iter().map(Some).collect(),
+                None => chunk.iter().map(|values| along(values).ok()).collect(),
+            };
+            let at = chunk.iter().zip(forces);
+            at.filter_map(|(values, f)| project(values, &f?))
+                .collect::<Vec<_>>()
         })
         .collect();
     scored.sort_by(|a, b| a.1.total_cmp(&b.1));

@@ -649,6 +649,11 @@ fn jacobian(
         &eval,
         &exact,
         &mut jac,
+        &|points| {
+            if !precise {
+                obj.prefetch_user(points);
+            }
+        },
     );
     (jac, rise)
 }

@@ -263,6 +263,45 @@ impl ForceFit {
             .map_err(FitError::BadData)?;
         Ok(out)
     }
+
+    /// [`ForceFit::predict_checked_rows`] at each of the full parameter vectors `values`, the
+    /// model's state integrated for all of them side by side
+    /// ([`ForceModel::mass_and_force_lanes`]; the same values to the bit); `None` where that
+    /// is not done (a model without one internal variable, too many vectors, a model error):
+    /// then each is predicted on its own.
+    pub(crate) fn predict_lanes(
+        &self,
+        data: &ForceData,
+        values: &[Vec<f64>],
+        rows: Option<&[usize]>,
+    ) -> Option<Vec<Vec<f64>>> {
+        let n_model = self.model.params().len();
+        let params = self.params();
+        let full: Vec<Vec<f64>> = values
+            .iter()
+            .map(|v| full_values(&held(&params, v).ok()?, &[]).ok())
+            .collect::<Option<_>>()?;
+        let ps: Vec<&[f64]> = full.iter().map(|f| &f[..n_model]).collect();
+        let track = Track {
+            t: data.t,
+            x: data.x,
+            v: data.v,
+        };
+        let found = self.model.mass_and_force_lanes(&ps, &track, rows)?;
+        let n = track.len_at(rows);
+        let predicted = full.iter().zip(found).map(|(f, (mass, force))| {
+            let offset = f.get(n_model).copied().unwrap_or(0.0);
+            (0..n)
+                .map(|k| {
+                    let i = rows.map_or(k, |r| r[k]);
+                    // As `predict_checked_rows`: measured less the residual.
+                    let r = data.f[i] - (mass[k] * data.a[i] + force[k] + offset);
+                    data.f[i] - r
+                })
+                .collect()
+        });
+        Some(predicted.collect())
+    }
 }
 
 /// The residuals of a force-level fit, at every sample or at the samples `rows` only.
@@ -330,6 +369,24 @@ impl Residuals for ForceResiduals<'_> {
             sink(k, d.f[i] - (mass[k] * d.a[i] + force[k] + offset));
         }
         Ok(())
+    }
+
+    /// A sum with state: its parts with state integrated at the points side by side and kept
+    /// ([`PartCache::prefetch`]).
+    fn prefetch(&self, points: &[Vec<f64>]) {
+        let Some(parts) = &self.parts else {
+            return;
+        };
+        let n_model = self.model.params().len();
+        let full: Vec<Vec<f64>> = points
+            .iter()
+            .filter_map(|x| full_values(self.all, x).ok())
+            .map(|mut f| {
+                f.truncate(n_model);
+                f
+            })
+            .collect();
+        parts.prefetch(&full, &self.track(), self.rows);
     }
 
     /// Exact for models that give their [`ForceModel::gradient`]: built-ins without state,

@@ -260,6 +260,7 @@ impl LevenbergMarquardt {
                 &|point, out| obj.residuals_user(&obj.to_user(point), out).is_some(),
                 &exact,
                 &mut self.jac,
+                &|points| obj.prefetch_internal(points),
             );
         }
         self.jac

@@ -49,6 +49,12 @@ pub trait Residuals: Sync {
         None
     }
 
+    /// Told ahead that the residuals are about to be asked at each of the free values
+    /// `points` (a Jacobian's difference columns, in parallel): a problem may prepare what
+    /// they share. Nothing it does may change what [`Residuals::residuals`] returns. The
+    /// default does nothing.
+    fn prefetch(&self, _points: &[Vec<f64>]) {}
+
     /// Samples over which the residuals are known to be correlated, whatever their own
     /// autocorrelation shows (a derivative filter's window, when the model reads its output):
     /// the blocks of the robust standard errors are at least twice this long. 1 (the
@@ -156,6 +162,17 @@ impl<'a> Objective<'a> {
             .zip(u)
             .map(|(t, &u)| t.to_user(u))
             .collect()
+    }
+
+    /// [`Residuals::prefetch`] at the internal coordinates `points`.
+    pub fn prefetch_internal(&self, points: &[Vec<f64>]) {
+        let user: Vec<Vec<f64>> = points.iter().map(|u| self.to_user(u)).collect();
+        self.problem.prefetch(&user);
+    }
+
+    /// [`Residuals::prefetch`] at the user values `points`.
+    pub fn prefetch_user(&self, points: &[Vec<f64>]) {
+        self.problem.prefetch(points);
     }
 
     /// Evaluate at user values `x`, streaming residuals to `sink`; `None` on failure (counted

@@ -22,7 +22,7 @@ use std::ops::Range;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use crate::physics::force_model::{ForceModel, ModelError};
-use crate::physics::track::Track;
+use crate::physics::track::{self, Track};
 
 /// Values of one part's parameters kept, per part: the point where the Jacobian is taken,
 /// the noise probes around it, and the columns being differenced in parallel.
@@ -107,6 +107,43 @@ impl PartCache {
             }
         }
         Ok(())
+    }
+
+    /// Ahead of evaluations of the sum at each of `points` (a Jacobian's difference columns):
+    /// each part with internal state whose values at two or more of them are not kept is
+    /// integrated at those values side by side ([`ForceModel::mass_and_force_lanes`]) and
+    /// kept, so the evaluations that follow find it. Nothing changes in what they return: a
+    /// contribution integrated so is the one an evaluation computes, to the bit, and a part
+    /// that cannot be integrated side by side is left to the evaluations.
+    pub(super) fn prefetch(&self, points: &[Vec<f64>], track: &Track, rows: Option<&[usize]>) {
+        let n = track.len_at(rows);
+        for (i, (part, range)) in self.parts.iter().enumerate() {
+            if part.n_internal() == 0 {
+                continue;
+            }
+            let mut missing: Vec<&[f64]> = Vec::new();
+            for p in points {
+                let values = &p[range.clone()];
+                let known = missing.iter().any(|m| same(m, values));
+                if !known && self.find(i, values, n).is_none() {
+                    missing.push(values);
+                }
+            }
+            if missing.len() < 2 || missing.len() > track::MAX_LANES.min(SLOTS) {
+                continue;
+            }
+            let Some(found) = part.mass_and_force_lanes(&missing, track, rows) else {
+                continue;
+            };
+            for (values, (mass, force)) in missing.iter().zip(found) {
+                let c = Contribution {
+                    values: values.to_vec(),
+                    mass,
+                    force,
+                };
+                self.keep(i, Arc::new(c));
+            }
+        }
     }
 
     /// Part `i`'s kept contribution at exactly `values` with `n` results, moved to the front.
@@ -253,6 +290,54 @@ mod tests {
             .mass_and_force_along(&bad, &track, None, &mut m, &mut f)
             .unwrap_err();
         assert!(err.to_string().contains("tau must be positive"), "{err}");
+    }
+
+    /// Difference columns prefetched side by side: each part with state is kept at every
+    /// column's values, and the evaluations that follow are the sum's own to the bit.
+    #[test]
+    fn prefetched_columns_give_the_sums_own_arithmetic_to_the_bit() {
+        let sum = sum();
+        let n = 600;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t.iter().map(|t| 0.01 * (40.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.4 * (40.0 * t).cos()).collect();
+        let track = Track {
+            t: &t,
+            x: &x,
+            v: &v,
+        };
+        let rows: Vec<usize> = (0..n).filter(|i| i % 4 != 1).collect();
+        let base = [3.0, 0.2, 1.7, 1.5, 0.5, 0.9, 0.03];
+        let columns: Vec<Vec<f64>> = (0..base.len())
+            .map(|j| {
+                let mut p = base.to_vec();
+                p[j] += 1e-3;
+                p
+            })
+            .collect();
+        let cache = PartCache::of(&sum).unwrap();
+        let k = rows.len();
+        let (mut m, mut f) = (vec![0.0; k], vec![0.0; k]);
+        cache
+            .mass_and_force_along(&base, &track, Some(&rows), &mut m, &mut f)
+            .unwrap();
+        cache.prefetch(&columns, &track, Some(&rows));
+        // Both parts with state (the first and the last) are kept at their two columns' values.
+        for (part, values) in [(0, &columns[1][..2]), (2, &columns[5][5..])] {
+            assert!(cache.find(part, values, k).is_some(), "part {part}");
+        }
+        let bits = |a: &[f64]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        for p in &columns {
+            let (mut m1, mut f1) = (vec![0.0; k], vec![0.0; k]);
+            sum.mass_and_force_along(p, &track, Some(&rows), &mut m1, &mut f1)
+                .unwrap();
+            let (mut m2, mut f2) = (vec![0.0; k], vec![0.0; k]);
+            cache
+                .mass_and_force_along(p, &track, Some(&rows), &mut m2, &mut f2)
+                .unwrap();
+            assert_eq!(bits(&m1), bits(&m2));
+            assert_eq!(bits(&f1), bits(&f2));
+        }
     }
 
     #[test]

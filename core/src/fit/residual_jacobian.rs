@@ -100,7 +100,9 @@ pub struct StepFloor {
 /// A column whose rms change is below `SIGNAL_TO_NOISE × floor.noise` is recomputed with a
 /// longer step (up to `floor.max[j]`); the steps used are written back to `steps`, so a
 /// caller that keeps them starts the next Jacobian from there. Columns marked in `exact` are
-/// left as they are (known exactly). The columns are computed in parallel.
+/// left as they are (known exactly). The columns are computed in parallel, after
+/// `prefetch` is handed their first points (all at once: a problem whose evaluations share
+/// work prepares it there; see [`super::objective::Residuals::prefetch`]).
 ///
 /// Returns how far each column's change stands above the noise (its rms change over
 /// `floor.noise`; infinite for an exact column or noiseless residuals): a column below
@@ -115,10 +117,25 @@ pub fn forward_difference(
     eval: Eval,
     exact: &[bool],
     jac: &mut DMatrix<f64>,
+    prefetch: &(dyn Fn(&[Vec<f64>]) + Sync),
 ) -> Vec<f64> {
     let todo: Vec<usize> = (0..steps.len())
         .filter(|&j| !exact.get(j).copied().unwrap_or(false))
         .collect();
+    // Each column's first point, as `column` computes it: the problem may prepare them at once.
+    if todo.len() >= 2 {
+        let points: Vec<Vec<f64>> = todo
+            .iter()
+            .map(|&j| {
+                let h0 = steps[j].abs();
+                let h = if flip(j, x[j] + h0) { -h0 } else { h0 };
+                let mut point = x.to_vec();
+                point[j] = x[j] + h;
+                point
+            })
+            .collect();
+        prefetch(&points);
+    }
     let columns: Vec<(usize, f64, Vec<f64>)> = todo
         .par_iter()
         .map(|&j| {

@@ -147,6 +147,22 @@ pub trait ForceModel: Send + Sync {
         track::mass_and_force_along(self, p, track, rows, mass, force)
     }
 
+    /// Along a whole record for several parameter vectors `ps` at once: each one's added mass
+    /// and force at `rows`, as [`ForceModel::mass_and_force_along`] gives them into zeroed
+    /// buffers, to the bit; `None` when the model does not integrate them side by side, or errs
+    /// for any of them (each is then evaluated on its own). Provided by
+    /// [`track::mass_and_force_lanes`] (a model with one internal variable, up to
+    /// [`track::MAX_LANES`] vectors); a model that wraps another without changing its
+    /// parameters should forward it.
+    fn mass_and_force_lanes(
+        &self,
+        ps: &[&[f64]],
+        track: &Track,
+        rows: Option<&[usize]>,
+    ) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+        track::mass_and_force_lanes(self, ps, track, rows)
+    }
+
     /// Along a whole record: [`ForceModel::gradient`] at the `k`-th of `rows` (`None`: every
     /// sample), acceleration `a[i]` at sample `i`, parameter `j`'s entry written to
     /// `grad[j·n + k]` (`n` results); `Ok(false)` when the model gives none. Provided by

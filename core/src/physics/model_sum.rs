@@ -247,6 +247,20 @@ impl ForceModel for ModelSum {
         Ok(())
     }
 
+    /// A sum of one part is that part; a sum of several adds its parts sample by sample and
+    /// is not integrated side by side.
+    fn mass_and_force_lanes(
+        &self,
+        ps: &[&[f64]],
+        track: &Track,
+        rows: Option<&[usize]>,
+    ) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+        match self.parts.as_slice() {
+            [one] => one.mass_and_force_lanes(ps, track, rows),
+            _ => None,
+        }
+    }
+
     /// Each memoryless part's columns from its own gradient along the record; NaN in the
     /// columns of a part with state or without a gradient (differenced by the fitter).
     fn gradient_along(

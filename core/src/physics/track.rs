@@ -173,6 +173,108 @@ where
     Ok(())
 }
 
+/// The most parameter vectors [`mass_and_force_lanes`] integrates side by side.
+pub const MAX_LANES: usize = 4;
+
+/// The provided [`ForceModel::mass_and_force_lanes`]: `m`'s added mass and force at `rows`
+/// (`None`: every sample) for each of the parameter vectors `ps`, as
+/// [`mass_and_force_along`] gives them into zeroed buffers, to the bit — or `None` when they
+/// are not integrated side by side (a model without exactly one internal variable, fewer than
+/// two or more than [`MAX_LANES`] vectors) or when the model errs for any of them: then each
+/// is evaluated on its own, which gives its error.
+///
+/// A model's state is integrated sample by sample, each RK4 stage waiting on the one before:
+/// one integration keeps a core's arithmetic units mostly idle. Integrating the difference
+/// columns of a Jacobian together, stage by stage, gives the core independent chains to run
+/// at once: three `bouc_wen` integrations of 150 001 samples took 10.2–10.4 ms side by side
+/// against 22.7–24.2 ms one after another (a stand-alone measurement of the same loop, the
+/// same bits). Each lane does the operations of [`steps`] in their order.
+pub fn mass_and_force_lanes<M: ForceModel + ?Sized>(
+    m: &M,
+    ps: &[&[f64]],
+    track: &Track,
+    rows: Option<&[usize]>,
+) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+    if m.n_internal() != 1 || track.t.is_empty() {
+        return None;
+    }
+    match ps.len() {
+        2 => lanes::<M, 2>(m, ps.try_into().ok()?, track, rows),
+        3 => lanes::<M, 3>(m, ps.try_into().ok()?, track, rows),
+        4 => lanes::<M, 4>(m, ps.try_into().ok()?, track, rows),
+        _ => None,
+    }
+}
+
+/// [`mass_and_force_lanes`] for `L` parameter vectors of a model with one internal variable.
+fn lanes<M: ForceModel + ?Sized, const L: usize>(
+    m: &M,
+    ps: [&[f64]; L],
+    track: &Track,
+    rows: Option<&[usize]>,
+) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+    let n = track.len_at(rows);
+    let mut out: Vec<(Vec<f64>, Vec<f64>)> = (0..L).map(|_| (vec![0.0; n], vec![0.0; n])).collect();
+    let mut z = [[0.0_f64; 1]; L];
+    for (zl, p) in z.iter_mut().zip(ps) {
+        m.initial_internal(p, zl);
+    }
+    let (mut k1, mut k2, mut k3, mut k4, mut zs) = (
+        [[0.0_f64; 1]; L],
+        [[0.0; 1]; L],
+        [[0.0; 1]; L],
+        [[0.0; 1]; L],
+        [[0.0; 1]; L],
+    );
+    let (t, x, v) = (track.t, track.x, track.v);
+    let last = t.len() - 1;
+    let mut next = 0;
+    for i in 0..=last {
+        let k = rows.map_or(Some(i), |r| (r.get(next) == Some(&i)).then_some(next));
+        for l in 0..L {
+            let s = track.state(i, &z[l]);
+            if let Some(k) = k {
+                let (ma, f) = m.mass_and_force(ps[l], &s, &mut k1[l]).ok()?;
+                out[l].0[k] += ma;
+                out[l].1[k] += f;
+            } else {
+                m.rates(ps[l], &s, &mut k1[l]).ok()?;
+            }
+        }
+        if k.is_some() {
+            next += 1;
+        }
+        if i == last {
+            break;
+        }
+        let h = t[i + 1] - t[i];
+        let (tm, xm, vm) = (
+            0.5 * (t[i] + t[i + 1]),
+            0.5 * (x[i] + x[i + 1]),
+            0.5 * (v[i] + v[i + 1]),
+        );
+        for l in 0..L {
+            zs[l][0] = z[l][0] + 0.5 * h * k1[l][0];
+            m.rates(ps[l], &midpoint(tm, xm, vm, &zs[l]), &mut k2[l])
+                .ok()?;
+        }
+        for l in 0..L {
+            zs[l][0] = z[l][0] + 0.5 * h * k2[l][0];
+            m.rates(ps[l], &midpoint(tm, xm, vm, &zs[l]), &mut k3[l])
+                .ok()?;
+        }
+        for l in 0..L {
+            zs[l][0] = z[l][0] + h * k3[l][0];
+            m.rates(ps[l], &track.state(i + 1, &zs[l]), &mut k4[l])
+                .ok()?;
+        }
+        for l in 0..L {
+            z[l][0] += h / 6.0 * (k1[l][0] + 2.0 * (k2[l][0] + k3[l][0]) + k4[l][0]);
+        }
+    }
+    Some(out)
+}
+
 /// The state at an interval's midpoint: kinematics `t`, `x`, `v` with stage state `z`.
 fn midpoint(t: f64, x: f64, v: f64, z: &[f64]) -> ModelState<'_> {
     ModelState { t, x, v, z }
@@ -364,6 +466,69 @@ mod tests {
             assert_eq!(got, want, "{nz} internal variables");
             assert!(got.iter().any(|f| f.abs() > 1e-3), "{nz}: the state moved");
         }
+    }
+
+    /// Side by side, each parameter vector's integration is its own to the bit; a model
+    /// error in any of them, or a model without exactly one internal variable, gives `None`.
+    #[test]
+    fn lanes_integrate_as_one_at_a_time_to_the_bit() {
+        let n = 300;
+        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+        let x: Vec<f64> = t.iter().map(|t| 0.01 * (30.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.3 * (30.0 * t).cos()).collect();
+        let track = Track {
+            t: &t,
+            x: &x,
+            v: &v,
+        };
+        let rows: Vec<usize> = (0..n).filter(|i| i % 4 != 2).collect();
+        let relax = Relax("slow", vec![spec("c"), spec("tau")]);
+        let ps: Vec<[f64; 2]> = vec![[2.5, 0.02], [2.5000001, 0.02], [2.5, 0.0200001], [1.0, 0.5]];
+        let bits = |a: &[f64]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        for rows in [None, Some(rows.as_slice())] {
+            for lanes in 2..=MAX_LANES {
+                let p: Vec<&[f64]> = ps[..lanes].iter().map(|p| p.as_slice()).collect();
+                let got = relax.mass_and_force_lanes(&p, &track, rows).unwrap();
+                for (p, (mass, force)) in p.iter().zip(&got) {
+                    let k = track.len_at(rows);
+                    let (mut m1, mut f1) = (vec![0.0; k], vec![0.0; k]);
+                    relax
+                        .mass_and_force_along(p, &track, rows, &mut m1, &mut f1)
+                        .unwrap();
+                    assert_eq!(bits(&m1), bits(mass));
+                    assert_eq!(bits(&f1), bits(force));
+                    assert!(force.iter().any(|f| f.abs() > 1e-3), "the state moved");
+                }
+            }
+        }
+        let p: Vec<&[f64]> = ps.iter().map(|p| p.as_slice()).collect();
+        assert!(relax.mass_and_force_lanes(&p[..1], &track, None).is_none());
+        let chain = Chain(2, vec![spec("c"), spec("tau")]);
+        assert!(chain.mass_and_force_lanes(&p[..2], &track, None).is_none());
+        // A model error in one lane: none, so each is evaluated on its own and gives its own.
+        struct Strict(Vec<ParamSpec>);
+        impl ForceModel for Strict {
+            fn name(&self) -> &str {
+                "strict"
+            }
+            fn params(&self) -> &[ParamSpec] {
+                &self.0
+            }
+            fn n_internal(&self) -> usize {
+                1
+            }
+            fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
+                if p[1] <= 0.0 {
+                    return Err(ModelError::new("strict", "tau must be positive"));
+                }
+                dz[0] = (p[0] * s.v - s.z[0]) / p[1];
+                Ok(s.z[0])
+            }
+        }
+        let strict = Strict(vec![spec("c"), spec("tau")]);
+        assert!(strict.mass_and_force_lanes(&p[..2], &track, None).is_some());
+        let bad: Vec<&[f64]> = vec![&[2.5, 0.02], &[2.5, 0.0]];
+        assert!(strict.mass_and_force_lanes(&bad, &track, None).is_none());
     }
 
     #[test]
