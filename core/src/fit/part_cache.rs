@@ -298,9 +298,7 @@ mod tests {
     fn prefetched_columns_give_the_sums_own_arithmetic_to_the_bit() {
         let sum = sum();
         let n = 600;
-        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
-        let x: Vec<f64> = t.iter().map(|t| 0.01 * (40.0 * t).sin()).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.4 * (40.0 * t).cos()).collect();
+        let [t, x, v] = crate::physics::track::sine_kinematics(n, 40.0);
         let track = Track {
             t: &t,
             x: &x,

@@ -131,7 +131,7 @@ where
 {
     let nz = z.len();
     m.initial_internal(p, z);
-    let (t, x, v) = (track.t, track.x, track.v);
+    let t = track.t;
     let last = t.len() - 1;
     let mut next = 0;
     for i in 0..=last {
@@ -147,12 +147,7 @@ where
         if i == last {
             break;
         }
-        let h = t[i + 1] - t[i];
-        let (tm, xm, vm) = (
-            0.5 * (t[i] + t[i + 1]),
-            0.5 * (x[i] + x[i + 1]),
-            0.5 * (v[i] + v[i + 1]),
-        );
+        let (h, tm, xm, vm) = interval(track, i);
         // The intermediate stages need only the rates, not the force.
         for j in 0..nz {
             zs[j] = z[j] + 0.5 * h * k1[j];
@@ -226,7 +221,7 @@ fn lanes<M: ForceModel + ?Sized, const L: usize>(
         [[0.0; 1]; L],
         [[0.0; 1]; L],
     );
-    let (t, x, v) = (track.t, track.x, track.v);
+    let t = track.t;
     let last = t.len() - 1;
     let mut next = 0;
     for i in 0..=last {
@@ -247,12 +242,7 @@ fn lanes<M: ForceModel + ?Sized, const L: usize>(
         if i == last {
             break;
         }
-        let h = t[i + 1] - t[i];
-        let (tm, xm, vm) = (
-            0.5 * (t[i] + t[i + 1]),
-            0.5 * (x[i] + x[i + 1]),
-            0.5 * (v[i] + v[i + 1]),
-        );
+        let (h, tm, xm, vm) = interval(track, i);
         for l in 0..L {
             zs[l][0] = z[l][0] + 0.5 * h * k1[l][0];
             m.rates(ps[l], &midpoint(tm, xm, vm, &zs[l]), &mut k2[l])
@@ -273,6 +263,19 @@ fn lanes<M: ForceModel + ?Sized, const L: usize>(
         }
     }
     Some(out)
+}
+
+/// The sample interval from `i` to `i + 1` of `track`: its length and the kinematics at its
+/// midpoint (linear within it).
+#[inline(always)]
+fn interval(track: &Track, i: usize) -> (f64, f64, f64, f64) {
+    let (t, x, v) = (track.t, track.x, track.v);
+    (
+        t[i + 1] - t[i],
+        0.5 * (t[i] + t[i + 1]),
+        0.5 * (x[i] + x[i + 1]),
+        0.5 * (v[i] + v[i + 1]),
+    )
 }
 
 /// The state at an interval's midpoint: kinematics `t`, `x`, `v` with stage state `z`.
@@ -306,6 +309,15 @@ pub fn gradient_along<M: ForceModel + ?Sized>(
         }
     }
     Ok(true)
+}
+
+/// Test kinematics: `n` samples a millisecond apart, x = 0.01·sin ωt and its velocity.
+#[cfg(test)]
+pub(crate) fn sine_kinematics(n: usize, omega: f64) -> [Vec<f64>; 3] {
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
+    let x = t.iter().map(|t| 0.01 * (omega * t).sin()).collect();
+    let v = t.iter().map(|t| 0.01 * omega * (omega * t).cos()).collect();
+    [t, x, v]
 }
 
 #[cfg(test)]
@@ -446,9 +458,7 @@ mod tests {
     #[test]
     fn every_state_size_integrates_as_sample_by_sample_to_the_bit() {
         let n = 400;
-        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
-        let x: Vec<f64> = t.iter().map(|t| 0.01 * (30.0 * t).sin()).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.3 * (30.0 * t).cos()).collect();
+        let [t, x, v] = sine_kinematics(n, 30.0);
         let track = Track {
             t: &t,
             x: &x,
@@ -473,9 +483,7 @@ mod tests {
     #[test]
     fn lanes_integrate_as_one_at_a_time_to_the_bit() {
         let n = 300;
-        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
-        let x: Vec<f64> = t.iter().map(|t| 0.01 * (30.0 * t).sin()).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.3 * (30.0 * t).cos()).collect();
+        let [t, x, v] = sine_kinematics(n, 30.0);
         let track = Track {
             t: &t,
             x: &x,
