@@ -181,7 +181,7 @@ impl TrajectoryLevel<'_> {
     /// again when another start had won the short fits; when it had won them itself, the
     /// search just run was its own, and it is taken as it is (the fallback of [`scouted`]):
     /// on the Silverbox-layout bench record every second-step candidate's neutral start won
-    /// and its second scout fit (1–8 s each) ended at that fallback.
+    /// and its second scout fit (1.0–6.7 s each) ended at that fallback.
     pub(in crate::discovery) fn searched(
         &self,
         with: SearchModel,
