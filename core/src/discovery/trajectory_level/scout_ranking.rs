@@ -118,10 +118,7 @@ pub(in crate::discovery) fn scouted(
     (rig, setup, train): (&Rig, &TrajectorySetup, &[usize]),
     settings: &DiscoverySettings,
 ) -> (SearchModel, f64, f64) {
-    let train_rms = |s: &SearchModel| {
-        s.residual(rig)
-            .map_or(f64::INFINITY, |r| rms_over(&r, train))
-    };
+    let train_rms = |s: &SearchModel| training_rms(s, rig, train);
     // Only the scout fit's RMS and values are used: no standard errors.
     let quick = DiscoverySettings {
         fit: settings.fit.clone().errors(false),
@@ -151,13 +148,17 @@ pub(in crate::discovery) fn unfitted(
 ) -> (SearchModel, f64, f64) {
     let (ms, rms) = rayon::join(
         || scout.mean_square(&stage).unwrap_or(f64::INFINITY),
-        || {
-            stage
-                .residual(rig)
-                .map_or(f64::INFINITY, |r| rms_over(&r, train))
-        },
+        || training_rms(&stage, rig, train),
     );
     (stage, ms, rms)
+}
+
+/// `stage`'s RMS at the samples `train` of the whole record `rig` (m); infinite when its
+/// simulation fails.
+fn training_rms(stage: &SearchModel, rig: &Rig, train: &[usize]) -> f64 {
+    stage
+        .residual(rig)
+        .map_or(f64::INFINITY, |r| rms_over(&r, train))
 }
 
 #[cfg(test)]
