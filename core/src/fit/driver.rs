@@ -17,6 +17,7 @@ use nalgebra::DMatrix;
 use super::covariance::{self, MIN_BLOCKS};
 use super::error::FitError;
 use super::fit_param::{BoundSide, FitParam};
+use super::kept_points::Kept;
 use super::levenberg_marquardt::{BoundStop, MAX_FD_STEP, NOISE_PROBE};
 use super::noise_floor::Quantity;
 use super::objective::{Objective, Residuals};
@@ -63,7 +64,8 @@ fn run_watched(
         (&names, transforms),
     );
     let u0 = vec![0.0; obj.dim()];
-    if obj.cost(&u0).is_none() {
+    // Kept: the refinement begins here, and the end is compared with it.
+    if obj.evaluate_kept(Kept::Start, &obj.to_user(&u0)).is_none() {
         return Err(FitError::StartFails(
             obj.last_failure().unwrap_or_else(|| "unknown".into()),
         ));

@@ -38,6 +38,7 @@
 use argmin::core::{Error as ArgminError, Problem, Solver, TerminationReason, KV};
 use nalgebra::{DMatrix, DVector};
 
+use super::kept_points::Kept;
 use super::lm_state::LmState;
 use super::objective::Objective;
 use super::residual_jacobian::{forward_difference, residual_noise, StepFloor};
@@ -132,6 +133,8 @@ pub struct LevenbergMarquardt {
     trial: Vec<f64>,
     jac: DMatrix<f64>,
     steps: Vec<f64>,
+    /// The parameters whose columns the last Jacobian differenced (the others were exact).
+    differenced: Vec<usize>,
     /// The difference steps' floor above the residuals' noise, measured once (lazily: an
     /// exact Jacobian needs no noise).
     floor: Option<StepFloor>,
@@ -148,6 +151,7 @@ impl LevenbergMarquardt {
             trial: Vec::new(),
             jac: DMatrix::zeros(0, 0),
             steps: Vec::new(),
+            differenced: Vec::new(),
             floor: None,
         }
     }
@@ -242,7 +246,11 @@ impl LevenbergMarquardt {
             .jacobian_internal(u, &mut self.jac)
             .unwrap_or_else(|| vec![false; p]);
         let all_exact = exact.iter().all(|&e| e);
+        self.differenced = (0..p).filter(|&j| !exact[j]).collect();
         if !all_exact {
+            if self.floor.is_none() {
+                self.prefetch_first(obj, u);
+            }
             let fd_step = self.fd_step;
             let floor = self.floor.get_or_insert_with(|| StepFloor {
                 noise: residual_noise(u, r, &vec![NOISE_PROBE; p], &|point, out| {
@@ -300,6 +308,9 @@ impl LevenbergMarquardt {
         state.u = cand;
         state.rss = new_rss;
         std::mem::swap(&mut state.residuals, &mut self.trial);
+        // Kept: the fit compares its end with its start and takes its errors there.
+        let x = ls.obj.to_user(&state.u);
+        ls.obj.keep(Kept::Accepted, &x, new_rss, &state.residuals);
         state.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
         state.nu = 2.0;
         if ls.stop_at_bound.is_some_and(|pinned| pinned(&state.u)) {
@@ -337,9 +348,48 @@ impl LevenbergMarquardt {
             .zip(delta.iter())
             .map(|(a, b)| a + b)
             .collect();
+        self.prefetch_trial(obj, &cand);
         let new_rss = obj.residuals_user(&obj.to_user(&cand), &mut self.trial)?;
         let predicted = -2.0 * g.dot(&delta) - delta.dot(&(a * &delta));
         let rho = (state.rss - new_rss) / predicted;
         (new_rss < state.rss && rho > 0.0).then_some((cand, new_rss, rho, delta.amax()))
+    }
+
+    /// Ahead of the first Jacobian at `u`: the two points of the noise probe
+    /// ([`residual_noise`]) and the first points of the difference columns, handed to the
+    /// problem at once, as [`LevenbergMarquardt::prefetch_trial`] hands the next ones.
+    fn prefetch_first(&self, obj: &Objective, u: &[f64]) {
+        let probe = |sign: f64| u.iter().map(|u| u + sign * NOISE_PROBE).collect();
+        let points: Vec<Vec<f64>> = [probe(1.0), probe(-1.0)]
+            .into_iter()
+            .chain(self.columns_at(u))
+            .collect();
+        obj.prefetch_internal(&points);
+    }
+
+    /// The first point of each differenced column of a Jacobian at `u`: the parameter moved
+    /// by its step, as [`forward_difference`] moves it.
+    fn columns_at<'s>(&'s self, u: &'s [f64]) -> impl Iterator<Item = Vec<f64>> + 's {
+        self.differenced.iter().map(move |&j| {
+            let mut point = u.to_vec();
+            point[j] = u[j] + self.steps[j].abs();
+            point
+        })
+    }
+
+    /// Ahead of evaluating the trial point `cand`: it and the first points of the difference
+    /// columns the next Jacobian takes there if the step is accepted (the last Jacobian's
+    /// differenced parameters, each moved by its step as [`forward_difference`] moves it),
+    /// handed to the problem at once ([`Objective::prefetch_internal`]). A problem that
+    /// integrates state prepares them side by side, where the trial alone would be
+    /// integrated by itself and the columns after it; a rejected step wastes the columns.
+    fn prefetch_trial(&self, obj: &Objective, cand: &[f64]) {
+        if self.differenced.is_empty() {
+            return;
+        }
+        let points: Vec<Vec<f64>> = std::iter::once(cand.to_vec())
+            .chain(self.columns_at(cand))
+            .collect();
+        obj.prefetch_internal(&points);
     }
 }

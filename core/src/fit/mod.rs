@@ -38,6 +38,7 @@ mod error;
 mod filter_noise;
 mod fit_param;
 mod force_fit;
+mod kept_points;
 mod levenberg_marquardt;
 mod lm_state;
 mod noise_floor;

@@ -6,6 +6,8 @@
 //! [`Objective`] maps internal coordinates through the bound transforms, scores the mean
 //! squared residual, and counts every evaluation and every failure in its [`Tally`], which
 //! the fit's observer ([`super::observer::FitObserver`]) reads for the progress display.
+//! It keeps the residuals of the fit's start and latest accepted point
+//! ([`super::kept_points`]) and answers a second asking at them without evaluating again.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -13,6 +15,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use argmin::core::{CostFunction, Error as ArgminError};
 use nalgebra::DMatrix;
 
+use super::kept_points::{Kept, KeptPoints};
 use super::transform::BoundTransform;
 
 /// A least-squares problem: residuals as a function of the free parameters' user values.
@@ -98,6 +101,7 @@ pub struct Objective<'a> {
     problem: &'a dyn Residuals,
     transforms: Vec<BoundTransform>,
     tally: Arc<Tally>,
+    kept: KeptPoints,
 }
 
 impl<'a> Objective<'a> {
@@ -112,6 +116,7 @@ impl<'a> Objective<'a> {
                 last_failure: Mutex::new(None),
                 best: Mutex::new(f64::INFINITY),
             }),
+            kept: KeptPoints::default(),
         }
     }
 
@@ -176,8 +181,12 @@ impl<'a> Objective<'a> {
     }
 
     /// Evaluate at user values `x`, streaming residuals to `sink`; `None` on failure (counted
-    /// and remembered). Returns the residual sum of squares.
+    /// and remembered). Returns the residual sum of squares. At a kept point ([`Kept`]) the
+    /// kept residuals are streamed instead, and no evaluation is counted.
     pub fn eval_user(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Option<f64> {
+        if let Some(rss) = self.kept.recall(x, sink) {
+            return Some(rss);
+        }
         let tally = &*self.tally;
         tally.evaluations.fetch_add(1, Ordering::Relaxed);
         let mut rss = 0.0;
@@ -203,6 +212,21 @@ impl<'a> Objective<'a> {
                 *slot = r;
             }
         })
+    }
+
+    /// Keep the residuals `residuals` (sum of squares `rss`) at user values `x` as the fit's
+    /// point `which`, to answer the next asking at `x` with.
+    pub fn keep(&self, which: Kept, x: &[f64], rss: f64, residuals: &[f64]) {
+        self.kept.keep(which, x, rss, residuals);
+    }
+
+    /// Evaluate at user values `x` and keep the residuals as the fit's point `which`; the
+    /// residual sum of squares, `None` on failure.
+    pub fn evaluate_kept(&self, which: Kept, x: &[f64]) -> Option<f64> {
+        let mut residuals = vec![0.0; self.len()];
+        let rss = self.residuals_user(x, &mut residuals)?;
+        self.keep(which, x, rss, &residuals);
+        Some(rss)
     }
 
     /// The problem's precise residuals ([`Residuals::precise_residuals`]) at user values `x`

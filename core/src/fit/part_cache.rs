@@ -111,7 +111,7 @@ impl PartCache {
 
     /// Ahead of evaluations of the sum at each of `points` (a Jacobian's difference columns):
     /// each part with internal state whose values at two or more of them are not kept is
-    /// integrated at those values side by side ([`ForceModel::mass_and_force_lanes`]) and
+    /// integrated at those values (the first [`track::MAX_LANES`] of them) side by side ([`ForceModel::mass_and_force_lanes`]) and
     /// kept, so the evaluations that follow find it. Nothing changes in what they return: a
     /// contribution integrated so is the one an evaluation computes, to the bit, and a part
     /// that cannot be integrated side by side is left to the evaluations.
@@ -129,7 +129,9 @@ impl PartCache {
                     missing.push(values);
                 }
             }
-            if missing.len() < 2 || missing.len() > track::MAX_LANES.min(SLOTS) {
+            // More than fit side by side: the first ones, the rest left to the evaluations.
+            missing.truncate(track::MAX_LANES.min(SLOTS));
+            if missing.len() < 2 {
                 continue;
             }
             let Some(found) = part.mass_and_force_lanes(&missing, track, rows) else {
