@@ -45,6 +45,7 @@ use super::noise_floor::Quantity;
 use super::objective::Residuals;
 use super::part_cache::PartCache;
 use super::result::{FitProgress, FitResult};
+use super::row_halves;
 use super::solver::{FitSettings, Solver};
 use crate::data::force_data::ForceData;
 use crate::physics::force_model::ForceModel;
@@ -358,10 +359,14 @@ impl Residuals for ForceResiduals<'_> {
             Some(parts) => {
                 parts.mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
             }
-            None => {
-                self.model
-                    .mass_and_force_along(p, &self.track(), self.rows, &mut mass, &mut force)
-            }
+            None => row_halves::mass_and_force_along(
+                self.model,
+                p,
+                &self.track(),
+                self.rows,
+                &mut mass,
+                &mut force,
+            ),
         }
         .map_err(|e| e.to_string())?;
         for k in 0..n {
@@ -405,7 +410,7 @@ impl Residuals for ForceResiduals<'_> {
         let p = &full[..n_model];
         let n = self.len();
         let mut grad = vec![0.0; n * n_model];
-        match m.gradient_along(p, &self.track(), self.data.a, self.rows, &mut grad) {
+        match row_halves::gradient_along(m, p, &self.track(), self.data.a, self.rows, &mut grad) {
             Ok(true) => {}
             Ok(false) => return None,
             Err(e) => return Some(Err(e.to_string())),

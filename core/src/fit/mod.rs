@@ -48,6 +48,7 @@ mod offset;
 mod part_cache;
 mod residual_jacobian;
 mod result;
+mod row_halves;
 mod same_term;
 mod solver;
 mod stages;
