@@ -13,6 +13,8 @@
 
 #![deny(clippy::unwrap_used)]
 
+mod allocator;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
