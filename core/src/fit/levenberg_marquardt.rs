@@ -36,7 +36,7 @@
 //!   words).
 
 use argmin::core::{Error as ArgminError, Problem, Solver, TerminationReason, KV};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Dyn, MatrixView};
 
 use super::kept_points::Kept;
 use super::lm_state::LmState;
@@ -197,9 +197,7 @@ impl Solver<LeastSquares<'_, '_>, LmState> for LevenbergMarquardt {
     ) -> Result<(LmState, Option<KV>), ArgminError> {
         let ls = least_squares(problem)?;
         let all_exact = self.jacobian(ls.obj, &state.u, &state.residuals);
-        let jt = self.jac.transpose();
-        let a = &jt * &self.jac;
-        let g = &jt * DVector::from_column_slice(&state.residuals);
+        let (a, g) = normal_equations(&self.jac, &state.residuals);
         let (cosine, inner_cosine) = cosines(ls.obj.transforms(), &state, &a, &g);
         let end = if state.rss.sqrt() == 0.0 || cosine < self.tol.sqrt() * 1e-2 {
             Some((
@@ -214,6 +212,76 @@ impl Solver<LeastSquares<'_, '_>, LmState> for LevenbergMarquardt {
             None => (state, None),
         })
     }
+}
+
+/// JᵀJ and Jᵀr, each entry the very number nalgebra gives from a transposed copy of J
+/// (`&J.transpose() * &J`, `&J.transpose() * DVector::from(r)`) without copying a record-long
+/// matrix and vector each iteration. nalgebra multiplies matrices of more than
+/// [`SMALL_DIM`] rows and columns with matrixmultiply, which reads any strides: there it is
+/// given Jᵀ as a view of J's own storage. Smaller ones it multiplies column by column
+/// (`gemv`), each entry a sum in row order from the first product: [`ordered_dots`] takes
+/// those sums in the same order (nalgebra's `gemv` on a row-strided view reads out of
+/// bounds, so the view is not given to it).
+fn normal_equations(jac: &DMatrix<f64>, r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+    let (n, p) = jac.shape();
+    let columns: Vec<&[f64]> = jac.as_slice().chunks_exact(n.max(1)).take(p).collect();
+    let g = DVector::from_vec(ordered_dots(&columns, r));
+    let a = if p > SMALL_DIM && n > SMALL_DIM {
+        let jt = MatrixView::from_slice_with_strides_generic(
+            jac.as_slice(),
+            Dyn(p),
+            Dyn(n),
+            Dyn(n),
+            Dyn(1),
+        );
+        jt * jac
+    } else {
+        let mut a = DMatrix::zeros(p, p);
+        for (j, column) in columns.iter().enumerate() {
+            a.column_mut(j)
+                .copy_from_slice(&ordered_dots(&columns, column));
+        }
+        a
+    };
+    (a, g)
+}
+
+/// nalgebra's bound (in rows and columns) above which it multiplies with matrixmultiply.
+const SMALL_DIM: usize = 5;
+
+/// Σ_k c[k]·v[k] for each column c of `columns`, summed in k order from the first product
+/// (0 for no rows), up to five columns in one pass over the rows.
+fn ordered_dots(columns: &[&[f64]], v: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(columns.len());
+    for group in columns.chunks(5) {
+        match group.len() {
+            1 => out.extend(dots::<1>(group, v)),
+            2 => out.extend(dots::<2>(group, v)),
+            3 => out.extend(dots::<3>(group, v)),
+            4 => out.extend(dots::<4>(group, v)),
+            _ => out.extend(dots::<5>(group, v)),
+        }
+    }
+    out
+}
+
+/// [`ordered_dots`] of exactly `N` columns, their sums side by side in registers.
+fn dots<const N: usize>(columns: &[&[f64]], v: &[f64]) -> [f64; N] {
+    let n = v.len();
+    let mut acc = [0.0; N];
+    if n == 0 || columns.len() != N || columns.iter().any(|c| c.len() < n) {
+        return acc;
+    }
+    let cols: [&[f64]; N] = std::array::from_fn(|i| &columns[i][..n]);
+    for i in 0..N {
+        acc[i] = cols[i][0] * v[0];
+    }
+    for k in 1..n {
+        for i in 0..N {
+            acc[i] += cols[i][k] * v[k];
+        }
+    }
+    acc
 }
 
 /// The largest cosine between the residuals and a column of the Jacobian (`a` = JᵀJ,
@@ -271,10 +339,11 @@ impl LevenbergMarquardt {
                 &|points| obj.prefetch_internal(points),
             );
         }
-        self.jac
-            .iter_mut()
-            .filter(|v| !v.is_finite())
-            .for_each(|v| *v = 0.0);
+        for v in self.jac.as_mut_slice() {
+            if !v.is_finite() {
+                *v = 0.0;
+            }
+        }
         all_exact
     }
 
@@ -391,5 +460,42 @@ impl LevenbergMarquardt {
             .chain(self.columns_at(cand))
             .collect();
         obj.prefetch_internal(&points);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// JᵀJ and Jᵀr from J's own storage are those of a transposed copy to the bit, with few
+    /// parameters (nalgebra's own loops) and many (matrixmultiply).
+    #[test]
+    fn normal_equations_are_those_of_a_transposed_copy() {
+        for (n, p) in [
+            (1001, 1),
+            (1001, 3),
+            (1001, 5),
+            (1001, 6),
+            (1001, 12),
+            (4, 7),
+            (1, 2),
+        ] {
+            let jac = DMatrix::from_fn(n, p, |k, j| ((k * 7 + j * 13) as f64 * 0.37).sin() * 1e3);
+            let r: Vec<f64> = (0..n).map(|k| (k as f64 * 0.11).cos()).collect();
+            let (a, g) = normal_equations(&jac, &r);
+            let jt = jac.transpose();
+            let (a0, g0) = (&jt * &jac, &jt * DVector::from_column_slice(&r));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(a.as_slice()),
+                bits(a0.as_slice()),
+                "JᵀJ, {p} parameters"
+            );
+            assert_eq!(
+                bits(g.as_slice()),
+                bits(g0.as_slice()),
+                "Jᵀr, {p} parameters"
+            );
+        }
     }
 }
