@@ -417,8 +417,8 @@ impl Residuals for ForceResiduals<'_> {
         }
         // Column of each free parameter among all (the offset, the last, has slope 1).
         let free = (0..self.all.len()).filter(|&j| !self.all[j].fixed);
-        for (c, j) in free.enumerate() {
-            let mut column = jac.column_mut(c);
+        let columns = jac.as_mut_slice().chunks_exact_mut(n);
+        for (column, j) in columns.zip(free) {
             if j < n_model {
                 for (out, g) in column.iter_mut().zip(&grad[j * n..(j + 1) * n]) {
                     *out = -g;

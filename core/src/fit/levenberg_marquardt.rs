@@ -225,8 +225,7 @@ impl Solver<LeastSquares<'_, '_>, LmState> for LevenbergMarquardt {
 fn normal_equations(jac: &DMatrix<f64>, r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
     let (n, p) = jac.shape();
     let columns: Vec<&[f64]> = jac.as_slice().chunks_exact(n.max(1)).take(p).collect();
-    let g = DVector::from_vec(ordered_dots(&columns, r));
-    let a = if p > SMALL_DIM && n > SMALL_DIM {
+    if p > SMALL_DIM && n > SMALL_DIM {
         let jt = MatrixView::from_slice_with_strides_generic(
             jac.as_slice(),
             Dyn(p),
@@ -234,16 +233,52 @@ fn normal_equations(jac: &DMatrix<f64>, r: &[f64]) -> (DMatrix<f64>, DVector<f64
             Dyn(n),
             Dyn(1),
         );
-        jt * jac
-    } else {
-        let mut a = DMatrix::zeros(p, p);
-        for (j, column) in columns.iter().enumerate() {
-            a.column_mut(j)
-                .copy_from_slice(&ordered_dots(&columns, column));
+        return (jt * jac, DVector::from_vec(ordered_dots(&columns, r)));
+    }
+    match p {
+        1 => small_normal::<1>(&columns, r),
+        2 => small_normal::<2>(&columns, r),
+        3 => small_normal::<3>(&columns, r),
+        4 => small_normal::<4>(&columns, r),
+        5 => small_normal::<5>(&columns, r),
+        _ => {
+            // Few rows, many columns: each column of JᵀJ as nalgebra's `gemv` sums it.
+            let mut a = DMatrix::zeros(p, p);
+            for (j, column) in columns.iter().enumerate() {
+                a.column_mut(j)
+                    .copy_from_slice(&ordered_dots(&columns, column));
+            }
+            (a, DVector::from_vec(ordered_dots(&columns, r)))
         }
-        a
-    };
-    (a, g)
+    }
+}
+
+/// JᵀJ and Jᵀr of the `P` columns `columns`, each entry summed in row order from the first
+/// product as nalgebra's `gemv` sums it, all in one pass over the rows (JᵀJ's upper
+/// triangle, mirrored: a product is the same either way round).
+fn small_normal<const P: usize>(columns: &[&[f64]], r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
+    let n = r.len();
+    let (mut a, mut g) = ([[0.0; P]; P], [0.0; P]);
+    if n > 0 && columns.len() == P && columns.iter().all(|c| c.len() >= n) {
+        let cols: [&[f64]; P] = std::array::from_fn(|i| &columns[i][..n]);
+        for i in 0..P {
+            g[i] = cols[i][0] * r[0];
+            for j in i..P {
+                a[i][j] = cols[i][0] * cols[j][0];
+            }
+        }
+        for k in 1..n {
+            let x: [f64; P] = std::array::from_fn(|i| cols[i][k]);
+            for i in 0..P {
+                g[i] += x[i] * r[k];
+                for j in i..P {
+                    a[i][j] += x[i] * x[j];
+                }
+            }
+        }
+    }
+    let a = DMatrix::from_fn(P, P, |i, j| if i <= j { a[i][j] } else { a[j][i] });
+    (a, DVector::from_row_slice(&g))
 }
 
 /// nalgebra's bound (in rows and columns) above which it multiplies with matrixmultiply.

@@ -273,8 +273,10 @@ impl<'a> Objective<'a> {
             *lock(&self.tally.last_failure) = Some(e);
             return None;
         }
+        let n = jac.nrows().max(1);
         let exact: Vec<bool> = jac
-            .column_iter()
+            .as_slice()
+            .chunks_exact(n)
             .map(|c| c.iter().all(|v| v.is_finite()))
             .collect();
         exact.iter().any(|&e| e).then_some(exact)
@@ -284,10 +286,12 @@ impl<'a> Objective<'a> {
     /// times each transform's slope), as [`Objective::jacobian_user`].
     pub fn jacobian_internal(&self, u: &[f64], jac: &mut DMatrix<f64>) -> Option<Vec<bool>> {
         let exact = self.jacobian_user(&self.to_user(u), jac)?;
-        for (j, (t, &uj)) in self.transforms.iter().zip(u).enumerate() {
+        let n = jac.nrows().max(1);
+        let columns = jac.as_mut_slice().chunks_exact_mut(n);
+        for (j, ((t, &uj), column)) in self.transforms.iter().zip(u).zip(columns).enumerate() {
             if exact[j] {
                 let slope = t.slope(uj);
-                jac.column_mut(j).iter_mut().for_each(|c| *c *= slope);
+                column.iter_mut().for_each(|c| *c *= slope);
             }
         }
         Some(exact)
