@@ -336,18 +336,9 @@ impl ForceResiduals<'_> {
             v: self.data.v,
         }
     }
-}
 
-impl Residuals for ForceResiduals<'_> {
-    fn len(&self) -> usize {
-        self.rows.map_or(self.data.t.len(), <[usize]>::len)
-    }
-
-    fn correlation_span(&self) -> usize {
-        self.span
-    }
-
-    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+    /// The residuals at free values `x`, each passed to `each(k, r_k)` in order of `k`.
+    fn stream(&self, x: &[f64], mut each: impl FnMut(usize, f64)) -> Result<(), String> {
         let n_model = self.model.params().len();
         let full = full_values(self.all, x)?;
         let p = &full[..n_model];
@@ -371,9 +362,36 @@ impl Residuals for ForceResiduals<'_> {
         .map_err(|e| e.to_string())?;
         for k in 0..n {
             let i = self.row(k);
-            sink(k, d.f[i] - (mass[k] * d.a[i] + force[k] + offset));
+            each(k, d.f[i] - (mass[k] * d.a[i] + force[k] + offset));
         }
         Ok(())
+    }
+}
+
+impl Residuals for ForceResiduals<'_> {
+    fn len(&self) -> usize {
+        self.rows.map_or(self.data.t.len(), <[usize]>::len)
+    }
+
+    fn correlation_span(&self) -> usize {
+        self.span
+    }
+
+    fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
+        self.stream(x, |k, r| sink(k, r))
+    }
+
+    /// Written and summed in order, as streaming them gives, without a `dyn` call per
+    /// residual.
+    fn residuals_into(&self, x: &[f64], out: &mut [f64]) -> Result<f64, String> {
+        let mut rss = 0.0;
+        self.stream(x, |k, r| {
+            rss += r * r;
+            if let Some(slot) = out.get_mut(k) {
+                *slot = r;
+            }
+        })?;
+        Ok(rss)
     }
 
     /// A sum with state: its parts with state integrated at the points side by side and kept
