@@ -378,7 +378,7 @@ impl Residuals for ForceResiduals<'_> {
     }
 
     fn residuals(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Result<(), String> {
-        self.stream(x, |k, r| sink(k, r))
+        self.stream(x, sink)
     }
 
     /// Written and summed in order, as streaming them gives, without a `dyn` call per
