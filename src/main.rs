@@ -215,6 +215,7 @@ struct CampaignArgs {
 }
 
 fn main() -> ExitCode {
+    allocator::keep_freed_memory();
     let cli = Cli::parse();
     interrupt::install();
     let quiet = cli.quiet;
