@@ -44,12 +44,8 @@ pub struct KeptPoints {
 impl KeptPoints {
     /// Keep the residuals `residuals` (sum of squares `rss`) at free values `x` in slot
     /// `which`, replacing what it held.
-    pub fn keep(&self, which: Kept, x: &[f64], rss: f64, residuals: &[f64]) {
-        let point = KeptPoint {
-            x: x.to_vec(),
-            rss,
-            residuals: residuals.to_vec(),
-        };
+    pub fn keep(&self, which: Kept, x: Vec<f64>, rss: f64, residuals: Vec<f64>) {
+        let point = KeptPoint { x, rss, residuals };
         lock(&self.slots)[which as usize] = Some(Arc::new(point));
     }
 
@@ -80,14 +76,14 @@ mod tests {
     #[test]
     fn a_point_is_recalled_at_its_exact_values_only() {
         let kept = KeptPoints::default();
-        kept.keep(Kept::Start, &[1.0, 2.0], 5.0, &[1.0, 2.0]);
-        kept.keep(Kept::Accepted, &[1.5, 2.0], 0.5, &[0.5, 0.5]);
+        kept.keep(Kept::Start, vec![1.0, 2.0], 5.0, vec![1.0, 2.0]);
+        kept.keep(Kept::Accepted, vec![1.5, 2.0], 0.5, vec![0.5, 0.5]);
         let mut got = vec![0.0; 2];
         let rss = kept.recall(&[1.0, 2.0], &mut |i, r| got[i] = r);
         assert_eq!((rss, got.as_slice()), (Some(5.0), [1.0, 2.0].as_slice()));
         let next = f64::from_bits(1.5_f64.to_bits() + 1);
         assert_eq!(kept.recall(&[next, 2.0], &mut |_, _| {}), None);
-        kept.keep(Kept::Accepted, &[1.25, 2.0], 0.25, &[0.25, 0.25]);
+        kept.keep(Kept::Accepted, vec![1.25, 2.0], 0.25, vec![0.25, 0.25]);
         assert_eq!(kept.recall(&[1.5, 2.0], &mut |_, _| {}), None);
         assert_eq!(kept.recall(&[1.25, 2.0], &mut |_, _| {}), Some(0.25));
         assert_eq!(kept.recall(&[1.0, 2.0], &mut |_, _| {}), Some(5.0));

@@ -414,7 +414,8 @@ impl LevenbergMarquardt {
         std::mem::swap(&mut state.residuals, &mut self.trial);
         // Kept: the fit compares its end with its start and takes its errors there.
         let x = ls.obj.to_user(&state.u);
-        ls.obj.keep(Kept::Accepted, &x, new_rss, &state.residuals);
+        ls.obj
+            .keep(Kept::Accepted, x, new_rss, state.residuals.clone());
         state.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
         state.nu = 2.0;
         if ls.stop_at_bound.is_some_and(|pinned| pinned(&state.u)) {

@@ -248,7 +248,7 @@ impl<'a> Objective<'a> {
 
     /// Keep the residuals `residuals` (sum of squares `rss`) at user values `x` as the fit's
     /// point `which`, to answer the next asking at `x` with.
-    pub fn keep(&self, which: Kept, x: &[f64], rss: f64, residuals: &[f64]) {
+    pub fn keep(&self, which: Kept, x: Vec<f64>, rss: f64, residuals: Vec<f64>) {
         self.kept.keep(which, x, rss, residuals);
     }
 
@@ -257,7 +257,7 @@ impl<'a> Objective<'a> {
     pub fn evaluate_kept(&self, which: Kept, x: &[f64]) -> Option<f64> {
         let mut residuals = vec![0.0; self.len()];
         let rss = self.residuals_user(x, &mut residuals)?;
-        self.keep(which, x, rss, &residuals);
+        self.keep(which, x.to_vec(), rss, residuals);
         Some(rss)
     }
 

@@ -111,8 +111,9 @@ impl PartCache {
 
     /// Ahead of evaluations of the sum at each of `points` (a Jacobian's difference columns):
     /// each part with internal state whose values at two or more of them are not kept is
-    /// integrated at those values (the first [`track::MAX_LANES`] of them) side by side ([`ForceModel::mass_and_force_lanes`]) and
-    /// kept, so the evaluations that follow find it. Nothing changes in what they return: a
+    /// integrated at those values (the first [`track::MAX_LANES`] of them) side by side
+    /// ([`ForceModel::mass_and_force_lanes`]) and kept, so the evaluations that follow find
+    /// it. Nothing changes in what they return: a
     /// contribution integrated so is the one an evaluation computes, to the bit, and a part
     /// that cannot be integrated side by side is left to the evaluations.
     pub(super) fn prefetch(&self, points: &[Vec<f64>], track: &Track, rows: Option<&[usize]>) {

@@ -96,6 +96,7 @@ mod tests {
     use super::*;
     use crate::physics::force_model::ModelState;
     use crate::physics::param_spec::ParamSpec;
+    use crate::physics::track::sine_kinematics;
 
     /// `c·|v|^n·sgn v + m_a·a` with an error past a speed limit: memoryless, with a gradient.
     struct Law(Vec<ParamSpec>);
@@ -135,10 +136,8 @@ mod tests {
         let spec = |n: &str| ParamSpec::new(n, "", 1.0, -10.0, 10.0, "");
         let law = Law(vec![spec("c"), spec("n"), spec("m_a"), spec("limit")]);
         let n = 3 * SPLIT_ROWS;
-        let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
-        let x: Vec<f64> = t.iter().map(|t| 0.01 * (7.0 * t).sin()).collect();
-        let v: Vec<f64> = t.iter().map(|t| 0.07 * (7.0 * t).cos()).collect();
-        let a: Vec<f64> = t.iter().map(|t| -0.49 * (7.0 * t).sin()).collect();
+        let [t, x, v] = sine_kinematics(n, 7.0);
+        let a: Vec<f64> = x.iter().map(|x| -49.0 * x).collect();
         let track = Track {
             t: &t,
             x: &x,
