@@ -28,6 +28,10 @@
 //! ```
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
+
+/// Interior samples a thread filters at a time.
+const INTERIOR_CHUNK: usize = 8192;
 use thiserror::Error;
 
 /// Order of the paper's filter for ω from φ.
@@ -229,16 +233,27 @@ impl PolyFilter {
         let (s1, s2) = (1.0 / dt, 1.0 / (dt * dt));
 
         // Interior: samples lead ..= n − w + lead have a complete window.
+        // In chunks of samples on the threads there are: each sample's sums are its own, the
+        // same to the bit in any chunking (a 1 600-sample window over 150 001 samples was
+        // 0.13 s on one core while the record loaded).
         let wv = fit.weights(lead, 0);
         let w1 = fit.weights(lead, 1);
         let w2 = fit.weights(lead, 2);
-        for start in 0..=(n - w) {
-            let (v, a, b) = dot3(&y[start..start + w], &wv, &w1, &w2);
-            let i = start + lead;
-            out.value[i] = v;
-            out.d1[i] = a * s1;
-            out.d2[i] = b * s2;
-        }
+        let interior = lead..=(n - w + lead);
+        let Derivatives { value, d1, d2 } = &mut out;
+        value[interior.clone()]
+            .par_chunks_mut(INTERIOR_CHUNK)
+            .zip(d1[interior.clone()].par_chunks_mut(INTERIOR_CHUNK))
+            .zip(d2[interior].par_chunks_mut(INTERIOR_CHUNK))
+            .enumerate()
+            .for_each(|(k, ((value, d1), d2))| {
+                let first = k * INTERIOR_CHUNK;
+                for (j, ((v, a), b)) in value.iter_mut().zip(d1).zip(d2).enumerate() {
+                    let start = first + j;
+                    let (sv, sa, sb) = dot3(&y[start..start + w], &wv, &w1, &w2);
+                    (*v, *a, *b) = (sv, sa * s1, sb * s2);
+                }
+            });
 
         if self.boundary == Boundary::Shifted {
             // One fit over the first and one over the last complete window; the polynomial
@@ -875,6 +890,32 @@ mod tests {
                 (re - 1.0).abs() < 1e-6 && im.abs() < 1e-6,
                 "k {k}: {re} {im}"
             );
+        }
+    }
+
+    /// The interior filtered in chunks on threads: each sample the same to the bit as its own
+    /// window's sums, across chunk edges and in the last, short chunk.
+    #[test]
+    fn the_chunked_interior_is_each_windows_own_sums() {
+        let n = 2 * INTERIOR_CHUNK + 777;
+        let y: Vec<f64> = (0..n)
+            .map(|i| (i as f64 * 1e-3).sin() + 1e-3 * ((i * 7919) % 13) as f64)
+            .collect();
+        for (order, w) in [(2, 801), (3, 40)] {
+            let f = PolyFilter::new(order, w).unwrap();
+            let d = f.apply(1e-3, &y).unwrap();
+            let fit = Fit::new(order, w).unwrap();
+            let lead = f.lead();
+            let weights = [0, 1, 2].map(|k| fit.weights(lead, k));
+            for start in
+                (0..=(n - w)).filter(|s| s % 97 == 0 || s % INTERIOR_CHUNK < 2 || *s == n - w)
+            {
+                let (v, a, b) = dot3(&y[start..start + w], &weights[0], &weights[1], &weights[2]);
+                let i = start + lead;
+                assert_eq!(d.value[i].to_bits(), v.to_bits(), "value at {i}");
+                assert_eq!(d.d1[i].to_bits(), (a * (1.0 / 1e-3)).to_bits(), "d1 at {i}");
+                assert_eq!(d.d2[i].to_bits(), (b * (1.0 / (1e-3 * 1e-3))).to_bits(), "d2 at {i}");
+            }
         }
     }
 
