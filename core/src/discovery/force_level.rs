@@ -18,6 +18,7 @@ use super::acceptance;
 use super::blocks::{block_length, Blocks};
 use super::candidate::Candidate;
 use super::choice::{self, Said, Trial, Yardstick};
+use super::costly_first::costly_first;
 use super::error::DiscoveryError;
 use super::findings::Discovery;
 use super::force_gap::{locate_gap, GapLocation};
@@ -248,6 +249,13 @@ fn start_grid(specs: &[crate::physics::param_spec::ParamSpec]) -> Vec<Vec<f64>> 
                 .flat_map(|point| axis.iter().map(|&v| [point.as_slice(), &[v]].concat()))
                 .collect()
         })
+}
+
+/// How costly a candidate's fits are expected to be, for ordering (larger first): a model
+/// with internal state is integrated along the record at every evaluation, and more
+/// parameters mean more columns and iterations.
+fn cost_rank(model: &Arc<dyn ForceModel>) -> (bool, usize) {
+    (model.n_internal() > 0, model.params().len())
 }
 
 /// Find the effects missing from `base` among `candidates`, at force level.
@@ -563,22 +571,24 @@ impl Level for ForceLevel<'_> {
     ) -> Result<Vec<(CandidateScore, Option<Trial>)>, DiscoveryError> {
         let settings = self.settings;
         let current_residual = self.residual(&current.stage)?;
-        Ok(tried
-            .par_iter()
-            .enumerate()
-            .map(|(index, c)| {
-                settings
-                    .observer
-                    .candidate(step, index, tried.len(), &c.name);
-                let best = self.best_trial(c, &current_residual, |start| {
-                    current.stage.with(&c.model, start, 0)
-                });
-                let n_own = c.model.params().len();
-                let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
-                settings.observer.scored(step, &s.0);
-                s
-            })
-            .collect())
+        let score = |index: usize| {
+            let c = tried[index];
+            settings
+                .observer
+                .candidate(step, index, tried.len(), &c.name);
+            let best = self.best_trial(c, &current_residual, |start| {
+                current.stage.with(&c.model, start, 0)
+            });
+            let n_own = c.model.params().len();
+            let s = choice::scored(&c.name, n_own, best, current, yardstick, settings);
+            settings.observer.scored(step, &s.0);
+            s
+        };
+        Ok(costly_first(
+            tried.len(),
+            |i| cost_rank(&tried[i].model),
+            score,
+        ))
     }
 
     fn replacement_trial(

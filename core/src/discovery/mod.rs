@@ -30,6 +30,7 @@ pub mod before_after_validation;
 pub mod blocks;
 pub mod candidate;
 mod choice;
+mod costly_first;
 pub mod error;
 pub mod findings;
 pub mod force_gap;

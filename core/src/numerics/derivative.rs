@@ -914,7 +914,11 @@ mod tests {
                 let i = start + lead;
                 assert_eq!(d.value[i].to_bits(), v.to_bits(), "value at {i}");
                 assert_eq!(d.d1[i].to_bits(), (a * (1.0 / 1e-3)).to_bits(), "d1 at {i}");
-                assert_eq!(d.d2[i].to_bits(), (b * (1.0 / (1e-3 * 1e-3))).to_bits(), "d2 at {i}");
+                assert_eq!(
+                    d.d2[i].to_bits(),
+                    (b * (1.0 / (1e-3 * 1e-3))).to_bits(),
+                    "d2 at {i}"
+                );
             }
         }
     }
