@@ -280,15 +280,19 @@ impl PolyFilter {
             return Err(FilterError::TooShort { len: n, window: w });
         }
         let weights = Fit::new(self.order, w)?.weights(lead, 0);
-        let (mut sum, mut count) = (0.0, 0usize);
-        for start in (0..=(n - w)).step_by(stride.max(1)) {
-            let window = &y[start..start + w];
-            let value: f64 = window.iter().zip(&weights).map(|(y, w)| y * w).sum();
-            let r = window[lead] - value;
-            sum += r * r;
-            count += 1;
-        }
-        Ok((sum / count.max(1) as f64).sqrt())
+        // Each sample's residual on the threads there are, summed in sample order after.
+        let starts: Vec<usize> = (0..=(n - w)).step_by(stride.max(1)).collect();
+        let residuals: Vec<f64> = starts
+            .par_iter()
+            .with_min_len(INTERIOR_CHUNK / 8)
+            .map(|&start| {
+                let window = &y[start..start + w];
+                let value: f64 = window.iter().zip(&weights).map(|(y, w)| y * w).sum();
+                window[lead] - value
+            })
+            .collect();
+        let sum = residuals.iter().fold(0.0, |sum, r| sum + r * r);
+        Ok((sum / residuals.len().max(1) as f64).sqrt())
     }
 
     /// White-noise gain of the `derivative`-th output (0 = value) at interior samples: the
@@ -894,9 +898,10 @@ mod tests {
     }
 
     /// The interior filtered in chunks on threads: each sample the same to the bit as its own
-    /// window's sums, across chunk edges and in the last, short chunk.
+    /// window's sums, across chunk edges and in the last, short chunk; and the residual's RMS
+    /// the sum in sample order.
     #[test]
-    fn the_chunked_interior_is_each_windows_own_sums() {
+    fn the_chunked_interior_and_residual_are_each_windows_own_sums() {
         let n = 2 * INTERIOR_CHUNK + 777;
         let y: Vec<f64> = (0..n)
             .map(|i| (i as f64 * 1e-3).sin() + 1e-3 * ((i * 7919) % 13) as f64)
@@ -919,6 +924,21 @@ mod tests {
                     (b * (1.0 / (1e-3 * 1e-3))).to_bits(),
                     "d2 at {i}"
                 );
+            }
+            // The residual's RMS: each sample's residual, summed in sample order.
+            for stride in [1, 7] {
+                let mut sum = 0.0;
+                let starts = (0..=(n - w)).step_by(stride);
+                let count = starts.clone().count();
+                for start in starts {
+                    let window = &y[start..start + w];
+                    let value: f64 = window.iter().zip(&weights[0]).map(|(y, w)| y * w).sum();
+                    let r = y[start + lead] - value;
+                    sum += r * r;
+                }
+                let rms = f.residual_rms(&y, stride).unwrap();
+                let want = (sum / count as f64).sqrt();
+                assert_eq!(rms.to_bits(), want.to_bits(), "stride {stride}");
             }
         }
     }
