@@ -21,9 +21,12 @@ pub struct LocalMax {
 /// noise at a crest (whose swings reach 6 σ over a slow cycle's top) makes no second maximum
 /// while the oscillation is well above the noise. On a record with the rig's sensors (x
 /// noise σ ≈ 0.05 mm in 10 µm steps) the strict maxima were 8 412 on the paper's sweep,
-/// most of them noise, drawn as a band from zero to the envelope; these are one a cycle. On
-/// a noiseless run they are the strict maxima (the first of a flat top); the ends of the
-/// record are never maxima.
+/// most of them noise, drawn as a band from zero to the envelope; these are one a cycle
+/// where the trolley moves (27, 47 and 41 over ω 4.5–6, 6–8 and 8–9.4 rad/s, where the
+/// sweep makes 26.7, 47.4 and 41.2 cycles), while where it stands still the noise's own
+/// swings of more than 4 σ still count (596 below 3.8 rad/s, 0.1–0.2 mm high). On a
+/// noiseless run they are the strict maxima (the first of a flat top); the ends of the record
+/// are never maxima.
 pub fn local_maxima(t: &[f64], x: &[f64], omega: &[f64]) -> Vec<LocalMax> {
     let n = x.len().min(t.len()).min(omega.len());
     let x = &x[..n];
