@@ -561,7 +561,7 @@ impl Level for ForceLevel<'_> {
 
     /// Each candidate a small multi-start ([`candidate_starts`], [`ForceLevel::best_trial`]); the
     /// candidates are independent trials against the same current model: fitted in
-    /// parallel, scored in their order.
+    /// parallel, the costliest started first ([`costly_first`]), scored in their order.
     fn score_step(
         &self,
         step: usize,

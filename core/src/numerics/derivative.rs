@@ -14,8 +14,10 @@
 //! Every output is a convolution with fixed weights. They come from a QR factorisation of the
 //! Vandermonde matrix in coordinates scaled to [−1, 1] (well conditioned even for 800 samples
 //! at order 3) and are computed once per call: once for the interior, and one polynomial fit
-//! for each end. A filter leaves noise: [`PolyFilter::noise_gain`] gives the standard
-//! deviation of each output per unit of white input noise, for noise floors.
+//! for each end; the interior is filtered in chunks on rayon's threads, each sample's sums its
+//! own, so the result is the same to the bit on any number of cores. A filter leaves noise:
+//! [`PolyFilter::noise_gain`] gives the standard deviation of each output per unit of white
+//! input noise, for noise floors.
 //!
 //! ```
 //! use stf_core::numerics::derivative::{sample_step, PolyFilter};
@@ -29,10 +31,10 @@
 
 use nalgebra::DMatrix;
 use rayon::prelude::*;
+use thiserror::Error;
 
 /// Interior samples a thread filters at a time.
 const INTERIOR_CHUNK: usize = 8192;
-use thiserror::Error;
 
 /// Order of the paper's filter for ω from φ.
 pub const PAPER_OMEGA_ORDER: usize = 2;
