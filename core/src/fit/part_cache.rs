@@ -176,47 +176,9 @@ fn same(a: &[f64], b: &[f64]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::force_model::ModelState;
     use crate::physics::model_sum::ModelSum;
     use crate::physics::param_spec::ParamSpec;
-
-    /// `c·|v|^n·sgn v + m_a` as added mass: memoryless.
-    struct Law(Vec<ParamSpec>);
-    impl ForceModel for Law {
-        fn name(&self) -> &str {
-            "law"
-        }
-        fn params(&self) -> &[ParamSpec] {
-            &self.0
-        }
-        fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
-            Ok(p[2])
-        }
-        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-            Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-        }
-    }
-
-    /// A force relaxing towards `c·v` with time constant `tau`: one internal state.
-    struct Relax(&'static str, Vec<ParamSpec>);
-    impl ForceModel for Relax {
-        fn name(&self) -> &str {
-            self.0
-        }
-        fn params(&self) -> &[ParamSpec] {
-            &self.1
-        }
-        fn n_internal(&self) -> usize {
-            1
-        }
-        fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
-            if p[1] <= 0.0 {
-                return Err(ModelError::new(self.0, "tau must be positive"));
-            }
-            dz[0] = (p[0] * s.v - s.z[0]) / p[1];
-            Ok(s.z[0])
-        }
-    }
+    use crate::physics::test_models::{sine_kinematics, Law, Relax};
 
     fn spec(name: &str) -> ParamSpec {
         ParamSpec::new(name, "", 1.0, -10.0, 10.0, "")
@@ -301,7 +263,7 @@ mod tests {
     fn prefetched_columns_give_the_sums_own_arithmetic_to_the_bit() {
         let sum = sum();
         let n = 600;
-        let [t, x, v] = crate::physics::track::sine_kinematics(n, 40.0);
+        let [t, x, v] = sine_kinematics(n, 40.0);
         let track = Track {
             t: &t,
             x: &x,

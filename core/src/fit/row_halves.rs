@@ -94,40 +94,8 @@ pub fn gradient_along(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::force_model::ModelState;
     use crate::physics::param_spec::ParamSpec;
-    use crate::physics::track::sine_kinematics;
-
-    /// `c·|v|^n·sgn v + m_a·a` with an error past a speed limit: memoryless, with a gradient.
-    struct Law(Vec<ParamSpec>);
-    impl ForceModel for Law {
-        fn name(&self) -> &str {
-            "law"
-        }
-        fn params(&self) -> &[ParamSpec] {
-            &self.0
-        }
-        fn added_mass(&self, p: &[f64], _s: &ModelState) -> Result<f64, ModelError> {
-            Ok(p[2])
-        }
-        fn force(&self, p: &[f64], s: &ModelState, _dz: &mut [f64]) -> Result<f64, ModelError> {
-            if s.v.abs() > p[3] {
-                return Err(ModelError::new("law", format!("too fast at t = {}", s.t)));
-            }
-            Ok(p[0] * s.v.abs().powf(p[1]) * s.v.signum())
-        }
-        fn gradient(
-            &self,
-            p: &[f64],
-            s: &ModelState,
-            a: f64,
-            grad: &mut [f64],
-        ) -> Result<bool, ModelError> {
-            let u = s.v.abs().powf(p[1]) * s.v.signum();
-            grad.copy_from_slice(&[u, p[0] * u * s.v.abs().ln(), a, 0.0]);
-            Ok(true)
-        }
-    }
+    use crate::physics::test_models::{sine_kinematics, Law};
 
     /// Both halves give one pass's added mass, force and gradient to the bit, at rows with
     /// gaps, and a failure in either half is the failure one pass meets first.

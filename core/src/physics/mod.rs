@@ -11,4 +11,6 @@ pub mod oscillator_params;
 pub mod param_spec;
 pub mod resistance;
 pub mod resolved_model;
+#[cfg(test)]
+pub(crate) mod test_models;
 pub mod track;

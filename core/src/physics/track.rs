@@ -316,20 +316,12 @@ pub fn gradient_along<M: ForceModel + ?Sized>(
     Ok(true)
 }
 
-/// Test kinematics: `n` samples a millisecond apart, x = 0.01·sin ωt and its velocity.
-#[cfg(test)]
-pub(crate) fn sine_kinematics(n: usize, omega: f64) -> [Vec<f64>; 3] {
-    let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-3).collect();
-    let x = t.iter().map(|t| 0.01 * (omega * t).sin()).collect();
-    let v = t.iter().map(|t| 0.01 * omega * (omega * t).cos()).collect();
-    [t, x, v]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::physics::model_sum::ModelSum;
     use crate::physics::param_spec::ParamSpec;
+    use crate::physics::test_models::{sine_kinematics, Relax};
     use std::sync::Arc;
 
     /// `c·v^3 + m_a` as added mass: memoryless, with a gradient.
@@ -356,24 +348,6 @@ mod tests {
         ) -> Result<bool, ModelError> {
             grad[..2].copy_from_slice(&[s.v.powi(3), a]);
             Ok(true)
-        }
-    }
-
-    /// A force relaxing towards `c·v` with time constant `tau`: one internal state.
-    struct Relax(&'static str, Vec<ParamSpec>);
-    impl ForceModel for Relax {
-        fn name(&self) -> &str {
-            self.0
-        }
-        fn params(&self) -> &[ParamSpec] {
-            &self.1
-        }
-        fn n_internal(&self) -> usize {
-            1
-        }
-        fn force(&self, p: &[f64], s: &ModelState, dz: &mut [f64]) -> Result<f64, ModelError> {
-            dz[0] = (p[0] * s.v - s.z[0]) / p[1];
-            Ok(s.z[0])
         }
     }
 
