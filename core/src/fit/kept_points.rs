@@ -17,7 +17,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::objective::lock;
+use super::objective::{lock, same_bits};
 
 /// Which point of a fit a slot keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,13 +52,10 @@ impl KeptPoints {
     /// The kept residuals at exactly the free values `x` (bit for bit), streamed to `sink` in
     /// order; their sum of squares. `None` when no slot holds `x`.
     pub fn recall(&self, x: &[f64], sink: &mut dyn FnMut(usize, f64)) -> Option<f64> {
-        let same = |p: &KeptPoint| {
-            p.x.len() == x.len() && p.x.iter().zip(x).all(|(a, b)| a.to_bits() == b.to_bits())
-        };
         let point = lock(&self.slots)
             .iter()
             .flatten()
-            .find(|p| same(p))
+            .find(|p| same_bits(&p.x, x))
             .cloned()?;
         for (i, &r) in point.residuals.iter().enumerate() {
             sink(i, r);

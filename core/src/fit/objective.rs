@@ -89,6 +89,12 @@ pub(super) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
+/// Whether two value vectors are the same bit for bit: the test by which a fit's kept
+/// residuals and a sum's kept contributions are found again.
+pub(super) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// The counts of a fit's evaluations, shared (behind an `Arc`) by its [`Objective`] and the
 /// observer that shows them.
 #[derive(Debug)]

@@ -19,8 +19,9 @@
 
 use std::collections::VecDeque;
 use std::ops::Range;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex};
 
+use super::objective::{lock, same_bits};
 use crate::physics::force_model::{ForceModel, ModelError};
 use crate::physics::track::{self, Track};
 
@@ -125,7 +126,7 @@ impl PartCache {
             let mut missing: Vec<&[f64]> = Vec::new();
             for p in points {
                 let values = &p[range.clone()];
-                let known = missing.iter().any(|m| same(m, values));
+                let known = missing.iter().any(|m| same_bits(m, values));
                 if !known && self.find(i, values, n).is_none() {
                     missing.push(values);
                 }
@@ -151,10 +152,10 @@ impl PartCache {
 
     /// Part `i`'s kept contribution at exactly `values` with `n` results, moved to the front.
     fn find(&self, i: usize, values: &[f64], n: usize) -> Option<Arc<Contribution>> {
-        let mut kept = self.kept[i].lock().unwrap_or_else(PoisonError::into_inner);
+        let mut kept = lock(&self.kept[i]);
         let at = kept
             .iter()
-            .position(|c| c.mass.len() == n && same(&c.values, values))?;
+            .position(|c| c.mass.len() == n && same_bits(&c.values, values))?;
         let c = kept.remove(at)?;
         kept.push_front(c.clone());
         Some(c)
@@ -162,15 +163,10 @@ impl PartCache {
 
     /// Keep part `i`'s contribution `c` in front, the oldest beyond [`SLOTS`] dropped.
     fn keep(&self, i: usize, c: Arc<Contribution>) {
-        let mut kept = self.kept[i].lock().unwrap_or_else(PoisonError::into_inner);
+        let mut kept = lock(&self.kept[i]);
         kept.push_front(c);
         kept.truncate(SLOTS);
     }
-}
-
-/// Whether two value vectors are the same bit for bit.
-fn same(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 #[cfg(test)]
