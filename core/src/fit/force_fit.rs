@@ -42,7 +42,7 @@ use super::error::FitError;
 use super::filter_noise::{self, FilterNoise};
 use super::fit_param::{full_values, held, FitParam};
 use super::noise_floor::Quantity;
-use super::objective::Residuals;
+use super::objective::{written_and_summed, Residuals};
 use super::part_cache::PartCache;
 use super::result::{FitProgress, FitResult};
 use super::row_halves;
@@ -385,12 +385,7 @@ impl Residuals for ForceResiduals<'_> {
     /// residual.
     fn residuals_into(&self, x: &[f64], out: &mut [f64]) -> Result<f64, String> {
         let mut rss = 0.0;
-        self.stream(x, |k, r| {
-            rss += r * r;
-            if let Some(slot) = out.get_mut(k) {
-                *slot = r;
-            }
-        })?;
+        self.stream(x, written_and_summed(out, &mut rss))?;
         Ok(rss)
     }
 

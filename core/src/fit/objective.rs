@@ -38,12 +38,7 @@ pub trait Residuals: Sync {
     /// sum to the bit (a call per residual through a `dyn` sink was 3 % of a discovery).
     fn residuals_into(&self, x: &[f64], out: &mut [f64]) -> Result<f64, String> {
         let mut rss = 0.0;
-        self.residuals(x, &mut |i, r| {
-            rss += r * r;
-            if let Some(slot) = out.get_mut(i) {
-                *slot = r;
-            }
-        })?;
+        self.residuals(x, &mut written_and_summed(out, &mut rss))?;
         Ok(rss)
     }
 
@@ -87,6 +82,20 @@ pub const PENALTY_LN_COST: f64 = 690.775_527_898_213_7;
 
 pub(super) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A residual sink that writes residual `i` to `out[i]` (none past its end) and adds its
+/// square to `rss`, in the order the residuals come.
+pub(super) fn written_and_summed<'o>(
+    out: &'o mut [f64],
+    rss: &'o mut f64,
+) -> impl FnMut(usize, f64) + 'o {
+    move |i, r| {
+        *rss += r * r;
+        if let Some(slot) = out.get_mut(i) {
+            *slot = r;
+        }
+    }
 }
 
 /// Whether two value vectors are the same bit for bit: the test by which a fit's kept
