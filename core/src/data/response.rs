@@ -3,6 +3,8 @@
 
 use serde::Serialize;
 
+use crate::numerics::derivative::noise_sigma;
+
 /// A local maximum of the displacement.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct LocalMax {
@@ -24,7 +26,7 @@ pub struct LocalMax {
 /// most of them noise, drawn as a band from zero to the envelope; these are one a cycle
 /// where the trolley moves (27, 47 and 41 over ω 4.5–6, 6–8 and 8–9.4 rad/s, where the
 /// sweep makes 26.7, 47.4 and 41.2 cycles), while where it stands still the noise's own
-/// swings of more than 4 σ still count (596 below 3.8 rad/s, 0.1–0.2 mm high). On a
+/// swings of more than 4 σ still count (596 below 3.8 rad/s, 0.06–0.22 mm high). On a
 /// noiseless run they are the strict maxima (the first of a flat top); the ends of the record
 /// are never maxima.
 pub fn local_maxima(t: &[f64], x: &[f64], omega: &[f64]) -> Vec<LocalMax> {
@@ -58,19 +60,12 @@ pub fn local_maxima(t: &[f64], x: &[f64], omega: &[f64]) -> Vec<LocalMax> {
 }
 
 /// How far `x` must fall from a maximum for it to count ([`local_maxima`]): four noise
-/// standard deviations, estimated from second differences (σ ≈ 1.4826 · median|Δ²x| / √6,
-/// which ignores a smooth trend), and at least one and a half of the smallest nonzero step
-/// between samples, so an encoder's flicker between two counts makes no maxima.
+/// standard deviations ([`noise_sigma`], as a record's kinematics estimate it), and at least
+/// one and a half of the smallest nonzero step between samples, so an encoder's flicker
+/// between two counts makes no maxima.
 pub fn noise_step(x: &[f64]) -> f64 {
     let finite: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-    let mut d2: Vec<f64> = finite
-        .windows(3)
-        .map(|w| (w[0] - 2.0 * w[1] + w[2]).abs())
-        .collect();
-    let sigma = match d2.len() {
-        0 => 0.0,
-        len => *d2.select_nth_unstable_by(len / 2, f64::total_cmp).1 * 1.4826 / 6f64.sqrt(),
-    };
+    let sigma = noise_sigma(&finite);
     let quantum = finite
         .windows(2)
         .map(|w| (w[1] - w[0]).abs())
